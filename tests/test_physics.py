@@ -66,10 +66,12 @@ def test_inverse_dynamics_undoes_forward_dynamics(q1, q2, w1, w2, t1, t2):
     np.testing.assert_allclose(arm.inverse_dynamics(q, qd, qdd), tau, atol=1e-12 * scale)
 
 
-@settings(max_examples=100, deadline=None)
+@pytest.mark.parametrize("params", [TUTORIAL_ARM, DAMPED_TUTORIAL, GAME_ARM, GAME_ARM.replace(damping1=0.2)],
+                         ids=["gravity", "gravity+damping", "plain", "damping"])
+@settings(max_examples=50, deadline=None)
 @given(q1=angles, q2=angles, w1=speeds, w2=speeds, t1=torques, t2=torques)
-def test_component_closures_equal_array_methods(q1, q2, w1, w2, t1, t2):
-    arm = TwoJointArm(DAMPED_TUTORIAL)
+def test_component_closures_equal_array_methods(params, q1, q2, w1, w2, t1, t2):
+    arm = TwoJointArm(params)
     dyn = arm.component_dynamics("float")
     qdd = arm.forward_dynamics([q1, q2], [w1, w2], [t1, t2])
     np.testing.assert_allclose(dyn.accel(q1, q2, w1, w2, t1, t2), qdd, rtol=1e-11, atol=1e-9)

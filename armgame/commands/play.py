@@ -1,0 +1,109 @@
+"""armgame play: the game, in a window or headless from a script."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from ..errors import UserError
+
+DEFAULT_SEED = 10  # the 2012 game's: every class sees the same targets unless asked otherwise
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, e.g. 800x800, got {text!r}") from None
+    if not (200 <= w <= 10000 and 200 <= h <= 10000):
+        raise argparse.ArgumentTypeError(f"window size must be 200 to 10000 px a side, got {text!r}")
+    return w, h
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"must be from 0 to 2^63 - 1, got {text!r}")
+    return value
+
+
+def add_game_options(p: argparse.ArgumentParser) -> None:
+    """Options that define a game: shared by every command that plays one."""
+    p.add_argument("--seed", type=_seed, default=DEFAULT_SEED,
+                   help=f"target sequence (default: {DEFAULT_SEED}, the same targets every game)")
+    p.add_argument("--duration", type=float, default=60.0, help="game length in seconds (default: 60)")
+    p.add_argument("--keys", default="dfjk",
+                   help="keys for pectoralis, posterior deltoid, biceps, triceps (default: dfjk)")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "play",
+        help="play the game (a window, or --headless from a script)",
+        description="Hit the red targets with the hand. d/f drive the shoulder flexor and extensor, j/k the "
+        "elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, p pauses, "
+        "F11 toggles fullscreen, Esc quits.",
+    )
+    add_game_options(p)
+    p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
+    p.add_argument("--script", metavar="FILE", help="input timeline, one 'TIME KEY ACTION' a line (headless)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--fullscreen", action="store_true", help="fill the screen (for a projector)")
+    p.add_argument("--size", type=_size, default=(800, 800), help="window size, e.g. 1024x768 (default: 800x800)")
+    p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
+    p.set_defaults(run=run)
+
+
+def game_config(args: argparse.Namespace):
+    from ..game.muscles import DEFAULT_MUSCLES, remap_keys
+    from ..game.rules import GameConfig
+
+    if not (math.isfinite(args.duration) and args.duration > 0):
+        raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
+    return GameConfig(seed=args.seed, time_limit=args.duration, muscles=remap_keys(DEFAULT_MUSCLES, args.keys))
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from ..game.script import load_script
+    from ..game.session import GameSession
+
+    session = GameSession(game_config(args))
+    if args.script and not args.headless:
+        raise UserError("--script drives a headless game: add --headless")
+    if args.headless:
+        events = load_script(Path(args.script), session.keys, session.config.dt) if args.script else []
+        result = session.play(events)
+    else:
+        if not 1 <= args.fps <= 1000:
+            raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
+        result = _play_in_window(session, args)
+    if args.json:
+        print(json.dumps(result.as_dict(), sort_keys=True))
+    else:
+        print(f"your score is: {result.score}  ({result.hits} hits, {result.resets} resets, "
+              f"{session.time:.1f} s of {result.duration:g} s)")
+    return 0
+
+
+def _play_in_window(session, args: argparse.Namespace):
+    try:
+        import pygame
+
+        from ..frontend import GameWindow, open_window
+    except ImportError as exc:
+        raise UserError(f"the window needs pygame-ce: {exc}") from None
+    try:
+        screen = open_window(args.size, args.fullscreen)
+    except pygame.error as exc:
+        raise UserError(f"cannot open a window ({exc}); use --headless where there is no display") from None
+    try:
+        GameWindow(session, screen, fps=args.fps).run()
+    finally:
+        pygame.display.quit()
+    return session.result()

@@ -1,0 +1,1 @@
+"""The game: muscles, rules and the fixed-step session. Pure Python; nothing here draws."""

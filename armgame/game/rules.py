@@ -1,0 +1,131 @@
+"""The game's rules: targets, hits, score, resets, the hidden-arm mode and the clock.
+
+Everything is in world coordinates (metres, shoulder at the origin, x forward, y up);
+the renderer maps the world's ``view`` rectangle onto the window.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass, field
+
+from ..errors import UserError
+from ..physics.params import GAME_ARM, TwoJointParams
+from .muscles import DEFAULT_MUSCLES, MuscleSpec
+
+#: The 2012 game's screen (800 x 800 px, shoulder at (400, 600), 500 px/m) in metres.
+GAME_VIEW = (-0.8, 0.8, -0.4, 1.2)
+
+#: The game arm with some joint viscosity: a limb at rest stays put, and a swing dies out
+#: over a second or two instead of spinning forever (the 2012 game had none).
+GAME_PLAY_ARM = GAME_ARM.replace(damping1=0.2, damping2=0.15)
+
+
+@dataclass(frozen=True)
+class GameConfig:
+    """Everything that defines a game; with the input timeline it determines the result."""
+
+    arm: TwoJointParams = GAME_PLAY_ARM
+    start_posture: tuple[float, float] = (math.radians(45.0), math.radians(90.0))
+    time_limit: float = 60.0
+    target_radius: float = 0.05
+    #: Targets are drawn uniformly in this joint-space box (degrees), as in the 2012 game.
+    target_shoulder_range: tuple[float, float] = (15.0, 90.0)
+    target_elbow_range: tuple[float, float] = (45.0, 90.0)
+    seed: int = 0
+    muscles: tuple[MuscleSpec, ...] = DEFAULT_MUSCLES
+    integrator: str = "rk4"
+    dt: float = 0.001
+    reset_cost: int = 1
+    view: tuple[float, float, float, float] = GAME_VIEW
+    scene: str = "game"
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.time_limit) and 0.0 < self.time_limit <= 24 * 3600):
+            raise UserError(f"the game's duration must be between 0 and 86400 s, got {self.time_limit!r}")
+        if not (math.isfinite(self.dt) and 0.0 < self.dt <= 0.05):
+            raise UserError(f"the physics step must be between 0 and 0.05 s, got {self.dt!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
+            raise UserError(f"--seed must be a whole number from 0 to 2^63 - 1, got {self.seed!r}")
+        if not (math.isfinite(self.target_radius) and self.target_radius > 0.0):
+            raise UserError(f"the target radius must be a positive number of metres, got {self.target_radius!r}")
+
+    @property
+    def total_steps(self) -> int:
+        return round(self.time_limit / self.dt)
+
+
+@dataclass(frozen=True)
+class Target:
+    x: float
+    y: float
+    radius: float
+
+    def contains(self, x: float, y: float) -> bool:
+        return (x - self.x) ** 2 + (y - self.y) ** 2 <= self.radius * self.radius
+
+
+@dataclass
+class Scoreboard:
+    score: int = 0
+    hits: int = 0
+    resets: int = 0
+    hit_times: list[float] = field(default_factory=list)
+
+
+class GameRules:
+    """Targets, scoring and the clock; told where the hand is after every physics step."""
+
+    def __init__(self, config: GameConfig) -> None:
+        self.config = config
+        self._rng = random.Random(config.seed)
+        self.board = Scoreboard()
+        self.arm_visible = True
+        q1, q2 = config.start_posture
+        self.target = self._draw_target(self._hand(q1, q2))
+
+    def _hand(self, q1: float, q2: float) -> tuple[float, float]:
+        p = self.config.arm
+        return (p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2))
+
+    def _draw_target(self, hand: tuple[float, float]) -> Target:
+        """A target centred on the hand of a random posture: reachable by construction.
+
+        Its whole disc must be on screen, and it must not appear on top of the hand.
+        """
+        c = self.config
+        xmin, xmax, ymin, ymax = c.view
+        r = c.target_radius
+        best, best_distance = None, -1.0
+        for _ in range(1000):
+            q1 = math.radians(self._rng.uniform(*c.target_shoulder_range))
+            q2 = math.radians(self._rng.uniform(*c.target_elbow_range))
+            x, y = self._hand(q1, q2)
+            if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
+                continue
+            distance = math.dist((x, y), hand)
+            if distance > 3.0 * r:
+                return Target(x, y, r)
+            if distance > best_distance:
+                best, best_distance = Target(x, y, r), distance
+        if best is None:
+            raise UserError("no target fits on screen with these settings (target radius or ranges too large)")
+        return best  # the ranges are too narrow to keep clear of the hand: the farthest one found
+
+    def hand_moved(self, x: float, y: float, t: float) -> bool:
+        """Score a hit if the hand is on the target; returns whether it was."""
+        if self.target.contains(x, y):
+            self.board.score += 1
+            self.board.hits += 1
+            self.board.hit_times.append(t)
+            self.target = self._draw_target((x, y))
+            return True
+        return False
+
+    def reset_penalty(self) -> None:
+        self.board.resets += 1
+        self.board.score = max(0, self.board.score - self.config.reset_cost)
+
+    def toggle_arm(self) -> None:
+        self.arm_visible = not self.arm_visible

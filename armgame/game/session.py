@@ -1,0 +1,210 @@
+"""The fixed-step game session: physics, muscles and rules driven from any input source.
+
+The session knows nothing of windows or clocks. It advances in whole physics steps, and
+input events take effect at the start of a given step, so a game is fully determined by
+its configuration and its input timeline: a headless script, the keyboard in a window and
+a replay all produce the same result from the same timeline, bit for bit, whatever the
+frame rate or the machine's load. ``RealTimeDriver`` turns real elapsed time into steps for
+the window.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import asdict, dataclass
+
+from .. import __version__
+from ..physics.integrators import Integrator
+from ..physics.twojoint import TwoJointArm
+from .muscles import MuscleSet
+from .rules import GameConfig, GameRules
+
+DOWN, UP = "down", "up"
+RESET_KEY, TOGGLE_ARM_KEY = "space", "tab"
+
+
+@dataclass(frozen=True)
+class InputEvent:
+    """A key going down or up, taking effect before physics step ``step``."""
+
+    step: int
+    key: str
+    action: str
+
+
+@dataclass(frozen=True)
+class GameResult:
+    score: int
+    hits: int
+    resets: int
+    seed: int
+    duration: float
+    steps: int
+    scene: str
+    integrator: str
+    dt: float
+    version: str
+
+    def as_dict(self) -> dict[str, object]:
+        return asdict(self)
+
+
+class GameSession:
+    def __init__(self, config: GameConfig) -> None:
+        self.config = config
+        self.model = TwoJointArm(config.arm)
+        self._physics_step = Integrator(config.integrator, self.model).step_components
+        self.muscles = MuscleSet(config.muscles, config.dt)
+        self.rules = GameRules(config)
+        self.keys = (*self.muscles.keys, RESET_KEY, TOGGLE_ARM_KEY)
+        self.steps = 0
+        self.total_steps = config.total_steps
+        q1, q2 = config.start_posture
+        self.state: tuple[float, float, float, float] = (q1, q2, 0.0, 0.0)
+        self.previous_state = self.state
+        self.held = [False] * len(self.muscles.keys)
+        self.timeline: list[InputEvent] = []
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def time(self) -> float:
+        return self.steps * self.config.dt
+
+    @property
+    def time_left(self) -> float:
+        return max(0.0, (self.total_steps - self.steps) * self.config.dt)
+
+    @property
+    def over(self) -> bool:
+        return self.steps >= self.total_steps
+
+    def hand(self) -> tuple[float, float]:
+        p = self.config.arm
+        q1, q2 = self.state[0], self.state[1]
+        return p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2)
+
+    def result(self) -> GameResult:
+        b, c = self.rules.board, self.config
+        return GameResult(b.score, b.hits, b.resets, c.seed, c.time_limit, self.steps, c.scene, c.integrator, c.dt,
+                          __version__)
+
+    # ------------------------------------------------------------------- input
+    def key_event(self, key: str, action: str) -> bool:
+        """Apply a key event before the next physics step. Returns whether it changed anything.
+
+        Unknown keys, repeats of a held key and events after the end are ignored, and
+        only events that did something enter the timeline.
+        """
+        if self.over:
+            return False
+        if key in self.muscles.keys:
+            i = self.muscles.keys.index(key)
+            down = action == DOWN
+            if self.held[i] == down:
+                return False
+            self.held[i] = down
+            self.muscles.command(i, down)
+        elif key == RESET_KEY and action == DOWN:
+            self._reset_arm()
+        elif key == TOGGLE_ARM_KEY and action == DOWN:
+            self.rules.toggle_arm()
+        else:
+            return False
+        self.timeline.append(InputEvent(self.steps, key, action))
+        return True
+
+    def _reset_arm(self) -> None:
+        q1, q2 = self.config.start_posture
+        self.state = self.previous_state = (q1, q2, 0.0, 0.0)
+        self.muscles.reset()
+        self.rules.reset_penalty()
+
+    # ----------------------------------------------------------------- physics
+    def advance(self, n: int) -> int:
+        """Run up to ``n`` physics steps (fewer if the game ends); returns how many ran.
+
+        This is the hot loop of every game, so the muscle update (exactly
+        ``MuscleSet.step``, unrolled for the four muscles), the torque and the hit test are
+        written out here with local names rather than called.
+        """
+        n = min(n, self.total_steps - self.steps)
+        if n <= 0:
+            return 0
+        step = self._physics_step
+        dt = self.config.dt
+        arm = self.config.arm
+        l1, l2 = arm.l1, arm.l2
+        cos, sin = math.cos, math.sin
+        rules = self.rules
+        target = rules.target
+        tx, ty, rr = target.x, target.y, target.radius * target.radius
+        muscles = self.muscles
+        a0, a1, a2, a3 = muscles.activation
+        g0, g1, g2, g3 = muscles.goal
+        r0, r1, r2, r3 = muscles.rate
+        (s0, e0), (s1, e1), (s2, e2), (s3, e3) = muscles.moments
+        q1, q2, w1, w2 = self.state
+        previous = self.state
+        start = self.steps
+        for k in range(n):
+            t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
+            t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
+            a0 += (g0 - a0) * r0
+            a1 += (g1 - a1) * r1
+            a2 += (g2 - a2) * r2
+            a3 += (g3 - a3) * r3
+            previous = (q1, q2, w1, w2)
+            q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
+            s12 = q1 + q2
+            hx = l1 * cos(q1) + l2 * cos(s12)
+            hy = l1 * sin(q1) + l2 * sin(s12)
+            if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
+                rules.hand_moved(hx, hy, (start + k + 1) * dt)
+                target = rules.target
+                tx, ty, rr = target.x, target.y, target.radius * target.radius
+        muscles.activation = [a0, a1, a2, a3]
+        self.steps = start + n
+        self.state = (q1, q2, w1, w2)
+        self.previous_state = previous
+        return n
+
+    def play(self, events: Iterable[InputEvent]) -> GameResult:
+        """Play the whole game from a timeline (sorted by step) with no clock at all."""
+        for event in events:
+            if event.step >= self.total_steps:
+                break
+            self.advance(event.step - self.steps)
+            self.key_event(event.key, event.action)
+        self.advance(self.total_steps - self.steps)
+        return self.result()
+
+    def interpolated_angles(self, alpha: float) -> tuple[float, float]:
+        """Joint angles a fraction ``alpha`` of a step past the previous state, for smooth drawing."""
+        (p1, p2, _, _), (c1, c2, _, _) = self.previous_state, self.state
+        return p1 + alpha * (c1 - p1), p2 + alpha * (c2 - p2)
+
+
+class RealTimeDriver:
+    """Consumes real elapsed time in fixed physics steps ("Fix Your Timestep!").
+
+    A frame longer than ``max_frame_time`` (a dragged window, a stall) is clamped, so the
+    game slows down for a moment rather than freezing in a spiral of catch-up steps. The
+    clock is kept as a running total rather than a leftover fraction, so frames of 1/30 s
+    and of 1/120 s reach the same step at the same moment.
+    """
+
+    def __init__(self, session: GameSession, max_frame_time: float = 0.25) -> None:
+        self.session = session
+        self.max_frame_time = max_frame_time
+        self.clock = 0.0
+        self.steps_taken = 0
+
+    def advance(self, elapsed: float) -> float:
+        """Step the session through ``elapsed`` seconds; returns the interpolation fraction."""
+        dt = self.session.config.dt
+        self.clock += min(max(elapsed, 0.0), self.max_frame_time)
+        due = math.floor(self.clock / dt + 1e-9)
+        self.session.advance(due - self.steps_taken)
+        self.steps_taken = due
+        return min(max(self.clock / dt - due, 0.0), 1.0)
