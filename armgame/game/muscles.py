@@ -23,8 +23,8 @@ class MuscleSpec:
     key: str
     #: Torque on (shoulder, elbow) at full activation, in N m: a row of the muscle-to-joint matrix.
     moment: tuple[float, float]
-    rise_time: float = 0.06
-    decay_time: float = 0.12
+    rise_time: float = 0.08
+    decay_time: float = 0.10
 
     def __post_init__(self) -> None:
         for label in ("rise_time", "decay_time"):
