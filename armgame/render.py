@@ -23,6 +23,7 @@ TARGET = (220, 30, 30)
 TEXT = (20, 20, 20)
 FAINT = (120, 120, 120)
 BAR_BACK = (225, 225, 230)
+PANEL = (245, 245, 248)
 MUSCLE_COLOURS = ((40, 110, 200), (40, 160, 120), (200, 120, 30), (150, 60, 170))
 
 
@@ -86,12 +87,13 @@ class GameRenderer:
         pygame.draw.circle(screen, TARGET, view.to_screen(target.x, target.y), view.length(target.radius))
         if session.rules.arm_visible:
             shoulder_px, elbow_px, hand_px = (view.to_screen(*p) for p in ((0.0, 0.0), elbow, hand))
-            width = view.length(0.03)
+            width = view.length(0.024)
             pygame.draw.line(screen, LINK, shoulder_px, elbow_px, width)
             pygame.draw.line(screen, LINK, elbow_px, hand_px, width)
             for joint in (shoulder_px, elbow_px):
-                pygame.draw.circle(screen, JOINT, joint, view.length(0.022))
-        pygame.draw.circle(screen, HAND, view.to_screen(*hand), view.length(0.012))
+                pygame.draw.circle(screen, JOINT, joint, view.length(0.02))
+        # The hand is the one thing a player must see, arm hidden or not: larger than the link is wide.
+        pygame.draw.circle(screen, HAND, view.to_screen(*hand), view.length(0.016))
         self._draw_hud(screen, view, session)
         if paused:
             self._banner(screen, view, "Paused", "press P to play on")
@@ -130,7 +132,7 @@ class GameRenderer:
         cx, cy = screen.get_width() / 2, view.top + view.scale * 0.55
         panel = pygame.Rect(0, 0, max(head.get_width(), sub.get_width()) + 60 * unit, 130 * unit)
         panel.center = (round(cx), round(cy))
-        pygame.draw.rect(screen, (245, 245, 248), panel, border_radius=round(10 * unit))
+        pygame.draw.rect(screen, PANEL, panel, border_radius=round(10 * unit))
         pygame.draw.rect(screen, FAINT, panel, 2, border_radius=round(10 * unit))
         screen.blit(head, head.get_rect(center=(cx, cy - 22 * unit)))
         screen.blit(sub, sub.get_rect(center=(cx, cy + 32 * unit)))
