@@ -1,38 +1,22 @@
-"""M, C and G checked against the tutorial's method: a SymPy Euler-Lagrange derivation from T and U."""
+"""M, C and G checked against the tutorial's method: a SymPy Euler-Lagrange derivation from T and U.
+
+The derivation itself lives in ``armgame.derive`` (behind ``armgame derive``); this test evaluates it
+at many more states than the command does.
+"""
 
 import numpy as np
 import sympy as sp
 
+from armgame.derive import derive_two_joint, parameter_values
 from armgame.physics import TUTORIAL_ARM, TwoJointArm
 
 
-def derive_two_joint():
-    t = sp.symbols("t")
-    l1, r1, r2, m1, m2, i1, i2, g = sp.symbols("l1 r1 r2 m1 m2 i1 i2 g", positive=True)
-    q1, q2 = sp.Function("q1")(t), sp.Function("q2")(t)
-    x1, y1 = r1 * sp.cos(q1), r1 * sp.sin(q1)
-    x2 = l1 * sp.cos(q1) + r2 * sp.cos(q1 + q2)
-    y2 = l1 * sp.sin(q1) + r2 * sp.sin(q1 + q2)
-    T = (m1 * (x1.diff(t) ** 2 + y1.diff(t) ** 2) / 2 + i1 * q1.diff(t) ** 2 / 2
-         + m2 * (x2.diff(t) ** 2 + y2.diff(t) ** 2) / 2 + i2 * (q1.diff(t) + q2.diff(t)) ** 2 / 2)
-    U = g * (m1 * y1 + m2 * y2)
-    L = T - U
-    Q = [sp.expand(L.diff(q.diff(t)).diff(t) - L.diff(q)) for q in (q1, q2)]
-    a1, a2, w1, w2, p1, p2 = sp.symbols("a1 a2 w1 w2 p1 p2")
-    plain = {q1.diff(t, 2): a1, q2.diff(t, 2): a2}
-    Q = [e.subs(plain).subs({q1.diff(t): w1, q2.diff(t): w2}).subs({q1: p1, q2: p2}) for e in Q]
-    M = sp.Matrix([[sp.expand(e).coeff(a) for a in (a1, a2)] for e in Q])
-    G = sp.Matrix([sp.expand(e).subs({a1: 0, a2: 0, w1: 0, w2: 0}) for e in Q])
-    C = sp.Matrix([sp.expand(e).subs({a1: 0, a2: 0}) for e in Q]) - G
-    params = (l1, r1, r2, m1, m2, i1, i2, g)
-    return [sp.lambdify((p1, p2, w1, w2, *params), expr, "numpy") for expr in (M, C, G)]
-
-
 def test_mass_coriolis_gravity_equal_the_euler_lagrange_derivation():
-    M_fn, C_fn, G_fn = derive_two_joint()
-    p = TUTORIAL_ARM
-    values = (p.l1, p.r1, p.r2, p.m1, p.m2, p.i1, p.i2, p.gravity)
-    arm = TwoJointArm(p)
+    d = derive_two_joint()
+    args = (*d.q, *d.qd, *d.params)
+    M_fn, C_fn, G_fn = (sp.lambdify(args, e, "numpy") for e in (d.M, d.C, d.G))
+    values = parameter_values(2)
+    arm = TwoJointArm(TUTORIAL_ARM)
     rng = np.random.default_rng(7)
     for q1, q2, w1, w2 in rng.uniform(-4, 4, (25, 4)):
         q, qd = np.array([q1, q2]), np.array([w1, w2])
@@ -41,3 +25,10 @@ def test_mass_coriolis_gravity_equal_the_euler_lagrange_derivation():
                                    atol=1e-12)
         np.testing.assert_allclose(arm.gravity(q), np.array(G_fn(q1, q2, w1, w2, *values), float).ravel(),
                                    atol=1e-12)
+    # T and U as the tutorial forms them: U zero hanging straight down, T = 1/2 qd' M qd.
+    subs = dict(zip(d.params, values, strict=True))
+    assert sp.simplify(d.U.subs({d.q[0]: -sp.pi / 2, d.q[1]: 0}).subs(subs)) == 0
+    q, qd = (0.3, 1.1), (-0.7, 2.0)
+    point = {**subs, **dict(zip(d.q, q, strict=True)), **dict(zip(d.qd, qd, strict=True))}
+    assert float(d.T.subs(point)) == np.float64(arm.kinetic_energy(q, qd)).item() or np.isclose(
+        float(d.T.subs(point)), arm.kinetic_energy(q, qd), rtol=1e-13)

@@ -1,0 +1,65 @@
+"""armgame demo: the tutorial's ideas as classroom demonstrations, in a window or headless."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from ..demos import DEMO_NAMES
+from ..errors import UserError
+
+_FIXED_STEP = "euler, symplectic-euler, rk4, midpoint or gauss4"
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "demo",
+        help="classroom demos: pendulum, passive, chaos, interaction",
+        description="Show one of the tutorial's ideas in a window (space pauses, r restarts, the arrow keys or "
+        "- and + slow down and speed up, Esc quits), or with --headless --out DIR write NAME.csv and the figure "
+        "NAME.png there. Demos: pendulum (the one-joint passive arm from 90 deg), passive (the two-joint passive "
+        "arm), chaos (two passive arms 1e-6 rad apart), interaction (a fast minimum-jerk reach and the torques "
+        "it needs, split into each joint's own and interaction torques). Figures need matplotlib: "
+        "pip install 'armgame[plot]'.",
+    )
+    p.add_argument("name", choices=DEMO_NAMES, metavar="NAME", help=", ".join(DEMO_NAMES))
+    p.add_argument("--headless", action="store_true", help="no window: write the CSV and figure to --out")
+    p.add_argument("--out", default=None, metavar="DIR", help="folder for NAME.csv and NAME.png (with --headless)")
+    p.add_argument("--no-figures", action="store_true", help="headless: write the CSV only (no matplotlib needed)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="headless: seconds to run (default: the demo's, 10 s for pendulum and passive)")
+    p.add_argument("--integrator", default="rk4", help=f"fixed-step scheme: {_FIXED_STEP} (default: rk4)")
+    p.add_argument("--dt", type=float, default=0.001, help="physics step in seconds (default: 0.001)")
+    p.add_argument("--gravity", action="store_true",
+                   help="interaction only: the reach in a vertical plane, so gravity adds its torques")
+    p.add_argument("--speed", type=float, default=1.0, help="window: initial playback rate (default: 1 = real time)")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
+    if not (math.isfinite(args.speed) and 0.01 <= args.speed <= 100):
+        raise UserError(f"--speed must lie between 0.01 and 100, got {args.speed!r}")
+    if args.headless:
+        if args.out is None:
+            raise UserError("--headless needs --out DIR, the folder to write the CSV and figure to")
+        from pathlib import Path
+
+        from ..demos.catalog import run_headless
+
+        result = run_headless(args.name, Path(args.out), args.duration, args.integrator, args.dt, args.gravity,
+                              figures=not args.no_figures)
+        print(f"{args.name}: {result.summary}")
+        for path in result.files:
+            print(f"wrote {path}")
+        return 0
+    if args.out is not None or args.no_figures or args.duration is not None:
+        raise UserError("--out, --no-figures and --duration apply with --headless only")
+    from ..demos.catalog import make_run
+
+    run_ = make_run(args.name, args.integrator, args.dt, args.gravity)
+    from ..demos.window import run_window
+
+    run_window(args.name, run_, speed=args.speed)
+    return 0

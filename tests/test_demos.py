@@ -1,0 +1,242 @@
+"""armgame demo: headless outputs, the tutorial's runs reproduced, the torque split, and the window."""
+
+import csv
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from armgame.cli import main
+from armgame.demos.reach import ReachPlan, joint_motion, reach_arm, reach_table, torque_split
+from armgame.demos.runs import VISIBLY_APART, chaos_run, record
+from armgame.physics import TUTORIAL_ARM, TwoJointArm
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+@pytest.mark.parametrize(
+    ("name", "columns"),
+    [("pendulum", ["t", "q1", "qd1"]), ("passive", ["t", "q1", "q2"]), ("chaos", ["t", "a_q1", "b_q1"]),
+     ("interaction", ["t", "q1", "tau1", "own_inertial1", "interaction_inertial2", "coriolis_centrifugal1"])],
+)
+def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_path, capsys):
+    out = tmp_path / "figs"
+    assert main(["demo", name, "--headless", "--out", str(out), "--duration", "0.5"]) == 0
+    header, data = read_csv(out / f"{name}.csv")
+    assert set(columns) <= set(header)
+    assert data[-1, 0] == pytest.approx(0.5)
+    assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
+    printed = capsys.readouterr().out
+    assert f"wrote {out / (name + '.png')}" in printed
+
+
+def test_pendulum_reproduces_the_tutorials_run(tmp_path):
+    assert main(["demo", "pendulum", "--headless", "--out", str(tmp_path), "--no-figures"]) == 0
+    _, data = read_csv(tmp_path / "pendulum.csv")
+    t = np.linspace(0.0, 10.0, 1001)  # the tutorial's 10 s at 100 Hz
+    np.testing.assert_allclose(data[:, 0], t, atol=1e-12)
+    m, r, g, i = 1.65, 0.50, 9.81, 0.025
+
+    def onejointarm(_t, state):  # the tutorial's code: theta from hanging straight down
+        theta, theta_dot = state
+        return [theta_dot, -(m * g * r * math.sin(theta)) / (i + m * r * r)]
+
+    ref = solve_ivp(onejointarm, (0, 10), [math.pi / 2, 0.0], method="DOP853", rtol=1e-12, atol=1e-12, t_eval=t)
+    np.testing.assert_allclose(data[:, 1] + math.pi / 2, ref.y[0], atol=1e-8)
+    np.testing.assert_allclose(data[:, 2], ref.y[1], atol=1e-7)
+
+
+def test_passive_reproduces_the_tutorials_run(tmp_path):
+    assert main(["demo", "passive", "--headless", "--out", str(tmp_path), "--no-figures"]) == 0
+    _, data = read_csv(tmp_path / "passive.csv")
+    t = np.linspace(0.0, 10.0, 2001)  # 10 s at 200 Hz, as twojointarm_passive.py
+    np.testing.assert_allclose(data[:, 0], t, atol=1e-12)
+    p = TUTORIAL_ARM
+
+    def twojointarm(_t, state):  # the tutorial's forward dynamics, a1 from the downward vertical
+        a1, a2, a1d, a2d = state
+        M11 = p.i1 + p.i2 + p.m1 * p.r1**2 + p.m2 * (p.l1**2 + p.r2**2 + 2 * p.l1 * p.r2 * math.cos(a2))
+        M12 = p.i2 + p.m2 * (p.r2**2 + p.l1 * p.r2 * math.cos(a2))
+        M22 = p.i2 + p.m2 * p.r2**2
+        C1 = -(p.m2 * p.l1 * a2d * a2d * p.r2 * math.sin(a2)) - 2 * p.m2 * p.l1 * a1d * a2d * p.r2 * math.sin(a2)
+        C2 = p.m2 * p.l1 * a1d * a1d * p.r2 * math.sin(a2)
+        G1 = 9.81 * math.sin(a1) * (p.m2 * p.l1 + p.m1 * p.r1) + 9.81 * p.m2 * p.r2 * math.sin(a1 + a2)
+        G2 = 9.81 * p.m2 * p.r2 * math.sin(a1 + a2)
+        acc = np.linalg.solve([[M11, M12], [M12, M22]], [-C1 - G1, -C2 - G2])
+        return [a1d, a2d, acc[0], acc[1]]
+
+    ref = solve_ivp(twojointarm, (0, 10), [0.0, math.pi / 2, 0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12,
+                    t_eval=t)
+    np.testing.assert_allclose(data[:, 1], ref.y[0] - math.pi / 2, atol=1e-8)  # q1 = a1 - 90 deg
+    np.testing.assert_allclose(data[:, 2], ref.y[1], atol=1e-8)
+    np.testing.assert_allclose(data[0, 5:7], [0.4554, -0.3384], atol=1e-12)
+
+
+def test_chaos_arms_start_together_and_part():
+    rec = record(chaos_run(), duration=8.0, sample_rate=50.0)
+    arm = TwoJointArm(TUTORIAL_ARM)
+    distance = np.hypot(*(arm.hand(rec.states[:, 0, :2]) - arm.hand(rec.states[:, 1, :2])).T)
+    assert distance[0] < 1e-6
+    assert np.all(distance[rec.t < 3.0] < 1e-3)
+    assert distance.max() > 10 * VISIBLY_APART
+
+
+@pytest.mark.parametrize("gravity", [False, True])
+def test_torque_split_sums_to_inverse_dynamics(gravity):
+    arm = TwoJointArm(reach_arm(gravity).params.replace(damping1=0.3, damping2=0.2))
+    table = reach_table(arm, ReachPlan(), np.linspace(0.0, ReachPlan().cycle, 500))
+    np.testing.assert_allclose(sum(table.parts.values()), table.total, atol=1e-12)
+    rng = np.random.default_rng(1)
+    q, qd, qdd = rng.uniform(-5, 5, (3, 40, 2))
+    np.testing.assert_allclose(sum(torque_split(arm, q, qd, qdd).values()), arm.inverse_dynamics(q, qd, qdd),
+                               atol=1e-12)
+    # The tutorial's reading: C_1 holds only elbow velocity, C_2 only shoulder velocity.
+    assert np.all(torque_split(arm, q, qd * [1, 0], qdd)["coriolis_centrifugal"][:, 0] == 0)
+    assert np.all(torque_split(arm, q, qd * [0, 1], qdd)["coriolis_centrifugal"][:, 1] == 0)
+
+
+def test_minimum_jerk_reach_is_consistent():
+    plan = ReachPlan()
+    arm = reach_arm(False)
+    dt = 1e-4
+    t = np.arange(0.0, plan.cycle, dt)
+    pos, vel, acc = plan.hand(t)
+    np.testing.assert_allclose(pos[0], plan.home, atol=1e-15)
+    np.testing.assert_allclose(plan.hand(plan.back_starts)[0], plan.target, atol=1e-15)
+    assert np.max(np.hypot(*vel.T)) == pytest.approx(1.875 * 0.4 / plan.move_time, rel=1e-6)  # bell peak
+    q, qd, qdd = joint_motion(arm, pos, vel, acc)
+    np.testing.assert_allclose(arm.hand(q), pos, atol=1e-12)
+    np.testing.assert_allclose(np.gradient(q, dt, axis=0)[1:-1], qd[1:-1], atol=1e-5)
+    # The jerk jumps where each move starts and stops, so a central difference is off by ~jerk * dt there.
+    assert np.max(np.abs(qdd)) > 10.0
+    np.testing.assert_allclose(np.gradient(qd, dt, axis=0)[1:-1], qdd[1:-1], atol=2e-2)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["demo", "pendulum", "--headless"], "--out"),
+        (["demo", "pendulum", "--gravity", "--headless", "--out", "x"], "--gravity"),
+        (["demo", "passive", "--integrator", "dop853", "--headless", "--out", "x"], "unknown integrator"),
+        (["demo", "passive", "--dt", "0", "--headless", "--out", "x"], "--dt"),
+        (["demo", "chaos", "--duration", "-1", "--headless", "--out", "x"], "--duration"),
+        (["demo", "chaos", "--duration", "2"], "--headless"),
+    ],
+)
+def test_user_errors_are_one_line(args, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+def test_missing_matplotlib_is_a_one_line_error(capsys, tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    assert main(["demo", "pendulum", "--headless", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "armgame[plot]" in err and err.count("\n") == 1
+    assert not list(tmp_path.iterdir())
+
+
+def test_help_and_headless_import_no_pygame(tmp_path):
+    code = (
+        "import sys, argparse\n"
+        "from armgame.commands import demo, derive\n"
+        "p = argparse.ArgumentParser(); s = p.add_subparsers()\n"
+        "demo.register(s); derive.register(s)\n"
+        "assert not {'numpy', 'scipy', 'pygame', 'sympy', 'matplotlib'} & set(sys.modules), sys.modules.keys()\n"
+        "from armgame.cli import main\n"
+        f"assert main(['demo', 'chaos', '--headless', '--out', {str(tmp_path)!r}, '--duration', '0.1',"
+        " '--no-figures']) == 0\n"
+        "assert 'pygame' not in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
+
+
+# ------------------------------------------------------------------- the window, under SDL's dummy driver
+@pytest.fixture
+def dummy_sdl(monkeypatch):
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    monkeypatch.setenv("SDL_AUDIODRIVER", "dummy")
+    import pygame
+
+    yield pygame
+    pygame.display.quit()
+
+
+def _dark(colour):
+    return max(colour[:3]) < 100
+
+
+def test_window_draws_the_arm_where_the_state_says(dummy_sdl):
+    pygame = dummy_sdl
+    from armgame.demos.catalog import make_run
+    from armgame.demos.window import DemoWindow
+
+    now = [100.0]
+    window = DemoWindow("pendulum", make_run("pendulum"), clock=lambda: now[0])
+    window.open()
+    window.frame()
+    screen = pygame.display.get_surface()
+    l = window.run.model.params.l  # noqa: E741
+    assert _dark(screen.get_at(window.to_window((l / 2, 0.0))))  # released horizontal
+    for _ in range(15):  # a quarter second at 60 frames per second, no sleeping
+        now[0] += 1 / 60
+        assert window.frame()
+    assert window.run.t == pytest.approx(0.25, abs=1.5e-3)
+    q = window.poses()[0][0]
+    assert -math.pi / 2 < q < -0.3  # fallen a good way towards hanging
+    assert _dark(screen.get_at(window.to_window((l / 2 * math.cos(q), l / 2 * math.sin(q)))))
+    assert screen.get_at(window.to_window((l * 0.8, 0.0)))[:3] == (255, 255, 255)  # no longer there
+
+
+def test_window_keys_pause_speed_restart_and_quit(dummy_sdl):
+    pygame = dummy_sdl
+    from armgame.demos.catalog import make_run
+    from armgame.demos.window import DemoWindow
+
+    now = [0.0]
+    window = DemoWindow("interaction", make_run("interaction"), clock=lambda: now[0])
+    window.open()
+
+    def tick(seconds):
+        now[0] += seconds
+        assert window.frame()
+
+    def key(k):
+        return window.handle(pygame.event.Event(pygame.KEYDOWN, key=k))
+
+    tick(0.0)
+    tick(0.1)
+    assert window.run.t == pytest.approx(0.1, abs=1.5e-3)
+    key(pygame.K_SPACE)
+    tick(0.2)
+    tick(0.2)
+    assert window.run.t == pytest.approx(0.1, abs=1.5e-3)  # paused
+    key(pygame.K_SPACE)
+    key(pygame.K_MINUS)
+    assert window.speed == 0.5
+    tick(0.0)
+    tick(0.2)
+    assert window.run.t == pytest.approx(0.2, abs=1.5e-3)  # slow motion: 0.2 s real is 0.1 s simulated
+    tick(5.0)  # a stall counts as MAX_FRAME_TIME at most
+    assert window.run.t == pytest.approx(0.325, abs=1.5e-3)
+    key(pygame.K_r)
+    tick(0.0)
+    assert window.run.t == 0.0
+    window.handle(pygame.event.Event(pygame.VIDEORESIZE, w=1000, h=600, size=(1000, 600)))
+    pygame.display.set_mode((1000, 600), pygame.RESIZABLE)
+    tick(0.0)
+    shoulder = window.to_window((0.0, 0.0))
+    assert shoulder[0] == 500  # scene scaled to 600 px high, centred
+    assert key(pygame.K_ESCAPE) is False
+    assert window.handle(pygame.event.Event(pygame.QUIT)) is False
