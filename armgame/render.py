@@ -91,9 +91,9 @@ class GameRenderer:
             pygame.draw.line(screen, LINK, shoulder_px, elbow_px, width)
             pygame.draw.line(screen, LINK, elbow_px, hand_px, width)
             for joint in (shoulder_px, elbow_px):
-                pygame.draw.circle(screen, JOINT, joint, view.length(0.02))
+                pygame.draw.circle(screen, JOINT, joint, view.length(0.016))
         # The hand is the one thing a player must see, arm hidden or not: larger than the link is wide.
-        pygame.draw.circle(screen, HAND, view.to_screen(*hand), view.length(0.016))
+        pygame.draw.circle(screen, HAND, view.to_screen(*hand), view.length(0.02))
         self._draw_hud(screen, view, session)
         if paused:
             self._banner(screen, view, "Paused", "press P to play on")

@@ -6,13 +6,13 @@ import os
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 os.environ["SDL_AUDIODRIVER"] = "dummy"
 
-import pygame  # noqa: E402
-import pytest  # noqa: E402
+import pygame
+import pytest
 
-from armgame.frontend import GameWindow, open_window  # noqa: E402
-from armgame.game.rules import GameConfig  # noqa: E402
-from armgame.game.session import GameSession  # noqa: E402
-from armgame.render import BACKGROUND, HAND, LINK, PANEL, TARGET, Viewport  # noqa: E402
+from armgame.frontend import GameWindow, open_window
+from armgame.game.rules import GameConfig
+from armgame.game.session import GameSession
+from armgame.render import BACKGROUND, HAND, LINK, PANEL, TARGET, Viewport
 
 
 class FakeClock:
@@ -42,7 +42,7 @@ def colour_at(screen, point):
 
 def world_points(session):
     arm = session.config.arm
-    q1, q2 = session.state[:2]
+    q1 = session.state[0]
     elbow = (arm.l1 * math.cos(q1), arm.l1 * math.sin(q1))
     hand = session.hand()
     mid_upper = (elbow[0] / 2, elbow[1] / 2)
