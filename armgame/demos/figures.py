@@ -62,7 +62,8 @@ def passive_figure(t: NDArray[np.float64], q: NDArray[np.float64], hand: NDArray
     left.set_xlabel("time (s)")
     left.set_ylabel("joint angle (deg)")
     left.set_title("Two-joint passive arm: joint angles")
-    left.legend(loc="upper right")
+    left.margins(y=0.2)  # headroom for the legend above the swings
+    left.legend(loc="upper center", ncols=2)
     left.grid(alpha=0.3)
     right.plot(hand[:, 0], hand[:, 1], color=ARM_A, lw=0.8)
     right.plot(hand[0, 0], hand[0, 1], "o", color="tab:green", label="start")
