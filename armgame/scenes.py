@@ -7,6 +7,7 @@ tests all draw from this one list.
 from __future__ import annotations
 
 import math
+import random
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -99,7 +100,43 @@ def _stiff() -> Scene:
     )
 
 
-SCENES = {s.name: s for s in (_tutorial_passive(), _pendulum(), _propeller(), _upright(), _stiff())}
+#: Seed of the game scene's key script: fixed, so every run and every machine sees the same presses.
+GAME_SCRIPT_SEED = 2012
+GAME_SCRIPT_DURATION = 60.0
+
+
+def game_torque_script(
+    seed: int = GAME_SCRIPT_SEED, duration: float = GAME_SCRIPT_DURATION
+) -> tuple[tuple[float, tuple[float, float]], ...]:
+    """Piecewise-constant torques that mimic a player's key presses, then zero from ``duration`` on.
+
+    Each joint's flexor or extensor is held (or neither) at 0.5 to 1 N m for 0.2 to 0.8 s.
+    Switches fall on multiples of 0.2 s, which every benchmark step (1/30 s to 1/4000 s)
+    lands on exactly, so a step never straddles a switch and each scheme shows its own order.
+    """
+    rng = random.Random(seed)
+    segments: list[tuple[float, tuple[float, float]]] = []
+    tick = 0  # in units of 0.2 s, kept integral so start times are exact multiples
+    while tick * 0.2 < duration - 1e-9:
+        torque = tuple(rng.choice((-1.0, 0.0, 1.0)) * round(rng.uniform(0.5, 1.0), 3) for _ in range(2))
+        segments.append((round(tick * 0.2, 10), (torque[0] + 0.0, torque[1] + 0.0)))
+        tick += rng.randint(1, 4)
+    segments.append((duration, (0.0, 0.0)))
+    return tuple(segments)
+
+
+def _game() -> Scene:
+    return Scene(
+        "game",
+        "the game's arm (horizontal plane) driven for 60 s by a fixed, seeded script of key-like torque presses",
+        TwoJointArm(GAME_ARM),
+        (math.pi / 4, math.pi / 2, 0.0, 0.0),
+        torque_segments=game_torque_script(),
+        duration=GAME_SCRIPT_DURATION,
+    )
+
+
+SCENES = {s.name: s for s in (_tutorial_passive(), _pendulum(), _propeller(), _upright(), _stiff(), _game())}
 
 
 def get_scene(name: str) -> Scene:

@@ -32,10 +32,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Simulate a named physics scene with a chosen integrator and write the trajectory as CSV "
         "(t, q1, q2, qd1, qd2 in rad and rad/s, hand_x, hand_y in m, tau1, tau2 in N m, energy in J).",
     )
-    p.add_argument("--scene", required=True, help="passive, pendulum, propeller, upright or stiff")
-    p.add_argument("--integrator", default="rk4",
-                   help="euler, symplectic-euler, rk4, midpoint, gauss4 or dop853 (default: rk4)")
-    p.add_argument("--dt", type=float, default=0.001, help="fixed step in seconds (default: 0.001)")
+    p.add_argument("--scene", required=True, help="passive, pendulum, propeller, upright, stiff or game")
+    # Defaults resolve in run(): they live in armgame.physics.defaults, which parsing must not import.
+    p.add_argument("--integrator", default=None,
+                   help="euler, symplectic-euler, rk4, midpoint, gauss4 or dop853 "
+                   "(default: SIMULATE_INTEGRATOR in armgame/physics/defaults.py, chosen by armgame bench)")
+    p.add_argument("--dt", type=float, default=None,
+                   help="fixed step in seconds (default: SIMULATE_DT in armgame/physics/defaults.py)")
     p.add_argument("--duration", type=float, default=None, help="seconds to simulate (default: the scene's)")
     p.add_argument("--initial", type=_initial_state, default=None, metavar="Q1,Q2[,QD1,QD2]",
                    help="initial joint angles in degrees and velocities in deg/s, in armgame's convention "
@@ -48,9 +51,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from ..physics.defaults import SIMULATE_DT, SIMULATE_INTEGRATOR
     from ..scenes import get_scene
     from ..simulation import simulate, write_csv
 
+    args.integrator = SIMULATE_INTEGRATOR if args.integrator is None else args.integrator
+    args.dt = SIMULATE_DT if args.dt is None else args.dt
     scene = get_scene(args.scene)
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")

@@ -55,24 +55,31 @@ def _symplectic_euler(dyn: ComponentDynamics) -> StepFunction:
     return step
 
 
+_SIXTH = 1.0 / 6.0
+
+
 def _rk4(dyn: ComponentDynamics) -> StepFunction:
     accel = dyn.accel
 
     def step(q1, q2, w1, w2, t1, t2, dt):
+        # Separate assignments, not tuple packing: this is the game's hot path, run per arm per step.
         h = 0.5 * dt
         a1, a2 = accel(q1, q2, w1, w2, t1, t2)
-        v1, v2 = w1 + h * a1, w2 + h * a2
+        v1 = w1 + h * a1
+        v2 = w2 + h * a2
         b1, b2 = accel(q1 + h * w1, q2 + h * w2, v1, v2, t1, t2)
-        u1, u2 = w1 + h * b1, w2 + h * b2
+        u1 = w1 + h * b1
+        u2 = w2 + h * b2
         c1, c2 = accel(q1 + h * v1, q2 + h * v2, u1, u2, t1, t2)
-        s1, s2 = w1 + dt * c1, w2 + dt * c2
+        s1 = w1 + dt * c1
+        s2 = w2 + dt * c2
         d1, d2 = accel(q1 + dt * u1, q2 + dt * u2, s1, s2, t1, t2)
-        k = dt / 6.0
+        k = dt * _SIXTH
         return (
-            q1 + k * (w1 + 2.0 * (v1 + u1) + s1),
-            q2 + k * (w2 + 2.0 * (v2 + u2) + s2),
-            w1 + k * (a1 + 2.0 * (b1 + c1) + d1),
-            w2 + k * (a2 + 2.0 * (b2 + c2) + d2),
+            q1 + k * (w1 + s1 + 2.0 * (v1 + u1)),
+            q2 + k * (w2 + s2 + 2.0 * (v2 + u2)),
+            w1 + k * (a1 + d1 + 2.0 * (b1 + c1)),
+            w2 + k * (a2 + d2 + 2.0 * (b2 + c2)),
         )
 
     return step

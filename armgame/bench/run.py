@@ -1,0 +1,222 @@
+"""The whole benchmark: every method on every case, the speed bars, the defaults the data choose."""
+
+from __future__ import annotations
+
+import math
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..physics import defaults
+from ..physics.batch import BatchRK4
+from ..physics.integrators import SCHEMES, Integrator
+from ..physics.params import GAME_ARM
+from ..physics.twojoint import TwoJointArm
+from . import peers
+from .measure import HARD_CASES, QUICK_STEPS, STEPS, Choice, Row, choose, make_case, measure_scheme
+from .mjcf import build_model, load_mujoco
+
+BATCH_ARMS = 10_000
+BATCH_DT = 0.001
+
+
+@dataclass
+class Options:
+    quick: bool = False
+    cases: Sequence[str] = HARD_CASES
+    integrators: Sequence[str] = tuple(SCHEMES)
+    peers: bool = True
+    bars: bool = True
+
+
+@dataclass
+class Result:
+    rows: list[Row]
+    bars: dict[str, Any]
+    choices: dict[str, Choice | None]
+    machine: dict[str, str]
+    notes: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+
+def machine_info(mujoco: Any | None) -> dict[str, str]:
+    import scipy
+
+    info = {
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "mujoco": getattr(mujoco, "__version__", "not installed"),
+        "machine": f"{platform.machine()} {platform.processor() or ''}".strip(),
+        "cpu": _cpu_name(),
+        "cores": str(os.cpu_count()),
+        "system": platform.platform(terse=True),
+    }
+    try:
+        import matplotlib
+
+        info["matplotlib"] = matplotlib.__version__
+    except ImportError:
+        info["matplotlib"] = "not installed"
+    return info
+
+
+def _cpu_name() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def run_bench(options: Options, progress: Callable[[str], None] = lambda _m: None) -> Result:
+    t_start = time.perf_counter()
+    mujoco = load_mujoco()
+    repeats = 3 if options.quick else 5
+    steps = QUICK_STEPS if options.quick else STEPS
+    notes: list[str] = []
+    if mujoco is None:
+        notes.append("MuJoCo is not installed (pip install 'armgame[bench]'): its rows and ratio are skipped")
+    rows: list[Row] = []
+    for name in options.cases:
+        progress(f"case {name}")
+        case = make_case(name)
+        for integrator in options.integrators:
+            for dt in steps:
+                rows.append(measure_scheme(case, integrator, dt, repeats))
+        if not options.peers:
+            continue
+        odeint_tols = (1e-6, peers.ODEINT_DEFAULT_TOL) if options.quick else peers.ODEINT_TOLS
+        for tol in odeint_tols:
+            rows.append(peers.measure_odeint(case, tol, repeats))
+        ivp_tols = (1e-6, 1e-10) if options.quick else peers.SOLVE_IVP_TOLS
+        for method in ("RK45", "DOP853"):
+            for tol in ivp_tols:
+                rows.append(peers.measure_solve_ivp(case, method, tol, repeats))
+        if mujoco is not None:
+            for integrator in ("RK4", "Euler"):
+                for dt in steps:
+                    rows.append(peers.measure_mujoco(mujoco, case, integrator, dt, repeats))
+    bars: dict[str, Any] = {}
+    if options.bars:
+        progress("speed bars")
+        bars = speed_bars(rows, mujoco, quick=options.quick)
+    choices = {
+        "game": choose(rows, ("game",), defaults.GAME_MAX_HAND_ERROR, defaults.GAME_MAX_ENERGY_DRIFT, "game"),
+        "simulate": choose(rows, HARD_CASES, defaults.SIMULATE_MAX_HAND_ERROR, defaults.SIMULATE_MAX_ENERGY_DRIFT,
+                           "passive"),
+    }
+    return Result(rows, bars, choices, machine_info(mujoco), notes, time.perf_counter() - t_start)
+
+
+# ------------------------------------------------------------------------------ speed bars
+def _per_step(run: Callable[[int], Any], steps: int, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        run(steps)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times) / steps
+
+
+def speed_bars(rows: Sequence[Row], mujoco: Any | None, quick: bool = False) -> dict[str, Any]:
+    """The three ratios the issue sets as bars, each measured in this run, plus context numbers."""
+    bars: dict[str, Any] = {}
+    repeats = 5
+    n = 5_000 if quick else 20_000
+    arm = TwoJointArm(GAME_ARM)
+    state = (math.pi / 4, math.pi / 2, 0.5, -0.3)
+
+    # 1. The game's default (as the data choose it, else defaults.py) vs the tutorial's odeint on
+    #    the passive case, with our hand error no worse than odeint's.
+    passive = [r for r in rows if r.case == "passive"]
+    tutorial = [r for r in passive if r.family == "tutorial" and r.tol == peers.ODEINT_DEFAULT_TOL]
+    game = choose(rows, ("game",), defaults.GAME_MAX_HAND_ERROR, defaults.GAME_MAX_ENERGY_DRIFT, "game")
+    name, dt = (game.integrator, game.dt) if game else (defaults.GAME_INTEGRATOR, defaults.GAME_DT)
+    ours = sorted((r for r in passive if r.family == "armgame" and r.method == name and not r.blew_up),
+                  key=lambda r: -r.dt)  # type: ignore[arg-type, operator]
+    if tutorial and ours:
+        ref = tutorial[0]
+        at_default = [r for r in ours if r.dt is not None and math.isclose(r.dt, dt)]
+        good = [r for r in ours if r.hand_error <= ref.hand_error]
+        pick = at_default[0] if at_default and at_default[0].hand_error <= ref.hand_error else (
+            good[0] if good else None)
+        if pick is not None:
+            bars["odeint_ratio"] = ref.time_per_sim_s / pick.time_per_sim_s
+            bars["odeint_detail"] = (
+                f"{pick.method} {pick.setting}: {pick.time_per_sim_s * 1e3:.3g} ms per simulated s, hand error "
+                f"{pick.hand_error:.2g} m; tutorial odeint (tol {ref.tol:.3g}): "
+                f"{ref.time_per_sim_s * 1e3:.3g} ms, {ref.hand_error:.2g} m")
+
+    # 2. One arm, one RK4 step, the game's way (torque set, one call), ours vs MuJoCo's.
+    step = Integrator("rk4", arm).step_components
+
+    def ours_rk4(k: int) -> None:
+        q1, q2, w1, w2 = state
+        for _ in range(k):
+            q1, q2, w1, w2 = step(q1, q2, w1, w2, 0.2, -0.1, BATCH_DT)
+
+    bars["rk4_step_us"] = _per_step(ours_rk4, n, repeats) * 1e6
+    numpy_step = Integrator("rk4", arm, "numpy").step_components
+
+    def ours_numpy(k: int) -> None:
+        q1, q2, w1, w2 = (np.float64(v) for v in state)
+        for _ in range(k):
+            q1, q2, w1, w2 = numpy_step(q1, q2, w1, w2, 0.2, -0.1, BATCH_DT)
+
+    bars["rk4_numpy_single_step_us"] = _per_step(ours_numpy, n // 10, repeats) * 1e6
+    if mujoco is not None:
+        model, data = build_model(mujoco, GAME_ARM, BATCH_DT, "RK4")
+
+        def mj_rk4(k: int) -> None:
+            data.qpos[:] = state[:2]
+            data.qvel[:] = state[2:]
+            applied, mj_step = data.qfrc_applied, mujoco.mj_step
+            for _ in range(k):
+                applied[0] = 0.2
+                applied[1] = -0.1
+                mj_step(model, data)
+
+        def mj_rk4_c_loop(k: int) -> None:
+            data.qpos[:] = state[:2]
+            data.qvel[:] = state[2:]
+            data.qfrc_applied[:] = (0.2, -0.1)
+            mujoco.mj_step(model, data, nstep=k)
+
+        bars["mujoco_rk4_step_us"] = _per_step(mj_rk4, n, repeats) * 1e6
+        bars["mujoco_rk4_c_loop_step_us"] = _per_step(mj_rk4_c_loop, n, repeats) * 1e6
+        bars["mujoco_ratio"] = bars["mujoco_rk4_step_us"] / bars["rk4_step_us"]
+        bars["mujoco_c_loop_ratio"] = bars["mujoco_rk4_c_loop_step_us"] / bars["rk4_step_us"]
+
+    # 3. A batch of 10,000 arms, RK4 at 1 ms.
+    rng = np.random.default_rng(0)
+    states = np.column_stack([rng.uniform(0, math.pi, BATCH_ARMS), rng.uniform(0.1, 2.5, BATCH_ARMS),
+                              rng.uniform(-5, 5, (BATCH_ARMS, 2))])
+    batch = BatchRK4(arm, states, rng.uniform(-1, 1, (BATCH_ARMS, 2)))
+    batch_steps = 50 if quick else 200
+    threads = min(2, os.cpu_count() or 1)
+    for k in sorted({1, threads}):
+        per = _per_step(lambda s, k=k: batch.run(BATCH_DT, s, threads=k), batch_steps, repeats)
+        bars[f"batch_rate_{k}_thread"] = BATCH_ARMS / per
+    bars["batch_threads"] = threads
+    bars["batch_rate"] = bars[f"batch_rate_{threads}_thread"]
+    alloc = Integrator("rk4", arm, "numpy").step_components
+    comps = [np.ascontiguousarray(states[:, i]) for i in range(4)]
+    t1, t2 = np.full(BATCH_ARMS, 0.2), np.full(BATCH_ARMS, -0.1)
+
+    def allocating(k: int) -> None:
+        q1, q2, w1, w2 = comps
+        for _ in range(k):
+            q1, q2, w1, w2 = alloc(q1, q2, w1, w2, t1, t2, BATCH_DT)
+
+    bars["batch_rate_integrator_numpy"] = BATCH_ARMS / _per_step(allocating, batch_steps // 2, repeats)
+    return bars

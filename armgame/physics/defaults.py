@@ -1,0 +1,26 @@
+"""The integrators and steps armgame uses by default, chosen from ``armgame bench`` data.
+
+The README's "Performance" section has the table these come from and the reasoning. In short:
+
+* the game's step and integrator are the cheapest (time per simulated second, one arm)
+  whose hand error stays below 0.1 mm over the first 2 s of the game case and whose
+  energy holds within 1e-6 (relative) over 60 s of the passive case, without blowing up
+  on any hard case;
+* ``simulate``'s are the cheapest that keep the hand within 1 um of the reference over
+  2 s on every hard case and the passive energy within 1e-9 over 60 s: offline runs are
+  for looking at, so they buy accuracy the game does not need.
+
+Re-run ``armgame bench`` after changing the dynamics or the integrators; its output names
+the choice the data make, which should match these.
+"""
+
+#: Criteria the defaults are chosen by (see the bench's ``choose_defaults``).
+GAME_MAX_HAND_ERROR = 1e-4  # m, over the first 2 s of the game case
+GAME_MAX_ENERGY_DRIFT = 1e-6  # relative, over 60 s of the passive case
+SIMULATE_MAX_HAND_ERROR = 1e-6  # m, over the first 2 s of every hard case
+SIMULATE_MAX_ENERGY_DRIFT = 1e-9  # relative, over 60 s of the passive case
+
+GAME_INTEGRATOR = "rk4"
+GAME_DT = 1.0 / 250.0
+SIMULATE_INTEGRATOR = "rk4"
+SIMULATE_DT = 1.0 / 1000.0
