@@ -84,7 +84,7 @@ def test_keyboard_drives_the_arm_and_tab_hides_it(window):
     for _ in range(30):
         clock.now += 1 / 60
         win.frame(1 / 60)
-    assert win.session.steps == 500
+    assert win.session.steps == round(0.5 / win.session.config.dt)
     assert win.session.held == [True, False, False, True]
     assert win.session.state[0] > math.radians(45) and win.session.state[1] < math.radians(90)
     post_key("tab")

@@ -11,6 +11,7 @@ import random
 from dataclasses import dataclass, field
 
 from ..errors import UserError
+from ..physics.defaults import GAME_DT, GAME_INTEGRATOR
 from ..physics.params import GAME_ARM, TwoJointParams
 from .muscles import DEFAULT_MUSCLES, MuscleSpec
 
@@ -36,8 +37,8 @@ class GameConfig:
     target_elbow_range: tuple[float, float] = (45.0, 90.0)
     seed: int = 0
     muscles: tuple[MuscleSpec, ...] = DEFAULT_MUSCLES
-    integrator: str = "rk4"
-    dt: float = 0.001
+    integrator: str = GAME_INTEGRATOR
+    dt: float = GAME_DT
     reset_cost: int = 1
     view: tuple[float, float, float, float] = GAME_VIEW
     scene: str = "game"
