@@ -1,0 +1,332 @@
+"""Replays: a game's full configuration, its input timeline and its result, as a JSON file.
+
+A game is fully determined by its ``GameConfig`` and its input timeline (see
+``armgame.game.session``), so a replay recomputes its result exactly: ``verify`` replays
+the timeline and compares. Floats are written with ``repr`` (Python's JSON does), which
+reads back bit for bit, so the rebuilt configuration equals the original one.
+
+A replay file is parsed strictly as data: JSON with an explicit schema check of every
+field, NaN/Infinity refused, sizes bounded. Nothing in it is ever executed or unpickled.
+
+What a replay cannot prove: that a human pressed the keys. A timeline written by a
+program replays like any other; the table shows how each game says it was driven.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, fields
+from datetime import UTC, datetime
+from pathlib import Path
+
+from . import __version__
+from .errors import UserError
+from .game.muscles import MuscleSet, MuscleSpec
+from .game.rules import GameConfig
+from .game.session import DOWN, UP, GameResult, GameSession, InputEvent
+from .game.timeline import play_timeline
+from .physics.integrators import SCHEMES
+from .physics.params import TwoJointParams
+from .storage import (
+    DataFileError,
+    atomic_write_bytes,
+    check_float,
+    check_int,
+    check_keys,
+    check_str,
+    dump_json,
+    parse_json,
+    read_limited,
+)
+
+FORMAT = "armgame-replay"
+FORMAT_VERSION = 1
+MAX_REPLAY_BYTES = 64 * 1024 * 1024
+MAX_EVENTS = 2_000_000
+#: A replay longer than this many physics steps would take minutes to verify: refused.
+MAX_STEPS = 50_000_000
+DRIVEN = ("keyboard", "script", "bot")
+MAX_NAME = 40
+_WORD = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]*")
+
+
+def check_name(name: object, what: str = "player name") -> str:
+    """A player's name: 1 to 40 printable characters, surrounding spaces trimmed."""
+    name = check_str(what, name, 10 * MAX_NAME).strip()
+    if not name:
+        raise ValueError(f"{what} is empty")
+    if len(name) > MAX_NAME:
+        raise ValueError(f"{what} must be at most {MAX_NAME} characters, got {len(name)}")
+    if not name.isprintable():
+        raise ValueError(f"{what} must not contain control characters, got {name!r}")
+    return name
+
+
+def check_word(name: str, value: object, max_len: int = 40) -> str:
+    value = check_str(name, value, max_len)
+    if not _WORD.fullmatch(value):
+        raise ValueError(f"{name} must be letters, digits and . _ + - , got {value!r}")
+    return value
+
+
+def check_date(name: str, value: object) -> str:
+    value = check_str(name, value, 40)
+    try:
+        when = datetime.fromisoformat(value)
+    except ValueError:
+        raise ValueError(f"{name} must be an ISO 8601 date and time, got {value!r}") from None
+    if when.tzinfo is None:
+        raise ValueError(f"{name} must carry its time zone, got {value!r}")
+    return value
+
+
+def now_iso() -> str:
+    return datetime.now(UTC).isoformat(timespec="microseconds")
+
+
+# --------------------------------------------------------------- GameConfig <-> JSON
+
+def config_to_dict(config: GameConfig) -> dict[str, object]:
+    return {
+        "arm": config.arm.as_dict(),
+        "start_posture": list(config.start_posture),
+        "time_limit": config.time_limit,
+        "target_radius": config.target_radius,
+        "target_shoulder_range": list(config.target_shoulder_range),
+        "target_elbow_range": list(config.target_elbow_range),
+        "seed": config.seed,
+        "muscles": [
+            {"name": m.name, "key": m.key, "moment": list(m.moment), "rise_time": m.rise_time,
+             "decay_time": m.decay_time}
+            for m in config.muscles
+        ],
+        "integrator": config.integrator,
+        "dt": config.dt,
+        "reset_cost": config.reset_cost,
+        "view": list(config.view),
+        "scene": config.scene,
+    }
+
+
+CONFIG_FIELDS = frozenset(f.name for f in fields(GameConfig))
+_ARM_FIELDS = frozenset(f.name for f in fields(TwoJointParams))
+_BIG = 1e6  # no physical quantity of the game comes near this
+
+
+def _floats(name: str, value: object, n: int, low: float = -_BIG, high: float = _BIG) -> tuple[float, ...]:
+    if not isinstance(value, list) or len(value) != n:
+        raise ValueError(f"{name} must be a list of {n} numbers")
+    return tuple(check_float(f"{name}[{i}]", v, low, high) for i, v in enumerate(value))
+
+
+def config_from_dict(data: object) -> GameConfig:
+    """Rebuild a ``GameConfig``, checking every field; raises ValueError or UserError."""
+    d = check_keys("config", data, set(CONFIG_FIELDS))
+    arm = check_keys("config.arm", d["arm"], set(_ARM_FIELDS))
+    arm_values = {k: check_float(f"config.arm.{k}", v, 0.0, _BIG) for k, v in arm.items()}
+    muscles_data = d["muscles"]
+    if not isinstance(muscles_data, list) or len(muscles_data) != MuscleSet.COUNT:
+        raise ValueError(f"config.muscles must be a list of {MuscleSet.COUNT} muscles")
+    muscles = []
+    for i, m in enumerate(muscles_data):
+        where = f"config.muscles[{i}]"
+        m = check_keys(where, m, {"name", "key", "moment", "rise_time", "decay_time"})
+        muscles.append(MuscleSpec(
+            check_str(f"{where}.name", m["name"], 40),
+            check_str(f"{where}.key", m["key"], 20),
+            _floats(f"{where}.moment", m["moment"], 2),  # type: ignore[arg-type]
+            check_float(f"{where}.rise_time", m["rise_time"], 0.0, 100.0, low_open=True),
+            check_float(f"{where}.decay_time", m["decay_time"], 0.0, 100.0, low_open=True),
+        ))
+    keys = [m.key for m in muscles]
+    if len(set(keys)) != len(keys) or {"space", "tab"} & set(keys):
+        raise ValueError(f"config.muscles keys must differ from each other and from space and tab, got {keys}")
+    integrator = check_str("config.integrator", d["integrator"], 40)
+    if integrator not in SCHEMES:
+        raise ValueError(f"config.integrator must be one of {', '.join(SCHEMES)}, got {integrator!r}")
+    config = GameConfig(
+        arm=TwoJointParams(**arm_values),
+        start_posture=_floats("config.start_posture", d["start_posture"], 2, -100.0, 100.0),  # type: ignore[arg-type]
+        time_limit=check_float("config.time_limit", d["time_limit"], 0.0, 86400.0, low_open=True),
+        target_radius=check_float("config.target_radius", d["target_radius"], 0.0, 100.0, low_open=True),
+        target_shoulder_range=_floats("config.target_shoulder_range", d["target_shoulder_range"], 2),  # type: ignore[arg-type]
+        target_elbow_range=_floats("config.target_elbow_range", d["target_elbow_range"], 2),  # type: ignore[arg-type]
+        seed=check_int("config.seed", d["seed"], 0, 2**63 - 1),
+        muscles=tuple(muscles),
+        integrator=integrator,
+        dt=check_float("config.dt", d["dt"], 0.0, 0.05, low_open=True),
+        reset_cost=check_int("config.reset_cost", d["reset_cost"], 0, 1000),
+        view=_floats("config.view", d["view"], 4),  # type: ignore[arg-type]
+        scene=check_word("config.scene", d["scene"]),
+    )
+    if config.total_steps > MAX_STEPS:
+        raise ValueError(f"the game is {config.total_steps} physics steps long, more than a replay may be "
+                         f"({MAX_STEPS})")
+    return config
+
+
+# ----------------------------------------------------------------------- results
+
+_RESULT_FIELDS = frozenset(f.name for f in fields(GameResult))
+_COUNT_MAX = 10**9
+
+
+def result_from_dict(data: object) -> GameResult:
+    d = check_keys("result", data, set(_RESULT_FIELDS))
+    return GameResult(
+        score=check_int("result.score", d["score"], 0, _COUNT_MAX),
+        hits=check_int("result.hits", d["hits"], 0, _COUNT_MAX),
+        resets=check_int("result.resets", d["resets"], 0, _COUNT_MAX),
+        seed=check_int("result.seed", d["seed"], 0, 2**63 - 1),
+        duration=check_float("result.duration", d["duration"], 0.0, 86400.0, low_open=True),
+        steps=check_int("result.steps", d["steps"], 0, MAX_STEPS),
+        scene=check_word("result.scene", d["scene"]),
+        integrator=check_word("result.integrator", d["integrator"]),
+        dt=check_float("result.dt", d["dt"], 0.0, 0.05, low_open=True),
+        version=check_word("result.version", d["version"]),
+    )
+
+
+def same_outcome(a: GameResult, b: GameResult) -> bool:
+    """Whether two results are the same game outcome; the armgame version may differ."""
+    return {k: v for k, v in a.as_dict().items() if k != "version"} == \
+        {k: v for k, v in b.as_dict().items() if k != "version"}
+
+
+# ------------------------------------------------------------------------ replay
+
+@dataclass(frozen=True)
+class Replay:
+    config: GameConfig
+    timeline: tuple[InputEvent, ...]
+    #: The result as recorded; ``replay()`` recomputes it from the timeline.
+    result: GameResult
+    driven: str = "keyboard"
+    #: The bot's or the script's name, if any.
+    driver: str | None = None
+    player: str | None = None
+    date: str = ""
+    version: str = __version__
+
+    @property
+    def steps(self) -> int:
+        return self.result.steps
+
+    @property
+    def complete(self) -> bool:
+        """Whether the game ran to the end of its clock (a game quit early is not a score)."""
+        return self.result.steps >= self.config.total_steps
+
+    @classmethod
+    def from_session(cls, session: GameSession, driven: str, driver: str | None = None,
+                     player: str | None = None) -> Replay:
+        if driven not in DRIVEN:
+            raise ValueError(f"driven must be one of {', '.join(DRIVEN)}, got {driven!r}")
+        return cls(session.config, tuple(session.timeline), session.result(), driven, driver, player, now_iso())
+
+    def with_player(self, player: str) -> Replay:
+        return Replay(self.config, self.timeline, self.result, self.driven, self.driver, check_name(player),
+                      self.date, self.version)
+
+    def replay(self) -> GameResult:
+        """Recompute the result: the timeline replayed on a fresh session, no clock."""
+        return play_timeline(GameSession(self.config), self.timeline, self.result.steps)
+
+    def verify(self) -> tuple[bool, GameResult]:
+        recomputed = self.replay()
+        return same_outcome(recomputed, self.result), recomputed
+
+    # ------------------------------------------------------------------ files
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "format": FORMAT,
+            "format_version": FORMAT_VERSION,
+            "armgame_version": self.version,
+            "date": self.date,
+            "player": self.player,
+            "driven": self.driven,
+            "driver": self.driver,
+            "scene": self.config.scene,
+            "config": config_to_dict(self.config),
+            "timeline": [[e.step, e.key, e.action] for e in self.timeline],
+            "result": self.result.as_dict(),
+        }
+
+    def to_bytes(self) -> bytes:
+        return dump_json(self.as_dict())
+
+    def save(self, path: Path) -> None:
+        try:
+            atomic_write_bytes(Path(path), self.to_bytes())
+        except OSError as exc:
+            raise DataFileError(f"{path}: cannot write the replay: {exc.strerror or exc}") from None
+
+    @classmethod
+    def from_dict(cls, data: object) -> Replay:
+        """Rebuild a replay from parsed JSON; raises ValueError (or UserError) naming the bad field."""
+        if not isinstance(data, dict) or data.get("format") != FORMAT:
+            raise ValueError("not an armgame replay (no \"format\": \"armgame-replay\")")
+        d = check_keys("replay", data, {"format", "format_version", "armgame_version", "date", "player", "driven",
+                                        "driver", "scene", "config", "timeline", "result"})
+        fmt = check_int("format_version", d["format_version"], 1, 10**6)
+        if fmt != FORMAT_VERSION:
+            raise ValueError(f"replay format {fmt} is not supported by armgame {__version__} "
+                             f"(it reads format {FORMAT_VERSION})")
+        config = config_from_dict(d["config"])
+        if d["scene"] != config.scene:
+            raise ValueError(f"scene {d['scene']!r} differs from config.scene {config.scene!r}")
+        result = result_from_dict(d["result"])
+        if result.steps > config.total_steps:
+            raise ValueError(f"result.steps {result.steps} is past the game's end ({config.total_steps} steps)")
+        for name in ("seed", "scene", "integrator", "dt"):
+            if getattr(result, name) != getattr(config, name):
+                raise ValueError(f"result.{name} {getattr(result, name)!r} differs from config.{name}")
+        if result.duration != config.time_limit:
+            raise ValueError(f"result.duration {result.duration!r} differs from config.time_limit")
+        driven = check_str("driven", d["driven"], 20)
+        if driven not in DRIVEN:
+            raise ValueError(f"driven must be one of {', '.join(DRIVEN)}, got {driven!r}")
+        driver = None if d["driver"] is None else check_str("driver", d["driver"], 200)
+        player = None if d["player"] is None else check_name(d["player"])
+        timeline = _timeline_from_list(d["timeline"], config, result.steps)
+        return cls(config, timeline, result, driven, driver, player, check_date("date", d["date"]),
+                   check_word("armgame_version", d["armgame_version"]))
+
+    @classmethod
+    def from_bytes(cls, data: bytes, source: str = "replay") -> Replay:
+        try:
+            return cls.from_dict(parse_json(data))
+        except DataFileError:
+            raise
+        except UnicodeDecodeError:
+            raise DataFileError(f"{source}: not a text file (UTF-8 JSON expected)") from None
+        except (ValueError, TypeError, UserError) as exc:  # UserError: GameConfig's own checks
+            raise DataFileError(f"{source}: {exc}") from None
+
+    @classmethod
+    def load(cls, path: Path) -> Replay:
+        return cls.from_bytes(read_limited(Path(path), MAX_REPLAY_BYTES, "replay file"), str(path))
+
+
+def _timeline_from_list(data: object, config: GameConfig, last_step: int) -> tuple[InputEvent, ...]:
+    if not isinstance(data, list):
+        raise ValueError("timeline must be a list of [step, key, action]")
+    if len(data) > MAX_EVENTS:
+        raise ValueError(f"timeline has {len(data)} events, more than {MAX_EVENTS}")
+    keys = (*(m.key for m in config.muscles), "space", "tab")
+    events: list[InputEvent] = []
+    previous = 0
+    for i, item in enumerate(data):
+        where = f"timeline[{i}]"
+        if not isinstance(item, list) or len(item) != 3:
+            raise ValueError(f"{where} must be [step, key, action]")
+        step, key, action = item
+        step = check_int(f"{where} step", step, previous, last_step)
+        if key not in keys:
+            raise ValueError(f"{where}: unknown key {key!r}; keys are {' '.join(keys)}")
+        if action not in (DOWN, UP):
+            raise ValueError(f"{where}: action must be 'down' or 'up', got {action!r}")
+        events.append(InputEvent(step, key, action))
+        previous = step
+    return tuple(events)
+
