@@ -17,6 +17,9 @@ from .render import GameRenderer
 
 CAPTION = "armgame - hit the red targets with the black dot"
 DEFAULT_SIZE = (800, 800)
+NAME_LENGTH = 24
+#: Keys still being mashed as the clock runs out must not type themselves into the name.
+NAME_ENTRY_DELAY = 0.5
 
 
 def open_window(size: tuple[int, int] = DEFAULT_SIZE, fullscreen: bool = False) -> pygame.Surface:
@@ -41,12 +44,21 @@ class GameWindow:
         screen: pygame.Surface,
         clock: Callable[[], float] = time.perf_counter,
         fps: int = 60,
+        driver: RealTimeDriver | None = None,
+        ask_name: bool = False,
     ) -> None:
         self.session = session
         self.screen = screen
         self.clock = clock
         self.fps = fps
-        self.driver = RealTimeDriver(session)
+        # A driver given from outside (a replay's timeline) is the only input: keys just pause and quit.
+        self.keyboard = driver is None
+        self.driver = driver or RealTimeDriver(session)
+        #: The name typed on the end screen while it is being typed (None: no prompt), and once confirmed.
+        self.name_entry: str | None = None
+        self.player_name: str | None = None
+        self.ask_name = ask_name
+        self._over_for = 0.0
         names = tuple(m.name for m in session.config.muscles)
         self.renderer = GameRenderer(session.muscles.keys, names)
         self.paused = False
@@ -57,6 +69,8 @@ class GameWindow:
     def handle(self, event: pygame.event.Event) -> None:
         if event.type == pygame.QUIT:
             self.running = False
+        elif self.name_entry is not None and event.type in (pygame.TEXTINPUT, pygame.KEYDOWN):
+            self._type_name(event)
         elif event.type == pygame.KEYDOWN:
             name = key_name(event)
             if name == "escape":
@@ -65,15 +79,32 @@ class GameWindow:
                 self.set_paused(not self.paused)
             elif name == "f11":
                 self._toggle_fullscreen()
-            elif not self.paused:
+            elif not self.paused and self.keyboard:
                 self.session.key_event(name, DOWN)
-        elif event.type == pygame.KEYUP and not self.paused:
+        elif event.type == pygame.KEYUP and not self.paused and self.keyboard:
             self.session.key_event(key_name(event), UP)
         elif event.type == pygame.WINDOWFOCUSLOST and not self.session.over:
             self.set_paused(True)
 
+    def _type_name(self, event: pygame.event.Event) -> None:
+        if event.type == pygame.TEXTINPUT:
+            if self._over_for >= NAME_ENTRY_DELAY:
+                typed = "".join(c for c in event.text if c.isprintable())
+                self.name_entry = (self.name_entry + typed)[:NAME_LENGTH]
+            return
+        name = key_name(event)
+        if name == "escape":
+            self.running = False
+        elif name == "backspace":
+            self.name_entry = self.name_entry[:-1]
+        elif name in ("return", "enter") and self.name_entry.strip():
+            self.player_name = self.name_entry.strip()
+            self.running = False
+        elif name == "f11":
+            self._toggle_fullscreen()
+
     def set_paused(self, paused: bool) -> None:
-        if paused:
+        if paused and self.keyboard:
             # A key released while paused (or while the window is away) would otherwise stay held.
             for key, held in zip(self.session.muscles.keys, self.session.held, strict=True):
                 if held:
@@ -97,7 +128,11 @@ class GameWindow:
             self.alpha = self.driver.advance(elapsed)
         else:
             self.alpha = 1.0
-        self.renderer.draw(self.screen, self.session, self.alpha, self.paused)
+            self._over_for += elapsed
+            if self.ask_name and self.name_entry is None and self.player_name is None:
+                self.name_entry = ""
+                pygame.key.start_text_input()
+        self.renderer.draw(self.screen, self.session, self.alpha, self.paused, self.name_entry)
         pygame.display.flip()
 
     def run(self, max_frames: int | None = None) -> GameSession:

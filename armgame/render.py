@@ -76,7 +76,9 @@ class GameRenderer:
             surface = self._text[key] = self._font(size).render(string, True, colour)
         return surface
 
-    def draw(self, screen: pygame.Surface, session: GameSession, alpha: float = 1.0, paused: bool = False) -> None:
+    def draw(self, screen: pygame.Surface, session: GameSession, alpha: float = 1.0, paused: bool = False,
+             name: str | None = None) -> None:
+        """One frame; ``name``, when not None, is the player's name being typed on the end screen."""
         view = Viewport.fit(screen.get_size(), session.config.view)
         screen.fill(BACKGROUND)
         arm = session.config.arm
@@ -97,6 +99,8 @@ class GameRenderer:
         self._draw_hud(screen, view, session)
         if paused:
             self._banner(screen, view, "Paused", "press P to play on")
+        elif session.over and name is not None:
+            self._name_prompt(screen, view, session.rules.board.score, name)
         elif session.over:
             board = session.rules.board
             self._banner(screen, view, f"Your score: {board.score}",
@@ -136,3 +140,25 @@ class GameRenderer:
         pygame.draw.rect(screen, FAINT, panel, 2, border_radius=round(10 * unit))
         screen.blit(head, head.get_rect(center=(cx, cy - 22 * unit)))
         screen.blit(sub, sub.get_rect(center=(cx, cy + 32 * unit)))
+
+    def _name_prompt(self, screen: pygame.Surface, view: Viewport, score: int, name: str) -> None:
+        unit = view.scale / 500.0
+        head = self.text(f"Your score: {score}", max(16, round(64 * unit)))
+        ask = self.text("Type your name for the high-score table", max(10, round(26 * unit)))
+        hint = self.text("Enter to save   -   Esc to quit without saving", max(10, round(22 * unit)), FAINT)
+        font = self._font(max(12, round(40 * unit)))
+        typed = font.render(name + "|", True, TEXT)  # not cached: it changes with every key
+        box_w = max(font.size("M" * 16)[0], typed.get_width()) + 24 * unit
+        cx, cy = screen.get_width() / 2, view.top + view.scale * 0.55
+        panel = pygame.Rect(0, 0, max(head.get_width(), ask.get_width(), box_w) + 60 * unit, 250 * unit)
+        panel.center = (round(cx), round(cy))
+        pygame.draw.rect(screen, PANEL, panel, border_radius=round(10 * unit))
+        pygame.draw.rect(screen, FAINT, panel, 2, border_radius=round(10 * unit))
+        screen.blit(head, head.get_rect(center=(cx, cy - 80 * unit)))
+        screen.blit(ask, ask.get_rect(center=(cx, cy - 28 * unit)))
+        box = pygame.Rect(0, 0, box_w, font.get_height() + 12 * unit)
+        box.center = (round(cx), round(cy + 25 * unit))
+        pygame.draw.rect(screen, BACKGROUND, box, border_radius=round(4 * unit))
+        pygame.draw.rect(screen, TEXT, box, 2, border_radius=round(4 * unit))
+        screen.blit(typed, typed.get_rect(midleft=(box.left + 12 * unit, box.centery)))
+        screen.blit(hint, hint.get_rect(center=(cx, cy + 85 * unit)))

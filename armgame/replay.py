@@ -52,7 +52,7 @@ _WORD = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]*")
 
 def check_name(name: object, what: str = "player name") -> str:
     """A player's name: 1 to 40 printable characters, surrounding spaces trimmed."""
-    name = check_str(what, name, 10 * MAX_NAME).strip()
+    name = check_str(what, name, 10**6).strip()
     if not name:
         raise ValueError(f"{what} is empty")
     if len(name) > MAX_NAME:

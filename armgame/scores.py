@@ -48,6 +48,7 @@ from .replay import (
     now_iso,
 )
 from .storage import (
+    STRICT_DECODER,
     DataFileError,
     atomic_write_bytes,
     check_float,
@@ -177,7 +178,8 @@ class Damage:
     found: int
 
     def describe(self, path: Path) -> str:
-        return f"{path} is damaged ({self.reason}); {self.recovered} valid entries recovered"
+        entries = "1 valid entry" if self.recovered == 1 else f"{self.recovered} valid entries"
+        return f"{path} is damaged ({self.reason}); {entries} recovered"
 
 
 class ScoreTable:
@@ -309,7 +311,7 @@ def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
     try:
         table = parse_json(text)
     except ValueError as exc:
-        return _salvage(text, f"not valid JSON: {exc}")
+        return _salvage(text, str(exc))
     try:
         if not isinstance(table, dict) or table.get("format") != FORMAT:
             raise ValueError(f"not an armgame score table (no \"format\": \"{FORMAT}\")")
@@ -339,7 +341,7 @@ def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
 
 
 def _salvage(text: str, reason: str) -> tuple[list[ScoreEntry], Damage]:
-    decoder = json.JSONDecoder(parse_constant=_refuse)
+    decoder = STRICT_DECODER
     entries: list[ScoreEntry] = []
     seen: set[str] = set()
     i = text.find("{")
@@ -355,10 +357,6 @@ def _salvage(text: str, reason: str) -> tuple[list[ScoreEntry], Damage]:
             entries.append(entry)
         i = text.find("{", end)
     return entries, Damage(reason, len(entries), len(entries))
-
-
-def _refuse(name: str) -> float:
-    raise ValueError(f"{name} is not a JSON number")
 
 
 def table_bytes(entries: list[ScoreEntry]) -> bytes:

@@ -69,12 +69,27 @@ def _no_constants(name: str) -> float:
     raise ValueError(f"{name} is not a JSON number")
 
 
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):  # 1e999 parses as infinity
+        raise ValueError(f"{text[:20]} is out of range")
+    return value
+
+
+#: A decoder that yields plain data only: no NaN/Infinity, no out-of-range floats.
+STRICT_DECODER = json.JSONDecoder(parse_constant=_no_constants, parse_float=_finite_float)
+
+
 def parse_json(text: str | bytes) -> object:
     """Parse JSON text as plain data: no NaN/Infinity, bounded nesting, no code ever run."""
+    if isinstance(text, bytes):
+        text = text.decode("utf-8")
     try:
-        return json.loads(text, parse_constant=_no_constants)
+        return STRICT_DECODER.decode(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"not valid JSON: {exc}") from None
     except RecursionError:
-        raise ValueError("nested too deeply") from None
+        raise ValueError("not valid JSON: nested too deeply") from None
 
 
 def read_limited(path: Path, limit: int, what: str) -> bytes:

@@ -54,7 +54,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--fullscreen", action="store_true", help="fill the screen (for a projector)")
     p.add_argument("--size", type=_size, default=(800, 800), help="window size, e.g. 1024x768 (default: 800x800)")
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
+    _add_score_options(p)
     p.set_defaults(run=run)
+
+
+def _add_score_options(p: argparse.ArgumentParser) -> None:
+    from .scores import add_scores_option
+
+    p.add_argument("--name", help="the player's name for the high-score table (the window asks at the end "
+                   "otherwise; a headless game enters the table only with --name)")
+    p.add_argument("--record", metavar="FILE", help="save the game's replay to FILE (JSON)")
+    add_scores_option(p)
 
 
 def game_config(args: argparse.Namespace):
@@ -74,6 +84,7 @@ def run(args: argparse.Namespace) -> int:
     from ..game.session import GameSession
 
     session = GameSession(game_config(args))
+    _check_score_options(args)
     if args.script and not args.headless:
         raise UserError("--script drives a headless game: add --headless")
     if args.headless:
@@ -88,7 +99,56 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"your score is: {result.score}  ({result.hits} hits, {result.resets} resets, "
               f"{session.time:.1f} s of {result.duration:g} s)")
+    _keep(session, args)
     return 0
+
+
+def _check_score_options(args: argparse.Namespace) -> None:
+    """Refuse a bad --name or --record before the game, not after a minute of play."""
+    from pathlib import Path
+
+    from ..replay import check_name
+
+    if args.name is not None:
+        try:
+            args.name = check_name(args.name, "--name")
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+    if args.record and not Path(args.record).expanduser().resolve().parent.is_dir():
+        raise UserError(f"--record {args.record}: its folder does not exist")
+
+
+def _keep(session, args: argparse.Namespace) -> None:
+    """Save the replay where --record asks, and enter a finished game with a name in the table."""
+    import sys
+    from pathlib import Path
+
+    from ..replay import Replay
+    from ..scores import ScoreTable
+    from .scores import scores_dir
+
+    out = sys.stderr if args.json else sys.stdout
+    bot = getattr(args, "bot", None)
+    driven = "bot" if bot else "script" if args.headless else "keyboard"
+    driver = bot or (Path(args.script).name if args.script else None)
+    replay = Replay.from_session(session, driven, driver, args.name)
+    if args.record:
+        replay.save(Path(args.record).expanduser())
+        print(f"replay saved to {args.record}", file=out)
+    if args.name is None:
+        if not args.headless and session.over:
+            print("no name given: the score was not saved to the high-score table", file=out)
+        return
+    if not replay.complete:
+        print("the game was stopped before the end: not entered in the high-score table", file=out)
+        return
+    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
+    try:
+        entry = table.add(replay)
+    except OSError as exc:
+        raise UserError(f"cannot save the score in {table.folder}: {exc.strerror or exc}") from None
+    print(f"saved to the high-score table as {entry.name}: #{table.rank(entry)} "
+          f"({table.path})", file=out)
 
 
 def _play_in_window(session, args: argparse.Namespace):
@@ -103,7 +163,9 @@ def _play_in_window(session, args: argparse.Namespace):
     except pygame.error as exc:
         raise UserError(f"cannot open a window ({exc}); use --headless where there is no display") from None
     try:
-        GameWindow(session, screen, fps=args.fps).run()
+        window = GameWindow(session, screen, fps=args.fps, ask_name=args.name is None)
+        window.run()
+        args.name = args.name or window.player_name  # the name typed on the end screen
     finally:
         pygame.display.quit()
     return session.result()
