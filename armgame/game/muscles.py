@@ -35,8 +35,8 @@ class MuscleSpec:
             raise UserError(f"muscle {self.name}: moments must be finite, got {self.moment!r}")
 
 
-SHOULDER_MAX_TORQUE = 1.0
-ELBOW_MAX_TORQUE = 0.75
+SHOULDER_MAX_TORQUE = 1.5
+ELBOW_MAX_TORQUE = 1.125
 
 DEFAULT_MUSCLES: tuple[MuscleSpec, ...] = (
     MuscleSpec("pectoralis", "d", (SHOULDER_MAX_TORQUE, 0.0)),

@@ -20,8 +20,10 @@ GAME_VIEW = (-0.8, 0.8, -0.4, 1.2)
 
 #: The game arm with joint viscosity (the 2012 game had none): a tap of a key moves the arm
 #: and the swing dies out within about a second instead of spinning on like a propeller.
-#: A 0.2 s tap of d turns the shoulder about 15 deg; 0.5 s about 40 deg.
-GAME_PLAY_ARM = GAME_ARM.replace(damping1=0.6, damping2=0.45)
+#: A 0.2 s tap of d turns the shoulder about 50 deg. Heavier viscosity (0.6 and 0.45) made the
+#: arm so slow that damping, not inertia, set every torque, and a player who ignores the
+#: interaction torques did as well as one who knows them (the autopilot bots, armgame/game/bots.py).
+GAME_PLAY_ARM = GAME_ARM.replace(damping1=0.36, damping2=0.27)
 
 
 @dataclass(frozen=True)

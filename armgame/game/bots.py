@@ -1,0 +1,363 @@
+"""Autopilots: bots that play the game by pressing the four muscle keys, as a player would.
+
+A bot is an input source like the keyboard or a script: before a physics step it looks at
+what a player sees (the arm, the target, the clock and the four activation bars) and
+returns key presses and releases, which go through ``GameSession.key_event`` and into the
+session's timeline. So a bot game replays headless from its timeline bit for bit, and the
+same bot drives a headless game and the window through the same ``Autopilot``.
+
+Both bots plan every reach the same way: a minimum-jerk (quintic) joint trajectory from the
+arm's current state to the target's inverse-kinematics posture, lasting the shortest time
+whose torques, by the bot's own model, fit within the muscles. They track it with the same
+computed-torque law, ``tau = M^(qdd_d + kp e + kd e') + C^ + B qd``, and turn the torque
+into keys the same way. They differ only in the internal model (M^, C^):
+
+* ``model`` knows the arm's dynamics: the full mass matrix and the Coriolis-centrifugal
+  torques, the interaction torques included.
+* ``naive`` drives each joint as if the other did not move: its mass matrix is the diagonal
+  of the true one and it has no Coriolis-centrifugal torques.
+
+Keys are binary, so a bot turns a desired torque into presses with a one-step-ahead
+sigma-delta on the muscles' activations: at each decision it predicts, from the muscle model
+(which a practised player learns from the bars), the activation each key choice gives one
+control period later, and picks the antagonist pair whose net torque then comes nearest the
+desired one.
+
+Bots decide every ``CONTROL_PERIOD`` (5 ms, five physics steps): the muscles' 80-100 ms time
+constants filter the presses, so one period moves an activation by at most 6 percent of its
+range (a ripple of at most 0.06 N m); deciding every 1 ms scored no more hits in our
+measurements but cost five times the decisions and timeline events.
+
+Nothing here is random: a bot's game is a function of the game's seed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from typing import Protocol
+
+from ..errors import UserError
+from .rules import GameConfig, Target
+from .session import DOWN, UP, GameResult, GameSession
+
+CONTROL_PERIOD = 0.005
+
+
+class Bot(Protocol):
+    """An input source: ``act`` is called before every ``period_steps``-th physics step."""
+
+    name: str
+
+    def period_steps(self, dt: float) -> int: ...
+
+    def act(self, session: GameSession) -> list[tuple[str, str]]: ...
+
+
+# ---------------------------------------------------------------- internal models
+@dataclass(frozen=True)
+class InternalModel:
+    """The bot's belief about the arm: ``torque(q, qd, qdd)`` and ``inertia(q, v)`` (M^ v)."""
+
+    name: str
+    interaction: bool  # whether it knows the off-diagonal inertia and the Coriolis-centrifugal torques
+    a: float
+    b: float
+    d: float
+    k1: float
+    k2: float
+
+    @classmethod
+    def of(cls, config: GameConfig, interaction: bool) -> InternalModel:
+        p = config.arm
+        if p.has_gravity:
+            raise UserError("the bots play the game's horizontal arm: they know no gravity")
+        a = p.i1 + p.i2 + p.m1 * p.r1**2 + p.m2 * (p.l1**2 + p.r2**2)
+        return cls("model" if interaction else "naive", interaction, a, p.m2 * p.l1 * p.r2, p.i2 + p.m2 * p.r2**2,
+                   p.damping1, p.damping2)
+
+    def inertial(self, q2: float, v1: float, v2: float) -> tuple[float, float]:
+        bc = self.b * math.cos(q2)
+        m11 = self.a + 2.0 * bc
+        if not self.interaction:
+            return m11 * v1, self.d * v2
+        m12 = self.d + bc
+        return m11 * v1 + m12 * v2, m12 * v1 + self.d * v2
+
+    def bias(self, q2: float, w1: float, w2: float) -> tuple[float, float]:
+        """Coriolis-centrifugal plus damping torques (what holds no acceleration)."""
+        if not self.interaction:
+            return self.k1 * w1, self.k2 * w2
+        h = self.b * math.sin(q2)
+        return -h * (2.0 * w1 * w2 + w2 * w2) + self.k1 * w1, h * w1 * w1 + self.k2 * w2
+
+    def accel(self, q2: float, w1: float, w2: float, t1: float, t2: float) -> tuple[float, float]:
+        """The motion the model expects from torques (t1, t2): its forward model."""
+        c1, c2 = self.bias(q2, w1, w2)
+        f1, f2 = t1 - c1, t2 - c2
+        bc = self.b * math.cos(q2)
+        m11 = self.a + 2.0 * bc
+        if not self.interaction:
+            return f1 / m11, f2 / self.d
+        m12 = self.d + bc
+        r = 1.0 / (m11 * self.d - m12 * m12)
+        return (self.d * f1 - m12 * f2) * r, (m11 * f2 - m12 * f1) * r
+
+    def torque(self, q2: float, w1: float, w2: float, a1: float, a2: float) -> tuple[float, float]:
+        i1, i2 = self.inertial(q2, a1, a2)
+        c1, c2 = self.bias(q2, w1, w2)
+        return i1 + c1, i2 + c2
+
+
+# --------------------------------------------------------------------- planning
+@dataclass(frozen=True)
+class Quintic:
+    """One joint's minimum-jerk-like path: a quintic from (q0, v0, a0) to (qf, 0, 0) in time T."""
+
+    c: tuple[float, float, float, float, float, float]
+    duration: float
+    end: float
+
+    @classmethod
+    def between(cls, q0: float, v0: float, a0: float, qf: float, duration: float) -> Quintic:
+        t = duration
+        h = qf - q0
+        c3 = (20.0 * h - (12.0 * v0) * t - (3.0 * a0) * t * t) / (2.0 * t**3)
+        c4 = (-30.0 * h + (16.0 * v0) * t + (3.0 * a0) * t * t) / (2.0 * t**4)
+        c5 = (12.0 * h - (6.0 * v0) * t - a0 * t * t) / (2.0 * t**5)
+        return cls((q0, v0, 0.5 * a0, c3, c4, c5), duration, qf)
+
+    def at(self, t: float) -> tuple[float, float, float]:
+        if t >= self.duration:
+            return self.end, 0.0, 0.0
+        c0, c1, c2, c3, c4, c5 = self.c
+        q = c0 + t * (c1 + t * (c2 + t * (c3 + t * (c4 + t * c5))))
+        v = c1 + t * (2.0 * c2 + t * (3.0 * c3 + t * (4.0 * c4 + t * 5.0 * c5)))
+        a = 2.0 * c2 + t * (6.0 * c3 + t * (12.0 * c4 + t * 20.0 * c5))
+        return q, v, a
+
+
+def target_posture(config: GameConfig, x: float, y: float, q1_now: float) -> tuple[float, float]:
+    """The elbow-flexed (q2 > 0) posture with the hand at (x, y), shoulder angle unwrapped near ``q1_now``.
+
+    The game draws its targets with the elbow flexed, and reaching the other solution would
+    swing the forearm through the straight-arm singularity.
+    """
+    l1, l2 = config.arm.l1, config.arm.l2
+    c2 = (x * x + y * y - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
+    q2 = math.acos(min(1.0, max(-1.0, c2)))
+    q1 = math.atan2(y, x) - math.atan2(l2 * math.sin(q2), l1 + l2 * math.cos(q2))
+    q1 += 2.0 * math.pi * round((q1_now - q1) / (2.0 * math.pi))
+    return q1, q2
+
+
+# ---------------------------------------------------------------------- the bot
+@dataclass
+class _Plan:
+    target: Target
+    start: float
+    paths: tuple[Quintic, Quintic]
+    retry_at: float
+
+
+class ReachingBot:
+    """Plans minimum-jerk reaches and tracks them by computed torque through its internal model."""
+
+    #: Candidate reach durations (s); the planner takes the shortest whose torques fit.
+    DURATIONS = tuple(0.2 + 0.025 * i for i in range(57))
+    #: Fraction of each joint's strength the plan may use: the rest is left for feedback.
+    TORQUE_MARGIN = 0.9
+    #: Feedback gains on the joint error, as accelerations (1/s^2 and 1/s): critically damped at about 1.2 Hz.
+    KP = 60.0
+    KD = 15.5
+    #: How long after a plan's end the bot waits, holding the posture, before it replans a miss.
+    SETTLE = 0.1
+    #: What a player sees is this old (s): a visual reaction time.
+    REACTION_TIME = 0.25
+
+    def __init__(self, name: str, interaction: bool, control_period: float = CONTROL_PERIOD) -> None:
+        self.name = name
+        self.interaction = interaction
+        self.control_period = control_period
+        self._model: InternalModel | None = None
+        self._config: GameConfig | None = None
+        self._plan: _Plan | None = None
+        self._setup: tuple | None = None
+        self._history: deque = deque()
+
+    def period_steps(self, dt: float) -> int:
+        return max(1, round(self.control_period / dt))
+
+    # -------------------------------------------------------------- set-up
+    def _bind(self, session: GameSession) -> None:
+        config = session.config
+        self._config = config
+        self._model = InternalModel.of(config, self.interaction)
+        period = self.period_steps(config.dt) * config.dt
+        joints = []
+        # Each joint's agonist (positive moment) and antagonist, with their rates over one period.
+        for j in (0, 1):
+            pos = max(range(4), key=lambda i: session.muscles.moments[i][j])
+            neg = min(range(4), key=lambda i: session.muscles.moments[i][j])
+            spec_p, spec_n = config.muscles[pos], config.muscles[neg]
+            joints.append((
+                pos, neg, session.muscles.moments[pos][j], session.muscles.moments[neg][j],
+                -math.expm1(-period / spec_p.rise_time), -math.expm1(-period / spec_p.decay_time),
+                -math.expm1(-period / spec_n.rise_time), -math.expm1(-period / spec_n.decay_time),
+            ))
+        self._setup = (period, tuple(joints))
+        self._plan = None
+        self._history = deque()
+
+    def _strength(self, j: int) -> float:
+        assert self._setup is not None
+        jp = self._setup[1][j]
+        return min(jp[2], -jp[3])
+
+    def _replan(self, target: Target, state: tuple[float, float, float, float], now: float) -> None:
+        assert self._model is not None and self._config is not None
+        q1, q2, w1, w2 = state
+        f1, f2 = target_posture(self._config, target.x, target.y, q1)
+        # The plan starts at zero acceleration: the bot does not see acceleration.
+        limit1, limit2 = self.TORQUE_MARGIN * self._strength(0), self.TORQUE_MARGIN * self._strength(1)
+        model = self._model
+        paths = None
+        for duration in self.DURATIONS:
+            paths = (Quintic.between(q1, w1, 0.0, f1, duration), Quintic.between(q2, w2, 0.0, f2, duration))
+            fits = True
+            for i in range(13):
+                t = duration * i / 12.0
+                _p1, v1, a1 = paths[0].at(t)
+                p2, v2, a2 = paths[1].at(t)
+                t1, t2 = model.torque(p2, v1, v2, a1, a2)
+                if abs(t1) > limit1 or abs(t2) > limit2:
+                    fits = False
+                    break
+            if fits:
+                break
+        assert paths is not None
+        self._plan = _Plan(target, now, paths, now + paths[0].duration + self.SETTLE)
+
+    def _estimate(self) -> tuple[float, float, float, float]:
+        """The arm now, predicted from what the bot saw a reaction time ago and the torques it has
+        commanded since (an efference copy), through its own forward model."""
+        assert self._model is not None and self._setup is not None
+        period = self._setup[0]
+        accel = self._model.accel
+        history = self._history
+        q1, q2, w1, w2 = history[0][0]
+        for _, _, t1, t2 in history:
+            a1, a2 = accel(q2, w1, w2, t1, t2)
+            w1 += a1 * period
+            w2 += a2 * period
+            q1 += w1 * period
+            q2 += w2 * period
+        return q1, q2, w1, w2
+
+    # ----------------------------------------------------------------- act
+    def act(self, session: GameSession) -> list[tuple[str, str]]:
+        if session.over:
+            return []
+        if self._config is not session.config:
+            self._bind(session)
+        assert self._model is not None and self._setup is not None
+        period, joints = self._setup
+        if not self._history:
+            # Before the first move the arm sat still at its start posture with the first target shown.
+            lag = max(1, round(self.REACTION_TIME / period))
+            self._history = deque([(session.state, session.rules.target, 0.0, 0.0)] * lag, maxlen=lag)
+        now = session.time
+        seen_target = self._history[0][1]
+        q1, q2, w1, w2 = self._estimate()
+        plan = self._plan
+        if plan is None or plan.target is not seen_target or now >= plan.retry_at:
+            self._replan(seen_target, (q1, q2, w1, w2), now)
+            plan = self._plan
+            assert plan is not None
+        # The torque wanted one period from now, when this decision's presses have had their effect.
+        t = now + period - plan.start
+        d1, v1, a1 = plan.paths[0].at(t)
+        d2, v2, a2 = plan.paths[1].at(t)
+        p1, p2 = q1 + w1 * period, q2 + w2 * period
+        u1 = a1 + self.KP * (d1 - p1) + self.KD * (v1 - w1)
+        u2 = a2 + self.KP * (d2 - p2) + self.KD * (v2 - w2)
+        i1, i2 = self._model.inertial(p2, u1, u2)
+        c1, c2 = self._model.bias(p2, w1, w2)
+        events: list[tuple[str, str]] = []
+        act, held, keys = session.muscles.activation, session.held, session.muscles.keys
+        applied = []
+        for (pos, neg, mp, mn, rp, dp, rn, dn), want in zip(joints, (i1 + c1, i2 + c2), strict=True):
+            ap, an = act[pos], act[neg]
+            # Predicted activations one period on, with each muscle's key down or up.
+            ap_on, ap_off = ap + (1.0 - ap) * rp, ap - ap * dp
+            an_on, an_off = an + (1.0 - an) * rn, an - an * dn
+            best, best_cost, best_net = (False, False), math.inf, 0.0
+            for on_p, on_n in ((False, False), (True, False), (False, True), (True, True)):
+                net = mp * (ap_on if on_p else ap_off) + mn * (an_on if on_n else an_off)
+                # A little cost on co-contraction: pushing against oneself is wasted effort.
+                cost = (net - want) ** 2 + 1e-4 * (on_p + on_n)
+                if cost < best_cost:
+                    best, best_cost, best_net = (on_p, on_n), cost, net
+            # The torque over the coming period, for the forward model: between now's and the end's.
+            applied.append(0.5 * (mp * ap + mn * an + best_net))
+            for index, on in zip((pos, neg), best, strict=True):
+                if on != held[index]:
+                    events.append((keys[index], DOWN if on else UP))
+        self._history.append((session.state, session.rules.target, applied[0], applied[1]))
+        return events
+
+
+BOT_NAMES = ("model", "naive")
+
+
+def make_bot(name: str) -> ReachingBot:
+    """A fresh bot by name: ``model`` (knows the interaction torques) or ``naive`` (does not)."""
+    if name == "model":
+        return ReachingBot("model", interaction=True)
+    if name == "naive":
+        return ReachingBot("naive", interaction=False)
+    raise UserError(f"unknown bot {name!r}: choose one of {', '.join(BOT_NAMES)}")
+
+
+# ----------------------------------------------------------------- the driver
+class Autopilot:
+    """A session with a bot at the keys: ``advance(n)`` runs n physics steps, letting the bot act
+    before every step that starts one of its control periods.
+
+    The bot acts at whole multiples of its period counted from the start of the game, never
+    at frame boundaries, so the window (any frame rate) and a headless run give the same
+    timeline. It quacks like a ``GameSession`` for ``RealTimeDriver`` (``config``, ``advance``).
+    """
+
+    def __init__(self, session: GameSession, bot: Bot) -> None:
+        self.session = session
+        self.bot = bot
+        self.config = session.config
+        self.period = bot.period_steps(session.config.dt)
+
+    def advance(self, n: int) -> int:
+        session, period = self.session, self.period
+        done = 0
+        while done < n and not session.over:
+            offset = session.steps % period
+            if offset == 0:
+                for key, action in self.bot.act(session):
+                    session.key_event(key, action)
+            ran = session.advance(min(n - done, period - offset))
+            if ran == 0:
+                break
+            done += ran
+        return done
+
+    def play(self) -> GameResult:
+        """The whole game, headless, as fast as the machine allows."""
+        self.advance(self.session.total_steps - self.session.steps)
+        return self.session.result()
+
+
+def play_bot(config: GameConfig, bot: Bot | str) -> GameSession:
+    """Play one whole game headless with ``bot`` (an instance or a name); returns the finished session."""
+    session = GameSession(config)
+    Autopilot(session, make_bot(bot) if isinstance(bot, str) else bot).play()
+    return session
