@@ -113,7 +113,9 @@ def make_case(name: str) -> Case:
     if scene.free_after == math.inf:
         raise ValueError(f"case {name!r} never goes torque-free, so its energy cannot be checked")
     if free_start > 0.0:
-        free_state = tuple(reference_trajectory(scene.model, scene.initial, [free_start], scene.torque_segments)[0])
+        # Python floats, not numpy scalars: the schemes run several times faster on them.
+        free_state = tuple(map(float, reference_trajectory(scene.model, scene.initial, [free_start],
+                                                           scene.torque_segments)[0]))
     else:
         free_state = scene.initial
     return Case(scene, scene.model, scene.torque_segments, free_start, free_state)  # type: ignore[arg-type]
@@ -195,7 +197,7 @@ def measure_scheme(case: Case, name: str, dt: float, repeats: int) -> Row:
         ok = False
     t = np.arange(steps + 1) * dt
     error = hand_error(case, t, np.array(states)) if ok else math.inf
-    rhs = count[0] / (len(states) - 1) / dt
+    rhs = count[0] / max(1, len(states) - 1) / dt
 
     def timed() -> None:
         q1, q2, w1, w2 = start
@@ -250,12 +252,12 @@ def choose(
     max_error: float,
     max_drift: float,
     cost_case: str,
-    drift_case: str = "passive",
+    drift_cases: Sequence[str] = ("passive",),
 ) -> Choice | None:
     """The cheapest (integrator, dt) of ours on ``cost_case`` that meets the bars on every case measured.
 
-    It must keep the hand within ``max_error`` on each of ``error_cases``, the energy of
-    ``drift_case`` within ``max_drift``, and blow up on no case.
+    It must keep the hand within ``max_error`` on each of ``error_cases``, the energy of each of
+    ``drift_cases`` within ``max_drift``, and blow up on no case.
     """
     ours = [r for r in rows if r.family == "armgame"]
     by_key: dict[tuple[str, float], dict[str, Row]] = {}
@@ -263,19 +265,20 @@ def choose(
         by_key.setdefault((r.method, r.dt), {})[r.case] = r  # type: ignore[index]
     best: Choice | None = None
     for (name, dt), per_case in by_key.items():
-        if cost_case not in per_case or drift_case not in per_case:
+        if cost_case not in per_case or not any(c in per_case for c in drift_cases):
             continue
         if any(r.blew_up for r in per_case.values()):
             continue
         if any(c in per_case and per_case[c].hand_error >= max_error for c in error_cases):
             continue
-        if per_case[drift_case].energy_drift >= max_drift:
+        drift = max(per_case[c].energy_drift for c in drift_cases if c in per_case)
+        if drift >= max_drift:
             continue
         cost = per_case[cost_case].time_per_sim_s
         if best is None or cost < best.time_per_sim_s:
             worst = max(per_case[c].hand_error for c in error_cases if c in per_case)
             reason = (f"cheapest on {cost_case} ({cost * 1e3:.3g} ms per simulated s) with hand error "
-                      f"{worst:.2g} m < {max_error:g} m and {drift_case} energy drift "
-                      f"{per_case[drift_case].energy_drift:.2g} < {max_drift:g}, no blow-up")
+                      f"{worst:.2g} m < {max_error:g} m on {', '.join(error_cases)}, energy drift "
+                      f"{drift:.2g} < {max_drift:g} on {', '.join(drift_cases)}, no blow-up")
             best = Choice(name, dt, cost, reason)
     return best

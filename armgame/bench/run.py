@@ -113,7 +113,7 @@ def run_bench(options: Options, progress: Callable[[str], None] = lambda _m: Non
     choices = {
         "game": choose(rows, ("game",), defaults.GAME_MAX_HAND_ERROR, defaults.GAME_MAX_ENERGY_DRIFT, "game"),
         "simulate": choose(rows, HARD_CASES, defaults.SIMULATE_MAX_HAND_ERROR, defaults.SIMULATE_MAX_ENERGY_DRIFT,
-                           "passive"),
+                           "passive", drift_cases=HARD_CASES),
     }
     return Result(rows, bars, choices, machine_info(mujoco), notes, time.perf_counter() - t_start)
 
