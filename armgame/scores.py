@@ -244,6 +244,12 @@ class ScoreTable:
         # The replay first: a crash in between leaves a spare replay, never an entry without one.
         atomic_write_bytes(self.replays / file_name, data)
         with self._locked():
+            # Under the lock nobody else is writing the table: any temporary file of it was left by a
+            # writer that died mid-write (the kill leaves no chance to clean up). Replays are written
+            # outside the lock, so their temporary files are left alone.
+            for stale in self.folder.glob(f".{TABLE_NAME}.*.tmp"):
+                with contextlib.suppress(OSError):
+                    stale.unlink()
             entries, damage = self.read()
             if damage:
                 kept = self._set_aside()
