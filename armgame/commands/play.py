@@ -50,6 +50,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
     p.add_argument("--script", metavar="FILE", help="input timeline, one 'TIME KEY ACTION' a line (headless)")
+    p.add_argument("--bot", metavar="NAME", help="an autopilot at the muscle keys: model (knows the interaction "
+                   "torques) or naive (drives each joint as if the other did not move)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.add_argument("--fullscreen", action="store_true", help="fill the screen (for a projector)")
     p.add_argument("--size", type=_size, default=(800, 800), help="window size, e.g. 1024x768 (default: 800x800)")
@@ -87,7 +89,13 @@ def run(args: argparse.Namespace) -> int:
     _check_score_options(args)
     if args.script and not args.headless:
         raise UserError("--script drives a headless game: add --headless")
-    if args.headless:
+    if args.bot and args.script:
+        raise UserError("--bot and --script both drive the game: give one of them")
+    if args.headless and args.bot:
+        from ..game.bots import Autopilot, make_bot
+
+        result = Autopilot(session, make_bot(args.bot)).play()
+    elif args.headless:
         events = load_script(Path(args.script), session.keys, session.config.dt) if args.script else []
         result = session.play(events)
     else:
@@ -158,12 +166,19 @@ def _play_in_window(session, args: argparse.Namespace):
         from ..frontend import GameWindow, open_window
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
+    driver = None
+    if args.bot:
+        from ..game.bots import Autopilot, make_bot
+        from ..game.session import RealTimeDriver
+
+        # The bot steps the game through the same Autopilot as headless: the keyboard only pauses and quits.
+        driver = RealTimeDriver(Autopilot(session, make_bot(args.bot)))  # type: ignore[arg-type]
     try:
         screen = open_window(args.size, args.fullscreen)
     except pygame.error as exc:
         raise UserError(f"cannot open a window ({exc}); use --headless where there is no display") from None
     try:
-        window = GameWindow(session, screen, fps=args.fps, ask_name=args.name is None)
+        window = GameWindow(session, screen, fps=args.fps, driver=driver, ask_name=args.name is None)
         window.run()
         args.name = args.name or window.player_name  # the name typed on the end screen
     finally:

@@ -23,10 +23,11 @@ sigma-delta on the muscles' activations: at each decision it predicts, from the 
 control period later, and picks the antagonist pair whose net torque then comes nearest the
 desired one.
 
-Bots decide every ``CONTROL_PERIOD`` (5 ms, five physics steps): the muscles' 80-100 ms time
-constants filter the presses, so one period moves an activation by at most 6 percent of its
-range (a ripple of at most 0.06 N m); deciding every 1 ms scored no more hits in our
-measurements but cost five times the decisions and timeline events.
+Bots decide every ``CONTROL_PERIOD`` (4 ms): the game's physics rate (250 Hz), so a bot can
+press or release before any step, as the keyboard can. The muscles' 80-100 ms time constants
+filter the presses, so one decision moves an activation by at most 5 percent of its range (a
+ripple of at most 0.07 N m). Under a finer physics step the bot still decides every 4 ms, on
+whole steps, so its play hardly depends on the step.
 
 Nothing here is random: a bot's game is a function of the game's seed.
 """
@@ -42,7 +43,7 @@ from ..errors import UserError
 from .rules import GameConfig, Target
 from .session import DOWN, UP, GameResult, GameSession
 
-CONTROL_PERIOD = 0.005
+CONTROL_PERIOD = 0.004
 
 
 class Bot(Protocol):

@@ -1,0 +1,68 @@
+"""The autopilots: deterministic, keyboard-only, replayable, and knowing the interaction torques pays."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from armgame.errors import UserError
+from armgame.game.bots import Autopilot, make_bot, play_bot
+from armgame.game.rules import GameConfig
+from armgame.game.session import GameSession, RealTimeDriver
+
+
+@pytest.mark.parametrize("name", ["model", "naive"])
+def test_a_bot_plays_the_same_game_from_the_same_seed(name):
+    a = play_bot(GameConfig(seed=4, time_limit=6.0), name)
+    b = play_bot(GameConfig(seed=4, time_limit=6.0), name)
+    assert a.timeline == b.timeline and a.result() == b.result() and a.state == b.state
+    assert a.rules.board.hits >= 1
+
+
+@pytest.mark.parametrize("name", ["model", "naive"])
+def test_bots_press_only_the_muscle_keys(name):
+    session = play_bot(GameConfig(seed=2, time_limit=6.0), name)
+    assert session.timeline
+    assert {e.key for e in session.timeline} <= set(session.muscles.keys)
+    assert session.rules.board.resets == 0
+
+
+def test_model_beats_naive():
+    for seed in (0, 7):
+        config = GameConfig(seed=seed, time_limit=20.0)
+        model, naive = (play_bot(config, n).rules.board.hits for n in ("model", "naive"))
+        assert naive >= 1 and model >= 1.5 * naive, (seed, model, naive)
+
+
+def test_a_bot_game_replays_from_its_timeline():
+    played = play_bot(GameConfig(seed=3, time_limit=5.0), "model")
+    replay = GameSession(GameConfig(seed=3, time_limit=5.0))
+    assert replay.play(played.timeline) == played.result()
+    assert replay.state == played.state
+
+
+def test_the_window_driver_gives_the_headless_game_at_any_frame_rate():
+    headless = play_bot(GameConfig(seed=1, time_limit=3.0), "naive")
+    for fps in (24.0, 60.0, 144.0):
+        session = GameSession(GameConfig(seed=1, time_limit=3.0))
+        driver = RealTimeDriver(Autopilot(session, make_bot("naive")))  # type: ignore[arg-type]
+        while not session.over:
+            driver.advance(1.0 / fps)
+        assert session.timeline == headless.timeline and session.result() == headless.result()
+
+
+def test_unknown_bot_is_refused():
+    with pytest.raises(UserError, match="unknown bot"):
+        make_bot("oracle")
+
+
+def test_play_headless_bot_json():
+    run = subprocess.run([sys.executable, "-m", "armgame", "play", "--headless", "--bot", "model", "--json",
+                          "--duration", "5", "--seed", "3"], capture_output=True, text=True, check=True)
+    result = json.loads(run.stdout)
+    expected = play_bot(GameConfig(seed=3, time_limit=5.0), "model").result()
+    assert result["seed"] == 3 and result["hits"] == expected.hits
+    both = subprocess.run([sys.executable, "-m", "armgame", "play", "--headless", "--bot", "model", "--script", "x"],
+                          capture_output=True, text=True)
+    assert both.returncode != 0 and "--bot" in both.stderr
