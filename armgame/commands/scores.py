@@ -58,7 +58,8 @@ def run(args: argparse.Namespace) -> int:
     right = {0, 2, 3, 4, 6, 7}
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     more = f", the top {len(shown)} shown" if len(shown) < len(entries) else ""
-    print(f"High scores in {table.path} ({len(entries)} entries{more})")
+    count = "1 entry" if len(entries) == 1 else f"{len(entries)} entries"
+    print(f"High scores in {table.path} ({count}{more})")
     for r in rows:
         cells = [c.rjust(w) if i in right else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths, strict=True))]
         print("  ".join(cells).rstrip())
