@@ -84,8 +84,16 @@ def simulate(
         row = 1
         for i in range(steps):
             t1, t2 = scene.torque_at(i * dt)
-            q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
-            if row < len(sample_steps) and sample_steps[row] == i + 1:
+            try:
+                q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
+            except (ValueError, OverflowError, ZeroDivisionError):  # a diverged implicit solve ends in math.cos(inf)
+                q1 = math.nan
+            if (row < len(sample_steps) and sample_steps[row] == i + 1) or q1 != q1:
+                if not all(map(math.isfinite, (q1, q2, w1, w2))):
+                    raise UserError(
+                        f"the run blew up at t = {(i + 1) * dt:g} s: {integrator} is unstable at --dt {dt:g} "
+                        f"on this scene; try a smaller --dt or another --integrator"
+                    )
                 states[row] = (q1, q2, w1, w2)
                 row += 1
     if scene.joints == 1:

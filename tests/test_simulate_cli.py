@@ -59,6 +59,8 @@ def test_fixed_step_matches_reference_in_csv(tmp_path):
         (["--scene", "passive", "--integrator", "leapfrog"], "unknown integrator"),
         (["--scene", "passive", "--initial", "1,2,3"], "--initial"),
         (["--scene", "passive", "--dt", "abc"], "--dt"),
+        (["--scene", "stiff", "--integrator", "euler", "--dt", "0.03"], "blew up"),
+        (["--scene", "propeller", "--integrator", "gauss4", "--dt", "0.03"], "blew up"),
     ],
 )
 def test_bad_arguments_give_one_line_and_nonzero_exit(tmp_path, args, message):
