@@ -22,7 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "it needs, split into each joint's own and interaction torques). Figures need matplotlib: "
         "pip install 'armgame[plot]'.",
     )
-    p.add_argument("name", choices=DEMO_NAMES, metavar="NAME", help=", ".join(DEMO_NAMES))
+    names = (*DEMO_NAMES, "autopilot")  # autopilot: the model and naive bots play the game side by side
+    p.add_argument("name", choices=names, metavar="NAME", help=", ".join(names))
     p.add_argument("--headless", action="store_true", help="no window: write the CSV and figure to --out")
     p.add_argument("--out", default=None, metavar="DIR", help="folder for NAME.csv and NAME.png (with --headless)")
     p.add_argument("--no-figures", action="store_true", help="headless: write the CSV only (no matplotlib needed)")
@@ -41,6 +42,16 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
     if not (math.isfinite(args.speed) and 0.01 <= args.speed <= 100):
         raise UserError(f"--speed must lie between 0.01 and 100, got {args.speed!r}")
+    if args.name == "autopilot":
+        from pathlib import Path
+
+        from ..demos import autopilot
+
+        if args.headless:
+            print(autopilot.run_headless(None if args.out is None else Path(args.out), args.duration))
+        else:
+            autopilot.run_window()
+        return 0
     if args.headless:
         if args.out is None:
             raise UserError("--headless needs --out DIR, the folder to write the CSV and figure to")
