@@ -71,6 +71,19 @@ def test_batch_rk4_agrees_with_single_arm_rk4(arm):
         np.testing.assert_allclose(got, s, rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize(("dt", "speed"), [(0.001, 3.0), (0.05, 20.0)], ids=["series", "full-trig"])
+def test_batch_elbow_trig_by_angle_addition_is_exact_to_round_off(dt, speed):
+    """Small increments take the series; large ones (here up to 0.5 rad) fall back to sin and cos."""
+    model = TwoJointArm(GAME_ARM)
+    rng = np.random.default_rng(5)
+    states = np.column_stack([rng.uniform(-3, 3, (9, 2)), rng.uniform(-speed, speed, (9, 2))])
+    batch = BatchRK4(model, states, (0.4, -0.3))
+    batch.step(dt)
+    single = Integrator("rk4", model)
+    expected = [single.step(tuple(x), (0.4, -0.3), dt) for x in states]
+    np.testing.assert_allclose(batch.states, expected, rtol=1e-13, atol=1e-13)
+
+
 def test_batch_threads_give_the_same_result_as_one_thread():
     model = TwoJointArm(GAME_ARM)
     rng = np.random.default_rng(4)
