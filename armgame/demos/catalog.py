@@ -102,11 +102,11 @@ def run_headless(name: str, out_dir: Path, duration: float | None = None, integr
     duration = info.duration if duration is None else duration
     if not (math.isfinite(duration) and duration > 0.0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {duration!r}")
-    if figures:
+    run = make_run(name, integrator, dt, gravity)
+    if figures:  # after the arguments are checked: a bad one is the first thing to hear about
         from .figures import require_matplotlib
 
         require_matplotlib()
-    run = make_run(name, integrator, dt, gravity)
     out_dir = _prepare_folder(out_dir)
     csv_path, png_path = out_dir / f"{name}.csv", out_dir / f"{name}.png"
     files = [csv_path]
