@@ -112,7 +112,11 @@ def write_csv(trajectory: Trajectory, path: Path) -> None:
     else:
         header = ["t", "q1", "q2", "qd1", "qd2", "hand_x", "hand_y", "tau1", "tau2", "energy"]
         columns = [trajectory.t, s[:, 0], s[:, 1], s[:, 2], s[:, 3], hand[:, 0], hand[:, 1], u[:, 0], u[:, 1], energy]
-    path = Path(path)
+    write_table(Path(path), header, columns)
+
+
+def write_table(path: Path, header: list[str], columns: list[NDArray[np.float64]]) -> Path:
+    """A CSV with a header line and full float precision, written whole or not at all."""
     if path.parent and not path.parent.exists():
         raise UserError(f"cannot write {path}: folder {path.parent} does not exist")
     tmp = path.with_name(path.name + ".part")
@@ -122,3 +126,4 @@ def write_csv(trajectory: Trajectory, path: Path) -> None:
     except OSError as exc:
         tmp.unlink(missing_ok=True)
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+    return path

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import UserError
 from ..scenes import get_scene
-from ..simulation import Trajectory, write_csv
+from ..simulation import Trajectory, write_csv, write_table
 from . import DEMO_NAMES
 from .reach import COMPONENTS, ReachRun, reach_table
 from .runs import chaos_run, check_fixed_step, passive_run, pendulum_run, record
@@ -69,15 +69,6 @@ def make_run(name: str, integrator: str = "rk4", dt: float = 0.001, gravity: boo
     return ReachRun(gravity=gravity, dt=dt)
 
 
-def _write_table(path: Path, header: list[str], columns: list[np.ndarray]) -> Path:
-    tmp = path.with_name(path.name + ".part")
-    try:
-        np.savetxt(tmp, np.column_stack(columns), delimiter=",", header=",".join(header), comments="", fmt="%.17g")
-        tmp.replace(path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
-    return path
 
 
 def _prepare_folder(out_dir: Path) -> Path:
@@ -137,7 +128,7 @@ def run_headless(name: str, out_dir: Path, duration: float | None = None, integr
         for arm, s, h in (("a", rec.states[:, 0], hand_a), ("b", rec.states[:, 1], hand_b)):
             header += [f"{arm}_{c}" for c in ("q1", "q2", "qd1", "qd2", "hand_x", "hand_y")]
             columns += [s[:, 0], s[:, 1], s[:, 2], s[:, 3], h[:, 0], h[:, 1]]
-        _write_table(csv_path, [*header, "hand_distance"], [*columns, distance])
+        write_table(csv_path, [*header, "hand_distance"], [*columns, distance])
         from .runs import VISIBLY_APART
 
         apart = np.flatnonzero(distance > VISIBLY_APART)
@@ -159,7 +150,7 @@ def run_headless(name: str, out_dir: Path, duration: float | None = None, integr
         for key, _, _ in COMPONENTS:
             header += [f"{key}1", f"{key}2"]
             columns += [table.parts[key][:, 0], table.parts[key][:, 1]]
-        _write_table(csv_path, header, columns)
+        write_table(csv_path, header, columns)
         peak = np.max(np.abs(table.total), axis=0)
         own = np.max(np.abs(table.parts["own_inertial"]), axis=0)
         inter = np.max(np.abs(table.parts["interaction_inertial"] + table.parts["coriolis_centrifugal"]), axis=0)
