@@ -25,7 +25,6 @@ from ..physics.twojoint import TwoJointArm
 from .measure import (
     BLOWUP_SPEED,
     ENERGY_SAMPLE,
-    ENERGY_WINDOW,
     ERROR_WINDOW,
     Case,
     Row,
@@ -116,7 +115,7 @@ def measure_odeint(case: Case, tol: float, repeats: int) -> Row:
         warnings.filterwarnings("ignore", "the matrix subclass", PendingDeprecationWarning)
         states = _odeint_segments(counted, case.scene.initial, t, case.segments, tol)
         elapsed = median_time(lambda: _odeint_segments(rhs, case.scene.initial, t, case.segments, tol), repeats)
-        te = _grid(ENERGY_WINDOW, 1.0 / ENERGY_SAMPLE)
+        te = _grid(case.energy_window, 1.0 / ENERGY_SAMPLE)
         free = _odeint_segments(rhs, case.free_state, te, ((0.0, (0.0, 0.0)),), tol)
     ok = _sane(states) and _sane(free)
     label = "odeint (tutorial)"
@@ -139,7 +138,7 @@ class _CountingModel:
 def measure_solve_ivp(case: Case, method: str, tol: float, repeats: int) -> Row:
     t = _grid(ERROR_WINDOW, OUTPUT_RATE)
     counter = _CountingModel(case.model)
-    te = _grid(ENERGY_WINDOW, 1.0 / ENERGY_SAMPLE)
+    te = _grid(case.energy_window, 1.0 / ENERGY_SAMPLE)
     ok = True
     try:
         states = reference_trajectory(counter, case.scene.initial, t, case.segments, rtol=tol, atol=tol,
@@ -182,7 +181,7 @@ def measure_mujoco(mujoco: Any, case: Case, integrator: str, dt: float, repeats:
     t = np.arange(steps + 1) * dt
     elapsed = median_time(lambda: _mujoco_run(mujoco, mj_model, data, case.scene.initial, torques), repeats)
     every = max(1, round(ENERGY_SAMPLE / dt))
-    free = np.array(_mujoco_run(mujoco, mj_model, data, case.free_state, [(0.0, 0.0)] * round(ENERGY_WINDOW / dt),
+    free = np.array(_mujoco_run(mujoco, mj_model, data, case.free_state, [(0.0, 0.0)] * round(case.energy_window / dt),
                                 record_every=every))
     te = np.arange(len(free)) * every * dt
     ok = ok and _sane(free)

@@ -81,8 +81,11 @@ def text_report(result: Result) -> str:
     lines.append("speed bars (each measured in this run):")
     lines += [f"  {line}" for line in bars_text(result.bars)] or ["  (not measured)"]
     lines.append("defaults the data choose:")
-    for role, current in (("game", (defaults.GAME_INTEGRATOR, defaults.GAME_DT)),
-                          ("simulate", (defaults.SIMULATE_INTEGRATOR, defaults.SIMULATE_DT))):
+    if not result.choices:
+        lines.append("  (not judged: see the note below)")
+    roles = (("game", (defaults.GAME_INTEGRATOR, defaults.GAME_DT)),
+             ("simulate", (defaults.SIMULATE_INTEGRATOR, defaults.SIMULATE_DT)))
+    for role, current in roles if result.choices else ():
         c = result.choices.get(role)
         if c is None:
             lines.append(f"  {role}: no measured setting meets the criteria (measure more cases or steps)")

@@ -19,7 +19,18 @@ from ..physics.integrators import SCHEMES, Integrator
 from ..physics.params import GAME_ARM
 from ..physics.twojoint import TwoJointArm
 from . import peers
-from .measure import HARD_CASES, QUICK_STEPS, STEPS, Choice, Row, choose, make_case, measure_scheme
+from .measure import (
+    ENERGY_WINDOW,
+    HARD_CASES,
+    QUICK_ENERGY_WINDOW,
+    QUICK_STEPS,
+    STEPS,
+    Choice,
+    Row,
+    choose,
+    make_case,
+    measure_scheme,
+)
 from .mjcf import build_model, load_mujoco
 
 BATCH_ARMS = 10_000
@@ -89,7 +100,7 @@ def run_bench(options: Options, progress: Callable[[str], None] = lambda _m: Non
     rows: list[Row] = []
     for name in options.cases:
         progress(f"case {name}")
-        case = make_case(name)
+        case = make_case(name, QUICK_ENERGY_WINDOW if options.quick else ENERGY_WINDOW)
         for integrator in options.integrators:
             for dt in steps:
                 rows.append(measure_scheme(case, integrator, dt, repeats))
@@ -110,11 +121,16 @@ def run_bench(options: Options, progress: Callable[[str], None] = lambda _m: Non
     if options.bars:
         progress("speed bars")
         bars = speed_bars(rows, mujoco, quick=options.quick)
-    choices = {
-        "game": choose(rows, ("game",), defaults.GAME_MAX_HAND_ERROR, defaults.GAME_MAX_ENERGY_DRIFT, "game"),
-        "simulate": choose(rows, HARD_CASES, defaults.SIMULATE_MAX_HAND_ERROR, defaults.SIMULATE_MAX_ENERGY_DRIFT,
-                           "passive", drift_cases=HARD_CASES),
-    }
+    choices: dict[str, Choice | None] = {}
+    if options.quick:
+        notes.append(f"--quick: steps 1/30, 1/250, 1/1000 s and energy over {QUICK_ENERGY_WINDOW:g} s; the defaults "
+                     "are judged only by the full run")
+    else:
+        choices = {
+            "game": choose(rows, ("game",), defaults.GAME_MAX_HAND_ERROR, defaults.GAME_MAX_ENERGY_DRIFT, "game"),
+            "simulate": choose(rows, HARD_CASES, defaults.SIMULATE_MAX_HAND_ERROR,
+                               defaults.SIMULATE_MAX_ENERGY_DRIFT, "passive", drift_cases=HARD_CASES),
+        }
     return Result(rows, bars, choices, machine_info(mujoco), notes, time.perf_counter() - t_start)
 
 
@@ -136,12 +152,11 @@ def speed_bars(rows: Sequence[Row], mujoco: Any | None, quick: bool = False) -> 
     arm = TwoJointArm(GAME_ARM)
     state = (math.pi / 4, math.pi / 2, 0.5, -0.3)
 
-    # 1. The game's default (as the data choose it, else defaults.py) vs the tutorial's odeint on
+    # 1. The game's default (defaults.py, which every grid measures) vs the tutorial's odeint on
     #    the passive case, with our hand error no worse than odeint's.
     passive = [r for r in rows if r.case == "passive"]
     tutorial = [r for r in passive if r.family == "tutorial" and r.tol == peers.ODEINT_DEFAULT_TOL]
-    game = choose(rows, ("game",), defaults.GAME_MAX_HAND_ERROR, defaults.GAME_MAX_ENERGY_DRIFT, "game")
-    name, dt = (game.integrator, game.dt) if game else (defaults.GAME_INTEGRATOR, defaults.GAME_DT)
+    name, dt = defaults.GAME_INTEGRATOR, defaults.GAME_DT
     ours = sorted((r for r in passive if r.family == "armgame" and r.method == name and not r.blew_up),
                   key=lambda r: -r.dt)  # type: ignore[arg-type, operator]
     if tutorial and ours:
@@ -207,8 +222,10 @@ def speed_bars(rows: Sequence[Row], mujoco: Any | None, quick: bool = False) -> 
     for k in sorted({1, threads}):
         per = _per_step(lambda s, k=k: batch.run(BATCH_DT, s, threads=k), batch_steps, repeats)
         bars[f"batch_rate_{k}_thread"] = BATCH_ARMS / per
-    bars["batch_threads"] = threads
-    bars["batch_rate"] = bars[f"batch_rate_{threads}_thread"]
+    # Two threads pay off only when the machine has a core to spare: report the better of the two.
+    best = max(sorted({1, threads}), key=lambda k: bars[f"batch_rate_{k}_thread"])
+    bars["batch_threads"] = best
+    bars["batch_rate"] = bars[f"batch_rate_{best}_thread"]
     alloc = Integrator("rk4", arm, "numpy").step_components
     comps = [np.ascontiguousarray(states[:, i]) for i in range(4)]
     t1, t2 = np.full(BATCH_ARMS, 0.2), np.full(BATCH_ARMS, -0.1)
