@@ -220,3 +220,12 @@ def test_headless_cli_bad_input_is_one_line(tmp_path, args, message):
     proc = run_cli("play", "--headless", *args)
     assert proc.returncode != 0
     assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr
+
+
+def test_unreadable_script_files_are_one_line(tmp_path):
+    binary = tmp_path / "binary.txt"
+    binary.write_bytes(b"\xff\xfe\x00 d down\n")
+    for path, message in ((binary, "not a text file"), (tmp_path, "is a folder")):
+        proc = run_cli("play", "--headless", "--script", str(path))
+        assert proc.returncode == 2
+        assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr

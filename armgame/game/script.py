@@ -14,6 +14,7 @@ import math
 from pathlib import Path
 
 from ..errors import UserError
+from ..storage import read_limited
 from .session import DOWN, UP, InputEvent
 
 MAX_SCRIPT_BYTES = 16 * 1024 * 1024
@@ -55,17 +56,9 @@ def parse_script(text: str, keys: tuple[str, ...], dt: float, source: str = "scr
 
 
 def load_script(path: Path, keys: tuple[str, ...], dt: float) -> list[InputEvent]:
-    path = Path(path)
+    data = read_limited(Path(path), MAX_SCRIPT_BYTES, "script file")
     try:
-        if path.stat().st_size > MAX_SCRIPT_BYTES:
-            raise ScriptError(f"{path}: script larger than {MAX_SCRIPT_BYTES // (1024 * 1024)} MiB")
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScriptError(f"{path}: no such script file") from None
-    except IsADirectoryError:
-        raise ScriptError(f"{path}: is a folder, not a script file") from None
+        text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise ScriptError(f"{path}: not a text file (UTF-8 expected)") from None
-    except OSError as exc:
-        raise ScriptError(f"{path}: cannot read: {exc.strerror or exc}") from None
     return parse_script(text, keys, dt, source=str(path))
