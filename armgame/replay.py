@@ -24,7 +24,6 @@ from .errors import UserError
 from .game.muscles import MuscleSet, MuscleSpec
 from .game.rules import GameConfig
 from .game.session import DOWN, UP, GameResult, GameSession, InputEvent
-from .game.timeline import play_timeline
 from .physics.integrators import SCHEMES
 from .physics.params import TwoJointParams
 from .storage import (
@@ -230,7 +229,7 @@ class Replay:
 
     def replay(self) -> GameResult:
         """Recompute the result: the timeline replayed on a fresh session, no clock."""
-        return play_timeline(GameSession(self.config), self.timeline, self.result.steps)
+        return GameSession(self.config).play(self.timeline, self.result.steps)
 
     def verify(self) -> tuple[bool, GameResult]:
         recomputed = self.replay()

@@ -13,7 +13,7 @@ from armgame.cli import main
 from armgame.game.muscles import DEFAULT_MUSCLES, remap_keys
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
-from armgame.game.timeline import TimelineDriver, play_timeline
+from armgame.game.timeline import TimelineDriver
 from armgame.physics.params import GAME_ARM
 from armgame.replay import CONFIG_FIELDS, Replay, config_from_dict, config_to_dict
 from armgame.storage import DataFileError
@@ -43,7 +43,7 @@ def played(time_limit=3.0, seed=4, stop=None, **config) -> GameSession:
     session = GameSession(GameConfig(time_limit=time_limit, seed=seed, **config))
     events = [InputEvent(round(float(t) / session.config.dt), k, a)
               for t, k, a in (line.split() for line in SCRIPT.splitlines())]
-    play_timeline(session, events, stop)
+    session.play(events, stop)
     return session
 
 

@@ -169,20 +169,43 @@ class GameSession:
         self.previous_state = previous
         return n
 
-    def play(self, events: Iterable[InputEvent]) -> GameResult:
-        """Play the whole game from a timeline (sorted by step) with no clock at all."""
-        for event in events:
-            if event.step >= self.total_steps:
-                break
-            self.advance(event.step - self.steps)
-            self.key_event(event.key, event.action)
-        self.advance(self.total_steps - self.steps)
+    def play(self, events: Iterable[InputEvent], stop_step: int | None = None) -> GameResult:
+        """Play the game from a timeline (sorted by step) with no clock at all.
+
+        ``stop_step`` ends a game that was quit early where it stopped: the arm could still
+        drift onto a target afterwards, so playing on to the clock's end would not reproduce it.
+        """
+        TimelineInput(events, stop_step).run_to(self, self.total_steps)
         return self.result()
 
     def interpolated_angles(self, alpha: float) -> tuple[float, float]:
         """Joint angles a fraction ``alpha`` of a step past the previous state, for smooth drawing."""
         (p1, p2, _, _), (c1, c2, _, _) = self.previous_state, self.state
         return p1 + alpha * (c1 - p1), p2 + alpha * (c2 - p2)
+
+
+class TimelineInput:
+    """Feeds a sorted timeline into a session up to a given step, remembering where it is."""
+
+    def __init__(self, events: Iterable[InputEvent], stop_step: int | None = None) -> None:
+        self.events = list(events)
+        self.index = 0
+        self.stop_step = stop_step
+
+    def run_to(self, session: GameSession, step: int) -> None:
+        """Advance ``session`` to ``step`` (or its end, or ``stop_step``), applying due events."""
+        limit = min(step, session.total_steps if self.stop_step is None else self.stop_step)
+        events = self.events
+        while self.index < len(events) and events[self.index].step <= limit:
+            event = events[self.index]
+            session.advance(event.step - session.steps)
+            session.key_event(event.key, event.action)
+            self.index += 1
+        session.advance(limit - session.steps)
+
+    @property
+    def finished(self) -> bool:
+        return self.index >= len(self.events)
 
 
 class RealTimeDriver:
