@@ -40,6 +40,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ..errors import UserError
+from ..physics.twojoint import TwoJointArm
 from .rules import GameConfig, Target
 from .session import DOWN, UP, GameResult, GameSession
 
@@ -74,9 +75,8 @@ class InternalModel:
         p = config.arm
         if p.has_gravity:
             raise UserError("the bots play the game's horizontal arm: they know no gravity")
-        a = p.i1 + p.i2 + p.m1 * p.r1**2 + p.m2 * (p.l1**2 + p.r2**2)
-        return cls("model" if interaction else "naive", interaction, a, p.m2 * p.l1 * p.r2, p.i2 + p.m2 * p.r2**2,
-                   p.damping1, p.damping2)
+        arm = TwoJointArm(p)  # the true arm's inertia constants; "naive" then drops what it does not know
+        return cls("model" if interaction else "naive", interaction, arm.a, arm.b, arm.d, p.damping1, p.damping2)
 
     def inertial(self, q2: float, v1: float, v2: float) -> tuple[float, float]:
         bc = self.b * math.cos(q2)
