@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import random
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from .errors import UserError
@@ -27,7 +27,6 @@ class Scene:
     torque_segments: tuple[tuple[float, tuple[float, float]], ...] = ((0.0, (0.0, 0.0)),)
     duration: float = 10.0
     joints: int = 2
-    tags: tuple[str, ...] = field(default=())
 
     def torque_at(self, t: float) -> tuple[float, float]:
         current = self.torque_segments[0][1]
