@@ -54,8 +54,8 @@ def frame_cost(driver: str, frames: int = 300) -> dict[str, float]:
 import os, time, statistics, json
 os.environ['SDL_VIDEODRIVER'] = {driver!r}
 import pygame
-from armgame.frontend import open_window
-from armgame.render import GameRenderer
+from armgame.ui.frontend import open_window
+from armgame.ui.render import GameRenderer
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 session = GameSession(GameConfig())
@@ -95,7 +95,7 @@ os.environ['SDL_VIDEODRIVER'] = {driver!r}
 from armgame.commands.play import DEFAULT_SEED
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
-from armgame.frontend import GameWindow, open_window
+from armgame.ui.frontend import GameWindow, open_window
 session = GameSession(GameConfig(seed=DEFAULT_SEED))
 window = GameWindow(session, open_window((800, 800)))
 window.frame(0.0)

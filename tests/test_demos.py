@@ -180,7 +180,7 @@ def _dark(colour):
 def test_window_draws_the_arm_where_the_state_says(dummy_sdl):
     pygame = dummy_sdl
     from armgame.demos.catalog import make_run
-    from armgame.demos.window import DemoWindow
+    from armgame.ui.demo_window import DemoWindow
 
     now = [100.0]
     window = DemoWindow("pendulum", make_run("pendulum"), clock=lambda: now[0])
@@ -202,7 +202,7 @@ def test_window_draws_the_arm_where_the_state_says(dummy_sdl):
 def test_window_keys_pause_speed_restart_and_quit(dummy_sdl):
     pygame = dummy_sdl
     from armgame.demos.catalog import make_run
-    from armgame.demos.window import DemoWindow
+    from armgame.ui.demo_window import DemoWindow
 
     now = [0.0]
     window = DemoWindow("interaction", make_run("interaction"), clock=lambda: now[0])

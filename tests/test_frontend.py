@@ -9,10 +9,10 @@ os.environ["SDL_AUDIODRIVER"] = "dummy"
 import pygame
 import pytest
 
-from armgame.frontend import GameWindow, open_window
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
-from armgame.render import BACKGROUND, HAND, LINK, PANEL, TARGET, Viewport
+from armgame.ui.frontend import GameWindow, open_window
+from armgame.ui.render import BACKGROUND, HAND, LINK, PANEL, TARGET, Viewport
 
 
 class FakeClock:

@@ -15,8 +15,8 @@ from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
 from armgame.game.timeline import TimelineDriver
 from armgame.physics.params import GAME_ARM
-from armgame.replay import CONFIG_FIELDS, Replay, config_from_dict, config_to_dict
-from armgame.storage import DataFileError
+from armgame.records.replay import CONFIG_FIELDS, Replay, config_from_dict, config_to_dict
+from armgame.records.storage import DataFileError
 
 SCRIPT = """\
 0.00 k down
@@ -201,7 +201,7 @@ def test_missing_replay_file(tmp_path, capsys):
 def test_the_window_plays_a_replay_from_its_timeline_only(tmp_path):
     import pygame
 
-    from armgame.frontend import GameWindow, open_window
+    from armgame.ui.frontend import GameWindow, open_window
 
     recorded = played(time_limit=2.0)
     replay = Replay.from_session(recorded, "script")

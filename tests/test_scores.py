@@ -15,12 +15,12 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 
 import pytest
 
-import armgame.scores as scores_module
+import armgame.records.scores as scores_module
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
-from armgame.replay import Replay
-from armgame.scores import ScoreEntry, ScoreTable, default_scores_dir, parse_table, table_bytes
+from armgame.records.replay import Replay
+from armgame.records.scores import ScoreEntry, ScoreTable, default_scores_dir, parse_table, table_bytes
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -116,8 +116,8 @@ import sys
 from pathlib import Path
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
-from armgame.replay import Replay
-from armgame.scores import ScoreTable
+from armgame.records.replay import Replay
+from armgame.records.scores import ScoreTable
 session = GameSession(GameConfig(time_limit=0.2))
 session.advance(session.total_steps)
 replay = Replay.from_session(session, "script", player="looper")
@@ -311,7 +311,7 @@ def test_table_file_is_one_entry_a_line_and_reads_back(tmp_path):
 def finished_window():
     import pygame
 
-    from armgame.frontend import NAME_ENTRY_DELAY, GameWindow, open_window
+    from armgame.ui.frontend import NAME_ENTRY_DELAY, GameWindow, open_window
 
     def make(**options):
         window = GameWindow(GameSession(GameConfig(time_limit=0.2)), open_window((500, 500)), fps=0, **options)

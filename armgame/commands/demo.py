@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     from ..demos.catalog import make_run
 
     run_ = make_run(args.name, args.integrator, args.dt, args.gravity)
-    from ..demos.window import run_window
+    from ..ui.demo_window import run_window
 
     run_window(args.name, run_, speed=args.speed)
     return 0

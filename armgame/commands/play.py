@@ -115,7 +115,7 @@ def _check_score_options(args: argparse.Namespace) -> None:
     """Refuse a bad --name or --record before the game, not after a minute of play."""
     from pathlib import Path
 
-    from ..replay import check_name
+    from ..records.replay import check_name
 
     if args.name is not None:
         try:
@@ -131,8 +131,8 @@ def _keep(session, args: argparse.Namespace) -> None:
     import sys
     from pathlib import Path
 
-    from ..replay import Replay
-    from ..scores import ScoreTable
+    from ..records.replay import Replay
+    from ..records.scores import ScoreTable
     from .scores import scores_dir
 
     out = sys.stderr if args.json else sys.stdout
@@ -163,7 +163,7 @@ def _play_in_window(session, args: argparse.Namespace):
     try:
         import pygame
 
-        from ..frontend import GameWindow, open_window
+        from ..ui.frontend import GameWindow, open_window
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
     driver = None

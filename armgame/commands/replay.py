@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..errors import UserError
     from ..game.session import GameSession
-    from ..replay import Replay
+    from ..records.replay import Replay
 
     replay = Replay.load(Path(args.file))
     if args.headless:
@@ -64,8 +64,8 @@ def _watch(session, replay, args: argparse.Namespace) -> None:
     try:
         import pygame
 
-        from ..frontend import GameWindow, open_window
         from ..game.timeline import TimelineDriver
+        from ..ui.frontend import GameWindow, open_window
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
     try:

@@ -15,7 +15,7 @@ def add_scores_option(p: argparse.ArgumentParser) -> None:
 def scores_dir(args: argparse.Namespace):
     from pathlib import Path
 
-    from ..scores import default_scores_dir
+    from ..records.scores import default_scores_dir
 
     return Path(args.scores).expanduser() if getattr(args, "scores", None) else default_scores_dir()
 
@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from ..errors import UserError
-    from ..scores import ScoreTable
+    from ..records.scores import ScoreTable
 
     if args.top < 1:
         raise UserError(f"--top must be 1 or more, got {args.top}")

@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..scores import TABLE_NAME
+    from ..records.scores import TABLE_NAME
 
     path = Path(args.file)
     if path.is_dir():
@@ -40,7 +40,7 @@ def _looks_like_table(path) -> bool:
 
 def _verify_replay(path) -> int:
     from .. import __version__
-    from ..replay import Replay
+    from ..records.replay import Replay
 
     replay = Replay.load(path)
     ok, got = replay.verify()
@@ -62,7 +62,7 @@ def _verify_table(folder) -> int:
     import sys
 
     from ..errors import UserError
-    from ..scores import ScoreTable
+    from ..records.scores import ScoreTable
 
     table = ScoreTable(folder)
     if not table.path.is_file():

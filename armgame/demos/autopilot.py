@@ -72,7 +72,7 @@ def run_window(seed: int = WINDOW_SEED, duration: float = 60.0, size: tuple[int,
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     import pygame
 
-    from ..render import GameRenderer
+    from ..ui.render import GameRenderer
 
     pygame.display.init()
     pygame.font.init()

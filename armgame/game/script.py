@@ -14,7 +14,7 @@ import math
 from pathlib import Path
 
 from ..errors import UserError
-from ..storage import read_limited
+from ..records.storage import read_limited
 from .session import DOWN, UP, InputEvent
 
 MAX_SCRIPT_BYTES = 16 * 1024 * 1024

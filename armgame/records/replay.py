@@ -19,13 +19,13 @@ from dataclasses import dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
 
-from . import __version__
-from .errors import UserError
-from .game.muscles import MuscleSet, MuscleSpec
-from .game.rules import GameConfig
-from .game.session import DOWN, UP, GameResult, GameSession, InputEvent
-from .physics.integrators import SCHEMES
-from .physics.params import TwoJointParams
+from .. import __version__
+from ..errors import UserError
+from ..game.muscles import MuscleSet, MuscleSpec
+from ..game.rules import GameConfig
+from ..game.session import DOWN, UP, GameResult, GameSession, InputEvent
+from ..physics.integrators import SCHEMES
+from ..physics.params import TwoJointParams
 from .storage import (
     DataFileError,
     atomic_write_bytes,

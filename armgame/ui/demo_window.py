@@ -17,10 +17,10 @@ from typing import Any
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame
 
+from ..demos.catalog import get_info
+from ..demos.reach import COMPONENTS, ReachRun
+from ..demos.runs import VISIBLY_APART
 from ..errors import UserError
-from .catalog import get_info
-from .reach import COMPONENTS, ReachRun
-from .runs import VISIBLY_APART
 
 SCENE_SIZE = (800, 800)
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)

@@ -12,7 +12,7 @@ change is read-modify-write under an exclusive ``fcntl.flock`` on ``scores.lock`
 games finishing at the same moment queue for a few milliseconds and both entries land;
 the kernel drops the lock when its holder exits, even by SIGKILL, so there is no stale
 lock to clean up. The new table is written to a temporary file in the same folder,
-fsynced and renamed over the old one (``armgame.storage.atomic_write_bytes``): readers
+fsynced and renamed over the old one (``armgame.records.storage.atomic_write_bytes``): readers
 need no lock, since they always see a whole table, old or new. An append-only log would
 need partial-line recovery and a compaction step that is itself such a rewrite.
 
@@ -83,7 +83,7 @@ def default_scores_dir() -> Path:
     env = os.environ.get(SCORES_ENV)
     if env:
         return Path(env).expanduser()
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     if (root / "pyproject.toml").is_file() and (root / "scores").is_dir():
         return root / "scores"
     if sys.platform == "win32" and os.environ.get("LOCALAPPDATA"):

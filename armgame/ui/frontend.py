@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 import pygame
 
-from .game.session import DOWN, UP, GameSession, RealTimeDriver
+from ..game.session import DOWN, UP, GameSession, RealTimeDriver
 from .render import GameRenderer
 
 CAPTION = "armgame - hit the red targets with the black dot"

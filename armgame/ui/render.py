@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import pygame
 
-from .game.session import GameSession
+from ..game.session import GameSession
 
 BACKGROUND = (255, 255, 255)
 LINK = (70, 70, 80)
