@@ -37,6 +37,7 @@ SCRIPT = """\
 @pytest.fixture(autouse=True)
 def _scores_in_tmp(tmp_path, monkeypatch):
     monkeypatch.setenv("ARMGAME_SCORES", str(tmp_path / "scores"))  # never the repository's scores/
+    monkeypatch.setenv("ARMGAME_CACHE", str(tmp_path / "cache"))  # nor the user's verification cache
 
 
 def played(time_limit=3.0, seed=4, stop=None, **config) -> GameSession:

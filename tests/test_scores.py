@@ -28,6 +28,7 @@ REPO = Path(__file__).resolve().parent.parent
 @pytest.fixture(autouse=True)
 def _scores_in_tmp(tmp_path, monkeypatch):
     monkeypatch.setenv("ARMGAME_SCORES", str(tmp_path / "default-scores"))  # never the repository's scores/
+    monkeypatch.setenv("ARMGAME_CACHE", str(tmp_path / "cache"))  # nor the user's verification cache
 
 
 def quick_replay(player: str = "ann", resets: int = 0, seed: int = 10) -> Replay:
@@ -63,14 +64,15 @@ def test_entries_are_best_first_ties_by_date(tmp_path):
         fake_entry(4, 5, "2025-03-01T11:00:00+01:00"),  # 10:00:00 UTC: the earliest of the fives
     ])
     warnings = []
-    assert [e.id[-1] for e in ScoreTable(tmp_path, warnings.append).entries()] == ["2", "4", "3", "1"]
+    assert [e.id[-1] for e in ScoreTable(tmp_path, warnings.append).all_entries()] == ["2", "4", "3", "1"]
     assert warnings == []
 
 
 def test_add_saves_the_replay_beside_the_table_and_checks_out(tmp_path):
     table = ScoreTable(tmp_path)
     entry = table.add(quick_replay("Ann Lee"))
-    assert [e.id for e in table.entries()] == [entry.id]
+    assert [e.id for e in table.all_entries()] == [entry.id]
+    assert table.entries() == []  # a 0.2 s game is a custom game: kept, never ranked
     assert (tmp_path / "replays" / entry.replay).is_file() and entry.replay.endswith(".json")
     assert table.check(entry).ok
     assert Replay.load(table.replay_path(entry)).player == "Ann Lee"
@@ -87,10 +89,10 @@ def test_unnamed_or_unfinished_games_do_not_enter(tmp_path):
 
 
 def _writer(folder: str, who: int, count: int, barrier) -> None:
-    replay = quick_replay(f"writer {who}")
+    replays = [quick_replay(f"writer {who}", seed=k) for k in range(count)]  # the same replay enters once
     barrier.wait()
     table = ScoreTable(Path(folder))
-    for _ in range(count):
+    for replay in replays:
         table.add(replay)
 
 
@@ -105,7 +107,7 @@ def test_concurrent_writers_all_keep_their_entries(tmp_path):
         p.join(30)
         assert p.exitcode == 0
     warnings = []
-    entries = ScoreTable(tmp_path, warnings.append).entries()
+    entries = ScoreTable(tmp_path, warnings.append).all_entries()
     assert len(entries) == writers * each and len({e.id for e in entries}) == writers * each
     assert sorted({e.name for e in entries}) == [f"writer {w}" for w in range(writers)]
     assert warnings == [] and len(list((tmp_path / "replays").iterdir())) == writers * each
@@ -118,13 +120,13 @@ from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 from armgame.records.replay import Replay
 from armgame.records.scores import ScoreTable
-session = GameSession(GameConfig(time_limit=0.2))
-session.advance(session.total_steps)
-replay = Replay.from_session(session, "script", player="looper")
 table = ScoreTable(Path(sys.argv[1]))
-print("ready", flush=True)
-while True:
-    table.add(replay)
+for seed in range(int(sys.argv[2]), 10**9):  # a new game each time: the same replay enters once
+    session = GameSession(GameConfig(time_limit=0.02, seed=seed))
+    session.advance(session.total_steps)
+    table.add(Replay.from_session(session, "script", player="looper"))
+    if seed == int(sys.argv[2]):
+        print("ready", flush=True)  # one entry is in: the kill lands among the following writes
 """
 
 
@@ -133,8 +135,8 @@ def test_a_writer_killed_mid_write_never_leaves_a_partial_table(tmp_path):
     write_table(tmp_path, [fake_entry(n, n % 50) for n in range(1, 2001)])
     before = len(parse_table((tmp_path / "scores.json").read_bytes())[0])
     for delay in (0.13, 0.37):
-        proc = subprocess.Popen([sys.executable, "-c", KILLED_WRITER, str(tmp_path)], stdout=subprocess.PIPE,
-                                cwd=REPO)
+        proc = subprocess.Popen([sys.executable, "-c", KILLED_WRITER, str(tmp_path), str(int(delay * 10**6))],
+                                stdout=subprocess.PIPE, cwd=REPO)
         assert proc.stdout.readline() == b"ready\n"
         deadline = time.monotonic() + delay
         while time.monotonic() < deadline:  # every read, at any moment, is a whole table
@@ -149,8 +151,8 @@ def test_a_writer_killed_mid_write_never_leaves_a_partial_table(tmp_path):
         before = len(entries)
     assert before > 2000  # the writer did get entries in
     # A leftover temporary file is never taken for the table, and the next write works.
-    ScoreTable(tmp_path).add(quick_replay("after"))
-    assert len(ScoreTable(tmp_path).entries()) == before + 1
+    ScoreTable(tmp_path).add(quick_replay("after", seed=10**6))
+    assert len(ScoreTable(tmp_path).all_entries()) == before + 1
     assert not list(tmp_path.glob(".scores.json.*.tmp"))  # a killed writer's leftovers are cleared
 
 
@@ -159,14 +161,14 @@ def test_a_truncated_table_is_kept_aside_and_its_valid_entries_recovered(tmp_pat
     first, second = table.add(quick_replay("ann")), table.add(quick_replay("bob"))
     data = table.path.read_bytes()
     table.path.write_bytes(data[: data.index(second.id.encode()) + 10])  # cut inside the second entry
-    assert [e.id for e in table.entries()] == [first.id]
+    assert [e.id for e in table.all_entries()] == [first.id]
     assert len(warnings) == 1 and "damaged" in warnings[0] and "1 valid entry recovered" in warnings[0]
     damaged = table.path.read_bytes()
     third = table.add(quick_replay("cleo"))
     kept = list(tmp_path.glob("scores.json.corrupt-*"))
     assert len(kept) == 1 and kept[0].read_bytes() == damaged  # the damaged file, byte for byte
     assert "kept as scores.json.corrupt-" in warnings[-1] and warnings[-1].count("\n") == 0
-    assert {e.id for e in table.entries()} == {first.id, third.id}
+    assert {e.id for e in table.all_entries()} == {first.id, third.id}
     assert len(warnings) == 2  # the table is clean again
 
 
@@ -205,16 +207,16 @@ def test_hostile_entries_are_dropped_with_a_clear_message(tmp_path, bad):
     b"[]",
     b'{"format": "armgame-scores", "format_version": 1, "entries": [NaN]}',
     b'{"format": "armgame-scores", "format_version": 1, "entries": [1e999]}',
-    b'{"format": "armgame-scores", "format_version": 2, "entries": []}',
+    b'{"format": "armgame-scores", "format_version": 3, "entries": []}',
     b"[" * 100_000,
     b"cos\nsystem\n(S'echo pwned'\ntR.",
 ])
 def test_garbage_tables_are_damage_not_a_crash(tmp_path, content):
     tmp_path.joinpath("scores.json").write_bytes(content)
     table = ScoreTable(tmp_path, warn=(warnings := []).append)
-    assert table.entries() == [] and len(warnings) == 1
+    assert table.all_entries() == [] and len(warnings) == 1
     table.add(quick_replay())
-    assert len(table.entries()) == 1
+    assert len(table.all_entries()) == 1
     assert [p.read_bytes() for p in tmp_path.glob("scores.json.corrupt-*")] == [content]
 
 
@@ -247,7 +249,7 @@ def test_tampering_is_flagged(tmp_path, capsys):
     # Another game's replay put in place of this one's; a replay deleted.
     table.replay_path(swapped).write_bytes(table.replay_path(other).read_bytes())
     table.replay_path(missing).unlink()
-    labels = {e.name: table.check(e).label for e in table.entries() if e.id != other.id}
+    labels = {e.name: table.check(e).label for e in table.all_entries() if e.id != other.id}
     assert labels == {"honest": "ok", "typed": "NOT ITS REPLAY", "swapped": "REPLAY CHANGED",
                       "missing": "REPLAY MISSING", "forged": "NOT REPRODUCED"}
     assert table.check(honest).ok
@@ -270,9 +272,11 @@ def test_cli_headless_play_enters_the_table_only_with_a_name(tmp_path, capsys):
     assert json.loads(out.splitlines()[-1])["score"] == 0  # with --json, stdout is only the JSON
     assert main(["scores", "--scores", str(folder)]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[1].split()[:2] == ["#", "name"]
-    assert [row.split()[1] for row in out[2:]] == ["Zoe", "Yan"]  # equal scores: the earlier first
-    assert all(row.rstrip().endswith("ok") and " script " in row for row in out[2:])
+    # 0.2 s games are not the standard game: listed apart, never ranked.
+    assert out[1].strip() == "no ranked games yet" and out[2].startswith("Custom games")
+    assert out[3].split()[:2] == ["#", "name"]
+    assert [row.split()[1] for row in out[4:]] == ["Zoe", "Yan"]  # equal scores: the earlier first
+    assert all(row.rstrip().endswith("ok") and " script " in row for row in out[4:])
 
 
 @pytest.mark.parametrize("name", ["x" * 10_000, "a\x07b", "   "])

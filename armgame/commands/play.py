@@ -72,15 +72,21 @@ def _add_score_options(p: argparse.ArgumentParser) -> None:
 def game_config(args: argparse.Namespace):
     from ..game.muscles import DEFAULT_MUSCLES, remap_keys
     from ..game.rules import GameConfig
+    from ..limits import MAX_GAME_SECONDS, MAX_GAME_STEPS
 
-    if not (math.isfinite(args.duration) and args.duration > 0):
-        raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
-    return GameConfig(seed=args.seed, time_limit=args.duration, muscles=remap_keys(DEFAULT_MUSCLES, args.keys))
+    if not (math.isfinite(args.duration) and 0 < args.duration <= MAX_GAME_SECONDS):
+        raise UserError(f"--duration must be a positive number of seconds up to {MAX_GAME_SECONDS:g} (the longest "
+                        f"game a replay may hold), got {args.duration!r}")
+    config = GameConfig(seed=args.seed, time_limit=args.duration, muscles=remap_keys(DEFAULT_MUSCLES, args.keys))
+    if config.total_steps > MAX_GAME_STEPS:
+        raise UserError(f"--duration {args.duration:g} is {config.total_steps} physics steps, more than a replay may "
+                        f"hold ({MAX_GAME_STEPS})")
+    return config
 
 
 def run(args: argparse.Namespace) -> int:
     import json
-    from pathlib import Path
+    import sys
 
     from ..game.script import load_script
     from ..game.session import GameSession
@@ -96,7 +102,8 @@ def run(args: argparse.Namespace) -> int:
 
         result = Autopilot(session, make_bot(args.bot)).play()
     elif args.headless:
-        events = load_script(Path(args.script), session.keys, session.config.dt) if args.script else []
+        events = load_script(args.script_path, session.keys, session.config.dt, session.total_steps) \
+            if args.script else []
         result = session.play(events)
     else:
         if not 1 <= args.fps <= 1000:
@@ -107,23 +114,31 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"your score is: {result.score}  ({result.hits} hits, {result.resets} resets, "
               f"{session.time:.1f} s of {result.duration:g} s)")
+    if session.event_limit_reached:
+        from ..limits import MAX_EVENTS
+
+        print(f"the game was stopped at {session.time:.1f} s: it reached {MAX_EVENTS} input events, the most a "
+              f"replay holds", file=sys.stderr)
     _keep(session, args)
     return 0
 
 
 def _check_score_options(args: argparse.Namespace) -> None:
-    """Refuse a bad --name or --record before the game, not after a minute of play."""
-    from pathlib import Path
-
+    """Refuse a bad --name, --record, --script or --scores before the game, not after a minute of play."""
     from ..records.replay import check_name
+    from ..records.storage import check_output_path, check_writable_folder, user_path
+    from .scores import scores_dir
 
     if args.name is not None:
         try:
             args.name = check_name(args.name, "--name")
         except ValueError as exc:
             raise UserError(str(exc)) from None
-    if args.record and not Path(args.record).expanduser().resolve().parent.is_dir():
-        raise UserError(f"--record {args.record}: its folder does not exist")
+    args.script_path = user_path(args.script, "--script") if args.script is not None else None
+    if args.record is not None:
+        check_output_path(user_path(args.record, "--record"), "replay")
+    if args.name is not None or not args.headless:  # a game that may enter the table
+        check_writable_folder(scores_dir(args), "--scores")
 
 
 def _keep(session, args: argparse.Namespace) -> None:
@@ -133,15 +148,16 @@ def _keep(session, args: argparse.Namespace) -> None:
 
     from ..records.replay import Replay
     from ..records.scores import ScoreTable
+    from ..records.storage import check_output_path, user_path
     from .scores import scores_dir
 
     out = sys.stderr if args.json else sys.stdout
     bot = getattr(args, "bot", None)
     driven = "bot" if bot else "script" if args.headless else "keyboard"
-    driver = bot or (Path(args.script).name if args.script else None)
+    driver = bot or (driver_name(Path(args.script).name) if args.script else None)
     replay = Replay.from_session(session, driven, driver, args.name)
     if args.record:
-        replay.save(Path(args.record).expanduser())
+        replay.save(check_output_path(user_path(args.record, "--record"), "replay"))
         print(f"replay saved to {args.record}", file=out)
     if args.name is None:
         if not args.headless and session.over:
@@ -155,8 +171,17 @@ def _keep(session, args: argparse.Namespace) -> None:
         entry = table.add(replay)
     except OSError as exc:
         raise UserError(f"cannot save the score in {table.folder}: {exc.strerror or exc}") from None
-    print(f"saved to the high-score table as {entry.name}: #{table.rank(entry)} "
+    except ValueError as exc:
+        raise UserError(f"not entered in the high-score table: {exc}") from None
+    kind = "" if table.ruleset(entry) != "custom" else " among custom games (not ranked: not the standard game)"
+    print(f"saved to the high-score table as {entry.name}: #{table.rank(entry)}{kind} "
           f"({table.path})", file=out)
+
+
+def driver_name(file_name: str) -> str:
+    """A script's file name as the table shows it: printable, at most 60 characters."""
+    cleaned = "".join(c if c.isprintable() else "?" for c in file_name).strip() or "script"
+    return cleaned if len(cleaned) <= 60 else cleaned[:57] + "..."
 
 
 def _play_in_window(session, args: argparse.Namespace):

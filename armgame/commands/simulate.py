@@ -30,7 +30,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "simulate",
         help="simulate a named scene and write a CSV",
         description="Simulate a named physics scene with a chosen integrator and write the trajectory as CSV "
-        "(t, q1, q2, qd1, qd2 in rad and rad/s, hand_x, hand_y in m, tau1, tau2 in N m, energy in J).",
+        "(t, q1, q2, qd1, qd2 in rad and rad/s, hand_x, hand_y in m, tau1, tau2 in N m, energy in J). Rows are "
+        "written as they come; a run over the budget (50,000,000 steps or 5,000,000 rows) is refused before it "
+        "starts, and a run that blows up stops with one line.",
     )
     p.add_argument("--scene", required=True, help="passive, pendulum, propeller, upright, stiff or game")
     # Defaults resolve in run(): they live in armgame.physics.defaults, which parsing must not import.
@@ -49,25 +51,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from ..physics.defaults import SIMULATE_DT, SIMULATE_INTEGRATOR
+    from ..records.storage import user_path
     from ..scenes import get_scene
-    from ..simulation import simulate, write_csv
+    from ..simulation import simulate_to_csv
 
     args.integrator = SIMULATE_INTEGRATOR if args.integrator is None else args.integrator
     args.dt = SIMULATE_DT if args.dt is None else args.dt
+    out = user_path(args.out, "--out")
     scene = get_scene(args.scene)
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
-    trajectory = simulate(scene, args.integrator, args.dt, args.duration, args.initial, args.sample_rate)
-    write_csv(trajectory, Path(args.out))
-    summary = f"{scene.name}: {len(trajectory.t)} rows to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
-        f"{trajectory.t[-1]:g} s)"
-    energy = trajectory.energy()
-    free = trajectory.t >= scene.free_after
-    if free.sum() > 1 and energy[free][0] != 0.0:
-        drift = abs(energy[-1] - energy[free][0]) / abs(energy[free][0])
+    run_ = simulate_to_csv(scene, args.integrator, args.dt, out, args.duration, args.initial, args.sample_rate)
+    summary = f"{scene.name}: {run_.rows} rows to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
+        f"{run_.t_end:g} s)"
+    if run_.energy_start is not None and run_.rows > 1 and run_.energy_start != 0.0:
+        drift = abs(run_.energy_end - run_.energy_start) / abs(run_.energy_start)
         summary += f"; energy change while torque-free {drift:.2e} relative"
     print(summary)
     return 0

@@ -15,6 +15,8 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 
 from .. import __version__
+from ..errors import UserError
+from ..limits import MAX_EVENTS
 from ..physics.integrators import Integrator
 from ..physics.twojoint import TwoJointArm
 from .muscles import MuscleSet
@@ -31,6 +33,10 @@ class InputEvent:
     step: int
     key: str
     action: str
+
+
+class NonFiniteStateError(UserError):
+    """The arm's state overflowed: the configuration's physics blows up at this step."""
 
 
 @dataclass(frozen=True)
@@ -65,6 +71,7 @@ class GameSession:
         self.previous_state = self.state
         self.held = [False] * len(self.muscles.keys)
         self.timeline: list[InputEvent] = []
+        self.event_limit_reached = False
 
     # ------------------------------------------------------------------ queries
     @property
@@ -97,6 +104,12 @@ class GameSession:
         only events that did something enter the timeline.
         """
         if self.over:
+            return False
+        if len(self.timeline) >= MAX_EVENTS:
+            # A replay holds at most MAX_EVENTS events: the game stops here rather than record
+            # what no reader would accept. The replay is of a game stopped early (never ranked).
+            self.total_steps = self.steps
+            self.event_limit_reached = True
             return False
         if key in self.muscles.keys:
             i = self.muscles.keys.index(key)
@@ -147,22 +160,29 @@ class GameSession:
         q1, q2, w1, w2 = self.state
         previous = self.state
         start = self.steps
-        for k in range(n):
-            t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
-            t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
-            a0 += (g0 - a0) * r0
-            a1 += (g1 - a1) * r1
-            a2 += (g2 - a2) * r2
-            a3 += (g3 - a3) * r3
-            previous = (q1, q2, w1, w2)
-            q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
-            s12 = q1 + q2
-            hx = l1 * cos(q1) + l2 * cos(s12)
-            hy = l1 * sin(q1) + l2 * sin(s12)
-            if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
-                rules.hand_moved(hx, hy, (start + k + 1) * dt)
-                target = rules.target
-                tx, ty, rr = target.x, target.y, target.radius * target.radius
+        k = 0
+        try:  # free in CPython 3.11+ when nothing is raised; math.cos(inf) raises ValueError
+            for k in range(n):
+                t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
+                t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
+                a0 += (g0 - a0) * r0
+                a1 += (g1 - a1) * r1
+                a2 += (g2 - a2) * r2
+                a3 += (g3 - a3) * r3
+                previous = (q1, q2, w1, w2)
+                q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
+                s12 = q1 + q2
+                hx = l1 * cos(q1) + l2 * cos(s12)
+                hy = l1 * sin(q1) + l2 * sin(s12)
+                if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
+                    rules.hand_moved(hx, hy, (start + k + 1) * dt)
+                    target = rules.target
+                    tx, ty, rr = target.x, target.y, target.radius * target.radius
+        except (ValueError, OverflowError, ZeroDivisionError):
+            q1 = math.nan
+        if not math.isfinite(q1 + q2 + w1 + w2):  # once per call, not per step: the hot loop stays as it was
+            raise NonFiniteStateError(f"the arm's state became non-finite by t = {(start + k + 1) * dt:g} s: "
+                                 f"this game's physics blows up ({self.config.integrator}, dt {dt:g} s)")
         muscles.activation = [a0, a1, a2, a3]
         self.steps = start + n
         self.state = (q1, q2, w1, w2)

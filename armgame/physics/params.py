@@ -19,18 +19,29 @@ class ParameterError(UserError, ValueError):
     """An impossible physical parameter; the message names the field and the value."""
 
 
-def _check_positive(name: str, value: float) -> None:
-    if not isinstance(value, (int, float)) or isinstance(value, bool):
-        raise ParameterError(f"{name} must be a number, got {value!r}")
-    if not math.isfinite(value) or value <= 0.0:
-        raise ParameterError(f"{name} must be a finite number > 0, got {value!r}")
+#: Plausible range of every physical parameter (low, high, unit), checked whenever an arm is built.
+#: Far wider than any human or robot arm, yet narrow enough that the dynamics stay well
+#: conditioned: a mass or inertia of 1e-300 would make the mass matrix singular to round-off.
+PARAMETER_RANGES: dict[str, tuple[float, float, str]] = {
+    "l": (0.01, 10.0, "m"),  # link lengths
+    "r": (0.001, 10.0, "m"),  # centre of mass from the proximal joint (also at most the link's length)
+    "m": (0.01, 1000.0, "kg"),
+    "i": (1e-5, 1000.0, "kg m^2"),  # about the centre of mass
+    "gravity": (0.0, 100.0, "m/s^2"),
+    "damping": (0.0, 100.0, "N m s/rad"),
+}
 
 
-def _check_non_negative(name: str, value: float) -> None:
+def _check_range(name: str, value: float, kind: str) -> None:
+    low, high, unit = PARAMETER_RANGES[kind]
     if not isinstance(value, (int, float)) or isinstance(value, bool):
         raise ParameterError(f"{name} must be a number, got {value!r}")
-    if not math.isfinite(value) or value < 0.0:
-        raise ParameterError(f"{name} must be a finite number >= 0, got {value!r}")
+    if not (math.isfinite(value) and low <= value <= high):
+        raise ParameterError(f"{name} must be from {low:g} to {high:g} {unit}, got {value!r}")
+
+
+def _kind(name: str) -> str:
+    return name if name == "gravity" else "damping" if name.startswith("damping") else name[0]
 
 
 @dataclass(frozen=True)
@@ -56,10 +67,8 @@ class TwoJointParams:
     damping2: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("l1", "l2", "r1", "r2", "m1", "m2", "i1", "i2"):
-            _check_positive(name, getattr(self, name))
-        for name in ("gravity", "damping1", "damping2"):
-            _check_non_negative(name, getattr(self, name))
+        for f in fields(self):
+            _check_range(f.name, getattr(self, f.name), _kind(f.name))
         for com, length in (("r1", "l1"), ("r2", "l2")):
             if getattr(self, com) > getattr(self, length):
                 raise ParameterError(
@@ -103,10 +112,8 @@ class OneJointParams:
     damping: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("l", "r", "m", "i"):
-            _check_positive(name, getattr(self, name))
-        for name in ("gravity", "damping"):
-            _check_non_negative(name, getattr(self, name))
+        for f in fields(self):
+            _check_range(f.name, getattr(self, f.name), _kind(f.name))
         if self.r > self.l:
             raise ParameterError(
                 f"r must not exceed l (the centre of mass lies on the link), got r={self.r!r} > l={self.l!r}"

@@ -23,7 +23,8 @@ from .. import __version__
 from ..errors import UserError
 from ..game.muscles import MuscleSet, MuscleSpec
 from ..game.rules import GameConfig
-from ..game.session import DOWN, UP, GameResult, GameSession, InputEvent
+from ..game.session import DOWN, UP, GameResult, GameSession, InputEvent, TimelineInput
+from ..limits import MAX_EVENTS, MAX_GAME_SECONDS, MAX_GAME_STEPS, MAX_HITS, MAX_REPLAY_BYTES
 from ..physics.integrators import SCHEMES
 from ..physics.params import TwoJointParams
 from .storage import (
@@ -40,10 +41,8 @@ from .storage import (
 
 FORMAT = "armgame-replay"
 FORMAT_VERSION = 1
-MAX_REPLAY_BYTES = 64 * 1024 * 1024
-MAX_EVENTS = 2_000_000
-#: A replay longer than this many physics steps would take minutes to verify: refused.
-MAX_STEPS = 50_000_000
+#: Shared with the writers (``armgame.limits``): nothing is recorded that this reader refuses.
+MAX_STEPS = MAX_GAME_STEPS
 DRIVEN = ("keyboard", "script", "bot")
 MAX_NAME = 40
 _WORD = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]*")
@@ -109,20 +108,49 @@ def config_to_dict(config: GameConfig) -> dict[str, object]:
 
 CONFIG_FIELDS = frozenset(f.name for f in fields(GameConfig))
 _ARM_FIELDS = frozenset(f.name for f in fields(TwoJointParams))
-_BIG = 1e6  # no physical quantity of the game comes near this
+
+#: Plausible ranges of a replay's game settings (the arm's own are ``PARAMETER_RANGES`` in
+#: ``armgame.physics.params``). Wide enough for any custom game a class would design, narrow
+#: enough that no setting makes the physics or the target draw blow up or run for hours.
+GAME_RANGES: dict[str, tuple[float, float, str]] = {
+    "dt": (1e-4, 0.02, "s"),
+    "time_limit": (0.0, MAX_GAME_SECONDS, "s"),  # and at most MAX_GAME_STEPS steps
+    "target_radius": (0.005, 0.5, "m"),
+    "target_range": (-360.0, 360.0, "deg"),
+    "start_posture": (-7.0, 7.0, "rad"),
+    "view": (-20.0, 20.0, "m"),
+    "moment": (-50.0, 50.0, "N m"),
+    "muscle_time": (0.001, 10.0, "s"),  # rise and decay times, also at least one physics step
+}
 
 
-def _floats(name: str, value: object, n: int, low: float = -_BIG, high: float = _BIG) -> tuple[float, ...]:
+def _ranged(name: str, value: object, kind: str, low_open: bool = False) -> float:
+    low, high, _unit = GAME_RANGES[kind]
+    return check_float(name, value, low, high, low_open)
+
+
+def _floats(name: str, value: object, n: int, kind: str) -> tuple[float, ...]:
     if not isinstance(value, list) or len(value) != n:
         raise ValueError(f"{name} must be a list of {n} numbers")
-    return tuple(check_float(f"{name}[{i}]", v, low, high) for i, v in enumerate(value))
+    return tuple(_ranged(f"{name}[{i}]", v, kind) for i, v in enumerate(value))
+
+
+def _ordered(name: str, pair: tuple[float, ...]) -> tuple[float, ...]:
+    if not pair[0] <= pair[1]:
+        raise ValueError(f"{name} must be [low, high], got {list(pair)}")
+    return pair
 
 
 def config_from_dict(data: object) -> GameConfig:
-    """Rebuild a ``GameConfig``, checking every field; raises ValueError or UserError."""
+    """Rebuild a ``GameConfig``, checking every field against its range; raises ValueError naming it."""
     d = check_keys("config", data, set(CONFIG_FIELDS))
     arm = check_keys("config.arm", d["arm"], set(_ARM_FIELDS))
-    arm_values = {k: check_float(f"config.arm.{k}", v, 0.0, _BIG) for k, v in arm.items()}
+    arm_values = {k: check_float(f"config.arm.{k}", v, -1e300, 1e300) for k, v in arm.items()}
+    try:
+        arm_params = TwoJointParams(**arm_values)
+    except ValueError as exc:  # ParameterError names the field and its range
+        raise ValueError(f"config.arm.{exc}") from None
+    dt = _ranged("config.dt", d["dt"], "dt")
     muscles_data = d["muscles"]
     if not isinstance(muscles_data, list) or len(muscles_data) != MuscleSet.COUNT:
         raise ValueError(f"config.muscles must be a list of {MuscleSet.COUNT} muscles")
@@ -130,12 +158,16 @@ def config_from_dict(data: object) -> GameConfig:
     for i, m in enumerate(muscles_data):
         where = f"config.muscles[{i}]"
         m = check_keys(where, m, {"name", "key", "moment", "rise_time", "decay_time"})
+        times = {}
+        for t in ("rise_time", "decay_time"):
+            times[t] = _ranged(f"{where}.{t}", m[t], "muscle_time")
+            if times[t] < dt:
+                raise ValueError(f"{where}.{t} must be at least the physics step {dt:g} s, got {times[t]!r}")
         muscles.append(MuscleSpec(
             check_str(f"{where}.name", m["name"], 40),
             check_str(f"{where}.key", m["key"], 20),
-            _floats(f"{where}.moment", m["moment"], 2),  # type: ignore[arg-type]
-            check_float(f"{where}.rise_time", m["rise_time"], 0.0, 100.0, low_open=True),
-            check_float(f"{where}.decay_time", m["decay_time"], 0.0, 100.0, low_open=True),
+            _floats(f"{where}.moment", m["moment"], 2, "moment"),  # type: ignore[arg-type]
+            times["rise_time"], times["decay_time"],
         ))
     keys = [m.key for m in muscles]
     if len(set(keys)) != len(keys) or {"space", "tab"} & set(keys):
@@ -143,30 +175,37 @@ def config_from_dict(data: object) -> GameConfig:
     integrator = check_str("config.integrator", d["integrator"], 40)
     if integrator not in SCHEMES:
         raise ValueError(f"config.integrator must be one of {', '.join(SCHEMES)}, got {integrator!r}")
+    time_limit = _ranged("config.time_limit", d["time_limit"], "time_limit", low_open=True)
+    if round(time_limit / dt) > MAX_GAME_STEPS:
+        raise ValueError(f"the game is {round(time_limit / dt)} physics steps long (config.time_limit / config.dt), "
+                         f"more than a replay may be ({MAX_GAME_STEPS})")
+    view = _floats("config.view", d["view"], 4, "view")
+    if not (view[0] < view[1] and view[2] < view[3]):
+        raise ValueError(f"config.view must be [xmin, xmax, ymin, ymax] with min < max, got {list(view)}")
     config = GameConfig(
-        arm=TwoJointParams(**arm_values),
-        start_posture=_floats("config.start_posture", d["start_posture"], 2, -100.0, 100.0),  # type: ignore[arg-type]
-        time_limit=check_float("config.time_limit", d["time_limit"], 0.0, 86400.0, low_open=True),
-        target_radius=check_float("config.target_radius", d["target_radius"], 0.0, 100.0, low_open=True),
-        target_shoulder_range=_floats("config.target_shoulder_range", d["target_shoulder_range"], 2),  # type: ignore[arg-type]
-        target_elbow_range=_floats("config.target_elbow_range", d["target_elbow_range"], 2),  # type: ignore[arg-type]
+        arm=arm_params,
+        start_posture=_floats("config.start_posture", d["start_posture"], 2, "start_posture"),  # type: ignore[arg-type]
+        time_limit=time_limit,
+        target_radius=_ranged("config.target_radius", d["target_radius"], "target_radius"),
+        target_shoulder_range=_ordered("config.target_shoulder_range", _floats(  # type: ignore[arg-type]
+            "config.target_shoulder_range", d["target_shoulder_range"], 2, "target_range")),
+        target_elbow_range=_ordered("config.target_elbow_range", _floats(  # type: ignore[arg-type]
+            "config.target_elbow_range", d["target_elbow_range"], 2, "target_range")),
         seed=check_int("config.seed", d["seed"], 0, 2**63 - 1),
         muscles=tuple(muscles),
         integrator=integrator,
-        dt=check_float("config.dt", d["dt"], 0.0, 0.05, low_open=True),
+        dt=dt,
         reset_cost=check_int("config.reset_cost", d["reset_cost"], 0, 1000),
-        view=_floats("config.view", d["view"], 4),  # type: ignore[arg-type]
+        view=view,  # type: ignore[arg-type]
         scene=check_word("config.scene", d["scene"]),
     )
-    if config.total_steps > MAX_STEPS:
-        raise ValueError(f"the game is {config.total_steps} physics steps long, more than a replay may be "
-                         f"({MAX_STEPS})")
     return config
 
 
 # ----------------------------------------------------------------------- results
 
 _RESULT_FIELDS = frozenset(f.name for f in fields(GameResult))
+_VERIFY_CHUNK = 2_500  # steps between checks of the running score during verification
 _COUNT_MAX = 10**9
 
 
@@ -174,14 +213,14 @@ def result_from_dict(data: object) -> GameResult:
     d = check_keys("result", data, set(_RESULT_FIELDS))
     return GameResult(
         score=check_int("result.score", d["score"], 0, _COUNT_MAX),
-        hits=check_int("result.hits", d["hits"], 0, _COUNT_MAX),
+        hits=check_int("result.hits", d["hits"], 0, MAX_HITS),
         resets=check_int("result.resets", d["resets"], 0, _COUNT_MAX),
         seed=check_int("result.seed", d["seed"], 0, 2**63 - 1),
-        duration=check_float("result.duration", d["duration"], 0.0, 86400.0, low_open=True),
+        duration=check_float("result.duration", d["duration"], 0.0, MAX_GAME_SECONDS, low_open=True),
         steps=check_int("result.steps", d["steps"], 0, MAX_STEPS),
         scene=check_word("result.scene", d["scene"]),
         integrator=check_word("result.integrator", d["integrator"]),
-        dt=check_float("result.dt", d["dt"], 0.0, 0.05, low_open=True),
+        dt=_ranged("result.dt", d["dt"], "dt"),
         version=check_word("result.version", d["version"]),
     )
 
@@ -232,7 +271,20 @@ class Replay:
         return GameSession(self.config).play(self.timeline, self.result.steps)
 
     def verify(self) -> tuple[bool, GameResult]:
-        recomputed = self.replay()
+        """Replay and compare. Bounded: the game is at most ``MAX_GAME_STEPS`` long (checked at load),
+        and the replay stops as soon as it scores more hits or resets than recorded, so a replay
+        that claims little cannot make its verifier draw a target at every step for hours."""
+        session = GameSession(self.config)
+        feed = TimelineInput(self.timeline, self.result.steps)
+        claimed = self.result
+        board = session.rules.board
+        step = 0
+        while step < claimed.steps:
+            step = min(step + _VERIFY_CHUNK, claimed.steps)
+            feed.run_to(session, step)
+            if board.hits > claimed.hits or board.resets > claimed.resets:
+                break
+        recomputed = session.result()
         return same_outcome(recomputed, self.result), recomputed
 
     # ------------------------------------------------------------------ files
@@ -255,10 +307,10 @@ class Replay:
         return dump_json(self.as_dict())
 
     def save(self, path: Path) -> None:
-        try:
-            atomic_write_bytes(Path(path), self.to_bytes())
-        except OSError as exc:
-            raise DataFileError(f"{path}: cannot write the replay: {exc.strerror or exc}") from None
+        data = self.to_bytes()
+        if len(data) > MAX_REPLAY_BYTES:  # cannot happen within MAX_EVENTS; kept as the writer's half of the limit
+            raise DataFileError(f"{path}: the replay would be {len(data)} bytes, more than a replay may be")
+        atomic_write_bytes(Path(path), data, "replay")
 
     @classmethod
     def from_dict(cls, data: object) -> Replay:
@@ -299,12 +351,12 @@ class Replay:
             raise
         except UnicodeDecodeError:
             raise DataFileError(f"{source}: not a text file (UTF-8 JSON expected)") from None
-        except (ValueError, TypeError, UserError) as exc:  # UserError: GameConfig's own checks
+        except (ValueError, TypeError, UserError, RecursionError) as exc:  # UserError: GameConfig's own checks
             raise DataFileError(f"{source}: {exc}") from None
 
     @classmethod
-    def load(cls, path: Path) -> Replay:
-        return cls.from_bytes(read_limited(Path(path), MAX_REPLAY_BYTES, "replay file"), str(path))
+    def load(cls, path: Path, follow: bool = True) -> Replay:
+        return cls.from_bytes(read_limited(Path(path), MAX_REPLAY_BYTES, "replay file", follow), str(path))
 
 
 def _timeline_from_list(data: object, config: GameConfig, last_step: int) -> tuple[InputEvent, ...]:

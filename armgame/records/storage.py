@@ -1,19 +1,34 @@
-"""Durable little files: atomic writes and JSON read strictly as data.
+"""Durable little files: one safe way to read and to write every file armgame touches.
 
-Shared by the replay files and the high-score table. A write goes to a temporary file in
-the target's own folder (a rename is only atomic within one file system), is flushed and
-fsynced, renamed over the target, and then the folder itself is fsynced so that the rename
-survives a power cut. A reader therefore sees the old file or the new one, never a mixture.
+Every reader and writer of the program goes through this module: scripts, replays, the
+score table and its cache, settings, ``simulate --out``, ``play --record`` and figures.
+What it guarantees, whatever is planted at the path:
+
+* Reading: the path is opened without blocking (``O_NONBLOCK``, so a FIFO cannot hang the
+  reader), then ``fstat`` must show a regular file, and at most ``limit + 1`` bytes are
+  read. Inside a folder armgame owns (the score table's), symlinks are not followed.
+* Writing: the target, if it exists, must be a regular file (or a symlink, which is
+  replaced, never written through); a device, FIFO, socket or folder is refused in one line.
+  The data goes to a temporary file created exclusively (``O_CREAT | O_EXCL | O_NOFOLLOW``,
+  so a planted temporary name or symlink is never written through) in the target's own
+  folder (a rename is only atomic within one file system), is flushed and fsynced, renamed
+  over the target, and then the folder is fsynced so that the rename survives a power cut.
+  A reader therefore sees the old file or the new one, never a mixture.
+* Paths given by the user: ``~user`` that names nobody is one line, not a traceback.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import math
 import os
-import tempfile
+import secrets
+import stat
+from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 from ..errors import UserError
 
@@ -29,26 +44,142 @@ def _read_umask() -> int:
 
 
 _UMASK = _read_umask()
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_NOCTTY = getattr(os, "O_NOCTTY", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
 
 
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    path = Path(path)
-    folder = path.parent
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+def show_path(path: object) -> str:
+    """A path for a one-line message: control characters escaped, at most 200 characters."""
+    text = str(path)
+    if not text.isprintable():
+        text = repr(text)[1:-1]
+    return text if len(text) <= 200 else text[:197] + "..."
+
+
+def user_path(text: str | os.PathLike[str], what: str = "path") -> Path:
+    """A path the user typed, ``~`` expanded; a ``~user`` that names nobody is a ``UserError``."""
+    if isinstance(text, str) and not text:
+        raise UserError(f"{what} is empty")
     try:
-        # mkstemp makes the file private (0600); a shared classroom table wants the usual mode.
-        with contextlib.suppress(OSError, AttributeError):
-            os.fchmod(fd, 0o666 & ~_UMASK)
+        return Path(text).expanduser()
+    except RuntimeError:  # Path("~nosuchuser/x").expanduser(): "Could not determine home directory"
+        raise UserError(f"{what} {str(text)[:80]!r}: no such user's home folder") from None
+
+
+def _kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISLNK(mode):
+        return "a symbolic link"
+    return "not a regular file"
+
+
+def check_output_path(path: Path, what: str = "file") -> Path:
+    """Refuse, before any work, a target that is not (or cannot become) a regular file.
+
+    An existing symlink is allowed: the atomic rename replaces the link itself, so nothing is
+    ever written through it. The folder must exist and be a folder.
+    """
+    path = Path(path)
+    if not path.name or path.name in (".", ".."):
+        raise DataFileError(f"{show_path(path)}: not a file name")
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        st = None
+    except OSError as exc:
+        raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
+    if st is not None and not (stat.S_ISREG(st.st_mode) or stat.S_ISLNK(st.st_mode)):
+        raise DataFileError(f"{show_path(path)}: is {_kind(st.st_mode)}; the {what} is written only to a regular file")
+    folder = path.parent
+    if not folder.is_dir():
+        raise DataFileError(f"{show_path(path)}: cannot write the {what}: folder {folder} does not exist")
+    return path
+
+
+def check_writable_folder(folder: Path, what: str = "folder") -> None:
+    """Find out before a game that its results could not be saved there (not after it)."""
+    folder = Path(folder)
+    probe = folder
+    while not probe.exists():  # the nearest existing ancestor decides whether mkdir will work
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise DataFileError(f"{what} {folder}: {probe} is not a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise DataFileError(f"{what} {folder}: {probe} cannot be written by you")
+
+
+def _temporary(folder: Path, name: str) -> tuple[int, Path]:
+    for _ in range(100):
+        tmp = folder / f".{name}.{secrets.token_hex(6)}.tmp"
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666 & ~_UMASK)
+        except FileExistsError:
+            continue
+        return fd, tmp
+    raise DataFileError(f"{folder}: cannot create a temporary file")
+
+
+@contextlib.contextmanager
+def atomic_writer(path: Path, what: str = "file") -> Iterator[BinaryIO]:
+    """Yield a binary file whose content replaces ``path`` atomically when the block ends cleanly.
+
+    Rows can be streamed into it (``simulate`` writes as it integrates); on any error the
+    temporary file is removed and the target stays as it was.
+    """
+    path = check_output_path(Path(path), what)
+    folder = path.parent
+    try:
+        fd, tmp = _temporary(folder, path.name)
+    except OSError as exc:
+        raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
+    try:
         with os.fdopen(fd, "wb") as f:
-            f.write(data)
+            yield f
             f.flush()
             os.fsync(f.fileno())
+        check_output_path(path, what)  # the target may have been swapped for a FIFO while we wrote
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
         raise
     fsync_folder(folder)
+
+
+def atomic_write_bytes(path: Path, data: bytes, what: str = "file") -> None:
+    with atomic_writer(path, what) as f:
+        f.write(data)
+
+
+def copy_aside(source_fd: int, target: Path) -> None:
+    """Copy an open file's bytes to a new file ``target`` (created exclusively), fsynced."""
+    fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666 & ~_UMASK)
+    try:
+        os.lseek(source_fd, 0, os.SEEK_SET)
+        while chunk := os.read(source_fd, 1 << 20):
+            view = memoryview(chunk)
+            while view:
+                view = view[os.write(fd, view):]
+        os.fsync(fd)
+    except BaseException:
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(target)
+        raise
+    os.close(fd)
+    fsync_folder(target.parent)
 
 
 def fsync_folder(folder: Path) -> None:
@@ -92,20 +223,54 @@ def parse_json(text: str | bytes) -> object:
         raise ValueError("not valid JSON: nested too deeply") from None
 
 
-def read_limited(path: Path, limit: int, what: str) -> bytes:
+def open_regular(path: Path, what: str, follow: bool = True) -> int:
+    """Open ``path`` for reading without blocking and return the descriptor of a regular file.
+
+    ``O_NONBLOCK`` makes opening a FIFO return at once (no writer needed); ``fstat`` on the
+    open descriptor then refuses it, so there is no window between the check and the read.
+    ``follow=False`` refuses a symlink (files inside a folder armgame owns).
+    """
     path = Path(path)
+    flags = os.O_RDONLY | os.O_NONBLOCK | _NOCTTY | _CLOEXEC | (0 if follow else _NOFOLLOW)
     try:
-        with open(path, "rb") as f:
-            data = f.read(limit + 1)
+        fd = os.open(path, flags)
     except FileNotFoundError:
-        raise DataFileError(f"{path}: no such {what}") from None
+        raise DataFileError(f"{show_path(path)}: no such {what}") from None
     except IsADirectoryError:
-        raise DataFileError(f"{path}: is a folder, not a {what}") from None
+        raise DataFileError(f"{show_path(path)}: is a folder, not a {what}") from None
     except OSError as exc:
-        raise DataFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        if exc.errno == errno.ELOOP and not follow:
+            raise DataFileError(f"{show_path(path)}: is a symbolic link; a {what} here must be a regular file") \
+                from None
+        raise DataFileError(f"{show_path(path)}: cannot read: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise DataFileError(f"{show_path(path)}: is {_kind(st.st_mode)}, not a {what}")
+        if os.get_blocking(fd) is False:
+            os.set_blocking(fd, True)  # a regular file never blocks; plain reads from here on
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
+def read_limited(path: Path, limit: int, what: str, follow: bool = True) -> bytes:
+    """At most ``limit`` bytes of the regular file ``path``; anything else is one ``DataFileError``."""
+    path = Path(path)
+    fd = open_regular(path, what, follow)
+    try:
+        with os.fdopen(fd, "rb") as f:
+            data = f.read(limit + 1)
+    except OSError as exc:
+        raise DataFileError(f"{show_path(path)}: cannot read: {exc.strerror or exc}") from None
     if len(data) > limit:
-        raise DataFileError(f"{path}: larger than {limit // (1024 * 1024)} MiB, too large for a {what}")
+        raise DataFileError(f"{show_path(path)}: larger than {_size(limit)}, too large for a {what}")
     return data
+
+
+def _size(n: int) -> str:
+    return f"{n // (1024 * 1024)} MiB" if n >= 1024 * 1024 else f"{n} bytes"
 
 
 def dump_json(value: object) -> bytes:

@@ -1,0 +1,73 @@
+"""Rulesets: the named games that rank, each identified by the digest of its configuration.
+
+A replay carries its whole ``GameConfig``, so without rulesets a replay would define its own
+rules: a bigger target, a lighter arm or a longer clock would rank beside fair games. A
+ruleset fixes everything but the seed: arm, muscles, targets, radius, start posture, view,
+clock, integrator and step. Its identity is the SHA-256 of its canonical configuration
+(``canonical_config``: the replay's ``config`` object with the seed removed and the muscles'
+key bindings removed, as compact JSON with sorted keys and floats by ``repr``, which
+round-trips exactly). An entry ranks only if its replay's configuration has the digest of a
+ranked ruleset; everything else is a custom game, kept and listed apart, never ranked.
+
+Key bindings are left out because ``--keys`` only says which key drives which muscle: the
+timeline names muscles by their key, and the physics and the targets are the same.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+
+from ..game.rules import GameConfig
+from .replay import config_to_dict
+
+#: The label of any configuration that is not a named ruleset.
+CUSTOM = "custom"
+
+
+def canonical_config(config: GameConfig) -> bytes:
+    data = config_to_dict(config)
+    del data["seed"]
+    data["muscles"] = [{k: v for k, v in m.items() if k != "key"} for m in data["muscles"]]  # type: ignore[attr-defined]
+    return json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False).encode("utf-8")
+
+
+def config_digest(config: GameConfig) -> str:
+    """SHA-256 (hex) of the canonical configuration: equal digests, equal games but for the seed."""
+    return hashlib.sha256(canonical_config(config)).hexdigest()
+
+
+@dataclass(frozen=True)
+class Ruleset:
+    name: str
+    config: GameConfig
+    description: str
+
+    @property
+    def digest(self) -> str:
+        return config_digest(self.config)
+
+    @property
+    def steps(self) -> int:
+        """What verifying one game of this ruleset costs, in physics steps."""
+        return self.config.total_steps
+
+
+#: The rulesets that rank. ``standard`` is today's default game (``GameConfig()``), the seed aside.
+RULESETS: dict[str, Ruleset] = {
+    r.name: r for r in (
+        Ruleset("standard", GameConfig(), "the default game: 60 s, the game arm, 5 cm targets"),
+    )
+}
+_BY_DIGEST = {r.digest: r for r in RULESETS.values()}
+
+
+def ruleset_of(config: GameConfig) -> Ruleset | None:
+    """The ranked ruleset ``config`` plays (whatever its seed and key bindings), or None for a custom game."""
+    return _BY_DIGEST.get(config_digest(config))
+
+
+def ruleset_name(config: GameConfig) -> str:
+    found = ruleset_of(config)
+    return found.name if found else CUSTOM
