@@ -32,7 +32,7 @@ MAX_TABLE_ENTRIES = 150_000
 MAX_SCRIPT_BYTES = 16 * 1024 * 1024
 
 #: ``simulate``: physics steps, output rows and memory of one run.
-MAX_SIMULATE_STEPS = 50_000_000
+MAX_SIMULATE_STEPS = 20_000_000
 MAX_SIMULATE_ROWS = 5_000_000
 #: Bytes per output row of the CSV at full precision (10 columns of up to 24 characters).
 SIMULATE_ROW_BYTES = 240

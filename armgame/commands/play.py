@@ -115,10 +115,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"your score is: {result.score}  ({result.hits} hits, {result.resets} resets, "
               f"{session.time:.1f} s of {result.duration:g} s)")
     if session.event_limit_reached:
-        from ..limits import MAX_EVENTS
-
-        print(f"the game was stopped at {session.time:.1f} s: it reached {MAX_EVENTS} input events, the most a "
-              f"replay holds", file=sys.stderr)
+        print(f"the game was stopped at {session.time:.1f} s: it reached {len(session.timeline)} input events, the "
+              f"most a replay holds", file=sys.stderr)
     _keep(session, args)
     return 0
 

@@ -31,8 +31,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="simulate a named scene and write a CSV",
         description="Simulate a named physics scene with a chosen integrator and write the trajectory as CSV "
         "(t, q1, q2, qd1, qd2 in rad and rad/s, hand_x, hand_y in m, tau1, tau2 in N m, energy in J). Rows are "
-        "written as they come; a run over the budget (50,000,000 steps or 5,000,000 rows) is refused before it "
-        "starts, and a run that blows up stops with one line.",
+        "written as they come; a run over the budget (20,000,000 steps or 5,000,000 rows; dop853: 20,000 "
+        "evaluations per simulated second, 2,000,000 in all) is refused before it starts, and a run that blows "
+        "up stops with one line.",
     )
     p.add_argument("--scene", required=True, help="passive, pendulum, propeller, upright, stiff or game")
     # Defaults resolve in run(): they live in armgame.physics.defaults, which parsing must not import.
