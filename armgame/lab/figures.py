@@ -153,10 +153,14 @@ def learning_figure(rows: Sequence[Mapping[str, Any]], path: Path,
 
     The first trials of an unperturbed block that follows a perturbed one are labelled
     "after-effect": there the error flips sign when an internal model of the field was learned.
+    Trials are placed by their ``trial`` number, or in row order when the numbers do not increase.
     """
     label, scale = _measure(metric)
     if not rows:
         raise UserError("no trials to draw")
+    numbers = [r["trial"] for r in rows]
+    if any(b <= a for a, b in itertools.pairwise(numbers)):  # numbered per block, or merged runs: plot in order
+        rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
     fig = _figure()
     ax = fig.add_subplot()
     spans = blocks_of(rows)
