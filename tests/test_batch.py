@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from armgame.errors import UserError
 from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, replay_many
-from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet
+from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet, MuscleSpec, remap_keys
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
 from armgame.game.session import GameSession, InputEvent
 
@@ -71,6 +71,30 @@ def test_batch_equals_single_sessions_on_random_timelines(seeds, durations, stop
     for i, (c, timeline, stop) in enumerate(zip(configs, timelines, stop_steps, strict=True)):
         single = GameSession(c)
         assert results[i] == single.play(timeline, stop)
+        assert_same_game(batch, i, single)
+
+
+ARMS = {"game": GAME_PLAY_ARM, "vertical": GAME_PLAY_ARM.replace(gravity=9.81),
+        "frictionless": GAME_PLAY_ARM.replace(damping1=0.0, damping2=0.0)}
+
+
+@settings(max_examples=6, deadline=None)
+@given(arm=st.sampled_from(sorted(ARMS)), integrator=st.sampled_from(["rk4", "euler", "symplectic-euler"]),
+       muscles=st.sampled_from(["default", "remapped", "biarticular"]), timeline_seed=st.integers(0, 2**32 - 1))
+def test_every_arm_and_batchable_integrator_equals_the_single_session(arm, integrator, muscles, timeline_seed):
+    """The kernel's gravity, damping and plain variants, the generic path, other keys and moment arms."""
+    rng = random.Random(timeline_seed)
+    muscles = {"default": DEFAULT_MUSCLES, "remapped": remap_keys(DEFAULT_MUSCLES, "jkdf"),
+               "biarticular": tuple(MuscleSpec(m.name, m.key, (m.moment[0] + 0.3, m.moment[1] - 0.2), 0.05, 0.12)
+                                    for m in DEFAULT_MUSCLES)}[muscles]
+    configs = [GameConfig(seed=s, time_limit=2.0, arm=ARMS[arm], integrator=integrator, muscles=muscles,
+                          target_radius=0.15) for s in range(3)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
+    batch = BatchGameSession(configs)
+    results = batch.play(timelines)
+    for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
+        single = GameSession(c)
+        assert results[i] == single.play(timeline)
         assert_same_game(batch, i, single)
 
 
