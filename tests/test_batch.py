@@ -258,3 +258,88 @@ def test_play_with_no_events_and_a_stop_at_zero():
     results = batch.play([[], [InputEvent(0, "space", "down")]], [None, 0])
     assert [r.steps for r in results] == [125, 0] and results[1].resets == 1
     assert batch.state(1) == (math.radians(45.0), math.radians(90.0), 0.0, 0.0)
+
+
+# ------------------------------------------------------------------ scoring a class from the command line
+
+def write_scripts(folder, count: int, seconds: float = 3.0) -> list:
+    folder.mkdir(exist_ok=True)
+    paths = []
+    for i in range(count):
+        rng = random.Random(i)
+        lines = [f"{e.step * 0.004:.3f} {e.key} {e.action}" for e in student_timeline(rng, 0.004, seconds)]
+        path = folder / f"student{i:02d}.txt"
+        path.write_text("# a student\n" + "\n".join(lines) + "\n")
+        paths.append(path)
+    return paths
+
+
+def test_play_many_scripts_prints_one_json_line_each_equal_to_playing_them_alone(tmp_path, capsys):
+    import json
+
+    from armgame.cli import main
+
+    paths = write_scripts(tmp_path / "class", 4)
+    order = [paths[2], paths[0], paths[3]]
+    assert main(["play", "--headless", "--seed", "5", "--duration", "3", "--json", "--script",
+                 *map(str, order)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    for line, path in zip(lines, order, strict=True):
+        assert main(["play", "--headless", "--seed", "5", "--duration", "3", "--json", "--script", str(path)]) == 0
+        alone = json.loads(capsys.readouterr().out)
+        assert json.loads(line) == {"script": str(path), **alone}
+
+
+def test_a_folder_of_scripts_plays_its_txt_files_in_sorted_order_and_follows_no_link(tmp_path, capsys):
+    import json
+
+    from armgame.cli import main
+
+    folder = tmp_path / "class"
+    paths = write_scripts(folder, 3)
+    (folder / "notes.md").write_text("not a script")
+    (folder / ".hidden.txt").write_text("0.0 x down\n")
+    outside = tmp_path / "outside.txt"
+    outside.write_text("0.0 d down\n")
+    (folder / "link.txt").symlink_to(outside)
+    (folder / "sub.txt").mkdir()
+    assert main(["play", "--headless", "--duration", "3", "--json", "--script", str(folder)]) == 0
+    scripts = [json.loads(line)["script"] for line in capsys.readouterr().out.splitlines()]
+    assert scripts == [str(p) for p in paths]
+    assert main(["play", "--headless", "--duration", "3", "--script", str(folder)]) == 0
+    assert capsys.readouterr().out.splitlines()[0].startswith(f"{paths[0]}: score ")
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--name", "Ann"], "--name and --record are for one game"),
+    (["--record", "x.json"], "--name and --record are for one game"),
+    (["--bot", "model"], "--bot and --script"),
+])
+def test_options_for_one_game_are_refused_for_many_in_one_line(tmp_path, capsys, extra, message):
+    from armgame.cli import main
+
+    paths = write_scripts(tmp_path / "class", 2)
+    assert main(["play", "--headless", "--script", *map(str, paths), *extra]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and message in err
+    assert not (tmp_path / "x.json").exists()
+
+
+def test_a_class_run_is_bounded_and_checks_every_script_before_playing(tmp_path, capsys, monkeypatch):
+    import armgame.game.batch as batch_module
+    from armgame.cli import main
+
+    paths = write_scripts(tmp_path / "class", 3)
+    monkeypatch.setattr(batch_module, "MAX_SCRIPTS", 2)
+    assert main(["play", "--headless", "--script", str(tmp_path / "class")]) == 2
+    assert "more than the 2" in capsys.readouterr().err
+    monkeypatch.setattr(batch_module, "MAX_SCRIPTS", 100)
+    monkeypatch.setattr(batch_module, "MAX_SCRIPT_EVENTS", 5)
+    assert main(["play", "--headless", "--script", *map(str, paths)]) == 2
+    assert "more than 5 events" in capsys.readouterr().err
+    monkeypatch.setattr(batch_module, "MAX_SCRIPT_EVENTS", 10**6)
+    paths[2].write_text("0.0 d down\nbad line\n")
+    played = []
+    monkeypatch.setattr(batch_module, "replay_many", lambda *a, **k: played.append(a))
+    assert main(["play", "--headless", "--script", *map(str, paths)]) == 2
+    assert "student02.txt, line 2" in capsys.readouterr().err and not played
