@@ -15,6 +15,7 @@ from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem,
 from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet, MuscleSpec, remap_keys
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
 from armgame.game.session import GameSession, InputEvent
+from armgame.records.replay import Replay
 
 KEYS = ("d", "f", "j", "k")
 
@@ -252,6 +253,25 @@ def test_replay_many_groups_what_can_share_a_batch_and_plays_the_rest_alone():
     assert replay_many(configs, timelines, stops, batch_size=2) == expected
 
 
+@pytest.mark.parametrize("games", [3, 8])  # most of the batch playing on, or most of it stopped
+def test_games_stopped_early_keep_the_state_of_their_last_step_and_its_events(games):
+    rng = random.Random(4)
+    configs = [GameConfig(seed=s, time_limit=3.0 if s else 1.0, target_radius=0.15) for s in range(games)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit, extras=False) for c in configs]
+    stops = [None] * games
+    for i in (1, 2):  # quit at an event's step, with a reset (space) among its events
+        at = timelines[i][len(timelines[i]) // 2].step
+        timelines[i] = [e for e in timelines[i] if e.step <= at] + [InputEvent(at, "space", "down")]
+        stops[i] = at
+    batch = BatchGameSession(configs)
+    results = batch.play(timelines, stops)
+    for i in range(games):
+        single = GameSession(configs[i])
+        assert results[i] == single.play(timelines[i], stops[i])
+        assert_same_game(batch, i, single)
+    assert results[1].resets >= 1 and batch.state(1)[2:] == (0.0, 0.0)
+
+
 def test_play_with_no_events_and_a_stop_at_zero():
     configs = [GameConfig(seed=1, time_limit=0.5), GameConfig(seed=2, time_limit=0.5)]
     batch = BatchGameSession(configs)
@@ -343,3 +363,79 @@ def test_a_class_run_is_bounded_and_checks_every_script_before_playing(tmp_path,
     monkeypatch.setattr(batch_module, "replay_many", lambda *a, **k: played.append(a))
     assert main(["play", "--headless", "--script", *map(str, paths)]) == 2
     assert "student02.txt, line 2" in capsys.readouterr().err and not played
+
+
+# ------------------------------------------------------------------ verifying many replays
+
+def recorded(seed: int, seconds: float = 2.0, player: str | None = "Ann", **config) -> Replay:
+    session = GameSession(GameConfig(seed=seed, time_limit=seconds, **config))
+    session.play(student_timeline(random.Random(seed), session.config.dt, seconds, extras=True))
+    return Replay.from_session(session, "script", f"s{seed}.txt", player)
+
+
+def test_verify_replays_equals_verifying_each_alone():
+    from dataclasses import replace as dc_replace
+
+    from armgame.records.batch_verify import verify_replays
+
+    replays = [recorded(s) for s in range(4)] + [recorded(9, integrator="gauss4"), recorded(8, target_radius=0.2)]
+    replays[1] = dc_replace(replays[1], result=dc_replace(replays[1].result, score=replays[1].result.score + 1))
+    quit_early = GameSession(GameConfig(seed=5, time_limit=3.0))
+    quit_early.play([InputEvent(0, "d", "down")], stop_step=200)
+    replays.append(Replay.from_session(quit_early, "keyboard"))
+    assert verify_replays(replays) == [r.verify() for r in replays]
+    assert [ok for ok, _ in verify_replays(replays)] == [True, False, True, True, True, True, True]
+
+
+def test_verify_a_folder_of_replays_in_batches(tmp_path, capsys, monkeypatch):
+    from dataclasses import replace as dc_replace
+
+    import armgame.records.batch_verify as bv
+    from armgame.cli import main
+
+    folder = tmp_path / "replays"
+    folder.mkdir()
+    for s in range(5):
+        recorded(s).save(folder / f"game{s}.json")
+    bad = recorded(7)
+    dc_replace(bad, result=dc_replace(bad.result, hits=bad.result.hits + 1, score=bad.result.score + 1)).save(
+        folder / "game7.json")
+    (folder / "broken.json").write_text('{"format": "armgame-replay"')
+    recorded(6).save(tmp_path / "outside.json")
+    (folder / "link.json").symlink_to(tmp_path / "outside.json")
+    (folder / "notes.txt").write_text("not a replay")
+    monkeypatch.setattr(bv, "CHUNK", 3)  # several chunks
+    assert main(["verify", str(folder)]) == 2
+    lines = capsys.readouterr().out.splitlines()
+    names = ["broken.json", *(f"game{s}.json" for s in range(5)), "game7.json"]  # sorted; link.json not followed
+    assert [line.split(": ")[0] for line in lines[:-1]] == [str(folder / n) for n in names]
+    assert lines[0].startswith(f"{folder / 'broken.json'}: BAD REPLAY: ")
+    assert sum(": matches: " in line for line in lines) == 5
+    assert ": DIFFERS: " in lines[6] and "game7.json" in lines[6]
+    assert lines[-1] == f"{folder}: 7 replays, 1 differ, 1 unreadable"
+    (folder / "broken.json").unlink()
+    assert main(["verify", str(folder)]) == 1
+    (folder / "game7.json").unlink()
+    assert main(["verify", str(folder)]) == 0
+    capsys.readouterr()
+    (tmp_path / "empty").mkdir()
+    assert main(["verify", str(tmp_path / "empty")]) == 2
+    assert "no score table (scores.json) and no replays (*.json)" in capsys.readouterr().err
+
+
+def test_verify_a_table_checks_its_entries_in_batches_as_one_by_one(tmp_path, capsys, monkeypatch):
+    import armgame.records.batch_verify as bv
+    from armgame.cli import main
+    from armgame.records.scores import ScoreTable
+
+    table = ScoreTable(tmp_path / "scores")
+    entries = [table.add(recorded(s, player=f"student {s}")) for s in range(6)]
+    table.replay_path(entries[1]).unlink()  # REPLAY MISSING
+    path = table.replay_path(entries[3])  # REPLAY CHANGED
+    path.write_bytes(path.read_bytes().replace(b'"player": "student 3"', b'"player": "student 9"'))
+    monkeypatch.setattr(bv, "CHUNK", 4)
+    ordered = sorted(table.read()[0], key=lambda e: e.when)
+    assert list(bv.check_entries(table, ordered)) == [(e, table.check(e)) for e in ordered]
+    assert main(["verify", str(tmp_path / "scores")]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert sum(line.endswith(": ok") for line in out) == 4 and out[-1].endswith("6 entries, 2 flagged")

@@ -276,8 +276,13 @@ class BatchGameSession:
             self._run(None if len(alive) == self.n else alive, chunk)
             left -= chunk
 
-    def _run(self, games: np.ndarray | None, count: int) -> None:
-        """``count`` physics steps of the games at indices ``games`` (None: all), none of which may end."""
+    def _run(self, games: np.ndarray | None, count: int, clocks: np.ndarray | None = None) -> None:
+        """``count`` physics steps of the games at indices ``games`` (None: all), none of which may end.
+
+        With ``games`` None, ``clocks`` (a mask) says whose step counts advance: the others are
+        stepped for nothing (``play`` keeps games that have stopped in the batch rather than
+        gather the rest every step, and puts their states back at the end).
+        """
         if count <= 0:
             return
         if games is None:
@@ -303,8 +308,10 @@ class BatchGameSession:
             self._x[:, games], self._act[:, games] = x[:4], act
             self.target_x[games], self.target_y[games], self._slack[games] = tx, ty, slack
             self.steps[games] += count
-        else:
+        elif clocks is None:
             self.steps += count
+        else:
+            self.steps[clocks] += count
 
     def _hit_test(self, i: int, state: np.ndarray, step: int) -> bool:
         """The single session's hit test and scoring, on Python floats, for game ``i`` after step ``step``."""
@@ -345,6 +352,17 @@ class BatchGameSession:
         muscle_steps, flat, goal, rate, specials, held = schedule
         limits = np.array(limit, dtype=np.int64)
         alive = np.flatnonzero(limits > now)
+        # Games that stop while at least half the batch plays on stay in it, stepped for nothing:
+        # cheaper than gathering the others every step. Their slack is infinite (no hits) and
+        # their states are put back at the end.
+        running = limits > now
+        stopped: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+        def stop(games: np.ndarray) -> None:
+            for i in games.tolist():
+                stopped[i] = (self._x[:, i].copy(), self._act[:, i].copy())
+                self._slack[i] = np.inf
+            running[games] = False
         # Every step where something happens: an event of some game, or some game's stop.
         stops_at = np.unique(np.concatenate([muscle_steps, np.array([s for s, _, _ in specials], dtype=np.int64),
                                              limits[limits > now]]))
@@ -353,10 +371,11 @@ class BatchGameSession:
         lo, special = np.searchsorted(muscle_steps, now, side="left"), 0
         for target, hi in zip([now, *stops_at.tolist()], [lo, *bounds], strict=True):
             if target > now:
-                self._run(None if len(alive) == self.n else alive, target - now)
+                if 2 * len(alive) >= self.n:
+                    self._run(None, target - now, None if len(alive) == self.n else running)
+                else:
+                    self._run(alive, target - now)
                 now = target
-                if len(alive) and int(limits[alive].min()) <= now:
-                    alive = alive[limits[alive] > now]
             if hi > lo:  # the muscle keys pressed and released at this step
                 where = flat[lo:hi]
                 goal_flat[where] = goal[lo:hi]
@@ -366,6 +385,11 @@ class BatchGameSession:
                 _, i, key = specials[special]
                 self.key_event(i, key, DOWN)
                 special += 1
+            if len(alive) and int(limits[alive].min()) <= now:  # after their events at their last step
+                stop(alive[limits[alive] <= now])
+                alive = alive[limits[alive] > now]
+        for i, (x, act) in stopped.items():
+            self._x[:, i], self._act[:, i], self._slack[i] = x, act, -1.0
         for i, row in held.items():
             self.held[i] = row
         return [self.result(i) for i in range(self.n)]
