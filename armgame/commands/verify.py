@@ -10,11 +10,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "verify",
         help="check that a replay (or every entry of a score table) reproduces its score",
         description="Replay the game of FILE from its input timeline and compare the result with the recorded "
-        "one, and name the ruleset it plays (standard, or custom). FILE is a replay, or a score table "
-        "(scores.json, or its folder): then every entry is checked against its replay. Exit status: 0 if "
-        "everything matches, 1 if not, 2 on a bad file.",
+        "one, and name the ruleset it plays (standard, or custom). FILE is a replay, a score table "
+        "(scores.json, or its folder: every entry is checked against its replay) or a folder of replays "
+        "(every *.json file in it; symbolic links are not followed). Many games are recomputed together "
+        "in batches. Exit status: 0 if everything matches, 1 if not, 2 on a bad file.",
     )
-    p.add_argument("file", metavar="FILE", help="a replay file, a scores.json or a scores folder")
+    p.add_argument("file", metavar="FILE", help="a replay file, a scores.json, a scores folder or a folder of replays")
     p.set_defaults(run=run)
 
 
@@ -23,6 +24,8 @@ def run(args: argparse.Namespace) -> int:
     from ..records.storage import user_path
 
     path = user_path(args.file, "FILE")
+    if path.is_dir() and not (path / TABLE_NAME).exists() and not (path / TABLE_NAME).is_symlink():
+        return _verify_folder(path)
     if path.is_dir():
         return _verify_table(path)
     if path.name == TABLE_NAME or _looks_like_table(path):
@@ -48,12 +51,36 @@ def _looks_like_table(path) -> bool:
 
 
 def _verify_replay(path) -> int:
-    from .. import __version__
     from ..records.replay import Replay
-    from ..records.rulesets import ruleset_name
 
     replay = Replay.load(path)
-    ok, got = replay.verify()
+    return _report(path, replay, *replay.verify())
+
+
+def _verify_folder(folder) -> int:
+    from ..errors import UserError
+    from ..records.batch_verify import replay_files, verify_files
+    from ..records.scores import TABLE_NAME
+
+    paths = replay_files(folder)
+    if not paths:
+        raise UserError(f"{folder}: no score table ({TABLE_NAME}) and no replays (*.json) there")
+    differ = bad = 0
+    for path, replay, got, ok in verify_files(paths):
+        if got is None:
+            bad += 1
+            print(f"{path}: BAD REPLAY: {str(replay).removeprefix(f'{path}: ')}")
+        else:
+            differ += _report(path, replay, ok, got)
+    print(f"{folder}: {len(paths)} replays, {differ} differ, {bad} unreadable")
+    return 2 if bad else 1 if differ else 0
+
+
+def _report(path, replay, ok: bool, got) -> int:
+    """One line on a recomputed replay; 0 if it matches, else 1."""
+    from .. import __version__
+    from ..records.rulesets import ruleset_name
+
     r = replay.result
     who = f"{replay.player}'s game" if replay.player else "game"
     about = f"{who} ({ruleset_name(replay.config)} rules, {replay.driven}, seed {r.seed}, {r.duration:g} s)"
@@ -72,6 +99,7 @@ def _verify_table(folder) -> int:
     import sys
 
     from ..errors import UserError
+    from ..records.batch_verify import check_entries
     from ..records.scores import ScoreTable, VerificationCache
 
     cache = VerificationCache()
@@ -83,8 +111,7 @@ def _verify_table(folder) -> int:
         print(f"armgame verify: {damage.describe(table.path)}", file=sys.stderr)
     flagged = 0
     seen: set[str] = set()
-    for e in sorted(entries, key=lambda e: e.when):
-        c = table.check(e)
+    for e, c in check_entries(table, sorted(entries, key=lambda e: e.when)):
         if c.ok and e.replay_sha256 in seen:
             c = type(c)(False, "DUPLICATE", "the same replay is entered more than once", c.ruleset)
         seen.add(e.replay_sha256)

@@ -39,12 +39,13 @@ import stat
 import sys
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
 
 from .. import __version__
+from ..game.session import GameResult
 from ..limits import MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
 from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_name
@@ -457,13 +458,45 @@ class ScoreTable:
 
     def check(self, entry: ScoreEntry) -> Check:
         """Whether the entry's replay is the one it names and reproduces its game. Never raises."""
-        try:
-            return self._check(entry)
-        except Exception as exc:  # one entry's failure never takes the table down
-            reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
-            return Check(False, "BAD REPLAY", reason)
+        return self.check_many([entry])[0]
 
-    def _check(self, entry: ScoreEntry) -> Check:
+    def check_many(self, entries: Sequence[ScoreEntry],
+                   recompute: Callable[[Sequence[Replay]], list[tuple[bool, GameResult]]] | None = None,
+                   ) -> list[Check]:
+        """``check`` for each entry; the games not in the cache are recomputed together.
+
+        ``recompute`` maps replays to ``replay.verify()`` of each (``records.batch_verify`` passes
+        the batched one); if it fails, the games are recomputed one at a time, so one entry's
+        failure still marks only that entry.
+        """
+        found: list[Check | tuple[str, dict | Replay]] = []
+        for entry in entries:
+            try:
+                found.append(self._claim(entry))
+            except Exception as exc:  # one entry's failure never takes the table down
+                found.append(_bad(exc))
+        pending = {digest: item for f in found if not isinstance(f, Check)
+                   for digest, item in [f] if isinstance(item, Replay)}
+        verdicts = _recompute(list(pending.values()), recompute)
+        for (digest, replay), verdict in zip(pending.items(), verdicts, strict=True):
+            cached = {"claims": replay_claims(replay), **verdict}
+            if self.cache:
+                self.cache.put(digest, cached)
+            pending[digest] = cached  # type: ignore[assignment]
+        checks = []
+        for entry, f in zip(entries, found, strict=True):
+            if isinstance(f, Check):
+                checks.append(f)
+                continue
+            digest, item = f
+            try:
+                checks.append(self._judge(entry, pending[digest] if isinstance(item, Replay) else item))
+            except Exception as exc:
+                checks.append(_bad(exc))
+        return checks
+
+    def _claim(self, entry: ScoreEntry) -> Check | tuple[str, dict | Replay]:
+        """A failed ``Check``; or the replay's digest with its cached verdict, or the replay still to recompute."""
         try:
             path = self._replay_file(entry)
             data = read_limited(path, MAX_REPLAY_BYTES, "replay file", follow=False)
@@ -474,15 +507,19 @@ class ScoreTable:
         if digest != entry.replay_sha256:
             return Check(False, "REPLAY CHANGED", f"{path.name} is not the replay this entry was saved with")
         cached = self.cache.get(digest) if self.cache else None
-        if cached is None:
-            try:
-                replay = Replay.from_bytes(data, str(path))
-            except DataFileError as exc:
-                cached = {"claims": None, "ok": False, "label": "BAD REPLAY", "detail": str(exc)}
-            else:
-                cached = {"claims": replay_claims(replay), **_verdict(replay)}
+        if cached is not None:
+            return digest, cached
+        try:
+            return digest, Replay.from_bytes(data, str(path))
+        except DataFileError as exc:
+            cached = {"claims": None, "ok": False, "label": "BAD REPLAY", "detail": str(exc)}
             if self.cache:
                 self.cache.put(digest, cached)
+            return digest, cached
+
+    @staticmethod
+    def _judge(entry: ScoreEntry, cached: dict) -> Check:
+        """The verdict on an entry whose replay's claims and recomputed verdict are ``cached``."""
         claims = cached["claims"]
         if claims is None:
             return Check(False, cached["label"], cached["detail"])
@@ -495,6 +532,21 @@ class ScoreTable:
                 return Check(False, "NOT ITS REPLAY", f"the entry says {key} {getattr(entry, key)!r}, its replay "
                              f"{value!r}", claims["ruleset"])
         return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"])
+
+
+def _bad(exc: Exception) -> Check:
+    reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+    return Check(False, "BAD REPLAY", reason)
+
+
+def _recompute(replays: list[Replay],
+               recompute: Callable[[Sequence[Replay]], list[tuple[bool, GameResult]]] | None) -> list[dict]:
+    if replays and recompute is not None:
+        try:
+            return [_judged(replay, *outcome) for replay, outcome in zip(replays, recompute(replays), strict=True)]
+        except Exception:  # e.g. one game's blow-up stopped the batch: find it one game at a time
+            pass
+    return [_verdict(replay) for replay in replays]
 
 
 class TableBusyError(TableError):
@@ -517,6 +569,10 @@ def _verdict(replay: Replay) -> dict[str, object]:
         ok, recomputed = replay.verify()
     except Exception as exc:  # a blow-up (NonFiniteState) or anything else the game raises
         return {"ok": False, "label": "BAD REPLAY", "detail": str(exc) or type(exc).__name__}
+    return _judged(replay, ok, recomputed)
+
+
+def _judged(replay: Replay, ok: bool, recomputed: GameResult) -> dict[str, object]:
     if ok:
         return {"ok": True, "label": "ok", "detail": ""}
     r = replay.result
