@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ..words import plural
+
 SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else scores/ in a checkout, "
                "else ~/.local/share/armgame/scores)")
 
@@ -58,8 +60,7 @@ def run(args: argparse.Namespace) -> int:
     right = {0, 2, 3, 4, 6, 7}
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     more = f", the top {len(shown)} shown" if len(shown) < len(entries) else ""
-    count = "1 entry" if len(entries) == 1 else f"{len(entries)} entries"
-    print(f"High scores in {table.path} ({count}{more})")
+    print(f"High scores in {table.path} ({plural(len(entries), 'entry')}{more})")
     for r in rows:
         cells = [c.rjust(w) if i in right else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths, strict=True))]
         print("  ".join(cells).rstrip())

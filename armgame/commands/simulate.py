@@ -6,6 +6,7 @@ import argparse
 import math
 
 from ..errors import UserError
+from ..words import plural
 
 
 def _initial_state(text: str) -> tuple[float, float, float, float]:
@@ -62,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
     trajectory = simulate(scene, args.integrator, args.dt, args.duration, args.initial, args.sample_rate)
     write_csv(trajectory, Path(args.out))
-    summary = f"{scene.name}: {len(trajectory.t)} rows to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
+    summary = f"{scene.name}: {plural(len(trajectory.t), 'row')} to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
         f"{trajectory.t[-1]:g} s)"
     energy = trajectory.energy()
     free = trajectory.t >= scene.free_after

@@ -38,6 +38,7 @@ from dataclasses import asdict, dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
 
+from ..words import plural
 from .replay import (
     DRIVEN,
     MAX_REPLAY_BYTES,
@@ -178,8 +179,7 @@ class Damage:
     found: int
 
     def describe(self, path: Path) -> str:
-        entries = "1 valid entry" if self.recovered == 1 else f"{self.recovered} valid entries"
-        return f"{path} is damaged ({self.reason}); {entries} recovered"
+        return f"{path} is damaged ({self.reason}); {plural(self.recovered, 'valid entry')} recovered"
 
 
 class ScoreTable:
@@ -299,7 +299,7 @@ class ScoreTable:
         if not ok:
             return Check(False, "NOT REPRODUCED",
                          f"recorded score {r.score}, the replay gives {recomputed.score} "
-                         f"({recomputed.hits} hits, {recomputed.resets} resets)")
+                         f"({plural(recomputed.hits, 'hit')}, {plural(recomputed.resets, 'reset')})")
         return Check(True, "ok")
 
 
