@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import itertools
+import re
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from . import __version__
 from .errors import UserError
@@ -15,8 +18,27 @@ COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "rep
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # one line, not the whole usage block
-        self.exit(2, f"{self.prog}: error: {message}\n")
+    """Errors in one line that name the command (``armgame demo: error: ...``), not the usage block."""
+
+    def parse_known_args(self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+                         ) -> tuple[argparse.Namespace, list[str]]:
+        self._arg_strings = list(sys.argv[1:] if args is None else args)  # for error()'s hint
+        return super().parse_known_args(args, namespace)
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message}{_dash_value_hint(message, getattr(self, '_arg_strings', []))}\n")
+
+
+def _dash_value_hint(message: str, arg_strings: Sequence[str]) -> str:
+    """For ``--initial -60,0``: argparse reads a value starting with '-' as an option; say how to pass it."""
+    found = re.match(r"argument (\S+): expected one argument", message)
+    if not found:
+        return ""
+    names = found.group(1).split("/")
+    for option, value in itertools.pairwise(arg_strings):
+        if option in names and value.startswith("-"):
+            return f" (for a value starting with '-', join it with '=': {option}={value})"
+    return ""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -28,12 +50,16 @@ def build_parser() -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMAND_MODULES:
         importlib.import_module(f"armgame.commands.{name}").register(subparsers)
+    parser.set_defaults(_commands=subparsers.choices)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # left over by the command's parser: its error, under its name
+        parser_of_command = args._commands.get(getattr(args, "command", None), parser)
+        parser_of_command.error(f"unrecognized arguments: {' '.join(extra)}")
     if not getattr(args, "run", None):
         parser.print_help()
         return 0

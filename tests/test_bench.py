@@ -157,3 +157,102 @@ def test_bench_refuses_an_unknown_case_in_one_line(tmp_path):
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2
     assert "unknown case 'nope'" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+# ------------------------------------------------------------------- figures and the printed report
+def _synthetic_rows():
+    """Rows shaped like a full run's: five cases, ours at eight steps, three peers at tolerances."""
+    from armgame.bench.measure import STEPS, Row, step_label
+
+    rows = []
+    for c, case in enumerate(("passive", "propeller", "upright", "stiff", "game")):
+        for name, order in (("euler", 1), ("symplectic-euler", 1), ("rk4", 4), ("midpoint", 2), ("gauss4", 4)):
+            for dt in STEPS:
+                error = min(0.5, 10.0 ** c * dt**order)
+                rows.append(Row(case, name, "armgame", step_label(dt), dt, None, 2e-4 / dt * 1e-3, 1 / dt,
+                                error, error, blew_up=(case == "stiff" and dt > 0.02)))
+        for method, family, cost in (("odeint (tutorial)", "tutorial", 0.02), ("solve_ivp RK45", "scipy", 0.008),
+                                     ("mujoco rk4", "mujoco", 0.002)):
+            for tol in (1e-6, 1e-8, 1e-10):
+                rows.append(Row(case, method, family, f"tol={tol:g}", None, tol, cost * (1 - math.log10(tol) / 10),
+                                500.0, tol, tol, False))
+    return rows
+
+
+@pytest.fixture
+def bench_slides(monkeypatch):
+    from armgame.bench import figures
+
+    captured, real = [], figures.save
+
+    def keep(fig, path):
+        captured.append(fig)
+        return real(fig, path)
+
+    monkeypatch.setattr(figures, "save", keep)
+    return captured
+
+
+@pytest.mark.parametrize("cases", [5, 1])
+def test_bench_figures_read_on_a_slide(cases, tmp_path, bench_slides):
+    from figure_checks import assert_reads_on_a_slide
+
+    from armgame.bench import figures
+
+    rows = [r for r in _synthetic_rows() if r.case in ("passive", "propeller", "upright", "stiff", "game")[:cases]]
+    figures.work_precision(rows, tmp_path / "wp.png")
+    figures.convergence(rows, tmp_path / "conv.png")
+    assert (tmp_path / "wp.png").stat().st_size > 0 and (tmp_path / "conv.png").stat().st_size > 0
+    for fig in bench_slides:
+        assert_reads_on_a_slide(fig)
+        panels = [ax for ax in fig.get_axes() if ax.axison]
+        assert [ax.get_title() for ax in panels] == list(dict.fromkeys(r.case for r in rows))
+        assert len(fig.get_axes()) == len(panels) + 1  # and one cell for the legend
+        colours = {}  # a method keeps its colour in every panel
+        for ax in panels:
+            for line in ax.get_lines():
+                if not line.get_label().startswith("_"):
+                    assert colours.setdefault(line.get_label(), line.get_color()) == line.get_color()
+    legend = [t.get_text() for ax in bench_slides[1].get_axes() if ax.get_legend() for t in ax.get_legend().texts]
+    assert legend[-3:] == ["slope 1 (reference)", "slope 2 (reference)", "slope 4 (reference)"]
+
+
+def test_the_slide_check_catches_a_legend_on_the_data_and_overlapping_labels():
+    from figure_checks import assert_reads_on_a_slide
+
+    from armgame import plotstyle
+
+    with plotstyle.slide_style():
+        fig = plotstyle.slide_figure()
+        ax = fig.subplots()
+        ax.plot([0, 1], [0, 1], label="a line")
+        ax.legend(loc="upper left")
+    with pytest.raises(AssertionError, match="legend on the data"):
+        assert_reads_on_a_slide(fig)
+    ax.get_legend().remove()
+    ax.text(0.5, 0.5, "slope 1")
+    ax.text(0.5, 0.5, "slope 2")
+    with pytest.raises(AssertionError, match="overlaps"):
+        assert_reads_on_a_slide(fig)
+    ax.texts[-1].remove()
+    ax.set_xlabel("tiny", fontsize=6)
+    with pytest.raises(AssertionError):
+        assert_reads_on_a_slide(fig)
+
+
+def test_text_report_prints_the_ratios_and_the_machine():
+    from armgame.bench.report import text_report
+    from armgame.bench.run import Result
+
+    bars = {"odeint_ratio": 17.4, "odeint_detail": "rk4 dt=1/250", "rk4_step_us": 2.5,
+            "rk4_numpy_single_step_us": 9.0, "mujoco_rk4_step_us": 7.0, "mujoco_rk4_c_loop_step_us": 6.5,
+            "mujoco_ratio": 2.8, "mujoco_c_loop_ratio": 2.6, "batch_rate": 10.3e6, "batch_threads": 1,
+            "batch_rate_1_thread": 10.3e6, "batch_rate_2_thread": 7.0e6, "batch_rate_integrator_numpy": 6.7e6}
+    machine = {"cpu": "Intel(R) Xeon(R) CPU @ 2.20GHz", "cores": "2", "system": "Linux", "python": "3.11.7",
+               "numpy": "2.4.6", "scipy": "1.17.1", "mujoco": "4.0.0", "matplotlib": "3.11.2", "load": "3.1 2.0 1.5"}
+    text = text_report(Result([], bars, {}, machine, [], 12.0))
+    assert "17x faster (MISSES the 20x bar)" in text
+    assert "ours 2.80x faster (meets the 2.5x bar)" in text
+    assert "10.3 M arm-steps/s with 1 thread (meets the 10 M bar) [1 thread 10.3 M, 2 threads 7.0 M" in text
+    assert "machine: Intel(R) Xeon(R) CPU @ 2.20GHz, 2 cores, Linux; load average 3.1 2.0 1.5" in text
+    assert "versions: python 3.11.7, numpy 2.4.6, scipy 1.17.1, mujoco 4.0.0" in text

@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 import pytest
+from figure_checks import assert_reads_on_a_slide
 from scipy.integrate import solve_ivp
 
 from armgame.cli import main
@@ -15,6 +16,21 @@ from armgame.demos.runs import VISIBLY_APART, chaos_run, record
 from armgame.physics import TUTORIAL_ARM, TwoJointArm
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture
+def slides(monkeypatch):
+    """The figures the demos save, captured for inspection."""
+    from armgame import plotstyle
+
+    figures, real = [], plotstyle.save
+
+    def keep(fig, path):
+        figures.append(fig)
+        return real(fig, path)
+
+    monkeypatch.setattr(plotstyle, "save", keep)
+    return figures
 
 
 def read_csv(path):
@@ -28,7 +44,7 @@ def read_csv(path):
     [("pendulum", ["t", "q1", "qd1"]), ("passive", ["t", "q1", "q2"]), ("chaos", ["t", "a_q1", "b_q1"]),
      ("interaction", ["t", "q1", "tau1", "own_inertial1", "interaction_inertial2", "coriolis_centrifugal1"])],
 )
-def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_path, capsys):
+def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_path, capsys, slides):
     out = tmp_path / "figs"
     assert main(["demo", name, "--headless", "--out", str(out), "--duration", "0.5"]) == 0
     header, data = read_csv(out / f"{name}.csv")
@@ -37,6 +53,32 @@ def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_pa
     assert (out / f"{name}.png").read_bytes()[:8] == PNG_MAGIC
     printed = capsys.readouterr().out
     assert f"wrote {out / (name + '.png')}" in printed
+    (fig,) = slides
+    assert_reads_on_a_slide(fig)
+
+
+def test_pendulum_figure_puts_angle_and_velocity_on_their_own_axes(tmp_path, slides):
+    assert main(["demo", "pendulum", "--headless", "--out", str(tmp_path), "--duration", "2"]) == 0
+    (fig,) = slides
+    labels = [ax.get_ylabel() for ax in fig.get_axes()]
+    assert labels == ["angle from hanging (deg)", "angular velocity (deg/s)"]
+    angle, velocity = (ax.get_lines()[0].get_ydata() for ax in fig.get_axes())
+    assert angle[0] == pytest.approx(90.0) and velocity[0] == 0.0
+
+
+def test_interaction_figure_shares_one_newton_metre_scale_and_prints_each_bar(tmp_path, slides):
+    assert main(["demo", "interaction", "--headless", "--out", str(tmp_path)]) == 0
+    (fig,) = slides
+    shoulder, elbow = (ax for ax in fig.get_axes() if ax.get_ylabel().endswith("torque (N m)"))
+    assert shoulder.get_ylim() == elbow.get_ylim()
+    bar_axes = [ax for ax in fig.get_axes() if ax.patches]
+    assert len(bar_axes) == 2 and bar_axes[0].get_xlim() == bar_axes[1].get_xlim()
+    for ax in bar_axes:
+        printed = [t.get_text() for t in ax.texts]
+        widths = [p.get_width() for p in ax.patches]
+        assert printed == [f"{w:.2f} N m" for w in widths]
+    _, data = read_csv(tmp_path / "interaction.csv")
+    assert float(bar_axes[0].texts[-1].get_text().split()[0]) == pytest.approx(np.max(np.abs(data[:, 11])), abs=0.006)
 
 
 def test_pendulum_reproduces_the_tutorials_run(tmp_path):

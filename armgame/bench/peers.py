@@ -102,6 +102,19 @@ def _sane(states: NDArray[np.float64]) -> bool:
     return bool(np.all(np.isfinite(states)) and np.all(np.abs(states[:, 2:]) < BLOWUP_SPEED))
 
 
+def odeint_run(case: Case, tol: float) -> Callable[[], None]:
+    """The timed part of ``measure_odeint``: the tutorial's method over the error window."""
+    rhs = tutorial_rhs(case.model)
+    t = _grid(ERROR_WINDOW, OUTPUT_RATE)
+
+    def timed() -> None:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.filterwarnings("ignore", "the matrix subclass", PendingDeprecationWarning)
+            _odeint_segments(rhs, case.scene.initial, t, case.segments, tol)
+
+    return timed
+
+
 def measure_odeint(case: Case, tol: float, repeats: int) -> Row:
     rhs = tutorial_rhs(case.model)
     count = [0]

@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ..words import plural
 from .measure import Row
 from .run import Result
 
@@ -66,10 +67,10 @@ def bars_text(bars: dict[str, Any]) -> list[str]:
                    f"-> {bars['mujoco_c_loop_ratio']:.2f}x")
     if "batch_rate" in bars:
         ok = "meets" if bars["batch_rate"] >= 10e6 else "MISSES"
-        per = ", ".join(f"{k.split('_')[2]} thread(s) {v / 1e6:.1f} M" for k, v in bars.items()
+        per = ", ".join(f"{plural(int(k.split('_')[2]), 'thread')} {v / 1e6:.1f} M" for k, v in bars.items()
                         if k.startswith("batch_rate_") and k.endswith("thread"))
         out.append(f"batch of 10,000 arms, RK4, dt 1 ms (BatchRK4): {bars['batch_rate'] / 1e6:.1f} M arm-steps/s "
-                   f"with {bars['batch_threads']} thread(s) ({ok} the 10 M bar) [{per}; "
+                   f"with {plural(bars['batch_threads'], 'thread')} ({ok} the 10 M bar) [{per}; "
                    f"Integrator numpy backend {bars['batch_rate_integrator_numpy'] / 1e6:.1f} M]")
     return out
 
@@ -96,7 +97,9 @@ def text_report(result: Result) -> str:
     for note in result.notes:
         lines.append(f"note: {note}")
     m = result.machine
-    lines.append(f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}")
+    cores = plural(int(m["cores"]), "core") if m["cores"].isdigit() else f"{m['cores']} cores"
+    lines.append(f"machine: {m['cpu']}, {cores}, {m['system']}; load average "
+                 f"{m.get('load', 'unknown')} (1, 5, 15 min) as the run started")
     lines.append("versions: " + ", ".join(f"{k} {m[k]}" for k in ("python", "numpy", "scipy", "mujoco", "matplotlib")))
     lines.append(f"benchmark took {result.seconds:.0f} s")
     return "\n".join(lines)

@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
             raise UserError(f"--out {out} exists and is not a folder")
         from ..bench import figures
 
-        figures._pyplot()  # fail now, in one line, not after minutes of measuring
+        figures.require()  # fail now, in one line, not after minutes of measuring
     options = Options(quick=args.quick, cases=args.cases, integrators=args.integrators, peers=not args.no_peers,
                       bars=not args.no_bars)
     progress = (lambda m: None) if args.json else (lambda m: print(f"... {m}", file=sys.stderr, flush=True))

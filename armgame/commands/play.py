@@ -6,6 +6,7 @@ import argparse
 import math
 
 from ..errors import UserError
+from ..words import plural
 
 DEFAULT_SEED = 10  # the 2012 game's: every class sees the same targets unless asked otherwise
 
@@ -119,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(result.as_dict(), sort_keys=True))
     else:
-        print(f"your score is: {result.score}  ({result.hits} hits, {result.resets} resets, "
+        print(f"your score is: {result.score}  ({plural(result.hits, 'hit')}, {plural(result.resets, 'reset')}, "
               f"{session.time:.1f} s of {result.duration:g} s)")
     if session.event_limit_reached:
         print(f"the game was stopped at {session.time:.1f} s: it reached {len(session.timeline)} input events, the "

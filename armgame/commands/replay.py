@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ..words import plural
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     from .play import _size
@@ -52,9 +54,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         r = replay.result
         verdict = "as recorded" if (result.score, result.hits, result.resets) == (r.score, r.hits, r.resets) \
-            else f"recorded {r.score} ({r.hits} hits, {r.resets} resets): DIFFERS"
+            else f"recorded {r.score} ({plural(r.hits, 'hit')}, {plural(r.resets, 'reset')}): DIFFERS"
         print(f"replay of {who} ({replay.driven}, seed {r.seed}): score {result.score} "
-              f"({result.hits} hits, {result.resets} resets), {verdict}")
+              f"({plural(result.hits, 'hit')}, {plural(result.resets, 'reset')}), {verdict}")
     return 0
 
 

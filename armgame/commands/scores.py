@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ..words import plural
+
 SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else scores/ in a checkout, "
                "else ~/.local/share/armgame/scores)")
 
@@ -85,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
             kind.append((e, c))
     if cache is not None:
         cache.save()
-    count = "1 entry" if len(entries) == 1 else f"{len(entries)} entries"
+    count = plural(len(entries), "entry")
     names = ", ".join(RULESETS)
     print(f"High scores in {table.path} ({count}; ranked: {names} games{'' if args.no_check else ', replays checked'})")
     _print_rows(ranked, args.no_check)

@@ -6,6 +6,7 @@ import argparse
 import math
 
 from ..errors import UserError
+from ..words import plural
 
 
 def _initial_state(text: str) -> tuple[float, float, float, float]:
@@ -64,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
     run_ = simulate_to_csv(scene, args.integrator, args.dt, out, args.duration, args.initial, args.sample_rate)
-    summary = f"{scene.name}: {run_.rows} rows to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
+    summary = f"{scene.name}: {plural(run_.rows, 'row')} to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
         f"{run_.t_end:g} s)"
     if run_.energy_start is not None and run_.rows > 1 and run_.energy_start != 0.0:
         drift = abs(run_.energy_end - run_.energy_start) / abs(run_.energy_start)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ..words import plural
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
@@ -72,7 +74,7 @@ def _verify_folder(folder) -> int:
             print(f"{path}: BAD REPLAY: {str(replay).removeprefix(f'{path}: ')}")
         else:
             differ += _report(path, replay, ok, got)
-    print(f"{folder}: {len(paths)} replays, {differ} differ, {bad} unreadable")
+    print(f"{folder}: {plural(len(paths), 'replay')}, {differ} differ, {bad} unreadable")
     return 2 if bad else 1 if differ else 0
 
 
@@ -85,13 +87,13 @@ def _report(path, replay, ok: bool, got) -> int:
     who = f"{replay.player}'s game" if replay.player else "game"
     about = f"{who} ({ruleset_name(replay.config)} rules, {replay.driven}, seed {r.seed}, {r.duration:g} s)"
     if ok:
-        print(f"{path}: matches: {about}: score {r.score}, {r.hits} hits, {r.resets} resets")
+        print(f"{path}: matches: {about}: score {r.score}, {plural(r.hits, 'hit')}, {plural(r.resets, 'reset')}")
         return 0
     note = f" (recorded with armgame {replay.version}, checked with {__version__})" \
         if replay.version != __version__ else ""
-    print(f"{path}: DIFFERS: {about}: recorded score {r.score}, {r.hits} hits, {r.resets} resets, "
-          f"{r.steps} steps; the replay gives score {got.score}, {got.hits} hits, {got.resets} resets, "
-          f"{got.steps} steps{note}")
+    print(f"{path}: DIFFERS: {about}: recorded score {r.score}, {plural(r.hits, 'hit')}, "
+          f"{plural(r.resets, 'reset')}, {plural(r.steps, 'step')}; the replay gives score {got.score}, "
+          f"{plural(got.hits, 'hit')}, {plural(got.resets, 'reset')}, {plural(got.steps, 'step')}{note}")
     return 1
 
 
@@ -120,5 +122,5 @@ def _verify_table(folder) -> int:
         line = f"{e.name}: score {e.score} ({e.how}{rules}, {e.date[:16].replace('T', ' ')}): {c.label}"
         print(line + (f": {c.detail}" if c.detail else ""))
     cache.save()
-    print(f"{table.path}: {len(entries)} entries, {flagged} flagged")
+    print(f"{table.path}: {plural(len(entries), 'entry')}, {flagged} flagged")
     return 2 if damage else 1 if flagged else 0

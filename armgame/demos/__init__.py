@@ -5,4 +5,4 @@ matplotlib when asked); only ``window`` imports pygame. This file stays import-l
 line can list the demos without loading numpy.
 """
 
-DEMO_NAMES = ("pendulum", "passive", "chaos", "interaction")
+DEMO_NAMES = ("pendulum", "passive", "chaos", "interaction", "planning")

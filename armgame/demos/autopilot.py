@@ -17,6 +17,7 @@ from ..errors import UserError
 from ..game.bots import BOT_NAMES, Autopilot, make_bot, play_bot
 from ..game.rules import GameConfig
 from ..game.session import GameSession, RealTimeDriver
+from ..words import plural
 
 TABLE_SEEDS = tuple(range(10))
 WINDOW_SEED = 10  # the game's own default seed: the targets a class sees in `armgame play`
@@ -44,7 +45,7 @@ def format_table(rows: list[Row], duration: float) -> str:
     for r in rows:
         lines.append(f"{r.seed:>4} {r.hits['model']:>6} {r.hits['naive']:>6} {r.ratio:>12.2f}")
     lines.append(f"{'all':>4} {sum(r.hits['model'] for r in rows):>6} {sum(r.hits['naive'] for r in rows):>6} "
-                 f"{min(r.ratio for r in rows):>8.2f} min")
+                 f"{min(r.ratio for r in rows):>12.2f}  (min ratio)")
     return "\n".join(lines)
 
 
@@ -121,7 +122,7 @@ def run_window(seed: int = WINDOW_SEED, duration: float = 60.0, size: tuple[int,
                 alpha = driver.advance(elapsed) if not session.over else 1.0
                 area = screen.subsurface(pygame.Rect(i * half, caption_h, half, h - caption_h))
                 renderer.draw(area, session, alpha, paused)
-                label = font.render(f"{name}: {session.rules.board.hits} hits", True, (20, 20, 28))
+                label = font.render(f"{name}: {plural(session.rules.board.hits, 'hit')}", True, (20, 20, 28))
                 # Along the bottom: the top of each half is the game's own score and clock.
                 screen.blit(label, (i * half + (half - label.get_width()) // 2, h - label.get_height() - 12))
             text = pygame.font.Font(None, 24).render(CAPTION, True, (60, 60, 70))

@@ -42,6 +42,10 @@ INFO: dict[str, DemoInfo] = {
                  "A fast reach and the torque each joint needs. Interaction torques (orange, red) are there only "
                  "because the other joint moves.",
                  2.6, 1000.0, False),
+        DemoInfo("planning", "armgame demo: planning a reach",
+                 "One reach planned two ways. Minimum jerk (dark) moves the hand straight; minimum torque change "
+                 "(orange), computed on the arm's own dynamics, curves it.",
+                 0.6, 1000.0, False),
     )
 }
 assert tuple(INFO) == DEMO_NAMES
@@ -55,7 +59,8 @@ def get_info(name: str) -> DemoInfo:
 
 
 def make_run(name: str, integrator: str = "rk4", dt: float = 0.001, gravity: bool = False) -> Any:
-    """The steppable run behind demo ``name`` (a ``PassiveRun`` or, for interaction, a ``ReachRun``)."""
+    """The steppable run behind demo ``name``: a ``PassiveRun``, or for the prescribed reaches a ``ReachRun``
+    (interaction) or a ``PlanningRun`` (planning)."""
     get_info(name)
     check_fixed_step(integrator, dt)
     if gravity and name != "interaction":
@@ -66,6 +71,10 @@ def make_run(name: str, integrator: str = "rk4", dt: float = 0.001, gravity: boo
         return passive_run(integrator, dt)
     if name == "chaos":
         return chaos_run(integrator, dt)
+    if name == "planning":
+        from .planning import PlanningRun
+
+        return PlanningRun(dt)
     return ReachRun(gravity=gravity, dt=dt)
 
 
@@ -90,6 +99,9 @@ def run_headless(name: str, out_dir: Path, duration: float | None = None, integr
                  dt: float = 0.001, gravity: bool = False, figures: bool = True) -> HeadlessResult:
     """Run demo ``name`` without a window; write ``NAME.csv`` and (with ``figures``) ``NAME.png`` to ``out_dir``."""
     info = get_info(name)
+    if name == "planning" and duration is not None:
+        raise UserError("--duration does not apply to the planning demo: it plans one reach of "
+                        f"{info.duration:g} s (the optimal path's shape does not depend on its duration)")
     duration = info.duration if duration is None else duration
     if not (math.isfinite(duration) and duration > 0.0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {duration!r}")
@@ -139,6 +151,21 @@ def run_headless(name: str, out_dir: Path, duration: float | None = None, integr
             from .figures import chaos_figure
 
             files.append(chaos_figure(rec.t, distance, hand_a, hand_b, png_path))
+    elif name == "planning":
+        from .planning import summary as planning_summary
+
+        planning = run.planning
+        header, columns = ["t"], [planning.jerk.t]
+        for prefix, reach in (("mj", planning.jerk), ("mtc", planning.torque_change)):
+            header += [f"{prefix}_{c}" for c in ("q1", "q2", "hand_x", "hand_y", "speed", "tau1", "tau2", "dtau1",
+                                                 "dtau2")]
+            columns += [*reach.q.T, *reach.hand.T, reach.speed, *reach.torque.T, *reach.torque_rate.T]
+        write_table(csv_path, header, columns)
+        summary = planning_summary(planning)
+        if figures:
+            from .figures import planning_figure
+
+            files.append(planning_figure(planning, png_path))
     else:
         steps = math.floor(duration / dt + 1e-9)
         every = max(1, round(1.0 / (info.sample_rate * dt)))

@@ -47,6 +47,7 @@ from pathlib import Path
 from .. import __version__
 from ..game.session import GameResult
 from ..limits import MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
+from ..words import plural
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
 from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_name
 from .storage import (
@@ -210,8 +211,7 @@ class Damage:
     found: int
 
     def describe(self, path: Path) -> str:
-        entries = "1 valid entry" if self.recovered == 1 else f"{self.recovered} valid entries"
-        return f"{path} is damaged ({self.reason}); {entries} recovered"
+        return f"{path} is damaged ({self.reason}); {plural(self.recovered, 'valid entry')} recovered"
 
 
 def replay_claims(replay: Replay) -> dict[str, object]:
@@ -577,8 +577,8 @@ def _judged(replay: Replay, ok: bool, recomputed: GameResult) -> dict[str, objec
         return {"ok": True, "label": "ok", "detail": ""}
     r = replay.result
     return {"ok": False, "label": "NOT REPRODUCED",
-            "detail": f"recorded score {r.score}, the replay gives {recomputed.score} ({recomputed.hits} hits, "
-                      f"{recomputed.resets} resets)"}
+            "detail": f"recorded score {r.score}, the replay gives {recomputed.score} "
+                      f"({plural(recomputed.hits, 'hit')}, {plural(recomputed.resets, 'reset')})"}
 
 
 # ------------------------------------------------------------------ the verification cache

@@ -8,6 +8,7 @@ scaled to the (resizable) window, so a projector's resolution changes nothing bu
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections import deque
@@ -15,6 +16,7 @@ from collections.abc import Callable
 from typing import Any
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+import numpy as np
 import pygame
 
 from ..demos.catalog import get_info
@@ -39,6 +41,8 @@ PATH = (200, 200, 205)
 # Vertical-plane arms hang from a shoulder near the centre; the horizontal reach uses the game's layout.
 VERTICAL_LAYOUT = ((400, 450), 400.0)
 HORIZONTAL_LAYOUT = ((400, 570), 500.0)  # the game's scale, raised to leave room for the bars
+PLANNING_LAYOUT = ((330, 540), 450.0)  # the reach left of centre, its speed plot on the right
+SPEED_PLOT = pygame.Rect(560, 290, 220, 170)
 SHORT_LABELS = {
     "own_inertial": "own inertia",
     "interaction_inertial": "interaction, inertial",
@@ -50,6 +54,12 @@ SHORT_LABELS = {
 
 def _rgb(hex_colour: str) -> tuple[int, int, int]:
     return int(hex_colour[1:3], 16), int(hex_colour[3:5], 16), int(hex_colour[5:7], 16)
+
+
+def _tick_step(scale: float) -> float:
+    """A round tick spacing (1, 2 or 5 times a power of ten) giving one to three ticks each side of zero."""
+    magnitude = 10.0 ** math.floor(math.log10(scale))
+    return next(m * magnitude for m in (5.0, 2.0, 1.0, 0.5) if scale / (m * magnitude) >= 1.0)
 
 
 class DemoWindow:
@@ -67,6 +77,8 @@ class DemoWindow:
         self.accumulator = 0.0
         self.last_time: float | None = None
         self.shoulder, self.pixels_per_metre = VERTICAL_LAYOUT if self.info.vertical else HORIZONTAL_LAYOUT
+        if name == "planning":
+            self.shoulder, self.pixels_per_metre = PLANNING_LAYOUT
         self.trails: list[deque[tuple[float, float]]] = []
         self.parted_at: float | None = None
         self.screen: Any = None
@@ -201,30 +213,71 @@ class DemoWindow:
             if self.parted_at is not None:
                 return f"hands {d:.2f} m apart: parted at t = {self.parted_at:.1f} s"
             return f"hands {d:.1e} m apart"
+        if self.name == "planning":
+            jerk, torque_change = run.hand_speeds_now()
+            return f"hand speed {jerk:4.2f} m/s (min jerk)   {torque_change:4.2f} m/s (min torque change)"
         return f"hand speed {run.hand_speed_now():.2f} m/s" + ("   (vertical plane, gravity on)" if run.gravity
                                                                else "   (horizontal plane)")
 
     def _draw_bars(self, run: ReachRun) -> None:
         parts, total = run.torques_now()
-        # Each joint on its own scale: the class compares parts within a joint, and the elbow's torques
-        # are a third of the shoulder's, too small to read on a shared scale.
-        scales = run.torque_scales()
+        # One N m scale for both joints, as in the figure, so the shoulder's larger torques look larger.
+        scale = max(run.torque_scales())
         rows = [(SHORT_LABELS[k], parts[k], _rgb(c)) for k, _, c in COMPONENTS
                 if (k != "gravity" or run.gravity) and k != "damping"]
         rows.append(("TOTAL", total, INK))
         row_h, half = (28 if len(rows) <= 4 else 25), 120
-        top = SCENE_SIZE[1] - 36 - (len(rows) + 1) * row_h
+        top = SCENE_SIZE[1] - 58 - (len(rows) + 1) * row_h
         centres = (400, 660)
-        for x, joint, value in zip(centres, ("shoulder", "elbow"), total, strict=True):
-            self._text(f"{joint} {value:+5.1f} N m", self.small_font, INK, (x, top), "midtop")
+        for x, joint in zip(centres, ("shoulder", "elbow"), strict=True):
+            self._text(f"{joint} (N m)", self.small_font, INK, (x, top), "midtop")
         for r, (label, values, colour) in enumerate(rows):
             y = top + row_h + r * row_h
             self._text(label, self.small_font, INK, (20, y + 3))
-            for x, v, scale in zip(centres, values, scales, strict=True):
+            for x, v in zip(centres, values, strict=True):
                 length = round(half * v / scale)
                 pygame.draw.rect(self.scene, colour, pygame.Rect(min(x, x + length), y, abs(length), row_h - 6))
+                # The value on the side the bar leaves free, so it never runs into the other joint's bars.
+                self._text(f"{v:+.1f}", self.small_font, INK, (x - 4, y + 3) if v >= 0 else (x + 4, y + 3),
+                           "topright" if v >= 0 else "topleft")
+        axis_y = top + (len(rows) + 1) * row_h - 2
+        step = _tick_step(scale)
         for x in centres:
-            pygame.draw.line(self.scene, FAINT, (x, top + row_h - 2), (x, top + (len(rows) + 1) * row_h - 4), 1)
+            pygame.draw.line(self.scene, FAINT, (x, top + row_h - 2), (x, axis_y), 1)
+            pygame.draw.line(self.scene, FAINT, (x - half, axis_y), (x + half, axis_y), 1)
+            for k in range(-int(scale // step), int(scale // step) + 1):
+                tx = x + round(half * k * step / scale)
+                pygame.draw.line(self.scene, FAINT, (tx, axis_y), (tx, axis_y + 5), 1)
+                self._text(f"{k * step:g}", self.small_font, FAINT, (tx, axis_y + 6), "midtop")
+
+    def _draw_planning(self, run: Any) -> None:
+        """Both planned paths, the start and target, and the two speed profiles with a moving cursor."""
+        for path, colour in zip(run.paths, (TRAIL, TRAIL_B), strict=True):
+            pygame.draw.lines(self.scene, colour, False, [self.to_scene(tuple(p)) for p in path[::5]], 4)
+        for end in (run.planning.start, run.planning.target):
+            pygame.draw.circle(self.scene, PATH, self.to_scene(end), 14, 3)
+        box = SPEED_PLOT
+        top = max(float(np.max(s)) for s in run.speeds)
+        pygame.draw.line(self.scene, FAINT, box.bottomleft, box.bottomright, 1)
+        pygame.draw.line(self.scene, FAINT, box.bottomleft, box.topleft, 1)
+        self._text("hand speed (m/s)", self.small_font, INK, (box.left, box.top - 6), "bottomleft")
+        for value, y in ((0.0, box.bottom), (top, box.top)):
+            self._text(f"{value:.1f}", self.small_font, FAINT, (box.left - 4, y), "midright")
+        every = max(1, len(run.speeds[0]) // 220)
+        for speeds, colour in zip(run.speeds, (LINK, ARM_B), strict=True):
+            points = [(box.left + round(box.width * i / len(speeds)), box.bottom - round(box.height * v / top))
+                      for i, v in list(enumerate(speeds))[::every]]
+            pygame.draw.lines(self.scene, colour, False, points, 3)
+        cursor = box.left + round(box.width * (run.steps % len(run.speeds[0])) / len(run.speeds[0]))
+        pygame.draw.line(self.scene, FAINT, (cursor, box.top), (cursor, box.bottom), 1)
+        self._text("out", self.small_font, FAINT, (box.left + box.width // 4, box.bottom + 4), "midtop")
+        self._text("back", self.small_font, FAINT, (box.left + 3 * box.width // 4, box.bottom + 4), "midtop")
+        y = SCENE_SIZE[1] - 92
+        for colour, text in ((LINK, "minimum jerk: straight, bell-shaped speed"),
+                             (ARM_B, "minimum torque change: the arm's dynamics curve it")):
+            pygame.draw.line(self.scene, colour, (20, y + 9), (48, y + 9), 5)
+            self._text(text, self.small_font, INK, (56, y))
+            y += 26
 
     def draw(self) -> None:
         scene = self.scene
@@ -240,6 +293,8 @@ class DemoWindow:
             for end in (run.plan.home, run.plan.target):
                 pygame.draw.circle(scene, PATH, self.to_scene(end), 14, 3)
             self._draw_bars(run)
+        if self.name == "planning":
+            self._draw_planning(run)
         for trail, colour in zip(self.trails, (TRAIL, TRAIL_B), strict=False):
             if len(trail) > 1:
                 pygame.draw.lines(scene, colour, False, list(trail), 3)

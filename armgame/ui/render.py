@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import pygame
 
 from ..game.session import GameSession
+from ..words import plural
 
 BACKGROUND = (255, 255, 255)
 LINK = (70, 70, 80)
@@ -104,7 +105,7 @@ class GameRenderer:
         elif session.over:
             board = session.rules.board
             self._banner(screen, view, f"Your score: {board.score}",
-                         f"{board.hits} hits, {board.resets} resets   -   Esc to quit")
+                         f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}   -   Esc to quit")
 
     def _draw_hud(self, screen: pygame.Surface, view: Viewport, session: GameSession) -> None:
         unit = view.scale / 500.0  # HUD sizes are designed for the 2012 game's 500 px per metre
