@@ -227,6 +227,8 @@ class ScoreTable:
         """Save ``replay`` beside the table and enter its game; returns the new entry."""
         if replay.player is None:
             raise ValueError("a game enters the table under a player's name")
+        if replay.task is not None:
+            raise ValueError("a lab run is not a game: it never enters the high-score table")
         if not replay.complete:
             raise ValueError("only a game played to the end enters the table")
         entry_id = uuid.uuid4().hex
@@ -288,6 +290,8 @@ class ScoreTable:
             replay = Replay.from_bytes(data, str(path))
         except DataFileError as exc:
             return Check(False, "BAD REPLAY", str(exc))
+        if replay.task is not None:
+            return Check(False, "NOT A GAME", f"{path.name} is a lab run, which is never ranked")
         r = replay.result
         claimed = {"name": replay.player, "score": r.score, "hits": r.hits, "resets": r.resets, "seed": r.seed,
                    "scene": r.scene, "duration": r.duration, "driven": replay.driven}

@@ -1,0 +1,78 @@
+"""The task section of a lab replay: the protocol a run played and the trials it produced.
+
+A lab run is recorded as any game is (``armgame.records.replay``: its ``GameConfig``, input
+timeline and result), plus this section. Verifying replays the timeline on a fresh
+``LabSession`` of the same protocol and compares the result AND every trial (target, go-cue
+step, end step, hit), so a replay that verifies is the data ``armgame analyze`` measures.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ..game.rules import GameConfig
+from ..game.session import GameResult, InputEvent
+from ..records.storage import check_int, check_keys, check_str
+from .protocol import Protocol, protocol_from_dict
+from .session import LAB_SCENE, LabSession
+
+TASK_KIND = "centre-out"
+
+Trial = tuple[int, int, int, bool]
+
+
+@dataclass(frozen=True)
+class LabTask:
+    protocol: Protocol
+    #: Each finished trial as (target, go_step, end_step, hit).
+    trials: tuple[Trial, ...]
+
+    @classmethod
+    def of(cls, session: LabSession) -> LabTask:
+        return cls(session.protocol, tuple((t, g, e, h) for t, g, e, h in session.trial_records()))  # type: ignore[misc]
+
+    def as_dict(self) -> dict[str, object]:
+        return {"kind": TASK_KIND, "protocol": self.protocol.as_dict(), "trials": [list(t) for t in self.trials]}
+
+    @classmethod
+    def from_dict(cls, data: object, config: GameConfig, last_step: int) -> LabTask:
+        """Rebuild and check a task section; raises ValueError naming the bad field."""
+        d = check_keys("task", data, {"kind", "protocol", "trials"})
+        kind = check_str("task.kind", d["kind"], 40)
+        if kind != TASK_KIND:
+            raise ValueError(f"task.kind must be {TASK_KIND!r}, got {kind!r}")
+        if config.scene != LAB_SCENE:
+            raise ValueError(f"a replay with a task must have scene {LAB_SCENE!r}, got {config.scene!r}")
+        try:
+            protocol = protocol_from_dict(d["protocol"], "task.protocol")
+        except ValueError as exc:
+            raise ValueError(f"task.protocol: {exc}") from None
+        trials_data = d["trials"]
+        if not isinstance(trials_data, list) or len(trials_data) > protocol.trials:
+            raise ValueError(f"task.trials must be a list of at most {protocol.trials} trials")
+        trials = []
+        for i, item in enumerate(trials_data):
+            where = f"task.trials[{i}]"
+            if not isinstance(item, list) or len(item) != 4 or not isinstance(item[3], bool):
+                raise ValueError(f"{where} must be [target, go_step, end_step, hit]")
+            target = check_int(f"{where} target", item[0], 0, protocol.targets - 1)
+            go = check_int(f"{where} go_step", item[1], 0, last_step)
+            end = check_int(f"{where} end_step", item[2], go, last_step)
+            trials.append((target, go, end, item[3]))
+        return cls(protocol, tuple(trials))
+
+    def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> LabSession:
+        """The run re-simulated from its timeline: the session, with every trial's hand path."""
+        session = LabSession(config, self.protocol)
+        session.play(timeline, steps)
+        return session
+
+    def verify(self, config: GameConfig, timeline: Sequence[InputEvent],
+               result: GameResult) -> tuple[bool, GameResult, LabSession]:
+        from ..records.replay import same_outcome
+
+        session = self.session(config, timeline, result.steps)
+        recomputed = session.result()
+        same_trials = tuple(tuple(t) for t in session.trial_records()) == self.trials
+        return same_outcome(recomputed, result) and same_trials, recomputed, session
