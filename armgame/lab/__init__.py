@@ -1,8 +1,11 @@
-"""The adaptation lab: a centre-out reaching task on the game's session, its perturbations, bots and measures.
+"""The dynamics lab: adaptation experiments measured per reach. Pure Python and numpy; no pygame.
 
-Pure (no pygame): ``protocol`` (blocks, presets, TOML files), ``perturbations`` (force fields and
-visual transforms per trial), ``session`` (``LabSession``, the task on ``GameSession``), ``bots``
-(the adapting bot), ``record`` (the task section of a lab replay), ``runs`` (headless runs and
-their outputs), and the metrics helper's ``metrics``, ``learner`` and ``figures``. The window is
-``armgame.ui.lab_window``; the commands are ``armgame lab`` and ``armgame analyze``.
+``protocol`` (blocks of baseline, exposure and washout trials, catch trials, presets and
+teachers' TOML files), ``perturbations`` (each trial's force field or visual transform),
+``session`` (``LabSession``: the centre-out task on the game's fixed-step session), ``bots``
+(the game's bots in the lab, and the adapting bot), ``record`` (the task section of a lab
+replay), ``analysis`` (rows and figures of a run), ``metrics`` (per-reach metrics from hand
+paths), ``learner`` (the trial-by-trial state-space learner) and ``figures`` (matplotlib, imported
+only when a figure is drawn). The window is ``armgame.ui.lab_window``; the commands are
+``armgame lab`` and ``armgame analyze``.
 """
