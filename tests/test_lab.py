@@ -215,6 +215,21 @@ def test_curl_scaling_deflects_the_model_bot_by_centimetres():
     assert 0.015 < -np.mean(deflections) < 0.05, deflections
 
 
+def test_a_bot_that_knows_the_field_counters_it_with_its_keys():
+    """A bot whose internal model holds the preset's field (b^ = b, no learning) cancels it within its
+    muscles' strength and reaches as straight as without a field."""
+    p = Protocol("scan", (Block("exposure", 8, Perturbation.make("curl", b=CURL_B)),))
+    knowing = make_lab_bot("adaptive")
+    knowing.curl_learner.slow = CURL_B
+    knowing.curl_learner.retention_slow, knowing.curl_learner.rate_slow, knowing.curl_learner.rate_fast = 1.0, 0, 0
+    session = LabSession(lab_config(p, 3), p)
+    Autopilot(session, knowing).play()
+    assert session.result().hits == 8
+    assert max(abs(perpendicular(session, o)) for o in session.outcomes) < 0.01
+    # Its own measurement of the field it met (the learner's input) is close to the truth.
+    assert all(abs(b - CURL_B) < 0.1 * CURL_B for _, b, *_ in knowing.history)
+
+
 @pytest.mark.parametrize("show, x, y, q, expected", [
     (rotation(90.0, (1.0, 1.0)), 2.0, 1.0, (0, 0), (1.0, 2.0)),
     (mirror(90.0, (1.0, 1.0)), 1.5, 1.2, (0, 0), (0.5, 1.2)),

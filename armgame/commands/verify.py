@@ -47,6 +47,9 @@ def _verify_replay(path) -> int:
     r = replay.result
     who = f"{replay.player}'s game" if replay.player else "game"
     about = f"{who} ({replay.driven}, seed {r.seed}, {r.duration:g} s)"
+    if replay.task is not None:  # a lab run: its trials were compared too
+        who = f"{replay.player}'s lab run" if replay.player else "lab run"
+        about = f"{who} ({replay.task.protocol.name}, {replay.driven}, seed {r.seed}, {len(replay.task.trials)} trials)"
     if ok:
         print(f"{path}: matches: {about}: score {r.score}, {r.hits} hits, {r.resets} resets")
         return 0

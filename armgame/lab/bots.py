@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 from ..errors import UserError
 from ..game.bots import ReachingBot
+from .learner import TwoRateLearner
 from .session import LabSession
 
 LAB_BOT_NAMES = ("model", "naive", "adaptive")
@@ -39,18 +40,13 @@ LAB_BOT_NAMES = ("model", "naive", "adaptive")
 
 @dataclass(frozen=True)
 class LearningRates:
-    """The two-rate learner's retention (A) and learning (B) rates, fast and slow (Smith et al. 2006's values)."""
+    """The two-rate learner's retention (A) and learning (B) rates, fast and slow: Smith et al. 2006's values
+    by default. ``TwoRateLearner`` checks them (0 to 1, the fast process forgetting and learning faster)."""
 
     retention_fast: float = 0.59
     retention_slow: float = 0.992
     rate_fast: float = 0.21
     rate_slow: float = 0.02
-
-    def __post_init__(self) -> None:
-        for name in ("retention_fast", "retention_slow", "rate_fast", "rate_slow"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and 0.0 <= value <= 1.0):
-                raise UserError(f"the learner's {name.replace('_', ' ')} must be from 0 to 1, got {value!r}")
 
 
 class LabBot(ReachingBot):
@@ -61,10 +57,9 @@ class LabBot(ReachingBot):
         self.rates = rates
         self._trial: int | None = None
         self._log: list[tuple[float, float, float, float, float, float, float, float, float, float]] = []
-        self.curl_learner = self.rotation_learner = None
+        self.curl_learner: TwoRateLearner | None = None
+        self.rotation_learner: TwoRateLearner | None = None
         if rates is not None:
-            from .learner import TwoRateLearner
-
             self.curl_learner = TwoRateLearner(rates.retention_fast, rates.retention_slow, rates.rate_fast,
                                                rates.rate_slow)
             self.rotation_learner = TwoRateLearner(rates.retention_fast, rates.retention_slow, rates.rate_fast,
