@@ -241,11 +241,7 @@ def write_trials_csv(path: Path, rows: Iterable[Mapping[str, object]]) -> None:
             what = f"lacks {', '.join(sorted(missing))}" if missing else f"has unknown {', '.join(sorted(unknown))}"
             raise ValueError(f"trial row {n} {what}")
         writer.writerow([_format(name, row[name], n) for name in TRIAL_COLUMNS])
-    _check_writable(path)
-    try:
-        atomic_write_bytes(path, out.getvalue().encode("utf-8"))
-    except OSError as exc:
-        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+    _write_text(path, out.getvalue())
 
 
 def read_trials_csv(path: Path) -> list[dict[str, object]]:
@@ -297,6 +293,36 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
     except csv.Error as exc:
         raise TrialsFileError(f"{path}: line {reader.line_num}: not CSV: {exc}") from None
     return rows
+
+
+CLASS_COLUMNS: tuple[str, ...] = ("trial", "block", "perturbation", "mean", "sem", "n")
+
+
+def write_class_csv(path: Path, curve: Iterable[Mapping[str, object]]) -> None:
+    """Write a class curve (``figures.class_curve``): one row per trial, ``CLASS_COLUMNS``, atomically.
+
+    ``mean`` and ``sem`` are in the measure's own unit; NaN (no data, or fewer than two students)
+    is an empty field. Same file rules as ``write_trials_csv``.
+    """
+    path = Path(path)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(CLASS_COLUMNS)
+    for n, row in enumerate(curve, start=1):
+        if set(row) != set(CLASS_COLUMNS):
+            raise ValueError(f"class curve row {n} must have exactly the fields {', '.join(CLASS_COLUMNS)}")
+        writer.writerow([_format("trial", row["trial"], n), _format("block", row["block"], n),
+                         _format("perturbation", row["perturbation"], n), _format("mean", row["mean"], n),
+                         _format("sem", row["sem"], n), _format("trial", row["n"], n)])
+    _write_text(path, out.getvalue())
+
+
+def _write_text(path: Path, text: str) -> None:
+    check_regular_target(path)
+    try:
+        atomic_write_bytes(path, text.encode("utf-8"))
+    except OSError as exc:
+        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
 def _format(name: str, value: object, n: int) -> str:
@@ -357,7 +383,12 @@ def _show(value: object) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _check_writable(path: Path) -> None:
+def check_regular_target(path: Path) -> None:
+    """Refuse to write ``path`` unless it is absent (in an existing folder) or a regular file (``UserError``).
+
+    A symbolic link is refused too: the atomic rename would replace the link, not write where it points,
+    which surprises whoever made it.
+    """
     try:
         info = os.lstat(path)
     except FileNotFoundError:
