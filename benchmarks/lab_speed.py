@@ -5,8 +5,8 @@
 Every case runs the same 60 s busy key timeline (benchmarks/game_speed.py's) headless; the
 timings are interleaved and each figure is the fastest of its repeats, so load elsewhere on a
 shared machine skews them alike. ``--base DIR`` adds the game as built by another checkout
-(e.g. ``git archive`` of the commit before loads existed) run in a child process the same way:
-the game's own loop must not have moved.
+(e.g. ``git archive`` of the commit before loads existed) and the game as built by this one, each
+run in a fresh child process the same way: the game's own loop must not have moved.
 """
 
 from __future__ import annotations
@@ -27,6 +27,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from game_speed import busy_timeline
 
 SECONDS = 60.0
+_CHILD = """
+import sys, time
+sys.path[:0] = [{checkout!r}, {checkout!r} + "/benchmarks"]
+from armgame.game.rules import GameConfig
+from armgame.game.session import GameSession
+from game_speed import busy_timeline
+session = GameSession(GameConfig(time_limit=60.0))
+timeline = busy_timeline(session.config.dt, 60.0)
+start = time.perf_counter()
+session.play(timeline)
+print(time.perf_counter() - start)
+"""
 
 
 def _protocol(p: Perturbation) -> Protocol:
@@ -56,22 +68,20 @@ def main() -> None:
     makers = cases()
     timeline = busy_timeline(GameConfig().dt, SECONDS)
     best = {name: float("inf") for name in makers}
-    if args.base:
-        best["game (base)"] = float("inf")
-    child = (f"import sys, time; sys.path.insert(0, {args.base!r}); sys.path.insert(0, {args.base + '/benchmarks'!r});"
-             "from armgame.game.rules import GameConfig; from armgame.game.session import GameSession;"
-             "from game_speed import busy_timeline; s = GameSession(GameConfig(time_limit=60.0));"
-             "t = busy_timeline(s.config.dt, 60.0); a = time.perf_counter(); s.play(t);"
-             "print(time.perf_counter() - a)") if args.base else ""
+    here = str(Path(__file__).resolve().parent.parent)
+    children = {"game, child process (this checkout)": here, "game, child process (base)": args.base} \
+        if args.base else {}
+    best.update({name: float("inf") for name in children})
     for _ in range(args.repeats):
         for name, make in makers.items():
             session = make()
             start = time.perf_counter()
             session.play(timeline, round(SECONDS / session.config.dt))
             best[name] = min(best[name], time.perf_counter() - start)
-        if args.base:
-            out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, check=True)
-            best["game (base)"] = min(best["game (base)"], float(out.stdout))
+        for name, checkout in children.items():
+            out = subprocess.run([sys.executable, "-c", _CHILD.format(checkout=checkout)], capture_output=True,
+                                 text=True, check=True)
+            best[name] = min(best[name], float(out.stdout))
     game = best["game"]
     print(json.dumps({name: {"wall_seconds": round(t, 4), "times_real_time": round(SECONDS / t, 1),
                              "cost_vs_game": round(t / game, 3)} for name, t in best.items()}, indent=1))

@@ -96,6 +96,34 @@ def test_analyze_leaves_out_what_does_not_verify(tmp_path, capsys):
     assert len(read_trials_csv(tmp_path / "t.csv")) == 16
 
 
+def test_class_curve_merges_verified_students(tmp_path, capsys):
+    folder = _short_runs(tmp_path, [1, 2, 3])
+    data = json.loads((folder / "student3.json").read_text())
+    data["task"]["trials"][0][3] = not data["task"]["trials"][0][3]  # a miss recorded as a hit, or back
+    (folder / "cheat.json").write_text(json.dumps(data))
+    game = tmp_path / "game.json"
+    assert main(["play", "--headless", "--duration", "1", "--record", str(game)]) == 0
+    (folder / "game.json").write_bytes(game.read_bytes())
+    capsys.readouterr()
+    code = main(["analyze", "--class", str(folder), "--out", str(tmp_path / "curve"), "--no-figures"])
+    captured = capsys.readouterr()
+    assert code == 1, captured.err
+    assert "cheat.json: DIFFERS" in captured.err and "game.json: a game, not a lab run" in captured.err
+    lines = (tmp_path / "curve" / "class_curve.csv").read_text().splitlines()
+    assert lines[0] == "trial,block,perturbation,mean,sem,n"
+    assert "class curve of 3 students (2 left out), 16 trials, max_perpendicular_error_m" in captured.out
+    assert len(lines) == 17 and all(line.endswith(",3") for line in lines[1:])
+    # The mean is the mean over the three students' own tables.
+    students = []
+    for seed in (1, 2, 3):
+        assert main(["analyze", str(folder / f"student{seed}.json"), "--out", str(tmp_path / f"s{seed}.csv")]) == 0
+        students.append(read_trials_csv(tmp_path / f"s{seed}.csv"))
+    fifth = lines[5].split(",")
+    values = [s[4]["max_perpendicular_error_m"] for s in students]
+    assert float(fifth[3]) == pytest.approx(np.mean(values), rel=1e-12)
+    assert float(fifth[4]) == pytest.approx(np.std(values, ddof=1) / np.sqrt(3), rel=1e-12)
+
+
 @pytest.mark.parametrize("argv, message", [
     (["lab", "curl", "--headless"], "--headless needs a --bot"),
     (["lab", "spiral"], "unknown lab protocol 'spiral'"),

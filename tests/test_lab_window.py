@@ -40,7 +40,7 @@ def screen():
 def view_of(win):
     s = win.session
     hx, hy = s.home
-    span = max(0.12, 1.9 * s.protocol.distance)
+    span = max(0.08, 1.45 * s.protocol.distance)
     return Viewport.fit(win.screen.get_size(), (hx - span, hx + span, hy - span, hy + 1.35 * span))
 
 

@@ -21,8 +21,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "reaction_time, movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m, "
         "path_length_ratio, hit). A replay that does not verify is reported and left out. With --class DIR: "
         "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
-        "per trial: class_curve.csv and class_curve.png in --out. Exit status: 0 if every replay was analysed, "
-        "1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
+        "per trial of --metric: class_curve.csv and class_curve.png in --out. Exit status: 0 if every replay "
+        "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
     )
     p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
     p.add_argument("--out", metavar="PATH", required=True,
@@ -107,6 +107,7 @@ def _replays(args: argparse.Namespace) -> int:
 def _class(args: argparse.Namespace) -> int:
     from ..lab.analysis import figure_metric
     from ..lab.figures import class_curve
+    from ..lab.metrics import write_class_csv
 
     folder = Path(args.class_dir)
     if not folder.is_dir():
@@ -146,7 +147,7 @@ def _class(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
     csv_path = out / "class_curve.csv"
-    write_class_csv(csv_path, curve, metric)
+    write_class_csv(csv_path, curve)
     written = [csv_path]
     if not args.no_figures:
         from ..lab.figures import class_figure
@@ -157,25 +158,3 @@ def _class(args: argparse.Namespace) -> int:
     for path in written:
         print(f"wrote {path}")
     return 1 if skipped else 0
-
-
-def write_class_csv(path: Path, curve, metric: str) -> None:
-    """trial, block, perturbation, mean, sem, n (the metric named in the header's mean and sem columns)."""
-    import csv
-    import io
-    import math
-
-    from ..records.storage import atomic_write_bytes
-
-    if path.is_symlink() or (path.exists() and not path.is_file()):
-        raise UserError(f"{path}: not a regular file: not overwritten")
-    text = io.StringIO()
-    writer = csv.writer(text, lineterminator="\n")
-    writer.writerow(["trial", "block", "perturbation", f"mean_{metric}", f"sem_{metric}", "n"])
-    for c in curve:
-        writer.writerow([c["trial"], c["block"], c["perturbation"],
-                         *("" if not math.isfinite(c[k]) else repr(float(c[k])) for k in ("mean", "sem")), c["n"]])
-    try:
-        atomic_write_bytes(path, text.getvalue().encode("utf-8"))
-    except OSError as exc:
-        raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None

@@ -114,7 +114,10 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
         from .protocol import target_positions
 
         learning_figure(rows, out / "learning.png", metric=figure_metric(session.protocol))
+        perturbed = [b.perturbation.label() for b in session.protocol.blocks if b.perturbation.kind != "none"]
+        caption = f"{session.protocol.name}: {', '.join(dict.fromkeys(perturbed)) or 'no perturbation'}; " \
+                  f"seed {session.config.seed}"
         paths_figure(path_groups(session), session.home, target_positions(session.protocol, session.home),
-                     out / "paths.png")
+                     out / "paths.png", target_radius=session.protocol.target_radius, caption=caption)
         written += [out / "learning.png", out / "paths.png"]
     return written

@@ -34,7 +34,7 @@ class LabRenderer(GameRenderer):
              paused: bool = False, name: str | None = None) -> None:
         hx, hy = session.home
         reach = session.protocol.distance
-        span = max(0.12, 1.9 * reach)
+        span = max(0.08, 1.45 * reach)
         view = Viewport.fit(screen.get_size(), (hx - span, hx + span, hy - span, hy + 1.35 * span))
         screen.fill(BACKGROUND)
         for x, y in target_positions(session.protocol, session.home):
