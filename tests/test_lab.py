@@ -313,3 +313,55 @@ def test_lab_runs_never_enter_the_high_score_table(tmp_path):
     assert replay.task is not None
     with pytest.raises(ValueError, match="never enters the high-score table"):
         ScoreTable(tmp_path / "scores").add(replay)
+
+
+# ------------------------------------------------------------ the adapting bot
+def adaptive_run(perturbation: Perturbation, rates=None, exposure=24, catch=0, seed=4):
+    from armgame.lab.bots import LearningRates
+
+    blocks = (Block("baseline", 8, Perturbation()), Block("exposure", exposure, perturbation, catch),
+              Block("washout", 8, Perturbation()))
+    p = Protocol("fast", blocks, timeout=1.5)
+    session = LabSession(lab_config(p, seed), p)
+    bot = make_lab_bot("adaptive", rates or LearningRates(0.6, 0.99, 0.4, 0.1))
+    Autopilot(session, bot).play()
+    return session, bot
+
+
+def test_adaptive_bot_learns_a_visual_rotation():
+    """Initial direction error starts near the rotation (+30 deg, counter-clockwise), decays as the bot
+    aims the other way, and errs clockwise on the first washout trials."""
+    from armgame.lab.analysis import trial_rows
+
+    session, bot = adaptive_run(Perturbation.make("rotation", angle=30.0))
+    rows = trial_rows(session)
+    error = {b: np.array([r["initial_direction_error_deg"] for r in rows if r["block"] == b])
+             for b in ("baseline", "exposure", "washout")}
+    assert abs(error["baseline"].mean()) < 6.0
+    assert 20.0 < error["exposure"][0] < 40.0
+    assert abs(error["exposure"][-8:].mean()) < 0.5 * error["exposure"][0]
+    assert error["washout"][:2].mean() < -10.0
+    measured = [h[3] for h in bot.history if session.plans[h[0]].active.kind == "rotation"]
+    assert np.allclose(np.degrees(measured), 30.0, atol=1.0)  # what it saw against what it felt
+
+
+def test_catch_trials_show_the_learned_field():
+    """On a catch trial late in exposure the field is off but the bot still expects it: the reach errs
+    the other way (counter-clockwise), an after-effect within the exposure block."""
+    session, _ = adaptive_run(Perturbation.make("curl", b=CURL_B), exposure=32, catch=3)
+    late = [o for o in session.outcomes if o.plan.block == 1 and o.plan.index >= 8 + 16]
+    catch = [perpendicular(session, o) for o in session.outcomes if o.plan.catch]
+    assert len(catch) == 3
+    assert [o.plan.catch for o in session.outcomes].count(True) == 3
+    field = [perpendicular(session, o) for o in late if not o.plan.catch]
+    assert np.mean(field) < 0 and all(c > 0.01 for c in catch)
+
+
+def test_a_bot_that_does_not_learn_shows_no_after_effect():
+    from armgame.lab.bots import LearningRates
+
+    session, bot = adaptive_run(Perturbation.make("curl", b=CURL_B), rates=LearningRates(0.59, 0.992, 0.0, 0.0))
+    washout = [perpendicular(session, o) for o in session.outcomes if o.plan.block == 2]
+    exposure = [perpendicular(session, o) for o in session.outcomes if o.plan.block == 1]
+    assert bot.curl_estimate == 0.0
+    assert max(abs(w) for w in washout) < 0.006 and np.mean(exposure[-8:]) < -0.015

@@ -139,3 +139,21 @@ def test_command_errors_are_one_line(argv, message, capsys, monkeypatch, tmp_pat
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "\n" not in err and err.startswith(f"armgame {argv[0]}: error:")
+
+
+def test_lab_out_writes_the_figures(tmp_path, capsys):
+    protocol = tmp_path / "short.toml"
+    protocol.write_text(SHORT)
+    assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--out", str(tmp_path / "run")]) == 0
+    out = capsys.readouterr().out
+    for name in ("trials.csv", "learning.png", "paths.png"):
+        assert f"wrote {tmp_path / 'run' / name}" in out and (tmp_path / "run" / name).is_file()
+    assert (tmp_path / "run" / "learning.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "run" / "paths.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert len(read_trials_csv(tmp_path / "run" / "trials.csv")) == 16
+
+
+def test_replay_headless_recomputes_a_lab_run(curl_run, capsys):
+    assert main(["replay", str(curl_run / "curl.json"), "--headless", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert (result["hits"], result["scene"]) == (120, "lab")

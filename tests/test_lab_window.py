@@ -78,3 +78,21 @@ def test_a_bot_in_the_window_plays_the_headless_trials(screen):
         frames += 1
     assert session.trial_records() == headless.trial_records()
     win.frame(0.0)  # the end banner draws
+
+
+def test_a_lab_replay_plays_back_in_the_lab_window(screen):
+    """armgame replay of a lab run: the timeline drives a LabSession in the lab window, to the same trials."""
+    from armgame.game.timeline import TimelineDriver
+    from armgame.lab.record import LabTask
+
+    recorded = LabSession(lab_config(PROTOCOL, 5), PROTOCOL)
+    Autopilot(recorded, make_lab_bot("model")).play()
+    task = LabTask.of(recorded)
+    session = task.new_session(recorded.config)
+    driver = TimelineDriver(session, recorded.timeline, recorded.steps)
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0, driver=driver)
+    frames = 0
+    while not driver.done and frames < 1000:
+        win.frame(0.25)
+        frames += 1
+    assert session.trial_records() == recorded.trial_records() and session.state == recorded.state

@@ -76,9 +76,13 @@ class LabTask:
             raise ValueError("task.paths_sha256 must be 64 hexadecimal digits")
         return cls(protocol, tuple(trials), digest)
 
+    def new_session(self, config: GameConfig) -> LabSession:
+        """A fresh session of this task, at its start (for a window to replay the timeline into)."""
+        return LabSession(config, self.protocol)
+
     def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> LabSession:
         """The run re-simulated from its timeline: the session, with every trial's hand path."""
-        session = LabSession(config, self.protocol)
+        session = self.new_session(config)
         session.play(timeline, steps)
         return session
 
