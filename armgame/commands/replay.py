@@ -41,7 +41,8 @@ def run(args: argparse.Namespace) -> int:
     else:
         if not 1 <= args.fps <= 1000:
             raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
-        session = GameSession(replay.config)
+        # A lab run is watched on its own task's session and window.
+        session = replay.task.new_session(replay.config) if replay.task is not None else GameSession(replay.config)
         _watch(session, replay, args)
         result, played = session.result(), session.steps
     if args.json:
@@ -77,6 +78,11 @@ def _watch(session, replay, args: argparse.Namespace) -> None:
     try:
         pygame.display.set_caption(f"armgame replay - {replay.player or 'a game'}, seed {replay.config.seed}")
         driver = TimelineDriver(session, replay.timeline, replay.steps)
-        GameWindow(session, screen, fps=args.fps, driver=driver).run()
+        if replay.task is not None:
+            from ..ui.lab_window import LabWindow
+
+            LabWindow(session, screen, fps=args.fps, driver=driver).run()
+        else:
+            GameWindow(session, screen, fps=args.fps, driver=driver).run()
     finally:
         pygame.display.quit()

@@ -86,6 +86,10 @@ def _report(path, replay, ok: bool, got) -> int:
     r = replay.result
     who = f"{replay.player}'s game" if replay.player else "game"
     about = f"{who} ({ruleset_name(replay.config)} rules, {replay.driven}, seed {r.seed}, {r.duration:g} s)"
+    if replay.task is not None:  # a lab run: its trials were compared too
+        who = f"{replay.player}'s lab run" if replay.player else "lab run"
+        about = (f"{who} ({replay.task.protocol.name}, {replay.driven}, seed {r.seed}, "
+                 f"{plural(len(replay.task.trials), 'trial')})")
     if ok:
         print(f"{path}: matches: {about}: score {r.score}, {plural(r.hits, 'hit')}, {plural(r.resets, 'reset')}")
         return 0

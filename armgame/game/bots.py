@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -186,6 +187,11 @@ class ReachingBot:
         self._plan: _Plan | None = None
         self._setup: tuple | None = None
         self._history: deque = deque()
+        #: What the bot believes pushes on the arm besides its muscles, ``(q1, q2, w1, w2) -> (t1, t2)`` N m,
+        #: and where it aims for a target, ``(x, y) -> (x, y)``: None in the game; the lab's adapting bot
+        #: (armgame/lab/bots.py) learns both.
+        self.load_estimate: Callable[[float, float, float, float], tuple[float, float]] | None = None
+        self.aim: Callable[[float, float], tuple[float, float]] | None = None
 
     def period_steps(self, dt: float) -> int:
         return max(1, round(self.control_period / dt))
@@ -219,7 +225,8 @@ class ReachingBot:
     def _replan(self, target: Target, state: tuple[float, float, float, float], now: float) -> None:
         assert self._model is not None and self._config is not None
         q1, q2, w1, w2 = state
-        f1, f2 = target_posture(self._config, target.x, target.y, q1)
+        x, y = (target.x, target.y) if self.aim is None else self.aim(target.x, target.y)
+        f1, f2 = target_posture(self._config, x, y, q1)
         # The plan starts at zero acceleration: the bot does not see acceleration.
         limit1, limit2 = self.TORQUE_MARGIN * self._strength(0), self.TORQUE_MARGIN * self._strength(1)
         model = self._model
@@ -229,9 +236,12 @@ class ReachingBot:
             fits = True
             for i in range(13):
                 t = duration * i / 12.0
-                _p1, v1, a1 = paths[0].at(t)
+                p1, v1, a1 = paths[0].at(t)
                 p2, v2, a2 = paths[1].at(t)
                 t1, t2 = model.torque(p2, v1, v2, a1, a2)
+                if self.load_estimate is not None:
+                    e1, e2 = self.load_estimate(p1, p2, v1, v2)
+                    t1, t2 = t1 - e1, t2 - e2
                 if abs(t1) > limit1 or abs(t2) > limit2:
                     fits = False
                     break
@@ -247,8 +257,12 @@ class ReachingBot:
         period = self._setup[0]
         accel = self._model.accel
         history = self._history
+        load = self.load_estimate
         q1, q2, w1, w2 = history[0][0]
         for _, _, t1, t2 in history:
+            if load is not None:
+                e1, e2 = load(q1, q2, w1, w2)
+                t1, t2 = t1 + e1, t2 + e2
             a1, a2 = accel(q2, w1, w2, t1, t2)
             w1 += a1 * period
             w2 += a2 * period
@@ -285,6 +299,9 @@ class ReachingBot:
         u2 = a2 + self.KP * (d2 - p2) + self.KD * (v2 - w2)
         i1, i2 = self._model.inertial(p2, u1, u2)
         c1, c2 = self._model.bias(p2, w1, w2)
+        if self.load_estimate is not None:
+            e1, e2 = self.load_estimate(p1, p2, w1, w2)
+            c1, c2 = c1 - e1, c2 - e2
         events: list[tuple[str, str]] = []
         act, held, keys = session.muscles.activation, session.held, session.muscles.keys
         applied = []

@@ -1,9 +1,11 @@
 """The dynamics lab: adaptation experiments measured per reach. Pure Python and numpy; no pygame.
 
-The lab owns the experiment protocols (blocks of baseline, exposure and washout trials, catch
-trials, presets and teachers' protocol files), the centre-out task that runs them on the game's
-fixed-step session, the per-reach metrics computed from re-simulated hand paths (``metrics``),
-the trial-by-trial state-space learner that drives the adapting bot (``learner``) and the
-figures a teacher shows (``figures``, which imports matplotlib only when a figure is drawn).
-The window that plays a protocol lives in ``armgame.ui``; the commands in ``armgame.commands``.
+``protocol`` (blocks of baseline, exposure and washout trials, catch trials, presets and
+teachers' TOML files), ``perturbations`` (each trial's force field or visual transform),
+``session`` (``LabSession``: the centre-out task on the game's fixed-step session), ``bots``
+(the game's bots in the lab, and the adapting bot), ``record`` (the task section of a lab
+replay), ``analysis`` (rows and figures of a run), ``metrics`` (per-reach metrics from hand
+paths), ``learner`` (the trial-by-trial state-space learner) and ``figures`` (matplotlib, imported
+only when a figure is drawn). The window is ``armgame.ui.lab_window``; the commands are
+``armgame lab`` and ``armgame analyze``.
 """

@@ -18,6 +18,7 @@ import re
 from dataclasses import dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 from .. import __version__
 from ..errors import UserError
@@ -245,6 +246,8 @@ class Replay:
     player: str | None = None
     date: str = ""
     version: str = __version__
+    #: A lab run's task section (``armgame.lab.record.LabTask``): the protocol and the trials; None for a game.
+    task: Any = None
 
     @property
     def steps(self) -> int:
@@ -264,16 +267,22 @@ class Replay:
 
     def with_player(self, player: str) -> Replay:
         return Replay(self.config, self.timeline, self.result, self.driven, self.driver, check_name(player),
-                      self.date, self.version)
+                      self.date, self.version, self.task)
 
     def replay(self) -> GameResult:
         """Recompute the result: the timeline replayed on a fresh session, no clock."""
+        if self.task is not None:
+            return self.task.session(self.config, self.timeline, self.result.steps).result()
         return GameSession(self.config).play(self.timeline, self.result.steps)
 
     def verify(self) -> tuple[bool, GameResult]:
         """Replay and compare. Bounded: the game is at most ``MAX_GAME_STEPS`` long (checked at load),
         and the replay stops as soon as it scores more hits or resets than recorded, so a replay
-        that claims little cannot make its verifier draw a target at every step for hours."""
+        that claims little cannot make its verifier draw a target at every step for hours. A lab
+        run is compared trial by trial as well (its length was checked at load like a game's)."""
+        if self.task is not None:
+            ok, recomputed, _ = self.task.verify(self.config, self.timeline, self.result)
+            return ok, recomputed
         session = GameSession(self.config)
         feed = TimelineInput(self.timeline, self.result.steps)
         claimed = self.result
@@ -301,7 +310,7 @@ class Replay:
             "config": config_to_dict(self.config),
             "timeline": [[e.step, e.key, e.action] for e in self.timeline],
             "result": self.result.as_dict(),
-        }
+        } | ({} if self.task is None else {"task": self.task.as_dict()})
 
     def to_bytes(self) -> bytes:
         return dump_json(self.as_dict())
@@ -318,7 +327,7 @@ class Replay:
         if not isinstance(data, dict) or data.get("format") != FORMAT:
             raise ValueError("not an armgame replay (no \"format\": \"armgame-replay\")")
         d = check_keys("replay", data, {"format", "format_version", "armgame_version", "date", "player", "driven",
-                                        "driver", "scene", "config", "timeline", "result"})
+                                        "driver", "scene", "config", "timeline", "result"}, frozenset({"task"}))
         fmt = check_int("format_version", d["format_version"], 1, 10**6)
         if fmt != FORMAT_VERSION:
             raise ValueError(f"replay format {fmt} is not supported by armgame {__version__} "
@@ -340,8 +349,13 @@ class Replay:
         driver = None if d["driver"] is None else check_str("driver", d["driver"], 200)
         player = None if d["player"] is None else check_name(d["player"])
         timeline = _timeline_from_list(d["timeline"], config, result.steps)
+        task = None
+        if "task" in d:
+            from ..lab.record import LabTask
+
+            task = LabTask.from_dict(d["task"], config, result.steps)
         return cls(config, timeline, result, driven, driver, player, check_date("date", d["date"]),
-                   check_word("armgame_version", d["armgame_version"]))
+                   check_word("armgame_version", d["armgame_version"]), task)
 
     @classmethod
     def from_bytes(cls, data: bytes, source: str = "replay") -> Replay:

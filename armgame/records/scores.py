@@ -362,6 +362,8 @@ class ScoreTable:
         """
         if replay.player is None:
             raise ValueError("a game enters the table under a player's name")
+        if replay.task is not None:
+            raise ValueError("a lab run is not a game: it never enters the high-score table")
         if not replay.complete:
             raise ValueError("only a game played to the end enters the table")
         # The replay first: a crash in between leaves a spare replay, never an entry without one.
@@ -510,12 +512,15 @@ class ScoreTable:
         if cached is not None:
             return digest, cached
         try:
-            return digest, Replay.from_bytes(data, str(path))
+            replay = Replay.from_bytes(data, str(path))
         except DataFileError as exc:
             cached = {"claims": None, "ok": False, "label": "BAD REPLAY", "detail": str(exc)}
             if self.cache:
                 self.cache.put(digest, cached)
             return digest, cached
+        if replay.task is not None:
+            return Check(False, "NOT A GAME", f"{path.name} is a lab run, which is never ranked")
+        return digest, replay
 
     @staticmethod
     def _judge(entry: ScoreEntry, cached: dict) -> Check:

@@ -1,0 +1,160 @@
+"""armgame analyze: per-reach measures of lab replays, verified first; a class's mean learning curve."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..errors import UserError
+
+#: A class folder is read up to this many replays: the work is bounded before it starts.
+MAX_CLASS_FILES = 500
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "analyze",
+        help="per-reach measures of lab replays (verified first), or a class's mean learning curve",
+        description="Re-simulate each lab replay from its input timeline, check that it reproduces its recorded "
+        "trials, and measure every reach: one row per reach (block, trial, target_deg, perturbation, "
+        "reaction_time, movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m, "
+        "path_length_ratio, hit). A replay that does not verify is reported and left out. With --class DIR: "
+        "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
+        "per trial of --metric: class_curve.csv and class_curve.png in --out. Exit status: 0 if every replay "
+        "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
+    )
+    p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
+    p.add_argument("--out", metavar="PATH", required=True,
+                   help="a .csv file (all reaches in one table), or a folder (one REPLAY.trials.csv each); "
+                   "with --class, the folder for class_curve.csv and class_curve.png")
+    p.add_argument("--class", dest="class_dir", metavar="DIR", help="a folder of students' lab replays")
+    p.add_argument("--metric", default=None,
+                   help="the class curve's measure (default: max_perpendicular_error_m for force fields, "
+                   "initial_direction_error_deg for visual transforms)")
+    p.add_argument("--no-figures", action="store_true", help="with --class: the CSV only (no matplotlib needed)")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.class_dir is not None:
+        if args.replays:
+            raise UserError("give replays or --class DIR, not both")
+        return _class(args)
+    if not args.replays:
+        raise UserError("no replay given: armgame analyze REPLAY... --out trials.csv (or --class DIR)")
+    if args.no_figures or args.metric:
+        raise UserError("--no-figures and --metric apply with --class only")
+    return _replays(args)
+
+
+def verified_rows(path: Path):
+    """(rows, session) of a lab replay that reproduces its trials; raises UserError otherwise."""
+    from ..lab.analysis import trial_rows
+    from ..records.replay import Replay, same_outcome
+
+    if path.is_symlink() or not path.is_file():
+        raise UserError(f"{path}: not a regular file")
+    replay = Replay.load(path)
+    if replay.task is None:
+        raise UserError(f"{path}: a game, not a lab run: nothing to analyse")
+    ok, recomputed, session = replay.task.verify(replay.config, replay.timeline, replay.result)
+    if not ok:
+        same = same_outcome(recomputed, replay.result)
+        why = "its trials differ" if same else f"its result differs ({recomputed.hits} hits, not {replay.result.hits})"
+        raise UserError(f"{path}: DIFFERS: the replay does not reproduce its recording ({why}): not analysed")
+    return trial_rows(session), session
+
+
+def _replays(args: argparse.Namespace) -> int:
+    from ..lab.metrics import write_trials_csv
+
+    out = Path(args.out).expanduser()
+    one_table = out.suffix.lower() == ".csv"
+    if one_table and not out.resolve().parent.is_dir():
+        raise UserError(f"--out {args.out}: its folder does not exist")
+    if not one_table and out.exists() and not out.is_dir():
+        raise UserError(f"--out {args.out}: not a folder (give a .csv file for one table)")
+    table: list[dict[str, object]] = []
+    skipped = 0
+    written = []
+    for name in args.replays:
+        path = Path(name)
+        try:
+            rows, session = verified_rows(path)
+        except UserError as exc:
+            print(f"armgame analyze: {exc}", file=sys.stderr)
+            skipped += 1
+            continue
+        print(f"{path}: verified: {session.protocol.name}, seed {session.config.seed}, {len(rows)} reaches")
+        if one_table:
+            table += rows
+        else:
+            out.mkdir(parents=True, exist_ok=True)
+            target = out / f"{path.stem}.trials.csv"
+            write_trials_csv(target, rows)
+            written.append(target)
+    if skipped == len(args.replays):
+        raise UserError("no replay could be analysed")
+    if one_table:
+        write_trials_csv(out, table)
+        written.append(out)
+    for path in written:
+        print(f"wrote {path}")
+    return 1 if skipped else 0
+
+
+def _class(args: argparse.Namespace) -> int:
+    from ..lab.analysis import figure_metric
+    from ..lab.figures import class_curve
+    from ..lab.metrics import write_class_csv
+
+    folder = Path(args.class_dir)
+    if not folder.is_dir():
+        raise UserError(f"--class {args.class_dir}: not a folder")
+    out = Path(args.out).expanduser()
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {args.out}: not a folder")
+    if not args.no_figures:
+        from ..lab.figures import require_matplotlib
+
+        require_matplotlib()
+    files = sorted(p for p in folder.iterdir() if p.suffix.lower() == ".json")
+    if not files:
+        raise UserError(f"{folder}: no replays (*.json) there")
+    if len(files) > MAX_CLASS_FILES:
+        raise UserError(f"{folder}: {len(files)} replays, more than a class curve reads ({MAX_CLASS_FILES})")
+    students, protocol, skipped = [], None, 0
+    for path in files:
+        try:
+            rows, session = verified_rows(path)
+            if protocol is not None and session.protocol != protocol:
+                raise UserError(f"{path}: protocol {session.protocol.name!r} differs from the class's "
+                                f"({protocol.name!r}, from {files[0].name}): not in the curve")
+        except UserError as exc:
+            print(f"armgame analyze: {exc}", file=sys.stderr)
+            skipped += 1
+            continue
+        protocol = protocol or session.protocol
+        students.append(rows)
+        print(f"{path.name}: verified: {len(rows)} reaches")
+    if not students:
+        raise UserError(f"{folder}: no replay could be analysed")
+    metric = args.metric or figure_metric(protocol)
+    curve = class_curve(students, metric)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
+    csv_path = out / "class_curve.csv"
+    write_class_csv(csv_path, curve)
+    written = [csv_path]
+    if not args.no_figures:
+        from ..lab.figures import class_figure
+
+        class_figure(curve, out / "class_curve.png", metric=metric)
+        written.append(out / "class_curve.png")
+    print(f"class curve of {len(students)} students ({skipped} left out), {len(curve)} trials, {metric}")
+    for path in written:
+        print(f"wrote {path}")
+    return 1 if skipped else 0

@@ -1,0 +1,197 @@
+"""armgame lab: centre-out adaptation experiments, played in a window or by a bot headless."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from ..errors import UserError
+from .play import DEFAULT_SEED, _seed, _size
+
+
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number from 0 to 1, got {text!r}") from None
+    if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+        raise argparse.ArgumentTypeError(f"must be from 0 to 1, got {text!r}")
+    return value
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 0 <= value <= 1000:
+        raise argparse.ArgumentTypeError(f"must be from 0 to 1000, got {text!r}")
+    return value
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    from ..lab.protocol import PRESETS
+
+    p = subparsers.add_parser(
+        "lab",
+        help="adaptation experiments: centre-out reaches in a force field or a changed display",
+        description="Reach from home to targets around it, in blocks: baseline (nothing changed), exposure "
+        "(a force field or a changed display), washout (back to normal). PROTOCOL is a preset ("
+        + ", ".join(PRESETS) + ") or a TOML protocol file. In a window you play with the muscle keys (d f j k); "
+        "--bot lets a bot play (model, naive, or adaptive: the model bot learning the perturbation trial by "
+        "trial with a two-rate learner). --out DIR writes trials.csv (one row per reach), learning.png and "
+        "paths.png; --record FILE saves the run as a replay that 'armgame verify' and 'armgame analyze' check.",
+    )
+    p.add_argument("protocol", metavar="PROTOCOL", help=f"a preset ({', '.join(PRESETS)}) or a .toml file")
+    p.add_argument("--seed", type=_seed, default=DEFAULT_SEED,
+                   help=f"target order and go-cue delays (default: {DEFAULT_SEED})")
+    p.add_argument("--bot", metavar="NAME", help="a bot plays: model, naive or adaptive")
+    p.add_argument("--headless", action="store_true", help="no window (needs --bot): run as fast as possible")
+    p.add_argument("--out", metavar="DIR", help="write trials.csv, learning.png and paths.png to DIR")
+    p.add_argument("--no-figures", action="store_true", help="with --out: trials.csv only (no matplotlib needed)")
+    p.add_argument("--record", metavar="FILE", help="save the run's replay to FILE (JSON)")
+    p.add_argument("--name", help="the player's name, kept in the replay (never in the high-score table)")
+    p.add_argument("--catch", type=_count, default=None, metavar="N",
+                   help="N catch trials (the perturbation off, unannounced) in each perturbed block")
+    p.add_argument("--keys", default="dfjk",
+                   help="keys for pectoralis, posterior deltoid, biceps, triceps (default: dfjk)")
+    p.add_argument("--retention", type=_rate, nargs=2, metavar=("FAST", "SLOW"), default=None,
+                   help="adaptive bot: the learner's retention rates A_f A_s (default: 0.59 0.992)")
+    p.add_argument("--learning", type=_rate, nargs=2, metavar=("FAST", "SLOW"), default=None,
+                   help="adaptive bot: the learner's learning rates B_f B_s (default: 0.21 0.02; 0 0 learns nothing)")
+    p.add_argument("--fullscreen", action="store_true", help="fill the screen (for a projector)")
+    p.add_argument("--size", type=_size, default=(800, 800), help="window size, e.g. 1024x768 (default: 800x800)")
+    p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
+    p.set_defaults(run=run)
+
+
+def load_protocol_argument(text: str):
+    from ..lab.protocol import PRESETS, load_protocol, preset
+
+    if text in PRESETS:
+        return preset(text)
+    if text.endswith(".toml") or Path(text).exists():
+        return load_protocol(Path(text))
+    raise UserError(f"unknown lab protocol {text!r}: choose a preset ({', '.join(PRESETS)}) or give a .toml file")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..game.muscles import DEFAULT_MUSCLES, remap_keys
+    from ..lab.bots import LAB_BOT_NAMES, LearningRates, make_lab_bot
+    from ..lab.protocol import with_catch_trials
+    from ..lab.session import LabSession, lab_config
+
+    protocol = load_protocol_argument(args.protocol)
+    if args.catch is not None:
+        try:
+            protocol = with_catch_trials(protocol, args.catch)
+        except ValueError as exc:
+            raise UserError(f"--catch {args.catch}: {exc}") from None
+    if args.headless and not args.bot:
+        raise UserError("--headless needs a --bot to play (model, naive or adaptive); people play in the window")
+    if args.bot and args.bot not in LAB_BOT_NAMES:
+        raise UserError(f"unknown lab bot {args.bot!r}: choose one of {', '.join(LAB_BOT_NAMES)}")
+    if (args.retention or args.learning) and args.bot != "adaptive":
+        raise UserError("--retention and --learning set the adaptive bot's learner: add --bot adaptive")
+    if args.no_figures and not args.out:
+        raise UserError("--no-figures applies with --out only")
+    _check_outputs(args)
+    config = lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys))
+    session = LabSession(config, protocol)
+    bot = None
+    if args.bot:
+        defaults = LearningRates()
+        rates = LearningRates(*(args.retention or (defaults.retention_fast, defaults.retention_slow)),
+                              *(args.learning or (defaults.rate_fast, defaults.rate_slow)))
+        bot = make_lab_bot(args.bot, rates if args.bot == "adaptive" else None)
+    if args.headless:
+        from ..game.bots import Autopilot
+
+        Autopilot(session, bot).play()  # type: ignore[arg-type]
+    else:
+        if not 1 <= args.fps <= 1000:
+            raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
+        _play_in_window(session, bot, args)
+    _report(session, args)
+    return 0
+
+
+def _check_outputs(args: argparse.Namespace) -> None:
+    """Refuse a bad --record, --name or missing matplotlib before the run, not after it."""
+    if args.name is not None:
+        from ..records.replay import check_name
+
+        try:
+            args.name = check_name(args.name, "--name")
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+    if args.record and not Path(args.record).expanduser().resolve().parent.is_dir():
+        raise UserError(f"--record {args.record}: its folder does not exist")
+    if args.out and not args.no_figures:
+        from ..lab.figures import require_matplotlib
+
+        require_matplotlib()
+    if args.out:
+        out = Path(args.out).expanduser()
+        if out.exists() and not out.is_dir():
+            raise UserError(f"--out {args.out}: not a folder")
+
+
+def _report(session, args: argparse.Namespace) -> None:
+    from ..lab.analysis import block_summary, trial_rows, write_run_outputs
+    from ..lab.record import LabTask
+    from ..records.replay import Replay, now_iso
+
+    done, total = len(session.outcomes), len(session.plans)
+    print(f"lab {session.protocol.name}: {done} of {total} trials, {session.result().hits} hits, seed "
+          f"{session.config.seed}{'' if session.finished else ' (stopped before the end)'}")
+    if session.outcomes:
+        for b in block_summary(trial_rows(session)):
+            print(f"  {b['block']}: {b['trials']} trials, {b['hits']} hits; max perpendicular error "
+                  f"first 8 {_cm(b['early'])}, last 8 {_cm(b['late'])}")
+    if args.record:
+        driven = "bot" if args.bot else "keyboard"
+        replay = Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name,
+                        now_iso(), task=LabTask.of(session))
+        replay.save(Path(args.record).expanduser())
+        print(f"replay saved to {args.record}")
+    if args.out:
+        if not session.outcomes:
+            raise UserError("no trial was finished: nothing to write to --out")
+        out = Path(args.out).expanduser()
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
+        for path in write_run_outputs(session, out, figures=not args.no_figures):
+            print(f"wrote {path}")
+
+
+def _cm(value: object) -> str:
+    v = float(value)  # type: ignore[arg-type]
+    return "n/a" if not math.isfinite(v) else f"{100.0 * v:+.2f} cm"
+
+
+def _play_in_window(session, bot, args: argparse.Namespace) -> None:
+    try:
+        import pygame
+
+        from ..ui.frontend import open_window
+        from ..ui.lab_window import LabWindow
+    except ImportError as exc:
+        raise UserError(f"the window needs pygame-ce: {exc}") from None
+    driver = None
+    if bot is not None:
+        from ..game.bots import Autopilot
+        from ..game.session import RealTimeDriver
+
+        driver = RealTimeDriver(Autopilot(session, bot))  # type: ignore[arg-type]
+    try:
+        screen = open_window(args.size, args.fullscreen)
+    except pygame.error as exc:
+        raise UserError(f"cannot open a window ({exc}); use --headless --bot NAME where there is no display") from None
+    try:
+        LabWindow(session, screen, fps=args.fps, driver=driver).run()
+    finally:
+        pygame.display.quit()

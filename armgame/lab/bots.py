@@ -1,0 +1,196 @@
+"""Bots in the lab: the game's reaching bots, and one that adapts to the perturbation trial by trial.
+
+``LabBot`` is the game's ``ReachingBot`` (minimum-jerk plans tracked by computed torque
+through an internal model, keys pressed by sigma-delta; armgame/game/bots.py) told that a lab
+run returns the arm home between trials: at each new trial it forgets what it saw before the
+jump, as a player's eyes would.
+
+The ``adaptive`` bot adds to the ``model`` bot's internal model an estimate of the
+perturbation, updated after each trial by a state-space learner (the two-rate model of Smith,
+Ghazizadeh & Shadmehr 2006, ``armgame.lab.learner``):
+
+* a curl field: its internal model adds the torque ``J(q)^T b^ [[0, 1], [-1, 0]] v`` it expects
+  the field to exert, which it cancels and predicts. After a trial it measures the field it met
+  by least squares on what it felt: from the states it saw every control period, the torque
+  the arm's motion needed (inverse dynamics, accelerations by central differences) minus its
+  muscles' torque is the external torque, fitted as ``b`` times the unit field's torque. The
+  learner's error is ``e = b_measured - b^``.
+* a visual rotation: it aims its true hand at the target rotated by ``-theta^`` about home.
+  After a trial it measures the rotation as the angle from its true hand's displacement (felt)
+  to the shown hand's (seen) at the trial's end; ``e = theta_measured - theta^``.
+
+So with the field on, errors start large and shrink as ``b^`` grows; on a catch trial or in
+washout, the bot still expects the field and errs the other way (the after-effect), and
+unlearns at the learner's rates. Mirror and joint-space displays are not learned by this bot (it
+plays them as the model bot does): they need more than one parameter.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import UserError
+from ..game.bots import ReachingBot
+from .learner import TwoRateLearner
+from .session import LabSession
+
+LAB_BOT_NAMES = ("model", "naive", "adaptive")
+
+
+@dataclass(frozen=True)
+class LearningRates:
+    """The two-rate learner's retention (A) and learning (B) rates, fast and slow: Smith et al. 2006's values
+    by default. ``TwoRateLearner`` checks them (0 to 1, the fast process forgetting and learning faster)."""
+
+    retention_fast: float = 0.59
+    retention_slow: float = 0.992
+    rate_fast: float = 0.21
+    rate_slow: float = 0.02
+
+
+class LabBot(ReachingBot):
+    """A reaching bot for the lab: forgets its view at each new trial; learns if given rates."""
+
+    def __init__(self, name: str, interaction: bool, rates: LearningRates | None = None) -> None:
+        super().__init__(name, interaction)
+        self.rates = rates
+        self._trial: int | None = None
+        self._log: list[tuple[float, float, float, float, float, float, float, float, float, float]] = []
+        self.curl_learner: TwoRateLearner | None = None
+        self.rotation_learner: TwoRateLearner | None = None
+        if rates is not None:
+            self.curl_learner = TwoRateLearner(rates.retention_fast, rates.retention_slow, rates.rate_fast,
+                                               rates.rate_slow)
+            self.rotation_learner = TwoRateLearner(rates.retention_fast, rates.retention_slow, rates.rate_fast,
+                                                   rates.rate_slow)
+        #: (trial, measured field b, estimate b^ it reached with; measured rotation, estimate) per trial.
+        self.history: list[tuple[int, float, float, float, float]] = []
+
+    # ------------------------------------------------------------- the estimates
+    @property
+    def curl_estimate(self) -> float:
+        return float(self.curl_learner.estimate) if self.curl_learner is not None else 0.0
+
+    @property
+    def rotation_estimate(self) -> float:
+        """Radians, counter-clockwise."""
+        return float(self.rotation_learner.estimate) if self.rotation_learner is not None else 0.0
+
+    def _install(self, session: LabSession) -> None:
+        p = session.config.arm
+        l1, l2 = p.l1, p.l2
+        b = self.curl_estimate
+        if b != 0.0:
+            def load(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
+                fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
+                return curl_unit_torque(l1, l2, q1, q2, b * fx, b * fy)
+            self.load_estimate = load
+        else:
+            self.load_estimate = None
+        theta = self.rotation_estimate
+        if theta != 0.0:
+            hx, hy = session.home
+            c, s = math.cos(-theta), math.sin(-theta)
+
+            def aim(x: float, y: float) -> tuple[float, float]:
+                dx, dy = x - hx, y - hy
+                return hx + c * dx - s * dy, hy + s * dx + c * dy
+            self.aim = aim
+        else:
+            self.aim = None
+
+    # ------------------------------------------------------------------- act
+    def act(self, session: LabSession) -> list[tuple[str, str]]:  # type: ignore[override]
+        if session.over:
+            return []
+        if session.trial_index != self._trial:
+            if self._trial is not None and self.rates is not None and session.outcomes:
+                self._learn(session)
+            self._trial = session.trial_index
+            self._bind(session)  # the arm jumped home: what the bot saw before is no use now
+            self._install(session)
+            self._log = []
+        if self.rates is not None and session.phase == "reach":
+            q1, q2, w1, w2 = session.state
+            t1, t2 = session.muscles.torque()
+            x, y = session.hand()
+            cx, cy = session.cursor
+            self._log.append((q1, q2, w1, w2, t1, t2, x, y, cx, cy))
+        return super().act(session)
+
+    # ----------------------------------------------------------------- learn
+    def _learn(self, session: LabSession) -> None:
+        outcome = session.outcomes[-1]
+        log = self._log
+        assert self.curl_learner is not None and self.rotation_learner is not None
+        b_hat, theta_hat = self.curl_estimate, self.rotation_estimate
+        b_seen = self._measure_curl(session, log)
+        theta_seen = self._measure_rotation(session, log)
+        self.history.append((outcome.plan.index, b_seen, b_hat, theta_seen, theta_hat))
+        self.curl_learner.update(b_seen - b_hat)
+        self.rotation_learner.update(theta_seen - theta_hat)
+
+    def _measure_curl(self, session: LabSession, log: list) -> float:
+        """The curl field's b that best explains the external torque felt over the reach (0 if none moved)."""
+        if len(log) < 5:
+            return 0.0
+        assert self._setup is not None
+        period = self._setup[0]
+        arm = session.model
+        l1, l2 = arm.params.l1, arm.params.l2
+        k1, k2 = arm.params.damping1, arm.params.damping2
+        num = den = 0.0
+        for k in range(1, len(log) - 1):
+            q1, q2, w1, w2, t1, t2, *_ = log[k]
+            qd1 = (log[k + 1][2] - log[k - 1][2]) / (2.0 * period)
+            qd2 = (log[k + 1][3] - log[k - 1][3]) / (2.0 * period)
+            bc, h = arm.b * math.cos(q2), arm.b * math.sin(q2)
+            m11, m12 = arm.a + 2.0 * bc, arm.d + bc
+            need1 = m11 * qd1 + m12 * qd2 - h * (2.0 * w1 * w2 + w2 * w2) + k1 * w1
+            need2 = m12 * qd1 + arm.d * qd2 + h * w1 * w1 + k2 * w2
+            r1, r2 = need1 - t1, need2 - t2
+            fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
+            g1, g2 = curl_unit_torque(l1, l2, q1, q2, fx, fy)
+            num += r1 * g1 + r2 * g2
+            den += g1 * g1 + g2 * g2
+        return num / den if den > 1e-12 else 0.0
+
+    @staticmethod
+    def _measure_rotation(session: LabSession, log: list) -> float:
+        """The angle from the felt displacement to the seen one at the trial's end (0 if the hand stayed home)."""
+        if not log:
+            return 0.0
+        hx, hy = session.home
+        _q1, _q2, _w1, _w2, _t1, _t2, x, y, cx, cy = log[-1]
+        dx, dy, sx, sy = x - hx, y - hy, cx - hx, cy - hy
+        if math.hypot(dx, dy) < 0.2 * session.protocol.distance:
+            return 0.0
+        return math.atan2(dx * sy - dy * sx, dx * sx + dy * sy)
+
+
+def curl_unit_force(l1: float, l2: float, q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
+    """The curl field's force at b = 1 N s/m: (vy, -vx) with v the hand's velocity."""
+    s1, c1 = math.sin(q1), math.cos(q1)
+    s12, c12 = math.sin(q1 + q2), math.cos(q1 + q2)
+    vx = (-l1 * s1 - l2 * s12) * w1 - l2 * s12 * w2
+    vy = (l1 * c1 + l2 * c12) * w1 + l2 * c12 * w2
+    return vy, -vx
+
+
+def curl_unit_torque(l1: float, l2: float, q1: float, q2: float, fx: float, fy: float) -> tuple[float, float]:
+    """J(q)^T (fx, fy)."""
+    s1, c1 = math.sin(q1), math.cos(q1)
+    s12, c12 = math.sin(q1 + q2), math.cos(q1 + q2)
+    return (-l1 * s1 - l2 * s12) * fx + (l1 * c1 + l2 * c12) * fy, -l2 * s12 * fx + l2 * c12 * fy
+
+
+def make_lab_bot(name: str, rates: LearningRates | None = None) -> LabBot:
+    """``model``, ``naive`` (the game's bots) or ``adaptive`` (the model bot learning the perturbation)."""
+    if name == "model":
+        return LabBot("model", interaction=True)
+    if name == "naive":
+        return LabBot("naive", interaction=False)
+    if name == "adaptive":
+        return LabBot("adaptive", interaction=True, rates=rates or LearningRates())
+    raise UserError(f"unknown lab bot {name!r}: choose one of {', '.join(LAB_BOT_NAMES)}")

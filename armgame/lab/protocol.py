@@ -1,0 +1,298 @@
+"""Lab protocols: the blocks of a centre-out experiment, the perturbation of each, presets and TOML files.
+
+A protocol is data: which targets (count, distance, size), the timing (hold, go-cue delay,
+time-out) and a list of blocks, each with its number of trials, its perturbation and its catch
+trials. The same protocol, seed and input timeline give the same trials, bit for bit.
+
+Perturbation kinds (parameters in brackets, with their TOML names):
+
+* ``none``;
+* ``curl`` (``b``, N s/m): the force field ``F = b [[0, 1], [-1, 0]] v`` at the hand;
+  ``b > 0`` pushes clockwise of the hand's motion;
+* ``constant`` (``fx``, ``fy``, N): a steady force at the hand;
+* ``spring`` (``stiffness``, N/m): a spring from the hand to the home position;
+* ``rotation`` (``angle``, degrees): the hand is shown, and scored, rotated about home,
+  counter-clockwise for ``angle > 0``;
+* ``mirror`` (``axis``, degrees): the hand is shown mirrored in the line through home at that
+  angle from +x (90: left and right swap);
+* ``jointspace`` (``gain``, m/rad): Flanagan & Rao's display: the hand is shown at
+  ``home + gain (q1 - q1_home, q2 - q2_home)``, shoulder angle across, elbow angle up.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from ..errors import UserError
+from ..records.storage import check_float, check_int, check_keys, check_str, read_limited
+
+FORCE_KINDS = ("curl", "constant", "spring")
+VISUAL_KINDS = ("rotation", "mirror", "jointspace")
+KINDS = ("none", *FORCE_KINDS, *VISUAL_KINDS)
+
+#: Each kind's parameters: (name, low, high, default, unit).
+PARAMETERS: dict[str, tuple[tuple[str, float, float, float, str], ...]] = {
+    "none": (),
+    "curl": (("b", -50.0, 50.0, 0.0, "N s/m"),),
+    "constant": (("fx", -20.0, 20.0, 0.0, "N"), ("fy", -20.0, 20.0, 0.0, "N")),
+    "spring": (("stiffness", 0.0, 500.0, 0.0, "N/m"),),
+    "rotation": (("angle", -180.0, 180.0, 0.0, "deg"),),
+    "mirror": (("axis", -180.0, 180.0, 90.0, "deg"),),
+    "jointspace": (("gain", 0.01, 2.0, 0.25, "m/rad"),),
+}
+
+#: The curl preset's field. Chosen by measurement (README "Lab", ``tests/test_lab.py``): the model
+#: bot, which knows the arm but not the field, is pushed 2-3 cm off its 10 cm reaches, and a bot
+#: that knows the field cancels it within its muscles' strength and reaches straight.
+CURL_B = 2.0
+ROTATION_ANGLE = 30.0
+JOINTSPACE_GAIN = 0.25
+
+MAX_BLOCKS = 20
+MAX_TRIALS = 2000
+MAX_TARGETS = 64
+
+
+@dataclass(frozen=True)
+class Perturbation:
+    """One perturbation: ``kind`` and its parameters (only the kind's own are used)."""
+
+    kind: str = "none"
+    params: tuple[tuple[str, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise UserError(f"unknown perturbation {self.kind!r}: choose one of {', '.join(KINDS)}")
+
+    @classmethod
+    def make(cls, kind: str, **values: float) -> Perturbation:
+        if kind not in KINDS:
+            raise UserError(f"unknown perturbation {kind!r}: choose one of {', '.join(KINDS)}")
+        params = []
+        for name, _low, _high, default, _unit in PARAMETERS[kind]:
+            params.append((name, float(values.pop(name, default))))
+        if values:
+            raise UserError(f"perturbation {kind} has no parameter {', '.join(sorted(values))}")
+        return cls(kind, tuple(params))
+
+    def __getitem__(self, name: str) -> float:
+        return dict(self.params)[name]
+
+    @property
+    def is_force(self) -> bool:
+        return self.kind in FORCE_KINDS
+
+    @property
+    def is_visual(self) -> bool:
+        return self.kind in VISUAL_KINDS
+
+    def label(self) -> str:
+        """e.g. ``curl b=2 N s/m``; ``none`` for none."""
+        units = {name: unit for name, _l, _h, _d, unit in PARAMETERS[self.kind]}
+        parts = [f"{name}={value:g} {units[name]}" for name, value in self.params]
+        return " ".join([self.kind, *parts])
+
+    def as_dict(self) -> dict[str, object]:
+        return {"perturbation": self.kind, **dict(self.params)}
+
+
+NONE = Perturbation()
+
+
+@dataclass(frozen=True)
+class Block:
+    name: str
+    trials: int
+    perturbation: Perturbation = NONE
+    #: Trials of this block run with the perturbation off, unannounced (never among its first cycle of targets).
+    catch_trials: int = 0
+    instruction: str = ""
+
+
+DEFAULT_INSTRUCTIONS = {
+    "baseline": "Reach straight to each target as soon as it appears, and hold it.",
+    "exposure": "Something has changed: keep reaching straight to each target, and hold it.",
+    "washout": "Back to normal: keep reaching straight to each target, and hold it.",
+}
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """A centre-out experiment. Distances in m, times in s, angles in degrees."""
+
+    name: str
+    blocks: tuple[Block, ...]
+    targets: int = 8
+    distance: float = 0.10
+    target_radius: float = 0.02
+    home_radius: float = 0.02
+    #: The hand must stay on the target this long to end the trial with a hit.
+    hold_time: float = 0.2
+    #: The go cue comes after the hand has stayed at home for a random time in this range.
+    delay: tuple[float, float] = (0.5, 1.0)
+    #: A trial with no hit ends this long after its go cue.
+    timeout: float = 3.0
+    #: The first target's direction from home (degrees counter-clockwise from +x); the rest follow evenly.
+    first_target_deg: float = 0.0
+    #: The arm's posture at home (shoulder, elbow; degrees): the game's start posture.
+    home_posture_deg: tuple[float, float] = (45.0, 90.0)
+    perturbations: tuple[Perturbation, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "perturbations", tuple(dict.fromkeys(b.perturbation for b in self.blocks)))
+
+    @property
+    def trials(self) -> int:
+        return sum(b.trials for b in self.blocks)
+
+    def target_angles_deg(self) -> tuple[float, ...]:
+        return tuple(self.first_target_deg + 360.0 * i / self.targets for i in range(self.targets))
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "name": self.name,
+            "targets": self.targets,
+            "distance": self.distance,
+            "target_radius": self.target_radius,
+            "home_radius": self.home_radius,
+            "hold_time": self.hold_time,
+            "delay_min": self.delay[0],
+            "delay_max": self.delay[1],
+            "timeout": self.timeout,
+            "first_target_deg": self.first_target_deg,
+            "home_shoulder_deg": self.home_posture_deg[0],
+            "home_elbow_deg": self.home_posture_deg[1],
+            "blocks": [
+                {"name": b.name, "trials": b.trials, "catch_trials": b.catch_trials, "instruction": b.instruction,
+                 **b.perturbation.as_dict()}
+                for b in self.blocks
+            ],
+        }
+
+
+def _blocks(exposure: Perturbation, baseline: int = 16, exposure_trials: int = 80, washout: int = 24,
+            catch: int = 0) -> tuple[Block, ...]:
+    return (
+        Block("baseline", baseline, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"]),
+        Block("exposure", exposure_trials, exposure, catch, DEFAULT_INSTRUCTIONS["exposure"]),
+        Block("washout", washout, NONE, 0, DEFAULT_INSTRUCTIONS["washout"]),
+    )
+
+
+def preset(name: str) -> Protocol:
+    """A named protocol: ``null``, ``curl``, ``rotation``, ``mirror`` or ``jointspace``."""
+    if name == "null":
+        return Protocol("null", _blocks(NONE))
+    if name == "curl":
+        return Protocol("curl", _blocks(Perturbation.make("curl", b=CURL_B)))
+    if name == "rotation":
+        return Protocol("rotation", _blocks(Perturbation.make("rotation", angle=ROTATION_ANGLE)))
+    if name == "mirror":
+        return Protocol("mirror", _blocks(Perturbation.make("mirror", axis=90.0)))
+    if name == "jointspace":
+        return Protocol("jointspace", _blocks(Perturbation.make("jointspace", gain=JOINTSPACE_GAIN)))
+    raise UserError(f"unknown lab preset {name!r}: choose one of {', '.join(PRESETS)}, or give a .toml file")
+
+
+PRESETS = ("null", "curl", "rotation", "mirror", "jointspace")
+
+
+def with_catch_trials(protocol: Protocol, catch: int) -> Protocol:
+    """The protocol with ``catch`` catch trials in each block that has a perturbation."""
+    blocks = tuple(replace(b, catch_trials=catch) if b.perturbation.kind != "none" else b for b in protocol.blocks)
+    return _checked(replace(protocol, blocks=blocks))
+
+
+# ----------------------------------------------------------------- from data
+MAX_PROTOCOL_BYTES = 256 * 1024
+_TOP = {"name", "targets", "distance", "target_radius", "home_radius", "hold_time", "delay_min", "delay_max",
+        "timeout", "first_target_deg", "home_shoulder_deg", "home_elbow_deg"}
+_BLOCK = {"name", "trials", "catch_trials", "instruction", "perturbation"}
+
+
+def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
+    """Build and check a protocol from plain data (a TOML file's or a replay's); raises ValueError."""
+    optional = frozenset(_TOP - {"blocks"})
+    d = check_keys(where, data, {"blocks"}, optional)
+    defaults = Protocol("custom", ())
+
+    def number(key: str, low: float, high: float, default: float, low_open: bool = False) -> float:
+        return check_float(f"{key}", d[key], low, high, low_open) if key in d else default
+
+    name = check_str("name", d["name"], 40) if "name" in d else "custom"
+    blocks_data = d["blocks"]
+    if not isinstance(blocks_data, list) or not 1 <= len(blocks_data) <= MAX_BLOCKS:
+        raise ValueError(f"blocks must be a list of 1 to {MAX_BLOCKS} blocks")
+    blocks = []
+    for i, b in enumerate(blocks_data):
+        w = f"blocks[{i}]"
+        if not isinstance(b, dict):
+            raise ValueError(f"{w} must be a table")
+        kind = check_str(f"{w}.perturbation", b.get("perturbation", "none"), 20)
+        if kind not in KINDS:
+            raise ValueError(f"{w}.perturbation must be one of {', '.join(KINDS)}, got {kind!r}")
+        param_names = {p[0] for p in PARAMETERS[kind]}
+        check_keys(w, b, {"trials"}, frozenset((_BLOCK - {"trials"}) | param_names))
+        values = {p: check_float(f"{w}.{p}", b[p], low, high) for p, low, high, _d, _u in PARAMETERS[kind] if p in b}
+        block_name = check_str(f"{w}.name", b.get("name", f"block {i + 1}"), 40)
+        blocks.append(Block(
+            block_name,
+            check_int(f"{w}.trials", b["trials"], 1, MAX_TRIALS),
+            Perturbation.make(kind, **values),
+            check_int(f"{w}.catch_trials", b.get("catch_trials", 0), 0, MAX_TRIALS),
+            check_str(f"{w}.instruction", b.get("instruction", DEFAULT_INSTRUCTIONS.get(block_name, "")), 200),
+        ))
+    protocol = Protocol(
+        name,
+        tuple(blocks),
+        targets=check_int("targets", d["targets"], 1, MAX_TARGETS) if "targets" in d else defaults.targets,
+        distance=number("distance", 0.01, 0.3, defaults.distance),
+        target_radius=number("target_radius", 0.002, 0.1, defaults.target_radius),
+        home_radius=number("home_radius", 0.002, 0.1, defaults.home_radius),
+        hold_time=number("hold_time", 0.0, 5.0, defaults.hold_time),
+        delay=(number("delay_min", 0.0, 10.0, defaults.delay[0]), number("delay_max", 0.0, 10.0, defaults.delay[1])),
+        timeout=number("timeout", 0.2, 60.0, defaults.timeout),
+        first_target_deg=number("first_target_deg", -360.0, 360.0, defaults.first_target_deg),
+        home_posture_deg=(number("home_shoulder_deg", -180.0, 180.0, defaults.home_posture_deg[0]),
+                          number("home_elbow_deg", 5.0, 175.0, defaults.home_posture_deg[1])),
+    )
+    return _checked(protocol)
+
+
+def _checked(p: Protocol) -> Protocol:
+    if p.delay[0] > p.delay[1]:
+        raise ValueError(f"delay_min ({p.delay[0]:g} s) must not exceed delay_max ({p.delay[1]:g} s)")
+    if p.trials > MAX_TRIALS:
+        raise ValueError(f"the protocol has {p.trials} trials, more than {MAX_TRIALS}")
+    for i, b in enumerate(p.blocks):
+        if b.catch_trials and b.perturbation.kind == "none":
+            raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} has no perturbation to switch off")
+        if b.catch_trials > max(0, b.trials - p.targets):
+            raise ValueError(f"blocks[{i}].catch_trials must be at most trials - targets "
+                             f"({max(0, b.trials - p.targets)}): catch trials never fall in a block's first cycle")
+    return p
+
+
+def load_protocol(path: Path) -> Protocol:
+    """Read a TOML protocol file; one line naming the file and the bad key on any fault."""
+    raw = read_limited(Path(path), MAX_PROTOCOL_BYTES, "protocol file")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise UserError(f"{path}: not a text file (UTF-8 TOML expected)") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise UserError(f"{path}: not valid TOML: {exc}") from None
+    try:
+        return protocol_from_dict(data)
+    except (ValueError, TypeError, UserError) as exc:
+        raise UserError(f"{path}: {exc}") from None
+
+
+def target_positions(protocol: Protocol, home: tuple[float, float]) -> tuple[tuple[float, float], ...]:
+    hx, hy = home
+    r = protocol.distance
+    return tuple((hx + r * math.cos(math.radians(a)), hy + r * math.sin(math.radians(a)))
+                 for a in protocol.target_angles_deg())

@@ -1,0 +1,105 @@
+"""The task section of a lab replay: the protocol a run played and the trials it produced.
+
+A lab run is recorded as any game is (``armgame.records.replay``: its ``GameConfig``, input
+timeline and result), plus this section. Verifying replays the timeline on a fresh
+``LabSession`` of the same protocol and compares the result, every trial (target, go-cue
+step, end step, hit) and a SHA-256 of every trial's hand path (its floats' bytes): a timeline
+changed by one key one step is caught even when it ends the same trials at the same steps, so a
+replay that verifies is, bit for bit, the data ``armgame analyze`` measures.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..game.rules import GameConfig
+from ..game.session import GameResult, InputEvent
+from ..records.storage import check_int, check_keys, check_str
+from .protocol import Protocol, protocol_from_dict
+from .session import LAB_SCENE, LabSession
+
+TASK_KIND = "centre-out"
+
+Trial = tuple[int, int, int, bool]
+_HEX64 = re.compile(r"[0-9a-f]{64}")
+
+
+@dataclass(frozen=True)
+class LabTask:
+    protocol: Protocol
+    #: Each finished trial as (target, go_step, end_step, hit).
+    trials: tuple[Trial, ...]
+    #: SHA-256 (hex) of the shown hand's path of every trial, in order.
+    paths_sha256: str
+
+    @classmethod
+    def of(cls, session: LabSession) -> LabTask:
+        return cls(session.protocol, tuple((t, g, e, h) for t, g, e, h in session.trial_records()),  # type: ignore[misc]
+                   paths_digest(session))
+
+    def as_dict(self) -> dict[str, object]:
+        return {"kind": TASK_KIND, "protocol": self.protocol.as_dict(), "trials": [list(t) for t in self.trials],
+                "paths_sha256": self.paths_sha256}
+
+    @classmethod
+    def from_dict(cls, data: object, config: GameConfig, last_step: int) -> LabTask:
+        """Rebuild and check a task section; raises ValueError naming the bad field."""
+        d = check_keys("task", data, {"kind", "protocol", "trials", "paths_sha256"})
+        kind = check_str("task.kind", d["kind"], 40)
+        if kind != TASK_KIND:
+            raise ValueError(f"task.kind must be {TASK_KIND!r}, got {kind!r}")
+        if config.scene != LAB_SCENE:
+            raise ValueError(f"a replay with a task must have scene {LAB_SCENE!r}, got {config.scene!r}")
+        try:
+            protocol = protocol_from_dict(d["protocol"], "task.protocol")
+        except ValueError as exc:
+            raise ValueError(f"task.protocol: {exc}") from None
+        trials_data = d["trials"]
+        if not isinstance(trials_data, list) or len(trials_data) > protocol.trials:
+            raise ValueError(f"task.trials must be a list of at most {protocol.trials} trials")
+        trials = []
+        for i, item in enumerate(trials_data):
+            where = f"task.trials[{i}]"
+            if not isinstance(item, list) or len(item) != 4 or not isinstance(item[3], bool):
+                raise ValueError(f"{where} must be [target, go_step, end_step, hit]")
+            target = check_int(f"{where} target", item[0], 0, protocol.targets - 1)
+            go = check_int(f"{where} go_step", item[1], 0, last_step)
+            end = check_int(f"{where} end_step", item[2], go, last_step)
+            trials.append((target, go, end, item[3]))
+        digest = check_str("task.paths_sha256", d["paths_sha256"], 64)
+        if not _HEX64.fullmatch(digest):
+            raise ValueError("task.paths_sha256 must be 64 hexadecimal digits")
+        return cls(protocol, tuple(trials), digest)
+
+    def new_session(self, config: GameConfig) -> LabSession:
+        """A fresh session of this task, at its start (for a window to replay the timeline into)."""
+        return LabSession(config, self.protocol)
+
+    def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> LabSession:
+        """The run re-simulated from its timeline: the session, with every trial's hand path."""
+        session = self.new_session(config)
+        session.play(timeline, steps)
+        return session
+
+    def verify(self, config: GameConfig, timeline: Sequence[InputEvent],
+               result: GameResult) -> tuple[bool, GameResult, LabSession]:
+        from ..records.replay import same_outcome
+
+        session = self.session(config, timeline, result.steps)
+        recomputed = session.result()
+        same_trials = tuple(tuple(t) for t in session.trial_records()) == self.trials
+        same_paths = paths_digest(session) == self.paths_sha256
+        return same_outcome(recomputed, result) and same_trials and same_paths, recomputed, session
+
+
+def paths_digest(session: LabSession) -> str:
+    h = hashlib.sha256()
+    for o in session.outcomes:
+        h.update(np.asarray(o.xs, dtype="<f8").tobytes())
+        h.update(np.asarray(o.ys, dtype="<f8").tobytes())
+    return h.hexdigest()

@@ -1,0 +1,260 @@
+"""The centre-out task on the game's fixed-step session.
+
+``LabSession`` is a ``GameSession``: the same arm, muscles, integrator, key events, input
+timeline, ``TimelineInput`` and ``Autopilot``, so a lab run is recorded and replayed exactly
+as a game is. Only the rules differ, and the physics of perturbed trials:
+
+1. Hold: home is shown; once the (shown) hand has stayed inside it for the trial's delay (a
+   seeded random 0.5-1.0 s), the go cue comes: home goes and the target appears.
+2. Reach: the trial ends with a hit when the shown hand has stayed inside the target for the
+   hold time (0.2 s), or with a miss at the time-out.
+3. The arm is put back at home, at rest, with the muscles relaxed (a robot returning the hand),
+   and the next trial's hold begins. After the last trial the session is over.
+
+Each trial runs with its block's perturbation (off on a catch trial): a force field through a
+``LoadedArm``'s closures, a visual transform on the shown hand. The shown hand is recorded
+every physics step from the go cue to the trial's end, for the per-reach metrics.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass, field
+
+from .. import __version__
+from ..errors import UserError
+from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
+from ..game.rules import GameConfig, Target
+from ..game.session import GameResult, GameSession
+from ..physics.integrators import Integrator
+from ..physics.loads import loaded_arm
+from .perturbations import Display, display_for, loads_for
+from .protocol import NONE, Perturbation, Protocol, target_positions
+
+HOLD, REACH = "hold", "reach"
+LAB_SCENE = "lab"
+
+
+@dataclass(frozen=True)
+class TrialPlan:
+    """What a trial will be, fixed before it starts by the protocol and the seed."""
+
+    index: int
+    block: int
+    block_name: str
+    target: int
+    target_deg: float
+    position: tuple[float, float]
+    delay_steps: int
+    perturbation: Perturbation
+    catch: bool
+
+    @property
+    def active(self) -> Perturbation:
+        """The perturbation actually on: none on a catch trial."""
+        return NONE if self.catch else self.perturbation
+
+
+@dataclass
+class TrialOutcome:
+    plan: TrialPlan
+    go_step: int
+    end_step: int
+    hit: bool
+    #: The shown hand (m) after every physics step from the go cue to the end, both included.
+    xs: list[float] = field(default_factory=list, repr=False)
+    ys: list[float] = field(default_factory=list, repr=False)
+
+
+def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]) -> tuple[TrialPlan, ...]:
+    """Every trial of the protocol: targets in shuffled cycles (each target once a cycle), go-cue delays,
+    catch trials, all drawn from one ``random.Random(seed)`` in a fixed order."""
+    rng = random.Random(seed)
+    positions = target_positions(protocol, home)
+    angles = protocol.target_angles_deg()
+    plans: list[TrialPlan] = []
+    for b, block in enumerate(protocol.blocks):
+        order: list[int] = []
+        while len(order) < block.trials:
+            cycle = list(range(protocol.targets))
+            rng.shuffle(cycle)
+            order += cycle
+        catch = set(rng.sample(range(protocol.targets, block.trials), block.catch_trials))
+        for i in range(block.trials):
+            delay = rng.uniform(*protocol.delay)
+            t = order[i]
+            plans.append(TrialPlan(len(plans), b, block.name, t, angles[t] % 360.0, positions[t],
+                                   max(1, round(delay / dt)), block.perturbation, i in catch))
+    return tuple(plans)
+
+
+def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = DEFAULT_MUSCLES,
+               **options: object) -> GameConfig:
+    """The ``GameConfig`` a lab run plays on: the game's arm and muscles, home as the start posture,
+    and a clock long enough for every trial (a run that fidgets at home past it ends there)."""
+    worst = protocol.trials * (protocol.delay[1] + protocol.timeout)
+    time_limit = float(min(86400, math.ceil(1.5 * worst + 60.0)))
+    home = tuple(math.radians(a) for a in protocol.home_posture_deg)
+    return GameConfig(start_posture=home, time_limit=time_limit, seed=seed, muscles=muscles,  # type: ignore[arg-type]
+                      target_radius=protocol.target_radius, scene=LAB_SCENE, **options)  # type: ignore[arg-type]
+
+
+class LabSession(GameSession):
+    """A centre-out experiment on the game's session: see the module's docstring."""
+
+    def __init__(self, config: GameConfig, protocol: Protocol) -> None:
+        super().__init__(config)
+        if config.scene != LAB_SCENE:
+            raise UserError(f"a lab run's scene is {LAB_SCENE!r}, got {config.scene!r}")
+        self.protocol = protocol
+        self.home_q = config.start_posture
+        self.home = self.hand()
+        self.home_target = Target(*self.home, protocol.home_radius)
+        for x, y in target_positions(protocol, self.home):
+            self.model.inverse_kinematics((x, y))  # UnreachableError (one line) for a target out of reach
+        self.plans = schedule(protocol, config.seed, config.dt, self.home)
+        self.hold_steps = max(1, round(protocol.hold_time / config.dt))
+        self.timeout_steps = max(1, round(protocol.timeout / config.dt))
+        self._physics: dict[Perturbation, tuple[object, Display | None]] = {}
+        self.outcomes: list[TrialOutcome] = []
+        self.trial_index = 0
+        self.finished = False
+        self.phase = HOLD
+        self.cursor = self.home
+        self._counter = 0
+        self._go_step = 0
+        self._xs: list[float] = []
+        self._ys: list[float] = []
+        self.rules.target = self.home_target
+        self._enter_trial()
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def over(self) -> bool:
+        return self.finished or self.steps >= self.total_steps
+
+    @property
+    def plan(self) -> TrialPlan | None:
+        return self.plans[self.trial_index] if self.trial_index < len(self.plans) else None
+
+    @property
+    def block(self):
+        plan = self.plan or self.plans[-1]
+        return self.protocol.blocks[plan.block]
+
+    def result(self) -> GameResult:
+        b, c = self.rules.board, self.config
+        return GameResult(b.score, b.hits, b.resets, c.seed, c.time_limit, self.steps, c.scene, c.integrator, c.dt,
+                          __version__)
+
+    def trial_records(self) -> list[list[object]]:
+        """Each finished trial as [target, go_step, end_step, hit]: what a replay records and verify checks."""
+        return [[o.plan.target, o.go_step, o.end_step, o.hit] for o in self.outcomes]
+
+    # ----------------------------------------------------------------- physics
+    def physics_for(self, perturbation: Perturbation) -> tuple[object, Display | None]:
+        """(step function, shown-hand transform) of a perturbation, built once per run."""
+        if perturbation not in self._physics:
+            loads = loads_for(perturbation, self.home)
+            step = self._physics_step if loads is None else \
+                Integrator(self.config.integrator, loaded_arm(self.model, loads)).step_components
+            self._physics[perturbation] = (step, display_for(perturbation, self.home, self.home_q))
+        return self._physics[perturbation]
+
+    def _enter_trial(self) -> None:
+        plan = self.plan
+        if plan is None:
+            self.finished = True
+            return
+        self._step, self._show = self.physics_for(plan.active)
+        self.phase = HOLD
+        self._counter = 0
+        self.rules.target = self.home_target
+
+    def shown_hand(self) -> tuple[float, float]:
+        x, y = self.hand()
+        if self._show is None:
+            return x, y
+        return self._show(x, y, self.state[0], self.state[1])
+
+    def advance(self, n: int) -> int:
+        """Run up to ``n`` physics steps (fewer if the run ends); returns how many ran."""
+        n = min(n, self.total_steps - self.steps)
+        if n <= 0 or self.finished:
+            return 0
+        dt = self.config.dt
+        arm = self.config.arm
+        l1, l2 = arm.l1, arm.l2
+        cos, sin = math.cos, math.sin
+        muscles = self.muscles
+        a0, a1, a2, a3 = muscles.activation
+        g0, g1, g2, g3 = muscles.goal
+        r0, r1, r2, r3 = muscles.rate
+        (s0, e0), (s1, e1), (s2, e2), (s3, e3) = muscles.moments
+        q1, q2, w1, w2 = self.state
+        previous = self.state
+        step, show = self._step, self._show
+        ran = 0
+        while ran < n:
+            t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
+            t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
+            a0 += (g0 - a0) * r0
+            a1 += (g1 - a1) * r1
+            a2 += (g2 - a2) * r2
+            a3 += (g3 - a3) * r3
+            previous = (q1, q2, w1, w2)
+            q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
+            self.steps += 1
+            ran += 1
+            s12 = q1 + q2
+            hx = l1 * cos(q1) + l2 * cos(s12)
+            hy = l1 * sin(q1) + l2 * sin(s12)
+            if show is not None:
+                hx, hy = show(hx, hy, q1, q2)
+            if self._task_step(hx, hy):
+                # The trial ended: the arm goes home at rest, the muscles relax, the next trial's physics apply.
+                q1, q2 = self.home_q
+                w1 = w2 = 0.0
+                previous = (q1, q2, w1, w2)
+                a0 = a1 = a2 = a3 = 0.0
+                step, show = self._step, self._show
+                self.cursor = self.home
+                if self.finished:
+                    break
+        muscles.activation = [a0, a1, a2, a3]
+        self.state = (q1, q2, w1, w2)
+        self.previous_state = previous
+        return ran
+
+    def _task_step(self, x: float, y: float) -> bool:
+        """The task's rules after a physics step, with the shown hand at (x, y); True when the trial ended."""
+        self.cursor = (x, y)
+        plan = self.plans[self.trial_index]
+        if self.phase == HOLD:
+            home = self.home_target
+            self._counter = self._counter + 1 if home.contains(x, y) else 0
+            if self._counter >= plan.delay_steps:
+                self.phase = REACH
+                self._go_step = self.steps
+                self._counter = 0
+                self._xs, self._ys = [x], [y]
+                self.rules.target = Target(*plan.position, self.protocol.target_radius)
+            return False
+        self._xs.append(x)
+        self._ys.append(y)
+        self._counter = self._counter + 1 if self.rules.target.contains(x, y) else 0
+        hit = self._counter >= self.hold_steps
+        if not hit and self.steps - self._go_step < self.timeout_steps:
+            return False
+        self.outcomes.append(TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys))
+        if hit:
+            self.rules.board.hits += 1
+            self.rules.board.score += 1
+        self.trial_index += 1
+        self._enter_trial()
+        return True
+
+    def _reset_arm(self) -> None:
+        super()._reset_arm()  # the reset key: home, at rest, counted; the trial's clock runs on
+        self.cursor = self.shown_hand()

@@ -1,0 +1,367 @@
+"""The centre-out task (armgame/lab/): protocols and their files, the trial schedule, the session's rules,
+perturbations per trial, determinism, and lab replays that verify."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from armgame.errors import UserError
+from armgame.game.bots import Autopilot
+from armgame.game.session import InputEvent
+from armgame.lab.bots import make_lab_bot
+from armgame.lab.perturbations import joint_space, mirror, rotation
+from armgame.lab.protocol import (
+    CURL_B,
+    PRESETS,
+    Block,
+    Perturbation,
+    Protocol,
+    load_protocol,
+    preset,
+    protocol_from_dict,
+    target_positions,
+    with_catch_trials,
+)
+from armgame.lab.record import LabTask
+from armgame.lab.session import LabSession, lab_config, schedule
+from armgame.records.replay import Replay, now_iso
+from armgame.records.scores import ScoreTable
+
+
+def short(perturbation: Perturbation, trials=(4, 8, 4), **options) -> Protocol:
+    kinds = (Perturbation(), perturbation, Perturbation())
+    names = ("baseline", "exposure", "washout")
+    return Protocol("short", tuple(Block(n, t, k) for n, t, k in zip(names, trials, kinds, strict=True)), **options)
+
+
+def bot_run(protocol: Protocol, bot: str = "model", seed: int = 3):
+    session = LabSession(lab_config(protocol, seed), protocol)
+    player = make_lab_bot(bot)
+    Autopilot(session, player).play()
+    return session, player
+
+
+def perpendicular(session: LabSession, outcome) -> float:
+    """The signed peak distance from the home-target line (+ = counter-clockwise side)."""
+    hx, hy = session.home
+    tx, ty = outcome.plan.position
+    ux, uy = (tx - hx) / math.hypot(tx - hx, ty - hy), (ty - hy) / math.hypot(tx - hx, ty - hy)
+    d = (np.array(outcome.xs) - hx) * -uy + (np.array(outcome.ys) - hy) * ux
+    return float(d[np.argmax(np.abs(d))])
+
+
+# ------------------------------------------------------------------ protocols
+@pytest.mark.parametrize("name", PRESETS)
+def test_presets_round_trip_through_plain_data(name):
+    p = preset(name)
+    assert [b.name for b in p.blocks] == ["baseline", "exposure", "washout"]
+    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    assert p.blocks[1].perturbation.kind == ("none" if name == "null" else name)
+
+
+def test_toml_protocol_file(tmp_path):
+    path = tmp_path / "mine.toml"
+    path.write_text("""
+name = "class A"
+targets = 4
+distance = 0.12
+timeout = 2.5
+
+[[blocks]]
+name = "baseline"
+trials = 8
+
+[[blocks]]
+name = "exposure"
+trials = 20
+perturbation = "curl"
+b = -1.5
+catch_trials = 3
+
+[[blocks]]
+name = "washout"
+trials = 8
+""")
+    p = load_protocol(path)
+    assert (p.name, p.targets, p.distance, p.timeout, p.trials) == ("class A", 4, 0.12, 2.5, 36)
+    assert p.blocks[1].perturbation == Perturbation.make("curl", b=-1.5)
+    assert p.blocks[1].catch_trials == 3
+    assert p.blocks[0].instruction.startswith("Reach straight")
+
+
+@pytest.mark.parametrize("text, message", [
+    ("blocks = []", "blocks must be a list of 1 to 20 blocks"),
+    ("distance = 5\n[[blocks]]\ntrials = 3", "distance must be a finite number from 0.01 to 0.3, got 5.0"),
+    ("colour = 1\n[[blocks]]\ntrials = 3", "has unknown field(s) colour"),
+    ("[[blocks]]\ntrials = 0", "blocks[0].trials must be from 1 to 2000, got 0"),
+    ("[[blocks]]\ntrials = 3\nperturbation = 'gravity'", "blocks[0].perturbation must be one of none, curl"),
+    ("[[blocks]]\ntrials = 3\nperturbation = 'curl'\nangle = 3", "blocks[0] has unknown field(s) angle"),
+    ("[[blocks]]\ntrials = 3\nperturbation = 'curl'\nb = 'x'", "blocks[0].b must be a number, got 'x'"),
+    ("[[blocks]]\ntrials = 12\ncatch_trials = 2", "blocks[0].catch_trials: block 'block 1' has no perturbation"),
+    ("[[blocks]]\ntrials = 9\nperturbation = 'curl'\ncatch_trials = 2", "catch_trials must be at most"),
+    ("delay_min = 2.0\n[[blocks]]\ntrials = 3", "delay_min (2 s) must not exceed delay_max (1 s)"),
+    ("[[blocks]]\ntrials = 1500\n[[blocks]]\ntrials = 1500", "more than 2000"),
+    ("[[blocks]\ntrials = 3", "not valid TOML"),
+    ("home_elbow_deg = 1.0\n[[blocks]]\ntrials = 3", "home_elbow_deg must be a finite number from 5 to 175"),
+])
+def test_bad_protocol_files_get_one_line_naming_the_key(tmp_path, text, message):
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    with pytest.raises(UserError) as err:
+        load_protocol(path)
+    assert message in str(err.value) and "\n" not in str(err.value) and str(path) in str(err.value)
+
+
+def test_hostile_protocol_files(tmp_path):
+    big = tmp_path / "big.toml"
+    big.write_bytes(b"#" * (300 * 1024))
+    binary = tmp_path / "bin.toml"
+    binary.write_bytes(b"\xff\xfe\x00")
+    for path, message in ((big, "too large"), (binary, "not a text file"), (tmp_path, "is a folder"),
+                          (tmp_path / "none.toml", "no such protocol file")):
+        with pytest.raises(UserError, match=message):
+            load_protocol(path)
+
+
+def test_unreachable_targets_are_refused():
+    p = short(Perturbation(), distance=0.3, home_posture_deg=(45.0, 10.0))
+    with pytest.raises(UserError, match="out of reach"):
+        LabSession(lab_config(p, 0), p)
+
+
+# ------------------------------------------------------------------- schedule
+def test_schedule_cycles_targets_and_draws_delays_and_catch_trials():
+    p = with_catch_trials(preset("curl"), 6)
+    config = lab_config(p, 5)
+    plans = schedule(p, 5, config.dt, (0.0, 0.5))
+    assert len(plans) == p.trials == 120
+    start = 0
+    for block in p.blocks:
+        mine = plans[start:start + block.trials]
+        for c in range(0, block.trials - block.trials % 8, 8):
+            assert sorted(t.target for t in mine[c:c + 8]) == list(range(8))
+        catch = [t.index - start for t in mine if t.catch]
+        assert len(catch) == block.catch_trials and all(i >= 8 for i in catch)
+        start += block.trials
+    delays = [t.delay_steps * config.dt for t in plans]
+    assert 0.5 - config.dt <= min(delays) and max(delays) <= 1.0 + config.dt and np.std(delays) > 0.1
+    assert schedule(p, 5, config.dt, (0.0, 0.5)) == plans
+    assert schedule(p, 6, config.dt, (0.0, 0.5)) != plans
+    assert [t.active.kind for t in plans[16:96]].count("none") == 6
+
+
+def test_targets_lie_evenly_around_home():
+    p = preset("null")
+    positions = target_positions(p, (0.1, 0.5))
+    assert len(positions) == 8
+    for i, (x, y) in enumerate(positions):
+        assert math.isclose(math.hypot(x - 0.1, y - 0.5), 0.10)
+        assert math.isclose(math.degrees(math.atan2(y - 0.5, x - 0.1)) % 360.0, 45.0 * i, abs_tol=1e-9)
+
+
+# --------------------------------------------------------------- the session
+def test_no_input_every_trial_times_out_after_its_delay():
+    p = short(Perturbation(), trials=(2, 1, 1), timeout=1.0)
+    session = LabSession(lab_config(p, 1), p)
+    session.play([])
+    assert session.finished and session.over and len(session.outcomes) == 4
+    previous_end = 0
+    for o in session.outcomes:
+        assert not o.hit
+        assert o.go_step - previous_end == o.plan.delay_steps  # the hand sat at home all along
+        assert o.end_step - o.go_step == round(1.0 / session.config.dt)
+        assert len(o.xs) == o.end_step - o.go_step + 1
+        assert (o.xs[0], o.ys[0]) == pytest.approx(session.home)
+        previous_end = o.end_step
+    assert session.result().hits == 0 and session.steps == previous_end
+
+
+def test_leaving_home_delays_the_go_cue():
+    p = short(Perturbation(), trials=(1, 1, 1), timeout=0.5)
+    session = LabSession(lab_config(p, 1), p)
+    # d held for 0.3 s from the start moves the hand out of home; the hold restarts once the arm is back.
+    session.play([InputEvent(0, "d", "down"), InputEvent(75, "d", "up"), InputEvent(100, "space", "down")])
+    first = session.outcomes[0]
+    assert first.go_step >= 100 + first.plan.delay_steps
+    assert session.result().resets == 1
+
+
+def test_model_bot_hits_every_target_and_reaches_straight():
+    session, _ = bot_run(short(Perturbation()))
+    assert session.result().hits == len(session.outcomes) == 16
+    assert max(abs(perpendicular(session, o)) for o in session.outcomes) < 0.01
+
+
+def test_same_protocol_seed_and_timeline_give_the_same_trials_bit_for_bit():
+    p = short(Perturbation.make("curl", b=CURL_B))
+    a, _ = bot_run(p)
+    b, _ = bot_run(p)
+    replayed = LabSession(lab_config(p, 3), p)
+    replayed.play(a.timeline, a.steps)
+    for other in (b, replayed):
+        assert other.trial_records() == a.trial_records()
+        assert all(x.xs == y.xs and x.ys == y.ys for x, y in zip(a.outcomes, other.outcomes, strict=True))
+        assert other.state == a.state
+
+
+def test_curl_scaling_deflects_the_model_bot_by_centimetres():
+    """The preset's b: the model bot (knows the arm, not the field) is pushed clockwise by centimetres."""
+    p = Protocol("scan", (Block("exposure", 8, Perturbation.make("curl", b=CURL_B)),))
+    naive_to_field, _ = bot_run(p)
+    deflections = [perpendicular(naive_to_field, o) for o in naive_to_field.outcomes]
+    assert all(d < 0 for d in deflections)  # b > 0: clockwise, the right of the reach
+    assert 0.015 < -np.mean(deflections) < 0.05, deflections
+
+
+def test_a_bot_that_knows_the_field_counters_it_with_its_keys():
+    """A bot whose internal model holds the preset's field (b^ = b, no learning) cancels it within its
+    muscles' strength and reaches as straight as without a field."""
+    p = Protocol("scan", (Block("exposure", 8, Perturbation.make("curl", b=CURL_B)),))
+    knowing = make_lab_bot("adaptive")
+    knowing.curl_learner.slow = CURL_B
+    knowing.curl_learner.retention_slow, knowing.curl_learner.rate_slow, knowing.curl_learner.rate_fast = 1.0, 0, 0
+    session = LabSession(lab_config(p, 3), p)
+    Autopilot(session, knowing).play()
+    assert session.result().hits == 8
+    assert max(abs(perpendicular(session, o)) for o in session.outcomes) < 0.01
+    # Its own measurement of the field it met (the learner's input) is close to the truth.
+    assert all(abs(b - CURL_B) < 0.1 * CURL_B for _, b, *_ in knowing.history)
+
+
+@pytest.mark.parametrize("show, x, y, q, expected", [
+    (rotation(90.0, (1.0, 1.0)), 2.0, 1.0, (0, 0), (1.0, 2.0)),
+    (mirror(90.0, (1.0, 1.0)), 1.5, 1.2, (0, 0), (0.5, 1.2)),
+    (mirror(0.0, (1.0, 1.0)), 1.5, 1.2, (0, 0), (1.5, 0.8)),
+    (joint_space(0.25, (1.0, 1.0), (0.5, 1.0)), 9.0, 9.0, (0.7, 0.6), (1.05, 0.9)),
+])
+def test_visual_transforms(show, x, y, q, expected):
+    assert show(x, y, *q) == pytest.approx(expected)
+
+
+def test_rotation_moves_the_scored_hand():
+    """Under a 30 deg rotation the model bot reaches the true target, so the shown hand, which is scored,
+    lands 30 deg counter-clockwise of it and the trials time out."""
+    p = short(Perturbation.make("rotation", angle=30.0), trials=(2, 3, 2), timeout=1.5)
+    session, _ = bot_run(p)
+    for o in session.outcomes:
+        hx, hy = session.home
+        angle = math.degrees(math.atan2(o.ys[-1] - hy, o.xs[-1] - hx))
+        off = (angle - o.plan.target_deg + 180.0) % 360.0 - 180.0
+        if o.plan.perturbation.kind == "rotation":
+            assert not o.hit and off == pytest.approx(30.0, abs=3.0)
+        else:
+            assert o.hit and abs(off) < 5.0
+
+
+# ------------------------------------------------------------------- replays
+def _replay(session, tmp_path, name="run.json"):
+    replay = Replay(session.config, tuple(session.timeline), session.result(), "bot", "model", None, now_iso(),
+                    task=LabTask.of(session))
+    path = tmp_path / name
+    replay.save(path)
+    return path
+
+
+def test_lab_replay_verifies_and_tampering_is_caught(tmp_path):
+    session, _ = bot_run(short(Perturbation.make("curl", b=CURL_B), trials=(2, 3, 2)))
+    path = _replay(session, tmp_path)
+    loaded = Replay.load(path)
+    assert loaded.task.protocol == session.protocol and loaded.task.trials == tuple(
+        tuple(t) for t in session.trial_records())
+    assert loaded.verify()[0]
+    data = json.loads(path.read_text())
+    data["task"]["trials"][1][2] += 1  # a trial said to end one step later
+    path.write_text(json.dumps(data))
+    assert not Replay.load(path).verify()[0]
+    data = json.loads(path.read_text())
+    data["task"]["trials"][1][2] -= 1
+    data["task"]["protocol"]["blocks"][1]["b"] = 1.0  # another field than the one played
+    path.write_text(json.dumps(data))
+    assert not Replay.load(path).verify()[0]
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d["task"].update(kind="maze"), "task.kind must be 'centre-out'"),
+    (lambda d: d["task"]["trials"][0].__setitem__(3, "yes"), "must be [target, go_step, end_step, hit]"),
+    (lambda d: d["task"]["trials"].append([0, 1, 2, True]), "task.trials must be a list of at most 3 trials"),
+    (lambda d: d["task"]["trials"][0].__setitem__(0, 99), "task.trials[0] target must be from 0 to 7"),
+    (lambda d: d["task"]["protocol"].update(targets=0), "task.protocol: targets must be from 1 to 64"),
+    (lambda d: d["task"].pop("protocol"), "task lacks protocol"),
+    (lambda d: d.update(scene="game") or d["config"].update(scene="game") or d["result"].update(scene="game"),
+     "a replay with a task must have scene 'lab'"),
+])
+def test_bad_lab_replays_get_one_line(tmp_path, change, message):
+    p = short(Perturbation(), trials=(1, 1, 1), timeout=0.5)
+    session = LabSession(lab_config(p, 1), p)
+    session.play([])
+    path = _replay(session, tmp_path)
+    data = json.loads(path.read_text())
+    change(data)
+    path.write_text(json.dumps(data))
+    with pytest.raises(UserError) as err:
+        Replay.load(path)
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_lab_runs_never_enter_the_high_score_table(tmp_path):
+    p = short(Perturbation(), trials=(1, 1, 1), timeout=0.5)
+    session = LabSession(lab_config(p, 1), p)
+    session.play([])
+    replay = Replay.load(_replay(session, tmp_path)).with_player("Ada")
+    assert replay.task is not None
+    with pytest.raises(ValueError, match="never enters the high-score table"):
+        ScoreTable(tmp_path / "scores").add(replay)
+
+
+# ------------------------------------------------------------ the adapting bot
+def adaptive_run(perturbation: Perturbation, rates=None, exposure=24, catch=0, seed=4):
+    from armgame.lab.bots import LearningRates
+
+    blocks = (Block("baseline", 8, Perturbation()), Block("exposure", exposure, perturbation, catch),
+              Block("washout", 8, Perturbation()))
+    p = Protocol("fast", blocks, timeout=1.5)
+    session = LabSession(lab_config(p, seed), p)
+    bot = make_lab_bot("adaptive", rates or LearningRates(0.6, 0.99, 0.4, 0.1))
+    Autopilot(session, bot).play()
+    return session, bot
+
+
+def test_adaptive_bot_learns_a_visual_rotation():
+    """Initial direction error starts near the rotation (+30 deg, counter-clockwise), decays as the bot
+    aims the other way, and errs clockwise on the first washout trials."""
+    from armgame.lab.analysis import trial_rows
+
+    session, bot = adaptive_run(Perturbation.make("rotation", angle=30.0))
+    rows = trial_rows(session)
+    error = {b: np.array([r["initial_direction_error_deg"] for r in rows if r["block"] == b])
+             for b in ("baseline", "exposure", "washout")}
+    assert abs(error["baseline"].mean()) < 6.0
+    assert 20.0 < error["exposure"][0] < 40.0
+    assert abs(error["exposure"][-8:].mean()) < 0.5 * error["exposure"][0]
+    assert error["washout"][:2].mean() < -10.0
+    measured = [h[3] for h in bot.history if session.plans[h[0]].active.kind == "rotation"]
+    assert np.allclose(np.degrees(measured), 30.0, atol=1.0)  # what it saw against what it felt
+
+
+def test_catch_trials_show_the_learned_field():
+    """On a catch trial late in exposure the field is off but the bot still expects it: the reach errs
+    the other way (counter-clockwise), an after-effect within the exposure block."""
+    session, _ = adaptive_run(Perturbation.make("curl", b=CURL_B), exposure=32, catch=3)
+    late = [o for o in session.outcomes if o.plan.block == 1 and o.plan.index >= 8 + 16]
+    catch = [perpendicular(session, o) for o in session.outcomes if o.plan.catch]
+    assert len(catch) == 3
+    assert [o.plan.catch for o in session.outcomes].count(True) == 3
+    field = [perpendicular(session, o) for o in late if not o.plan.catch]
+    assert np.mean(field) < 0 and all(c > 0.01 for c in catch)
+
+
+def test_a_bot_that_does_not_learn_shows_no_after_effect():
+    from armgame.lab.bots import LearningRates
+
+    session, bot = adaptive_run(Perturbation.make("curl", b=CURL_B), rates=LearningRates(0.59, 0.992, 0.0, 0.0))
+    washout = [perpendicular(session, o) for o in session.outcomes if o.plan.block == 2]
+    exposure = [perpendicular(session, o) for o in session.outcomes if o.plan.block == 1]
+    assert bot.curl_estimate == 0.0
+    assert max(abs(w) for w in washout) < 0.006 and np.mean(exposure[-8:]) < -0.015

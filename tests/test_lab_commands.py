@@ -1,0 +1,159 @@
+"""armgame lab and armgame analyze end to end: the adapting bot's learning curve, replays that verify,
+the trials table recomputed from a replay bit for bit, tampered and foreign files left out, one-line errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+from armgame.cli import main
+from armgame.lab.metrics import read_trials_csv
+
+SHORT = """
+name = "short"
+targets = 4
+timeout = 1.5
+
+[[blocks]]
+name = "baseline"
+trials = 4
+
+[[blocks]]
+name = "exposure"
+trials = 8
+perturbation = "curl"
+b = 2.0
+
+[[blocks]]
+name = "washout"
+trials = 4
+"""
+
+
+@pytest.fixture(scope="module")
+def curl_run(tmp_path_factory):
+    """The issue's command, once: armgame lab curl --bot adaptive --headless --out DIR (and a replay)."""
+    out = tmp_path_factory.mktemp("curl")
+    code = main(["lab", "curl", "--bot", "adaptive", "--headless", "--out", str(out / "run"), "--no-figures",
+                 "--record", str(out / "curl.json")])
+    assert code == 0
+    return out
+
+
+def block_values(rows, block, metric="max_perpendicular_error_m"):
+    return np.array([r[metric] for r in rows if r["block"] == block])
+
+
+def test_adaptive_bot_draws_the_textbook_learning_curve(curl_run):
+    """Error jumps when the field comes on (clockwise: negative), decays over exposure, and the first
+    washout reaches err the opposite way (the after-effect), decaying in turn."""
+    rows = read_trials_csv(curl_run / "run" / "trials.csv")
+    assert len(rows) == 120 and all(r["hit"] for r in rows)
+    baseline, exposure, washout = (block_values(rows, b) for b in ("baseline", "exposure", "washout"))
+    assert np.all(np.abs(baseline) < 0.006) and abs(baseline.mean()) < 0.002
+    early, late = exposure[:8].mean(), exposure[-8:].mean()
+    assert early < -0.015  # centimetres to the right of the reach
+    assert early < late < 0.0 and abs(late) < 0.6 * abs(early)
+    assert washout[:8].mean() > 0.006  # the after-effect: the other side
+    assert washout[-8:].mean() < washout[:8].mean()
+    assert exposure[0] < -0.01 and washout[0] > 0.01  # already on the first trial of each
+
+
+def test_the_lab_replay_verifies(curl_run, capsys):
+    assert main(["verify", str(curl_run / "curl.json")]) == 0
+    assert "matches: lab run (curl, bot, seed 10, 120 trials)" in capsys.readouterr().out
+
+
+def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path):
+    assert main(["analyze", str(curl_run / "curl.json"), "--out", str(tmp_path / "again.csv")]) == 0
+    assert (tmp_path / "again.csv").read_bytes() == (curl_run / "run" / "trials.csv").read_bytes()
+    assert main(["analyze", str(curl_run / "curl.json"), "--out", str(tmp_path / "each")]) == 0
+    assert (tmp_path / "each" / "curl.trials.csv").read_bytes() == (curl_run / "run" / "trials.csv").read_bytes()
+
+
+def _short_runs(tmp_path, seeds):
+    protocol = tmp_path / "short.toml"
+    protocol.write_text(SHORT)
+    folder = tmp_path / "class"
+    folder.mkdir()
+    for seed in seeds:
+        assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--seed", str(seed),
+                     "--record", str(folder / f"student{seed}.json"), "--name", f"Student {seed}"]) == 0
+    return folder
+
+
+def test_analyze_leaves_out_what_does_not_verify(tmp_path, capsys):
+    folder = _short_runs(tmp_path, [1])
+    good = folder / "student1.json"
+    data = json.loads(good.read_text())
+    data["timeline"][5][0] += 1  # a key pressed one step later than recorded
+    bad = folder / "tampered.json"
+    bad.write_text(json.dumps(data))
+    assert main(["analyze", str(bad), "--out", str(tmp_path / "t.csv")]) == 2
+    err = capsys.readouterr().err
+    assert "tampered.json: DIFFERS" in err and "no replay could be analysed" in err
+    assert main(["analyze", str(good), str(bad), "--out", str(tmp_path / "t.csv")]) == 1
+    assert len(read_trials_csv(tmp_path / "t.csv")) == 16
+
+
+def test_class_curve_merges_verified_students(tmp_path, capsys):
+    folder = _short_runs(tmp_path, [1, 2, 3])
+    data = json.loads((folder / "student3.json").read_text())
+    data["task"]["trials"][0][3] = not data["task"]["trials"][0][3]  # a miss recorded as a hit, or back
+    (folder / "cheat.json").write_text(json.dumps(data))
+    game = tmp_path / "game.json"
+    assert main(["play", "--headless", "--duration", "1", "--record", str(game)]) == 0
+    (folder / "game.json").write_bytes(game.read_bytes())
+    capsys.readouterr()
+    code = main(["analyze", "--class", str(folder), "--out", str(tmp_path / "curve"), "--no-figures"])
+    captured = capsys.readouterr()
+    assert code == 1, captured.err
+    assert "cheat.json: DIFFERS" in captured.err and "game.json: a game, not a lab run" in captured.err
+    lines = (tmp_path / "curve" / "class_curve.csv").read_text().splitlines()
+    assert lines[0] == "trial,block,perturbation,mean,sem,n"
+    assert "class curve of 3 students (2 left out), 16 trials, max_perpendicular_error_m" in captured.out
+    assert len(lines) == 17 and all(line.endswith(",3") for line in lines[1:])
+    # The mean is the mean over the three students' own tables.
+    students = []
+    for seed in (1, 2, 3):
+        assert main(["analyze", str(folder / f"student{seed}.json"), "--out", str(tmp_path / f"s{seed}.csv")]) == 0
+        students.append(read_trials_csv(tmp_path / f"s{seed}.csv"))
+    fifth = lines[5].split(",")
+    values = [s[4]["max_perpendicular_error_m"] for s in students]
+    assert float(fifth[3]) == pytest.approx(np.mean(values), rel=1e-12)
+    assert float(fifth[4]) == pytest.approx(np.std(values, ddof=1) / np.sqrt(3), rel=1e-12)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["lab", "curl", "--headless"], "--headless needs a --bot"),
+    (["lab", "spiral"], "unknown lab protocol 'spiral'"),
+    (["lab", "curl", "--headless", "--bot", "clever"], "unknown lab bot 'clever'"),
+    (["lab", "curl", "--headless", "--bot", "model", "--retention", "0.5", "0.9"], "add --bot adaptive"),
+    (["lab", "curl", "--headless", "--bot", "adaptive", "--retention", "0.995", "0.9"], "must forget faster"),
+    (["lab", "curl", "--headless", "--bot", "model", "--catch", "80"], "--catch 80: blocks[1].catch_trials"),
+    (["lab", "curl", "--headless", "--bot", "model", "--record", "/no/such/dir/r.json"], "its folder does not exist"),
+    (["analyze", "--out", "x.csv"], "no replay given"),
+])
+def test_command_errors_are_one_line(argv, message, capsys, monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and "\n" not in err and err.startswith(f"armgame {argv[0]}: error:")
+
+
+def test_lab_out_writes_the_figures(tmp_path, capsys):
+    protocol = tmp_path / "short.toml"
+    protocol.write_text(SHORT)
+    assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--out", str(tmp_path / "run")]) == 0
+    out = capsys.readouterr().out
+    for name in ("trials.csv", "learning.png", "paths.png"):
+        assert f"wrote {tmp_path / 'run' / name}" in out and (tmp_path / "run" / name).is_file()
+    assert (tmp_path / "run" / "learning.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "run" / "paths.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert len(read_trials_csv(tmp_path / "run" / "trials.csv")) == 16
+
+
+def test_replay_headless_recomputes_a_lab_run(curl_run, capsys):
+    assert main(["replay", str(curl_run / "curl.json"), "--headless", "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert (result["hits"], result["scene"]) == (120, "lab")
