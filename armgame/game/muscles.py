@@ -61,6 +61,10 @@ def remap_keys(muscles: tuple[MuscleSpec, ...], keys: str) -> tuple[MuscleSpec, 
     )
 
 
+class MuscleLevelError(UserError, ValueError):
+    """A muscle level outside 0..1 (or not a number)."""
+
+
 class MuscleSet:
     """Activations of the game's four muscles, stepped at a fixed physics step ``dt``.
 
@@ -86,6 +90,21 @@ class MuscleSet:
     def command(self, index: int, on: bool) -> None:
         self.goal[index] = 1.0 if on else 0.0
         self.rate[index] = self._rise[index] if on else self._decay[index]
+
+    def set_level(self, index: int, level: float) -> None:
+        """Drive muscle ``index`` toward ``level`` (0 to 1) instead of fully on or off.
+
+        The rate is the rise rate if the level is above the present activation, else the decay
+        rate: the activation moves monotonically toward its goal and never crosses it while the
+        command holds, so choosing the rate once, now, keeps the per-step update the exact
+        solution. Levels 0 and 1 do exactly what ``command`` does (a key), so key play is
+        unchanged.
+        """
+        level = float(level)
+        if not 0.0 <= level <= 1.0:  # also refuses NaN
+            raise MuscleLevelError(f"muscle {self.muscles[index].name}: level must be from 0 to 1, got {level!r}")
+        self.goal[index] = level
+        self.rate[index] = self._rise[index] if level > self.activation[index] else self._decay[index]
 
     def reset(self) -> None:
         self.activation = [0.0] * self.COUNT

@@ -11,13 +11,13 @@ the window.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 
 from .. import __version__
 from ..physics.integrators import Integrator
 from ..physics.twojoint import TwoJointArm
-from .muscles import MuscleSet
+from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
 
 DOWN, UP = "down", "up"
@@ -113,6 +113,24 @@ class GameSession:
             return False
         self.timeline.append(InputEvent(self.steps, key, action))
         return True
+
+    def set_muscle_levels(self, levels: Sequence[float]) -> None:
+        """Command every muscle's activation level (0 to 1) before the next physics step.
+
+        The continuous counterpart of the muscle keys, for programs (Gymnasium's continuous
+        reach): not recorded in the key timeline, ignored after the end, and it leaves the
+        keys' held state alone. Levels 0 and 1 act exactly as releasing and pressing a key.
+        """
+        if self.over:
+            return
+        if len(levels) != MuscleSet.COUNT:
+            raise MuscleLevelError(f"expected {MuscleSet.COUNT} muscle levels, got {len(levels)}")
+        values = [float(v) for v in levels]
+        for i, level in enumerate(values):  # check all before changing any
+            if not 0.0 <= level <= 1.0:
+                raise MuscleLevelError(f"muscle level {i} must be from 0 to 1, got {level!r}")
+        for i, level in enumerate(values):
+            self.muscles.set_level(i, level)
 
     def _reset_arm(self) -> None:
         q1, q2 = self.config.start_posture

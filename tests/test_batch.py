@@ -1,0 +1,236 @@
+"""The batched session against the single one: same hits, score, resets and steps, states to round-off."""
+
+import itertools
+import math
+import random
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from armgame.errors import UserError
+from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, replay_many
+from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet
+from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
+from armgame.game.session import GameSession, InputEvent
+
+KEYS = ("d", "f", "j", "k")
+
+
+def student_timeline(rng: random.Random, dt: float, seconds: float, extras: bool = True) -> list[InputEvent]:
+    """Keys switching every 0.1-0.5 s as a student's do; with ``extras``, resets, tab and stray keys too."""
+    events, held, t = [], set(), 0.0
+    while True:
+        t += rng.uniform(0.1, 0.5)
+        if t >= seconds + 0.5:  # a little past the end: late events must be ignored
+            return events
+        step = round(t / dt)
+        key = rng.choice(KEYS)
+        events.append(InputEvent(step, key, "up" if key in held else "down"))
+        held ^= {key}
+        if extras:
+            r = rng.random()
+            if r < 0.04:
+                events.append(InputEvent(step, "space", rng.choice(("down", "up"))))
+            elif r < 0.06:
+                events.append(InputEvent(step, "tab", "down"))
+            elif r < 0.08:  # a repeat of a held key, or an unknown key: both ignored
+                events.append(InputEvent(step, rng.choice((key, "x")), "down"))
+
+
+def assert_same_game(batch: BatchGameSession, i: int, single: GameSession) -> None:
+    assert batch.result(i) == single.result()
+    assert int(batch.steps[i]) == single.steps
+    assert batch.rules[i].target == single.rules.target
+    assert batch.rules[i].board == single.rules.board
+    assert (batch.target_x[i], batch.target_y[i]) == (single.rules.target.x, single.rules.target.y)
+    assert bool(batch.arm_visible[i]) == single.rules.arm_visible
+    assert batch.held[i].tolist() == single.held
+    np.testing.assert_allclose(batch.state(i), single.state, rtol=0.0, atol=STATE_TOLERANCE)
+    np.testing.assert_allclose(batch.activation[i], single.muscles.activation, rtol=0.0, atol=STATE_TOLERANCE)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    seeds=st.lists(st.integers(0, 2**63 - 1), min_size=1, max_size=5),
+    durations=st.lists(st.sampled_from([0.5, 1.0, 2.0, 3.0]), min_size=5, max_size=5),
+    stops=st.lists(st.one_of(st.none(), st.integers(0, 800)), min_size=5, max_size=5),
+    radius=st.sampled_from([0.05, 0.2]),
+    timeline_seed=st.integers(0, 2**32 - 1),
+)
+def test_batch_equals_single_sessions_on_random_timelines(seeds, durations, stops, radius, timeline_seed):
+    """Random keys, resets, tab, stray keys, games of different lengths, some stopped early."""
+    rng = random.Random(timeline_seed)
+    configs = [GameConfig(seed=s, time_limit=durations[i], target_radius=radius) for i, s in enumerate(seeds)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
+    stop_steps = stops[:len(configs)]
+    batch = BatchGameSession(configs)
+    results = batch.play(timelines, stop_steps)
+    for i, (c, timeline, stop) in enumerate(zip(configs, timelines, stop_steps, strict=True)):
+        single = GameSession(c)
+        assert results[i] == single.play(timeline, stop)
+        assert_same_game(batch, i, single)
+
+
+def test_many_long_games_equal_the_single_session():
+    """60 s games with a large target (many hits, many near misses): also the largest state difference."""
+    rng = random.Random(7)
+    configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(16)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
+    batch = BatchGameSession(configs)
+    results = batch.play(timelines)
+    worst = 0.0
+    for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
+        single = GameSession(c)
+        assert results[i] == single.play(timeline)
+        assert_same_game(batch, i, single)
+        worst = max(worst, max(abs(a - b) for a, b in zip(batch.state(i), single.state, strict=True)))
+    assert sum(r.hits for r in results) > 50 and sum(r.resets for r in results) > 0
+    assert worst <= STATE_TOLERANCE
+
+
+@pytest.mark.parametrize("inside", [True, False])
+def test_a_hit_on_the_knife_edge_is_decided_as_the_single_session_decides(inside):
+    """A target whose edge passes within a few ulps of where the hand will be."""
+    script = [InputEvent(0, "d", "down"), InputEvent(10, "j", "down"), InputEvent(40, "d", "up")]
+    config = GameConfig(time_limit=1.0)
+    probe = GameSession(config)
+    probe.play(script, stop_step=59)
+    px, py = probe.hand()
+    probe.advance(1)
+    hx, hy = probe.hand()
+    # The centre just ahead of the hand along its motion: outside before step 60, inside after.
+    r = config.target_radius * (1.0 - 1e-15 if inside else 1.0 + 1e-15)
+    ux, uy = (hx - px) / math.dist((hx, hy), (px, py)), (hy - py) / math.dist((hx, hy), (px, py))
+    edge = Target(hx + r * ux, hy + r * uy, config.target_radius)
+    single = GameSession(config)
+    single.rules.target = edge
+    batch = BatchGameSession([config, config])
+    for i in range(2):
+        batch.rules[i].target = edge
+        batch.target_x[i], batch.target_y[i] = edge.x, edge.y
+    expected = single.play(script)
+    assert (60 * config.dt in single.rules.board.hit_times) == inside
+    assert batch.play([script, script]) == [expected, expected]
+    assert_same_game(batch, 0, single)
+
+
+def test_the_step_api_equals_keys_levels_and_resets_of_single_sessions():
+    """set_held, set_levels, reset_arms, advance and restart, as a vector environment drives them."""
+    rng = np.random.default_rng(3)
+    configs = [GameConfig(seed=s, time_limit=2.0 + s % 3, target_radius=0.15) for s in range(6)]
+    batch = BatchGameSession(configs)
+    singles = [GameSession(c) for c in configs]
+    for turn in range(120):
+        if turn % 3 == 0:
+            held = rng.random((6, 4)) < 0.4
+            batch.set_held(held)
+            for s, row in zip(singles, held, strict=True):
+                for key, down in zip(KEYS, row, strict=True):
+                    s.key_event(key, "down" if down else "up")
+        elif turn % 3 == 1:
+            levels = rng.choice([0.0, 0.3, 0.7, 1.0], size=(6, 4))
+            mask = rng.random(6) < 0.5
+            batch.set_levels(levels[mask], mask)
+            for s, row, chosen in zip(singles, levels, mask, strict=True):
+                if chosen:
+                    s.set_muscle_levels(row)
+        else:
+            mask = rng.random(6) < 0.05
+            batch.reset_arms(mask)
+            for s, chosen in zip(singles, mask, strict=True):
+                if chosen:
+                    s.key_event("space", "down")
+        steps = int(rng.integers(1, 30))
+        batch.advance(steps)
+        for s in singles:
+            s.advance(steps)
+        if turn == 60:
+            mask = np.array([True, False, True, False, False, False])
+            batch.restart(mask, [101, 102])
+            singles[0] = GameSession(replace(configs[0], seed=101))
+            singles[2] = GameSession(replace(configs[2], seed=102))
+        for i, s in enumerate(singles):
+            assert_same_game(batch, i, s)
+    assert batch.over.sum() >= 4 and sum(s.rules.board.hits for s in singles) > 0
+
+
+def test_levels_zero_and_one_are_the_keys():
+    by_key, by_level = MuscleSet(DEFAULT_MUSCLES, 0.004), MuscleSet(DEFAULT_MUSCLES, 0.004)
+    for on in (True, False, True):
+        for i in range(4):
+            by_key.command(i, on)
+            by_level.set_level(i, 1.0 if on else 0.0)
+        for _ in range(50):
+            by_key.step()
+            by_level.step()
+        assert (by_key.goal, by_key.rate, by_key.activation) == (by_level.goal, by_level.rate, by_level.activation)
+
+
+def test_a_level_is_approached_from_either_side_without_crossing():
+    muscles = MuscleSet(DEFAULT_MUSCLES, 0.004)
+    muscles.set_level(0, 0.6)
+    trace = []
+    for _ in range(400):
+        muscles.step()
+        trace.append(muscles.activation[0])
+    assert all(b >= a for a, b in itertools.pairwise(trace)) and max(trace) <= 0.6 and trace[-1] > 0.59
+    muscles.set_level(0, 0.2)
+    assert muscles.rate[0] == muscles._decay[0]
+    for _ in range(400):
+        muscles.step()
+    assert 0.2 <= muscles.activation[0] < 0.21
+
+
+@pytest.mark.parametrize("levels", [(0.5, 0.5, 0.5), (0.0, 1.0, float("nan"), 0.0), (0.0, 1.1, 0.0, 0.0),
+                                    (-0.1, 0.0, 0.0, 0.0)])
+def test_bad_muscle_levels_are_refused_and_change_nothing(levels):
+    session = GameSession(GameConfig())
+    with pytest.raises(MuscleLevelError):
+        session.set_muscle_levels(levels)
+    assert session.muscles.goal == [0.0] * 4
+    batch = BatchGameSession([GameConfig()])
+    if len(levels) == 4:
+        with pytest.raises(MuscleLevelError):
+            batch.set_levels(np.array([levels]))
+        assert batch._goal.tolist() == [[0.0]] * 4
+
+
+def test_continuous_levels_move_the_arm_and_are_not_recorded():
+    session = GameSession(GameConfig(time_limit=1.0))
+    session.set_muscle_levels([0.5, 0.0, 0.25, 0.0])
+    session.advance(100)
+    assert session.timeline == [] and session.state[2] != 0.0
+    assert 0.49 < session.muscles.activation[0] < 0.5
+
+
+def test_games_that_cannot_share_a_batch_are_refused_naming_the_field():
+    with pytest.raises(UserError, match="target_radius"):
+        BatchGameSession([GameConfig(), GameConfig(target_radius=0.1)])
+    with pytest.raises(UserError, match="arm"):
+        BatchGameSession([GameConfig(), GameConfig(arm=GAME_PLAY_ARM.replace(damping1=0.1))])
+    with pytest.raises(UserError, match="gauss4"):
+        BatchGameSession([GameConfig(integrator="gauss4")])
+    assert batch_problem([GameConfig(seed=1, time_limit=5.0), GameConfig(seed=2, scene="other")]) is None
+
+
+def test_replay_many_groups_what_can_share_a_batch_and_plays_the_rest_alone():
+    rng = random.Random(11)
+    configs = [GameConfig(seed=1, time_limit=2.0), GameConfig(seed=2, time_limit=1.5, integrator="gauss4"),
+               GameConfig(seed=3, time_limit=2.0, target_radius=0.2), GameConfig(seed=4, time_limit=2.0),
+               GameConfig(seed=5, time_limit=2.0, target_radius=0.2), GameConfig(seed=6, time_limit=1.0),
+               GameConfig(seed=7, time_limit=2.0, dt=0.002)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
+    stops = [None, None, 300, None, None, 100, None]
+    expected = [GameSession(c).play(t, s) for c, t, s in zip(configs, timelines, stops, strict=True)]
+    assert replay_many(configs, timelines, stops, batch_size=2) == expected
+
+
+def test_play_with_no_events_and_a_stop_at_zero():
+    configs = [GameConfig(seed=1, time_limit=0.5), GameConfig(seed=2, time_limit=0.5)]
+    batch = BatchGameSession(configs)
+    results = batch.play([[], [InputEvent(0, "space", "down")]], [None, 0])
+    assert [r.steps for r in results] == [125, 0] and results[1].resets == 1
+    assert batch.state(1) == (math.radians(45.0), math.radians(90.0), 0.0, 0.0)
