@@ -23,7 +23,7 @@ from armgame.game.bots import ReachingBot, play_bot
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 
-REACH = "armgame/Reach-v0"
+REACH, CONTINUOUS = "armgame/Reach-v0", "armgame/ReachContinuous-v0"
 
 
 def rollout(env, seed, steps, action_seed=0):
@@ -44,11 +44,14 @@ def rollout(env, seed, steps, action_seed=0):
 def test_ids_are_registered_by_the_package():
     assert set(armgame.env.ENV_IDS) <= set(gym.registry)
     assert gym.spec(REACH).entry_point == "armgame.env.reach:ReachEnv"
+    assert gym.spec(CONTINUOUS).vector_entry_point == "armgame.env.vector:ReachVectorEnv"
 
 
-@pytest.mark.parametrize("kwargs", [{}, {"reset_key": True}, {"decision_steps": 1, "time_limit": 2.0}])
-def test_gymnasiums_checker_passes_without_a_warning(kwargs):
-    env = gym.make(REACH, **kwargs)
+@pytest.mark.parametrize(("env_id", "kwargs"), [(REACH, {}), (REACH, {"reset_key": True}),
+                                               (REACH, {"decision_steps": 1, "time_limit": 2.0}),
+                                               (CONTINUOUS, {}), (CONTINUOUS, {"reset_key": True})])
+def test_gymnasiums_checker_passes_without_a_warning(env_id, kwargs):
+    env = gym.make(env_id, **kwargs)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # Gymnasium's checker reports its doubts as warnings
         check_env(env.unwrapped)  # renders in both modes too (SDL's dummy drivers)
@@ -196,8 +199,9 @@ def test_rgb_array_frames_show_the_game():
 def test_the_docstring_examples_run():
     import armgame.env.policies
     import armgame.env.reach
+    import armgame.env.vector
 
-    for module in (armgame.env.reach, armgame.env.policies):
+    for module in (armgame.env.reach, armgame.env.policies, armgame.env.vector):
         failed, attempted = doctest.testmod(module)
         assert attempted >= 2 and failed == 0, module.__name__
 

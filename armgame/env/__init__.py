@@ -28,16 +28,17 @@ from __future__ import annotations
 
 import gymnasium
 
-ENV_IDS = ("armgame/Reach-v0",)
+ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
 
 
 def _register() -> None:
-    for env_id, continuous in zip(ENV_IDS, (False,), strict=True):
+    for env_id, continuous in zip(ENV_IDS, (False, True), strict=True):
         if env_id in gymnasium.registry:  # a re-import (importlib.reload) must not warn
             continue
         gymnasium.register(
             id=env_id,
             entry_point="armgame.env.reach:ReachEnv",
+            vector_entry_point="armgame.env.vector:ReachVectorEnv",
             kwargs={"continuous": continuous},
             # The game ends itself at its time limit (a truncation); no TimeLimit wrapper on top.
             max_episode_steps=None,

@@ -126,6 +126,20 @@ def observation_bounds(config: GameConfig) -> tuple[np.ndarray, np.ndarray]:
     return low, high
 
 
+def wrap_angle(q: float) -> float:
+    """``q`` in [-pi, pi]: itself when already there, else ``q - 2 pi round(q / 2 pi)``."""
+    if -math.pi <= q <= math.pi:
+        return q
+    return min(max(q - math.tau * round(q / math.tau), -math.pi), math.pi)
+
+
+def wrap_angles(q: np.ndarray) -> np.ndarray:
+    """``wrap_angle`` on an array, with the same floating-point operations, so a vector env equals single envs."""
+    wrapped = q - math.tau * np.rint(q / math.tau)
+    np.clip(wrapped, -math.pi, math.pi, out=wrapped)
+    return np.where(np.abs(q) <= math.pi, q, wrapped)
+
+
 def check_seed(seed: object) -> int:
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= seed < SEED_LIMIT:
         raise EnvArgumentError(f"seed must be a whole number from 0 to 2^63 - 1, got {seed!r}")
@@ -340,7 +354,7 @@ class ReachEnv(gym.Env):
         assert session is not None
         q1, q2, w1, w2 = session.state
         target = session.rules.target
-        return np.array((math.remainder(q1, math.tau), math.remainder(q2, math.tau), w1, w2,
+        return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2,
                          *session.muscles.activation, target.x, target.y, session.time_left))
 
     def _info(self) -> dict[str, int]:
