@@ -112,6 +112,19 @@ def test_next_step_autoreset():
     assert (obs[:, 4:8] > 0).all()  # and the games play on
 
 
+def test_gymnasiums_vector_wrappers_read_the_episodes():
+    envs = gym.make_vec(REACH, num_envs=3, time_limit=0.5)  # the vector entry point is the default
+    envs = gym.wrappers.vector.RecordEpisodeStatistics(envs)
+    envs.reset(seed=0)
+    envs.action_space.seed(0)
+    episodes = []
+    for _ in range(52):  # 25 steps a game, then the autoreset step
+        *_, info = envs.step(envs.action_space.sample())
+        if "episode" in info:
+            episodes.append(info["episode"]["l"][info["_episode"]].tolist())
+    assert episodes == [[25, 25, 25], [25, 25, 25]]
+
+
 def test_bad_vector_arguments_and_actions_are_refused():
     for kwargs in ({"num_envs": 0}, {"num_envs": True}, {"render_mode": "rgb_array"}, {"decision_steps": -2}):
         with pytest.raises(EnvArgumentError):
@@ -129,3 +142,19 @@ def test_bad_vector_arguments_and_actions_are_refused():
     levels.reset(seed=0)
     with pytest.raises(ValueError, match="finite"):
         levels.step(np.full((2, 4), np.nan))
+
+
+def test_the_speed_benchmark_runs():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "env_speed.py"
+    spec = importlib.util.spec_from_file_location("env_speed", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    result = bench.measure(quick=True, sizes=(3,), seconds=0.02, repeats=2)
+    rates = result["vector"][3]["reach"]["wall"]
+    assert rates["repeats"] == 2 and 0 < rates["min"] <= rates["median"] <= rates["max"]
+    assert result["single_ratio"]["median"] > 0
+    shares = bench.profile(num_envs=8, steps=3)
+    assert shares and 0.0 < sum(share for _, share in shares) <= 1.0 + 1e-9

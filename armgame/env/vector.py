@@ -122,26 +122,29 @@ class ReachVectorEnv(VectorEnv):
         n = self.num_envs
         rewards = np.empty(n)
         truncated = np.empty(n, dtype=bool)
-        cost = self.config.reset_cost
         for part, batch in self.parts:
-            # Games that ended at the last step are over, so neither the actions nor the physics
-            # touch them here; they start their next game after the others have stepped.
-            restart = self._autoreset[part]
-            playing = ~restart
-            hits, resets = batch.hits.copy(), batch.resets.copy()  # before the actions: a reset key costs
-            self._apply(batch, actions[part], playing)
-            batch.advance(self.decision_steps)
-            rewards[part] = batch.hits - hits
-            if cost:
-                rewards[part] -= cost * (batch.resets - resets)
-            if restart.any():
-                chosen = np.flatnonzero(restart) + part.start
-                batch.restart(restart, [self._game_seed(int(i), None) for i in chosen])
-            truncated[part] = batch.over  # a restarted game is not over
+            self._step_part(part, batch, actions, rewards, truncated)
         self._autoreset = truncated.copy()
         return self._observations(), rewards, np.zeros(n, dtype=bool), truncated, self._infos()
 
     # --------------------------------------------------------------- internals
+    def _step_part(self, part: slice, batch: BatchGameSession, actions: np.ndarray, rewards: np.ndarray,
+                   truncated: np.ndarray) -> None:
+        # Games that ended at the last step are over, so neither the actions nor the physics
+        # touch them here; they start their next game after the others have stepped.
+        restart = self._autoreset[part]
+        playing = ~restart
+        hits, resets = batch.hits.copy(), batch.resets.copy()  # before the actions: a reset key costs
+        self._apply(batch, actions[part], playing)
+        batch.advance(self.decision_steps)
+        rewards[part] = batch.hits - hits
+        if self.config.reset_cost:
+            rewards[part] -= self.config.reset_cost * (batch.resets - resets)
+        if restart.any():
+            chosen = np.flatnonzero(restart) + part.start
+            batch.restart(restart, [self._game_seed(int(i), None) for i in chosen])
+        truncated[part] = batch.over  # a restarted game is not over
+
     def _game_seed(self, i: int, seed: int | None) -> int:
         """Game ``i``'s next seed, exactly as single env ``i``'s ``reset(seed=seed)`` chooses it."""
         if seed is not None:
