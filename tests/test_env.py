@@ -49,6 +49,7 @@ def test_ids_are_registered_by_the_package():
 
 @pytest.mark.parametrize(("env_id", "kwargs"), [(REACH, {}), (REACH, {"reset_key": True}),
                                                (REACH, {"decision_steps": 1, "time_limit": 2.0}),
+                                               (REACH, {"decision_steps": 7, "time_limit": 0.23}),  # 0.232 s
                                                (CONTINUOUS, {}), (CONTINUOUS, {"reset_key": True})])
 def test_gymnasiums_checker_passes_without_a_warning(env_id, kwargs):
     env = gym.make(env_id, **kwargs)

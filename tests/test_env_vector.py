@@ -5,6 +5,8 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import data_equivalence
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import armgame.env
 import armgame.env.vector
@@ -91,6 +93,26 @@ def test_games_split_over_several_batches_equal_single_envs(monkeypatch):
         assert_same_step(native.step(actions), singles.step(actions), step)
     a, b = native.reset(), singles.reset()  # unseeded: each game's own generator draws the next seed
     assert data_equivalence(a, b, exact=True)
+
+
+@settings(max_examples=10, deadline=None)
+@given(n=st.integers(1, 4), decision_steps=st.integers(1, 7), time_limit=st.sampled_from([0.1, 0.23, 0.4]),
+       continuous=st.booleans(), reset_key=st.booleans(), seed=st.integers(0, 2**62), action_seed=st.integers(0, 99))
+def test_any_vector_env_equals_its_single_envs(n, decision_steps, time_limit, continuous, reset_key, seed,
+                                               action_seed):
+    env_id = CONTINUOUS if continuous else REACH
+    native, singles = make_pair(env_id, n, time_limit=time_limit, decision_steps=decision_steps,
+                                reset_key=reset_key)
+    native.action_space.seed(action_seed)
+    a, b = native.reset(seed=seed), singles.reset(seed=seed)
+    assert data_equivalence(a, b, exact=True)
+    for step in range(2 * (native.unwrapped.settings.episode_steps + 1) + 1):
+        actions = native.action_space.sample()
+        if reset_key:  # a press now and then, not every other step
+            actions[:, 4] = actions[:, 4] * (np.random.default_rng(step).random(n) < 0.1)
+        a = native.step(actions)
+        assert a[0] in native.observation_space
+        assert_same_step(a, singles.step(actions), step)
 
 
 def test_next_step_autoreset():
