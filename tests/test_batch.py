@@ -12,9 +12,10 @@ from hypothesis import strategies as st
 
 from armgame.errors import UserError
 from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, replay_many
-from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet
+from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet, MuscleSpec, remap_keys
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
-from armgame.game.session import GameSession, InputEvent
+from armgame.game.session import GameSession, InputEvent, TimelineInput
+from armgame.records.replay import Replay
 
 KEYS = ("d", "f", "j", "k")
 
@@ -74,6 +75,30 @@ def test_batch_equals_single_sessions_on_random_timelines(seeds, durations, stop
         assert_same_game(batch, i, single)
 
 
+ARMS = {"game": GAME_PLAY_ARM, "vertical": GAME_PLAY_ARM.replace(gravity=9.81),
+        "frictionless": GAME_PLAY_ARM.replace(damping1=0.0, damping2=0.0)}
+
+
+@settings(max_examples=6, deadline=None)
+@given(arm=st.sampled_from(sorted(ARMS)), integrator=st.sampled_from(["rk4", "euler", "symplectic-euler"]),
+       muscles=st.sampled_from(["default", "remapped", "biarticular"]), timeline_seed=st.integers(0, 2**32 - 1))
+def test_every_arm_and_batchable_integrator_equals_the_single_session(arm, integrator, muscles, timeline_seed):
+    """The kernel's gravity, damping and plain variants, the generic path, other keys and moment arms."""
+    rng = random.Random(timeline_seed)
+    muscles = {"default": DEFAULT_MUSCLES, "remapped": remap_keys(DEFAULT_MUSCLES, "jkdf"),
+               "biarticular": tuple(MuscleSpec(m.name, m.key, (m.moment[0] + 0.3, m.moment[1] - 0.2), 0.05, 0.12)
+                                    for m in DEFAULT_MUSCLES)}[muscles]
+    configs = [GameConfig(seed=s, time_limit=2.0, arm=ARMS[arm], integrator=integrator, muscles=muscles,
+                          target_radius=0.15) for s in range(3)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
+    batch = BatchGameSession(configs)
+    results = batch.play(timelines)
+    for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
+        single = GameSession(c)
+        assert results[i] == single.play(timeline)
+        assert_same_game(batch, i, single)
+
+
 def test_many_long_games_equal_the_single_session():
     """60 s games with a large target (many hits, many near misses): also the largest state difference."""
     rng = random.Random(7)
@@ -89,6 +114,35 @@ def test_many_long_games_equal_the_single_session():
         worst = max(worst, max(abs(a - b) for a, b in zip(batch.state(i), single.state, strict=True)))
     assert sum(r.hits for r in results) > 50 and sum(r.resets for r in results) > 0
     assert worst <= STATE_TOLERANCE
+
+
+def test_round_off_in_sin_and_cos_stays_well_within_the_stated_tolerance():
+    """Where numpy's sin and cos are not libm's they may be an ulp off: emulate that on the single session."""
+    from armgame.physics.integrators import scheme
+    from armgame.physics.twojoint import largest_abs_float
+
+    noise = random.Random(0)
+
+    def an_ulp_off(f):
+        def g(x):
+            y, r = f(x), noise.random()
+            return math.nextafter(y, math.inf) if r < 0.25 else math.nextafter(y, -math.inf) if r < 0.5 else y
+        return g
+
+    worst = 0.0
+    for game in range(2):
+        config = GameConfig(time_limit=60.0)
+        timeline = student_timeline(random.Random(game), config.dt, 60.0, extras=False)
+        exact, off = GameSession(config), GameSession(config)
+        off._physics_step = scheme("rk4").build(
+            off.model._build_components(an_ulp_off(math.cos), an_ulp_off(math.sin), largest_abs_float))
+        feed_exact, feed_off = TimelineInput(timeline), TimelineInput(timeline)
+        for step in range(100, config.total_steps + 1, 100):
+            feed_exact.run_to(exact, step)
+            feed_off.run_to(off, step)
+            worst = max(worst, *(abs(u - v) for u, v in zip(exact.state, off.state, strict=True)))
+        assert exact.result() == off.result()
+    assert 0.0 < worst < STATE_TOLERANCE / 100
 
 
 @pytest.mark.parametrize("inside", [True, False])
@@ -228,9 +282,189 @@ def test_replay_many_groups_what_can_share_a_batch_and_plays_the_rest_alone():
     assert replay_many(configs, timelines, stops, batch_size=2) == expected
 
 
+@pytest.mark.parametrize("games", [3, 8])  # most of the batch playing on, or most of it stopped
+def test_games_stopped_early_keep_the_state_of_their_last_step_and_its_events(games):
+    rng = random.Random(4)
+    configs = [GameConfig(seed=s, time_limit=3.0 if s else 1.0, target_radius=0.15) for s in range(games)]
+    timelines = [student_timeline(rng, c.dt, c.time_limit, extras=False) for c in configs]
+    stops = [None] * games
+    for i in (1, 2):  # quit at an event's step, with a reset (space) among its events
+        at = timelines[i][len(timelines[i]) // 2].step
+        timelines[i] = [e for e in timelines[i] if e.step <= at] + [InputEvent(at, "space", "down")]
+        stops[i] = at
+    batch = BatchGameSession(configs)
+    results = batch.play(timelines, stops)
+    for i in range(games):
+        single = GameSession(configs[i])
+        assert results[i] == single.play(timelines[i], stops[i])
+        assert_same_game(batch, i, single)
+    assert results[1].resets >= 1 and batch.state(1)[2:] == (0.0, 0.0)
+
+
 def test_play_with_no_events_and_a_stop_at_zero():
     configs = [GameConfig(seed=1, time_limit=0.5), GameConfig(seed=2, time_limit=0.5)]
     batch = BatchGameSession(configs)
     results = batch.play([[], [InputEvent(0, "space", "down")]], [None, 0])
     assert [r.steps for r in results] == [125, 0] and results[1].resets == 1
     assert batch.state(1) == (math.radians(45.0), math.radians(90.0), 0.0, 0.0)
+
+
+# ------------------------------------------------------------------ scoring a class from the command line
+
+def write_scripts(folder, count: int, seconds: float = 3.0) -> list:
+    folder.mkdir(exist_ok=True)
+    paths = []
+    for i in range(count):
+        rng = random.Random(i)
+        lines = [f"{e.step * 0.004:.3f} {e.key} {e.action}" for e in student_timeline(rng, 0.004, seconds)]
+        path = folder / f"student{i:02d}.txt"
+        path.write_text("# a student\n" + "\n".join(lines) + "\n")
+        paths.append(path)
+    return paths
+
+
+def test_play_many_scripts_prints_one_json_line_each_equal_to_playing_them_alone(tmp_path, capsys):
+    import json
+
+    from armgame.cli import main
+
+    paths = write_scripts(tmp_path / "class", 4)
+    order = [paths[2], paths[0], paths[3]]
+    assert main(["play", "--headless", "--seed", "5", "--duration", "3", "--json", "--script",
+                 *map(str, order)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    for line, path in zip(lines, order, strict=True):
+        assert main(["play", "--headless", "--seed", "5", "--duration", "3", "--json", "--script", str(path)]) == 0
+        alone = json.loads(capsys.readouterr().out)
+        assert json.loads(line) == {"script": str(path), **alone}
+
+
+def test_a_folder_of_scripts_plays_its_txt_files_in_sorted_order_and_follows_no_link(tmp_path, capsys):
+    import json
+
+    from armgame.cli import main
+
+    folder = tmp_path / "class"
+    paths = write_scripts(folder, 3)
+    (folder / "notes.md").write_text("not a script")
+    (folder / ".hidden.txt").write_text("0.0 x down\n")
+    outside = tmp_path / "outside.txt"
+    outside.write_text("0.0 d down\n")
+    (folder / "link.txt").symlink_to(outside)
+    (folder / "sub.txt").mkdir()
+    assert main(["play", "--headless", "--duration", "3", "--json", "--script", str(folder)]) == 0
+    scripts = [json.loads(line)["script"] for line in capsys.readouterr().out.splitlines()]
+    assert scripts == [str(p) for p in paths]
+    assert main(["play", "--headless", "--duration", "3", "--script", str(folder)]) == 0
+    assert capsys.readouterr().out.splitlines()[0].startswith(f"{paths[0]}: score ")
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--name", "Ann"], "--name and --record are for one game"),
+    (["--record", "x.json"], "--name and --record are for one game"),
+    (["--bot", "model"], "--bot and --script"),
+])
+def test_options_for_one_game_are_refused_for_many_in_one_line(tmp_path, capsys, extra, message):
+    from armgame.cli import main
+
+    paths = write_scripts(tmp_path / "class", 2)
+    assert main(["play", "--headless", "--script", *map(str, paths), *extra]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and message in err
+    assert not (tmp_path / "x.json").exists()
+
+
+def test_a_class_run_is_bounded_and_checks_every_script_before_playing(tmp_path, capsys, monkeypatch):
+    import armgame.game.batch as batch_module
+    from armgame.cli import main
+
+    paths = write_scripts(tmp_path / "class", 3)
+    monkeypatch.setattr(batch_module, "MAX_SCRIPTS", 2)
+    assert main(["play", "--headless", "--script", str(tmp_path / "class")]) == 2
+    assert "more than the 2" in capsys.readouterr().err
+    monkeypatch.setattr(batch_module, "MAX_SCRIPTS", 100)
+    monkeypatch.setattr(batch_module, "MAX_SCRIPT_EVENTS", 5)
+    assert main(["play", "--headless", "--script", *map(str, paths)]) == 2
+    assert "more than 5 events" in capsys.readouterr().err
+    monkeypatch.setattr(batch_module, "MAX_SCRIPT_EVENTS", 10**6)
+    paths[2].write_text("0.0 d down\nbad line\n")
+    played = []
+    monkeypatch.setattr(batch_module, "replay_many", lambda *a, **k: played.append(a))
+    assert main(["play", "--headless", "--script", *map(str, paths)]) == 2
+    assert "student02.txt, line 2" in capsys.readouterr().err and not played
+
+
+# ------------------------------------------------------------------ verifying many replays
+
+def recorded(seed: int, seconds: float = 2.0, player: str | None = "Ann", **config) -> Replay:
+    session = GameSession(GameConfig(seed=seed, time_limit=seconds, **config))
+    session.play(student_timeline(random.Random(seed), session.config.dt, seconds, extras=True))
+    return Replay.from_session(session, "script", f"s{seed}.txt", player)
+
+
+def test_verify_replays_equals_verifying_each_alone():
+    from dataclasses import replace as dc_replace
+
+    from armgame.records.batch_verify import verify_replays
+
+    replays = [recorded(s) for s in range(4)] + [recorded(9, integrator="gauss4"), recorded(8, target_radius=0.2)]
+    replays[1] = dc_replace(replays[1], result=dc_replace(replays[1].result, score=replays[1].result.score + 1))
+    quit_early = GameSession(GameConfig(seed=5, time_limit=3.0))
+    quit_early.play([InputEvent(0, "d", "down")], stop_step=200)
+    replays.append(Replay.from_session(quit_early, "keyboard"))
+    assert verify_replays(replays) == [r.verify() for r in replays]
+    assert [ok for ok, _ in verify_replays(replays)] == [True, False, True, True, True, True, True]
+
+
+def test_verify_a_folder_of_replays_in_batches(tmp_path, capsys, monkeypatch):
+    from dataclasses import replace as dc_replace
+
+    import armgame.records.batch_verify as bv
+    from armgame.cli import main
+
+    folder = tmp_path / "replays"
+    folder.mkdir()
+    for s in range(5):
+        recorded(s).save(folder / f"game{s}.json")
+    bad = recorded(7)
+    dc_replace(bad, result=dc_replace(bad.result, hits=bad.result.hits + 1, score=bad.result.score + 1)).save(
+        folder / "game7.json")
+    (folder / "broken.json").write_text('{"format": "armgame-replay"')
+    recorded(6).save(tmp_path / "outside.json")
+    (folder / "link.json").symlink_to(tmp_path / "outside.json")
+    (folder / "notes.txt").write_text("not a replay")
+    monkeypatch.setattr(bv, "CHUNK", 3)  # several chunks
+    assert main(["verify", str(folder)]) == 2
+    lines = capsys.readouterr().out.splitlines()
+    names = ["broken.json", *(f"game{s}.json" for s in range(5)), "game7.json"]  # sorted; link.json not followed
+    assert [line.split(": ")[0] for line in lines[:-1]] == [str(folder / n) for n in names]
+    assert lines[0].startswith(f"{folder / 'broken.json'}: BAD REPLAY: ")
+    assert sum(": matches: " in line for line in lines) == 5
+    assert ": DIFFERS: " in lines[6] and "game7.json" in lines[6]
+    assert lines[-1] == f"{folder}: 7 replays, 1 differ, 1 unreadable"
+    (folder / "broken.json").unlink()
+    assert main(["verify", str(folder)]) == 1
+    (folder / "game7.json").unlink()
+    assert main(["verify", str(folder)]) == 0
+    capsys.readouterr()
+    (tmp_path / "empty").mkdir()
+    assert main(["verify", str(tmp_path / "empty")]) == 2
+    assert "no score table (scores.json) and no replays (*.json)" in capsys.readouterr().err
+
+
+def test_verify_a_table_checks_its_entries_in_batches_as_one_by_one(tmp_path, capsys, monkeypatch):
+    import armgame.records.batch_verify as bv
+    from armgame.cli import main
+    from armgame.records.scores import ScoreTable
+
+    table = ScoreTable(tmp_path / "scores")
+    entries = [table.add(recorded(s, player=f"student {s}")) for s in range(6)]
+    table.replay_path(entries[1]).unlink()  # REPLAY MISSING
+    path = table.replay_path(entries[3])  # REPLAY CHANGED
+    path.write_bytes(path.read_bytes().replace(b'"player": "student 3"', b'"player": "student 9"'))
+    monkeypatch.setattr(bv, "CHUNK", 4)
+    ordered = sorted(table.read()[0], key=lambda e: e.when)
+    assert list(bv.check_entries(table, ordered)) == [(e, table.check(e)) for e in ordered]
+    assert main(["verify", str(tmp_path / "scores")]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert sum(line.endswith(": ok") for line in out) == 4 and out[-1].endswith("6 entries, 2 flagged")

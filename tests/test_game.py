@@ -225,7 +225,8 @@ def test_headless_cli_bad_input_is_one_line(tmp_path, args, message):
 def test_unreadable_script_files_are_one_line(tmp_path):
     binary = tmp_path / "binary.txt"
     binary.write_bytes(b"\xff\xfe\x00 d down\n")
-    for path, message in ((binary, "not a text file"), (tmp_path, "is a folder")):
+    (tmp_path / "empty").mkdir()
+    for path, message in ((binary, "not a text file"), (tmp_path / "empty", "no *.txt scripts")):
         proc = run_cli("play", "--headless", "--script", str(path))
         assert proc.returncode == 2
         assert len(proc.stderr.strip().splitlines()) == 1 and message in proc.stderr

@@ -49,7 +49,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
-    p.add_argument("--script", metavar="FILE", help="input timeline, one 'TIME KEY ACTION' a line (headless)")
+    p.add_argument("--script", metavar="FILE", nargs="+",
+                   help="input timeline, one 'TIME KEY ACTION' a line (headless); several files or a folder of "
+                   "*.txt scripts play a whole class in one batch, one result a line")
     p.add_argument("--bot", metavar="NAME", help="an autopilot at the muscle keys: model (knows the interaction "
                    "torques) or naive (drives each joint as if the other did not move)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
@@ -85,6 +87,10 @@ def run(args: argparse.Namespace) -> int:
     from ..game.script import load_script
     from ..game.session import GameSession
 
+    if args.script and (len(args.script) > 1 or Path(args.script[0]).is_dir()):
+        return _play_class(args)
+    if args.script:
+        args.script = args.script[0]
     session = GameSession(game_config(args))
     _check_score_options(args)
     if args.script and not args.headless:
@@ -108,6 +114,27 @@ def run(args: argparse.Namespace) -> int:
         print(f"your score is: {result.score}  ({result.hits} hits, {result.resets} resets, "
               f"{session.time:.1f} s of {result.duration:g} s)")
     _keep(session, args)
+    return 0
+
+
+def _play_class(args: argparse.Namespace) -> int:
+    """Many scripts, one batch: one line per script, in order, each naming its script."""
+    import json
+
+    from ..game.batch import play_scripts, script_paths
+
+    if not args.headless:
+        raise UserError("--script drives a headless game: add --headless")
+    if args.bot:
+        raise UserError("--bot and --script both drive the game: give one of them")
+    if args.name is not None or args.record:
+        raise UserError("--name and --record are for one game: give one script, not several")
+    paths = script_paths(args.script)
+    for path, result in zip(paths, play_scripts(game_config(args), paths), strict=True):
+        if args.json:
+            print(json.dumps({"script": str(path), **result.as_dict()}, sort_keys=True))
+        else:
+            print(f"{path}: score {result.score}  ({result.hits} hits, {result.resets} resets)")
     return 0
 
 

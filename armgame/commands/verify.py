@@ -11,9 +11,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="check that a replay (or every entry of a score table) reproduces its score",
         description="Replay the game of FILE from its input timeline and compare the result with the recorded "
         "one. FILE is a replay, or a score table (scores.json, or its folder): then every entry is checked "
-        "against its replay. Exit status: 0 if everything matches, 1 if not, 2 on a bad file.",
+        "against its replay, or a folder of replays: then every *.json file in it (symbolic links are not "
+        "followed). Many games are recomputed together in batches. "
+        "Exit status: 0 if everything matches, 1 if not, 2 on a bad file.",
     )
-    p.add_argument("file", metavar="FILE", help="a replay file, a scores.json or a scores folder")
+    p.add_argument("file", metavar="FILE", help="a replay file, a scores.json, a scores folder or a folder of replays")
     p.set_defaults(run=run)
 
 
@@ -23,6 +25,8 @@ def run(args: argparse.Namespace) -> int:
     from ..records.scores import TABLE_NAME
 
     path = Path(args.file)
+    if path.is_dir() and not (path / TABLE_NAME).exists():
+        return _verify_folder(path)
     if path.is_dir():
         return _verify_table(path)
     if path.name == TABLE_NAME or _looks_like_table(path):
@@ -39,11 +43,35 @@ def _looks_like_table(path) -> bool:
 
 
 def _verify_replay(path) -> int:
-    from .. import __version__
     from ..records.replay import Replay
 
     replay = Replay.load(path)
-    ok, got = replay.verify()
+    return _report(path, replay, *replay.verify())
+
+
+def _verify_folder(folder) -> int:
+    from ..errors import UserError
+    from ..records.batch_verify import replay_files, verify_files
+    from ..records.scores import TABLE_NAME
+
+    paths = replay_files(folder)
+    if not paths:
+        raise UserError(f"{folder}: no score table ({TABLE_NAME}) and no replays (*.json) there")
+    differ = bad = 0
+    for path, replay, got, ok in verify_files(paths):
+        if got is None:
+            bad += 1
+            print(f"{path}: BAD REPLAY: {str(replay).removeprefix(f'{path}: ')}")
+        else:
+            differ += _report(path, replay, ok, got)
+    print(f"{folder}: {len(paths)} replays, {differ} differ, {bad} unreadable")
+    return 2 if bad else 1 if differ else 0
+
+
+def _report(path, replay, ok: bool, got) -> int:
+    """One line on a recomputed replay; 0 if it matches, else 1."""
+    from .. import __version__
+
     r = replay.result
     who = f"{replay.player}'s game" if replay.player else "game"
     about = f"{who} ({replay.driven}, seed {r.seed}, {r.duration:g} s)"
@@ -62,6 +90,7 @@ def _verify_table(folder) -> int:
     import sys
 
     from ..errors import UserError
+    from ..records.batch_verify import check_entries
     from ..records.scores import ScoreTable
 
     table = ScoreTable(folder)
@@ -71,8 +100,7 @@ def _verify_table(folder) -> int:
     if damage:
         print(f"armgame verify: {damage.describe(table.path)}", file=sys.stderr)
     flagged = 0
-    for e in sorted(entries, key=lambda e: e.when):
-        c = table.check(e)
+    for e, c in check_entries(table, sorted(entries, key=lambda e: e.when)):
         flagged += not c.ok
         line = f"{e.name}: score {e.score} ({e.how}, {e.date[:16].replace('T', ' ')}): {c.label}"
         print(line + (f": {c.detail}" if c.detail else ""))

@@ -12,13 +12,16 @@ round-off. How that holds:
   numpy's float64 sin and cos are the C library's (checked on x86-64 with AVX2, numpy 2.4:
   identical on 6 million arguments), a batched game is bit for bit the single one. Where numpy
   uses its own vectorised sin and cos (AVX-512 builds), they may differ by an ulp, and the
-  states differ by round-off: ``STATE_TOLERANCE`` bounds that over a 60 s game.
-* The hit test never depends on numpy's round-off: numpy only flags games whose hand is
-  within a relative 1e-6 of a target's edge, and for those (rare: the hand is on or at a
-  target) the single session's own test is evaluated on Python floats from the game's state,
-  and the hit is scored by the game's own ``GameRules`` (which draws the next target from
-  the game's own random sequence). Given equal states the decision is identical, knife edge
-  or not.
+  states differ by round-off: ``STATE_TOLERANCE`` bounds that over a 60 s game. A hit could
+  then differ only if the hand crossed a target's edge within about 1e-13 m of it, where it
+  moves about 1e-3 m a step: a chance of the order of 1e-10 per crossing.
+* The hit test never depends on numpy's round-off: numpy only flags games whose hand may
+  be within a relative 1e-6 of a target's edge (a conservative bound on how far each hand
+  has moved since it was last measured, so the batch does not pay four more sin and cos
+  per step), and for those (rare: the hand is on or at a target) the single session's own
+  test is evaluated on Python floats from the game's state, and the hit is scored by the
+  game's own ``GameRules`` (which draws the next target from the game's own random
+  sequence). Given equal states the decision is identical, knife edge or not.
 * Events (keys, resets, tab) are applied between physics steps exactly where the single
   session applies them; ``play`` advances every game to the next step at which any game has
   an event, vectorised in between.
@@ -31,8 +34,11 @@ refuses them and ``replay_many`` plays such games one at a time.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import os
+import stat
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import fields, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -50,9 +56,12 @@ BATCH_INTEGRATORS = ("rk4", "euler", "symplectic-euler")
 #: Fields a batch's games may differ in; every other field of ``GameConfig`` must be equal.
 PER_GAME_FIELDS = ("seed", "time_limit", "scene")
 
-#: Largest joint-state difference (rad, rad/s) from the single session over a 60 s game where
-#: numpy's sin and cos are not the C library's; zero where they are (measured: tests/test_batch.py).
-STATE_TOLERANCE = 1e-9
+#: Largest joint-state difference (rad, rad/s) from the single session that a batch allows itself.
+#: Where numpy's sin and cos are the C library's the difference is zero (every test checks). Where
+#: they are not, they may be an ulp off: with sin and cos an ulp off in half their calls, 20 student
+#: games of 60 s stayed within 1.1e-13 of the exact ones, with the same results (the viscous arm
+#: forgets round-off rather than amplifying it; tests/test_batch.py repeats this on two games).
+STATE_TOLERANCE = 1e-10
 
 # A hand this close to a target's edge (relative to radius^2) is checked by the exact scalar test.
 _NEAR = 1.0 + 1e-6
@@ -105,7 +114,9 @@ class BatchGameSession:
         self.total_steps = np.array([g.total_steps for g in configs], dtype=np.int64)
         # Rows of the state: q1, q2, w1, w2; rows of the muscle arrays: the four muscles. Rows
         # are contiguous, so each is one fast array for the step.
-        self._x = np.empty((4, n))
+        # Rows 4-5 of ``_xs`` are scratch for the first RK4 stage's accelerations (see _Kernel.rk4).
+        self._xs = np.zeros((6, n))
+        self._x = self._xs[:4]
         self._act = np.zeros((MuscleSet.COUNT, n))
         self._goal = np.zeros((MuscleSet.COUNT, n))
         self._rate = np.empty((MuscleSet.COUNT, n))
@@ -117,7 +128,10 @@ class BatchGameSession:
         self.arm_visible = np.ones(n, dtype=bool)
         self.target_x = np.empty(n)
         self.target_y = np.empty(n)
+        # A lower bound on each hand's distance from its target's disc (m); negative: measure it.
+        self._slack = np.full(n, -1.0)
         self.rules: list[GameRules] = [None] * n  # type: ignore[list-item]
+        self._kernels: dict[int, _Kernel] = {}
         for i in range(n):
             self._start(i, configs[i])
 
@@ -132,6 +146,7 @@ class BatchGameSession:
         self.steps[i] = self.score[i] = self.hits[i] = self.resets[i] = 0
         self.arm_visible[i] = True
         self.target_x[i], self.target_y[i] = rules.target.x, rules.target.y
+        self._slack[i] = -1.0
 
     # ------------------------------------------------------------------ queries
     q1 = property(lambda self: self._x[0], doc="shoulder angles (rad), one per game")
@@ -220,6 +235,7 @@ class BatchGameSession:
     def _reset_arm(self, i: int) -> None:
         self._x[:, i] = (*self.config.start_posture, 0.0, 0.0)
         self._act[:, i] = 0.0
+        self._slack[i] = -1.0
         board = self.rules[i].board
         self.rules[i].reset_penalty()
         self.score[i], self.resets[i] = board.score, board.resets
@@ -265,53 +281,45 @@ class BatchGameSession:
             self._run(None if len(alive) == self.n else alive, chunk)
             left -= chunk
 
-    def _run(self, games: np.ndarray | None, count: int) -> None:
-        """``count`` physics steps of the games at indices ``games`` (None: all), none of which may end."""
+    def _run(self, games: np.ndarray | None, count: int, clocks: np.ndarray | None = None) -> None:
+        """``count`` physics steps of the games at indices ``games`` (None: all), none of which may end.
+
+        With ``games`` None, ``clocks`` (a mask) says whose step counts advance: the others are
+        stepped for nothing (``play`` keeps games that have stopped in the batch rather than
+        gather the rest every step, and puts their states back at the end).
+        """
         if count <= 0:
             return
         if games is None:
-            x, act, goal, rate = self._x, self._act, self._goal, self._rate
-            tx, ty = self.target_x, self.target_y
+            x, act, goal, rate = self._xs, self._act, self._goal, self._rate
+            tx, ty, slack = self.target_x, self.target_y, self._slack
+            base = self.steps
         else:  # work on compact copies, written back below
-            x, act, goal, rate = self._x[:, games], self._act[:, games], self._goal[:, games], self._rate[:, games]
-            tx, ty = self.target_x[games], self.target_y[games]
-        base = self.steps if games is None else self.steps[games]
-        step, dt = self._physics_step, self.config.dt
-        l1, l2 = self.config.arm.l1, self.config.arm.l2
-        s0, s1, s2, s3 = self._shoulder
-        e0, e1, e2, e3 = self._elbow
-        a0, a1, a2, a3 = act
-        near = _NEAR * self.target_radius * self.target_radius
-        change = np.empty_like(act)
-        cos, sin = np.cos, np.sin
-        for k in range(count):
-            # The session's hot loop, term for term: torque from the activations, then the muscles step.
-            t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
-            t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
-            np.subtract(goal, act, out=change)
-            change *= rate
-            act += change
-            x[0], x[1], x[2], x[3] = step(x[0], x[1], x[2], x[3], t1, t2, dt)
-            q1, q2 = x[0], x[1]
-            s12 = q1 + q2
-            dx = l1 * cos(q1) + l2 * cos(s12) - tx
-            dy = l1 * sin(q1) + l2 * sin(s12) - ty
-            dx *= dx
-            dy *= dy
-            dx += dy
-            if (dx <= near).any():
-                for j in np.flatnonzero(dx <= near):
-                    self._hit_test(int(j) if games is None else int(games[j]), x[:, j], int(base[j]) + k + 1, tx, ty,
-                                   int(j))
+            x, act, goal, rate = self._xs[:, games], self._act[:, games], self._goal[:, games], self._rate[:, games]
+            tx, ty, slack = self.target_x[games], self.target_y[games], self._slack[games]
+            base = self.steps[games]
+        m = x.shape[1]
+        kernel = self._kernels.get(m)
+        if kernel is None:
+            if len(self._kernels) > 2:  # keep the full batch's and a few others, not one per size ever seen
+                self._kernels = {k: v for k, v in self._kernels.items() if k == self.n}
+            kernel = self._kernels[m] = _Kernel(self, m)
+        for k, near in kernel.run(x, act, goal, rate, tx, ty, slack, count):
+            for j in near.tolist():
+                i = j if games is None else int(games[j])
+                if self._hit_test(i, x[:, j], int(base[j]) + k + 1):
+                    tx[j], ty[j], slack[j] = self.target_x[i], self.target_y[i], -1.0
         if games is not None:
-            self._x[:, games], self._act[:, games] = x, act
-            self.target_x[games], self.target_y[games] = tx, ty
+            self._x[:, games], self._act[:, games] = x[:4], act
+            self.target_x[games], self.target_y[games], self._slack[games] = tx, ty, slack
             self.steps[games] += count
-        else:
+        elif clocks is None:
             self.steps += count
+        else:
+            self.steps[clocks] += count
 
-    def _hit_test(self, i: int, state: np.ndarray, step: int, tx: np.ndarray, ty: np.ndarray, j: int) -> None:
-        """The single session's hit test and scoring, on Python floats, for game ``i`` (row ``j`` of the work)."""
+    def _hit_test(self, i: int, state: np.ndarray, step: int) -> bool:
+        """The single session's hit test and scoring, on Python floats, for game ``i`` after step ``step``."""
         p = self.config.arm
         q1, q2 = float(state[0]), float(state[1])
         s12 = q1 + q2
@@ -323,8 +331,10 @@ class BatchGameSession:
             rules.hand_moved(hx, hy, step * self.config.dt)
             board = rules.board
             self.score[i], self.hits[i] = board.score, board.hits
-            tx[j], ty[j] = rules.target.x, rules.target.y
-            self.target_x[i], self.target_y[i] = tx[j], ty[j]
+            self.target_x[i], self.target_y[i] = rules.target.x, rules.target.y
+            self._slack[i] = -1.0
+            return True
+        return False
 
     # ------------------------------------------------------------------- play
     def play(self, timelines: Sequence[Sequence[InputEvent]],
@@ -342,41 +352,286 @@ class BatchGameSession:
         if np.any(self.steps != self.steps[0]):
             raise ValueError("play needs every game of the batch at the same step")
         now = int(self.steps[0])
-        limit = np.array([t if s is None else min(int(s), t) for s, t in zip(stops, self.total_steps.tolist(),
-                                                                            strict=True)], dtype=np.int64)
-        # Every event TimelineInput would apply, at the step it takes effect: in list order, up to
-        # the first beyond the game's stop, never before the game's clock.
-        at, who, what = [], [], []
+        limit = [t if s is None else min(int(s), t) for s, t in zip(stops, self.total_steps.tolist(), strict=True)]
+        schedule = self._schedule(timelines, now, limit)
+        muscle_steps, flat, goal, rate, specials, held = schedule
+        limits = np.array(limit, dtype=np.int64)
+        alive = np.flatnonzero(limits > now)
+        # Games that stop while at least half the batch plays on stay in it, stepped for nothing:
+        # cheaper than gathering the others every step. Their slack is infinite (no hits) and
+        # their states are put back at the end.
+        running = limits > now
+        stopped: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+        def stop(games: np.ndarray) -> None:
+            for i in games.tolist():
+                stopped[i] = (self._x[:, i].copy(), self._act[:, i].copy())
+                self._slack[i] = np.inf
+            running[games] = False
+        # Every step where something happens: an event of some game, or some game's stop.
+        stops_at = np.unique(np.concatenate([muscle_steps, np.array([s for s, _, _ in specials], dtype=np.int64),
+                                             limits[limits > now]]))
+        bounds = np.searchsorted(muscle_steps, stops_at, side="right").tolist()
+        goal_flat, rate_flat = self._goal.reshape(-1), self._rate.reshape(-1)
+        lo, special = np.searchsorted(muscle_steps, now, side="left"), 0
+        for target, hi in zip([now, *stops_at.tolist()], [lo, *bounds], strict=True):
+            if target > now:
+                if 2 * len(alive) >= self.n:
+                    self._run(None, target - now, None if len(alive) == self.n else running)
+                else:
+                    self._run(alive, target - now)
+                now = target
+            if hi > lo:  # the muscle keys pressed and released at this step
+                where = flat[lo:hi]
+                goal_flat[where] = goal[lo:hi]
+                rate_flat[where] = rate[lo:hi]
+                lo = hi
+            while special < len(specials) and specials[special][0] == now:
+                _, i, key = specials[special]
+                self.key_event(i, key, DOWN)
+                special += 1
+            if len(alive) and int(limits[alive].min()) <= now:  # after their events at their last step
+                stop(alive[limits[alive] <= now])
+                alive = alive[limits[alive] > now]
+        for i, (x, act) in stopped.items():
+            self._x[:, i], self._act[:, i], self._slack[i] = x, act, -1.0
+        for i, row in held.items():
+            self.held[i] = row
+        return [self.result(i) for i in range(self.n)]
+
+    def _schedule(self, timelines: Sequence[Sequence[InputEvent]], now: int, limit: list[int]):
+        """What each timeline does and when, as ``TimelineInput`` and ``key_event`` would do it.
+
+        Key events do not depend on the motion, so their effect is worked out here once, in
+        plain Python: events in list order up to the first beyond the game's stop, each at the
+        later of its step and the game's clock; events at or after the game's end, repeats of a
+        held key and unknown keys dropped. Muscle commands come back as flat indices into the
+        (4, n) goal and rate arrays with their new values, sorted by step (of several for one
+        muscle at one step, the last, which is what applying them all in order leaves); resets
+        and tab as (step, game, key); the muscle keys held at the end by game.
+        """
+        index = {key: m for m, key in enumerate(self.muscle_keys)}
+        rise, decay = self._rise.tolist(), self._decay.tolist()
+        n, totals = self.n, self.total_steps.tolist()
+        steps: list[int] = []
+        flat: list[int] = []
+        goal: list[float] = []
+        rate: list[float] = []
+        specials: list[tuple[int, int, str]] = []
+        held_at_end: dict[int, list[bool]] = {}
         for i, events in enumerate(timelines):
-            clock, stop = now, int(limit[i])
+            clock, stop, end = now, limit[i], totals[i]
+            held = self.held[i].tolist()
+            last = [(-1, -1)] * len(held)  # per muscle: (step, position in the lists) of its last command
             for e in events:
                 if e.step > stop:
                     break
                 clock = max(clock, e.step)
-                at.append(clock)
-                who.append(i)
-                what.append(e)
-        order = np.argsort(np.array(at, dtype=np.int64), kind="stable")
-        at_sorted = np.array(at, dtype=np.int64)[order].tolist()
-        alive = np.flatnonzero(limit > now)
-        pos, total = 0, len(order)
-        while True:
-            next_event = at_sorted[pos] if pos < total else None
-            next_end = int(np.min(limit[alive])) if len(alive) else None
-            if next_event is None and next_end is None:
-                break
-            target = min(v for v in (next_event, next_end) if v is not None)
-            if target > now:
-                self._run(None if len(alive) == self.n else alive, target - now)
-                now = target
-            while pos < total and at_sorted[pos] == now:
-                k = order[pos]
-                e = what[k]
-                self.key_event(who[k], e.key, e.action)
-                pos += 1
-            if len(alive) and next_end == now:
-                alive = alive[limit[alive] > now]
-        return [self.result(i) for i in range(self.n)]
+                if clock >= end:
+                    continue
+                m = index.get(e.key)
+                if m is not None:
+                    down = e.action == DOWN
+                    if held[m] == down:
+                        continue
+                    held[m] = down
+                    values = (1.0, rise[m]) if down else (0.0, decay[m])
+                    if last[m][0] == clock:
+                        goal[last[m][1]], rate[last[m][1]] = values
+                    else:
+                        last[m] = (clock, len(steps))
+                        steps.append(clock)
+                        flat.append(m * n + i)
+                        goal.append(values[0])
+                        rate.append(values[1])
+                elif e.key in (RESET_KEY, TOGGLE_ARM_KEY) and e.action == DOWN:
+                    specials.append((clock, i, e.key))
+            held_at_end[i] = held
+        order = np.argsort(np.array(steps, dtype=np.int64), kind="stable")
+        specials.sort(key=lambda s: s[0])
+        return (np.array(steps, dtype=np.int64)[order], np.array(flat, dtype=np.intp)[order],
+                np.array(goal)[order], np.array(rate)[order], specials, held_at_end)
+
+class _Kernel:
+    """The session's hot loop for ``m`` games at once, every intermediate in preallocated arrays.
+
+    Each expression is the single session's (``GameSession.advance``, ``integrators._rk4``,
+    ``TwoJointArm.component_dynamics``' accel) with the same operations in the same order,
+    one numpy call per operation written into scratch: IEEE arithmetic is elementwise, so
+    every game gets the bits its scalar loop would. At a thousand games a call costs about
+    as much as its arithmetic, so the calls are the cheapest kind (positional ``out``,
+    constants as 0-d arrays, no broadcasting, names bound once in a closure), and where the
+    scalar code does the same operation to a shoulder and an elbow quantity, one call does
+    both rows of a (2, m) array. Integrators other than rk4 go through the generic numpy
+    closures (which allocate).
+    """
+
+    def __init__(self, batch: BatchGameSession, m: int) -> None:
+        self.batch, self.m = batch, m
+        self._bound: tuple[tuple[int, ...], Callable[[], bool]] | None = None
+
+    def stepper(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray,
+                slack: np.ndarray) -> Callable[[], bool]:
+        """One physics step of these arrays (state rows 0-3 of ``x``, rows 4-5 scratch) as a function.
+
+        The function returns whether some hand's ``slack`` ran out (see ``run``).
+        """
+        key = tuple(id(a) for a in (x, act, goal, rate, slack))
+        if self._bound is None or self._bound[0] != key:
+            self._bound = (key, self._build(x, act, goal, rate, slack))
+        return self._bound[1]
+
+    def _build(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray,
+               slack: np.ndarray) -> Callable[[], bool]:
+        batch, m = self.batch, self.m
+        model, config = batch.model, batch.config
+        p = model.params
+        gravity, damping = p.has_gravity, p.has_gravity or p.has_damping
+        const = np.array
+        B, D, G1, G2 = const(model.b), const(model.d), const(model.g1), const(model.g2)
+        DET0, AMD = const(model.a * model.d - model.d * model.d), const(model.a - model.d)
+        ONE, TWO, ZERO = const(1.0), const(2.0), const(0.0)
+        dt = config.dt
+        H, DT, SIXTH = const(0.5 * dt), const(dt), const(dt * (1.0 / 6.0))
+        # |change of the hand| <= (l1 + l2) |dq1| + l2 |dq2| (chords are shorter than arcs), a hair over.
+        REACH1, REACH2 = const((p.l1 + p.l2) * (1.0 + 1e-9)), const(p.l2 * (1.0 + 1e-9))
+        mul, add, sub, div, cos, sin = np.multiply, np.add, np.subtract, np.divide, np.cos, np.sin
+        empty = np.empty
+        trig, force, inertia, pair = empty((2, m)), empty((2, m)), empty((2, m)), empty((2, m))
+        bc, hs = trig
+        f1, f2 = force
+        inertia[0] = model.d
+        i1 = inertia[1]
+        p0, p1 = pair
+        viscosity = empty((2, m))
+        viscosity[0], viscosity[1] = p.damping1, p.damping2
+        m12, r, tmp, gc12, move, move2 = (empty(m) for _ in range(6))
+        torque = empty((2, m))
+        t1, t2 = torque
+        change, previous, total, mid = empty((4, m)), empty((2, m)), empty((4, m)), empty((4, m))
+        head, state = x[:2], x[:4]
+        near_mask = empty(m, dtype=bool)
+        # Stages 2-4: rows 0-3 the stage's state (q1 q2 w1 w2), rows 4-5 its accelerations, so rows 2-5
+        # are the stage's slopes (velocities, accelerations) without a copy; stage 1 is x itself.
+        s2, s3, s4 = (empty((6, m)) for _ in range(3))
+        stages = [(x, (*x, x[2:4], x[4:6]))] + [(s, (*s, s[2:4], s[4:6])) for s in (s2, s3, s4)]
+        # Torque rows: (activation row, moment) pairs; a zero moment adds a +0.0 term, kept as one "+ 0.0".
+        rows = []
+        for out, moments in ((t1, batch._shoulder), (t2, batch._elbow)):
+            terms = [(act[i], const(c)) for i, c in enumerate(moments) if c != 0.0]
+            rows.append((out, terms, len(terms) < len(moments)))
+        generic = None if config.integrator == "rk4" else batch._physics_step
+
+        def accel(q1, q2, w1, w2, o1, o2, velocity, out):
+            cos(q2, bc)
+            sin(q2, hs)
+            mul(trig, B, trig)  # bc = b cos q2, h = b sin q2
+            add(bc, D, m12)
+            # f1 = t1 + h (w1 + w1 + w2) w2 [- g1 cos q1 - g2 cos(q1 + q2)] [- k1 w1]
+            add(w1, w1, tmp)
+            add(tmp, w2, tmp)
+            mul(tmp, hs, tmp)
+            mul(tmp, w2, tmp)
+            add(t1, tmp, f1)
+            # f2 = t2 - h w1 w1 [- g2 cos(q1 + q2)] [- k2 w2]
+            mul(hs, w1, tmp)
+            mul(tmp, w1, tmp)
+            sub(t2, tmp, f2)
+            if gravity:
+                add(q1, q2, gc12)
+                cos(gc12, gc12)
+                mul(gc12, G2, gc12)
+                cos(q1, tmp)
+                mul(tmp, G1, tmp)
+                sub(f1, tmp, f1)
+                sub(f1, gc12, f1)
+                sub(f2, gc12, f2)
+            if damping:
+                mul(velocity, viscosity, pair)
+                sub(force, pair, force)
+            # r = 1 / (det0 - bc^2); qdd1 = (d f1 - m12 f2) r; qdd2 = ((m12 + a - d + bc) f2 - m12 f1) r
+            mul(bc, bc, r)
+            sub(DET0, r, r)
+            div(ONE, r, r)
+            add(m12, AMD, i1)
+            add(i1, bc, i1)
+            mul(force, inertia, out)
+            mul(m12, f2, p0)
+            mul(m12, f1, p1)
+            sub(out, pair, out)
+            mul(o1, r, o1)
+            mul(o2, r, o2)
+
+        def step() -> bool:
+            # Torque from the activations (t1 = a0 s0 + a1 s1 + a2 s2 + a3 s3, left to right), then the muscles step.
+            for out, terms, has_zero in rows:
+                if not terms:
+                    out.fill(0.0)
+                    continue
+                mul(terms[0][0], terms[0][1], out)
+                for a, c in terms[1:]:
+                    mul(a, c, tmp)
+                    add(out, tmp, out)
+                if has_zero:
+                    add(out, ZERO, out)  # the a * 0.0 terms: +0.0 each, and x + 0.0 + 0.0 == x + 0.0
+            sub(goal, act, change)
+            mul(change, rate, change)
+            add(act, change, act)
+            np.copyto(previous, head)
+            if generic is None:
+                # integrators._rk4: stage i's state is x + c (stage i-1's slopes), i.e. the scalar
+                # code's q1 + h * w1 and v1 = w1 + h * a1 and so on; then
+                # x + dt/6 (k1 + k4 + 2 (k2 + k3)), the scalar q1 + k * (w1 + s1 + 2.0 * (v1 + u1)).
+                accel(*stages[0][1])
+                for (before, _), (stage, views), c in zip(stages, stages[1:], (H, H, DT), strict=False):
+                    mul(before[2:], c, stage[:4])
+                    add(stage[:4], state, stage[:4])
+                    accel(*views)
+                add(s2[2:], s3[2:], mid)
+                mul(mid, TWO, mid)
+                add(x[2:], s4[2:], total)
+                add(total, mid, total)
+                mul(total, SIXTH, total)
+                add(state, total, state)
+            else:
+                x[0], x[1], x[2], x[3] = generic(x[0], x[1], x[2], x[3], t1, t2, dt)
+            sub(head, previous, previous)
+            np.abs(previous, previous)
+            mul(previous[0], REACH1, move)
+            mul(previous[1], REACH2, move2)
+            add(move, move2, move)
+            sub(slack, move, slack)
+            np.less(slack, ZERO, near_mask)
+            return bool(near_mask.any())
+
+        self.near_mask = near_mask
+        return step
+
+    def run(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray, tx: np.ndarray,
+            ty: np.ndarray, slack: np.ndarray, count: int) -> Iterator[tuple[int, np.ndarray]]:
+        """Step ``count`` times; after step k + 1, yields (k, indices) of the hands near their targets.
+
+        Measuring every hand after every step would cost four more sin and cos of the whole
+        batch. Instead ``slack`` holds a lower bound on each hand's distance from its target's
+        disc, lowered every step by a bound on how far the hand moved; only hands whose slack
+        runs out are measured (a few per step), and only those near the edge go to the exact test.
+        """
+        step = self.stepper(x, act, goal, rate, slack)
+        config = self.batch.config
+        l1, l2, radius = config.arm.l1, config.arm.l2, config.target_radius
+        near = _NEAR * radius * radius
+        for k in range(count):
+            if step():
+                where = np.flatnonzero(self.near_mask)
+                a, b = x[0, where], x[1, where]
+                s12 = a + b
+                dx = l1 * np.cos(a) + l2 * np.cos(s12) - tx[where]
+                dy = l1 * np.sin(a) + l2 * np.sin(s12) - ty[where]
+                d2 = dx * dx + dy * dy
+                slack[where] = np.sqrt(d2) - radius - 1e-9
+                close = where[d2 <= near]
+                if len(close):
+                    yield k, close
 
 
 def replay_many(configs: Sequence[GameConfig], timelines: Sequence[Sequence[InputEvent]],
@@ -412,4 +667,77 @@ def replay_many(configs: Sequence[GameConfig], timelines: Sequence[Sequence[Inpu
     return results  # type: ignore[return-value]
 
 
-__all__ = ["BATCH_INTEGRATORS", "STATE_TOLERANCE", "BatchGameSession", "batch_problem", "replay_many"]
+
+
+# ------------------------------------------------------------------ many scripts at once
+#: Bounds on one class run (``armgame play --headless --script A B ...``), checked before any game runs.
+MAX_SCRIPTS = 5000
+MAX_SCRIPT_EVENTS = 2_000_000
+MAX_SCRIPTS_BYTES = 256 * 1024 * 1024
+
+
+def files_in(folder: Path, suffix: str, limit: int, what: str) -> list[Path]:
+    """The regular files ``*suffix`` directly in ``folder``, sorted by name.
+
+    Symbolic links are skipped, never followed (a link could lead out of the folder), as
+    are hidden files and subfolders; more than ``limit`` files is refused before any is read.
+    """
+    try:
+        entries = sorted(os.scandir(folder), key=lambda e: e.name)
+    except OSError as exc:
+        raise UserError(f"{folder}: cannot list the folder: {exc.strerror or exc}") from None
+    found = [Path(e.path) for e in entries
+             if e.name.endswith(suffix) and not e.name.startswith(".") and e.is_file(follow_symlinks=False)]
+    if len(found) > limit:
+        raise UserError(f"{folder}: {len(found)} {what}, more than the {limit} one run takes")
+    return found
+
+
+def script_paths(names: Sequence[str | Path]) -> list[Path]:
+    """Script files from the command line: files as given, folders as their ``*.txt`` files in sorted order."""
+    paths: list[Path] = []
+    for name in names:
+        path = Path(name)
+        if path.is_dir():
+            inside = files_in(path, ".txt", MAX_SCRIPTS, "scripts")
+            if not inside:
+                raise UserError(f"{path}: no *.txt scripts in this folder")
+            paths += inside
+        else:
+            paths.append(path)
+        if len(paths) > MAX_SCRIPTS:
+            raise UserError(f"more than {MAX_SCRIPTS} scripts in one run: split the class into several runs")
+    total = 0
+    for path in paths:
+        try:
+            info = path.stat()
+        except OSError:
+            continue  # the reader names what is wrong with it
+        if stat.S_ISREG(info.st_mode):
+            total += info.st_size
+    if total > MAX_SCRIPTS_BYTES:
+        raise UserError(f"the scripts add up to {total // (1024 * 1024)} MiB, more than the "
+                        f"{MAX_SCRIPTS_BYTES // (1024 * 1024)} MiB one run takes")
+    return paths
+
+
+def play_scripts(config: GameConfig, paths: Sequence[Path]) -> list[GameResult]:
+    """Play one game per script (``config`` with each), all in one batch; results in order.
+
+    Every script is read and checked before any game runs, and their events together are
+    bounded by ``MAX_SCRIPT_EVENTS``.
+    """
+    from .script import load_script
+
+    keys = (*(m.key for m in config.muscles), RESET_KEY, TOGGLE_ARM_KEY)
+    timelines, total = [], 0
+    for path in paths:
+        if not path.is_file():
+            raise UserError(f"{path}: not a script file" if path.exists() else f"{path}: no such script file")
+        timeline = load_script(path, keys, config.dt)
+        total += len(timeline)
+        if total > MAX_SCRIPT_EVENTS:
+            raise UserError(f"the scripts hold more than {MAX_SCRIPT_EVENTS} events together (at {path}): "
+                            "split the class into several runs")
+        timelines.append(timeline)
+    return replay_many([config] * len(paths), timelines)

@@ -38,6 +38,7 @@ from dataclasses import asdict, dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
 
+from ..game.session import GameResult
 from .replay import (
     DRIVEN,
     MAX_REPLAY_BYTES,
@@ -277,6 +278,17 @@ class ScoreTable:
 
     def check(self, entry: ScoreEntry) -> Check:
         """Whether the entry's replay is the one it names and reproduces its game."""
+        found = self.claimed_replay(entry)
+        if isinstance(found, Check):
+            return found
+        return self.reproduced(found, *found.verify())
+
+    def claimed_replay(self, entry: ScoreEntry) -> Replay | Check:
+        """The entry's replay if it is the one the entry names, else the failed ``Check``; not yet replayed.
+
+        ``check`` is this and ``reproduced``; split so that many entries' replays can be
+        recomputed in one batch (``records.batch_verify``).
+        """
         path = self.replay_path(entry)
         try:
             data = read_limited(path, MAX_REPLAY_BYTES, "replay file")
@@ -295,7 +307,12 @@ class ScoreTable:
             if getattr(entry, key) != value:
                 return Check(False, "NOT ITS REPLAY",
                              f"the entry says {key} {getattr(entry, key)!r}, its replay {value!r}")
-        ok, recomputed = replay.verify()
+        return replay
+
+    @staticmethod
+    def reproduced(replay: Replay, ok: bool, recomputed: GameResult) -> Check:
+        """The verdict on a replay whose game was recomputed as ``recomputed`` (``ok``: the same outcome)."""
+        r = replay.result
         if not ok:
             return Check(False, "NOT REPRODUCED",
                          f"recorded score {r.score}, the replay gives {recomputed.score} "

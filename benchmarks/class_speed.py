@@ -1,0 +1,147 @@
+"""Scoring a class: 1,000 scripted 60 s games one after another against one batch, and their verification.
+
+    python benchmarks/class_speed.py                 # 1,000 games, 100 timed one by one, 3 repeats
+    python benchmarks/class_speed.py --games 300 --sample 300 --repeats 5 --json
+
+The scripts are seeded random key timelines like a student's: every 0.1-0.5 s one of the
+four muscle keys changes (pressed if up, released if down), and one switch in a hundred is
+followed by a reset. Every game is the standard one (seed 10, 60 s), as in a class.
+
+"One after another" is today's rate: ``GameSession(config).play(timeline)`` per game, timed
+on the first ``--sample`` games and scaled to all of them (the games cost the same to a few
+per cent). "Batched" is one ``BatchGameSession`` for all the games, timed whole, wall clock;
+the results of the sampled games are checked equal to the sequential ones. Verification is
+the same comparison for replays: ``Replay.verify`` one by one against
+``records.batch_verify.verify_replays`` (recomputation only, files already read).
+
+Each ratio is measured within one repeat, so both sides see the same machine load; the
+spread over repeats is printed beside the median. CPU-time ratios are printed too: on a
+loaded machine they move less than wall-clock ones.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import random
+import statistics
+import sys
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from armgame.game.batch import BatchGameSession
+from armgame.game.rules import GameConfig
+from armgame.game.session import GameSession, InputEvent
+from armgame.records.batch_verify import verify_replays
+from armgame.records.replay import Replay
+
+CLASS_SEED = 10  # armgame play's default: everyone in the class sees the same targets
+
+
+def student_timeline(rng: random.Random, dt: float, seconds: float) -> list[InputEvent]:
+    """Keys switching every 0.1-0.5 s, a reset after one switch in a hundred."""
+    events: list[InputEvent] = []
+    held: set[str] = set()
+    t = 0.0
+    while True:
+        t += rng.uniform(0.1, 0.5)
+        if t >= seconds:
+            return events
+        step = round(t / dt)
+        key = rng.choice("dfjk")
+        events.append(InputEvent(step, key, "up" if key in held else "down"))
+        held ^= {key}
+        if rng.random() < 0.01:
+            events.append(InputEvent(step, "space", "down"))
+
+
+def timed(work: Callable[[], object]) -> tuple[float, float, object]:
+    """(wall s, CPU s, result) of one call."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = work()
+    return time.perf_counter() - wall, time.process_time() - cpu, result
+
+
+def machine() -> dict[str, object]:
+    model = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            model = next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), model)
+    except OSError:
+        pass
+    return {"cpu": model, "cores": os.cpu_count(), "python": platform.python_version(), "numpy": np.__version__,
+            "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
+
+
+def one_repeat(configs: list[GameConfig], timelines: list[list[InputEvent]], sample: int) -> dict[str, float]:
+    n = len(configs)
+    scale = n / sample
+    # Games: one after another (a sample, scaled) and in one batch.
+    seq_wall, seq_cpu, seq_results = timed(lambda: [GameSession(c).play(t)
+                                                    for c, t in zip(configs[:sample], timelines[:sample],
+                                                                    strict=True)])
+    batch_wall, batch_cpu, batch_results = timed(lambda: BatchGameSession(configs).play(timelines))
+    if batch_results[:sample] != seq_results:
+        sys.exit("class_speed: the batch and the single sessions disagree: a bug")
+    # Verification of the same games as replays.
+    replays = [Replay(c, tuple(t), r, "script", f"student{i:04d}.txt", f"student {i}")
+               for i, (c, t, r) in enumerate(zip(configs, timelines, batch_results, strict=True))]
+    vseq_wall, vseq_cpu, vseq = timed(lambda: [r.verify() for r in replays[:sample]])
+    vbatch_wall, vbatch_cpu, vbatch = timed(lambda: verify_replays(replays))
+    if vbatch[:sample] != vseq or not all(ok for ok, _ in vbatch):
+        sys.exit("class_speed: batched verification disagrees with Replay.verify: a bug")
+    return {
+        "sequential_wall_s": seq_wall * scale, "batched_wall_s": batch_wall,
+        "ratio_wall": seq_wall * scale / batch_wall, "ratio_cpu": seq_cpu * scale / batch_cpu,
+        "verify_sequential_wall_s": vseq_wall * scale, "verify_batched_wall_s": vbatch_wall,
+        "verify_ratio_wall": vseq_wall * scale / vbatch_wall, "verify_ratio_cpu": vseq_cpu * scale / vbatch_cpu,
+        "mean_score": float(np.mean([r.score for r in batch_results])),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--games", type=int, default=1000, help="games in the class (default: 1000)")
+    parser.add_argument("--sample", type=int, default=100,
+                        help="games timed one after another, scaled to --games (default: 100)")
+    parser.add_argument("--seconds", type=float, default=60.0, help="length of each game (default: 60)")
+    parser.add_argument("--repeats", type=int, default=3, help="repeats, for the spread (default: 3)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    if not (1 <= args.sample <= args.games <= 100_000 and 1 <= args.repeats <= 20 and 0 < args.seconds <= 600):
+        parser.error("need 1 <= --sample <= --games <= 100000, 1 <= --repeats <= 20, 0 < --seconds <= 600")
+    config = GameConfig(seed=CLASS_SEED, time_limit=args.seconds)
+    configs = [config] * args.games
+    timelines = [student_timeline(random.Random(i), config.dt, args.seconds) for i in range(args.games)]
+    runs = [one_repeat(configs, timelines, args.sample) for _ in range(args.repeats)]
+
+    def summary(key: str) -> dict[str, float]:
+        values = [run[key] for run in runs]
+        return {"median": statistics.median(values), "min": min(values), "max": max(values)}
+
+    report = {"games": args.games, "sample": args.sample, "seconds": args.seconds, "repeats": args.repeats,
+              "events_per_game": sum(map(len, timelines)) / args.games, "machine": machine(),
+              **{key: summary(key) for key in runs[0]}, "runs": runs}
+    if args.json:
+        print(json.dumps(report, indent=1))
+        return 0
+    m = report["machine"]
+    print(f"{args.games} scripted {args.seconds:g} s games ({report['events_per_game']:.0f} key events each), "
+          f"{args.repeats} repeats; {m['cpu']}, {m['cores']} cores, load {m['load_average_1min']}, "
+          f"Python {m['python']}, numpy {m['numpy']}")
+    for label, prefix in (("play", ""), ("verify", "verify_")):
+        seq, batch = report[f"{prefix}sequential_wall_s"], report[f"{prefix}batched_wall_s"]
+        wall, cpu = report[f"{prefix}ratio_wall"], report[f"{prefix}ratio_cpu"]
+        print(f"{label:>6}: one after another {seq['median']:6.1f} s (first {args.sample} timed, scaled); "
+              f"batched {batch['median']:5.2f} s [{batch['min']:.2f}-{batch['max']:.2f}]; "
+              f"{wall['median']:.1f}x wall [{wall['min']:.1f}-{wall['max']:.1f}], "
+              f"{cpu['median']:.1f}x CPU [{cpu['min']:.1f}-{cpu['max']:.1f}]")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
