@@ -1,0 +1,49 @@
+"""Gymnasium environments over the game: how programs play armgame (optional extra ``[gym]``).
+
+This package owns the Gymnasium face of the game and nothing of the game itself: the env
+classes (``reach.ReachEnv`` for one game, ``vector.ReachVectorEnv`` for many in lockstep on
+``BatchGameSession``), their spaces and reward, the registration of their ids, and
+``policies.BotPolicy``, which lets the game's own bots play through an env. The rules, the
+muscles and the physics stay in ``armgame.game``; frames come from ``armgame.ui``'s renderer.
+
+Importing this package registers, with ``gymnasium.register``:
+
+* ``armgame/Reach-v0``: the standard game, the four muscle keys as ``MultiBinary(4)``;
+* ``armgame/ReachContinuous-v0``: the same game driven by four muscle levels, ``Box(0, 1, (4,))``.
+
+Both have a native vector entry point, so ``gymnasium.make_vec(id, num_envs=N)`` gives one
+``ReachVectorEnv`` stepping N games as numpy arrays (next-step autoreset). ``import armgame``
+imports neither gymnasium nor this package, and nothing here imports pygame until an env
+renders::
+
+    import gymnasium as gym
+    import armgame.env  # noqa: F401  (registers the ids)
+    env = gym.make("armgame/Reach-v0")
+
+Gymnasium also imports the module named before a colon, so ``gym.make("armgame.env:armgame/Reach-v0")``
+works without the import line.
+"""
+
+from __future__ import annotations
+
+import gymnasium
+
+ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
+
+
+def _register() -> None:
+    for env_id, continuous in zip(ENV_IDS, (False, True), strict=True):
+        if env_id in gymnasium.registry:  # a re-import (importlib.reload) must not warn
+            continue
+        gymnasium.register(
+            id=env_id,
+            entry_point="armgame.env.reach:ReachEnv",
+            vector_entry_point="armgame.env.vector:ReachVectorEnv",
+            kwargs={"continuous": continuous},
+            # The game ends itself at its time limit (a truncation); no TimeLimit wrapper on top.
+            max_episode_steps=None,
+            nondeterministic=False,
+        )
+
+
+_register()

@@ -1,0 +1,102 @@
+"""The game's bots as Gymnasium policies: observation in, keys out.
+
+``BotPolicy`` rebuilds, from an observation alone, the little a bot reads of a session (the
+joint state, the four activations, the target, the clock) and turns the key events the bot
+returns into a ``MultiBinary(4)`` action. What the bot knows besides (the arm, the muscles, the
+physics step) is the game's description, ``env.unwrapped.config``, not its state: the bot never
+sees the seed. The observation is float64, so the bot sees exactly what it sees in the game,
+and with a decision step equal to its control period it plays exactly the game's game.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+
+from ..game.bots import ReachingBot, make_bot
+from ..game.muscles import MuscleSet
+from ..game.rules import GameConfig, Target
+from ..game.session import DOWN
+
+
+class _Rules:
+    __slots__ = ("target",)
+
+    def __init__(self, target: Target) -> None:
+        self.target = target
+
+
+class _SeenGame:
+    """The part of a ``GameSession`` a bot reads, filled in from observations."""
+
+    over = False
+
+    def __init__(self, config: GameConfig, muscles: MuscleSet, target: Target) -> None:
+        self.config = config
+        self.muscles = muscles
+        self.rules = _Rules(target)
+        self.held = [False] * MuscleSet.COUNT
+        self.state = (0.0, 0.0, 0.0, 0.0)
+        self.time = 0.0
+
+
+class BotPolicy:
+    """A bot (``"model"``, ``"naive"`` or a ``ReachingBot``) playing through a Reach-v0 env.
+
+    ``policy(observation) -> action``. It decides at every env step, so a bot made here gets the
+    env's decision time as its control period; the game's bots decide every 4 ms, which
+    ``decision_steps=1`` gives. A new episode is recognised by its clock (time left going up)::
+
+        >>> import gymnasium as gym
+        >>> import armgame.env
+        >>> env = gym.make("armgame/Reach-v0", time_limit=3.0)
+        >>> policy = BotPolicy("model", env)
+        >>> obs, info = env.reset(seed=10)
+        >>> done = False
+        >>> while not done:
+        ...     obs, reward, terminated, truncated, info = env.step(policy(obs))
+        ...     done = terminated or truncated
+        >>> info["hits"] >= 1
+        True
+    """
+
+    def __init__(self, bot: str | ReachingBot, env: Any) -> None:
+        base = env.unwrapped
+        settings = base.settings
+        if settings.continuous or settings.reset_key:
+            raise ValueError("a bot plays the keys of armgame/Reach-v0 (no reset key)")
+        self.config: GameConfig = settings.config
+        self.dt = self.config.dt
+        self.total_steps = self.config.total_steps
+        if isinstance(bot, str):
+            make_bot(bot)  # refuses unknown names in the game's words
+            bot = ReachingBot(bot, interaction=bot == "model", control_period=settings.decision_time)
+        elif bot.period_steps(self.dt) != settings.decision_steps:
+            raise ValueError(f"the bot decides every {bot.control_period} s, the env every "
+                             f"{settings.decision_time} s: make it with control_period={settings.decision_time}")
+        self.bot = bot
+        self._muscles = MuscleSet(self.config.muscles, self.dt)
+        self._seen: _SeenGame | None = None
+        self._time_left = -1.0
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        q1, q2, w1, w2, a0, a1, a2, a3, tx, ty, time_left = observation.tolist()
+        seen = self._seen
+        if seen is None or time_left > self._time_left:
+            # A new game: a config of its own, so the bot binds afresh (its plan and memory cleared).
+            seen = self._seen = _SeenGame(dataclasses.replace(self.config), self._muscles,
+                                          Target(tx, ty, self.config.target_radius))
+        self._time_left = time_left
+        target = seen.rules.target
+        if (tx, ty) != (target.x, target.y):
+            seen.rules.target = Target(tx, ty, self.config.target_radius)
+        seen.state = (q1, q2, w1, w2)
+        seen.muscles.activation = [a0, a1, a2, a3]
+        seen.time = (self.total_steps - round(time_left / self.dt)) * self.dt  # as GameSession.time
+        keys = self._muscles.keys
+        for key, action in self.bot.act(seen):  # type: ignore[arg-type]  # quacks like a GameSession
+            seen.held[keys.index(key)] = action == DOWN
+        return np.array(seen.held, dtype=np.int8)
+

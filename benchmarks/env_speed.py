@@ -1,0 +1,198 @@
+"""Speed of the Gymnasium envs, beside Gymnasium's Acrobot-v1 measured in the same run.
+
+    python benchmarks/env_speed.py              # about a minute
+    python benchmarks/env_speed.py --quick      # a few seconds a figure, fewer repeats
+    python benchmarks/env_speed.py --json       # one JSON object
+
+Env steps per second (one env step = one decision: 5 physics steps of the game, 20 ms; one
+RK4 step of 0.2 s for Acrobot) with random actions drawn before the clock starts, episodes
+reset as they end:
+
+* single env, both through ``gymnasium.make`` (with its checker and order wrappers);
+* vector env at 1, 64, 1,024 and 8,192 envs: armgame's native ``ReachVectorEnv``
+  (``make_vec(..., vectorization_mode="vector_entry_point")``) and Acrobot's ``SyncVectorEnv``.
+
+Each figure is measured in several repeats, interleaved with its peer so that load from
+elsewhere falls on both; the report gives the median and the range over repeats, and the
+single-env ratio as the median of the paired ratios. Goals (issue 12): the single env no
+slower than Acrobot-v1; the vector env at 8,192 envs at least 1 M env-steps/s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable
+
+import gymnasium as gym
+import numpy as np
+
+import armgame.env  # noqa: F401  (registers armgame/Reach-v0)
+
+VECTOR_SIZES = (1, 64, 1024, 8192)
+SINGLE_GOAL = 1.0  # Reach-v0 steps per second over Acrobot-v1's
+VECTOR_GOAL = 1e6  # env-steps per second at 8,192 envs
+
+
+def single_runner(env_id: str) -> Callable[[float], tuple[float, float]]:
+    """Steps per second of one env through gymnasium.make, run for about ``seconds``: (wall, CPU)."""
+    env = gym.make(env_id)
+    env.action_space.seed(0)
+    actions = [env.action_space.sample() for _ in range(4096)]
+    env.reset(seed=0)
+
+    def run(seconds: float) -> tuple[float, float]:
+        steps, start, cpu = 0, time.perf_counter(), time.process_time()
+        end = start + seconds
+        while True:
+            for i in range(256):
+                _, _, terminated, truncated, _ = env.step(actions[(steps + i) % 4096])
+                if terminated or truncated:
+                    env.reset()
+            steps += 256
+            now = time.perf_counter()
+            if now >= end:
+                return steps / (now - start), steps / (time.process_time() - cpu)
+
+    return run
+
+
+def vector_runner(env_id: str, num_envs: int, mode: str) -> Callable[[float], tuple[float, float]]:
+    """Env-steps per second (vector steps x num_envs) of a vector env for about ``seconds``: (wall, CPU)."""
+    envs = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode)
+    envs.action_space.seed(0)
+    actions = [envs.action_space.sample() for _ in range(8)]
+    envs.reset(seed=0)
+    envs.step(actions[0])  # the first step may build what later steps reuse
+
+    def run(seconds: float) -> tuple[float, float]:
+        steps, start, cpu = 0, time.perf_counter(), time.process_time()
+        end = start + seconds
+        while True:
+            envs.step(actions[steps % 8])
+            steps += 1
+            now = time.perf_counter()
+            if now >= end:
+                return steps * num_envs / (now - start), steps * num_envs / (time.process_time() - cpu)
+
+    return run
+
+
+def spread(rates: list[float]) -> dict[str, float]:
+    return {"median": statistics.median(rates), "min": min(rates), "max": max(rates), "repeats": len(rates)}
+
+
+def paired(runners: dict[str, Callable[[float], tuple[float, float]]], seconds: float,
+           repeats: int) -> dict[str, dict[str, dict[str, float]]]:
+    """Each runner in turn, ``repeats`` times: wall-clock and CPU-time rates, each as median and range."""
+    wall: dict[str, list[float]] = {name: [] for name in runners}
+    cpu: dict[str, list[float]] = {name: [] for name in runners}
+    for _ in range(repeats):
+        for name, run in runners.items():
+            w, c = run(seconds)
+            wall[name].append(w)
+            cpu[name].append(c)
+    return {name: {"wall": spread(wall[name]), "cpu": spread(cpu[name]),
+                   "wall_rates": wall[name]}  # type: ignore[dict-item]
+            for name in runners}
+
+
+def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float | None = None,
+            repeats: int | None = None) -> dict[str, object]:
+    seconds = seconds or (0.3 if quick else 1.0)
+    repeats = repeats or (3 if quick else 5)
+    load_before = os.getloadavg()[0]
+    single_runners = {"reach": single_runner("armgame/Reach-v0"), "acrobot": single_runner("Acrobot-v1")}
+    for run in single_runners.values():
+        run(min(0.2, seconds))  # warm up
+    single = paired(single_runners, seconds, repeats)
+    ratios = [a / b for a, b in zip(single["reach"]["wall_rates"], single["acrobot"]["wall_rates"], strict=True)]
+    vector = {}
+    for n in sizes:
+        vector[n] = paired({"reach": vector_runner("armgame/Reach-v0", n, "vector_entry_point"),
+                            "acrobot_sync": vector_runner("Acrobot-v1", n, "sync")}, seconds, repeats)
+    return {
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+                   f"numpy {np.__version__}, gymnasium {gym.__version__}",
+        "load_average": [load_before, os.getloadavg()[0]],
+        "seconds_per_repeat": seconds,
+        "single": single,
+        "single_ratio": spread(ratios),
+        "vector": vector,
+    }
+
+
+def profile(num_envs: int = 8192, steps: int = 60) -> list[tuple[str, float]]:
+    """Where a vector step's time goes: the share of each function's own time, largest first."""
+    import cProfile
+    import pstats
+
+    envs = gym.make_vec("armgame/Reach-v0", num_envs=num_envs, vectorization_mode="vector_entry_point")
+    envs.action_space.seed(0)
+    actions = [envs.action_space.sample() for _ in range(8)]
+    envs.reset(seed=0)
+    envs.step(actions[0])
+    profiler = cProfile.Profile(time.process_time)
+    profiler.enable()
+    for i in range(steps):
+        envs.step(actions[i % 8])
+    profiler.disable()
+    stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
+    total = sum(row[2] for row in stats.values())
+    shares = sorted(((f"{os.path.basename(file)}:{line} {name}", row[2] / total)
+                     for (file, line, name), row in stats.items()), key=lambda item: -item[1])
+    return shares[:8]
+
+
+def fmt(s: dict[str, float]) -> str:
+    return f"{s['median']:,.0f} [{s['min']:,.0f} - {s['max']:,.0f}]"
+
+
+def report(result: dict) -> None:
+    load = result["load_average"]
+    print(f"env steps per second, wall clock: median [min - max] of {result['single']['reach']['wall']['repeats']} "
+          f"repeats of {result['seconds_per_repeat']} s, interleaved with the peer; per CPU second: median")
+    print(f"{result['machine']}; load average {load[0]:.1f} before, {load[1]:.1f} after")
+    s, r = result["single"], result["single_ratio"]
+    print(f"single env (gymnasium.make): armgame/Reach-v0 {fmt(s['reach']['wall'])} "
+          f"({s['reach']['cpu']['median']:,.0f} per CPU s); Acrobot-v1 {fmt(s['acrobot']['wall'])} "
+          f"({s['acrobot']['cpu']['median']:,.0f} per CPU s)")
+    print(f"  Reach-v0 / Acrobot-v1, paired: {r['median']:.2f} [{r['min']:.2f} - {r['max']:.2f}] "
+          f"(goal >= {SINGLE_GOAL:g})")
+    cpu = "per CPU s"
+    print(f"{'envs':>6}  {'Reach-v0 vector env':>32} {cpu:>11}  {'Acrobot-v1 SyncVectorEnv':>30} {cpu:>11}")
+    for n, rates in result["vector"].items():
+        ours, theirs = rates["reach"], rates["acrobot_sync"]
+        print(f"{n:>6}  {fmt(ours['wall']):>32} {ours['cpu']['median']:>11,.0f}  {fmt(theirs['wall']):>30} "
+              f"{theirs['cpu']['median']:>11,.0f}")
+    n = max(result["vector"])
+    top = result["vector"][n]["reach"]
+    print(f"vector env at {n:,} envs: {top['wall']['median'] / 1e6:.2f} M env-steps/s wall, "
+          f"{top['cpu']['median'] / 1e6:.2f} M per CPU second (goal >= {VECTOR_GOAL / 1e6:g} M)")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="shorter repeats, fewer of them")
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    parser.add_argument("--profile", action="store_true", help="also profile the vector env at 8,192 envs")
+    args = parser.parse_args()
+    result = measure(args.quick)
+    if args.profile:
+        result["profile"] = profile()
+    if args.json:
+        print(json.dumps(result, default=str))
+        return
+    report(result)
+    if args.profile:
+        print("where a vector step's CPU time goes at 8,192 envs (own time of each function):")
+        for name, share in result["profile"]:
+            print(f"  {share:6.1%}  {name}")
+
+
+if __name__ == "__main__":
+    main()
