@@ -11,7 +11,7 @@ from . import __version__
 from .errors import UserError
 
 # Commands whose module exists; each module's register() adds its parser.
-COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "replay", "verify")
+COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "replay", "verify", "settings")
 
 
 class _Parser(argparse.ArgumentParser):
