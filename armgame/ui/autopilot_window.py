@@ -7,6 +7,7 @@ so the two games and their scores fit a 1280 x 720 or 1366 x 768 projector; F11 
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -64,14 +65,14 @@ class AutopilotWindow:
         pad, gap = max(6, round(12 * u)), max(4, round(6 * u))
         renderer = self.games[0].renderer
         caption_h, help_h = max(14, round(22 * u)), max(12, round(18 * u))
-        lines = renderer.wrap_items(CAPTION.split(". "), caption_h, w - 2 * pad, gap)
+        lines = renderer.wrap_items(re.split(r"(?<=\.) ", CAPTION), caption_h, w - 2 * pad, gap)
         labels: list[Label] = []
         y = pad
         for line in lines:
             labels.append(renderer.label(line, caption_h, self.palette.ink, "caption", midtop=(w // 2, y)))
             y = labels[-1].rect.bottom + gap // 2
         help_label = renderer.label("    ".join(HELP), help_h, self.palette.faint, "help",
-                                     midbottom=(w // 2, h - pad))
+                                    midbottom=(w // 2, h - pad))
         top, bottom = y + gap, help_label.rect.top - gap
         half = w // 2
         areas = [pygame.Rect(i * half, top, half, max(bottom - top, 10)) for i in range(2)]

@@ -180,7 +180,11 @@ class Layout:
 
 
 def clock_text(seconds: float) -> str:
-    return f"{seconds:4.1f}" if seconds < 60 else f"{int(seconds) // 60}:{int(seconds) % 60:02d}"
+    """Seconds to a tenth under 100 s (a 60 s game counts 60.0, 59.9, ...), minutes and seconds above."""
+    if seconds < 100:
+        return f"{seconds:4.1f}"
+    whole = math.ceil(seconds)
+    return f"{whole // 60}:{whole % 60:02d}"
 
 
 class GameRenderer:
@@ -193,6 +197,8 @@ class GameRenderer:
         self.palette = PALETTES[palette] if isinstance(palette, str) else palette
         self._fonts: dict[int, pygame.font.Font] = {}
         self._text: dict[tuple[str, int, RGB], pygame.Surface] = {}
+        self._sizes: dict[tuple[str, int], tuple[int, int]] = {}
+        self._trail_colours: dict[int, list[RGB]] = {}
         self._backgrounds: dict[tuple, pygame.Surface] = {}
         self._veils: dict[tuple[int, int], pygame.Surface] = {}
 
@@ -213,8 +219,18 @@ class GameRenderer:
             surface = self._text[key] = self.font(height).render(string, True, colour)
         return surface
 
+    def text_size(self, text: str, height: int) -> tuple[int, int]:
+        """``Font.size``, remembered: a layout measures the same strings frame after frame."""
+        key = (text, height)
+        size = self._sizes.get(key)
+        if size is None:
+            if len(self._sizes) > 2048:
+                self._sizes.clear()
+            size = self._sizes[key] = self.font(height).size(text)
+        return size
+
     def label(self, text: str, height: int, colour: RGB, role: str, **anchor: object) -> Label:
-        w, h = self.font(height).size(text)
+        w, h = self.text_size(text, height)
         rect = pygame.Rect(0, 0, w, h)
         for name, value in anchor.items():
             setattr(rect, name, value)
@@ -222,21 +238,19 @@ class GameRenderer:
 
     def fit_text(self, text: str, height: int, width: int) -> str:
         """``text`` cut with an ellipsis to ``width`` px (a long name in the table)."""
-        font = self.font(height)
-        if font.size(text)[0] <= width:
+        if self.text_size(text, height)[0] <= width:
             return text
-        while text and font.size(text + "...")[0] > width:
+        while text and self.text_size(text + "...", height)[0] > width:
             text = text[:-1]
         return text + "..."
 
     def wrap_items(self, items: Sequence[str], height: int, width: int, gap: int) -> list[str]:
         """Help items on as few lines as fit ``width``; an item is never split."""
-        font = self.font(height)
         sep = " " * 4
         lines: list[str] = []
         for item in items:
             item = self.fit_text(item, height, width)
-            if lines and font.size(lines[-1] + sep + item)[0] <= width:
+            if lines and self.text_size(lines[-1] + sep + item, height)[0] <= width:
                 lines[-1] += sep + item
             else:
                 lines.append(item)
@@ -281,9 +295,9 @@ class GameRenderer:
         else:
             labels.append(score)
             # Right-aligned, but sized for the widest clock so it never moves as the digits change.
-            widest = self.font(big).size("Time 00.0")[0]
+            widest = self.text_size("Time 00.0", big)[0]
             labels.append(self.label(clock, big, clock_colour, "clock",
-                                      topleft=(hud_area.right - widest, y)))
+                                     topleft=(hud_area.right - widest, y)))
         y = labels[-1].rect.bottom + 2 * gap
         # The replay's progress and speed.
         progress = None
@@ -316,7 +330,7 @@ class GameRenderer:
                 cx = x0 + (i % columns) * (col_w + 2 * pad)
                 ry = block_top + (i // columns) * row_h
                 label = self.label(self.fit_text(f"{key}  {name}", small, col_w), small, p.ink, "muscle",
-                                    topleft=(cx, ry))
+                                   topleft=(cx, ry))
                 labels.append(label)
                 bars.append((pygame.Rect(cx, label.rect.bottom + gap // 2, col_w, bar_h), i,
                              min(max(activation[i], 0.0), 1.0)))
@@ -345,17 +359,20 @@ class GameRenderer:
         p = self.palette
         scene, view = lay.scene, lay.view
         if hud.countdown is not None and not hud.ended:
-            size = max(big, round(scene.height * 0.22))
+            size = max(big, round(scene.height * 0.2))
             number = self.label(str(hud.countdown), size, p.ink, "countdown", center=scene.center)
             hint = self.label("any key starts", normal, p.ink, "countdown",
-                               midtop=(scene.centerx, number.rect.bottom + gap))
+                              midtop=(scene.centerx, number.rect.bottom + gap))
             lay.labels += [number, hint]
+            # On a card of its own: the number must not tangle with the arm drawn behind it.
+            card = number.rect.union(hint.rect).inflate(6 * gap, 3 * gap)
+            lay.panels.append(card.clamp(scene))
         for x, y, age in hud.hits:
             if age < PLUS_ONE_TIME:
                 px, py = view.to_screen(x, y)
                 r = view.length(session.config.target_radius)
                 label = self.label("+1", big, p.ink, "effect",
-                                    midleft=(px + r + gap, py - round(age / PLUS_ONE_TIME * 2 * r)))
+                                   midleft=(px + r + gap, py - round(age / PLUS_ONE_TIME * 2 * r)))
                 label.rect.clamp_ip(scene)
                 lay.labels.append(label)
         if hud.ended:
@@ -372,7 +389,8 @@ class GameRenderer:
         lay.progress = None
         board = session.rules.board
         lines: list[tuple[str, int, RGB, str]] = [
-            (f"Your score: {board.score}" if hud.mode == "PLAY" else f"Score: {board.score}", big, p.ink, "end"),
+            (f"Your score: {board.score}" if hud.mode.startswith("PLAY") else f"Score: {board.score}", big, p.ink,
+             "end"),
             (f"{board.hits} hit{'s' if board.hits != 1 else ''}, {board.resets} reset"
              f"{'s' if board.resets != 1 else ''}", normal, p.ink, "end"),
         ]
@@ -400,7 +418,7 @@ class GameRenderer:
         y = inner.top
         for text, size, colour, role in lines:
             lab = self.label(self.fit_text(text, size, inner.width), size, colour, role,
-                              midtop=(inner.centerx, y))
+                             midtop=(inner.centerx, y))
             lay.labels.append(lab)
             y = lab.rect.bottom + gap
         if hud.name_entry is not None:
@@ -408,7 +426,7 @@ class GameRenderer:
             lay.name_box = pygame.Rect(inner.left, y, inner.width, box_h)
             typed = self.fit_text(hud.name_entry + "|", normal, inner.width - 2 * gap)
             lay.labels.append(self.label(typed, normal, p.ink, "name",
-                                          midleft=(inner.left + gap, lay.name_box.centery)))
+                                         midleft=(inner.left + gap, lay.name_box.centery)))
             y = lay.name_box.bottom + gap
             hint = "Enter saves   Esc quits without saving"
         else:
@@ -419,9 +437,9 @@ class GameRenderer:
                 for rank, name, score in standing.top:
                     colour = p.warn if rank == standing.rank else p.ink
                     lay.labels.append(self.label(f"{rank}.", small, colour, "table",
-                                                  topright=(inner.left + rank_w - gap, y)))
+                                                 topright=(inner.left + rank_w - gap, y)))
                     lay.labels.append(self.label(self.fit_text(name, small, name_w), small, colour, "table",
-                                                  topleft=(inner.left + rank_w, y)))
+                                                 topleft=(inner.left + rank_w, y)))
                     lay.labels.append(self.label(str(score), small, colour, "table", topright=(inner.right, y)))
                     y += row_h
             hint = "press any key to close"
@@ -452,9 +470,9 @@ class GameRenderer:
         pygame.draw.aacircle(surface, p.edge, centre, outer, max(1, round(lay.unit)))
         pygame.draw.aacircle(surface, p.edge, centre, inner, max(1, round(lay.unit)))
         # The shoulder is fixed to the body: a mount, not a joint that moves.
-        mount = view.length(0.05)
-        pygame.draw.rect(surface, p.base, pygame.Rect(centre[0] - mount, centre[1], 2 * mount, mount // 2),
-                         border_radius=max(2, mount // 6))
+        mount = view.length(0.07)
+        pygame.draw.rect(surface, p.base, pygame.Rect(centre[0] - mount, centre[1] - mount // 5, 2 * mount,
+                                                      mount // 2), border_radius=max(2, mount // 6))
         surface.set_clip(clip)
         self._backgrounds[key] = surface
         return surface
@@ -521,12 +539,15 @@ class GameRenderer:
         p = self.palette
         points = [view.to_screen(x, y) for x, y in trail]
         n = len(points)
-        width = max(1, view.length(0.006))
-        for i in range(1, n):
+        colours = self._trail_colours.get(n)
+        if colours is None:
             # Older segments fade into the scene: the path reads as a motion, newest at the hand.
-            a = i / n
-            colour = tuple(round(s + (t - s) * a) for s, t in zip(p.scene, p.trail, strict=True))
-            pygame.draw.aaline(screen, colour, points[i - 1], points[i], width)
+            colours = self._trail_colours[n] = [
+                tuple(round(s + (t - s) * i / n) for s, t in zip(p.scene, p.trail, strict=True)) for i in range(n)]
+        width = max(2, view.length(0.008))
+        line = pygame.draw.line
+        for i in range(1, n):
+            line(screen, colours[i], points[i - 1], points[i], width)
 
     def _draw_target(self, screen: pygame.Surface, lay: Layout, session: GameSession, hud: Hud) -> None:
         """A bullseye (a ring around a dot): a different shape from the hand's solid disc."""
