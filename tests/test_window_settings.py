@@ -225,3 +225,24 @@ def test_a_window_with_no_display_is_one_line_and_quick(command, tmp_path):
     assert out.returncode == 2
     assert out.stderr.count("\n") == 1 and "--headless" in out.stderr, out.stderr
     assert time.perf_counter() - start < 5.0
+
+
+def test_a_window_takes_its_keys_and_size_from_the_settings_unless_told(tmp_path):
+    from armgame.cli import build_parser
+    from armgame.commands.play import _window_settings, game_config
+
+    path = tmp_path / "settings.toml"
+    save(Settings(keys="asdf", size=(1024, 700), mute=True), path)
+    args = build_parser().parse_args(["play", "--settings", str(path)])
+    settings, _ = _window_settings(args)
+    assert game_config(args).muscles[0].key == "a" and settings.size == (1024, 700) and settings.mute
+    args = build_parser().parse_args(["play", "--settings", str(path), "--keys", "hjkl", "--size", "800x600"])
+    settings, _ = _window_settings(args)
+    assert game_config(args).muscles[0].key == "h" and settings.size == (800, 600)
+
+
+def test_the_clock_reads_the_same_way_all_game():
+    from armgame.ui.render import clock_text
+
+    assert clock_text(60.0) == "60.0" and clock_text(9.3) == " 9.3" and clock_text(99.9) == "99.9"
+    assert clock_text(120.0) == "2:00" and clock_text(100.01) == "1:41"

@@ -25,7 +25,7 @@ DECORATION = (0, 64)
 
 
 @contextlib.contextmanager
-def _quiet_stderr(quiet: bool) -> Iterator[None]:
+def quiet_stderr(quiet: bool = True) -> Iterator[None]:
     """Hide what C libraries print to stderr (libwayland's "XDG_RUNTIME_DIR is invalid" while SDL probes
     for a display that is not there): the user gets our one line instead."""
     if not quiet:
@@ -51,7 +51,7 @@ def init_display(hint: str = "use --headless where there is no display") -> None
     no_display = sys.platform.startswith("linux") and not (
         os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or os.environ.get("SDL_VIDEODRIVER"))
     try:
-        with _quiet_stderr(no_display):
+        with quiet_stderr(no_display):
             pygame.display.init()
         pygame.font.init()
     except pygame.error as exc:

@@ -394,6 +394,8 @@ class GameRenderer:
             (f"{board.hits} hit{'s' if board.hits != 1 else ''}, {board.resets} reset"
              f"{'s' if board.resets != 1 else ''}", normal, p.ink, "end"),
         ]
+        if not hud.mode.startswith("PLAY"):  # whose game it was: a bot's, a replay's
+            lines.insert(0, (hud.mode.split("   ")[0], normal, p.ink, "end"))
         if hud.name_entry is not None:
             lines.append(("Type your name for the high-score table", normal, p.ink, "end"))
         standing = hud.standing

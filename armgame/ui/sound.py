@@ -15,6 +15,8 @@ from pathlib import Path
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame
 
+from .display import quiet_stderr
+
 SOUND_NAMES = ("hit", "reset", "tick", "go", "end")
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
@@ -27,9 +29,11 @@ class Sounds:
         self.sounds: dict[str, pygame.mixer.Sound] = {}
         self.available = False
         try:
-            # A short buffer: a hit's sound must come with the hit, not 100 ms after.
+            # A short buffer: a hit's sound must come with the hit, not 100 ms after. ALSA prints its
+            # complaints to stderr when there is no sound card: the game is silent, and says nothing.
             pygame.mixer.pre_init(22050, -16, 1, 512)
-            pygame.mixer.init()
+            with quiet_stderr():
+                pygame.mixer.init()
         except (pygame.error, NotImplementedError):
             return
         for name in SOUND_NAMES:
