@@ -293,7 +293,7 @@ def test_autopilot_window_fits_two_games(dummy_sdl, size):
     for _ in range(5):
         window.frame(0.2)
     boxes = window.all_boxes(size)
-    assert_fits(size, boxes, int(14 * min(size) / 720) - 1, "autopilot")
+    assert_fits(size, boxes, int(14 * min(size) / 720), "autopilot")
     texts = [name for name, _ in boxes]
     assert any(t.startswith("mode: AUTOPILOT: model") for t in texts)
     assert any(t.startswith("mode: AUTOPILOT: naive") for t in texts)

@@ -11,6 +11,7 @@ import pygame
 import pytest
 
 from armgame.game.bots import Autopilot, make_bot
+from armgame.game.muscles import DEFAULT_MUSCLES, remap_keys
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, RealTimeDriver
 from armgame.ui.display import fit_size
@@ -421,3 +422,38 @@ def test_f11_toggles_fullscreen(window):
 def test_a_view_still_maps_the_world_as_before():
     view = Viewport.fit((800, 800), GameConfig().view)
     assert view.to_screen(0.0, 0.0) == (400, 600) and view.scale == 500 and view.length(0.1) == 50
+
+
+def test_each_mode_says_what_it_is_and_offers_only_its_keys(window):
+    screen = open_window((1280, 720))
+    session = GameSession(GameConfig())
+    bot = GameWindow(session, screen, clock=FakeClock(), fps=0, mode="AUTOPILOT: naive",
+                     driver=RealTimeDriver(Autopilot(session, make_bot("naive"))), sounds=FakeSounds())
+    assert bot.help_items() == ("p pause", "m mute", "F11 fullscreen", "Esc quit")
+    bot.frame(0.0)
+    lay = bot.renderer.layout((1280, 720), bot.session, bot.hud())
+    assert [lab.text for lab in lay.labels if lab.role == "mode"] == ["AUTOPILOT: naive"]
+    post_key("space")  # not a key of this mode: nothing happens
+    post_key("d")
+    bot.frame(0.0)
+    assert bot.session.rules.board.resets == 0 and bot.session.timeline == []
+    player, _ = window(window_options={"sounds": FakeSounds()})
+    assert "space reset (-1)" in player.help_items() and "m mute" in player.help_items()
+    mapped = GameWindow(GameSession(GameConfig(muscles=remap_keys(DEFAULT_MUSCLES, "mjkl"))), screen, fps=0,
+                        sounds=FakeSounds())
+    assert "m mute" not in mapped.help_items()  # m is a muscle there
+
+
+def test_demo_windows_toggle_fullscreen_with_f11():
+    from armgame.demos.catalog import make_run
+    from armgame.ui.demo_window import DemoWindow
+
+    demo = DemoWindow("chaos", make_run("chaos"), clock=lambda: 0.0, size=(800, 600))
+    demo.open()
+    try:
+        demo.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_F11))
+        assert demo.fullscreen
+        demo.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_F11))
+        assert not demo.fullscreen and demo.size == (800, 600)
+    finally:
+        demo.close()

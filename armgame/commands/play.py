@@ -36,9 +36,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "play",
         help="play the game (a window, or --headless from a script)",
-        description="Hit the red targets with the hand. d/f drive the shoulder flexor and extensor, j/k the "
-        "elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, p pauses, "
-        "m mutes, F11 toggles fullscreen, Esc quits. A 3-2-1 countdown (any key skips it) starts the clock.",
+        description="Hit the targets (rings) with the hand (a solid disc). d/f drive the shoulder flexor and "
+        "extensor, j/k the elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, "
+        "p pauses, m mutes, F11 toggles fullscreen, Esc quits. A 3-2-1 countdown (any key skips it) starts the "
+        "clock.",
     )
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")

@@ -2,7 +2,8 @@
 
 Each half is a game drawn by the game's own renderer (``GameRenderer``), labelled with its bot, under
 one caption that says what the class is comparing. The halves are laid out from the window's size,
-so the two games and their scores fit a 1280 x 720 or 1366 x 768 projector; F11 fills the screen.
+so the two games and their scores fit a 1280 x 720 or 1366 x 768 projector (on a tall screen one
+above the other); F11 fills the screen.
 """
 
 from __future__ import annotations
@@ -21,11 +22,11 @@ from ..game.session import GameSession, RealTimeDriver
 from .display import open_window, toggle_fullscreen
 from .render import PALETTES, GameRenderer, Hud, Label
 
-CAPTION = ("Same targets, same planner. Left: the bot knows the interaction torques. "
-           "Right: it drives each joint as if the other did not move.")
+CAPTION = ("Same targets, same planner. {0}: the bot knows the interaction torques. "
+           "{1}: it drives each joint as if the other did not move.")
 DEFAULT_SIZE = (1280, 720)
 HELP = ("p pause", "r restart", "F11 fullscreen", "Esc quit")
-WHO = {"model": "AUTOPILOT: model (knows the interaction torques)", "naive": "AUTOPILOT: naive"}
+WHO = {"model": "AUTOPILOT: model", "naive": "AUTOPILOT: naive"}
 
 
 @dataclass
@@ -65,7 +66,9 @@ class AutopilotWindow:
         pad, gap = max(6, round(12 * u)), max(4, round(6 * u))
         renderer = self.games[0].renderer
         caption_h, help_h = max(14, round(22 * u)), max(12, round(18 * u))
-        lines = renderer.wrap_items(re.split(r"(?<=\.) ", CAPTION), caption_h, w - 2 * pad, gap)
+        # Side by side on a wide screen, one above the other on a tall one (where neither would fit beside).
+        caption = CAPTION.format(*(("Top", "Bottom") if h > w else ("Left", "Right")))
+        lines = renderer.wrap_items(re.split(r"(?<=\.) ", caption), caption_h, w - 2 * pad, gap)
         labels: list[Label] = []
         y = pad
         for line in lines:
@@ -74,8 +77,12 @@ class AutopilotWindow:
         help_label = renderer.label("    ".join(HELP), help_h, self.palette.faint, "help",
                                     midbottom=(w // 2, h - pad))
         top, bottom = y + gap, help_label.rect.top - gap
-        half = w // 2
-        areas = [pygame.Rect(i * half, top, half, max(bottom - top, 10)) for i in range(2)]
+        if h > w:  # a tall screen: one game above the other, so neither gets narrow
+            half = (bottom - top) // 2
+            areas = [pygame.Rect(0, top + i * half, w, max(half, 10)) for i in range(2)]
+        else:
+            half = w // 2
+            areas = [pygame.Rect(i * half, top, half, max(bottom - top, 10)) for i in range(2)]
         return labels, areas, [help_label]
 
     def all_boxes(self, size: tuple[int, int]) -> list[tuple[str, pygame.Rect]]:
@@ -119,8 +126,9 @@ class AutopilotWindow:
         renderer = self.games[0].renderer
         for lab in labels + footer:
             screen.blit(renderer.text(lab.text, lab.height, lab.colour), lab.rect)
-        pygame.draw.line(screen, self.palette.edge, (areas[1].left, areas[1].top),
-                         (areas[1].left, areas[1].bottom), max(1, round(2 * min(screen.get_size()) / 720)))
+        end = areas[1].bottomleft if areas[1].left > areas[0].left else areas[1].topright
+        pygame.draw.line(screen, self.palette.edge, areas[1].topleft, end,
+                         max(1, round(2 * min(screen.get_size()) / 720)))
         pygame.display.flip()
 
     def hits(self) -> dict[str, int]:
