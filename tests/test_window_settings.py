@@ -246,3 +246,40 @@ def test_the_clock_reads_the_same_way_all_game():
 
     assert clock_text(60.0) == "60.0" and clock_text(9.3) == " 9.3" and clock_text(99.9) == "99.9"
     assert clock_text(120.0) == "2:00" and clock_text(100.01) == "1:41"
+
+
+def test_the_end_screen_callback_keeps_the_game_once_and_ranks_it(tmp_path, capsys):
+    """commands/play.py hands the window a callback; the window never touches the score files itself."""
+    from armgame.cli import build_parser
+    from armgame.commands.play import _keep, _standing, game_config
+    from armgame.game.session import GameSession
+    from armgame.records.scores import ScoreTable
+
+    def finished_game(args):
+        session = GameSession(game_config(args))
+        session.key_event("d", "down")
+        session.advance(session.total_steps)
+        return session
+
+    parser = build_parser()
+    scores = tmp_path / "scores"
+    earlier = parser.parse_args(["play", "--duration", "1", "--scores", str(scores), "--name", "Bob"])
+    _keep(finished_game(earlier), earlier)
+    args = parser.parse_args(["play", "--duration", "1", "--scores", str(scores)])
+    session = finished_game(args)
+    standing = _standing(session, args)("Ann")
+    assert args.kept and args.name == "Ann"
+    assert standing.entries == 2 and standing.rank in (1, 2)
+    assert sorted(name for _, name, _ in standing.top) == ["Ann", "Bob"]
+    assert [e.name for e in ScoreTable(scores).entries()].count("Ann") == 1
+    assert "saved to the high-score table as Ann" in capsys.readouterr().out
+    # No name (Esc on the prompt is another path): the table is shown, nothing is entered.
+    args = parser.parse_args(["play", "--duration", "1", "--scores", str(scores)])
+    standing = _standing(finished_game(args), args)(None)
+    assert standing.rank is None and standing.entries == 2
+    # A table that cannot be written is one line on stderr, and the end screen goes on without it.
+    not_a_folder = tmp_path / "not-a-folder"
+    not_a_folder.write_text("x")
+    args = parser.parse_args(["play", "--duration", "1", "--scores", str(not_a_folder)])
+    assert _standing(finished_game(args), args)("Cleo") is None
+    assert capsys.readouterr().err.count("armgame play: error:") == 1
