@@ -457,3 +457,16 @@ def test_demo_windows_toggle_fullscreen_with_f11():
         assert not demo.fullscreen and demo.size == (800, 600)
     finally:
         demo.close()
+
+
+def test_a_resize_is_remembered_but_a_fullscreen_round_trip_is_not(window):
+    win, _ = window((800, 600))
+    for _ in range(2):
+        post_key("f11")
+        win.frame(0.0)
+    pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, w=800, h=600, size=(800, 600)))
+    win.frame(0.0)
+    assert not win.resized
+    pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, w=900, h=650, size=(900, 650)))
+    win.frame(0.0)
+    assert win.resized and win.windowed_size == (900, 650)

@@ -174,8 +174,10 @@ class GameWindow:
         if event.type == pygame.QUIT:
             self.running = False
         elif event.type == pygame.VIDEORESIZE and not self.fullscreen:
-            self.windowed_size = (event.w, event.h)
-            self.resized = True
+            # SDL also reports the size a window opens at, or comes back to from fullscreen: not a change.
+            if (event.w, event.h) != self.windowed_size:
+                self.windowed_size = (event.w, event.h)
+                self.resized = True
         elif self.name_entry is not None and event.type in (pygame.TEXTINPUT, pygame.KEYDOWN):
             self._type_name(event)
         elif event.type == pygame.KEYDOWN:
