@@ -18,6 +18,7 @@ from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import pygame
 
@@ -50,6 +51,17 @@ def open_window(size: tuple[int, int] | None = DEFAULT_SIZE, fullscreen: bool = 
                 caption: str = CAPTION) -> pygame.Surface:
     """The game's window, fitted to the desktop (see ``armgame.ui.display``)."""
     return _open_window(size, fullscreen, caption, DEFAULT_SIZE)
+
+
+class SoundPlayer(Protocol):
+    """What the window needs of its sounds (``armgame.ui.sound.Sounds``; the tests pass a recorder)."""
+
+    available: bool
+    muted: bool
+
+    def play(self, name: str) -> None: ...
+
+    def toggle(self) -> bool: ...
 
 
 def key_name(event: pygame.event.Event) -> str:
@@ -88,6 +100,10 @@ class GameWindow:
     pause and quit). ``replay``: a recorded game, which adds speed and skip keys. ``standing``: called
     once when the end screen opens, with the name typed there (or None), returns the table's
     standing to show (the command passes it in: the window knows nothing of score files).
+    ``mode`` is the label that says what is on screen ("PLAY   seed 10", "AUTOPILOT: model",
+    "REPLAY   Ann   2026-11-22 14:03"); ``countdown`` puts 3-2-1 before the clock (never for a
+    replay); ``sounds`` plays hit, reset, tick, go and end; ``on_mute`` hears the m key (to persist it);
+    ``trail`` keeps the hand's last second for drawing.
     """
 
     def __init__(
@@ -101,7 +117,7 @@ class GameWindow:
         *,
         mode: str = "PLAY",
         countdown: bool = True,
-        sounds: object | None = None,
+        sounds: SoundPlayer | None = None,
         trail: bool = False,
         palette: str = "okabe-ito",
         standing: Callable[[str | None], Standing | None] | None = None,
