@@ -14,7 +14,8 @@ from . import __version__
 from .errors import UserError
 
 # Commands whose module exists; each module's register() adds its parser.
-COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "replay", "verify", "lab", "analyze")
+COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "replay", "verify", "lab", "analyze",
+                   "settings")
 
 
 class _Parser(argparse.ArgumentParser):

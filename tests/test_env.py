@@ -182,13 +182,16 @@ def test_bad_arguments_and_actions_are_refused_in_one_line():
 
 
 def test_rgb_array_frames_show_the_game():
-    from armgame.ui.render import HAND, TARGET, Viewport
+    from armgame.ui.render import PALETTES, GameRenderer
+
+    HAND, TARGET = PALETTES["okabe-ito"].hand, PALETTES["okabe-ito"].target
 
     env = gym.make(REACH, render_mode="rgb_array", render_size=(300, 200))
     obs, _ = env.reset(seed=3)
     frame = env.render()
     assert frame.shape == (200, 300, 3) and frame.dtype == np.uint8
-    view = Viewport.fit((300, 200), env.unwrapped.config.view)
+    session = env.unwrapped.session
+    view = GameRenderer(session.muscles.keys, ("",) * 4).layout((300, 200), session).view  # the scene's place
     x, y = view.to_screen(obs[8], obs[9])
     assert tuple(frame[y, x]) == TARGET
     hx, hy = env.unwrapped.session.hand()

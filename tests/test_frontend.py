@@ -1,4 +1,5 @@
-"""The game window under SDL's dummy driver: what is drawn where, and input through real pygame events."""
+"""The game window under SDL's dummy driver: what is drawn where, input through real pygame events,
+the countdown, the end screen, replays' controls, and the layout of every screen at every window size."""
 
 import math
 import os
@@ -9,10 +10,16 @@ os.environ["SDL_AUDIODRIVER"] = "dummy"
 import pygame
 import pytest
 
+from armgame.game.bots import Autopilot, make_bot
+from armgame.game.muscles import DEFAULT_MUSCLES, remap_keys
 from armgame.game.rules import GameConfig
-from armgame.game.session import GameSession
-from armgame.ui.frontend import GameWindow, open_window
-from armgame.ui.render import BACKGROUND, HAND, LINK, PANEL, TARGET, Viewport
+from armgame.game.session import GameSession, RealTimeDriver
+from armgame.ui.display import fit_size
+from armgame.ui.frontend import END_KEY_DELAY, GameWindow, ReplaySource, open_window
+from armgame.ui.render import MIN_TEXT_AT_720, PALETTES, GameRenderer, Hud, Standing, Viewport, contrast_ratio
+
+PALETTE = PALETTES["okabe-ito"]
+SIZES = [(640, 480), (1280, 720), (1366, 768), (1920, 1080), (720, 1280), (800, 800)]
 
 
 class FakeClock:
@@ -25,12 +32,30 @@ class FakeClock:
         return self.now
 
 
+class FakeSounds:
+    available = True
+
+    def __init__(self) -> None:
+        self.played: list[str] = []
+        self.muted = False
+
+    def play(self, name):
+        if not self.muted:
+            self.played.append(name)
+
+    def toggle(self):
+        self.muted = not self.muted
+        return self.muted
+
+
 @pytest.fixture
 def window():
-    def make(size=(800, 800), **config):
+    def make(size=(1280, 720), countdown=False, window_options=None, **config):
         screen = open_window(size)
         clock = FakeClock()
-        return GameWindow(GameSession(GameConfig(**config)), screen, clock=clock, fps=0), clock
+        win = GameWindow(GameSession(GameConfig(**config)), screen, clock=clock, fps=0, countdown=countdown,
+                         **(window_options or {}))
+        return win, clock
 
     yield make
     pygame.display.quit()
@@ -50,31 +75,31 @@ def world_points(session):
     return hand, mid_upper, mid_fore
 
 
+def post_key(name, down=True):
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=pygame.key.key_code(name)))
+
+
 @pytest.mark.parametrize("size", [(800, 800), (1280, 720), (600, 900)])
 def test_arm_target_and_hud_are_drawn_where_the_state_says(window, size):
     win, _ = window(size)
     win.frame(0.0)
-    view = Viewport.fit(win.screen.get_size(), win.session.config.view)
+    lay = win.renderer.layout(win.screen.get_size(), win.session, win.hud())
+    view = lay.view
     hand, mid_upper, mid_fore = world_points(win.session)
     target = win.session.rules.target
-    assert colour_at(win.screen, view.to_screen(target.x, target.y)) == TARGET
-    assert colour_at(win.screen, view.to_screen(*hand)) == HAND
-    assert colour_at(win.screen, view.to_screen(*mid_upper)) == LINK
-    assert colour_at(win.screen, view.to_screen(*mid_fore)) == LINK
-    # Far from the arm and the target: background.
-    assert colour_at(win.screen, view.to_screen(0.7, -0.35)) == BACKGROUND
-    # The HUD's score line sits at the top left of the scene: dark text pixels there.
-    x0, y0 = round(view.left + 16 * view.scale / 500), round(view.top + 12 * view.scale / 500)
-    box = [colour_at(win.screen, (x, y)) for x in range(x0, x0 + round(100 * view.scale / 500))
-           for y in range(y0, y0 + round(25 * view.scale / 500))]
-    assert any(sum(c) < 200 for c in box)
-    if size == (800, 800):
-        # The 2012 game's geometry: shoulder at (400, 600), 500 px per metre.
-        assert view.to_screen(0.0, 0.0) == (400, 600) and view.scale == 500
-
-
-def post_key(name, down=True):
-    pygame.event.post(pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=pygame.key.key_code(name)))
+    assert colour_at(win.screen, view.to_screen(target.x, target.y)) == PALETTE.target  # the bullseye's dot
+    ring_gap = view.to_screen(target.x + target.radius * 0.5, target.y)
+    assert colour_at(win.screen, ring_gap) != PALETTE.target  # a ring around a dot: not the hand's disc
+    assert colour_at(win.screen, view.to_screen(*hand)) == PALETTE.hand
+    assert colour_at(win.screen, view.to_screen(*mid_upper)) == PALETTE.link
+    assert colour_at(win.screen, view.to_screen(*mid_fore)) == PALETTE.link
+    assert colour_at(win.screen, view.to_screen(0.7, 1.1)) == PALETTE.scene  # outside the reachable workspace
+    assert colour_at(win.screen, view.to_screen(-0.5, 0.3)) == PALETTE.workspace
+    # The score is written where the layout puts it: dark text pixels in its rectangle.
+    score = next(lab for lab in lay.labels if lab.role == "score")
+    assert any(sum(colour_at(win.screen, (x, y))) < 200 for x in range(score.rect.left, score.rect.right)
+               for y in range(score.rect.top, score.rect.bottom))
+    assert lay.scene.contains(pygame.Rect(view.to_screen(-0.8, 1.2), (1, 1)))
 
 
 def test_keyboard_drives_the_arm_and_tab_hides_it(window):
@@ -89,11 +114,39 @@ def test_keyboard_drives_the_arm_and_tab_hides_it(window):
     assert win.session.state[0] > math.radians(45) and win.session.state[1] < math.radians(90)
     post_key("tab")
     win.frame(0.0)
-    view = Viewport.fit(win.screen.get_size(), win.session.config.view)
+    view = win.renderer.layout(win.screen.get_size(), win.session, win.hud()).view
     hand, mid_upper, _ = world_points(win.session)
     assert not win.session.rules.arm_visible
-    assert colour_at(win.screen, view.to_screen(*mid_upper)) == BACKGROUND
-    assert colour_at(win.screen, view.to_screen(*hand)) == HAND
+    assert colour_at(win.screen, view.to_screen(*mid_upper)) in (PALETTE.scene, PALETTE.workspace)
+    assert colour_at(win.screen, view.to_screen(*hand)) == PALETTE.hand
+
+
+def test_countdown_holds_the_clock_and_any_key_skips_it(window):
+    sounds = FakeSounds()
+    win, _ = window(countdown=True, window_options={"sounds": sounds})
+    win.frame(0.0)
+    assert win.hud().countdown == 3
+    for _ in range(60):  # 1.5 s of the 3 s countdown
+        win.frame(0.025)
+    assert win.session.steps == 0 and win.hud().countdown == 2
+    assert sounds.played == ["tick", "tick"]
+    post_key("d")  # skips the countdown; it is not a muscle command
+    win.frame(0.1)
+    assert win.countdown_left is None and win.session.timeline == [] and win.session.held == [False] * 4
+    win.frame(0.1)
+    assert win.session.steps == round(0.2 / win.session.config.dt)  # the clock starts in the frame of the key
+    assert sounds.played[-1] == "go"
+
+
+def test_countdown_runs_out_by_itself(window):
+    win, _ = window(countdown=True)
+    frames = 0
+    while win.countdown_left is not None:
+        win.frame(0.1)
+        frames += 1
+    assert frames in (30, 31) and win.session.steps == 0
+    win.frame(0.2)
+    assert win.session.steps == round(0.2 / win.session.config.dt)
 
 
 def test_windowed_game_equals_headless_replay_of_its_timeline(window):
@@ -112,7 +165,63 @@ def test_windowed_game_equals_headless_replay_of_its_timeline(window):
     assert win.session.rules.board.resets == 1
 
 
-def test_pause_stops_the_clock_and_releases_held_keys(window):
+def test_feedback_sounds_and_trail_leave_the_result_alone():
+    """Countdown, hit flashes, "+1", fades, the trail, sounds, pause and the end screen only read the game."""
+    screen = open_window((1280, 720))
+    try:
+        config = GameConfig(time_limit=8.0, seed=4)
+        session = GameSession(config)
+        sounds = FakeSounds()
+        driver = RealTimeDriver(Autopilot(session, make_bot("model")))  # type: ignore[arg-type]
+        win = GameWindow(session, screen, clock=FakeClock(), fps=0, driver=driver, sounds=sounds, trail=True,
+                         mode="AUTOPILOT: model", standing=lambda name: None)
+        frames = 0
+        while not win.ended:
+            win.frame(1 / 37)  # an odd frame rate: the physics must not care
+            frames += 1
+            if frames == 200:
+                win.set_paused(True)
+            if frames == 230:
+                win.set_paused(False)
+            if frames == 150:
+                assert len(win.hud().trail) > 10
+        assert session.rules.board.hits >= 3
+        assert sounds.played.count("hit") == session.rules.board.hits and sounds.played[-1] == "end"
+        headless = GameSession(config)
+        assert headless.play(session.timeline) == session.result()
+        assert headless.state == session.state
+    finally:
+        pygame.display.quit()
+
+
+def test_hit_flashes_and_says_plus_one(window):
+    win, _ = window()
+    target = win.session.rules.target
+    win.session.rules.hand_moved(target.x, target.y, 0.0)  # as the physics reports a hit
+    win.hits.append((target.x, target.y, win.session.time))
+    win.frame(0.0)
+    lay = win.renderer.layout(win.screen.get_size(), win.session, win.hud())
+    plus = [lab for lab in lay.labels if lab.text == "+1"]
+    assert plus and lay.scene.contains(plus[0].rect)
+    assert colour_at(win.screen, lay.view.to_screen(target.x, target.y)) == PALETTE.flash
+    # The next target fades in: right after the hit it is still close to the scene's colour.
+    new = win.session.rules.target
+    centre = colour_at(win.screen, lay.view.to_screen(new.x, new.y))
+    assert sum(abs(a - b) for a, b in zip(centre, PALETTE.scene, strict=True)) < 30
+
+
+def test_clock_turns_colour_in_the_last_ten_seconds(window):
+    win, _ = window(time_limit=12.0)
+    clock = next(lab for lab in win.renderer.layout((1280, 720), win.session, win.hud()).labels
+                 if lab.role == "clock")
+    assert clock.colour == PALETTE.ink
+    win.session.advance(round(3.0 / win.session.config.dt))
+    clock = next(lab for lab in win.renderer.layout((1280, 720), win.session, win.hud()).labels
+                 if lab.role == "clock")
+    assert clock.colour == PALETTE.warn
+
+
+def test_pause_stops_the_clock_releases_keys_and_leaves_hand_and_target_visible(window):
     win, _ = window()
     post_key("d")
     win.frame(0.1)
@@ -122,6 +231,12 @@ def test_pause_stops_the_clock_and_releases_held_keys(window):
     win.frame(0.5)
     assert win.paused and win.session.steps == steps
     assert win.session.held == [False] * 4
+    lay = win.renderer.layout(win.screen.get_size(), win.session, win.hud())
+    assert any(lab.text == "PAUSED" for lab in lay.labels)
+    assert not any(lay.scene.colliderect(lab.rect) for lab in lay.labels)  # the panel is aside
+    target = win.session.rules.target
+    assert colour_at(win.screen, lay.view.to_screen(target.x, target.y)) == PALETTE.target
+    assert colour_at(win.screen, lay.view.to_screen(*win.session.hand())) == PALETTE.hand
     post_key("p")
     win.frame(0.1)
     assert not win.paused and win.session.steps > steps
@@ -138,12 +253,220 @@ def test_escape_and_close_end_the_window(window):
     assert not win2.running
 
 
-def test_end_screen_shows_the_score(window):
-    win, _ = window(time_limit=0.5)
+def test_end_screen_asks_the_name_then_shows_rank_and_top_ten_until_a_key(window):
+    asked = []
+
+    def standing(name):
+        asked.append(name)
+        return Standing(2, 12, tuple((i, f"P{i}", 20 - i) for i in range(1, 11)))
+
+    win, _ = window(time_limit=0.5, window_options={"ask_name": True, "standing": standing})
     for _ in range(40):
         win.frame(1 / 60)
-    assert win.session.over
-    view = Viewport.fit(win.screen.get_size(), win.session.config.view)
-    cy = round(view.top + view.scale * 0.55)
-    row = [colour_at(win.screen, (x, cy - 22)) for x in range(250, 550)]
-    assert PANEL in row and any(sum(c) < 100 for c in row)  # the panel, and the title's dark letters on it
+    assert win.session.over and win.ended and win.name_entry == ""
+    for _ in range(40):
+        win.frame(1 / 60)
+    pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="Ann"))
+    post_key("return")
+    win.frame(0.0)
+    assert asked == ["Ann"] and win.player_name == "Ann"
+    lay = win.renderer.layout(win.screen.get_size(), win.session, win.hud())
+    texts = [lab.text for lab in lay.labels]
+    assert "Rank 2 of 12 in the table" in texts and "P10" in texts and "Your score: 0" in texts
+    post_key("x")  # too soon: a key still being mashed does not close it
+    win.frame(0.1)
+    assert win.running
+    win.frame(END_KEY_DELAY)
+    post_key("x")
+    win.frame(0.0)
+    assert not win.running
+
+
+# ------------------------------------------------------------------------------------------ replays
+def test_replay_speed_and_skips_match_a_fresh_replay(window):
+    config = GameConfig(time_limit=20.0, seed=5)
+    played = GameSession(config)
+    Autopilot(played, make_bot("model")).play()
+    source = ReplaySource(config, tuple(played.timeline), played.steps)
+    screen = open_window((1280, 720))
+    win = GameWindow(GameSession(config), screen, clock=FakeClock(), fps=0, replay=source, mode="REPLAY")
+    assert win.countdown_left is None and not win.keyboard
+    win.frame(0.2)
+    assert win.session.steps == round(0.2 / config.dt)
+    post_key("=")
+    post_key("=")
+    win.frame(0.0)
+    win.frame(0.2)
+    assert win.speed == 4.0 and win.session.steps == round(1.0 / config.dt)
+    post_key("right")
+    win.frame(0.0)
+    assert win.session.steps == round(6.0 / config.dt)
+    post_key("left")
+    post_key("left")
+    win.frame(0.0)
+    assert win.session.steps == 0  # clamped at the start
+    post_key("right")
+    post_key("right")
+    win.frame(0.0)
+    post_key("left")
+    win.frame(0.0)
+    fresh = GameSession(config)
+    fresh.play(played.timeline, round(5.0 / config.dt))
+    assert win.session.steps == fresh.steps and win.session.state == fresh.state
+    assert win.session.result() == fresh.result()
+    for _ in range(10):
+        post_key("-")
+    win.frame(0.0)
+    assert win.speed == 0.25
+    lay = win.renderer.layout((1280, 720), win.session, win.hud())
+    assert lay.progress is not None and lay.progress[1] == pytest.approx(0.25)
+    assert any("left/right 5 s" in lab.text for lab in lay.labels if lab.role == "help")
+    assert not any("shoulder" in lab.text for lab in lay.labels if lab.role == "help")
+    win.skip_to(source.stop_step)
+    win.frame(0.0)
+    assert win.ended and win.session.result() == played.result()
+
+
+# ------------------------------------------------------------------------------------------- layout
+def screens(session, renderer):
+    """Every screen the game window shows, as the HUD it hands the renderer."""
+    keys = session.muscles.keys
+    play_help = (f"{keys[0]}/{keys[1]} shoulder", f"{keys[2]}/{keys[3]} elbow", "space reset (-1)", "tab hide arm",
+                 "p pause", "m mute", "F11 fullscreen", "Esc quit")
+    table = Standing(3, 40, tuple((i, "W" * 24, 999) for i in range(1, 11)))
+    return {
+        "play": Hud(mode="PLAY   seed 10", help=play_help),
+        "countdown": Hud(mode="PLAY   seed 10", help=play_help, countdown=3),
+        "paused": Hud(mode="PLAY   seed 10", help=play_help, paused=True),
+        "hit": Hud(mode="PLAY   seed 10", help=play_help, hits=[(0.1, 0.6, 0.1)]),
+        "bot": Hud(mode="AUTOPILOT: model", help=("p pause", "m mute", "F11 fullscreen", "Esc quit")),
+        "replay": Hud(mode="REPLAY   Wolfgang Amadeus   2026-11-22 23:59", progress=(12.3, 60.0), speed=0.25,
+                      help=("p pause", "-/+ speed", "left/right 5 s", "m mute", "F11 fullscreen", "Esc quit")),
+        "name": Hud(mode="PLAY", ended=True, name_entry="W" * 24),
+        "end": Hud(mode="PLAY", ended=True, standing=table),
+        "end, no table": Hud(mode="REPLAY", ended=True),
+    }
+
+
+def assert_fits(size, boxes, min_height, what):
+    window = pygame.Rect((0, 0), size)
+    for name, rect in boxes:
+        assert window.contains(rect), f"{what} at {size}: {name!r} {rect} is cut"
+        if not name.startswith("bar") and name != "progress":
+            assert rect.height >= min_height, f"{what} at {size}: {name!r} is {rect.height} px high"
+    for i, (a, ra) in enumerate(boxes):
+        for b, rb in boxes[i + 1:]:
+            assert not ra.colliderect(rb), f"{what} at {size}: {a!r} {ra} overlaps {b!r} {rb}"
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_every_screen_fits_every_window(size):
+    pygame.display.init()
+    pygame.font.init()
+    session = GameSession(GameConfig())
+    session.key_event("d", "down")
+    session.advance(100)
+    renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+    min_height = math.floor(MIN_TEXT_AT_720 * min(size) / 720)
+    for what, hud in screens(session, renderer).items():
+        lay = renderer.layout(size, session, hud)
+        assert lay.labels, what
+        assert_fits(size, lay.boxes(), min_height, what)
+        if not hud.ended:  # the HUD never covers the arm's workspace
+            assert not any(lay.scene.colliderect(lab.rect) for lab in lay.labels if lab.role
+                           not in ("countdown", "effect")), what
+            assert min(lay.scene.size) >= 0.5 * min(size), what
+
+
+@pytest.mark.parametrize("palette", sorted(PALETTES))
+def test_text_colours_meet_wcag_aa(palette):
+    p = PALETTES[palette]
+    for text in (p.ink, p.faint):
+        for background in (p.window, p.scene, p.panel):
+            assert contrast_ratio(text, background) >= 4.5, (palette, text, background)
+    # The warning clock and the player's own row in the table are text too.
+    assert contrast_ratio(p.warn, p.window) >= 4.5 and contrast_ratio(p.warn, p.panel) >= 4.5
+    assert contrast_ratio((0, 0, 0), (255, 255, 255)) == pytest.approx(21.0)
+    assert contrast_ratio((118, 118, 118), (255, 255, 255)) == pytest.approx(4.54, abs=0.01)  # WCAG's example
+
+
+def test_muscle_colours_are_okabe_ito():
+    okabe_ito = {(230, 159, 0), (86, 180, 233), (0, 158, 115), (240, 228, 66), (0, 114, 178), (213, 94, 0),
+                 (204, 121, 167)}
+    assert set(PALETTE.muscles) <= okabe_ito and len(set(PALETTE.muscles)) == 4
+    assert PALETTE.target in okabe_ito
+
+
+# ------------------------------------------------------------------------------------ window sizes
+def test_windows_fit_the_desktop():
+    assert fit_size(None, (1200, 800), (1920, 1080)) == (1200, 800)
+    assert fit_size(None, (1200, 800), (1280, 720)) == (984, 656)  # shrunk, same shape, room for a title bar
+    assert fit_size((3000, 3000), (800, 800), (1366, 768)) == (704, 704)
+    assert fit_size((1024, 600), (800, 800), (1366, 768)) == (1024, 600)
+    screen = open_window((5000, 4000))
+    desktop = pygame.display.get_desktop_sizes()[0]
+    assert screen.get_width() <= desktop[0] and screen.get_height() <= desktop[1]
+    pygame.display.quit()
+
+
+def test_f11_toggles_fullscreen(window):
+    win, _ = window((800, 600))
+    post_key("f11")
+    win.frame(0.0)
+    assert win.fullscreen
+    post_key("f11")
+    win.frame(0.0)
+    assert not win.fullscreen and win.screen.get_size() == (800, 600)
+
+
+def test_a_view_still_maps_the_world_as_before():
+    view = Viewport.fit((800, 800), GameConfig().view)
+    assert view.to_screen(0.0, 0.0) == (400, 600) and view.scale == 500 and view.length(0.1) == 50
+
+
+def test_each_mode_says_what_it_is_and_offers_only_its_keys(window):
+    screen = open_window((1280, 720))
+    session = GameSession(GameConfig())
+    bot = GameWindow(session, screen, clock=FakeClock(), fps=0, mode="AUTOPILOT: naive",
+                     driver=RealTimeDriver(Autopilot(session, make_bot("naive"))), sounds=FakeSounds())
+    assert bot.help_items() == ("p pause", "m mute", "F11 fullscreen", "Esc quit")
+    bot.frame(0.0)
+    lay = bot.renderer.layout((1280, 720), bot.session, bot.hud())
+    assert [lab.text for lab in lay.labels if lab.role == "mode"] == ["AUTOPILOT: naive"]
+    post_key("space")  # not a key of this mode: nothing happens
+    post_key("d")
+    bot.frame(0.0)
+    assert bot.session.rules.board.resets == 0 and bot.session.timeline == []
+    player, _ = window(window_options={"sounds": FakeSounds()})
+    assert "space reset (-1)" in player.help_items() and "m mute" in player.help_items()
+    mapped = GameWindow(GameSession(GameConfig(muscles=remap_keys(DEFAULT_MUSCLES, "mjkl"))), screen, fps=0,
+                        sounds=FakeSounds())
+    assert "m mute" not in mapped.help_items()  # m is a muscle there
+
+
+def test_demo_windows_toggle_fullscreen_with_f11():
+    from armgame.demos.catalog import make_run
+    from armgame.ui.demo_window import DemoWindow
+
+    demo = DemoWindow("chaos", make_run("chaos"), clock=lambda: 0.0, size=(800, 600))
+    demo.open()
+    try:
+        demo.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_F11))
+        assert demo.fullscreen
+        demo.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_F11))
+        assert not demo.fullscreen and demo.size == (800, 600)
+    finally:
+        demo.close()
+
+
+def test_a_resize_is_remembered_but_a_fullscreen_round_trip_is_not(window):
+    win, _ = window((800, 600))
+    for _ in range(2):
+        post_key("f11")
+        win.frame(0.0)
+    pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, w=800, h=600, size=(800, 600)))
+    win.frame(0.0)
+    assert not win.resized
+    pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, w=900, h=650, size=(900, 650)))
+    win.frame(0.0)
+    assert win.resized and win.windowed_size == (900, 650)

@@ -16,7 +16,9 @@ from armgame.lab.protocol import Block, Perturbation, Protocol
 from armgame.lab.session import LabSession, lab_config
 from armgame.ui.frontend import open_window
 from armgame.ui.lab_window import CURSOR, HOME, LabWindow
-from armgame.ui.render import TARGET, Viewport
+from armgame.ui.render import PALETTES, Viewport
+
+TARGET = PALETTES["okabe-ito"].target
 
 PROTOCOL = Protocol("tiny", (Block("baseline", 2, Perturbation(), 0, "Reach straight."),
                              Block("exposure", 2, Perturbation.make("rotation", angle=30.0), 0, "Keep reaching.")),

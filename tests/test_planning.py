@@ -168,7 +168,8 @@ def test_the_window_draws_both_arms_where_their_plans_put_them(monkeypatch, plan
         screen = pygame.display.get_surface()
         jerk_hand, mtc_hand = (window.run.arm_points(*pose)[-1] for pose in window.poses())
         assert math.dist(jerk_hand, mtc_hand) > 0.02
-        assert tuple(screen.get_at(window.to_window(mtc_hand)))[:3] == ARM_B
+        colour = tuple(screen.get_at(window.to_window(mtc_hand)))[:3]
+        assert max(abs(a - b) for a, b in zip(colour, ARM_B, strict=True)) <= 8  # the scene is scaled smoothly
         assert max(tuple(screen.get_at(window.to_window(jerk_hand)))[:3]) < 100  # the dark arm's hand
         assert "min torque change" in window._status()
     finally:

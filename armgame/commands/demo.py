@@ -12,6 +12,8 @@ _FIXED_STEP = "euler, symplectic-euler, rk4, midpoint or gauss4"
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    from ..ui.options import add_window_options
+
     p = subparsers.add_parser(
         "demo",
         help="classroom demos: pendulum, passive, chaos, interaction, autopilot",
@@ -36,6 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--gravity", action="store_true",
                    help="interaction only: the reach in a vertical plane, so gravity adds its torques")
     p.add_argument("--speed", type=float, default=1.0, help="window: initial playback rate (default: 1 = real time)")
+    add_window_options(p, sound=False)
     p.set_defaults(run=run)
 
 
@@ -52,7 +55,9 @@ def run(args: argparse.Namespace) -> int:
         if args.headless:
             print(autopilot.run_headless(None if args.out is None else Path(args.out), args.duration))
         else:
-            autopilot.run_window()
+            from ..ui.autopilot_window import run_window as autopilot_window
+
+            autopilot_window(autopilot.WINDOW_SEED, size=_window_size(args), fullscreen=args.fullscreen)
         return 0
     if args.headless:
         if args.out is None:
@@ -74,5 +79,11 @@ def run(args: argparse.Namespace) -> int:
     run_ = make_run(args.name, args.integrator, args.dt, args.gravity)
     from ..ui.demo_window import run_window
 
-    run_window(args.name, run_, speed=args.speed)
+    run_window(args.name, run_, speed=args.speed, size=_window_size(args), fullscreen=args.fullscreen)
     return 0
+
+
+def _window_size(args: argparse.Namespace) -> tuple[int, int] | None:
+    from ..ui.options import window_settings
+
+    return window_settings(args)[0].size

@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from ..errors import UserError
-from .play import DEFAULT_SEED, _seed, _size
+from .play import DEFAULT_SEED, _seed
 
 
 def _rate(text: str) -> float:
@@ -60,8 +60,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="adaptive bot: the learner's retention rates A_f A_s (default: 0.59 0.992)")
     p.add_argument("--learning", type=_rate, nargs=2, metavar=("FAST", "SLOW"), default=None,
                    help="adaptive bot: the learner's learning rates B_f B_s (default: 0.21 0.02; 0 0 learns nothing)")
-    p.add_argument("--fullscreen", action="store_true", help="fill the screen (for a projector)")
-    p.add_argument("--size", type=_size, default=(800, 800), help="window size, e.g. 1024x768 (default: 800x800)")
+    from ..ui.options import add_window_options
+
+    add_window_options(p, sound=False)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
     p.set_defaults(run=run)
 
@@ -188,7 +189,10 @@ def _play_in_window(session, bot, args: argparse.Namespace) -> None:
 
         driver = RealTimeDriver(Autopilot(session, bot))  # type: ignore[arg-type]
     try:
-        screen = open_window(args.size, args.fullscreen)
+        from ..ui.options import window_settings
+
+        settings, _ = window_settings(args)
+        screen = open_window(settings.size, args.fullscreen, "armgame lab - reach from home to each target")
     except pygame.error as exc:
         raise UserError(f"cannot open a window ({exc}); use --headless --bot NAME where there is no display") from None
     try:

@@ -11,16 +11,6 @@ from ..words import plural
 DEFAULT_SEED = 10  # the 2012 game's: every class sees the same targets unless asked otherwise
 
 
-def _size(text: str) -> tuple[int, int]:
-    try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, e.g. 800x800, got {text!r}") from None
-    if not (200 <= w <= 10000 and 200 <= h <= 10000):
-        raise argparse.ArgumentTypeError(f"window size must be 200 to 10000 px a side, got {text!r}")
-    return w, h
-
-
 def _seed(text: str) -> int:
     try:
         value = int(text)
@@ -36,17 +26,21 @@ def add_game_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=_seed, default=DEFAULT_SEED,
                    help=f"target sequence (default: {DEFAULT_SEED}, the same targets every game)")
     p.add_argument("--duration", type=float, default=60.0, help="game length in seconds (default: 60)")
-    p.add_argument("--keys", default="dfjk",
-                   help="keys for pectoralis, posterior deltoid, biceps, triceps (default: dfjk)")
+    p.add_argument("--keys", default=None,
+                   help="keys for pectoralis, posterior deltoid, biceps, triceps (default: dfjk; a window: the "
+                   "settings file's)")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
+    from ..ui.options import add_window_options
+
     p = subparsers.add_parser(
         "play",
         help="play the game (a window, or --headless from a script)",
-        description="Hit the red targets with the hand. d/f drive the shoulder flexor and extensor, j/k the "
-        "elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, p pauses, "
-        "F11 toggles fullscreen, Esc quits.",
+        description="Hit the targets (rings) with the hand (a solid disc). d/f drive the shoulder flexor and "
+        "extensor, j/k the elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, "
+        "p pauses, m mutes, F11 toggles fullscreen, Esc quits. A 3-2-1 countdown (any key skips it) starts the "
+        "clock.",
     )
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
@@ -56,8 +50,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--bot", metavar="NAME", help="an autopilot at the muscle keys: model (knows the interaction "
                    "torques) or naive (drives each joint as if the other did not move)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
-    p.add_argument("--fullscreen", action="store_true", help="fill the screen (for a projector)")
-    p.add_argument("--size", type=_size, default=(800, 800), help="window size, e.g. 1024x768 (default: 800x800)")
+    add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
     _add_score_options(p)
     p.set_defaults(run=run)
@@ -80,7 +73,8 @@ def game_config(args: argparse.Namespace):
     if not (math.isfinite(args.duration) and 0 < args.duration <= MAX_GAME_SECONDS):
         raise UserError(f"--duration must be a positive number of seconds up to {MAX_GAME_SECONDS:g} (the longest "
                         f"game a replay may hold), got {args.duration!r}")
-    config = GameConfig(seed=args.seed, time_limit=args.duration, muscles=remap_keys(DEFAULT_MUSCLES, args.keys))
+    config = GameConfig(seed=args.seed, time_limit=args.duration,
+                        muscles=remap_keys(DEFAULT_MUSCLES, args.keys or "dfjk"))
     if config.total_steps > MAX_GAME_STEPS:
         raise UserError(f"--duration {args.duration:g} is {config.total_steps} physics steps, more than a replay may "
                         f"hold ({MAX_GAME_STEPS})")
@@ -99,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
         return _play_class(args)
     if args.script:
         args.script = args.script[0]
+    window = None if args.headless else _window_settings(args)  # before the game: its keys may come from there
     session = GameSession(game_config(args))
     _check_score_options(args)
     if args.script and not args.headless:
@@ -116,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         if not 1 <= args.fps <= 1000:
             raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
-        result = _play_in_window(session, args)
+        result = _play_in_window(session, args, window)
     if args.json:
         print(json.dumps(result.as_dict(), sort_keys=True))
     else:
@@ -125,7 +120,8 @@ def run(args: argparse.Namespace) -> int:
     if session.event_limit_reached:
         print(f"the game was stopped at {session.time:.1f} s: it reached {len(session.timeline)} input events, the "
               f"most a replay holds", file=sys.stderr)
-    _keep(session, args)
+    if not getattr(args, "kept", False):  # the window's end screen may have kept it already
+        _keep(session, args)
     return 0
 
 
@@ -168,8 +164,10 @@ def _check_score_options(args: argparse.Namespace) -> None:
         check_writable_folder(scores_dir(args), "--scores")
 
 
-def _keep(session, args: argparse.Namespace) -> None:
-    """Save the replay where --record asks, and enter a finished game with a name in the table."""
+def _keep(session, args: argparse.Namespace):
+    """Save the replay where --record asks, and enter a finished game with a name in the table.
+
+    Returns the new table entry, or None when the game was not entered."""
     import sys
     from pathlib import Path
 
@@ -203,6 +201,7 @@ def _keep(session, args: argparse.Namespace) -> None:
     kind = "" if table.ruleset(entry) != "custom" else " among custom games (not ranked: not the standard game)"
     print(f"saved to the high-score table as {entry.name}: #{table.rank(entry)}{kind} "
           f"({table.path})", file=out)
+    return entry
 
 
 def driver_name(file_name: str) -> str:
@@ -211,11 +210,43 @@ def driver_name(file_name: str) -> str:
     return cleaned if len(cleaned) <= 60 else cleaned[:57] + "..."
 
 
-def _play_in_window(session, args: argparse.Namespace):
-    try:
-        import pygame
+def _window_settings(args: argparse.Namespace):
+    from ..ui.options import window_settings
 
-        from ..ui.frontend import GameWindow, open_window
+    settings, path = window_settings(args)
+    args.keys = args.keys or settings.keys
+    return settings, path
+
+
+def _standing(session, args: argparse.Namespace):
+    """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
+    import sys
+
+    from ..records.rulesets import ruleset_of
+    from ..records.scores import ScoreTable
+    from ..ui.render import Standing
+    from .scores import scores_dir
+
+    def standing(name: str | None) -> Standing | None:
+        args.name = name or args.name
+        try:
+            entry = _keep(session, args)
+            args.kept = True
+            table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
+            entries = table.same_kind(entry) if entry is not None else \
+                table.of_kind(ruleset_of(session.config) is not None)
+        except UserError as exc:
+            print(f"armgame play: error: {exc}", file=sys.stderr)
+            return None
+        rank = next((i for i, e in enumerate(entries, 1) if entry is not None and e.id == entry.id), None)
+        return Standing(rank, len(entries), tuple((i, e.name, e.score) for i, e in enumerate(entries[:10], 1)))
+
+    return standing
+
+
+def _play_in_window(session, args: argparse.Namespace, window):
+    try:
+        from ..ui.frontend import play_window
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
     driver = None
@@ -225,14 +256,9 @@ def _play_in_window(session, args: argparse.Namespace):
 
         # The bot steps the game through the same Autopilot as headless: the keyboard only pauses and quits.
         driver = RealTimeDriver(Autopilot(session, make_bot(args.bot)))  # type: ignore[arg-type]
-    try:
-        screen = open_window(args.size, args.fullscreen)
-    except pygame.error as exc:
-        raise UserError(f"cannot open a window ({exc}); use --headless where there is no display") from None
-    try:
-        window = GameWindow(session, screen, fps=args.fps, driver=driver, ask_name=args.name is None)
-        window.run()
-        args.name = args.name or window.player_name  # the name typed on the end screen
-    finally:
-        pygame.display.quit()
+    settings, path = window
+    played = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps, driver=driver,
+                         ask_name=args.name is None, trail=args.trail, standing=_standing(session, args),
+                         mode=f"AUTOPILOT: {args.bot}" if args.bot else f"PLAY   seed {args.seed}")
+    args.name = args.name or played.player_name  # the name typed on the end screen
     return session.result()

@@ -8,20 +8,20 @@ from ..words import plural
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from .play import _size
+    from ..ui.options import add_window_options
 
     p = subparsers.add_parser(
         "replay",
         help="play back a recorded game (a window, or --headless --json)",
         description="Play back a replay file (from play --record, or the replays/ folder beside the score "
-        "table) at real-time speed in a window; the keyboard only pauses (p) and quits (Esc). With "
+        "table) at real-time speed in a window: p pauses, - and + set the speed (0.25x to 8x), the left and right "
+        "arrows skip 5 s back and forth, Esc quits; the game keys do nothing. With "
         "--headless the game is recomputed at once; --json prints the same object as play --headless --json.",
     )
     p.add_argument("file", metavar="FILE", help="the replay file (JSON)")
     p.add_argument("--headless", action="store_true", help="no window: recompute the game at once")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
-    p.add_argument("--fullscreen", action="store_true", help="fill the screen")
-    p.add_argument("--size", type=_size, default=(800, 800), help="window size (default: 800x800)")
+    add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
     p.set_defaults(run=run)
 
@@ -31,7 +31,6 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from ..errors import UserError
-    from ..game.session import GameSession
     from ..records.replay import Replay
 
     replay = Replay.load(Path(args.file))
@@ -41,9 +40,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         if not 1 <= args.fps <= 1000:
             raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
-        # A lab run is watched on its own task's session and window.
-        session = replay.task.new_session(replay.config) if replay.task is not None else GameSession(replay.config)
-        _watch(session, replay, args)
+        session = _watch(replay, args)
         result, played = session.result(), session.steps
     if args.json:
         print(json.dumps(result.as_dict(), sort_keys=True))
@@ -61,28 +58,40 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _watch(session, replay, args: argparse.Namespace) -> None:
+def _watch(replay, args: argparse.Namespace):
+    """The replay in a window; returns the session as the window left it (skips back replay it afresh)."""
     from ..errors import UserError
 
     try:
-        import pygame
-
-        from ..game.timeline import TimelineDriver
-        from ..ui.frontend import GameWindow, open_window
+        from ..ui.frontend import ReplaySource, play_window
+        from ..ui.options import window_settings
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
-    try:
-        screen = open_window(args.size, args.fullscreen)
-    except pygame.error as exc:
-        raise UserError(f"cannot open a window ({exc}); use --headless where there is no display") from None
-    try:
-        pygame.display.set_caption(f"armgame replay - {replay.player or 'a game'}, seed {replay.config.seed}")
-        driver = TimelineDriver(session, replay.timeline, replay.steps)
-        if replay.task is not None:
-            from ..ui.lab_window import LabWindow
+    settings, path = window_settings(args)
+    if replay.task is not None:  # a lab run is watched on its own task's session and window
+        return _watch_lab(replay, args, settings)
+    when = replay.date[:16].replace("T", " ") if replay.date else "date unknown"
+    source = ReplaySource(replay.config, replay.timeline, replay.steps)
+    session, _ = source.start()
+    window = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps, replay=source,
+                         trail=args.trail, mode=f"REPLAY   {replay.player or 'no name'}   {when}",
+                         caption=f"armgame replay - {replay.player or 'a game'}, seed {replay.config.seed}")
+    return window.session
 
-            LabWindow(session, screen, fps=args.fps, driver=driver).run()
-        else:
-            GameWindow(session, screen, fps=args.fps, driver=driver).run()
+
+def _watch_lab(replay, args: argparse.Namespace, settings):
+    import pygame
+
+    from ..game.timeline import TimelineDriver
+    from ..ui.frontend import open_window
+    from ..ui.lab_window import LabWindow
+
+    session = replay.task.new_session(replay.config)
+    screen = open_window(settings.size, args.fullscreen,
+                         f"armgame replay - {replay.player or 'a lab run'}, seed {replay.config.seed}")
+    try:
+        driver = TimelineDriver(session, replay.timeline, replay.steps)
+        LabWindow(session, screen, fps=args.fps, driver=driver).run()
     finally:
         pygame.display.quit()
+    return session

@@ -442,10 +442,19 @@ class ScoreTable:
                                  f"changed") from None
         raise TableError("cannot name a copy of the damaged table; nothing was changed")
 
+    def of_kind(self, ranked: bool) -> list[ScoreEntry]:
+        """Ranked games, or else custom games, best first: the entries one game is compared with."""
+        if ranked:
+            return self.entries()
+        return [e for e in self.all_entries() if self.ruleset(e) not in RULESETS]
+
+    def same_kind(self, entry: ScoreEntry) -> list[ScoreEntry]:
+        """The entries ``entry`` is compared with, best first."""
+        return self.of_kind(self.ruleset(entry) in RULESETS)
+
     def rank(self, entry: ScoreEntry) -> int:
         """The entry's place among the entries of its own kind (ranked games, or custom games)."""
-        ordered = self.entries() if self.ruleset(entry) in RULESETS else \
-            [e for e in self.all_entries() if self.ruleset(e) not in RULESETS]
+        ordered = self.same_kind(entry)
         return next((i for i, e in enumerate(ordered, 1) if e.id == entry.id), len(ordered))
 
     # ------------------------------------------------------------------ trust

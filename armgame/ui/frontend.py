@@ -1,42 +1,110 @@
-"""The game window: keyboard in, frames out, physics at its own fixed rate.
+"""The game window: keyboard in, frames and sounds out, physics at its own fixed rate.
 
 Real elapsed time comes from ``time.perf_counter`` (injectable for tests), never from
 ``pygame.time.Clock``, which sleeps to whole milliseconds; the clock only caps the frame
 rate. Keys become session events at the physics step they arrive before.
+
+Everything the window adds to the game (the 3-2-1 countdown, a hit's flash and "+1", sounds,
+the trail, the pause panel, the end screen) only reads the session: the game's timeline, and so
+its result, are the same as a headless run of that timeline. The countdown runs before the
+game's clock starts, and its keys are not game input.
 """
 
 from __future__ import annotations
 
+import math
 import time
-from collections.abc import Callable
+from collections import deque
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
 
 import pygame
 
-from ..game.session import DOWN, UP, GameSession, RealTimeDriver
-from .render import GameRenderer
+from ..game.rules import GameConfig
+from ..game.session import DOWN, UP, GameSession, InputEvent, RealTimeDriver
+from ..game.timeline import TimelineDriver
+from .display import open_window as _open_window
+from .display import toggle_fullscreen
+from .render import PLUS_ONE_TIME, GameRenderer, Hud, Standing
+from .settings import MIN_SIDE, Settings, SettingsError
+from .settings import load as load_settings
+from .settings import save as save_settings
 
-CAPTION = "armgame - hit the red targets with the black dot"
-DEFAULT_SIZE = (800, 800)
+CAPTION = "armgame - hit the targets with the hand"
+DEFAULT_SIZE = (1200, 800)
 NAME_LENGTH = 24
-#: Keys still being mashed as the clock runs out must not type themselves into the name.
+#: Keys still being mashed as the clock runs out must not type themselves into the name, nor close
+#: the end screen before the player has seen it.
 NAME_ENTRY_DELAY = 0.5
+END_KEY_DELAY = 0.8
+COUNTDOWN = 3
+TRAIL_SECONDS = 1.0
+REPLAY_SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
+SKIP_SECONDS = 5.0
+#: Longest real time one frame may account for (as RealTimeDriver's default): a stall skips ahead.
+MAX_FRAME = 0.25
 
 
-def open_window(size: tuple[int, int] = DEFAULT_SIZE, fullscreen: bool = False) -> pygame.Surface:
-    # display and font only: pygame.init() would also start the mixer, which the game never uses.
-    pygame.display.init()
-    pygame.font.init()
-    pygame.display.set_caption(CAPTION)
-    flags = pygame.FULLSCREEN if fullscreen else pygame.RESIZABLE
-    return pygame.display.set_mode((0, 0) if fullscreen else size, flags)
+def open_window(size: tuple[int, int] | None = DEFAULT_SIZE, fullscreen: bool = False,
+                caption: str = CAPTION) -> pygame.Surface:
+    """The game's window, fitted to the desktop (see ``armgame.ui.display``)."""
+    return _open_window(size, fullscreen, caption, DEFAULT_SIZE)
+
+
+class SoundPlayer(Protocol):
+    """What the window needs of its sounds (``armgame.ui.sound.Sounds``; the tests pass a recorder)."""
+
+    available: bool
+    muted: bool
+
+    def play(self, name: str) -> None: ...
+
+    def toggle(self) -> bool: ...
 
 
 def key_name(event: pygame.event.Event) -> str:
     return pygame.key.name(event.key).lower()
 
 
+@dataclass
+class ReplaySource:
+    """A recorded game to watch: its configuration, its timeline and where it stopped."""
+
+    config: GameConfig
+    timeline: Sequence[InputEvent]
+    stop_step: int
+
+    def start(self, step: int = 0) -> tuple[GameSession, TimelineDriver]:
+        """A fresh session replayed to ``step`` at once: how the window skips back, deterministically."""
+        session = GameSession(self.config)
+        # Sped up, a frame covers up to 8 times the usual stall limit: the window clamps real time itself.
+        driver = TimelineDriver(session, self.timeline, self.stop_step, max_frame_time=MAX_FRAME * max(REPLAY_SPEEDS))
+        seek(driver, step)
+        return session, driver
+
+
+def seek(driver: TimelineDriver, step: int) -> None:
+    """Run the driver's session forward to ``step`` (no further than the recording) with no clock."""
+    session = driver.session
+    driver.input.run_to(session, max(step, session.steps))
+    driver.steps_taken = session.steps
+    driver.clock = session.steps * session.config.dt
+
+
 class GameWindow:
-    """Runs one game in a window until the player quits; ``run`` returns the session."""
+    """Runs one game in a window until the player quits; ``run`` returns the session.
+
+    ``driver``: the input when it is not the keyboard (a bot or a replay's timeline; keys then only
+    pause and quit). ``replay``: a recorded game, which adds speed and skip keys. ``standing``: called
+    once when the end screen opens, with the name typed there (or None), returns the table's
+    standing to show (the command passes it in: the window knows nothing of score files).
+    ``mode`` is the label that says what is on screen ("PLAY   seed 10", "AUTOPILOT: model",
+    "REPLAY   Ann   2026-11-22 14:03"); ``countdown`` puts 3-2-1 before the clock (never for a
+    replay); ``sounds`` plays hit, reset, tick, go and end; ``on_mute`` hears the m key (to persist it);
+    ``trail`` keeps the hand's last second for drawing.
+    """
 
     def __init__(
         self,
@@ -46,45 +114,143 @@ class GameWindow:
         fps: int = 60,
         driver: RealTimeDriver | None = None,
         ask_name: bool = False,
+        *,
+        mode: str = "PLAY",
+        countdown: bool = True,
+        sounds: SoundPlayer | None = None,
+        trail: bool = False,
+        palette: str = "okabe-ito",
+        standing: Callable[[str | None], Standing | None] | None = None,
+        on_mute: Callable[[bool], None] | None = None,
+        replay: ReplaySource | None = None,
     ) -> None:
         self.session = session
         self.screen = screen
         self.clock = clock
         self.fps = fps
-        # A driver given from outside (a replay's timeline) is the only input: keys just pause and quit.
+        self.replay = replay
+        if replay is not None and driver is None:
+            session, driver = replay.start()
+            self.session = session
+        # A driver given from outside (a bot, a replay's timeline) is the only input: keys just pause and quit.
         self.keyboard = driver is None
         self.driver = driver or RealTimeDriver(session)
         #: The name typed on the end screen while it is being typed (None: no prompt), and once confirmed.
         self.name_entry: str | None = None
         self.player_name: str | None = None
         self.ask_name = ask_name
+        self.mode = mode
+        self.sounds = sounds
+        self.trail_on = trail
+        self.standing_of = standing
+        self.standing: Standing | None = None
+        self.on_mute = on_mute
+        self.ended = False
         self._over_for = 0.0
         names = tuple(m.name for m in session.config.muscles)
-        self.renderer = GameRenderer(session.muscles.keys, names)
+        self.renderer = GameRenderer(session.muscles.keys, names, palette)
         self.paused = False
         self.running = True
         self.fullscreen = bool(screen.get_flags() & pygame.FULLSCREEN)
+        self.windowed_size = DEFAULT_SIZE if self.fullscreen else screen.get_size()
+        self.resized = False
         self.alpha = 1.0
+        self.speed = 1.0
+        self.countdown_left: float | None = float(COUNTDOWN) if countdown and replay is None else None
+        self._last_count: int | None = None
+        self.hits: list[tuple[float, float, float]] = []  # x, y (m), game time of the hit
+        self.trail: deque[tuple[float, float, float]] = deque()
+
+    # ------------------------------------------------------------------ input
+    @property
+    def finished(self) -> bool:
+        """The game is over, or the replay has shown all that was recorded."""
+        if self.session.over:
+            return True
+        return isinstance(self.driver, TimelineDriver) and self.driver.done
+
+    def help_items(self) -> tuple[str, ...]:
+        keys = self.session.muscles.keys
+        items: list[str] = []
+        if self.keyboard:
+            items += [f"{keys[0]}/{keys[1]} shoulder", f"{keys[2]}/{keys[3]} elbow",
+                      f"space reset (-{self.session.config.reset_cost})", "tab hide arm"]
+        items.append("p pause")
+        if self.replay is not None:
+            items += ["-/+ speed", "left/right 5 s"]
+        if self.sounds is not None and getattr(self.sounds, "available", False) and self._mute_key_free():
+            items.append("m sound on" if self.sounds.muted else "m mute")
+        items += ["F11 fullscreen", "Esc quit"]
+        return tuple(items)
+
+    def _mute_key_free(self) -> bool:
+        return not (self.keyboard and "m" in self.session.muscles.keys)
 
     def handle(self, event: pygame.event.Event) -> None:
         if event.type == pygame.QUIT:
             self.running = False
+        elif event.type == pygame.VIDEORESIZE and not self.fullscreen:
+            # SDL also reports the size a window opens at, or comes back to from fullscreen: not a change.
+            if (event.w, event.h) != self.windowed_size:
+                self.windowed_size = (event.w, event.h)
+                self.resized = True
         elif self.name_entry is not None and event.type in (pygame.TEXTINPUT, pygame.KEYDOWN):
             self._type_name(event)
         elif event.type == pygame.KEYDOWN:
-            name = key_name(event)
-            if name == "escape":
-                self.running = False
-            elif name == "p" and not self.session.over:
-                self.set_paused(not self.paused)
-            elif name == "f11":
-                self._toggle_fullscreen()
-            elif not self.paused and self.keyboard:
-                self.session.key_event(name, DOWN)
-        elif event.type == pygame.KEYUP and not self.paused and self.keyboard:
+            self._key_down(event)
+        elif event.type == pygame.KEYUP and not self.paused and self.keyboard and self.countdown_left is None:
             self.session.key_event(key_name(event), UP)
-        elif event.type == pygame.WINDOWFOCUSLOST and not self.session.over:
+        elif event.type == pygame.WINDOWFOCUSLOST and not self.finished:
             self.set_paused(True)
+
+    def _key_down(self, event: pygame.event.Event) -> None:
+        name = key_name(event)
+        if name == "escape":
+            self.running = False
+        elif name == "f11":
+            self._toggle_fullscreen()
+        elif self.ended:
+            if self._over_for >= END_KEY_DELAY:
+                self.running = False
+        elif name == "m" and self.sounds is not None and self._mute_key_free():
+            muted = self.sounds.toggle()
+            if self.on_mute is not None:
+                self.on_mute(muted)
+        elif self.countdown_left is not None:
+            self.countdown_left = None  # any other key skips the countdown, and is not game input
+            self._play("go")
+        elif self.keyboard and not self.paused and name in self.session.muscles.keys:
+            self.session.key_event(name, DOWN)
+        elif name == "p":
+            self.set_paused(not self.paused)
+        elif self.replay is not None:
+            self._replay_key(name)
+        elif not self.paused and self.keyboard:
+            self.session.key_event(name, DOWN)
+
+    def _replay_key(self, name: str) -> None:
+        if name in ("+", "=", "up", "[+]", "keypad +"):
+            self.speed = next((s for s in REPLAY_SPEEDS if s > self.speed), self.speed)
+        elif name in ("-", "down", "[-]", "keypad -"):
+            self.speed = next((s for s in reversed(REPLAY_SPEEDS) if s < self.speed), self.speed)
+        elif name == "1":
+            self.speed = 1.0
+        elif name in ("left", "right"):
+            dt = self.session.config.dt
+            skip = round(SKIP_SECONDS / dt) * (1 if name == "right" else -1)
+            self.skip_to(self.session.steps + skip)
+
+    def skip_to(self, step: int) -> None:
+        """Show the replay at ``step``: forward by running on, back by replaying from the start."""
+        assert self.replay is not None
+        step = min(max(step, 0), self.replay.stop_step)
+        if step < self.session.steps:
+            self.session, self.driver = self.replay.start(step)
+            self.hits.clear()
+        else:
+            seek(self.driver, step)  # type: ignore[arg-type]
+        self.trail.clear()
+        self.alpha = 1.0
 
     def _type_name(self, event: pygame.event.Event) -> None:
         if event.type == pygame.TEXTINPUT:
@@ -99,7 +265,10 @@ class GameWindow:
             self.name_entry = self.name_entry[:-1]
         elif name in ("return", "enter") and self.name_entry.strip():
             self.player_name = self.name_entry.strip()
-            self.running = False
+            self.name_entry = None
+            pygame.key.stop_text_input()
+            self._over_for = 0.0
+            self._show_standing(self.player_name)
         elif name == "f11":
             self._toggle_fullscreen()
 
@@ -112,27 +281,97 @@ class GameWindow:
         self.paused = paused
 
     def _toggle_fullscreen(self) -> None:
-        self.fullscreen = not self.fullscreen
-        if self.fullscreen:
-            self.screen = pygame.display.set_mode((0, 0), pygame.FULLSCREEN)
+        self.screen = toggle_fullscreen(self.windowed_size)
+        self.fullscreen = bool(self.screen.get_flags() & pygame.FULLSCREEN)
+
+    def _play(self, name: str) -> None:
+        if self.sounds is not None:
+            self.sounds.play(name)
+
+    def _show_standing(self, name: str | None) -> None:
+        if self.standing_of is not None:
+            self.standing = self.standing_of(name)
+
+    # ------------------------------------------------------------------ frames
+    def _count_down(self, elapsed: float) -> None:
+        self.countdown_left -= max(elapsed, 0.0)
+        if self.countdown_left <= 0.0:
+            self.countdown_left = None
+            self._play("go")
+            return
+        number = math.ceil(self.countdown_left)
+        if number != self._last_count:
+            self._last_count = number
+            self._play("tick")
+
+    def _advance(self, elapsed: float) -> None:
+        session = self.session
+        board = session.rules.board
+        hits, resets, target = board.hits, board.resets, session.rules.target
+        self.alpha = self.driver.advance(min(max(elapsed, 0.0), MAX_FRAME) * self.speed)
+        if board.hits > hits:
+            # A task that keeps no hit times (the lab) still flashes where the target was.
+            self.hits.append((target.x, target.y, board.hit_times[-1] if board.hit_times else session.time))
+            self._play("hit")
+        if board.resets > resets:
+            self._play("reset")
+
+    def _end(self, elapsed: float) -> None:
+        self.alpha = 1.0
+        self._over_for += elapsed
+        if self.ended:
+            return
+        self.ended = True
+        self._over_for = 0.0
+        self._play("end")
+        if self.ask_name and self.player_name is None and self.session.over:
+            self.name_entry = ""
+            pygame.key.start_text_input()
         else:
-            self.screen = pygame.display.set_mode(DEFAULT_SIZE, pygame.RESIZABLE)
+            self._show_standing(None)
+
+    def hud(self) -> Hud:
+        now = self.session.time
+        self.hits = [h for h in self.hits if 0.0 <= now - h[2] < PLUS_ONE_TIME]
+        hud = Hud(mode=self.mode, help=self.help_items(), paused=self.paused,
+                  countdown=None if self.countdown_left is None else math.ceil(self.countdown_left),
+                  name_entry=self.name_entry, standing=self.standing, ended=self.ended,
+                  hits=[(x, y, now - t) for x, y, t in self.hits],
+                  trail=[(x, y) for _, x, y in self.trail])
+        if self.replay is not None:
+            dt = self.session.config.dt
+            hud.progress = (self.session.steps * dt, self.replay.stop_step * dt)
+            hud.speed = self.speed
+        return hud
+
+    def _update_trail(self) -> None:
+        if not self.trail_on:
+            return
+        arm = self.session.config.arm
+        q1, q2 = self.session.interpolated_angles(self.alpha)
+        now = (self.session.steps - 1 + self.alpha) * self.session.config.dt
+        x = arm.l1 * math.cos(q1) + arm.l2 * math.cos(q1 + q2)
+        y = arm.l1 * math.sin(q1) + arm.l2 * math.sin(q1 + q2)
+        if not self.trail or self.trail[-1][0] < now:
+            self.trail.append((now, x, y))
+        while self.trail and self.trail[0][0] < now - TRAIL_SECONDS:
+            self.trail.popleft()
 
     def frame(self, elapsed: float) -> None:
         """Handle pending events, advance physics by ``elapsed`` real seconds, draw."""
         for event in pygame.event.get():
             self.handle(event)
-        if self.paused:
-            elapsed = 0.0
-        if not self.session.over:
-            self.alpha = self.driver.advance(elapsed)
-        else:
-            self.alpha = 1.0
-            self._over_for += elapsed
-            if self.ask_name and self.name_entry is None and self.player_name is None:
-                self.name_entry = ""
-                pygame.key.start_text_input()
-        self.renderer.draw(self.screen, self.session, self.alpha, self.paused, self.name_entry)
+        if self.finished:
+            self._end(elapsed)
+        elif self.countdown_left is not None:
+            self._count_down(0.0 if self.paused else elapsed)
+        elif not self.paused:
+            self._advance(elapsed)
+            if self.finished:
+                self._end(0.0)
+        self._update_trail()
+        self.screen = pygame.display.get_surface() or self.screen
+        self.renderer.draw(self.screen, self.session, self.alpha, self.hud())
         pygame.display.flip()
 
     def run(self, max_frames: int | None = None) -> GameSession:
@@ -147,3 +386,40 @@ class GameWindow:
             if self.fps:
                 limiter.tick(self.fps)
         return self.session
+
+
+def play_window(session: GameSession, settings: Settings, settings_path: Path, *, fullscreen: bool = False,
+                fps: int = 60, driver: RealTimeDriver | None = None, ask_name: bool = False, trail: bool = False,
+                standing: Callable[[str | None], Standing | None] | None = None, mode: str = "PLAY",
+                replay: ReplaySource | None = None, caption: str = CAPTION) -> GameWindow:
+    """Open the window, play until the player quits, close it; returns the window (its session, name).
+
+    ``settings`` (``armgame.ui.settings.Settings``) give the size, palette and mute; a change made in
+    the window (m, a resize) is written back to ``settings_path``, re-read first so that an edit made
+    meanwhile is kept. Sounds play only if the mixer opens.
+    """
+    import sys
+
+    from .sound import Sounds
+
+    def remember(**changes: object) -> None:
+        try:
+            current, _ = load_settings(settings_path)
+            save_settings(current.with_changes(**changes), settings_path)
+        except SettingsError as exc:
+            print(f"armgame: settings not saved: {exc}", file=sys.stderr)
+
+    screen = open_window(settings.size, fullscreen, caption)
+    sounds = Sounds(muted=settings.mute)
+    try:
+        window = GameWindow(session, screen, fps=fps, driver=driver, ask_name=ask_name, mode=mode,
+                            sounds=sounds, trail=trail, palette=settings.palette,
+                            standing=standing, on_mute=lambda muted: remember(mute=muted), replay=replay)
+        window.run()
+        if window.resized:
+            w, h = window.windowed_size
+            remember(size=(max(MIN_SIDE, w), max(MIN_SIDE, h)))
+    finally:
+        sounds.close()
+        pygame.display.quit()
+    return window

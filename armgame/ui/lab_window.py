@@ -17,71 +17,99 @@ import pygame
 from ..game.session import RealTimeDriver
 from ..lab.protocol import target_positions
 from ..lab.session import HOLD, LabSession
+from ..words import plural
 from .frontend import GameWindow
-from .render import BACKGROUND, BAR_BACK, FAINT, MUSCLE_COLOURS, TARGET, GameRenderer, Viewport
+from .render import MIN_TEXT_AT_720, GameRenderer, Hud, Viewport
 
 CAPTION = "armgame lab - reach from home to each target"
-HOME = (70, 110, 200)
-HIT = (40, 150, 70)
+HOME = (0, 114, 178)  # Okabe-Ito blue: told apart from the (vermilion) target by colour-blind players too
+HIT = (0, 128, 90)
 CURSOR = (0, 0, 0)
-RING = (225, 225, 230)
+RING = (205, 210, 218)
 
 
 class LabRenderer(GameRenderer):
     """Draws one frame of a ``LabSession``; text and fonts cached as the game's renderer does."""
 
     def draw(self, screen: pygame.Surface, session: LabSession, alpha: float = 1.0,  # type: ignore[override]
-             paused: bool = False, name: str | None = None) -> None:
+             hud: Hud | None = None) -> None:
+        hud = hud or Hud()
+        p = self.palette
         hx, hy = session.home
         reach = session.protocol.distance
         span = max(0.08, 1.45 * reach)
         view = Viewport.fit(screen.get_size(), (hx - span, hx + span, hy - span, hy + 1.35 * span))
-        screen.fill(BACKGROUND)
+        screen.fill(p.scene)
         for x, y in target_positions(session.protocol, session.home):
             pygame.draw.circle(screen, RING, view.to_screen(x, y), view.length(session.protocol.target_radius), 2)
         home = session.home_target
         holding = session.phase == HOLD and not session.over
-        pygame.draw.circle(screen, HOME, view.to_screen(home.x, home.y), view.length(home.radius), 0 if holding else 2)
+        pygame.draw.circle(screen, HOME, view.to_screen(home.x, home.y), view.length(home.radius), 0 if holding else 3)
         if not holding and not session.over:
             target = session.rules.target
-            pygame.draw.circle(screen, TARGET, view.to_screen(target.x, target.y), view.length(target.radius))
+            pygame.draw.circle(screen, p.target, view.to_screen(target.x, target.y), view.length(target.radius))
         pygame.draw.circle(screen, CURSOR, view.to_screen(*session.cursor), view.length(0.006))
-        self._hud(screen, view, session)
-        if paused:
-            self._banner(screen, view, "Paused", "press P to go on")
+        self._hud(screen, session)
+        if hud.paused and not hud.ended:
+            self._panel(screen, "Paused", "press P to go on")
         elif session.over:
             done = len(session.outcomes)
-            self._banner(screen, view, "Done" if session.finished else "Time is up",
-                         f"{done} trials, {session.result().hits} hits   -   Esc to quit")
+            self._panel(screen, "Done" if session.finished else "Time is up",
+                        f"{plural(done, 'trial')}, {plural(session.result().hits, 'hit')}   -   Esc to quit")
 
-    def _hud(self, screen: pygame.Surface, view: Viewport, session: LabSession) -> None:
-        unit = min(screen.get_width(), screen.get_height()) / 800.0
-        big, small = max(12, round(30 * unit)), max(10, round(20 * unit))
-        x0, y0 = 16 * unit, 12 * unit
+    def _text_heights(self, screen: pygame.Surface) -> tuple[int, int, int]:
+        """Text heights (big, normal, small) for this window: never below the projector minimum."""
+        h = screen.get_height()
+        small = max(MIN_TEXT_AT_720 * h // 720, 14, round(h / 40))
+        return round(small * 1.6), round(small * 1.2), small
+
+    def _panel(self, screen: pygame.Surface, title: str, subtitle: str) -> None:
+        big, normal, _ = self._text_heights(screen)
+        head, sub = self.text(title, big), self.text(subtitle, normal, self.palette.faint)
+        pad = normal
+        panel = pygame.Rect(0, 0, max(head.get_width(), sub.get_width()) + 2 * pad,
+                            head.get_height() + sub.get_height() + 3 * pad)
+        panel.center = screen.get_rect().center
+        pygame.draw.rect(screen, self.palette.panel, panel, border_radius=pad // 2)
+        pygame.draw.rect(screen, self.palette.edge, panel, 2, border_radius=pad // 2)
+        screen.blit(head, head.get_rect(midtop=(panel.centerx, panel.top + pad)))
+        screen.blit(sub, sub.get_rect(midbottom=(panel.centerx, panel.bottom - pad)))
+
+    def _hud(self, screen: pygame.Surface, session: LabSession) -> None:
+        p = self.palette
+        big, normal, small = self._text_heights(screen)
+        margin = small
         plan = session.plan
         total = len(session.plans)
         number = total if plan is None else plan.index + 1
         block = session.block
-        screen.blit(self.text(f"Trial {number} of {total}  -  {block.name}", big), (x0, y0))
-        screen.blit(self.text(block.instruction or " ", small), (x0, y0 + 34 * unit))
+        y = margin
+        title = self.text(f"Trial {number} of {total}  -  {block.name}", big)
+        screen.blit(title, (margin, y))
+        y += title.get_height() + small // 3
+        if block.instruction:
+            screen.blit(self.text(self.fit_text(block.instruction, normal, screen.get_width() - 2 * margin), normal),
+                        (margin, y))
+            y += normal + small // 3
         if session.outcomes:
             last = session.outcomes[-1]
             seconds = (last.end_step - last.go_step) * session.config.dt
-            line, colour = (f"last trial: hit, {seconds:.2f} s", HIT) if last.hit else ("last trial: time out", TARGET)
-            screen.blit(self.text(line, small, colour), (x0, y0 + 58 * unit))
+            line, colour = (f"last trial: hit, {seconds:.2f} s", HIT) if last.hit else ("last trial: time out", p.warn)
+            screen.blit(self.text(line, small, colour), (margin, y))
         keys = self.key_labels
         help_line = f"{keys[0]}/{keys[1]} shoulder   {keys[2]}/{keys[3]} elbow   space home   p pause   esc quit"
-        help_text = self.text(help_line, small, FAINT)
-        screen.blit(help_text, (x0, screen.get_height() - help_text.get_height() - 10 * unit))
-        bar_w, bar_h, gap = 110 * unit, 10 * unit, 5 * unit
-        bx = screen.get_width() - bar_w - 16 * unit
+        help_text = self.text(self.fit_text(help_line, small, screen.get_width() - 2 * margin), small, p.faint)
+        screen.blit(help_text, (margin, screen.get_height() - help_text.get_height() - margin))
+        bar_w, bar_h, gap = 6 * small, small * 2 // 3, small // 2
+        bx = screen.get_width() - bar_w - margin
+        by = screen.get_height() - help_text.get_height() - 2 * margin - 4 * (bar_h + gap)
         for i, a in enumerate(session.muscles.activation):
-            y = y0 + i * (bar_h + gap)
+            row = by + i * (bar_h + gap)
             label = self.text(keys[i], small)
-            screen.blit(label, (bx - label.get_width() - 6 * unit, y - 3 * unit))
-            pygame.draw.rect(screen, BAR_BACK, (bx, y, bar_w, bar_h))
+            screen.blit(label, (bx - label.get_width() - small // 2, row + (bar_h - label.get_height()) // 2))
+            pygame.draw.rect(screen, p.bar_back, (bx, row, bar_w, bar_h))
             if a > 0.002:
-                pygame.draw.rect(screen, MUSCLE_COLOURS[i], (bx, y, max(1.0, bar_w * min(a, 1.0)), bar_h))
+                pygame.draw.rect(screen, p.muscles[i], (bx, row, max(1.0, bar_w * min(a, 1.0)), bar_h))
 
 
 class LabWindow(GameWindow):
@@ -89,6 +117,6 @@ class LabWindow(GameWindow):
 
     def __init__(self, session: LabSession, screen: pygame.Surface, clock: Callable[[], float] = time.perf_counter,
                  fps: int = 60, driver: RealTimeDriver | None = None) -> None:
-        super().__init__(session, screen, clock, fps, driver, ask_name=False)
+        super().__init__(session, screen, clock, fps, driver, ask_name=False, mode="LAB", countdown=False)
         pygame.display.set_caption(CAPTION)
         self.renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))

@@ -1,31 +1,100 @@
-"""Drawing the game with pygame. The only game module that imports pygame.
+"""Drawing the game with pygame: the arm, the target, the HUD and the panels.
 
-The renderer reads a session (and how far between two physics steps the frame falls)
-and draws one frame; it never changes the game. The world's view rectangle is scaled to
-the largest square that fits the window, so any window size or a projector's fullscreen
-shows the same scene.
+The renderer reads a session (and how far between two physics steps the frame falls) and a ``Hud``
+(what the window wants said: the mode, the keys that work, pause, countdown, the end screen) and draws
+one frame; it never changes the game. Every frame is first laid out (``GameRenderer.layout``: where
+each piece of text, each bar and the scene go, for this window size) and then drawn, so tests check
+the layout of every screen at every window size without looking at pixels: every text inside the
+window, no two overlapping, none smaller than a projector can show.
+
+Sizes follow the window: ``unit = min(width, height) / 720``, so the HUD text is 16 to 40 px at 720
+lines and the same proportions on a 4K projector. Landscape windows put the HUD in a sidebar beside a
+square scene, portrait and square ones in bands above and below it, so nothing is ever drawn over the
+arm's workspace except the panels that say the game is paused or over.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import pygame
 
 from ..game.session import GameSession
 from ..words import plural
 
-BACKGROUND = (255, 255, 255)
-LINK = (70, 70, 80)
-JOINT = (30, 30, 35)
-HAND = (0, 0, 0)
-TARGET = (220, 30, 30)
-TEXT = (20, 20, 20)
-FAINT = (120, 120, 120)
-BAR_BACK = (225, 225, 230)
-PANEL = (245, 245, 248)
-MUSCLE_COLOURS = ((40, 110, 200), (40, 160, 120), (200, 120, 30), (150, 60, 170))
+RGB = tuple[int, int, int]
+
+
+@dataclass(frozen=True)
+class Palette:
+    """Colours of one look. Text colours meet WCAG AA (4.5:1) on the surfaces they are drawn on."""
+
+    name: str
+    window: RGB  # behind the HUD
+    scene: RGB  # the arm's plane
+    workspace: RGB  # where the hand can reach
+    edge: RGB  # faint outlines
+    ink: RGB  # text
+    faint: RGB  # help text
+    link: RGB
+    base: RGB  # the shoulder's fixed mount
+    hand: RGB
+    target: RGB
+    flash: RGB
+    trail: RGB
+    warn: RGB  # the clock in its last 10 s
+    bar_back: RGB
+    muscles: tuple[RGB, RGB, RGB, RGB]
+    panel: RGB
+
+
+PALETTES: dict[str, Palette] = {
+    # Okabe & Ito (2008), "Color Universal Design": distinguishable with every common colour-vision
+    # deficiency. Blue/orange for the shoulder pair, bluish green/reddish purple for the elbow pair.
+    "okabe-ito": Palette(
+        "okabe-ito", window=(232, 235, 240), scene=(251, 251, 249), workspace=(240, 243, 248),
+        edge=(200, 205, 214), ink=(22, 26, 34), faint=(70, 76, 88), link=(62, 68, 82), base=(120, 126, 138),
+        hand=(15, 15, 20), target=(213, 94, 0), flash=(240, 228, 66), trail=(86, 180, 233), warn=(176, 58, 0),
+        bar_back=(214, 219, 227), muscles=((0, 114, 178), (230, 159, 0), (0, 158, 115), (204, 121, 167)),
+        panel=(255, 255, 255),
+    ),
+    # The 2012 game's colours (red target, black hand), on the same layout.
+    "classic": Palette(
+        "classic", window=(235, 235, 235), scene=(255, 255, 255), workspace=(246, 246, 246),
+        edge=(205, 205, 205), ink=(20, 20, 20), faint=(80, 80, 80), link=(70, 70, 80), base=(120, 120, 120),
+        hand=(0, 0, 0), target=(220, 30, 30), flash=(255, 200, 0), trail=(120, 160, 220), warn=(180, 0, 0),
+        bar_back=(225, 225, 230), muscles=((40, 110, 200), (40, 160, 120), (200, 120, 30), (150, 60, 170)),
+        panel=(255, 255, 255),
+    ),
+}
+
+#: Smallest text height at 720 lines, in pixels (a projector at the back of a classroom).
+MIN_TEXT_AT_720 = 14
+#: A hit's flash and "+1" last this long; the next target fades in over FADE_IN (seconds of game time).
+FLASH_TIME, PLUS_ONE_TIME, FADE_IN = 0.35, 0.9, 0.3
+WARN_SECONDS = 10.0
+
+
+def relative_luminance(colour: Sequence[int]) -> float:
+    """WCAG 2.1 relative luminance of an sRGB colour."""
+    def channel(c: int) -> float:
+        c = c / 255.0
+        return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+    r, g, b = (channel(c) for c in colour[:3])
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+
+def contrast_ratio(a: Sequence[int], b: Sequence[int]) -> float:
+    la, lb = sorted((relative_luminance(a), relative_luminance(b)), reverse=True)
+    return (la + 0.05) / (lb + 0.05)
+
+
+def font_size_for(height: int) -> int:
+    """pygame's default font renders lines about 0.68 times its nominal size high."""
+    return max(1, round(height / 0.68))
 
 
 @dataclass(frozen=True)
@@ -54,112 +123,465 @@ class Viewport:
         return max(1, round(metres * self.scale))
 
 
-class GameRenderer:
-    """Draws arm, target, HUD and the muscle bars; fonts and text are made once and cached."""
+@dataclass(frozen=True)
+class Standing:
+    """Where a finished game stands in the high-score table (from the command, never read here)."""
 
-    def __init__(self, key_labels: tuple[str, ...], muscle_names: tuple[str, ...]) -> None:
+    rank: int | None  # None: the game was not entered
+    entries: int
+    top: tuple[tuple[int, str, int], ...]  # (rank, name, score), best first
+
+
+@dataclass
+class Hud:
+    """What the window wants shown beyond the game itself."""
+
+    mode: str = "PLAY"
+    help: tuple[str, ...] = ()
+    paused: bool = False
+    countdown: int | None = None  # 3, 2, 1 before the clock starts
+    name_entry: str | None = None  # the name being typed on the end screen
+    standing: Standing | None = None
+    ended: bool = False  # the end screen
+    progress: tuple[float, float] | None = None  # a replay: seconds shown, seconds recorded
+    speed: float | None = None
+    hits: Sequence[tuple[float, float, float]] = ()  # recent hits: x, y (m) and age (s of game time)
+    trail: Sequence[tuple[float, float]] = ()  # hand positions (m), oldest first
+
+
+@dataclass(frozen=True)
+class Label:
+    text: str
+    height: int  # the line height asked for (px); the rect has the font's real one
+    colour: RGB
+    rect: pygame.Rect
+    role: str
+
+
+@dataclass
+class Layout:
+    size: tuple[int, int]
+    scene: pygame.Rect
+    view: Viewport
+    labels: list[Label] = field(default_factory=list)
+    bars: list[tuple[pygame.Rect, int, float]] = field(default_factory=list)  # rect, muscle, activation
+    panels: list[pygame.Rect] = field(default_factory=list)
+    progress: tuple[pygame.Rect, float] | None = None
+    name_box: pygame.Rect | None = None
+
+    @property
+    def unit(self) -> float:
+        return min(self.size) / 720.0
+
+    def boxes(self) -> list[tuple[str, pygame.Rect]]:
+        """Every text and bar rectangle, for the tests' overlap check."""
+        return [(f"{lab.role}: {lab.text}", lab.rect) for lab in self.labels] + \
+            [(f"bar {i}", r) for r, i, _ in self.bars] + \
+            ([("progress", self.progress[0])] if self.progress else [])
+
+
+def clock_text(seconds: float) -> str:
+    """Seconds to a tenth under 100 s (a 60 s game counts 60.0, 59.9, ...), minutes and seconds above."""
+    if seconds < 100:
+        return f"{seconds:4.1f}"
+    whole = math.ceil(seconds)
+    return f"{whole // 60}:{whole % 60:02d}"
+
+
+class GameRenderer:
+    """Lays out and draws frames; fonts, text and the static background are made once and cached."""
+
+    def __init__(self, key_labels: tuple[str, ...], muscle_names: tuple[str, ...],
+                 palette: str | Palette = "okabe-ito") -> None:
         self.key_labels = key_labels
         self.muscle_names = muscle_names
+        self.palette = PALETTES[palette] if isinstance(palette, str) else palette
         self._fonts: dict[int, pygame.font.Font] = {}
-        self._text: dict[tuple[str, int, tuple[int, int, int]], pygame.Surface] = {}
+        self._text: dict[tuple[str, int, RGB], pygame.Surface] = {}
+        self._sizes: dict[tuple[str, int], tuple[int, int]] = {}
+        self._trail_colours: dict[int, list[RGB]] = {}
+        self._backgrounds: dict[tuple, pygame.Surface] = {}
+        self._veils: dict[tuple[int, int], pygame.Surface] = {}
 
-    def _font(self, size: int) -> pygame.font.Font:
-        if size not in self._fonts:
-            self._fonts[size] = pygame.font.Font(None, size)
-        return self._fonts[size]
+    # ------------------------------------------------------------------ text
+    def font(self, height: int) -> pygame.font.Font:
+        """pygame's default font at a line height of about ``height`` px (created once per size)."""
+        if height not in self._fonts:
+            self._fonts[height] = pygame.font.Font(None, font_size_for(height))
+        return self._fonts[height]
 
-    def text(self, string: str, size: int, colour: tuple[int, int, int] = TEXT) -> pygame.Surface:
-        key = (string, size, colour)
+    def text(self, string: str, height: int, colour: RGB | None = None) -> pygame.Surface:
+        colour = self.palette.ink if colour is None else colour
+        key = (string, height, colour)
         surface = self._text.get(key)
         if surface is None:
             if len(self._text) > 512:  # the clock makes new strings every frame
                 self._text.clear()
-            surface = self._text[key] = self._font(size).render(string, True, colour)
+            surface = self._text[key] = self.font(height).render(string, True, colour)
         return surface
 
-    def draw(self, screen: pygame.Surface, session: GameSession, alpha: float = 1.0, paused: bool = False,
-             name: str | None = None) -> None:
-        """One frame; ``name``, when not None, is the player's name being typed on the end screen."""
-        view = Viewport.fit(screen.get_size(), session.config.view)
-        screen.fill(BACKGROUND)
+    def text_size(self, text: str, height: int) -> tuple[int, int]:
+        """``Font.size``, remembered: a layout measures the same strings frame after frame."""
+        key = (text, height)
+        size = self._sizes.get(key)
+        if size is None:
+            if len(self._sizes) > 2048:
+                self._sizes.clear()
+            size = self._sizes[key] = self.font(height).size(text)
+        return size
+
+    def label(self, text: str, height: int, colour: RGB, role: str, **anchor: object) -> Label:
+        w, h = self.text_size(text, height)
+        rect = pygame.Rect(0, 0, w, h)
+        for name, value in anchor.items():
+            setattr(rect, name, value)
+        return Label(text, height, colour, rect, role)
+
+    def fit_text(self, text: str, height: int, width: int) -> str:
+        """``text`` cut with an ellipsis to ``width`` px (a long name in the table)."""
+        if self.text_size(text, height)[0] <= width:
+            return text
+        while text and self.text_size(text + "...", height)[0] > width:
+            text = text[:-1]
+        return text + "..."
+
+    def wrap_items(self, items: Sequence[str], height: int, width: int, gap: int) -> list[str]:
+        """Help items on as few lines as fit ``width``; an item is never split."""
+        sep = " " * 4
+        lines: list[str] = []
+        for item in items:
+            item = self.fit_text(item, height, width)
+            if lines and self.text_size(lines[-1] + sep + item, height)[0] <= width:
+                lines[-1] += sep + item
+            else:
+                lines.append(item)
+        return lines
+
+    # ---------------------------------------------------------------- layout
+    def layout(self, size: tuple[int, int], session: GameSession, hud: Hud | None = None) -> Layout:
+        """Where everything goes in a window of ``size``: pure geometry, nothing drawn."""
+        hud = hud or Hud()
+        w, h = size
+        u = min(w, h) / 720.0
+        pad, gap = max(6, round(16 * u)), max(4, round(8 * u))
+        small = max(12, round(18 * u))
+        normal = max(13, round(22 * u))
+        big = max(18, round(40 * u))
+        p = self.palette
+        landscape = w >= 1.15 * h
+        if landscape:
+            side = min(max(round(w * 0.27), 200), 480, w - round(h * 0.55))
+            hud_area = pygame.Rect(pad, pad, side - 2 * pad, h - 2 * pad)
+            scene = pygame.Rect(side, pad, w - side - pad, h - 2 * pad)
+        else:
+            hud_area = pygame.Rect(pad, pad, w - 2 * pad, h - 2 * pad)
+            scene = pygame.Rect(pad, 0, w - 2 * pad, 0)  # top and height set below, between the bands
+        labels: list[Label] = []
+        bars: list[tuple[pygame.Rect, int, float]] = []
+        board = session.rules.board
+        x0, y = hud_area.left, hud_area.top
+        # The mode, score and clock.
+        # The mode's parts ("REPLAY", the player, the date) share a line where they fit.
+        for line in self.wrap_items(hud.mode.split("   "), normal, hud_area.width, gap):
+            labels.append(self.label(line, normal, p.ink, "mode", topleft=(x0, y)))
+            y = labels[-1].rect.bottom + gap // 2
+        y += gap // 2
+        score = self.label(f"Score {board.score}", big, p.ink, "score", topleft=(x0, y))
+        clock_colour = p.warn if 0 < session.time_left <= WARN_SECONDS else p.ink
+        clock = f"Time {clock_text(session.time_left)}"
+        if landscape:
+            labels.append(score)
+            y = score.rect.bottom + gap
+            labels.append(self.label(clock, big, clock_colour, "clock", topleft=(x0, y)))
+        else:
+            labels.append(score)
+            # Right-aligned, but sized for the widest clock so it never moves as the digits change.
+            widest = self.text_size("Time 00.0", big)[0]
+            labels.append(self.label(clock, big, clock_colour, "clock",
+                                     topleft=(hud_area.right - widest, y)))
+        y = labels[-1].rect.bottom + 2 * gap
+        # The replay's progress and speed.
+        progress = None
+        if hud.progress is not None:
+            shown, total = hud.progress
+            speed = f"   {hud.speed:g}x" if hud.speed is not None else ""
+            text = self.fit_text(f"{clock_text(shown).strip()} of {clock_text(total).strip()} s{speed}", small,
+                                 hud_area.width)
+            labels.append(self.label(text, small, p.ink, "progress", topleft=(x0, y)))
+            y = labels[-1].rect.bottom + gap // 2
+            progress = (pygame.Rect(x0, y, hud_area.width, max(4, round(8 * u))),
+                        min(max(shown / total, 0.0), 1.0) if total > 0 else 1.0)
+            y = progress[0].bottom + 2 * gap
+        # The muscle bars, or the pause panel in their place (the keys are released while paused).
+        block_top = y
+        columns = 1 if landscape else 2
+        col_w = (hud_area.width - (columns - 1) * 2 * pad) // columns
+        bar_h = max(5, round(10 * u))
+        row_h = self.font(small).get_height() + gap // 2 + bar_h + gap
+        block_h = row_h * (4 // columns)
+        if hud.paused and not hud.ended:
+            panel_labels = [self.label("PAUSED", big, p.ink, "pause", topleft=(x0, block_top)),
+                            self.label("p to play on", small, p.faint, "pause", topleft=(x0, 0))]
+            panel_labels[1].rect.top = panel_labels[0].rect.bottom + gap // 2
+            labels += panel_labels
+            block_h = max(block_h, panel_labels[1].rect.bottom - block_top)
+        else:
+            activation = session.muscles.activation
+            for i, (key, name) in enumerate(zip(self.key_labels, self.muscle_names, strict=True)):
+                cx = x0 + (i % columns) * (col_w + 2 * pad)
+                ry = block_top + (i // columns) * row_h
+                label = self.label(self.fit_text(f"{key}  {name}", small, col_w), small, p.ink, "muscle",
+                                   topleft=(cx, ry))
+                labels.append(label)
+                bars.append((pygame.Rect(cx, label.rect.bottom + gap // 2, col_w, bar_h), i,
+                             min(max(activation[i], 0.0), 1.0)))
+        y = block_top + block_h + gap
+        # The help line(s), at the bottom.
+        help_lines = self.wrap_items(hud.help, small, hud_area.width, gap)
+        line_h = self.font(small).get_height()
+        bottom = hud_area.bottom
+        for i, line in enumerate(reversed(help_lines)):
+            anchor = {"bottomleft": (x0, bottom - i * (line_h + gap // 2))} if landscape else \
+                {"midbottom": (w // 2, bottom - i * (line_h + gap // 2))}
+            labels.append(self.label(line, small, p.faint, "help", **anchor))
+        help_top = min((lab.rect.top for lab in labels if lab.role == "help"), default=bottom)
+        if not landscape:
+            scene.top = y
+            scene.height = max(help_top - gap - y, 10)
+        view = Viewport.fit(scene.size, session.config.view)
+        view = Viewport(view.left + scene.left, view.top + scene.top, view.scale, view.world)
+        lay = Layout(size, scene, view, labels, bars, [], progress)
+        self._scene_labels(lay, session, hud, big, normal, small, gap)
+        return lay
+
+    def _scene_labels(self, lay: Layout, session: GameSession, hud: Hud, big: int, normal: int, small: int,
+                      gap: int) -> None:
+        """What is written over the scene: countdown, "+1"s and the end panel."""
+        p = self.palette
+        scene, view = lay.scene, lay.view
+        if hud.countdown is not None and not hud.ended:
+            size = max(big, round(scene.height * 0.2))
+            number = self.label(str(hud.countdown), size, p.ink, "countdown", center=scene.center)
+            hint = self.label("any key starts", normal, p.ink, "countdown",
+                              midtop=(scene.centerx, number.rect.bottom + gap))
+            lay.labels += [number, hint]
+            # On a card of its own: the number must not tangle with the arm drawn behind it.
+            card = number.rect.union(hint.rect).inflate(6 * gap, 3 * gap)
+            lay.panels.append(card.clamp(scene))
+        for x, y, age in hud.hits:
+            if age < PLUS_ONE_TIME:
+                px, py = view.to_screen(x, y)
+                r = view.length(session.config.target_radius)
+                label = self.label("+1", big, p.ink, "effect",
+                                   midleft=(px + r + gap, py - round(age / PLUS_ONE_TIME * 2 * r)))
+                label.rect.clamp_ip(scene)
+                lay.labels.append(label)
+        if hud.ended:
+            self._end_panel(lay, session, hud, big, normal, small, gap)
+
+    def _end_panel(self, lay: Layout, session: GameSession, hud: Hud, big: int, normal: int, small: int,
+                   gap: int) -> None:
+        """The end screen: it covers the whole window, the game being over."""
+        p = self.palette
+        w, h = lay.size
+        # The HUD is hidden under the panel: only the panel's text is laid out.
+        lay.labels = []
+        lay.bars = []
+        lay.progress = None
+        board = session.rules.board
+        lines: list[tuple[str, int, RGB, str]] = [
+            (f"Your score: {board.score}" if hud.mode.startswith("PLAY") else f"Score: {board.score}", big, p.ink,
+             "end"),
+            (f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}", normal, p.ink, "end"),
+        ]
+        if not hud.mode.startswith("PLAY"):  # whose game it was: a bot's, a replay's
+            lines.insert(0, (hud.mode.split("   ")[0], normal, p.ink, "end"))
+        if hud.name_entry is not None:
+            lines.append(("Type your name for the high-score table", normal, p.ink, "end"))
+        standing = hud.standing
+        if hud.name_entry is None and standing is not None:
+            if standing.rank is not None:
+                lines.append((f"Rank {standing.rank} of {standing.entries} in the table", normal, p.ink, "end"))
+            if standing.top:
+                lines.append(("Top 10", normal, p.ink, "end"))
+        margin = max(8, round(24 * lay.unit))
+        panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
+        row_h = self.font(small).get_height() + gap // 2
+        content_h = sum(self.font(s).get_height() + gap for _, s, _, _ in lines)
+        if hud.name_entry is not None:
+            content_h += self.font(normal).get_height() + 3 * gap
+        elif standing is not None:
+            content_h += row_h * len(standing.top)
+        content_h += self.font(small).get_height() + 2 * gap  # the hint
+        panel = pygame.Rect(0, 0, panel_w, min(h - 2 * margin, content_h + 2 * margin))
+        panel.center = (w // 2, h // 2)
+        lay.panels.append(panel)
+        inner = panel.inflate(-2 * margin, -2 * margin)
+        y = inner.top
+        for text, size, colour, role in lines:
+            lab = self.label(self.fit_text(text, size, inner.width), size, colour, role,
+                             midtop=(inner.centerx, y))
+            lay.labels.append(lab)
+            y = lab.rect.bottom + gap
+        if hud.name_entry is not None:
+            box_h = self.font(normal).get_height() + 2 * gap
+            lay.name_box = pygame.Rect(inner.left, y, inner.width, box_h)
+            typed = self.fit_text(hud.name_entry + "|", normal, inner.width - 2 * gap)
+            lay.labels.append(self.label(typed, normal, p.ink, "name",
+                                         midleft=(inner.left + gap, lay.name_box.centery)))
+            y = lay.name_box.bottom + gap
+            hint = "Enter saves   Esc quits without saving"
+        else:
+            if standing is not None:
+                rank_w = self.font(small).size("10.")[0] + gap
+                score_w = self.font(small).size("9999")[0]
+                name_w = inner.width - rank_w - score_w - 2 * gap
+                for rank, name, score in standing.top:
+                    colour = p.warn if rank == standing.rank else p.ink
+                    lay.labels.append(self.label(f"{rank}.", small, colour, "table",
+                                                 topright=(inner.left + rank_w - gap, y)))
+                    lay.labels.append(self.label(self.fit_text(name, small, name_w), small, colour, "table",
+                                                 topleft=(inner.left + rank_w, y)))
+                    lay.labels.append(self.label(str(score), small, colour, "table", topright=(inner.right, y)))
+                    y += row_h
+            hint = "press any key to close"
+        lay.labels.append(self.label(hint, small, p.faint, "end", midtop=(inner.centerx, y + gap)))
+
+    # ------------------------------------------------------------------ drawing
+    def _background(self, lay: Layout, session: GameSession) -> pygame.Surface:
+        """The parts that never move (panels, scene, workspace, the shoulder's base), drawn once per size."""
+        key = (lay.size, lay.scene.topleft, lay.scene.size, self.palette.name)
+        surface = self._backgrounds.get(key)
+        if surface is not None:
+            return surface
+        if len(self._backgrounds) > 8:
+            self._backgrounds.clear()
+        p, view = self.palette, lay.view
+        surface = pygame.Surface(lay.size).convert() if pygame.display.get_surface() else pygame.Surface(lay.size)
+        surface.fill(p.window)
+        radius = max(4, round(12 * lay.unit))
+        pygame.draw.rect(surface, p.scene, lay.scene, border_radius=radius)
+        arm = session.config.arm
+        centre = view.to_screen(0.0, 0.0)
+        clip = surface.get_clip()
+        surface.set_clip(lay.scene)
+        # The reachable workspace: the annulus between |l1 - l2| and l1 + l2 from the shoulder.
+        outer, inner = view.length(arm.l1 + arm.l2), view.length(abs(arm.l1 - arm.l2))
+        pygame.draw.circle(surface, p.workspace, centre, outer)
+        pygame.draw.circle(surface, p.scene, centre, inner)
+        pygame.draw.aacircle(surface, p.edge, centre, outer, max(1, round(lay.unit)))
+        pygame.draw.aacircle(surface, p.edge, centre, inner, max(1, round(lay.unit)))
+        # The shoulder is fixed to the body: a mount, not a joint that moves.
+        mount = view.length(0.07)
+        pygame.draw.rect(surface, p.base, pygame.Rect(centre[0] - mount, centre[1] - mount // 5, 2 * mount,
+                                                      mount // 2), border_radius=max(2, mount // 6))
+        surface.set_clip(clip)
+        self._backgrounds[key] = surface
+        return surface
+
+    def _veil(self, size: tuple[int, int]) -> pygame.Surface:
+        veil = self._veils.get(size)
+        if veil is None:
+            veil = pygame.Surface(size, pygame.SRCALPHA)
+            veil.fill((*self.palette.window, 170))
+            self._veils = {size: veil}
+        return veil
+
+    def draw(self, screen: pygame.Surface, session: GameSession, alpha: float = 1.0, hud: Hud | None = None) -> Layout:
+        """One frame; returns its layout."""
+        hud = hud or Hud()
+        lay = self.layout(screen.get_size(), session, hud)
+        p, view = self.palette, lay.view
+        screen.blit(self._background(lay, session), (0, 0))
         arm = session.config.arm
         q1, q2 = session.interpolated_angles(alpha)
         elbow = (arm.l1 * math.cos(q1), arm.l1 * math.sin(q1))
         hand = (elbow[0] + arm.l2 * math.cos(q1 + q2), elbow[1] + arm.l2 * math.sin(q1 + q2))
-        target = session.rules.target
-        pygame.draw.circle(screen, TARGET, view.to_screen(target.x, target.y), view.length(target.radius))
+        clip = screen.get_clip()
+        screen.set_clip(lay.scene)
+        if len(hud.trail) > 1:
+            self._draw_trail(screen, view, hud.trail)
+        self._draw_target(screen, lay, session, hud)
         if session.rules.arm_visible:
-            shoulder_px, elbow_px, hand_px = (view.to_screen(*p) for p in ((0.0, 0.0), elbow, hand))
-            width = view.length(0.024)
-            pygame.draw.line(screen, LINK, shoulder_px, elbow_px, width)
-            pygame.draw.line(screen, LINK, elbow_px, hand_px, width)
-            for joint in (shoulder_px, elbow_px):
-                pygame.draw.circle(screen, JOINT, joint, view.length(0.016))
-        # The hand is the one thing a player must see, arm hidden or not: larger than the link is wide.
-        pygame.draw.circle(screen, HAND, view.to_screen(*hand), view.length(0.02))
-        self._draw_hud(screen, view, session)
-        if paused:
-            self._banner(screen, view, "Paused", "press P to play on")
-        elif session.over and name is not None:
-            self._name_prompt(screen, view, session.rules.board.score, name)
-        elif session.over:
-            board = session.rules.board
-            self._banner(screen, view, f"Your score: {board.score}",
-                         f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}   -   Esc to quit")
-
-    def _draw_hud(self, screen: pygame.Surface, view: Viewport, session: GameSession) -> None:
-        unit = view.scale / 500.0  # HUD sizes are designed for the 2012 game's 500 px per metre
-        big, small = max(12, round(34 * unit)), max(10, round(20 * unit))
-        x0, y0 = view.left + 16 * unit, view.top + 12 * unit
-        board = session.rules.board
-        screen.blit(self.text(f"Score {board.score}", big), (x0, y0))
-        clock = self.text(f"Time {session.time_left:4.1f}", big)
-        screen.blit(clock, (view.left + view.scale * 1.6 - clock.get_width() - 16 * unit, y0))
-        keys = self.key_labels
-        help_line = (f"{keys[0]}/{keys[1]} shoulder   {keys[2]}/{keys[3]} elbow   space reset (-1)   "
-                     f"tab hide arm   p pause   esc quit")
-        screen.blit(self.text(help_line, small, FAINT), (x0, y0 + 40 * unit))
-        bar_w, bar_h, gap = 150 * unit, 12 * unit, 6 * unit
-        top = y0 + 68 * unit
-        for i, (name, a) in enumerate(zip(self.muscle_names, session.muscles.activation, strict=True)):
-            y = top + i * (bar_h + gap)
-            label = self.text(f"{keys[i]}  {name}", small)
-            screen.blit(label, (x0, y - 2 * unit))
-            bx = x0 + 160 * unit
-            pygame.draw.rect(screen, BAR_BACK, (bx, y, bar_w, bar_h))
+            self._draw_arm(screen, view, elbow, hand)
+        self._draw_hand(screen, view, hand)
+        if hud.paused or hud.ended:
+            screen.blit(self._veil(screen.get_size()), (0, 0))
+            if hud.paused and not hud.ended:  # the veil dims the scene; hand and target stay clear
+                self._draw_target(screen, lay, session, hud)
+                self._draw_hand(screen, view, hand)
+        screen.set_clip(clip)
+        for rect, i, a in lay.bars:
+            pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2)
             if a > 0.002:
-                pygame.draw.rect(screen, MUSCLE_COLOURS[i], (bx, y, max(1.0, bar_w * min(a, 1.0)), bar_h))
+                fill = rect.copy()
+                fill.width = max(rect.height, round(rect.width * a))
+                pygame.draw.rect(screen, p.muscles[i], fill, border_radius=rect.height // 2)
+        if lay.progress is not None:
+            rect, fraction = lay.progress
+            pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2)
+            done = rect.copy()
+            done.width = max(rect.height, round(rect.width * fraction))
+            pygame.draw.rect(screen, p.link, done, border_radius=rect.height // 2)
+        radius = max(4, round(12 * lay.unit))
+        for panel in lay.panels:
+            pygame.draw.rect(screen, p.panel, panel, border_radius=radius)
+            pygame.draw.rect(screen, p.edge, panel, max(1, round(2 * lay.unit)), border_radius=radius)
+        if lay.name_box is not None:
+            pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2)
+            pygame.draw.rect(screen, p.ink, lay.name_box, max(1, round(2 * lay.unit)), border_radius=radius // 2)
+        for label in lay.labels:
+            if label.role == "name":  # changes with every key: not worth caching
+                screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect)
+            else:
+                screen.blit(self.text(label.text, label.height, label.colour), label.rect)
+        return lay
 
-    def _banner(self, screen: pygame.Surface, view: Viewport, title: str, subtitle: str) -> None:
-        unit = view.scale / 500.0
-        head = self.text(title, max(16, round(64 * unit)))
-        sub = self.text(subtitle, max(10, round(26 * unit)), FAINT)
-        cx, cy = screen.get_width() / 2, view.top + view.scale * 0.55
-        panel = pygame.Rect(0, 0, max(head.get_width(), sub.get_width()) + 60 * unit, 130 * unit)
-        panel.center = (round(cx), round(cy))
-        pygame.draw.rect(screen, PANEL, panel, border_radius=round(10 * unit))
-        pygame.draw.rect(screen, FAINT, panel, 2, border_radius=round(10 * unit))
-        screen.blit(head, head.get_rect(center=(cx, cy - 22 * unit)))
-        screen.blit(sub, sub.get_rect(center=(cx, cy + 32 * unit)))
+    def _draw_trail(self, screen: pygame.Surface, view: Viewport, trail: Sequence[tuple[float, float]]) -> None:
+        p = self.palette
+        points = [view.to_screen(x, y) for x, y in trail]
+        n = len(points)
+        colours = self._trail_colours.get(n)
+        if colours is None:
+            # Older segments fade into the scene: the path reads as a motion, newest at the hand.
+            colours = self._trail_colours[n] = [
+                tuple(round(s + (t - s) * i / n) for s, t in zip(p.scene, p.trail, strict=True)) for i in range(n)]
+        width = max(2, view.length(0.008))
+        line = pygame.draw.line
+        for i in range(1, n):
+            line(screen, colours[i], points[i - 1], points[i], width)
 
-    def _name_prompt(self, screen: pygame.Surface, view: Viewport, score: int, name: str) -> None:
-        unit = view.scale / 500.0
-        head = self.text(f"Your score: {score}", max(16, round(64 * unit)))
-        ask = self.text("Type your name for the high-score table", max(10, round(26 * unit)))
-        hint = self.text("Enter to save   -   Esc to quit without saving", max(10, round(22 * unit)), FAINT)
-        font = self._font(max(12, round(40 * unit)))
-        typed = font.render(name + "|", True, TEXT)  # not cached: it changes with every key
-        box_w = max(font.size("M" * 16)[0], typed.get_width()) + 24 * unit
-        cx, cy = screen.get_width() / 2, view.top + view.scale * 0.55
-        panel = pygame.Rect(0, 0, max(head.get_width(), ask.get_width(), box_w) + 60 * unit, 250 * unit)
-        panel.center = (round(cx), round(cy))
-        pygame.draw.rect(screen, PANEL, panel, border_radius=round(10 * unit))
-        pygame.draw.rect(screen, FAINT, panel, 2, border_radius=round(10 * unit))
-        screen.blit(head, head.get_rect(center=(cx, cy - 80 * unit)))
-        screen.blit(ask, ask.get_rect(center=(cx, cy - 28 * unit)))
-        box = pygame.Rect(0, 0, box_w, font.get_height() + 12 * unit)
-        box.center = (round(cx), round(cy + 25 * unit))
-        pygame.draw.rect(screen, BACKGROUND, box, border_radius=round(4 * unit))
-        pygame.draw.rect(screen, TEXT, box, 2, border_radius=round(4 * unit))
-        screen.blit(typed, typed.get_rect(midleft=(box.left + 12 * unit, box.centery)))
-        screen.blit(hint, hint.get_rect(center=(cx, cy + 85 * unit)))
+    def _draw_target(self, screen: pygame.Surface, lay: Layout, session: GameSession, hud: Hud) -> None:
+        """A bullseye (a ring around a dot): a different shape from the hand's solid disc."""
+        p, view = self.palette, lay.view
+        target = session.rules.target
+        centre = view.to_screen(target.x, target.y)
+        r = view.length(target.radius)
+        newest = min((age for _, _, age in hud.hits), default=None)
+        fade = 1.0 if newest is None else min(max(newest / FADE_IN, 0.0), 1.0)
+        colour = tuple(round(s + (t - s) * fade) for s, t in zip(p.scene, p.target, strict=True))
+        pygame.draw.circle(screen, colour, centre, r, max(2, r // 3))
+        pygame.draw.circle(screen, colour, centre, max(2, r // 4))
+        for x, y, age in hud.hits:
+            if age < FLASH_TIME:
+                k = age / FLASH_TIME
+                where = view.to_screen(x, y)
+                pygame.draw.circle(screen, p.flash, where, round(r * (1.0 + 0.8 * k)))
+                pygame.draw.aacircle(screen, p.target, where, round(r * (1.0 + 0.8 * k)), max(2, r // 5))
+
+    def _draw_arm(self, screen: pygame.Surface, view: Viewport, elbow: tuple[float, float],
+                  hand: tuple[float, float]) -> None:
+        p = self.palette
+        shoulder_px, elbow_px, hand_px = (view.to_screen(*pt) for pt in ((0.0, 0.0), elbow, hand))
+        width = view.length(0.024)
+        end = max(1, width // 2)
+        for a, b in ((shoulder_px, elbow_px), (elbow_px, hand_px)):
+            pygame.draw.aaline(screen, p.link, a, b, width)
+        for joint in (shoulder_px, elbow_px):  # rounded ends, and the joints drawn as pins on them
+            pygame.draw.aacircle(screen, p.link, joint, end)
+            pygame.draw.circle(screen, p.scene, joint, max(1, end // 2))
+        pygame.draw.aacircle(screen, p.link, hand_px, end)
+
+    def _draw_hand(self, screen: pygame.Surface, view: Viewport, hand: tuple[float, float]) -> None:
+        # The one thing a player must see, arm hidden or not: a solid disc, larger than the link is wide.
+        pygame.draw.aacircle(screen, self.palette.hand, view.to_screen(*hand), view.length(0.02))

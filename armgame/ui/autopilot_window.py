@@ -1,0 +1,159 @@
+"""The autopilot demo's window: the model and naive bots play the same game side by side.
+
+Each half is a game drawn by the game's own renderer (``GameRenderer``), labelled with its bot, under
+one caption that says what the class is comparing. The halves are laid out from the window's size,
+so the two games and their scores fit a 1280 x 720 or 1366 x 768 projector (on a tall screen one
+above the other); F11 fills the screen.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import pygame
+
+from ..game.bots import BOT_NAMES, Autopilot, make_bot
+from ..game.rules import GameConfig
+from ..game.session import GameSession, RealTimeDriver
+from .display import open_window, toggle_fullscreen
+from .render import PALETTES, GameRenderer, Hud, Label
+
+CAPTION = ("Same targets, same planner. {0}: the bot knows the interaction torques. "
+           "{1}: it drives each joint as if the other did not move.")
+DEFAULT_SIZE = (1280, 720)
+HELP = ("p pause", "r restart", "F11 fullscreen", "Esc quit")
+WHO = {"model": "AUTOPILOT: model", "naive": "AUTOPILOT: naive"}
+
+
+@dataclass
+class Game:
+    name: str
+    session: GameSession
+    driver: RealTimeDriver
+    renderer: GameRenderer
+
+
+class AutopilotWindow:
+    def __init__(self, seed: int, duration: float, screen: pygame.Surface,
+                 clock: Callable[[], float] = time.perf_counter) -> None:
+        self.seed, self.duration = seed, duration
+        self.screen = screen
+        self.clock = clock
+        self.palette = PALETTES["okabe-ito"]
+        self.windowed_size = screen.get_size()
+        self.paused = False
+        self.running = True
+        self.games: list[Game] = []
+        self.restart()
+
+    def restart(self) -> None:
+        self.games = []
+        for name in BOT_NAMES:
+            session = GameSession(GameConfig(seed=self.seed, time_limit=self.duration))
+            driver = RealTimeDriver(Autopilot(session, make_bot(name)))  # type: ignore[arg-type]
+            renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+            self.games.append(Game(name, session, driver, renderer))
+
+    # ---------------------------------------------------------------- layout
+    def layout(self, size: tuple[int, int]) -> tuple[list[Label], list[pygame.Rect], list[Label]]:
+        """The caption and help labels, and each game's area, for a window of ``size``."""
+        w, h = size
+        u = min(w, h) / 720.0
+        pad, gap = max(6, round(12 * u)), max(4, round(6 * u))
+        renderer = self.games[0].renderer
+        caption_h, help_h = max(14, round(22 * u)), max(12, round(18 * u))
+        # Side by side on a wide screen, one above the other on a tall one (where neither would fit beside).
+        caption = CAPTION.format(*(("Top", "Bottom") if h > w else ("Left", "Right")))
+        lines = renderer.wrap_items(re.split(r"(?<=\.) ", caption), caption_h, w - 2 * pad, gap)
+        labels: list[Label] = []
+        y = pad
+        for line in lines:
+            labels.append(renderer.label(line, caption_h, self.palette.ink, "caption", midtop=(w // 2, y)))
+            y = labels[-1].rect.bottom + gap // 2
+        help_label = renderer.label("    ".join(HELP), help_h, self.palette.faint, "help",
+                                    midbottom=(w // 2, h - pad))
+        top, bottom = y + gap, help_label.rect.top - gap
+        if h > w:  # a tall screen: one game above the other, so neither gets narrow
+            half = (bottom - top) // 2
+            areas = [pygame.Rect(0, top + i * half, w, max(half, 10)) for i in range(2)]
+        else:
+            half = w // 2
+            areas = [pygame.Rect(i * half, top, half, max(bottom - top, 10)) for i in range(2)]
+        return labels, areas, [help_label]
+
+    def all_boxes(self, size: tuple[int, int]) -> list[tuple[str, pygame.Rect]]:
+        """Every text and bar rectangle in window coordinates (for the tests)."""
+        labels, areas, footer = self.layout(size)
+        boxes = [(lab.text, lab.rect) for lab in labels + footer]
+        for game, area in zip(self.games, areas, strict=True):
+            lay = game.renderer.layout(area.size, game.session, self.hud(game))
+            boxes += [(name, rect.move(area.topleft)) for name, rect in lay.boxes()]
+        return boxes
+
+    def hud(self, game: Game) -> Hud:
+        return Hud(mode=WHO[game.name], paused=self.paused, ended=game.session.over)
+
+    # ----------------------------------------------------------------- frames
+    def handle(self, event: pygame.event.Event) -> None:
+        if event.type == pygame.QUIT:
+            self.running = False
+        elif event.type == pygame.VIDEORESIZE and not self.screen.get_flags() & pygame.FULLSCREEN:
+            self.windowed_size = (event.w, event.h)
+        elif event.type == pygame.KEYDOWN:
+            key = pygame.key.name(event.key).lower()
+            if key == "escape":
+                self.running = False
+            elif key in ("p", "space"):
+                self.paused = not self.paused
+            elif key == "r":
+                self.restart()
+            elif key == "f11":
+                self.screen = toggle_fullscreen(self.windowed_size)
+
+    def frame(self, elapsed: float) -> None:
+        for event in pygame.event.get():
+            self.handle(event)
+        screen = self.screen = pygame.display.get_surface() or self.screen
+        screen.fill(self.palette.window)
+        labels, areas, footer = self.layout(screen.get_size())
+        for game, area in zip(self.games, areas, strict=True):
+            alpha = game.driver.advance(0.0 if self.paused else elapsed) if not game.session.over else 1.0
+            game.renderer.draw(screen.subsurface(area), game.session, alpha, self.hud(game))
+        renderer = self.games[0].renderer
+        for lab in labels + footer:
+            screen.blit(renderer.text(lab.text, lab.height, lab.colour), lab.rect)
+        end = areas[1].bottomleft if areas[1].left > areas[0].left else areas[1].topright
+        pygame.draw.line(screen, self.palette.edge, areas[1].topleft, end,
+                         max(1, round(2 * min(screen.get_size()) / 720)))
+        pygame.display.flip()
+
+    def hits(self) -> dict[str, int]:
+        return {g.name: g.session.rules.board.hits for g in self.games}
+
+
+def run_window(seed: int, duration: float = 60.0, size: tuple[int, int] | None = None, fullscreen: bool = False,
+               max_frames: int | None = None, screenshot: Path | None = None) -> dict[str, int]:
+    """Two bot games side by side at real time until Esc or close; returns the hits of each bot."""
+    screen = open_window(size, fullscreen, "armgame demo: autopilot, model against naive", DEFAULT_SIZE)
+    window = AutopilotWindow(seed, duration, screen)
+    limiter = pygame.time.Clock()
+    last = window.clock()
+    frames = 0
+    try:
+        while window.running and (max_frames is None or frames < max_frames):
+            now = window.clock()
+            window.frame(now - last)
+            last = now
+            frames += 1
+            if screenshot is not None and window.games[0].session.time >= 20.0:
+                pygame.image.save(window.screen, str(screenshot))
+                screenshot = None
+            limiter.tick(60)
+    finally:
+        result = window.hits()
+        pygame.display.quit()
+    return result

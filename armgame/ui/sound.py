@@ -1,0 +1,62 @@
+"""The game's sounds: optional, and never a reason for the game to stop.
+
+The mixer is started only here, only by a window, and only if it opens: no audio device, no
+driver, a missing or damaged file each leave the game silent, never failing. Headless runs never
+import this module, so they never start the mixer. The sounds are the WAV files in ``assets/``
+(made by ``assets/make_sounds.py``); where they are not installed the game is simply silent.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from pathlib import Path
+
+os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+import pygame
+
+from .display import quiet_stderr
+
+SOUND_NAMES = ("hit", "reset", "tick", "go", "end")
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+
+
+class Sounds:
+    """Plays the named sounds when the mixer is open and sound is on; otherwise does nothing."""
+
+    def __init__(self, muted: bool = False, folder: Path = ASSETS) -> None:
+        self.muted = muted
+        self.sounds: dict[str, pygame.mixer.Sound] = {}
+        self.available = False
+        try:
+            # A short buffer: a hit's sound must come with the hit, not 100 ms after. ALSA prints its
+            # complaints to stderr when there is no sound card: the game is silent, and says nothing.
+            pygame.mixer.pre_init(22050, -16, 1, 512)
+            with quiet_stderr():
+                pygame.mixer.init()
+        except (pygame.error, NotImplementedError):
+            return
+        for name in SOUND_NAMES:
+            path = folder / f"{name}.wav"
+            try:
+                if path.is_file():
+                    self.sounds[name] = pygame.mixer.Sound(str(path))
+            except (pygame.error, OSError):
+                continue
+        self.available = bool(self.sounds)
+
+    def play(self, name: str) -> None:
+        if self.muted:
+            return
+        sound = self.sounds.get(name)
+        if sound is not None:
+            with contextlib.suppress(pygame.error):
+                sound.play()
+
+    def toggle(self) -> bool:
+        self.muted = not self.muted
+        return self.muted
+
+    def close(self) -> None:
+        if pygame.mixer.get_init():
+            pygame.mixer.quit()
