@@ -376,3 +376,23 @@ def test_any_table_round_trips_exactly(tmp_path_factory, rows):
         for name in TRIAL_COLUMNS:
             same = (math.isnan(a[name]) and math.isnan(b[name])) if isinstance(a[name], float) else False
             assert same or a[name] == b[name], name
+
+
+def under_header(cells):
+    return (HEADER + "\n" + ",".join(cells)).encode()
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.one_of(st.binary(max_size=300),
+                 st.lists(st.text(max_size=30), max_size=12).map(under_header),
+                 st.lists(st.sampled_from(["1", "-1", "", "x", "1e999", "nan", '"', "\x00", "true", "é"]),
+                          min_size=11, max_size=11).map(under_header)))
+def test_any_bytes_read_as_a_table_or_one_line_error(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("fuzz") / "t.csv"
+    path.write_bytes(data)
+    try:
+        rows = read_trials_csv(path)
+    except TrialsFileError as exc:
+        assert "\n" not in str(exc) and str(path) in str(exc)
+    else:
+        assert all(list(r) == list(TRIAL_COLUMNS) for r in rows)

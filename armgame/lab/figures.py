@@ -345,8 +345,10 @@ def _after_effect(ax: Any, spans: list[dict[str, Any]], key: str, scale: float) 
                       if math.isfinite(float(r[key])) and r["trial"] not in span["catch"]), None)
         if first is None:
             continue
-        ax.annotate("after-effect", xy=first, xytext=(30, -40 if first[1] > 0 else 40),
-                    textcoords="offset points", fontsize=15, color=CATCH, fontweight="bold",
+        # To the left, at the point's height: the perturbed block's errors lie on the other side of
+        # zero there, so the label sits in empty space rather than on the washout's own points.
+        ax.annotate("after-effect", xy=first, xytext=(-30, 0), textcoords="offset points", ha="right",
+                    va="center", fontsize=15, color=CATCH, fontweight="bold",
                     arrowprops={"arrowstyle": "->", "color": CATCH, "lw": 1.5})
 
 
