@@ -16,12 +16,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     p = subparsers.add_parser(
         "demo",
-        help="classroom demos: pendulum, passive, chaos, interaction, autopilot",
+        help="classroom demos: pendulum, passive, chaos, interaction, planning, autopilot",
         description="Show one of the tutorial's ideas in a window (space pauses, r restarts, the arrow keys or "
         "- and + slow down and speed up, Esc quits), or with --headless --out DIR write NAME.csv and the figure "
         "NAME.png there. Demos: pendulum (the one-joint passive arm from 90 deg), passive (the two-joint passive "
         "arm), chaos (two passive arms 1e-6 rad apart), interaction (a fast minimum-jerk reach and the torques "
-        "it needs, split into each joint's own and interaction torques), autopilot (two bots play the game, one "
+        "it needs, split into each joint's own and interaction torques), planning (one reach as minimum jerk beside "
+        "minimum torque change, computed on the arm's own dynamics), autopilot (two bots play the game, one "
         "knowing the interaction torques and one not; headless it prints their hits on seeds 0 to 9). "
         "Figures need matplotlib: "
         "pip install 'armgame[plot]'.",
@@ -32,7 +33,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=None, metavar="DIR", help="folder for NAME.csv and NAME.png (with --headless)")
     p.add_argument("--no-figures", action="store_true", help="headless: write the CSV only (no matplotlib needed)")
     p.add_argument("--duration", type=float, default=None,
-                   help="headless: seconds to run (default: the demo's, 10 s for pendulum and passive)")
+                   help="headless: seconds to run (default: the demo's, 10 s for pendulum and passive; "
+                   "planning takes none)")
     p.add_argument("--integrator", default="rk4", help=f"fixed-step scheme: {_FIXED_STEP} (default: rk4)")
     p.add_argument("--dt", type=float, default=0.001, help="physics step in seconds (default: 0.001)")
     p.add_argument("--gravity", action="store_true",

@@ -258,4 +258,5 @@ def summary(p: Planning) -> str:
             f"{abs(mtc.max_deviation()) * 100:.2f} cm; peak hand speed "
             f"{jerk.speed.max():.2f} and {mtc.speed.max():.2f} m/s; peak torque shoulder "
             f"{np.abs(jerk.torque[:, 0]).max():.2f} and {np.abs(mtc.torque[:, 0]).max():.2f} N m, elbow "
-            f"{np.abs(jerk.torque[:, 1]).max():.2f} and {np.abs(mtc.torque[:, 1]).max():.2f} N m")
+            f"{np.abs(jerk.torque[:, 1]).max():.2f} and {np.abs(mtc.torque[:, 1]).max():.2f} N m; converged "
+            f"(largest gradient component {p.optimality:.0e} of the cost)")
