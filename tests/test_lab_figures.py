@@ -10,6 +10,7 @@ import pytest
 from lab_synthetic import HOME, protocol, student, targets
 
 from armgame.errors import UserError
+from armgame.lab import figures
 from armgame.lab.figures import blocks_of, class_curve, class_figure, learning_figure, paths_figure
 from armgame.lab.metrics import CLASS_COLUMNS, write_class_csv
 
@@ -149,3 +150,16 @@ def test_nan_measures_are_gaps_not_errors(tmp_path, experiment):
     curve = class_curve([rows, experiment[0]])
     assert curve[21]["n"] == 1 and np.isnan(curve[21]["sem"])
     class_figure(curve, tmp_path / "class.png")
+
+
+def test_trials_numbered_per_block_are_drawn_in_row_order(tmp_path, experiment, monkeypatch):
+    rows = [dict(r) for r in experiment[0]]
+    first = {}
+    for r in rows:  # renumber within each block: 1..16, 1..64, 1..24
+        first.setdefault(r["block"], r["trial"])
+        r["trial"] = r["trial"] - first[r["block"]] + 1
+    drawn = []
+    monkeypatch.setattr(figures, "_shade_blocks", lambda ax, spans: drawn.extend(spans))
+    learning_figure(rows, tmp_path / "per_block.png")
+    assert [(s["first"], s["last"], s["catch"]) for s in drawn] == [(1, 16, []), (17, 80, [30, 46, 62]),
+                                                                    (81, 104, [])]

@@ -332,3 +332,67 @@ def test_reader_refuses_non_regular_big_and_binary_files(tmp_path, monkeypatch):
 
 def test_module_examples():
     assert doctest.testmod(metrics).failed == 0
+
+
+def test_a_clockwise_curl_field_reads_as_clockwise_errors():
+    # The README's sign claim: with F = b [[0, 1], [-1, 0]] v and b > 0 the force turns clockwise
+    # of the velocity, so a point mass servoed along a straight minimum-jerk reach errs clockwise
+    # (negative), whatever the reach direction; b < 0 errs counter-clockwise.
+    def servoed_reach(b, deg):
+        t = np.arange(0.0, 1.0, DT)
+        goal = straight(deg)(progress((t - START) / T))
+        x, v = goal[0].copy(), np.zeros(2)
+        hand = np.empty_like(goal)
+        for i in range(t.size):
+            hand[i] = x
+            force = 60.0 * (goal[i] - x) - 8.0 * v + b * np.array([v[1], -v[0]])
+            v = v + DT * force  # 1 kg; semi-implicit Euler
+            x = x + DT * v
+        return reach_metrics(Reach(t, hand, tuple(HOME), tuple(HOME + D * unit(deg)), GO, True))
+
+    for deg in (0.0, 135.0, -60.0):
+        cw, ccw = servoed_reach(10.0, deg), servoed_reach(-10.0, deg)
+        assert cw.initial_direction_error_deg < -1.0 and cw.max_perpendicular_error_m < -0.002
+        assert ccw.initial_direction_error_deg > 1.0 and ccw.max_perpendicular_error_m > 0.002
+
+
+measure = st.one_of(st.just(float("nan")), st.floats(allow_nan=False, allow_infinity=False))
+text = st.text(st.characters(codec="utf-8", categories=("L", "N", "P", "S", "Zs")), min_size=1, max_size=64).filter(
+    lambda s: s.strip() == s and s.isprintable())
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.fixed_dictionaries({
+    "block": text, "trial": st.integers(0, 1_000_000), "target_deg": st.floats(-1e6, 1e6),
+    "perturbation": text, "reaction_time": measure, "movement_time": measure.map(abs),
+    "peak_speed": measure.map(abs), "initial_direction_error_deg": measure, "max_perpendicular_error_m": measure,
+    "path_length_ratio": measure.map(abs), "hit": st.booleans()}), max_size=5))
+def test_any_table_round_trips_exactly(tmp_path_factory, rows):
+    path = tmp_path_factory.mktemp("round") / "trials.csv"
+    write_trials_csv(path, rows)
+    back = read_trials_csv(path)
+    assert len(back) == len(rows)
+    for a, b in zip(rows, back, strict=True):
+        for name in TRIAL_COLUMNS:
+            same = (math.isnan(a[name]) and math.isnan(b[name])) if isinstance(a[name], float) else False
+            assert same or a[name] == b[name], name
+
+
+def under_header(cells):
+    return (HEADER + "\n" + ",".join(cells)).encode()
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.one_of(st.binary(max_size=300),
+                 st.lists(st.text(max_size=30), max_size=12).map(under_header),
+                 st.lists(st.sampled_from(["1", "-1", "", "x", "1e999", "nan", '"', "\x00", "true", "é"]),
+                          min_size=11, max_size=11).map(under_header)))
+def test_any_bytes_read_as_a_table_or_one_line_error(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp("fuzz") / "t.csv"
+    path.write_bytes(data)
+    try:
+        rows = read_trials_csv(path)
+    except TrialsFileError as exc:
+        assert "\n" not in str(exc) and str(path) in str(exc)
+    else:
+        assert all(list(r) == list(TRIAL_COLUMNS) for r in rows)

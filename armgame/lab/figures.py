@@ -153,10 +153,14 @@ def learning_figure(rows: Sequence[Mapping[str, Any]], path: Path,
 
     The first trials of an unperturbed block that follows a perturbed one are labelled
     "after-effect": there the error flips sign when an internal model of the field was learned.
+    Trials are placed by their ``trial`` number, or in row order when the numbers do not increase.
     """
     label, scale = _measure(metric)
     if not rows:
         raise UserError("no trials to draw")
+    numbers = [r["trial"] for r in rows]
+    if any(b <= a for a, b in itertools.pairwise(numbers)):  # numbered per block, or merged runs: plot in order
+        rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
     fig = _figure()
     ax = fig.add_subplot()
     spans = blocks_of(rows)
@@ -172,12 +176,13 @@ def learning_figure(rows: Sequence[Mapping[str, Any]], path: Path,
     hit = np.array([bool(r["hit"]) for r in rows])
     is_catch = np.isin(trial, list(catch))
     normal = ~is_catch
-    ax.plot(trial[normal & hit], y[normal & hit], "o", color=LINE, ms=6, label="reach, target hit")
+    ms = _marker_size(len(rows))
+    ax.plot(trial[normal & hit], y[normal & hit], "o", color=LINE, ms=ms, label="reach, target hit")
     if (normal & ~hit).any():
-        ax.plot(trial[normal & ~hit], y[normal & ~hit], "o", mfc="white", mec=MISS, mew=1.5, ms=6,
+        ax.plot(trial[normal & ~hit], y[normal & ~hit], "o", mfc="white", mec=MISS, mew=1.5, ms=ms,
                 label="reach, target missed")
     if is_catch.any():
-        ax.plot(trial[is_catch], y[is_catch], "D", color=CATCH, ms=9, label="catch trial")
+        ax.plot(trial[is_catch], y[is_catch], "D", color=CATCH, ms=max(8.0, ms * 1.5), label="catch trial")
     _after_effect(ax, spans, metric, scale)
 
     ax.axhline(0.0, color="black", lw=1.0)
@@ -278,10 +283,11 @@ def class_figure(curve: Sequence[Mapping[str, Any]], path: Path, *,
         inside = (trial >= span["first"]) & (trial <= span["last"]) & ~catch
         ax.fill_between(trial[inside], mean[inside] - band[inside], mean[inside] + band[inside], color=LINE,
                         alpha=0.25, lw=0, label="± 1 s.e.m." if span is spans[0] else None)
-        ax.plot(trial[inside], mean[inside], "-o", color=LINE, ms=4, lw=1.5,
+        ax.plot(trial[inside], mean[inside], "-o", color=LINE, ms=_marker_size(len(curve)) * 0.7, lw=1.5,
                 label="class mean" if span is spans[0] else None)
     if catch.any():
-        ax.errorbar(trial[catch], mean[catch], yerr=band[catch], fmt="D", color=CATCH, ms=9, label="catch trial")
+        ax.errorbar(trial[catch], mean[catch], yerr=band[catch], fmt="D", color=CATCH,
+                    ms=max(8.0, _marker_size(len(curve)) * 1.5), label="catch trial")
     _after_effect(ax, spans, "mean", scale)
     ax.axhline(0.0, color="black", lw=1.0)
     ax.set_ylabel(label)
@@ -310,6 +316,11 @@ def _measure(metric: str) -> tuple[str, float]:
     return MEASURES[metric]
 
 
+def _marker_size(trials: int) -> float:
+    """Points that stay apart: 6 pt up to 100 trials, then smaller, down to 2.5 pt (about 400 trials)."""
+    return max(2.5, min(6.0, 600.0 / max(trials, 1)))
+
+
 def _shade_blocks(ax: Any, spans: list[dict[str, Any]]) -> None:
     unperturbed = spans[0]["perturbation"]
     shown: Counter = Counter()
@@ -334,8 +345,10 @@ def _after_effect(ax: Any, spans: list[dict[str, Any]], key: str, scale: float) 
                       if math.isfinite(float(r[key])) and r["trial"] not in span["catch"]), None)
         if first is None:
             continue
-        ax.annotate("after-effect", xy=first, xytext=(30, -40 if first[1] > 0 else 40),
-                    textcoords="offset points", fontsize=15, color=CATCH, fontweight="bold",
+        # To the left, at the point's height: the perturbed block's errors lie on the other side of
+        # zero there, so the label sits in empty space rather than on the washout's own points.
+        ax.annotate("after-effect", xy=first, xytext=(-30, 0), textcoords="offset points", ha="right",
+                    va="center", fontsize=15, color=CATCH, fontweight="bold",
                     arrowprops={"arrowstyle": "->", "color": CATCH, "lw": 1.5})
 
 
@@ -350,7 +363,10 @@ def _headroom(ax: Any, y: np.ndarray) -> None:
 def _legend_below(fig: Any, ax: Any, handles_from: Any = None) -> None:
     handles, labels = (handles_from or ax).get_legend_handles_labels()
     if handles:
-        fig.legend(handles, labels, loc="outside lower center", ncols=len(handles), frameon=False)
+        legend = fig.legend(handles, labels, loc="outside lower center", ncols=len(handles), frameon=False)
+        for handle in legend.legend_handles:  # one legible size, however small the plotted points
+            if hasattr(handle, "set_markersize"):
+                handle.set_markersize(9)
 
 
 def _save(fig: Any, path: Path) -> None:

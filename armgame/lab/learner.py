@@ -15,9 +15,9 @@ spontaneous recovery (after a brief counter-adaptation, error-clamp trials let t
 decay and the slow one's older adaptation re-emerge). With ``rate_fast = 0`` the fast process never
 moves from zero and the model is a single-rate learner ``x(n+1) = A_s x(n) + B_s e(n)``.
 
-Defaults: A_f = 0.59, A_s = 0.992, B_f = 0.21, B_s = 0.02, the values Smith et al. (2006, PLoS Biol
-4:e179) fitted to their force-field adaptation data (their illustrative simulations use slower
-processes, A_f = 0.92, A_s = 0.996, B_f = 0.03, B_s = 0.004).
+Defaults: A_f = 0.59, A_s = 0.992, B_f = 0.21, B_s = 0.02, the values of Smith et al. (2006, PLoS
+Biol 4:e179) for force-field adaptation, as later model code reuses them (retention per trial: the
+fast process keeps 59% of its state, half-life 1.3 trials; the slow one 99.2%, half-life 86 trials).
 """
 
 from __future__ import annotations

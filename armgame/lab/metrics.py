@@ -5,13 +5,13 @@ scored* (after any visual transform: under a visuomotor rotation the errors are 
 saw). From it ``reach_metrics`` computes the measures of the adaptation literature:
 
 - **speed**: the hand speed from the sampled positions by central differences (one-sided at the
-  record's two ends), ``np.gradient``; exact for a quadratic path, error O(dt^2) otherwise.
+  record's two ends), ``np.gradient`` with the record's uniform step; error O(dt^2).
 - **peak speed** (m/s): the largest sampled speed at or after the go cue.
 - **movement onset**: the last time before the peak at which the speed rises through ``threshold``
   (default 5%) of that reach's peak speed; **movement end**: the first time after the peak at which
   it falls through it. Both are interpolated linearly between samples. The end is the end of the
   *primary* movement: a corrective submovement after the speed has dropped below the threshold is
-  left out, as in the papers, so that path measures describe the planned reach and not the homing in.
+  left out, as is usual, so that path measures describe the planned reach and not the homing in.
   A speed already above the threshold at the first sample puts the onset there; one still above it
   at the last sample puts the end there (a trial cut off mid-movement, for example by a time-out).
 - **reaction time** (s): onset minus the go cue (negative for a movement started before the cue).
@@ -33,9 +33,9 @@ saw). From it ``reach_metrics`` computes the measures of the adaptation literatu
   that stops short from passing for a straighter one.)
 
 A reach with no movement (peak speed below ``min_peak_speed``, default 0.01 m/s) has NaN for every
-measure but its peak speed; a record with fewer than two samples after the go cue, or with a
-non-finite position, has NaN for all of them. ``reach_metrics`` never raises on a trial's content;
-it raises ``ValueError`` only for a malformed ``Reach`` (a programming error).
+measure but its peak speed; a record with fewer than two samples after the go cue, a non-finite
+position or times that do not increase has NaN for all of them. ``reach_metrics`` never raises on
+a trial's content; it raises ``ValueError`` only for a malformed ``Reach`` (a programming error).
 
 The trials table (``TRIAL_COLUMNS``) is CSV: one row per reach, NaN written as an empty field.
 """
