@@ -365,3 +365,35 @@ def test_a_bot_that_does_not_learn_shows_no_after_effect():
     exposure = [perpendicular(session, o) for o in session.outcomes if o.plan.block == 1]
     assert bot.curl_estimate == 0.0
     assert max(abs(w) for w in washout) < 0.006 and np.mean(exposure[-8:]) < -0.015
+
+
+@pytest.mark.parametrize("perturbation", [
+    Perturbation.make("constant", fx=1.0, fy=-0.5), Perturbation.make("spring", stiffness=20.0),
+    Perturbation.make("curl", b=-CURL_B), Perturbation.make("mirror", axis=90.0),
+    Perturbation.make("jointspace", gain=0.25)], ids=lambda p: p.kind)
+def test_every_perturbation_changes_the_reach_it_is_on(perturbation, tmp_path):
+    """The same target and bot with and without each perturbation: the shown path differs on the perturbed
+    trial only, and the run's replay verifies."""
+    p = Protocol("each", (Block("a", 1, Perturbation()), Block("b", 1, perturbation), Block("c", 1, Perturbation())),
+                 targets=1, first_target_deg=30.0, timeout=1.0)
+    session, _ = bot_run(p)
+    null, _ = bot_run(Protocol("each", tuple(Block(n, 1, Perturbation()) for n in "abc"), targets=1,
+                               first_target_deg=30.0, timeout=1.0))
+    for o, n in zip(session.outcomes, null.outcomes, strict=True):
+        apart = max(math.dist(a, b) for a, b in zip(zip(o.xs, o.ys, strict=True), zip(n.xs, n.ys, strict=True),
+                                                    strict=False))
+        assert (apart > 0.005) == (o.plan.block == 1), (o.plan.block, apart)
+        assert o.xs[0] == pytest.approx(session.home[0]) and o.ys[0] == pytest.approx(session.home[1])
+    assert Replay.load(_replay(session, tmp_path)).verify()[0]
+
+
+def test_a_replay_whose_start_posture_is_not_its_protocols_home_is_refused(tmp_path):
+    p = short(Perturbation(), trials=(1, 1, 1), timeout=0.5)
+    session = LabSession(lab_config(p, 1), p)
+    session.play([])
+    path = _replay(session, tmp_path)
+    data = json.loads(path.read_text())
+    data["config"]["start_posture"][0] += 0.01
+    path.write_text(json.dumps(data))
+    with pytest.raises(UserError, match="differs from its protocol's home posture"):
+        Replay.load(path).verify()

@@ -131,6 +131,7 @@ def test_class_curve_merges_verified_students(tmp_path, capsys):
     (["lab", "curl", "--headless", "--bot", "model", "--retention", "0.5", "0.9"], "add --bot adaptive"),
     (["lab", "curl", "--headless", "--bot", "adaptive", "--retention", "0.995", "0.9"], "must forget faster"),
     (["lab", "curl", "--headless", "--bot", "model", "--catch", "80"], "--catch 80: blocks[1].catch_trials"),
+    (["lab", "null", "--headless", "--bot", "model", "--catch", "3"], "has no perturbed block"),
     (["lab", "curl", "--headless", "--bot", "model", "--record", "/no/such/dir/r.json"], "its folder does not exist"),
     (["analyze", "--out", "x.csv"], "no replay given"),
 ])

@@ -1,6 +1,7 @@
 """The lab window under SDL's dummy driver: keys drive the task, the cursor and targets are drawn where the
 session says, and a bot in the window plays the same trials as headless."""
 
+import json
 import os
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
@@ -98,3 +99,32 @@ def test_a_lab_replay_plays_back_in_the_lab_window(screen):
         win.frame(0.25)
         frames += 1
     assert session.trial_records() == recorded.trial_records() and session.state == recorded.state
+
+
+def test_a_person_quitting_early_keeps_a_replay_that_verifies(tmp_path, monkeypatch, capsys):
+    """armgame lab in a window: keys pressed, Esc after a few seconds; the partial run is recorded and
+    verifies, and analyze measures the reaches it finished."""
+    from armgame.cli import main
+
+    def play_a_little(self, max_frames=None):
+        for i in range(200):
+            if i == 40:
+                pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_j))
+            if i == 44:
+                pygame.event.post(pygame.event.Event(pygame.KEYUP, key=pygame.K_j))
+            self.frame(1 / 20)
+        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_ESCAPE))
+        self.frame(1 / 20)
+        assert not self.running
+        return self.session
+
+    monkeypatch.setattr(LabWindow, "run", play_a_little)
+    record = tmp_path / "me.json"
+    assert main(["lab", "curl", "--record", str(record), "--name", "Ann", "--size", "640x480"]) == 0
+    out = capsys.readouterr().out
+    assert "(stopped before the end)" in out and f"replay saved to {record}" in out
+    assert main(["verify", str(record)]) == 0
+    assert "matches: Ann's lab run (curl, keyboard" in capsys.readouterr().out
+    data = json.loads(record.read_text())
+    assert data["driven"] == "keyboard" and [e[1] for e in data["timeline"]] == ["j", "j"]
+    assert len(data["task"]["trials"]) >= 2

@@ -156,3 +156,22 @@ def test_curl_sign_pushes_clockwise_of_the_motion():
     fx, fy = CurlField(2.0).force(0.0, 0.0, 1.0, 0.0, 0.0)
     assert (fx, fy) == (0.0, -2.0)  # moving along +x, pushed toward -y: clockwise
     assert math.isclose(np.dot((fx, fy), (1.0, 0.0)), 0.0)
+
+
+def test_a_time_dependent_field_reads_the_clock():
+    """F(x, v, t): the closures evaluate the field at clock.t, which the caller moves between steps."""
+
+    class Pulse:
+        def force(self, x, y, vx, vy, t):
+            return (2.0, 0.0) if t >= 1.0 else (0.0, 0.0)
+
+    arm = TwoJointArm(GAME_ARM)
+    loads = Loads(hand=Pulse())
+    accel = LoadedArm(arm, loads).component_dynamics().accel
+    state = (0.5, 1.2, 0.1, -0.2)
+    free = arm.forward_dynamics(state[:2], state[2:], (0.0, 0.0))
+    np.testing.assert_allclose(accel(*state, 0.0, 0.0), free, rtol=1e-13)
+    loads.clock.t = 1.5
+    pushed = arm.forward_dynamics(state[:2], state[2:], hand_force_torque(arm, Pulse(), state[:2], state[2:], 1.5))
+    np.testing.assert_allclose(accel(*state, 0.0, 0.0), pushed, rtol=1e-12)
+    assert np.max(np.abs(pushed - free)) > 0.1

@@ -85,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
 
     protocol = load_protocol_argument(args.protocol)
     if args.catch is not None:
+        if all(b.perturbation.kind == "none" for b in protocol.blocks):
+            raise UserError(f"--catch: protocol {protocol.name!r} has no perturbed block to put catch trials in")
         try:
             protocol = with_catch_trials(protocol, args.catch)
         except ValueError as exc:

@@ -11,9 +11,11 @@ as a game is. Only the rules differ, and the physics of perturbed trials:
 3. The arm is put back at home, at rest, with the muscles relaxed (a robot returning the hand),
    and the next trial's hold begins. After the last trial the session is over.
 
-Each trial runs with its block's perturbation (off on a catch trial): a force field through a
-``LoadedArm``'s closures, a visual transform on the shown hand. The shown hand is recorded
-every physics step from the go cue to the trial's end, for the per-reach metrics.
+Each trial's perturbation (its block's; none on a catch trial) is on from its go cue to its end,
+as a robot switches its field on for the movement: a force field through a ``LoadedArm``'s
+closures, a visual transform on the shown hand. So the hold at home is never disturbed (a steady
+force there would keep the go cue from ever coming). The shown hand is recorded every physics
+step from the go cue to the trial's end, for the per-reach metrics.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from .perturbations import Display, display_for, loads_for
 from .protocol import NONE, Perturbation, Protocol, target_positions
 
 HOLD, REACH = "hold", "reach"
+_WENT, _ENDED = 1, 2
 LAB_SCENE = "lab"
 
 
@@ -107,6 +110,8 @@ class LabSession(GameSession):
         super().__init__(config)
         if config.scene != LAB_SCENE:
             raise UserError(f"a lab run's scene is {LAB_SCENE!r}, got {config.scene!r}")
+        if tuple(config.start_posture) != tuple(math.radians(a) for a in protocol.home_posture_deg):
+            raise UserError("the run's start posture differs from its protocol's home posture")
         self.protocol = protocol
         self.home_q = config.start_posture
         self.home = self.hand()
@@ -167,7 +172,7 @@ class LabSession(GameSession):
         if plan is None:
             self.finished = True
             return
-        self._step, self._show = self.physics_for(plan.active)
+        self._step, self._show = self.physics_for(NONE)
         self.phase = HOLD
         self._counter = 0
         self.rules.target = self.home_target
@@ -212,23 +217,26 @@ class LabSession(GameSession):
             hy = l1 * sin(q1) + l2 * sin(s12)
             if show is not None:
                 hx, hy = show(hx, hy, q1, q2)
-            if self._task_step(hx, hy):
-                # The trial ended: the arm goes home at rest, the muscles relax, the next trial's physics apply.
-                q1, q2 = self.home_q
-                w1 = w2 = 0.0
-                previous = (q1, q2, w1, w2)
-                a0 = a1 = a2 = a3 = 0.0
-                step, show = self._step, self._show
-                self.cursor = self.home
-                if self.finished:
-                    break
+            event = self._task_step(hx, hy)
+            if event:
+                step, show = self._step, self._show  # the go cue switched the perturbation on, or the end off
+                if event == _ENDED:
+                    # The arm goes home at rest and the muscles relax.
+                    q1, q2 = self.home_q
+                    w1 = w2 = 0.0
+                    previous = (q1, q2, w1, w2)
+                    a0 = a1 = a2 = a3 = 0.0
+                    self.cursor = self.home
+                    if self.finished:
+                        break
         muscles.activation = [a0, a1, a2, a3]
         self.state = (q1, q2, w1, w2)
         self.previous_state = previous
         return ran
 
-    def _task_step(self, x: float, y: float) -> bool:
-        """The task's rules after a physics step, with the shown hand at (x, y); True when the trial ended."""
+    def _task_step(self, x: float, y: float) -> int:
+        """The task's rules after a physics step, with the shown hand at (x, y): 0, or _WENT at the go cue,
+        or _ENDED at the trial's end."""
         self.cursor = (x, y)
         plan = self.plans[self.trial_index]
         if self.phase == HOLD:
@@ -240,20 +248,22 @@ class LabSession(GameSession):
                 self._counter = 0
                 self._xs, self._ys = [x], [y]
                 self.rules.target = Target(*plan.position, self.protocol.target_radius)
-            return False
+                self._step, self._show = self.physics_for(plan.active)
+                return _WENT
+            return 0
         self._xs.append(x)
         self._ys.append(y)
         self._counter = self._counter + 1 if self.rules.target.contains(x, y) else 0
         hit = self._counter >= self.hold_steps
         if not hit and self.steps - self._go_step < self.timeout_steps:
-            return False
+            return 0
         self.outcomes.append(TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys))
         if hit:
             self.rules.board.hits += 1
             self.rules.board.score += 1
         self.trial_index += 1
         self._enter_trial()
-        return True
+        return _ENDED
 
     def _reset_arm(self) -> None:
         super()._reset_arm()  # the reset key: home, at rest, counted; the trial's clock runs on
