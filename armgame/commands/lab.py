@@ -198,6 +198,7 @@ def _play_in_window(session, bot, args: argparse.Namespace) -> None:
     except pygame.error as exc:
         raise UserError(f"cannot open a window ({exc}); use --headless --bot NAME where there is no display") from None
     try:
-        LabWindow(session, screen, fps=args.fps, driver=driver).run()
+        LabWindow(session, screen, fps=args.fps, driver=driver,
+                  mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}").run()
     finally:
         pygame.display.quit()

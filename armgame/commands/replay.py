@@ -91,7 +91,7 @@ def _watch_lab(replay, args: argparse.Namespace, settings):
                          f"armgame replay - {replay.player or 'a lab run'}, seed {replay.config.seed}")
     try:
         driver = TimelineDriver(session, replay.timeline, replay.steps)
-        LabWindow(session, screen, fps=args.fps, driver=driver).run()
+        LabWindow(session, screen, fps=args.fps, driver=driver, mode=f"REPLAY   {replay.player or 'no name'}").run()
     finally:
         pygame.display.quit()
     return session

@@ -31,6 +31,9 @@ RING = (205, 210, 218)
 class LabRenderer(GameRenderer):
     """Draws one frame of a ``LabSession``; text and fonts cached as the game's renderer does."""
 
+    #: What drives the run: "LAB" (a person at the keys), "AUTOPILOT: NAME" or "REPLAY".
+    mode = "LAB"
+
     def draw(self, screen: pygame.Surface, session: LabSession, alpha: float = 1.0,  # type: ignore[override]
              hud: Hud | None = None) -> None:
         hud = hud or Hud()
@@ -97,7 +100,10 @@ class LabRenderer(GameRenderer):
             line, colour = (f"last trial: hit, {seconds:.2f} s", HIT) if last.hit else ("last trial: time out", p.warn)
             screen.blit(self.text(line, small, colour), (margin, y))
         keys = self.key_labels
-        help_line = f"{keys[0]}/{keys[1]} shoulder   {keys[2]}/{keys[3]} elbow   space home   p pause   esc quit"
+        if self.mode == "LAB":
+            help_line = f"{keys[0]}/{keys[1]} shoulder   {keys[2]}/{keys[3]} elbow   space home   p pause   esc quit"
+        else:  # a bot or a replay drives: the muscle keys do nothing
+            help_line = f"{self.mode}   p pause   esc quit"
         help_text = self.text(self.fit_text(help_line, small, screen.get_width() - 2 * margin), small, p.faint)
         screen.blit(help_text, (margin, screen.get_height() - help_text.get_height() - margin))
         bar_w, bar_h, gap = 6 * small, small * 2 // 3, small // 2
@@ -116,7 +122,9 @@ class LabWindow(GameWindow):
     """The game window's loop (keys, pause, fullscreen, real-time fixed steps) drawing the lab."""
 
     def __init__(self, session: LabSession, screen: pygame.Surface, clock: Callable[[], float] = time.perf_counter,
-                 fps: int = 60, driver: RealTimeDriver | None = None) -> None:
-        super().__init__(session, screen, clock, fps, driver, ask_name=False, mode="LAB", countdown=False)
+                 fps: int = 60, driver: RealTimeDriver | None = None, mode: str = "LAB") -> None:
+        """``mode``: "LAB" for a person at the keys, else what drives it ("AUTOPILOT: adaptive", "REPLAY")."""
+        super().__init__(session, screen, clock, fps, driver, ask_name=False, mode=mode, countdown=False)
         pygame.display.set_caption(CAPTION)
         self.renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+        self.renderer.mode = mode
