@@ -113,8 +113,8 @@ class BatchGameSession:
         self.target_radius = c.target_radius
         self.total_steps = np.array([g.total_steps for g in configs], dtype=np.int64)
         # Rows of the state: q1, q2, w1, w2; rows of the muscle arrays: the four muscles. Rows
-        # are contiguous, so each is one fast array for the step.
-        # Rows 4-5 of ``_xs`` are scratch for the first RK4 stage's accelerations (see _Kernel.rk4).
+        # are contiguous, so each is one fast array for the step. Rows 4-5 of ``_xs`` are scratch
+        # for the first RK4 stage's accelerations (see _Kernel._build).
         self._xs = np.zeros((6, n))
         self._x = self._xs[:4]
         self._act = np.zeros((MuscleSet.COUNT, n))
@@ -274,11 +274,23 @@ class BatchGameSession:
         """Every game not over runs ``steps`` physics steps (or up to its end)."""
         left = int(steps)
         while left > 0:
-            alive = np.flatnonzero(self.steps < self.total_steps)
+            running = self.steps < self.total_steps
+            alive = np.flatnonzero(running)
             if len(alive) == 0:
                 return
             chunk = min(left, int(np.min(self.total_steps[alive] - self.steps[alive])))
-            self._run(None if len(alive) == self.n else alive, chunk)
+            if len(alive) == self.n:
+                self._run(None, chunk)
+            elif 2 * len(alive) >= self.n:
+                # Games over (waiting for a restart, say) ride along, stepped for nothing and put
+                # back: cheaper than gathering the others.
+                idle = np.flatnonzero(~running)
+                kept = self._x[:, idle].copy(), self._act[:, idle].copy(), self._slack[idle].copy()
+                self._slack[idle] = np.inf
+                self._run(None, chunk, running)
+                self._x[:, idle], self._act[:, idle], self._slack[idle] = kept
+            else:
+                self._run(alive, chunk)
             left -= chunk
 
     def _run(self, games: np.ndarray | None, count: int, clocks: np.ndarray | None = None) -> None:
