@@ -632,16 +632,30 @@ class _Kernel:
         config = self.batch.config
         l1, l2, radius = config.arm.l1, config.arm.l2, config.target_radius
         near = _NEAR * radius * radius
+        cos, sin, sqrt = math.cos, math.sin, math.sqrt
         for k in range(count):
             if step():
                 where = np.flatnonzero(self.near_mask)
-                a, b = x[0, where], x[1, where]
-                s12 = a + b
-                dx = l1 * np.cos(a) + l2 * np.cos(s12) - tx[where]
-                dy = l1 * np.sin(a) + l2 * np.sin(s12) - ty[where]
-                d2 = dx * dx + dy * dy
-                slack[where] = np.sqrt(d2) - radius - 1e-9
-                close = where[d2 <= near]
+                if len(where) <= 16:  # the usual few: plain floats cost less than numpy on tiny arrays
+                    angles = x[:2, where].tolist()
+                    gaps, close_list = [], []
+                    for j, a, b, x0, y0 in zip(where.tolist(), angles[0], angles[1], tx[where].tolist(),
+                                               ty[where].tolist(), strict=True):
+                        dx = l1 * cos(a) + l2 * cos(a + b) - x0
+                        dy = l1 * sin(a) + l2 * sin(a + b) - y0
+                        d2 = dx * dx + dy * dy
+                        gaps.append(sqrt(d2) - radius - 1e-9)
+                        if d2 <= near:
+                            close_list.append(j)
+                    slack[where] = gaps
+                    close = np.array(close_list, dtype=np.intp)
+                else:
+                    a, b = x[0, where], x[1, where]
+                    dx = l1 * np.cos(a) + l2 * np.cos(a + b) - tx[where]
+                    dy = l1 * np.sin(a) + l2 * np.sin(a + b) - ty[where]
+                    d2 = dx * dx + dy * dy
+                    slack[where] = np.sqrt(d2) - radius - 1e-9
+                    close = where[d2 <= near]
                 if len(close):
                     yield k, close
 
