@@ -339,6 +339,14 @@ def test_play_many_scripts_prints_one_json_line_each_equal_to_playing_them_alone
         assert json.loads(line) == {"script": str(path), **alone}
 
 
+def test_script_given_twice_adds_up(tmp_path, capsys):
+    from armgame.cli import main
+
+    a, b = write_scripts(tmp_path / "class", 2, seconds=1.0)
+    assert main(["play", "--headless", "--duration", "1", "--script", str(a), "--script", str(b)]) == 0
+    assert [line.split(": ")[0] for line in capsys.readouterr().out.splitlines()] == [str(a), str(b)]
+
+
 def test_a_folder_of_scripts_plays_its_txt_files_in_sorted_order_and_follows_no_link(tmp_path, capsys):
     import json
 

@@ -44,7 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
-    p.add_argument("--script", metavar="FILE", nargs="+",
+    p.add_argument("--script", metavar="FILE", nargs="+", action="extend",
                    help="input timeline, one 'TIME KEY ACTION' a line (headless); several files or a folder of "
                    "*.txt scripts play a whole class in one batch, one result a line")
     p.add_argument("--bot", metavar="NAME", help="an autopilot at the muscle keys: model (knows the interaction "

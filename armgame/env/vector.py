@@ -36,12 +36,11 @@ from .reach import (
 
 #: The most games one vector env holds (about 1 KB of state each).
 MAX_ENVS = 1_000_000
-#: Games per ``BatchGameSession``. A physics step makes a few hundred numpy temporaries the size
-#: of one per-game array; at 8,192 games (64 KB each) glibc gave the top of the heap back to the
-#: kernel after each step and faulted it in again on the next (about 400 page faults a step here),
-#: at 4,096 it did not, and 8,192 envs ran 5-10 % faster per CPU second as two batches of 4,096
-#: (benchmarks/env_speed.py, measured under load). Larger vectors run as several batches.
-GAMES_PER_BATCH = 4096
+#: Games per ``BatchGameSession``: larger vectors run as several batches, whose arrays stay
+#: small enough for the caches. Measured per CPU second under load (benchmarks/env_speed.py's
+#: runner): 8,192 envs as one batch 0.83 M env-steps against 0.79 M as two of 4,096; 32,768
+#: envs as batches of 4,096 or 8,192 0.79-0.84 M against 0.73 M as one batch.
+GAMES_PER_BATCH = 8192
 
 
 class ReachVectorEnv(VectorEnv):
@@ -130,12 +129,12 @@ class ReachVectorEnv(VectorEnv):
     # --------------------------------------------------------------- internals
     def _step_part(self, part: slice, batch: BatchGameSession, actions: np.ndarray, rewards: np.ndarray,
                    truncated: np.ndarray) -> None:
-        # Games that ended at the last step are over, so neither the actions nor the physics
-        # touch them here; they start their next game after the others have stepped.
+        # Games that ended at the last step are over, so neither their actions (the batch ignores
+        # input to a game that is over) nor the physics touch them here; they start their next
+        # game after the others have stepped.
         restart = self._autoreset[part]
-        playing = ~restart
         hits, resets = batch.hits.copy(), batch.resets.copy()  # before the actions: a reset key costs
-        self._apply(batch, actions[part], playing)
+        self._apply(batch, actions[part])
         batch.advance(self.decision_steps)
         rewards[part] = batch.hits - hits
         if self.config.reset_cost:
@@ -169,15 +168,15 @@ class ReachVectorEnv(VectorEnv):
                              f"got shape {pressed.shape}")
         return pressed.astype(bool)
 
-    def _apply(self, batch: BatchGameSession, actions: np.ndarray, playing: np.ndarray) -> None:
+    def _apply(self, batch: BatchGameSession, actions: np.ndarray) -> None:
         if self.settings.continuous:
-            batch.set_levels(actions[:, :4], playing)
+            batch.set_levels(actions[:, :4])
             press = actions[:, 4] >= 0.5 if self._width == 5 else None
         else:
-            batch.set_held(actions[:, :4], playing)
+            batch.set_held(actions[:, :4])
             press = actions[:, 4] if self._width == 5 else None
         if press is not None and press.any():
-            batch.reset_arms(press & playing)
+            batch.reset_arms(press)
 
     def _observations(self) -> np.ndarray:
         obs = np.empty((self.num_envs, 11))
