@@ -64,6 +64,25 @@ def test_the_lab_replay_verifies(curl_run, capsys):
     assert "matches: lab run (curl, bot, seed 10, 120 trials)" in capsys.readouterr().out
 
 
+def test_a_folder_of_replays_verifies_lab_runs_and_games_each_by_their_own_rules(curl_run, tmp_path, capsys):
+    """``verify FOLDER`` batches the standard games; a lab run is compared trial by trial, never as a game."""
+    import shutil
+
+    folder = tmp_path / "mixed"
+    folder.mkdir()
+    shutil.copy(curl_run / "curl.json", folder / "lab.json")
+    assert main(["play", "--headless", "--duration", "2", "--record", str(folder / "game.json")]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(folder)]) == 0
+    out = capsys.readouterr().out
+    assert "lab run (curl" in out and "120 trials" in out and "2 replays, 0 differ" in out
+    data = json.loads((folder / "lab.json").read_text())
+    data["task"]["trials"][5][3] = not data["task"]["trials"][5][3]  # a miss claimed as a hit, or the reverse
+    (folder / "lab.json").write_text(json.dumps(data))
+    assert main(["verify", str(folder)]) == 1
+    assert "1 differ" in capsys.readouterr().out
+
+
 def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path):
     assert main(["analyze", str(curl_run / "curl.json"), "--out", str(tmp_path / "again.csv")]) == 0
     assert (tmp_path / "again.csv").read_bytes() == (curl_run / "run" / "trials.csv").read_bytes()

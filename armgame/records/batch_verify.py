@@ -16,6 +16,7 @@ from pathlib import Path
 from ..game.batch import files_in, replay_many
 from ..game.session import GameResult
 from .replay import Replay, same_outcome
+from .rulesets import ruleset_of
 from .scores import Check, ScoreEntry, ScoreTable
 from .storage import DataFileError
 
@@ -32,10 +33,20 @@ def _chunks(items: Iterable, size: int) -> Iterator[list]:
 
 
 def verify_replays(replays: Sequence[Replay]) -> list[tuple[bool, GameResult]]:
-    """``[replay.verify() for replay in replays]``, recomputed in batches."""
-    results = replay_many([r.config for r in replays], [r.timeline for r in replays],
-                          [r.result.steps for r in replays])
-    return [(same_outcome(got, r.result), got) for r, got in zip(replays, results, strict=True)]
+    """``[replay.verify() for replay in replays]``, the games of ranked rulesets recomputed in batches.
+
+    Only those: their cost is known (the ruleset's steps) and they share a batch by construction.
+    A lab run is compared trial by trial, and a custom game's ``verify`` stops as soon as it scores
+    more than it claims (a rigged configuration could hit a target at every step), so both keep
+    their own ``verify``.
+    """
+    batched = [i for i, r in enumerate(replays) if r.task is None and ruleset_of(r.config) is not None]
+    results = replay_many([replays[i].config for i in batched], [replays[i].timeline for i in batched],
+                          [replays[i].result.steps for i in batched])
+    verdicts: list[tuple[bool, GameResult] | None] = [None] * len(replays)
+    for i, got in zip(batched, results, strict=True):
+        verdicts[i] = (same_outcome(got, replays[i].result), got)
+    return [v if v is not None else r.verify() for r, v in zip(replays, verdicts, strict=True)]
 
 
 def check_entries(table: ScoreTable, entries: Iterable[ScoreEntry]) -> Iterator[tuple[ScoreEntry, Check]]:
