@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..errors import UserError
 from ..physics.integrators import SCHEMES
+from ..records.storage import save_figure
 from .measure import Row
 
 FLOOR = 1e-13  # errors below this are round-off; drawn at the floor so log axes keep them
@@ -49,7 +50,7 @@ def work_precision(rows: Sequence[Row], path: Path) -> None:
     axes[0][-1].legend(fontsize=7, loc="best")
     fig.suptitle("Work-precision: one arm, as the game steps it (dotted: 0.1 mm)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 
@@ -81,5 +82,5 @@ def convergence(rows: Sequence[Row], path: Path) -> None:
     axes[0][-1].legend(fontsize=7, loc="best")
     fig.suptitle("Convergence: error against step, reference slopes 1, 2, 4")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)

@@ -33,11 +33,12 @@ def _figure(width: float, height: float) -> Any:
 
 
 def _save(fig: Any, path: Path) -> Path:
+    from ..records.storage import save_figure
+
     try:
-        fig.savefig(path)
+        return save_figure(fig, path)  # only a regular file, written whole or not at all
     except OSError as exc:
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
-    return path
 
 
 def pendulum_figure(t: NDArray[np.float64], q: NDArray[np.float64], qd: NDArray[np.float64], path: Path) -> Path:

@@ -284,11 +284,13 @@ class ScoreTable:
             found = next((r for r in RULESETS.values() if r.digest == entry.config_sha256), None)
             return found.name if found and found.name == entry.ruleset else CUSTOM
         if entry.replay_sha256 not in self._legacy_rulesets:
-            try:
-                replay = Replay.load(self._replay_file(entry), follow=False)
-                name = ruleset_name(replay.config)
-            except DataFileError:
-                name = CUSTOM
+            if self.cache is not None:  # the check caches what the replay says, its ruleset included
+                name = self.check(entry).ruleset or CUSTOM
+            else:
+                try:
+                    name = ruleset_name(Replay.load(self._replay_file(entry), follow=False).config)
+                except DataFileError:
+                    name = CUSTOM
             self._legacy_rulesets[entry.replay_sha256] = name
         return self._legacy_rulesets[entry.replay_sha256]
 
