@@ -145,7 +145,7 @@ def _keep(session, args: argparse.Namespace) -> None:
     from pathlib import Path
 
     from ..records.replay import Replay
-    from ..records.scores import ScoreTable
+    from ..records.scores import ScoreTable, VerificationCache
     from ..records.storage import check_output_path, user_path
     from .scores import scores_dir
 
@@ -164,7 +164,8 @@ def _keep(session, args: argparse.Namespace) -> None:
     if not replay.complete:
         print("the game was stopped before the end: not entered in the high-score table", file=out)
         return
-    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
+    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr),
+                       cache=VerificationCache())  # read only here: it knows older entries' rulesets
     try:
         entry = table.add(replay)
     except OSError as exc:

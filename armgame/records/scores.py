@@ -284,9 +284,10 @@ class ScoreTable:
             found = next((r for r in RULESETS.values() if r.digest == entry.config_sha256), None)
             return found.name if found and found.name == entry.ruleset else CUSTOM
         if entry.replay_sha256 not in self._legacy_rulesets:
-            if self.cache is not None:  # the check caches what the replay says, its ruleset included
-                name = self.check(entry).ruleset or CUSTOM
-            else:
+            cached = self.cache.get(entry.replay_sha256) if self.cache is not None else None
+            if cached is not None:  # a check already read this replay: its ruleset is known
+                name = cached["claims"]["ruleset"] if cached["claims"] else CUSTOM
+            else:  # read its configuration (no replaying: this serves the end screen too)
                 try:
                     name = ruleset_name(Replay.load(self._replay_file(entry), follow=False).config)
                 except DataFileError:
