@@ -285,7 +285,9 @@ class ScoreTable:
             return found.name if found and found.name == entry.ruleset else CUSTOM
         if entry.replay_sha256 not in self._legacy_rulesets:
             cached = self.cache.get(entry.replay_sha256) if self.cache is not None else None
-            if cached is not None:  # a check already read this replay: its ruleset is known
+            if all((entry.duration, entry.scene) != (r.config.time_limit, r.config.scene) for r in RULESETS.values()):
+                name = CUSTOM  # no ranked ruleset has this length: no need to read the replay
+            elif cached is not None:  # a check already read this replay: its ruleset is known
                 name = cached["claims"]["ruleset"] if cached["claims"] else CUSTOM
             else:  # read its configuration (no replaying: this serves the end screen too)
                 try:
