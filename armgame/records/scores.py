@@ -321,7 +321,8 @@ class ScoreTable:
 
         wait = LOCK_WAIT if wait is None else wait
         try:
-            fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT | _NOFOLLOW | os.O_NONBLOCK, 0o644)
+            # Read-only is enough for flock, so classmates can share a lock file one of them created.
+            fd = os.open(self.lock_path, os.O_RDONLY | os.O_CREAT | _NOFOLLOW | os.O_NONBLOCK, 0o644)
         except OSError as exc:
             raise TableError(f"{self.lock_path}: cannot open the lock: {exc.strerror or exc}") from None
         try:
