@@ -60,11 +60,14 @@ def slide_figure(width: float = SLIDE_INCHES[0], height: float = SLIDE_INCHES[1]
 
 
 def save(fig: Any, path: Path) -> Path:
+    """Write ``fig`` at slide resolution: only to a regular file, whole or not at all (a planted
+    symlink, FIFO or device at ``path`` is refused in one line)."""
+    from .records.storage import save_figure
+
     try:
-        fig.savefig(path, dpi=SLIDE_DPI)
+        return save_figure(fig, path, dpi=SLIDE_DPI)
     except OSError as exc:
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
-    return path
 
 
 def smallest_font_pt(fig: Any) -> float:

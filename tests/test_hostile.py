@@ -232,6 +232,19 @@ def test_scores_replays_each_game_once_then_uses_the_per_user_cache(tmp_path, mo
     assert out.count(" ok") >= 12
 
 
+def test_scores_checks_at_most_top_custom_entries_flagged_or_not(tmp_path, monkeypatch, capsys):
+    table = ScoreTable(tmp_path)
+    for i in range(6):
+        table.add(game(f"c{i}", seed=i, time_limit=0.2))
+    for entry in table.all_entries():  # every custom replay planted broken
+        table.replay_path(entry).write_text("{}")
+    checked = []
+    real = ScoreTable.check
+    monkeypatch.setattr(ScoreTable, "check", lambda self, e: checked.append(e.name) or real(self, e))
+    assert main(["scores", "--scores", str(tmp_path), "--top", "2"]) == 0
+    assert len(checked) == 2 and "2 flagged" in capsys.readouterr().out
+
+
 def test_a_planted_cache_beside_the_table_is_not_trusted(tmp_path, capsys):
     table = ScoreTable(tmp_path)
     entry = table.add(game())

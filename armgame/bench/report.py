@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 from pathlib import Path
@@ -124,11 +125,14 @@ def json_report(result: Result) -> str:
 
 
 def write_csv(rows: list[Row], path: Path) -> None:
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["case", "method", "family", "setting", "dt", "tol", "time_per_sim_s", "rhs_per_sim_s",
-                    "hand_error_m", "energy_drift", "blew_up", "note"])
-        for r in rows:
-            w.writerow([r.case, r.method, r.family, r.setting, "" if r.dt is None else repr(r.dt),
-                        "" if r.tol is None else repr(r.tol), repr(r.time_per_sim_s), repr(r.rhs_per_sim_s),
-                        repr(r.hand_error), repr(r.energy_drift), int(r.blew_up), r.note])
+    from ..records.storage import atomic_write_bytes
+
+    f = io.StringIO(newline="")
+    w = csv.writer(f)
+    w.writerow(["case", "method", "family", "setting", "dt", "tol", "time_per_sim_s", "rhs_per_sim_s",
+                "hand_error_m", "energy_drift", "blew_up", "note"])
+    for r in rows:
+        w.writerow([r.case, r.method, r.family, r.setting, "" if r.dt is None else repr(r.dt),
+                    "" if r.tol is None else repr(r.tol), repr(r.time_per_sim_s), repr(r.rhs_per_sim_s),
+                    repr(r.hand_error), repr(r.energy_drift), int(r.blew_up), r.note])
+    atomic_write_bytes(Path(path), f.getvalue().encode("utf-8"), "CSV")  # only a regular file, whole

@@ -148,6 +148,8 @@ def _play_class(args: argparse.Namespace) -> int:
 
 def _check_score_options(args: argparse.Namespace) -> None:
     """Refuse a bad --name, --record, --script or --scores before the game, not after a minute of play."""
+    import sys
+
     from ..records.replay import check_name
     from ..records.storage import check_output_path, check_writable_folder, user_path
     from .scores import scores_dir
@@ -160,8 +162,13 @@ def _check_score_options(args: argparse.Namespace) -> None:
     args.script_path = user_path(args.script, "--script") if args.script is not None else None
     if args.record is not None:
         check_output_path(user_path(args.record, "--record"), "replay")
-    if args.name is not None or not args.headless:  # a game that may enter the table
+    if args.name is not None:  # a game that will enter the table
         check_writable_folder(scores_dir(args), "--scores")
+    elif not args.headless:  # the window may ask for a name: say now if it could not be saved
+        try:
+            check_writable_folder(scores_dir(args), "--scores")
+        except UserError as exc:
+            print(f"armgame play: note: scores cannot be saved: {exc}", file=sys.stderr)
 
 
 def _keep(session, args: argparse.Namespace):
@@ -172,7 +179,7 @@ def _keep(session, args: argparse.Namespace):
     from pathlib import Path
 
     from ..records.replay import Replay
-    from ..records.scores import ScoreTable
+    from ..records.scores import ScoreTable, VerificationCache
     from ..records.storage import check_output_path, user_path
     from .scores import scores_dir
 
@@ -191,7 +198,8 @@ def _keep(session, args: argparse.Namespace):
     if not replay.complete:
         print("the game was stopped before the end: not entered in the high-score table", file=out)
         return
-    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
+    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr),
+                       cache=VerificationCache())  # read only here: it knows older entries' rulesets
     try:
         entry = table.add(replay)
     except OSError as exc:

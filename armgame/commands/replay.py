@@ -28,12 +28,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     import json
-    from pathlib import Path
 
     from ..errors import UserError
     from ..records.replay import Replay
+    from ..records.storage import user_path
 
-    replay = Replay.load(Path(args.file))
+    replay = Replay.load(user_path(args.file, "FILE"))
     if args.headless:
         result = replay.replay()
         played = result.steps

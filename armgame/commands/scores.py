@@ -72,10 +72,16 @@ def run(args: argparse.Namespace) -> int:
     limit = None if args.all else args.top
     seen: set[str] = set()
     ranked, custom, flagged = [], [], []
-    for e in entries:  # best first: each kind fills up to --top, flagged entries are listed apart
-        kind = ranked if table.ruleset(e) in RULESETS else custom
-        if limit is not None and len(kind) >= limit:
+    custom_checked = 0
+    # Best first. Ranked games: checked until --top of them pass (each costs exactly its ruleset,
+    # 15,000 steps, once per user thanks to the cache). Custom games cost up to MAX_GAME_STEPS each, so
+    # at most --top of them are checked, flagged ones included: planted entries cannot keep it busy.
+    for e in entries:
+        is_ranked = table.ruleset(e) in RULESETS
+        kind = ranked if is_ranked else custom
+        if limit is not None and (len(ranked) if is_ranked else custom_checked) >= limit:
             continue
+        custom_checked += not is_ranked
         if e.replay_sha256 in seen:
             flagged.append((e, _check("DUPLICATE", "the same replay is entered more than once")))
             continue

@@ -53,9 +53,11 @@ def run_headless(out: Path | None, duration: float | None) -> str:
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         path = out / "autopilot.csv"
+        from ..records.storage import atomic_write_bytes
+
         try:
-            path.write_text("seed,duration,model_hits,naive_hits\n" + "".join(
-                f"{r.seed},{duration:g},{r.hits['model']},{r.hits['naive']}\n" for r in rows), encoding="utf-8")
+            atomic_write_bytes(path, ("seed,duration,model_hits,naive_hits\n" + "".join(
+                f"{r.seed},{duration:g},{r.hits['model']},{r.hits['naive']}\n" for r in rows)).encode(), "CSV")
         except OSError as exc:
             raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
         text += f"\nwrote {path}"

@@ -155,6 +155,25 @@ class GameSession:
     def advance(self, n: int) -> int:
         """Run up to ``n`` physics steps (fewer if the game ends); returns how many ran.
 
+        A state that goes non-finite (a configuration whose physics blows up) raises
+        ``NonFiniteStateError`` in one line. Checked once per call, not per step, so the hot
+        loop in ``_advance`` is untouched.
+        """
+        start = self.steps
+        try:
+            ran = self._advance(n)
+        except (ValueError, OverflowError, ZeroDivisionError):  # math.cos(inf) on the way to the hand
+            ran = -1
+        if ran < 0 or not math.isfinite(self.state[0] + self.state[1] + self.state[2] + self.state[3]):
+            dt = self.config.dt
+            raise NonFiniteStateError(f"the arm's state became non-finite between t = {start * dt:g} and "
+                                      f"{(start + n) * dt:g} s: this game's physics blows up "
+                                      f"({self.config.integrator}, dt {dt:g} s)")
+        return ran
+
+    def _advance(self, n: int) -> int:
+        """Run up to ``n`` physics steps (fewer if the game ends); returns how many ran.
+
         This is the hot loop of every game, so the muscle update (exactly
         ``MuscleSet.step``, unrolled for the four muscles), the torque and the hit test are
         written out here with local names rather than called.
@@ -178,29 +197,22 @@ class GameSession:
         q1, q2, w1, w2 = self.state
         previous = self.state
         start = self.steps
-        k = 0
-        try:  # free in CPython 3.11+ when nothing is raised; math.cos(inf) raises ValueError
-            for k in range(n):
-                t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
-                t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
-                a0 += (g0 - a0) * r0
-                a1 += (g1 - a1) * r1
-                a2 += (g2 - a2) * r2
-                a3 += (g3 - a3) * r3
-                previous = (q1, q2, w1, w2)
-                q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
-                s12 = q1 + q2
-                hx = l1 * cos(q1) + l2 * cos(s12)
-                hy = l1 * sin(q1) + l2 * sin(s12)
-                if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
-                    rules.hand_moved(hx, hy, (start + k + 1) * dt)
-                    target = rules.target
-                    tx, ty, rr = target.x, target.y, target.radius * target.radius
-        except (ValueError, OverflowError, ZeroDivisionError):
-            q1 = math.nan
-        if not math.isfinite(q1 + q2 + w1 + w2):  # once per call, not per step: the hot loop stays as it was
-            raise NonFiniteStateError(f"the arm's state became non-finite by t = {(start + k + 1) * dt:g} s: "
-                                 f"this game's physics blows up ({self.config.integrator}, dt {dt:g} s)")
+        for k in range(n):
+            t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
+            t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
+            a0 += (g0 - a0) * r0
+            a1 += (g1 - a1) * r1
+            a2 += (g2 - a2) * r2
+            a3 += (g3 - a3) * r3
+            previous = (q1, q2, w1, w2)
+            q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
+            s12 = q1 + q2
+            hx = l1 * cos(q1) + l2 * cos(s12)
+            hy = l1 * sin(q1) + l2 * sin(s12)
+            if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
+                rules.hand_moved(hx, hy, (start + k + 1) * dt)
+                target = rules.target
+                tx, ty, rr = target.x, target.y, target.radius * target.radius
         muscles.activation = [a0, a1, a2, a3]
         self.steps = start + n
         self.state = (q1, q2, w1, w2)

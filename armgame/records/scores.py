@@ -285,11 +285,16 @@ class ScoreTable:
             found = next((r for r in RULESETS.values() if r.digest == entry.config_sha256), None)
             return found.name if found and found.name == entry.ruleset else CUSTOM
         if entry.replay_sha256 not in self._legacy_rulesets:
-            try:
-                replay = Replay.load(self._replay_file(entry), follow=False)
-                name = ruleset_name(replay.config)
-            except DataFileError:
-                name = CUSTOM
+            cached = self.cache.get(entry.replay_sha256) if self.cache is not None else None
+            if all((entry.duration, entry.scene) != (r.config.time_limit, r.config.scene) for r in RULESETS.values()):
+                name = CUSTOM  # no ranked ruleset has this length: no need to read the replay
+            elif cached is not None:  # a check already read this replay: its ruleset is known
+                name = cached["claims"]["ruleset"] if cached["claims"] else CUSTOM
+            else:  # read its configuration (no replaying: this serves the end screen too)
+                try:
+                    name = ruleset_name(Replay.load(self._replay_file(entry), follow=False).config)
+                except DataFileError:
+                    name = CUSTOM
             self._legacy_rulesets[entry.replay_sha256] = name
         return self._legacy_rulesets[entry.replay_sha256]
 
@@ -317,7 +322,8 @@ class ScoreTable:
 
         wait = LOCK_WAIT if wait is None else wait
         try:
-            fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT | _NOFOLLOW | os.O_NONBLOCK, 0o644)
+            # Read-only is enough for flock, so classmates can share a lock file one of them created.
+            fd = os.open(self.lock_path, os.O_RDONLY | os.O_CREAT | _NOFOLLOW | os.O_NONBLOCK, 0o644)
         except OSError as exc:
             raise TableError(f"{self.lock_path}: cannot open the lock: {exc.strerror or exc}") from None
         try:

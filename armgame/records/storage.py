@@ -163,6 +163,14 @@ def atomic_write_bytes(path: Path, data: bytes, what: str = "file") -> None:
         f.write(data)
 
 
+def save_figure(fig: object, path: Path, **options: object) -> Path:
+    """A matplotlib figure saved through ``atomic_writer`` (the format from the file's suffix)."""
+    path = Path(path)
+    with atomic_writer(path, "figure") as f:
+        fig.savefig(f, format=path.suffix.lstrip(".").lower() or "png", **options)  # type: ignore[attr-defined]
+    return path
+
+
 def copy_aside(source_fd: int, target: Path) -> None:
     """Copy an open file's bytes to a new file ``target`` (created exclusively), fsynced."""
     fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666 & ~_UMASK)
