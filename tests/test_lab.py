@@ -397,3 +397,15 @@ def test_a_replay_whose_start_posture_is_not_its_protocols_home_is_refused(tmp_p
     path.write_text(json.dumps(data))
     with pytest.raises(UserError, match="differs from its protocol's home posture"):
         Replay.load(path).verify()
+
+
+def test_a_lab_run_whose_state_goes_non_finite_stops_in_one_line():
+    """The lab's loop runs inside GameSession.advance, so a blow-up is caught as in the game."""
+    from armgame.game.session import NonFiniteStateError
+
+    p = short(Perturbation())
+    session = LabSession(lab_config(p, 1), p)
+    session.advance(10)
+    session._step = lambda q1, q2, w1, w2, t1, t2, dt: (q1, q2, math.inf, w2)  # a physics that blows up
+    with pytest.raises(NonFiniteStateError, match="non-finite"):
+        session.advance(10)

@@ -183,8 +183,8 @@ class LabSession(GameSession):
             return x, y
         return self._show(x, y, self.state[0], self.state[1])
 
-    def advance(self, n: int) -> int:
-        """Run up to ``n`` physics steps (fewer if the run ends); returns how many ran."""
+    def _advance(self, n: int) -> int:
+        """The task's hot loop: ``GameSession.advance`` runs it and stops a state gone non-finite."""
         n = min(n, self.total_steps - self.steps)
         if n <= 0 or self.finished:
             return 0
