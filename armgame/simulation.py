@@ -72,7 +72,8 @@ class RunPlan:
         return self.rows * SIMULATE_ROW_BYTES
 
     def describe(self) -> str:
-        return (f"{self.steps:,} steps, {self.rows:,} rows, about {_mib(self.csv_bytes)} of CSV "
+        return (f"{self.steps:,} steps, {self.rows:,} rows, about {_mib(self.csv_bytes)} of CSV and "
+                f"{_mib(_CHUNK_ROWS * 20 * 8)} of memory, rows being streamed "
                 f"(budget: {MAX_SIMULATE_STEPS:,} steps, {MAX_SIMULATE_ROWS:,} rows)")
 
 
@@ -108,7 +109,7 @@ def plan_run(scene: Scene, integrator: str, dt: float, duration: float | None = 
     plan = RunPlan(steps, every, steps // every + 1)
     # dop853 takes its own steps: its cost is bounded by DOP853_MAX_EVALS instead of the step budget.
     if (plan.steps > MAX_SIMULATE_STEPS and integrator != "dop853") or plan.rows > MAX_SIMULATE_ROWS:
-        raise UserError(f"the run is too large: {plan.describe()}; raise --dt or --sample-rate's spacing, or "
+        raise UserError(f"the run is too large: {plan.describe()}; raise --dt, lower --sample-rate or "
                         f"shorten --duration")
     return plan, duration, state0  # type: ignore[return-value]
 

@@ -186,6 +186,8 @@ def test_a_truncated_table_is_kept_aside_and_its_valid_entries_recovered(tmp_pat
     dict(seed=2**70),
     dict(date="yesterday"),
     dict(date="2025-03-01T10:00:00"),
+    dict(date="9999-12-31T23:59:59-23:59"),
+    dict(date="0001-01-01T00:00:00+23:59"),
     dict(replay="../../../etc/passwd"),
     dict(replay="/etc/passwd.json"),
     dict(replay_sha256="abc"),

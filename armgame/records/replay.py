@@ -76,6 +76,8 @@ def check_date(name: str, value: object) -> str:
         raise ValueError(f"{name} must be an ISO 8601 date and time, got {value!r}") from None
     if when.tzinfo is None:
         raise ValueError(f"{name} must carry its time zone, got {value!r}")
+    if not 1970 <= when.year <= 9000:  # far from datetime's ends, so any time zone conversion works
+        raise ValueError(f"{name} must be from 1970 to 9000, got {value!r}")
     return value
 
 

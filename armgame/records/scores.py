@@ -603,12 +603,17 @@ def _judged(replay: Replay, ok: bool, recomputed: GameResult) -> dict[str, objec
 
 # ------------------------------------------------------------------ the verification cache
 
-def default_cache_dir() -> Path:
+def default_cache_dir() -> Path | None:
     """``$ARMGAME_CACHE``, else ``$XDG_CACHE_HOME/armgame`` (``~/.cache/armgame``): written only by its user."""
     env = os.environ.get(CACHE_ENV)
     if env:
         return user_path(env, f"${CACHE_ENV}")
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    base = os.environ.get("XDG_CACHE_HOME")
+    if not base:
+        try:
+            base = str(Path.home() / ".cache")
+        except RuntimeError:  # no home folder at all: no cache (a shared temporary folder could be planted)
+            return None
     return Path(base) / "armgame"
 
 
@@ -626,8 +631,9 @@ class VerificationCache:
 
     def __init__(self, folder: Path | None = None) -> None:
         self.folder = Path(folder) if folder is not None else default_cache_dir()
-        self.path = self.folder / f"verified-{__version__}.json"
-        self._items: dict[str, dict] | None = None
+        self.path = self.folder / f"verified-{__version__}.json" if self.folder is not None else None
+        #: Without a folder the cache lives only as long as the command.
+        self._items: dict[str, dict] | None = None if self.path is not None else {}
         self._new: dict[str, dict] = {}
 
     def _load(self) -> dict[str, dict]:
@@ -649,7 +655,7 @@ class VerificationCache:
         self._new[digest] = verdict
 
     def save(self) -> None:
-        if not self._new:
+        if not self._new or self.folder is None or self.path is None:
             return
         items = {**self._load(), **self._new}
         if len(items) > self.MAX_ITEMS:

@@ -100,7 +100,10 @@ def check_output_path(path: Path, what: str = "file") -> Path:
         raise DataFileError(f"{show_path(path)}: is {_kind(st.st_mode)}; the {what} is written only to a regular file")
     folder = path.parent
     if not folder.is_dir():
-        raise DataFileError(f"{show_path(path)}: cannot write the {what}: folder {folder} does not exist")
+        raise DataFileError(f"{show_path(path)}: cannot write the {what}: folder {show_path(folder)} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):  # known before a game or a run, not after it
+        raise DataFileError(f"{show_path(path)}: cannot write the {what}: folder {show_path(folder)} is not "
+                            f"writable by you")
     return path
 
 
@@ -113,9 +116,9 @@ def check_writable_folder(folder: Path, what: str = "folder") -> None:
             break
         probe = probe.parent
     if not probe.is_dir():
-        raise DataFileError(f"{what} {folder}: {probe} is not a folder")
+        raise DataFileError(f"{what} {show_path(folder)}: {show_path(probe)} is not a folder")
     if not os.access(probe, os.W_OK | os.X_OK):
-        raise DataFileError(f"{what} {folder}: {probe} cannot be written by you")
+        raise DataFileError(f"{what} {show_path(folder)}: {show_path(probe)} cannot be written by you")
 
 
 def _temporary(folder: Path, name: str) -> tuple[int, Path]:
