@@ -289,6 +289,7 @@ def test_a_game_that_reaches_the_event_limit_stops_there_and_replays(tmp_path, m
     (["--duration", "1e7"], "too large"),
     (["--sample-rate", "1e9", "--dt", "1e-6", "--duration", "100"], "too large"),
     (["--dt", "10", "--duration", "100"], "blew up"),
+    (["--dt", "10"], "blew up"),  # the case: one step, a finite state moving at 1e18 rad/s
     (["--initial=1e308,1e308,1e308,1e308", "--integrator", "dop853"], "--initial"),
     (["--initial=700,0,1e6,0", "--integrator", "dop853"], "--initial"),
 ])

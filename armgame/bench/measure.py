@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..physics.defaults import BLOWUP_SPEED
 from ..physics.integrators import SCHEMES
 from ..physics.reference import reference_trajectory
 from ..physics.twojoint import ComponentDynamics, TwoJointArm
@@ -41,8 +42,6 @@ ERROR_WINDOW = 2.0  # s
 ENERGY_WINDOW = 60.0  # s
 QUICK_ENERGY_WINDOW = 10.0  # s: --quick must finish in under 30 s
 ENERGY_SAMPLE = 0.05  # s between energy samples
-#: Far beyond anything these cases reach (the propeller peaks near 40 rad/s): a run past it has blown up.
-BLOWUP_SPEED = 1e4  # rad/s
 
 
 @dataclass

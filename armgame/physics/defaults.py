@@ -24,3 +24,7 @@ GAME_INTEGRATOR = "rk4"
 GAME_DT = 1.0 / 250.0
 SIMULATE_INTEGRATOR = "rk4"
 SIMULATE_DT = 1.0 / 4000.0
+
+#: A joint faster than this has blown up: no scene, game or demo comes near it (the propeller peaks
+#: near 70 rad/s, ``simulate --initial`` allows 628). The benchmark and ``simulate`` judge by it.
+BLOWUP_SPEED = 1e4  # rad/s
