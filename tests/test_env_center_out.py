@@ -104,6 +104,19 @@ def test_the_model_bot_through_the_env_is_the_headless_lab_run():
     assert total == pytest.approx(120 - 0.1 * session.steps * session.config.dt, abs=1e-6)
 
 
+@pytest.mark.parametrize("perturbation", [Perturbation.make("curl", b=2.0), Perturbation.make("rotation", angle=30.0)])
+def test_the_adaptive_bot_learns_through_the_env_as_it_does_headless(perturbation):
+    protocol = Protocol("short", (Block("baseline", 4), Block("exposure", 8, perturbation), Block("washout", 4)))
+    headless = LabSession(lab_config(protocol, 3), protocol)
+    Autopilot(headless, make_lab_bot("adaptive")).play()
+    env = gym.make(CENTER_OUT, protocol=protocol, decision_steps=1)
+    _total, _reaches, terminated, _ = bot_run(env, 3, bot="adaptive")
+    assert terminated
+    # Its learning reads the cursor and the felt torques: every key and every trial as in the lab's own run.
+    assert env.unwrapped.session.timeline == headless.timeline
+    assert env.unwrapped.session.trial_records() == headless.trial_records()
+
+
 def test_a_curl_field_option_deflects_the_cursor():
     env = gym.make(CENTER_OUT, protocol=SHORT, decision_steps=1)
 
