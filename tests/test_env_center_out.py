@@ -190,13 +190,18 @@ def test_the_observation_is_documented_and_within_its_space():
     assert obs[16] == 5.0 and obs[17] == pytest.approx(session.time_left)
 
 
-def test_jointspace_bounds_the_cursor_by_nothing_and_is_refused_where_the_space_bounds_it():
-    env = gym.make(CENTER_OUT, protocol="jointspace")
-    assert env.observation_space.high[8] == math.inf
-    bounded = gym.make(CENTER_OUT)
+def test_what_the_bounds_cannot_bound_is_unbounded_and_refused_where_the_space_bounds_it():
+    bounded = gym.make(CENTER_OUT, protocol="curl")  # a curl field does no work: the game's speed bound holds
     assert bounded.observation_space.high[8] == pytest.approx(2.4)
-    with pytest.raises(EnvArgumentError, match="jointspace"):
-        bounded.reset(options={"perturbation": "jointspace"})
+    assert bounded.observation_space.high[2] == pytest.approx(34.4, abs=0.05)
+    joint = gym.make(CENTER_OUT, protocol="jointspace")
+    assert joint.observation_space.high[8] == math.inf and joint.observation_space.high[2] < math.inf
+    spring = gym.make(CENTER_OUT, perturbation={"perturbation": "spring", "stiffness": 100.0})
+    assert spring.observation_space.high[2] == math.inf and spring.observation_space.high[8] < math.inf
+    for option in ("jointspace", {"perturbation": "constant", "fx": 5.0}):
+        with pytest.raises(EnvArgumentError, match="needs an env made with it"):
+            bounded.reset(options={"perturbation": option})
+    joint.reset(seed=0, options={"perturbation": "rotation"})  # narrower bounds fit a wider space
 
 
 @pytest.mark.parametrize(("kwargs", "options", "match"), [

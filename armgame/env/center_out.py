@@ -155,8 +155,10 @@ class CenterOutEnv(gym.Env):
     within the arm's reach (0.8 m). The cursor is the hand, or the hand rotated or mirrored about home,
     so within three arm's lengths (2.4 m) of the shoulder; the ``jointspace`` display shows it at
     ``home + gain (q - q_home)`` for joint angles that nothing bounds, so an env whose protocol (or
-    perturbation) at ``make`` has that display observes the cursor in (-inf, inf) instead, and an env
-    made without it refuses a reset option that brings it in. The angles are wrapped as in
+    perturbation) at ``make`` has that display observes the cursor in (-inf, inf) instead. Likewise a
+    constant force or a spring at the hand feeds the arm energy the speed bound does not count (a curl
+    field does no work), so an env made with one observes unbounded velocities. An env made without
+    them refuses a reset option that brings them in. The angles are wrapped as in
     ``armgame/Reach-v0``. The run's clock is the lab's (``lab_config``: 1.5 times the slowest run's
     length plus 60 s, at most a day); a run that fidgets at home past it is truncated.
 
@@ -246,9 +248,7 @@ class CenterOutEnv(gym.Env):
             self.action_space = spaces.Box(0.0, 1.0, (4,), np.float32)
         else:
             self.action_space = spaces.MultiBinary(4)
-        self.unbounded_cursor = shows_joint_space(self.protocol)
-        self.observation_space = spaces.Box(*observation_bounds(speed_bound(base), base.arm.l1 + base.arm.l2,
-                                                                self.unbounded_cursor), dtype=np.float64)
+        self.observation_space = spaces.Box(*observation_bounds(self.protocol), dtype=np.float64)
         self.session: LabSession | None = None
         self._view: Any = None  # armgame.ui.lab_env_view.LabEnvView, made on the first frame
 
@@ -264,9 +264,12 @@ class CenterOutEnv(gym.Env):
                 raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, unknown)))}: "
                                        "choose protocol, perturbation")
             protocol = run_protocol(options.get("protocol", self.protocol), options.get("perturbation"))
-            if shows_joint_space(protocol) and not self.unbounded_cursor:
-                raise EnvArgumentError("the jointspace display's cursor has no bounds, which this env's observation "
-                                       "space has: make the env with it, e.g. gym.make(id, protocol='jointspace')")
+            low, high = observation_bounds(protocol)
+            space = self.observation_space
+            if np.any(low < space.low) or np.any(high > space.high):
+                raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
+                                       "spring force (unbounded speeds) needs an env made with it, e.g. "
+                                       "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
             self.protocol = protocol
         super().reset(seed=seed)
         lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
@@ -341,14 +344,20 @@ class CenterOutEnv(gym.Env):
         return {"trials_done": len(s.outcomes), "hits": s.rules.board.hits, "block": s.block.name}
 
 
-def shows_joint_space(protocol: Protocol) -> bool:
-    return any(p.kind == "jointspace" for p in protocol.perturbations)
+def observation_bounds(protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
+    """The observation's bounds for runs of ``protocol``.
 
-
-def observation_bounds(speed: float, reach: float, unbounded_cursor: bool) -> tuple[np.ndarray, np.ndarray]:
+    The speed bound is the game's (``reach.speed_bound``: the energy the muscles can feed against the
+    damping), which a curl field keeps (its force is perpendicular to the hand's velocity: it does no
+    work); a constant force or a spring feeds the arm energy of its own, so with either the speeds are
+    left unbounded. The joint-space display's cursor follows unbounded joint angles."""
+    kinds = {p.kind for p in protocol.perturbations}
+    config = lab_config(protocol, 0)
+    reach = config.arm.l1 + config.arm.l2
     pi, day = math.pi, MAX_RUN_SECONDS
+    speed = math.inf if kinds & {"constant", "spring"} else speed_bound(config)
     # |cursor - home| = |hand - home| <= |hand| + |home| under a rotation or mirror about home, both within reach.
-    c = math.inf if unbounded_cursor else 3.0 * reach
+    c = math.inf if "jointspace" in kinds else 3.0 * reach
     low = np.array([-pi, -pi, -speed, -speed, 0, 0, 0, 0, -c, -c, -reach, -reach, -reach, -reach, 0, 0, 0, 0])
     high = np.array([pi, pi, speed, speed, 1, 1, 1, 1, c, c, reach, reach, reach, reach, 1, day, MAX_TRIALS, day])
     return low, high
