@@ -9,9 +9,11 @@ muscles and the physics stay in ``armgame.game``; frames come from ``armgame.ui`
 Importing this package registers, with ``gymnasium.register``:
 
 * ``armgame/Reach-v0``: the standard game, the four muscle keys as ``MultiBinary(4)``;
-* ``armgame/ReachContinuous-v0``: the same game driven by four muscle levels, ``Box(0, 1, (4,))``.
+* ``armgame/ReachContinuous-v0``: the same game driven by four muscle levels, ``Box(0, 1, (4,))``;
+* ``armgame/CenterOut-v0`` and ``armgame/CenterOutContinuous-v0``: a run of the lab's centre-out
+  task (``center_out.CenterOutEnv`` on ``armgame.lab``'s ``LabSession``), keys or muscle levels.
 
-Both have a native vector entry point, so ``gymnasium.make_vec(id, num_envs=N)`` gives one
+The two Reach envs have a native vector entry point, so ``gymnasium.make_vec(id, num_envs=N)`` gives one
 ``ReachVectorEnv`` stepping N games as numpy arrays (next-step autoreset). ``import armgame``
 imports neither gymnasium nor this package, and nothing here imports pygame until an env
 renders::
@@ -29,6 +31,7 @@ from __future__ import annotations
 import gymnasium
 
 ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
+CENTER_OUT_IDS = ("armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0")
 
 
 def _register() -> None:
@@ -44,6 +47,11 @@ def _register() -> None:
             max_episode_steps=None,
             nondeterministic=False,
         )
+    for env_id, continuous in zip(CENTER_OUT_IDS, (False, True), strict=True):
+        if env_id not in gymnasium.registry:
+            # One episode is one protocol run; it ends itself (terminated, or truncated by the lab's clock).
+            gymnasium.register(id=env_id, entry_point="armgame.env.center_out:CenterOutEnv",
+                               kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
 
 
 _register()

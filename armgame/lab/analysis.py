@@ -39,23 +39,25 @@ def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
 
 def trial_rows(session: LabSession) -> list[dict[str, object]]:
     """One row per finished trial, with the columns of ``metrics.TRIAL_COLUMNS``."""
-    rows = []
-    for o in session.outcomes:
-        m = reach_metrics(reach_of(session, o))
-        rows.append({
-            "block": o.plan.block_name,
-            "trial": o.plan.index + 1,
-            "target_deg": o.plan.target_deg,
-            "perturbation": perturbation_label(o),
-            "reaction_time": m.reaction_time,
-            "movement_time": m.movement_time,
-            "peak_speed": m.peak_speed,
-            "initial_direction_error_deg": m.initial_direction_error_deg,
-            "max_perpendicular_error_m": m.max_perpendicular_error_m,
-            "path_length_ratio": m.path_length_ratio,
-            "hit": o.hit,
-        })
-    return rows
+    return [trial_row(session, o) for o in session.outcomes]
+
+
+def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
+    """One finished trial's row, with the columns of ``metrics.TRIAL_COLUMNS``."""
+    m = reach_metrics(reach_of(session, o))
+    return {
+        "block": o.plan.block_name,
+        "trial": o.plan.index + 1,
+        "target_deg": o.plan.target_deg,
+        "perturbation": perturbation_label(o),
+        "reaction_time": m.reaction_time,
+        "movement_time": m.movement_time,
+        "peak_speed": m.peak_speed,
+        "initial_direction_error_deg": m.initial_direction_error_deg,
+        "max_perpendicular_error_m": m.max_perpendicular_error_m,
+        "path_length_ratio": m.path_length_ratio,
+        "hit": o.hit,
+    }
 
 
 def path_groups(session: LabSession, per_group: int | None = None) -> dict[str, list[np.ndarray]]:

@@ -206,6 +206,22 @@ def with_catch_trials(protocol: Protocol, catch: int) -> Protocol:
     return _checked(replace(protocol, blocks=blocks))
 
 
+def with_perturbation(protocol: Protocol, perturbation: Perturbation) -> Protocol:
+    """The protocol with ``perturbation`` in place of its own: in every perturbed block or, for a protocol
+    with none (the ``null`` preset), in its blocks named ``exposure``. ``NONE`` switches the perturbed
+    blocks off (and their catch trials, which would have nothing to switch off)."""
+    perturbed = [b.perturbation.kind != "none" for b in protocol.blocks]
+    if not any(perturbed):
+        perturbed = [b.name == "exposure" for b in protocol.blocks]
+    if not any(perturbed):
+        raise UserError(f"protocol {protocol.name!r} has no perturbed block and no block named exposure "
+                        "to put a perturbation in")
+    catch_ok = perturbation.kind != "none"
+    blocks = tuple(replace(b, perturbation=perturbation, catch_trials=b.catch_trials if catch_ok else 0) if on else b
+                   for b, on in zip(protocol.blocks, perturbed, strict=True))
+    return replace(protocol, blocks=blocks)
+
+
 # ----------------------------------------------------------------- from data
 MAX_PROTOCOL_BYTES = 256 * 1024
 _TOP = {"name", "targets", "distance", "target_radius", "home_radius", "hold_time", "delay_min", "delay_max",

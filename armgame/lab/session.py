@@ -144,6 +144,14 @@ class LabSession(GameSession):
         return self.plans[self.trial_index] if self.trial_index < len(self.plans) else None
 
     @property
+    def phase_start_step(self) -> int:
+        """The physics step at which the current phase began: the go cue in a reach, the previous trial's
+        end (or the run's start) in a hold."""
+        if self.phase == REACH:
+            return self._go_step
+        return self.outcomes[-1].end_step if self.outcomes else 0
+
+    @property
     def block(self):
         plan = self.plan or self.plans[-1]
         return self.protocol.blocks[plan.block]
