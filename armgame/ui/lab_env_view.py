@@ -19,4 +19,5 @@ class LabEnvView(EnvView):
     def frame(self, session: LabSession) -> np.ndarray | None:  # type: ignore[override]
         if self._renderer is None:
             self._renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+            self._renderer.mode = ""  # an agent takes no keys: no help line
         return super().frame(session)

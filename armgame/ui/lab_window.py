@@ -31,7 +31,7 @@ RING = (205, 210, 218)
 class LabRenderer(GameRenderer):
     """Draws one frame of a ``LabSession``; text and fonts cached as the game's renderer does."""
 
-    #: What drives the run: "LAB" (a person at the keys), "AUTOPILOT: NAME" or "REPLAY".
+    #: What drives the run: "LAB" (a person at the keys), "AUTOPILOT: NAME", "REPLAY", or "" (a program).
     mode = "LAB"
 
     def draw(self, screen: pygame.Surface, session: LabSession, alpha: float = 1.0,  # type: ignore[override]
@@ -102,8 +102,10 @@ class LabRenderer(GameRenderer):
         keys = self.key_labels
         if self.mode == "LAB":
             help_line = f"{keys[0]}/{keys[1]} shoulder   {keys[2]}/{keys[3]} elbow   space home   p pause   esc quit"
-        else:  # a bot or a replay drives: the muscle keys do nothing
+        elif self.mode:  # a bot or a replay drives: the muscle keys do nothing
             help_line = f"{self.mode}   p pause   esc quit"
+        else:  # frames for a program (the Gymnasium env): no keys at all
+            help_line = " "
         help_text = self.text(self.fit_text(help_line, small, screen.get_width() - 2 * margin), small, p.faint)
         screen.blit(help_text, (margin, screen.get_height() - help_text.get_height() - margin))
         bar_w, bar_h, gap = 6 * small, small * 2 // 3, small // 2
