@@ -20,17 +20,17 @@ from gymnasium import spaces
 from ..errors import UserError
 from ..game.muscles import MuscleSet
 from ..game.rules import Target
-from ..game.session import DOWN, UP
+from ..game.session import DOWN
 from ..lab.analysis import trial_row
 from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
 from ..lab.protocol import MAX_TRIALS, PARAMETERS, PRESETS, Perturbation, Protocol, preset, with_perturbation
 from ..lab.session import HOLD, REACH, LabSession, lab_config
 from ..physics.twojoint import TwoJointArm
+from .base import EnvArgumentError, SessionEnv
 from .reach import (
     DEFAULT_DECISION_STEPS,
     MAX_DECISION_STEPS,
     SEED_LIMIT,
-    EnvArgumentError,
     _check_size,
     check_seed,
     speed_bound,
@@ -100,7 +100,7 @@ def run_protocol(protocol: object, perturbation: object | None) -> Protocol:
         raise EnvArgumentError(str(exc)) from None
 
 
-class CenterOutEnv(gym.Env):
+class CenterOutEnv(SessionEnv):
     r"""
     ## Description
 
@@ -218,15 +218,13 @@ class CenterOutEnv(gym.Env):
     * v0: Initial version (armgame 0.1).
     """
 
-    metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}  # noqa: RUF012
+    family = "CenterOut"
 
     def __init__(self, render_mode: str | None = None, *, protocol: str | Protocol = "null",
                  perturbation: object | None = None, decision_steps: int = DEFAULT_DECISION_STEPS,
                  continuous: bool = False, time_cost: float = DEFAULT_TIME_COST,
                  render_size: tuple[int, int] = (600, 600)) -> None:
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise EnvArgumentError(f"render_mode must be one of {self.metadata['render_modes']} or None, "
-                                   f"got {render_mode!r}")
+        self._check_render_mode(render_mode)
         if isinstance(decision_steps, bool) or not isinstance(decision_steps, int | np.integer) \
                 or not 1 <= decision_steps <= MAX_DECISION_STEPS:
             raise EnvArgumentError(f"decision_steps must be a whole number of physics steps from 1 to "
@@ -288,19 +286,9 @@ class CenterOutEnv(gym.Env):
         if session.over:
             raise gym.error.ResetNeeded("the run is over: call reset() before another step()")
         if self.continuous:
-            levels = np.asarray(action, dtype=np.float64)
-            if levels.shape != (4,) or not np.isfinite(levels).all():
-                raise ValueError(f"a CenterOutContinuous-v0 action is 4 finite numbers in [0, 1], got {action!r}")
-            session.set_muscle_levels(np.clip(levels, 0.0, 1.0).tolist())
+            self._set_levels(action, 4)
         else:
-            pressed = np.asarray(action).tolist()
-            if not isinstance(pressed, list) or len(pressed) != 4 or not all(p in (0, 1) for p in pressed):
-                raise ValueError(f"a CenterOut-v0 action is 4 zeros or ones (keys held), got {action!r}")
-            keys = session.muscles.keys
-            for i in range(4):
-                down = pressed[i] == 1
-                if down != session.held[i]:
-                    session.key_event(keys[i], DOWN if down else UP)
+            self._press_keys(action, 4)
         done, hits = len(session.outcomes), session.rules.board.hits
         ran = session.advance(self.decision_steps)
         reward = float(session.rules.board.hits - hits) - self.time_cost * ran * session.config.dt
@@ -311,24 +299,12 @@ class CenterOutEnv(gym.Env):
             self.render()
         return self._observation(), reward, session.finished, session.over and not session.finished, info
 
-    def render(self) -> np.ndarray | None:
-        if self.render_mode is None:
-            gym.logger.warn("render() needs a render_mode: make the env with render_mode='rgb_array' or 'human'")
-            return None
-        if self.session is None:
-            raise gym.error.ResetNeeded("call reset() before render()")
-        if self._view is None:
-            from ..ui.lab_env_view import LabEnvView  # pygame is imported here and only here
-
-            self._view = LabEnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
-        return self._view.frame(self.session)
-
-    def close(self) -> None:
-        if self._view is not None:
-            self._view.close()
-            self._view = None
-
     # --------------------------------------------------------------- internals
+    def _new_view(self) -> Any:
+        from ..ui.lab_env_view import LabEnvView  # pygame is imported here and only here
+
+        return LabEnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
+
     def _observation(self) -> np.ndarray:
         s = self.session
         assert s is not None

@@ -19,7 +19,8 @@ from gymnasium import spaces
 
 from ..errors import UserError
 from ..game.rules import GameConfig
-from ..game.session import DOWN, RESET_KEY, UP, GameSession
+from ..game.session import GameSession
+from .base import EnvArgumentError, SessionEnv
 
 #: Decision step of the standard envs in physics steps: 5 x 4 ms = 20 ms, a 50 Hz controller.
 DEFAULT_DECISION_STEPS = 5
@@ -27,10 +28,6 @@ MAX_DECISION_STEPS = 1000
 #: The game's seeds (``GameConfig.seed``) are whole numbers below this.
 SEED_LIMIT = 2**63
 OBSERVATION_NAMES = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "target_x", "target_y", "time_left")
-
-
-class EnvArgumentError(UserError, ValueError):
-    """A bad argument to an env: one line naming it (a ``ValueError`` too, as Gymnasium users expect)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -147,7 +144,7 @@ def check_seed(seed: object) -> int:
     return int(seed)
 
 
-class ReachEnv(gym.Env):
+class ReachEnv(SessionEnv):
     r"""
     ## Description
 
@@ -255,16 +252,14 @@ class ReachEnv(gym.Env):
     * v0: Initial version (armgame 0.1).
     """
 
-    # Gymnasium's own annotation; __init__ gives each env its render_fps from its decision step.
-    metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}  # noqa: RUF012
+    family = "Reach"
 
     def __init__(self, render_mode: str | None = None, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  config: GameConfig | None = None, render_size: tuple[int, int] = (600, 600)) -> None:
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise EnvArgumentError(f"render_mode must be one of {self.metadata['render_modes']} or None, "
-                                   f"got {render_mode!r}")
+        self._check_render_mode(render_mode)
         self.settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key)
+        self.continuous = self.settings.continuous
         self.config = self.settings.config
         self.decision_steps = self.settings.decision_steps
         self.decision_time = self.settings.decision_time
@@ -295,60 +290,21 @@ class ReachEnv(gym.Env):
             raise gym.error.ResetNeeded("the game is over (truncated): call reset() before another step()")
         board = session.rules.board
         hits, resets = board.hits, board.resets
-        if self.settings.continuous:
-            self._apply_levels(action)
+        if self.continuous:
+            self._set_levels(action, self.action_space.shape[0])
         else:
-            self._apply_keys(action)
+            self._press_keys(action, self.action_space.n)
         session.advance(self.decision_steps)
         reward = float((board.hits - hits) - self.config.reset_cost * (board.resets - resets))
         if self.render_mode == "human":
             self.render()
         return self._observation(), reward, False, session.over, self._info()
 
-    def render(self) -> np.ndarray | None:
-        if self.render_mode is None:
-            gym.logger.warn("render() needs a render_mode: make the env with render_mode='rgb_array' or 'human'")
-            return None
-        if self.session is None:
-            raise gym.error.ResetNeeded("call reset() before render()")
-        if self._view is None:
-            from ..ui.env_view import EnvView  # pygame is imported here and only here
-
-            self._view = EnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
-        return self._view.frame(self.session)
-
-    def close(self) -> None:
-        if self._view is not None:
-            self._view.close()
-            self._view = None
-
     # --------------------------------------------------------------- internals
-    def _apply_keys(self, action: Any) -> None:
-        pressed = np.asarray(action).tolist()
-        n = self.action_space.n
-        if not isinstance(pressed, list) or len(pressed) != n or not all(p in (0, 1) for p in pressed):
-            raise ValueError(f"a Reach-v0 action is {n} zeros or ones (keys held), got {action!r}")
-        session = self.session
-        assert session is not None
-        held, keys = session.held, session.muscles.keys
-        for i in range(4):
-            down = pressed[i] == 1
-            if down != held[i]:
-                session.key_event(keys[i], DOWN if down else UP)
-        if n == 5 and pressed[4] == 1:
-            session.key_event(RESET_KEY, DOWN)
+    def _new_view(self) -> Any:
+        from ..ui.env_view import EnvView  # pygame is imported here and only here
 
-    def _apply_levels(self, action: Any) -> None:
-        n = self.action_space.shape[0]
-        levels = np.asarray(action, dtype=np.float64)
-        if levels.shape != (n,) or not np.isfinite(levels).all():
-            raise ValueError(f"a ReachContinuous-v0 action is {n} finite numbers in [0, 1], got {action!r}")
-        levels = np.clip(levels, 0.0, 1.0)
-        session = self.session
-        assert session is not None
-        session.set_muscle_levels(levels[:4].tolist())
-        if n == 5 and levels[4] >= 0.5:
-            session.key_event(RESET_KEY, DOWN)
+        return EnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
 
     def _observation(self) -> np.ndarray:
         session = self.session

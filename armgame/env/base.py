@@ -1,0 +1,91 @@
+"""What every armgame env shares: a session driven by key or muscle-level actions, drawn by ``armgame.ui``.
+
+``ReachEnv`` (the game) and ``CenterOutEnv`` (the lab's task) differ in their session, spaces and
+reward; how an action reaches the session (the same key events a player's keys make, or muscle
+levels) and how frames are made (pygame imported on the first frame only) are written once here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from ..errors import UserError
+from ..game.session import DOWN, RESET_KEY, UP, GameSession
+
+
+class EnvArgumentError(UserError, ValueError):
+    """A bad argument to an env: one line naming it (a ``ValueError`` too, as Gymnasium users expect)."""
+
+
+class SessionEnv(gym.Env):
+    """A Gymnasium env over one armgame session (``self.session``, None before ``reset``).
+
+    Subclasses set ``family`` (the id's stem, e.g. ``"Reach"``), ``continuous``, ``render_mode``,
+    ``render_size`` and ``_view = None``, and give ``_new_view`` (which imports pygame).
+    """
+
+    # Gymnasium's own annotation; each env gives itself the render_fps of its decision step.
+    metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}  # noqa: RUF012
+    family = "armgame"
+    continuous = False
+    session: GameSession | None = None
+
+    @property
+    def env_name(self) -> str:
+        """The registered id's name, for messages: "Reach-v0", "CenterOutContinuous-v0", ..."""
+        return f"{self.family}{'Continuous' if self.continuous else ''}-v0"
+
+    def _check_render_mode(self, render_mode: str | None) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise EnvArgumentError(f"render_mode must be one of {self.metadata['render_modes']} or None, "
+                                   f"got {render_mode!r}")
+
+    # ---------------------------------------------------------------- actions
+    def _press_keys(self, action: Any, n: int) -> None:
+        """Hold the four muscle keys as the action says (a fifth entry presses the reset key)."""
+        pressed = np.asarray(action).tolist()
+        if not isinstance(pressed, list) or len(pressed) != n or not all(p in (0, 1) for p in pressed):
+            raise ValueError(f"a {self.env_name} action is {n} zeros or ones (keys held), got {action!r}")
+        session = self.session
+        assert session is not None
+        held, keys = session.held, session.muscles.keys
+        for i in range(4):
+            down = pressed[i] == 1
+            if down != held[i]:
+                session.key_event(keys[i], DOWN if down else UP)
+        if n == 5 and pressed[4] == 1:
+            session.key_event(RESET_KEY, DOWN)
+
+    def _set_levels(self, action: Any, n: int) -> None:
+        """Drive the four muscles toward the action's levels (a fifth entry >= 0.5 presses reset)."""
+        levels = np.asarray(action, dtype=np.float64)
+        if levels.shape != (n,) or not np.isfinite(levels).all():
+            raise ValueError(f"a {self.env_name} action is {n} finite numbers in [0, 1], got {action!r}")
+        levels = np.clip(levels, 0.0, 1.0)
+        session = self.session
+        assert session is not None
+        session.set_muscle_levels(levels[:4].tolist())
+        if n == 5 and levels[4] >= 0.5:
+            session.key_event(RESET_KEY, DOWN)
+
+    # ---------------------------------------------------------------- frames
+    def _new_view(self) -> Any:
+        raise NotImplementedError
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render() needs a render_mode: make the env with render_mode='rgb_array' or 'human'")
+            return None
+        if self.session is None:
+            raise gym.error.ResetNeeded("call reset() before render()")
+        if self._view is None:
+            self._view = self._new_view()
+        return self._view.frame(self.session)
+
+    def close(self) -> None:
+        if self._view is not None:
+            self._view.close()
+            self._view = None
