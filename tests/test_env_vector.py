@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 import armgame.env
 import armgame.env.vector
+import armgame.game.batch
 from armgame.env.policies import BotPolicy
 from armgame.env.reach import EnvArgumentError
 from armgame.env.vector import ReachVectorEnv
@@ -47,10 +48,13 @@ def test_make_vec_gives_the_native_vector_env(env_id):
     assert obs in envs.observation_space and info["_hits"].all()
 
 
+@pytest.mark.parametrize("series", ["exact", "series"])
 @pytest.mark.parametrize("kwargs", [{}, {"reset_key": True, "decision_steps": 4}])
-def test_the_vector_env_equals_single_envs_with_bots_playing_and_autoresets(kwargs):
+def test_the_vector_env_equals_single_envs_with_bots_playing_and_autoresets(kwargs, series, monkeypatch):
     # Bots score, so rewards are not all zero; 1.5 s games end twice (with 4 physics steps a decision
     # the last decision of a game holds 3).
+    if series == "series":  # the fast kernel of 2,048 and more envs, here on four
+        monkeypatch.setattr(armgame.game.batch, "SERIES_MIN_GAMES", 1)
     native, singles = make_pair(REACH, 4, time_limit=1.5, **kwargs)
     keys_env = gym.make(REACH, time_limit=1.5, decision_steps=kwargs.get("decision_steps", 5))
     policies = [BotPolicy(name, keys_env) for name in ("model", "naive", "model", "naive")]
@@ -95,14 +99,19 @@ def test_games_split_over_several_batches_equal_single_envs(monkeypatch):
     assert data_equivalence(a, b, exact=True)
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=12, deadline=None)
 @given(n=st.integers(1, 4), decision_steps=st.integers(1, 7), time_limit=st.sampled_from([0.1, 0.23, 0.4]),
-       continuous=st.booleans(), reset_key=st.booleans(), seed=st.integers(0, 2**62), action_seed=st.integers(0, 99))
+       continuous=st.booleans(), reset_key=st.booleans(), seed=st.integers(0, 2**62), action_seed=st.integers(0, 99),
+       series=st.booleans())
 def test_any_vector_env_equals_its_single_envs(n, decision_steps, time_limit, continuous, reset_key, seed,
-                                               action_seed):
+                                               action_seed, series):
     env_id = CONTINUOUS if continuous else REACH
-    native, singles = make_pair(env_id, n, time_limit=time_limit, decision_steps=decision_steps,
-                                reset_key=reset_key)
+    with pytest.MonkeyPatch.context() as mp:
+        if series:  # the fast kernel of 2,048 and more envs
+            mp.setattr(armgame.game.batch, "SERIES_MIN_GAMES", 1)
+        native, singles = make_pair(env_id, n, time_limit=time_limit, decision_steps=decision_steps,
+                                    reset_key=reset_key)
+        native.reset(seed=seed)  # builds the batches (which keep their kernel) while the patch holds
     native.action_space.seed(action_seed)
     a, b = native.reset(seed=seed), singles.reset(seed=seed)
     assert data_equivalence(a, b, exact=True)
