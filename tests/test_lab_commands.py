@@ -152,6 +152,9 @@ def test_class_curve_merges_verified_students(tmp_path, capsys):
     (["lab", "curl", "--headless", "--bot", "model", "--catch", "80"], "--catch 80: blocks[1].catch_trials"),
     (["lab", "null", "--headless", "--bot", "model", "--catch", "3"], "has no perturbed block"),
     (["lab", "curl", "--headless", "--bot", "model", "--record", "/no/such/dir/r.json"], "its folder does not exist"),
+    (["lab", "curl", "--headless", "--bot", "model", "--record", "/dev/null"], "is a device"),  # before the run
+    (["lab", "curl", "--headless", "--bot", "model", "--record", "~nosuchuser/r.json"], "no such user"),
+    (["lab", "curl", "--headless", "--bot", "model", "--out", "~nosuchuser/run"], "no such user"),
     (["analyze", "--out", "x.csv"], "no replay given"),
 ])
 def test_command_errors_are_one_line(argv, message, capsys, monkeypatch, tmp_path):
@@ -177,3 +180,9 @@ def test_replay_headless_recomputes_a_lab_run(curl_run, capsys):
     assert main(["replay", str(curl_run / "curl.json"), "--headless", "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
     assert (result["hits"], result["scene"]) == (120, "lab")
+
+
+def test_a_record_target_that_is_no_regular_file_is_refused_before_the_run(capsys):
+    assert main(["lab", "curl", "--headless", "--bot", "model", "--record", "/dev/null"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "is a device" in captured.err  # no trial was run only to be lost

@@ -129,15 +129,20 @@ def _check_outputs(args: argparse.Namespace) -> None:
             args.name = check_name(args.name, "--name")
         except ValueError as exc:
             raise UserError(str(exc)) from None
-    if args.record and not Path(args.record).expanduser().resolve().parent.is_dir():
-        raise UserError(f"--record {args.record}: its folder does not exist")
+    from ..records.storage import check_output_path, user_path
+
+    if args.record:
+        record = user_path(args.record, "--record")
+        if not record.resolve().parent.is_dir():
+            raise UserError(f"--record {args.record}: its folder does not exist")
+        args.record = check_output_path(record, "replay")  # a device, FIFO or folder: refused before the run
     if args.out and not args.no_figures:
         from ..lab.figures import require_matplotlib
 
         require_matplotlib()
     if args.out:
-        out = Path(args.out).expanduser()
-        if out.exists() and not out.is_dir():
+        args.out = user_path(args.out, "--out")
+        if args.out.exists() and not args.out.is_dir():
             raise UserError(f"--out {args.out}: not a folder")
 
 
@@ -157,12 +162,12 @@ def _report(session, args: argparse.Namespace) -> None:
         driven = "bot" if args.bot else "keyboard"
         replay = Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name,
                         now_iso(), task=LabTask.of(session))
-        replay.save(Path(args.record).expanduser())
+        replay.save(args.record)
         print(f"replay saved to {args.record}")
     if args.out:
         if not session.outcomes:
             raise UserError("no trial was finished: nothing to write to --out")
-        out = Path(args.out).expanduser()
+        out = args.out
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
