@@ -1,7 +1,13 @@
-"""The batched session against the single one: same hits, score, resets and steps, states to round-off."""
+"""The batched session against the single one: same hits, score, resets and steps, states to round-off.
+
+The main tests run on both kernels: numpy, and the compiled one (bit for bit everywhere).
+``ARMGAME_REQUIRE_COMPILED=1`` (set by ``.ci/run``) makes a missing build fail here instead of
+leaving the compiled kernel untested.
+"""
 
 import itertools
 import math
+import os
 import random
 from dataclasses import replace
 
@@ -11,6 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from armgame.errors import UserError
+from armgame.game import compiled
 from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, replay_many
 from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet, MuscleSpec, remap_keys
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
@@ -26,8 +33,20 @@ def _numpy_trig_is_libm() -> bool:
                 and np.array_equal(np.cos(x), [math.cos(v) for v in x]))
 
 
-#: Bit for bit where numpy's sin and cos are the C library's (as on x86-64 without AVX-512), else round-off.
+#: The numpy kernel: bit for bit where numpy's sin and cos are the C library's (as on x86-64 without
+#: AVX-512), else round-off. The compiled kernel calls the C library's, as Python's math does: bit for bit.
 TOLERANCE = 0.0 if _numpy_trig_is_libm() else STATE_TOLERANCE
+KERNELS = ["numpy", "compiled"] if compiled.AVAILABLE or os.environ.get("ARMGAME_REQUIRE_COMPILED") else ["numpy"]
+
+
+def tolerance(batch: BatchGameSession) -> float:
+    return 0.0 if batch.compiled is not None else TOLERANCE
+
+
+def batch_of(configs, kernel: str) -> BatchGameSession:
+    batch = BatchGameSession(configs, kernel=kernel)
+    assert (batch.compiled is not None) == (kernel == "compiled" and configs[0].integrator == "rk4")
+    return batch
 
 
 def student_timeline(rng: random.Random, dt: float, seconds: float, extras: bool = True) -> list[InputEvent]:
@@ -59,10 +78,11 @@ def assert_same_game(batch: BatchGameSession, i: int, single: GameSession) -> No
     assert (batch.target_x[i], batch.target_y[i]) == (single.rules.target.x, single.rules.target.y)
     assert bool(batch.arm_visible[i]) == single.rules.arm_visible
     assert batch.held[i].tolist() == single.held
-    np.testing.assert_allclose(batch.state(i), single.state, rtol=0.0, atol=TOLERANCE)
-    np.testing.assert_allclose(batch.activation[i], single.muscles.activation, rtol=0.0, atol=TOLERANCE)
+    np.testing.assert_allclose(batch.state(i), single.state, rtol=0.0, atol=tolerance(batch))
+    np.testing.assert_allclose(batch.activation[i], single.muscles.activation, rtol=0.0, atol=tolerance(batch))
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @settings(max_examples=12, deadline=None)
 @given(
     seeds=st.lists(st.integers(0, 2**63 - 1), min_size=1, max_size=5),
@@ -71,13 +91,13 @@ def assert_same_game(batch: BatchGameSession, i: int, single: GameSession) -> No
     radius=st.sampled_from([0.05, 0.2]),
     timeline_seed=st.integers(0, 2**32 - 1),
 )
-def test_batch_equals_single_sessions_on_random_timelines(seeds, durations, stops, radius, timeline_seed):
+def test_batch_equals_single_sessions_on_random_timelines(kernel, seeds, durations, stops, radius, timeline_seed):
     """Random keys, resets, tab, stray keys, games of different lengths, some stopped early."""
     rng = random.Random(timeline_seed)
     configs = [GameConfig(seed=s, time_limit=durations[i], target_radius=radius) for i, s in enumerate(seeds)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
     stop_steps = stops[:len(configs)]
-    batch = BatchGameSession(configs)
+    batch = batch_of(configs, kernel)
     results = batch.play(timelines, stop_steps)
     for i, (c, timeline, stop) in enumerate(zip(configs, timelines, stop_steps, strict=True)):
         single = GameSession(c)
@@ -89,10 +109,11 @@ ARMS = {"game": GAME_PLAY_ARM, "vertical": GAME_PLAY_ARM.replace(gravity=9.81),
         "frictionless": GAME_PLAY_ARM.replace(damping1=0.0, damping2=0.0)}
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @settings(max_examples=6, deadline=None)
 @given(arm=st.sampled_from(sorted(ARMS)), integrator=st.sampled_from(["rk4", "euler", "symplectic-euler"]),
        muscles=st.sampled_from(["default", "remapped", "biarticular"]), timeline_seed=st.integers(0, 2**32 - 1))
-def test_every_arm_and_batchable_integrator_equals_the_single_session(arm, integrator, muscles, timeline_seed):
+def test_every_arm_and_batchable_integrator_equals_the_single_session(kernel, arm, integrator, muscles, timeline_seed):
     """The kernel's gravity, damping and plain variants, the generic path, other keys and moment arms."""
     rng = random.Random(timeline_seed)
     muscles = {"default": DEFAULT_MUSCLES, "remapped": remap_keys(DEFAULT_MUSCLES, "jkdf"),
@@ -101,7 +122,7 @@ def test_every_arm_and_batchable_integrator_equals_the_single_session(arm, integ
     configs = [GameConfig(seed=s, time_limit=2.0, arm=ARMS[arm], integrator=integrator, muscles=muscles,
                           target_radius=0.15) for s in range(3)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
-    batch = BatchGameSession(configs)
+    batch = batch_of(configs, kernel)
     results = batch.play(timelines)
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
         single = GameSession(c)
@@ -109,12 +130,13 @@ def test_every_arm_and_batchable_integrator_equals_the_single_session(arm, integ
         assert_same_game(batch, i, single)
 
 
-def test_many_long_games_equal_the_single_session():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_many_long_games_equal_the_single_session(kernel):
     """60 s games with a large target (many hits, many near misses): also the largest state difference."""
     rng = random.Random(7)
     configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(16)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
-    batch = BatchGameSession(configs)
+    batch = batch_of(configs, kernel)
     results = batch.play(timelines)
     worst = 0.0
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
@@ -123,7 +145,7 @@ def test_many_long_games_equal_the_single_session():
         assert_same_game(batch, i, single)
         worst = max(worst, max(abs(a - b) for a, b in zip(batch.state(i), single.state, strict=True)))
     assert sum(r.hits for r in results) > 50 and sum(r.resets for r in results) > 0
-    assert worst <= TOLERANCE
+    assert worst <= tolerance(batch)
 
 
 def test_round_off_in_sin_and_cos_stays_well_within_the_stated_tolerance():
@@ -155,8 +177,9 @@ def test_round_off_in_sin_and_cos_stays_well_within_the_stated_tolerance():
     assert 0.0 < worst < STATE_TOLERANCE / 100
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("inside", [True, False])
-def test_a_hit_on_the_knife_edge_is_decided_as_the_single_session_decides(inside):
+def test_a_hit_on_the_knife_edge_is_decided_as_the_single_session_decides(kernel, inside):
     """A target whose edge passes within a few ulps of where the hand will be."""
     script = [InputEvent(0, "d", "down"), InputEvent(10, "j", "down"), InputEvent(40, "d", "up")]
     config = GameConfig(time_limit=1.0)
@@ -171,7 +194,7 @@ def test_a_hit_on_the_knife_edge_is_decided_as_the_single_session_decides(inside
     edge = Target(hx + r * ux, hy + r * uy, config.target_radius)
     single = GameSession(config)
     single.rules.target = edge
-    batch = BatchGameSession([config, config])
+    batch = batch_of([config, config], kernel)
     for i in range(2):
         batch.rules[i].target = edge
         batch.target_x[i], batch.target_y[i] = edge.x, edge.y
@@ -181,11 +204,12 @@ def test_a_hit_on_the_knife_edge_is_decided_as_the_single_session_decides(inside
     assert_same_game(batch, 0, single)
 
 
-def test_the_step_api_equals_keys_levels_and_resets_of_single_sessions():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_the_step_api_equals_keys_levels_and_resets_of_single_sessions(kernel):
     """set_held, set_levels, reset_arms, advance and restart, as a vector environment drives them."""
     rng = np.random.default_rng(3)
     configs = [GameConfig(seed=s, time_limit=2.0 + s % 3, target_radius=0.15) for s in range(6)]
-    batch = BatchGameSession(configs)
+    batch = batch_of(configs, kernel)
     singles = [GameSession(c) for c in configs]
     for turn in range(120):
         if turn % 3 == 0:
@@ -292,8 +316,9 @@ def test_replay_many_groups_what_can_share_a_batch_and_plays_the_rest_alone():
     assert replay_many(configs, timelines, stops, batch_size=2) == expected
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("games", [3, 8])  # most of the batch playing on, or most of it stopped
-def test_games_stopped_early_keep_the_state_of_their_last_step_and_its_events(games):
+def test_games_stopped_early_keep_the_state_of_their_last_step_and_its_events(kernel, games):
     rng = random.Random(4)
     configs = [GameConfig(seed=s, time_limit=3.0 if s else 1.0, target_radius=0.15) for s in range(games)]
     timelines = [student_timeline(rng, c.dt, c.time_limit, extras=False) for c in configs]
@@ -302,7 +327,7 @@ def test_games_stopped_early_keep_the_state_of_their_last_step_and_its_events(ga
         at = timelines[i][len(timelines[i]) // 2].step
         timelines[i] = [e for e in timelines[i] if e.step <= at] + [InputEvent(at, "space", "down")]
         stops[i] = at
-    batch = BatchGameSession(configs)
+    batch = batch_of(configs, kernel)
     results = batch.play(timelines, stops)
     for i in range(games):
         single = GameSession(configs[i])
@@ -311,9 +336,10 @@ def test_games_stopped_early_keep_the_state_of_their_last_step_and_its_events(ga
     assert results[1].resets >= 1 and batch.state(1)[2:] == (0.0, 0.0)
 
 
-def test_play_with_no_events_and_a_stop_at_zero():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_play_with_no_events_and_a_stop_at_zero(kernel):
     configs = [GameConfig(seed=1, time_limit=0.5), GameConfig(seed=2, time_limit=0.5)]
-    batch = BatchGameSession(configs)
+    batch = batch_of(configs, kernel)
     results = batch.play([[], [InputEvent(0, "space", "down")]], [None, 0])
     assert [r.steps for r in results] == [125, 0] and results[1].resets == 1
     assert batch.state(1) == (math.radians(45.0), math.radians(90.0), 0.0, 0.0)

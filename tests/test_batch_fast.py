@@ -1,4 +1,4 @@
-"""The fast kernel (``BatchGameSession(configs, exact=False)``) against the single session.
+"""The fast kernel (``BatchGameSession(configs, exact=False, kernel="numpy")``) against the single session.
 
 Its series only run from ``SERIES_MIN_GAMES`` games (2,048): these tests lower that to one game,
 so that a handful of games exercises the very arithmetic a large batch runs.
@@ -64,7 +64,7 @@ def test_fast_batch_equals_single_sessions_on_random_timelines(seeds, durations,
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
     stop_steps = stops[:len(configs)]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False)
+        batch = BatchGameSession(configs, exact=False, kernel="numpy")
         results = batch.play(timelines, stop_steps)
         assert results == replay_many(configs, timelines, stop_steps)
     for i, (c, timeline, stop) in enumerate(zip(configs, timelines, stop_steps, strict=True)):
@@ -79,7 +79,7 @@ def test_full_games_stay_within_round_off_and_score_the_same():
     configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(12)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False)
+        batch = BatchGameSession(configs, exact=False, kernel="numpy")
         results = batch.play(timelines)
     worst = 0.0
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
@@ -96,7 +96,7 @@ def test_the_step_api_with_levels_and_resets_equals_single_sessions():
     configs = [GameConfig(seed=s, time_limit=3.0, target_radius=0.15) for s in range(4)]
     singles = [GameSession(c) for c in configs]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False)
+        batch = BatchGameSession(configs, exact=False, kernel="numpy")
         for turn in range(150):
             if turn % 2:
                 levels = rng.choice([0.0, 0.4, 1.0], size=(4, 4))
@@ -121,11 +121,11 @@ def test_a_step_beyond_the_series_range_falls_back_to_the_exact_arithmetic():
     exact = BatchGameSession(configs)
     exact.play(timelines)
     with series_for_any_batch(SERIES_LIMIT=0.0):
-        fallen = BatchGameSession(configs, exact=False)
+        fallen = BatchGameSession(configs, exact=False, kernel="numpy")
         fallen.play(timelines)
     assert np.array_equal(fallen._x[:4], exact._x[:4])
     with series_for_any_batch():
-        fast = BatchGameSession(configs, exact=False)
+        fast = BatchGameSession(configs, exact=False, kernel="numpy")
         fast.play(timelines)
     assert not np.array_equal(fast._x[:4], exact._x[:4])  # the series did run: the test can fail
 
@@ -136,7 +136,7 @@ def test_large_steps_and_spins_beyond_the_series_range_still_equal_the_single_se
     configs = [GameConfig(seed=s, time_limit=6.0, dt=0.04, arm=arm, target_radius=0.1) for s in range(3)]
     timelines = [[InputEvent(0, k, "down") for k in KEYS[:1 + s]] for s in range(3)]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False)
+        batch = BatchGameSession(configs, exact=False, kernel="numpy")
         results = batch.play(timelines)
     assert float(np.abs(batch.w2).max()) * configs[0].dt > batch_module.SERIES_LIMIT
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
@@ -163,7 +163,7 @@ def knife_edge_game(inside: bool) -> tuple[GameConfig, list[InputEvent], Target]
 def test_a_decision_on_the_knife_edge_marks_the_game(inside):
     config, script, edge = knife_edge_game(inside)
     with series_for_any_batch():
-        batch = BatchGameSession([config, config], exact=False)
+        batch = BatchGameSession([config, config], exact=False, kernel="numpy")
     batch.rules[0].target = edge
     batch.target_x[0], batch.target_y[0] = edge.x, edge.y
     batch.play([script, script])
@@ -188,12 +188,12 @@ def test_replay_many_plays_games_marked_on_the_knife_edge_again_alone(monkeypatc
 
     monkeypatch.setattr(GameSession, "play", spy)
     with series_for_any_batch(KNIFE_EDGE=10.0):
-        results = replay_many(configs, timelines)
+        results = replay_many(configs, timelines, kernel="numpy")
     scorers = {c.seed for c, r in zip(configs, results, strict=True) if r.hits}
     assert len(scorers) >= 2 and scorers <= set(alone)  # every hit was decided, so marked
     alone.clear()
     with series_for_any_batch():
-        assert replay_many(configs, timelines) == results
+        assert replay_many(configs, timelines, kernel="numpy") == results
     assert alone == []
     assert results == [play(GameSession(c), t) for c, t in zip(configs, timelines, strict=True)]
 
@@ -209,7 +209,7 @@ def test_gravity_and_two_joint_muscles_in_the_fast_kernel(arm):
     configs = [GameConfig(seed=s, time_limit=5.0, target_radius=0.15, **kwargs) for s in range(3)]
     timelines = [student_timeline(random.Random(s), configs[0].dt, 5.0) for s in range(3)]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False)
+        batch = BatchGameSession(configs, exact=False, kernel="numpy")
         results = batch.play(timelines)
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
         single = GameSession(c)
@@ -222,8 +222,8 @@ def test_games_longer_than_the_fast_kernels_limit_run_the_exact_kernel():
     short, long = (GameConfig(time_limit=batch_module.FAST_MAX_SECONDS + extra) for extra in (0.0, 0.004))
     timelines = [[InputEvent(0, "d", "down"), InputEvent(100, "k", "down")]] * 2
     with series_for_any_batch():
-        fast = BatchGameSession([short, short], exact=False)
-        kept = BatchGameSession([short, long], exact=False)
+        fast = BatchGameSession([short, short], exact=False, kernel="numpy")
+        kept = BatchGameSession([short, long], exact=False, kernel="numpy")
     exact = BatchGameSession([short, long])
     for batch in (fast, kept, exact):
         batch.play(timelines, [3000, 3000])

@@ -66,9 +66,14 @@ from ..errors import UserError
 from ..physics.batch import SERIES_LIMIT
 from ..physics.integrators import Integrator
 from ..physics.twojoint import TwoJointArm
+from . import compiled
+from .compiled import NEAR, CompiledKernel, MuscleEvents, hand_move_bounds
 from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
 from .session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent
+
+#: ``BatchGameSession(kernel=...)``: None, the compiled kernel where built (and RK4), else numpy.
+KERNELS = (None, "compiled", "numpy")
 
 #: Integrators whose batched step is the single step to round-off (no batch-wide iteration).
 BATCH_INTEGRATORS = ("rk4", "euler", "symplectic-euler")
@@ -100,9 +105,6 @@ FAST_MAX_SECONDS = 60.0
 #: decision farther from the edge than this (700 times that) is the single session's decision.
 KNIFE_EDGE = 1e-8
 
-# A hand this close to a target's edge (relative to radius^2) is checked by the exact scalar test.
-_NEAR = 1.0 + 1e-6
-
 
 def batch_problem(configs: Sequence[GameConfig]) -> str | None:
     """Why these games cannot share one batch, or None if they can."""
@@ -130,13 +132,18 @@ class BatchGameSession:
     Where an argument is a boolean mask ``games`` of shape (n,), only those games are touched.
     """
 
-    def __init__(self, configs: Sequence[GameConfig], exact: bool = True) -> None:
+    def __init__(self, configs: Sequence[GameConfig], exact: bool = True, kernel: str | None = None) -> None:
         configs = list(configs)
         problem = batch_problem(configs)
         if problem:
             raise UserError(problem)
+        if kernel not in KERNELS:
+            raise ValueError(f"kernel {kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
+        if kernel == "compiled" and not compiled.AVAILABLE:
+            raise ValueError("kernel 'compiled': the compiled kernel is not built here (no C compiler at install?)")
         self.configs = configs
-        #: True: the single session's arithmetic, bit for bit; False: the fast RK4 kernel (see ``_Kernel``).
+        #: True: the single session's arithmetic, bit for bit; False: the numpy kernel may use its fast RK4
+        #: stages (see ``_Kernel``). The compiled kernel is exact and the fastest, so it ignores this.
         self.exact = bool(exact)
         self.config = c = configs[0]
         self.n = n = len(configs)
@@ -181,6 +188,11 @@ class BatchGameSession:
         self._kernels: dict[int, _Kernel] = {}
         for i in range(n):
             self._start(i, configs[i])
+        #: The compiled kernel where built (and asked for) and the integrator is RK4; else None: numpy.
+        self.compiled: CompiledKernel | None = None
+        if kernel != "numpy" and compiled.AVAILABLE and c.integrator == "rk4":
+            self.compiled = CompiledKernel(self)
+            self._rounds = False
 
     def _start(self, i: int, config: GameConfig) -> None:
         self.configs[i] = config
@@ -333,6 +345,11 @@ class BatchGameSession:
     def advance(self, steps: int) -> None:
         """Every game not over runs ``steps`` physics steps (or up to its end)."""
         left = int(steps)
+        if left <= 0:
+            return
+        if self.compiled is not None:
+            self.compiled.run(np.minimum(self.steps + min(left, int(self.total_steps.max())), self.total_steps))
+            return
         while left > 0:
             running = self.steps < self.total_steps
             alive = np.flatnonzero(running)
@@ -431,6 +448,11 @@ class BatchGameSession:
         schedule = self._schedule(timelines, now, limit)
         muscle_steps, flat, goal, rate, specials, held = schedule
         limits = np.array(limit, dtype=np.int64)
+        if self.compiled is not None:
+            self._play_compiled(MuscleEvents.by_game(self.n, muscle_steps, flat, goal, rate), specials, limits)
+            for i, row in held.items():
+                self.held[i] = row
+            return [self.result(i) for i in range(self.n)]
         alive = np.flatnonzero(limits > now)
         # Games that stop while at least half the batch plays on stay in it, stepped for nothing:
         # cheaper than gathering the others every step. Their slack is infinite (no hits) and
@@ -473,6 +495,34 @@ class BatchGameSession:
         for i, row in held.items():
             self.held[i] = row
         return [self.result(i) for i in range(self.n)]
+
+    def _play_compiled(self, events: MuscleEvents, specials: list[tuple[int, int, str]], limits: np.ndarray) -> None:
+        """``play`` on the compiled kernel: each game runs on its own to its next reset or tab, or its stop.
+
+        The kernel applies the muscle commands itself; at a game's reset or tab step (after that
+        step's muscle commands, as ``play`` orders them) the key goes through ``key_event``.
+        """
+        pending: dict[int, list[tuple[int, str]]] = {}
+        for step, i, key in specials:  # sorted by step, and in timeline order within a step
+            pending.setdefault(i, []).append((step, key))
+        halt = limits.copy()
+        for i, keys in pending.items():
+            keys.reverse()  # popped from the end
+            halt[i] = min(keys[-1][0], int(limits[i]))
+        while True:
+            self.compiled.run(halt, events)
+            if not pending:
+                return
+            for i in list(pending):
+                keys = pending[i]
+                at = keys[-1][0]  # where game i now is: its halt
+                while keys and keys[-1][0] == at:
+                    self.key_event(i, keys.pop()[1], DOWN)
+                if keys:
+                    halt[i] = min(keys[-1][0], int(limits[i]))
+                else:
+                    del pending[i]
+                    halt[i] = limits[i]
 
     def _schedule(self, timelines: Sequence[Sequence[InputEvent]], now: int, limit: list[int]):
         """What each timeline does and when, as ``TimelineInput`` and ``key_event`` would do it.
@@ -569,8 +619,7 @@ class _Kernel:
         ONE, TWO, ZERO = const(1.0), const(2.0), const(0.0)
         dt = config.dt
         H, DT, SIXTH = const(0.5 * dt), const(dt), const(dt * (1.0 / 6.0))
-        # |change of the hand| <= (l1 + l2) |dq1| + l2 |dq2| (chords are shorter than arcs), a hair over.
-        REACH1, REACH2 = const((p.l1 + p.l2) * (1.0 + 1e-9)), const(p.l2 * (1.0 + 1e-9))
+        REACH1, REACH2 = (const(c) for c in hand_move_bounds(p.l1, p.l2))
         mul, add, sub, div, cos, sin = np.multiply, np.add, np.subtract, np.divide, np.cos, np.sin
         empty = np.empty
         trig, force, inertia, pair = empty((2, m)), empty((2, m)), empty((2, m)), empty((2, m))
@@ -764,7 +813,7 @@ class _Kernel:
         self.anchor[0] = 0  # the states may have changed since the last run: the fast kernel's trig anew
         config = self.batch.config
         l1, l2, radius = config.arm.l1, config.arm.l2, config.target_radius
-        near = _NEAR * radius * radius
+        near = NEAR * radius * radius
         cos, sin, sqrt = math.cos, math.sin, math.sqrt
         for k in range(count):
             if step():
@@ -795,16 +844,17 @@ class _Kernel:
 
 def replay_many(configs: Sequence[GameConfig], timelines: Sequence[Sequence[InputEvent]],
                 stop_steps: Sequence[int | None] | None = None, batch_size: int = 4096,
-                exact: bool = False) -> list[GameResult]:
+                exact: bool = False, kernel: str | None = None) -> list[GameResult]:
     """Play many recorded games, in batches where their configurations allow; results in input order.
 
     Games whose configurations can share a batch (``batch_problem``) run together, at most
     ``batch_size`` at a time; the others (an implicit integrator) run one at a time in a
     ``GameSession``. Each result equals ``GameSession(config).play(timeline, stop_step)``.
 
-    The batches run the fast kernel unless ``exact``: a game in which some hit was decided
-    within ``KNIFE_EDGE`` of a target's edge (where round-off could tip it) is played again
-    alone, so the results are the single session's either way.
+    The batches run the compiled kernel where built (exact), else numpy's fast kernel unless
+    ``exact``: then a game in which some hit was decided within ``KNIFE_EDGE`` of a target's
+    edge (where round-off could tip it) is played again alone, so the results are the single
+    session's either way. ``kernel`` is ``BatchGameSession``'s.
     """
     n = len(configs)
     if len(timelines) != n:
@@ -825,7 +875,7 @@ def replay_many(configs: Sequence[GameConfig], timelines: Sequence[Sequence[Inpu
                 i = part[0]
                 results[i] = GameSession(configs[i]).play(timelines[i], stops[i])
                 continue
-            batch = BatchGameSession([configs[i] for i in part], exact=exact)
+            batch = BatchGameSession([configs[i] for i in part], exact=exact, kernel=kernel)
             played = batch.play([timelines[i] for i in part], [stops[i] for i in part])
             for i, r, edge in zip(part, played, batch.knife_edge.tolist(), strict=True):
                 results[i] = GameSession(configs[i]).play(timelines[i], stops[i]) if edge else r

@@ -1,0 +1,275 @@
+/* The batched game's hot loop, compiled: muscles, RK4 and the hand's slack for many games.
+ *
+ * Why C: a batch of a thousand games in numpy pays about 140 calls of call overhead per
+ * physics step, and Python floats pay the interpreter per operation; here each game runs its
+ * own steps in registers. Why it equals the single session bit for bit: every expression is
+ * ``GameSession._advance``'s, ``integrators._rk4``'s and ``TwoJointArm``'s accel, with the same
+ * IEEE double operations in the same order (C evaluates a + b + c as (a + b) + c, as Python
+ * does), and ``cos``/``sin`` are the C library's, which is what Python's ``math`` calls. The
+ * build (setup.py) turns off floating-point contraction, so no multiply-add is fused, and the
+ * builtin sin and cos, so the compiler cannot merge them into a ``sincos`` of its own choosing.
+ *
+ * The kernel knows nothing of targets' rules: it stops a game whose hand may be on its target
+ * (within a relative 1e-6 of the disc) and lets Python decide, with the single session's own
+ * test and its ``GameRules``. See ``armgame/game/compiled.py`` for the calling side.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* Layout of the ``params`` buffer (doubles), written by compiled.py's ``kernel_params``. */
+enum {
+    P_DT, P_H, P_K, P_B, P_D, P_DET0, P_AMD, P_G1, P_G2, P_K1, P_K2,
+    P_L1, P_L2, P_RADIUS, P_NEAR, P_REACH1, P_REACH2,
+    P_S0, P_S1, P_S2, P_S3, P_E0, P_E1, P_E2, P_E3,
+    P_COUNT
+};
+
+/* Which accel the single session uses (TwoJointArm._build_components). */
+enum { MODE_UNFORCED = 0, MODE_DAMPING = 1, MODE_GRAVITY = 2 };
+
+typedef struct {
+    double b, d, det0, amd, g1, g2, k1, k2;
+    int mode;
+} Arm;
+
+/* TwoJointArm's accel_unforced, accel_with_damping and accel_with_gravity_and_damping. */
+static inline void accel(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
+                         double *o1, double *o2)
+{
+    double gc12 = 0.0, f1, f2;
+    if (arm->mode == MODE_GRAVITY)
+        gc12 = arm->g2 * cos(q1 + q2);
+    double bc = arm->b * cos(q2);
+    double h = arm->b * sin(q2);
+    double m12 = arm->d + bc;
+    if (arm->mode == MODE_UNFORCED) {
+        f1 = t1 + h * (w1 + w1 + w2) * w2;
+        f2 = t2 - h * w1 * w1;
+    } else if (arm->mode == MODE_DAMPING) {
+        f1 = t1 + h * (w1 + w1 + w2) * w2 - arm->k1 * w1;
+        f2 = t2 - h * w1 * w1 - arm->k2 * w2;
+    } else {
+        f1 = t1 + h * (w1 + w1 + w2) * w2 - arm->g1 * cos(q1) - gc12 - arm->k1 * w1;
+        f2 = t2 - h * w1 * w1 - gc12 - arm->k2 * w2;
+    }
+    double r = 1.0 / (arm->det0 - bc * bc);
+    *o1 = (arm->d * f1 - m12 * f2) * r;
+    *o2 = ((m12 + arm->amd + bc) * f2 - m12 * f1) * r;
+}
+
+typedef struct {
+    Py_buffer view;
+    int held;
+} Buf;
+
+static void release(Buf *bufs, int count)
+{
+    for (int i = 0; i < count; i++)
+        if (bufs[i].held)
+            PyBuffer_Release(&bufs[i].view);
+}
+
+/* Get a C-contiguous buffer of ``count`` items of ``itemsize`` bytes (any whole number of them if
+ * ``count`` is -1), writable if asked. */
+static int get(PyObject *obj, Buf *buf, Py_ssize_t count, Py_ssize_t itemsize, int writable, const char *name)
+{
+    int flags = PyBUF_C_CONTIGUOUS | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, &buf->view, flags) < 0)
+        return -1;
+    buf->held = 1;
+    if (count < 0 ? buf->view.len % itemsize != 0 : buf->view.len != count * itemsize) {
+        if (count < 0)
+            PyErr_Format(PyExc_ValueError, "%s: %zd bytes, not items of %zd", name, buf->view.len, itemsize);
+        else
+            PyErr_Format(PyExc_ValueError, "%s: %zd bytes, expected %zd", name, buf->view.len, count * itemsize);
+        return -1;
+    }
+    return 0;
+}
+
+PyDoc_STRVAR(run_doc,
+"run(params, mode, n, x, act, goal, rate, slack, tx, ty, steps, halt, cursor, ev_end, ev_step, ev_muscle,\n"
+"    ev_goal, ev_rate, flags) -> int\n\n"
+"Step every game i from steps[i] up to halt[i], applying its muscle events on the way, and\n"
+"stop it early after a step that leaves its hand near its target (flags[i] = 1). Returns how\n"
+"many games were flagged. Arrays: x (4+, n) float64 rows q1 q2 w1 w2; act, goal, rate (4, n);\n"
+"slack, tx, ty (n,); steps, halt, cursor, ev_end (n,) int64; game i's events are\n"
+"cursor[i]:ev_end[i] of ev_step (int64), ev_muscle (int64, 0-3), ev_goal, ev_rate (float64),\n"
+"sorted by step; an event at step s applies before the step from s; flags (n,) uint8.");
+
+static PyObject *run(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *obj[17];
+    int mode;
+    Py_ssize_t n;
+    if (!PyArg_ParseTuple(args, "OinOOOOOOOOOOOOOOOO", &obj[0], &mode, &n, &obj[1], &obj[2], &obj[3], &obj[4],
+                          &obj[5], &obj[6], &obj[7], &obj[8], &obj[9], &obj[10], &obj[11], &obj[12], &obj[13],
+                          &obj[14], &obj[15], &obj[16]))
+        return NULL;
+    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY || n < 1) {
+        PyErr_Format(PyExc_ValueError, "mode %d, %zd games: expected mode 0, 1 or 2 and at least one game", mode, n);
+        return NULL;
+    }
+    Buf b[17];
+    memset(b, 0, sizeof b);
+    PyObject *result = NULL;
+    const Py_ssize_t D = sizeof(double), I = sizeof(int64_t);
+    /* x (rows q1 q2 w1 w2) may carry scratch rows after the state's four. */
+    if (get(obj[0], &b[0], P_COUNT, D, 0, "params") < 0 || get(obj[1], &b[1], -1, D, 1, "x") < 0)
+        goto done;
+    if (b[1].view.len % (n * D) || b[1].view.len / (n * D) < 4) {
+        PyErr_Format(PyExc_ValueError, "x: %zd bytes, expected (rows >= 4, %zd) float64", b[1].view.len, n);
+        goto done;
+    }
+    if (get(obj[2], &b[2], 4 * n, D, 1, "act") < 0 || get(obj[3], &b[3], 4 * n, D, 1, "goal") < 0
+        || get(obj[4], &b[4], 4 * n, D, 1, "rate") < 0 || get(obj[5], &b[5], n, D, 1, "slack") < 0
+        || get(obj[6], &b[6], n, D, 0, "tx") < 0 || get(obj[7], &b[7], n, D, 0, "ty") < 0
+        || get(obj[8], &b[8], n, I, 1, "steps") < 0 || get(obj[9], &b[9], n, I, 0, "halt") < 0
+        || get(obj[10], &b[10], n, I, 1, "cursor") < 0 || get(obj[11], &b[11], n, I, 0, "ev_end") < 0
+        || get(obj[12], &b[12], -1, I, 0, "ev_step") < 0)
+        goto done;
+    const Py_ssize_t events = b[12].view.len / I;
+    if (get(obj[13], &b[13], events, I, 0, "ev_muscle") < 0 || get(obj[14], &b[14], events, D, 0, "ev_goal") < 0
+        || get(obj[15], &b[15], events, D, 0, "ev_rate") < 0 || get(obj[16], &b[16], n, 1, 1, "flags") < 0)
+        goto done;
+
+    const double *p = b[0].view.buf;
+    double *x = b[1].view.buf, *act = b[2].view.buf, *goal = b[3].view.buf, *rate = b[4].view.buf;
+    double *slack = b[5].view.buf;
+    const double *tx = b[6].view.buf, *ty = b[7].view.buf;
+    int64_t *steps = b[8].view.buf, *cursor = b[10].view.buf;
+    const int64_t *halt = b[9].view.buf, *ev_end = b[11].view.buf, *ev_step = b[12].view.buf;
+    const int64_t *ev_muscle = b[13].view.buf;
+    const double *ev_goal = b[14].view.buf, *ev_rate = b[15].view.buf;
+    uint8_t *flags = b[16].view.buf;
+
+    /* The work is bounded before it starts: cursors within the events, muscles 0-3. */
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (cursor[i] < 0 || cursor[i] > ev_end[i] || ev_end[i] > events) {
+            PyErr_Format(PyExc_ValueError, "game %zd: events %lld:%lld of %zd", i, (long long)cursor[i],
+                         (long long)ev_end[i], events);
+            goto done;
+        }
+    }
+    for (Py_ssize_t e = 0; e < events; e++) {
+        if (ev_muscle[e] < 0 || ev_muscle[e] > 3) {
+            PyErr_Format(PyExc_ValueError, "event %zd: muscle %lld", e, (long long)ev_muscle[e]);
+            goto done;
+        }
+    }
+
+    const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], mode};
+    const double dt = p[P_DT], h = p[P_H], k = p[P_K];
+    const double l1 = p[P_L1], l2 = p[P_L2], radius = p[P_RADIUS], near = p[P_NEAR];
+    const double reach1 = p[P_REACH1], reach2 = p[P_REACH2];
+    const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
+    const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
+    Py_ssize_t flagged = 0;
+
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++) {
+        int64_t s = steps[i], c = cursor[i];
+        const int64_t stop = halt[i], end = ev_end[i];
+        flags[i] = 0;
+        if (s >= stop && (c >= end || ev_step[c] > s))
+            continue;
+        double q1 = x[i], q2 = x[n + i], w1 = x[2 * n + i], w2 = x[3 * n + i];
+        double a[4], g[4], r[4];
+        for (int m = 0; m < 4; m++) {
+            a[m] = act[m * n + i];
+            g[m] = goal[m * n + i];
+            r[m] = rate[m * n + i];
+        }
+        double sl = slack[i];
+        const double x0 = tx[i], y0 = ty[i];
+        for (;;) {
+            while (c < end && ev_step[c] <= s) {
+                g[ev_muscle[c]] = ev_goal[c];
+                r[ev_muscle[c]] = ev_rate[c];
+                c++;
+            }
+            if (s >= stop)
+                break;
+            /* GameSession._advance: torque from the activations, then the muscles step. */
+            const double t1 = a[0] * s0 + a[1] * s1 + a[2] * s2 + a[3] * s3;
+            const double t2 = a[0] * e0 + a[1] * e1 + a[2] * e2 + a[3] * e3;
+            for (int m = 0; m < 4; m++)
+                a[m] += (g[m] - a[m]) * r[m];
+            /* integrators._rk4 */
+            const double p1 = q1, p2 = q2;
+            double a1, a2, b1, b2, c1, c2, d1, d2;
+            accel(&arm, q1, q2, w1, w2, t1, t2, &a1, &a2);
+            const double v1 = w1 + h * a1, v2 = w2 + h * a2;
+            accel(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &b1, &b2);
+            const double u1 = w1 + h * b1, u2 = w2 + h * b2;
+            accel(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &c1, &c2);
+            const double z1 = w1 + dt * c1, z2 = w2 + dt * c2;
+            accel(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &d1, &d2);
+            q1 = p1 + k * (w1 + z1 + 2.0 * (v1 + u1));
+            q2 = p2 + k * (w2 + z2 + 2.0 * (v2 + u2));
+            const double n1 = w1 + k * (a1 + d1 + 2.0 * (b1 + c1));
+            const double n2 = w2 + k * (a2 + d2 + 2.0 * (b2 + c2));
+            w1 = n1;
+            w2 = n2;
+            s++;
+            /* A lower bound on the hand's distance from the disc, lowered by a bound on its move;
+             * measured only when it runs out (see _Kernel.run). */
+            sl -= fabs(q1 - p1) * reach1 + fabs(q2 - p2) * reach2;
+            if (sl < 0.0) {
+                const double dx = l1 * cos(q1) + l2 * cos(q1 + q2) - x0;
+                const double dy = l1 * sin(q1) + l2 * sin(q1 + q2) - y0;
+                const double d2h = dx * dx + dy * dy;
+                sl = sqrt(d2h) - radius - 1e-9;
+                if (d2h <= near) {
+                    flags[i] = 1;
+                    flagged++;
+                    break;
+                }
+            }
+        }
+        x[i] = q1;
+        x[n + i] = q2;
+        x[2 * n + i] = w1;
+        x[3 * n + i] = w2;
+        for (int m = 0; m < 4; m++) {
+            act[m * n + i] = a[m];
+            goal[m * n + i] = g[m];
+            rate[m * n + i] = r[m];
+        }
+        slack[i] = sl;
+        steps[i] = s;
+        cursor[i] = c;
+    }
+    Py_END_ALLOW_THREADS
+    result = PyLong_FromSsize_t(flagged);
+done:
+    release(b, 17);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"run", run, METH_VARARGS, run_doc},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_ckernel",
+    "The batched game's hot loop, compiled (optional: armgame.game.compiled falls back to numpy).",
+    -1, methods, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__ckernel(void)
+{
+    PyObject *m = PyModule_Create(&module);
+    /* VERSION changes with the calling convention, so a stale build is refused, not misread. */
+    if (m != NULL && (PyModule_AddIntConstant(m, "PARAMS", P_COUNT) < 0
+                      || PyModule_AddIntConstant(m, "VERSION", 1) < 0)) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}
