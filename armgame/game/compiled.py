@@ -36,8 +36,14 @@ if TYPE_CHECKING:
 KERNEL_VERSION = 1
 _PARAMS = 25
 
-if _ckernel is not None and (getattr(_ckernel, "VERSION", None) != KERNEL_VERSION
-                             or getattr(_ckernel, "PARAMS", None) != _PARAMS):
+
+
+def speaks_our_convention(module: object) -> bool:
+    """Whether a built ``_ckernel`` is the one this module calls (not a stale build of another)."""
+    return getattr(module, "VERSION", None) == KERNEL_VERSION and getattr(module, "PARAMS", None) == _PARAMS
+
+
+if _ckernel is not None and not speaks_our_convention(_ckernel):
     _ckernel = None
 
 #: Whether the compiled kernel is here to use.
