@@ -2,6 +2,7 @@
 
     python benchmarks/class_speed.py                 # 1,000 games, 100 timed one by one, 3 repeats
     python benchmarks/class_speed.py --games 300 --sample 300 --repeats 5 --json
+    python benchmarks/class_speed.py --kernel numpy  # the batch without the compiled kernel
 
 The scripts are seeded random key timelines like a student's: every 0.1-0.5 s one of the
 four muscle keys changes (pressed if up, released if down), and one switch in a hundred is
@@ -9,7 +10,9 @@ followed by a reset. Every game is the standard one (seed 10, 60 s), as in a cla
 
 "One after another" is today's rate: ``GameSession(config).play(timeline)`` per game, timed
 on the first ``--sample`` games and scaled to all of them (the games cost the same to a few
-per cent). "Batched" is one ``BatchGameSession`` for all the games, timed whole, wall clock;
+per cent). "Batched" is ``replay_many`` for all the games, as ``armgame play --headless --script``
+plays a class: one ``BatchGameSession(exact=False)``, whose games decided on a knife edge are
+played again alone (``--exact``: the exact kernel, bit for bit the single session), timed whole;
 the results of the sampled games are checked equal to the sequential ones. Verification is
 the same comparison for replays: ``Replay.verify`` one by one against
 ``records.batch_verify.verify_replays`` (recomputation only, files already read).
@@ -33,7 +36,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from armgame.game.batch import BatchGameSession
+from armgame.game import compiled
+from armgame.game.batch import KERNELS, replay_many
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
 from armgame.records.batch_verify import verify_replays
@@ -74,24 +78,26 @@ def machine() -> dict[str, object]:
     except OSError:
         pass
     return {"cpu": model, "cores": os.cpu_count(), "python": platform.python_version(), "numpy": np.__version__,
-            "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None}
+            "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None,
+            "compiled_kernel_built": compiled.AVAILABLE}
 
 
-def one_repeat(configs: list[GameConfig], timelines: list[list[InputEvent]], sample: int) -> dict[str, float]:
+def one_repeat(configs: list[GameConfig], timelines: list[list[InputEvent]], sample: int,
+               kernel: str | None, exact: bool) -> dict[str, float]:
     n = len(configs)
     scale = n / sample
     # Games: one after another (a sample, scaled) and in one batch.
     seq_wall, seq_cpu, seq_results = timed(lambda: [GameSession(c).play(t)
                                                     for c, t in zip(configs[:sample], timelines[:sample],
                                                                     strict=True)])
-    batch_wall, batch_cpu, batch_results = timed(lambda: BatchGameSession(configs).play(timelines))
+    batch_wall, batch_cpu, batch_results = timed(lambda: replay_many(configs, timelines, exact=exact, kernel=kernel))
     if batch_results[:sample] != seq_results:
         sys.exit("class_speed: the batch and the single sessions disagree: a bug")
     # Verification of the same games as replays.
     replays = [Replay(c, tuple(t), r, "script", f"student{i:04d}.txt", f"student {i}")
                for i, (c, t, r) in enumerate(zip(configs, timelines, batch_results, strict=True))]
     vseq_wall, vseq_cpu, vseq = timed(lambda: [r.verify() for r in replays[:sample]])
-    vbatch_wall, vbatch_cpu, vbatch = timed(lambda: verify_replays(replays))
+    vbatch_wall, vbatch_cpu, vbatch = timed(lambda: verify_replays(replays, kernel=kernel))
     if vbatch[:sample] != vseq or not all(ok for ok, _ in vbatch):
         sys.exit("class_speed: batched verification disagrees with Replay.verify: a bug")
     return {
@@ -110,6 +116,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="games timed one after another, scaled to --games (default: 100)")
     parser.add_argument("--seconds", type=float, default=60.0, help="length of each game (default: 60)")
     parser.add_argument("--repeats", type=int, default=3, help="repeats, for the spread (default: 3)")
+    parser.add_argument("--exact", action="store_true", help="play the batch with the exact kernel")
+    parser.add_argument("--kernel", choices=[k for k in KERNELS if k], default=None,
+                        help="the batch's kernel (default: compiled where built, else numpy)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
     if not (1 <= args.sample <= args.games <= 100_000 and 1 <= args.repeats <= 20 and 0 < args.seconds <= 600):
@@ -117,13 +126,15 @@ def main(argv: list[str] | None = None) -> int:
     config = GameConfig(seed=CLASS_SEED, time_limit=args.seconds)
     configs = [config] * args.games
     timelines = [student_timeline(random.Random(i), config.dt, args.seconds) for i in range(args.games)]
-    runs = [one_repeat(configs, timelines, args.sample) for _ in range(args.repeats)]
+    runs = [one_repeat(configs, timelines, args.sample, args.kernel, args.exact) for _ in range(args.repeats)]
+    kernel = (args.kernel or ("compiled" if compiled.AVAILABLE else "numpy")) + (" exact" if args.exact else "")
 
     def summary(key: str) -> dict[str, float]:
         values = [run[key] for run in runs]
         return {"median": statistics.median(values), "min": min(values), "max": max(values)}
 
-    report = {"games": args.games, "sample": args.sample, "seconds": args.seconds, "repeats": args.repeats,
+    report = {"games": args.games, "sample": args.sample, "kernel": kernel, "seconds": args.seconds,
+              "repeats": args.repeats,
               "events_per_game": sum(map(len, timelines)) / args.games, "machine": machine(),
               **{key: summary(key) for key in runs[0]}, "runs": runs}
     if args.json:
@@ -132,7 +143,7 @@ def main(argv: list[str] | None = None) -> int:
     m = report["machine"]
     print(f"{args.games} scripted {args.seconds:g} s games ({report['events_per_game']:.0f} key events each), "
           f"{args.repeats} repeats; {m['cpu']}, {m['cores']} cores, load {m['load_average_1min']}, "
-          f"Python {m['python']}, numpy {m['numpy']}")
+          f"Python {m['python']}, numpy {m['numpy']}; batch kernel: {kernel}")
     for label, prefix in (("play", ""), ("verify", "verify_")):
         seq, batch = report[f"{prefix}sequential_wall_s"], report[f"{prefix}batched_wall_s"]
         wall, cpu = report[f"{prefix}ratio_wall"], report[f"{prefix}ratio_cpu"]

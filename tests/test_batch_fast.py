@@ -1,7 +1,9 @@
-"""The fast kernel (``BatchGameSession(configs, exact=False, kernel="numpy")``) against the single session.
+"""The fast kernels (``BatchGameSession(configs, exact=False)``) against the single session.
 
-Its series only run from ``SERIES_MIN_GAMES`` games (2,048): these tests lower that to one game,
-so that a handful of games exercises the very arithmetic a large batch runs.
+Both kernels have one: numpy's and the compiled one take the elbow's cos and sin by angle
+addition. numpy's series only run from ``SERIES_MIN_GAMES`` games (2,048): these tests lower
+that to one game, so that a handful of games exercises the very arithmetic a large batch runs.
+The compiled kernel's run at any size.
 """
 
 import math
@@ -12,9 +14,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_batch import KEYS, student_timeline
+from test_batch import KERNELS, KEYS, student_timeline
 
 import armgame.game.batch as batch_module
+from armgame.game import compiled
 from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, replay_many
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
 from armgame.game.session import GameSession, InputEvent
@@ -30,6 +33,8 @@ def series_for_any_batch(**constants):
         mp.setattr(batch_module, "SERIES_MIN_GAMES", 1)
         for name, value in constants.items():
             mp.setattr(batch_module, name, value)
+            if name == "SERIES_LIMIT":
+                mp.setattr(compiled, name, value)
         yield
 
 
@@ -49,6 +54,7 @@ def assert_same_results(batch: BatchGameSession, i: int, single: GameSession) ->
     return worst
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @settings(max_examples=10, deadline=None)
 @given(
     seeds=st.lists(st.integers(0, 2**63 - 1), min_size=1, max_size=5),
@@ -57,29 +63,30 @@ def assert_same_results(batch: BatchGameSession, i: int, single: GameSession) ->
     radius=st.sampled_from([0.05, 0.2]),
     timeline_seed=st.integers(0, 2**32 - 1),
 )
-def test_fast_batch_equals_single_sessions_on_random_timelines(seeds, durations, stops, radius, timeline_seed):
+def test_fast_batch_equals_single_sessions_on_random_timelines(kernel, seeds, durations, stops, radius, timeline_seed):
     """Random keys, resets, tab, stray keys, games of different lengths, some stopped early."""
     rng = random.Random(timeline_seed)
     configs = [GameConfig(seed=s, time_limit=durations[i], target_radius=radius) for i, s in enumerate(seeds)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
     stop_steps = stops[:len(configs)]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False, kernel="numpy")
+        batch = BatchGameSession(configs, exact=False, kernel=kernel)
         results = batch.play(timelines, stop_steps)
-        assert results == replay_many(configs, timelines, stop_steps)
+        assert results == replay_many(configs, timelines, stop_steps, kernel=kernel)
     for i, (c, timeline, stop) in enumerate(zip(configs, timelines, stop_steps, strict=True)):
         single = GameSession(c)
         assert results[i] == single.play(timeline, stop)
         assert_same_results(batch, i, single)
 
 
-def test_full_games_stay_within_round_off_and_score_the_same():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_full_games_stay_within_round_off_and_score_the_same(kernel):
     """60 s games with a large target (many hits and near misses): the largest state difference, measured."""
     rng = random.Random(11)
     configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(12)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False, kernel="numpy")
+        batch = BatchGameSession(configs, exact=False, kernel=kernel)
         results = batch.play(timelines)
     worst = 0.0
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
@@ -91,12 +98,13 @@ def test_full_games_stay_within_round_off_and_score_the_same():
     assert 0.0 < worst <= MEASURED
 
 
-def test_the_step_api_with_levels_and_resets_equals_single_sessions():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_the_step_api_with_levels_and_resets_equals_single_sessions(kernel):
     rng = np.random.default_rng(5)
     configs = [GameConfig(seed=s, time_limit=3.0, target_radius=0.15) for s in range(4)]
     singles = [GameSession(c) for c in configs]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False, kernel="numpy")
+        batch = BatchGameSession(configs, exact=False, kernel=kernel)
         for turn in range(150):
             if turn % 2:
                 levels = rng.choice([0.0, 0.4, 1.0], size=(4, 4))
@@ -114,29 +122,31 @@ def test_the_step_api_with_levels_and_resets_equals_single_sessions():
         assert_same_results(batch, i, s)
 
 
-def test_a_step_beyond_the_series_range_falls_back_to_the_exact_arithmetic():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_a_step_beyond_the_series_range_falls_back_to_the_exact_arithmetic(kernel):
     """With the range at zero every step falls back: bit for bit the exact kernel."""
     configs = [GameConfig(seed=s, time_limit=2.0) for s in range(3)]
     timelines = [student_timeline(random.Random(s), configs[0].dt, 2.0) for s in range(3)]
     exact = BatchGameSession(configs)
     exact.play(timelines)
     with series_for_any_batch(SERIES_LIMIT=0.0):
-        fallen = BatchGameSession(configs, exact=False, kernel="numpy")
+        fallen = BatchGameSession(configs, exact=False, kernel=kernel)
         fallen.play(timelines)
     assert np.array_equal(fallen._x[:4], exact._x[:4])
     with series_for_any_batch():
-        fast = BatchGameSession(configs, exact=False, kernel="numpy")
+        fast = BatchGameSession(configs, exact=False, kernel=kernel)
         fast.play(timelines)
     assert not np.array_equal(fast._x[:4], exact._x[:4])  # the series did run: the test can fail
 
 
-def test_large_steps_and_spins_beyond_the_series_range_still_equal_the_single_session():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_large_steps_and_spins_beyond_the_series_range_still_equal_the_single_session(kernel):
     """dt = 40 ms and a frictionless arm: elbow increments well past 0.1 rad, some steps fall back."""
     arm = GAME_PLAY_ARM.replace(damping1=0.0, damping2=0.0)
     configs = [GameConfig(seed=s, time_limit=6.0, dt=0.04, arm=arm, target_radius=0.1) for s in range(3)]
     timelines = [[InputEvent(0, k, "down") for k in KEYS[:1 + s]] for s in range(3)]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False, kernel="numpy")
+        batch = BatchGameSession(configs, exact=False, kernel=kernel)
         results = batch.play(timelines)
     assert float(np.abs(batch.w2).max()) * configs[0].dt > batch_module.SERIES_LIMIT
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
@@ -159,11 +169,12 @@ def knife_edge_game(inside: bool) -> tuple[GameConfig, list[InputEvent], Target]
     return config, script, Target(hx + r * (hx - px) / length, hy + r * (hy - py) / length, config.target_radius)
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("inside", [True, False])
-def test_a_decision_on_the_knife_edge_marks_the_game(inside):
+def test_a_decision_on_the_knife_edge_marks_the_game(kernel, inside):
     config, script, edge = knife_edge_game(inside)
     with series_for_any_batch():
-        batch = BatchGameSession([config, config], exact=False, kernel="numpy")
+        batch = BatchGameSession([config, config], exact=False, kernel=kernel)
     batch.rules[0].target = edge
     batch.target_x[0], batch.target_y[0] = edge.x, edge.y
     batch.play([script, script])
@@ -175,7 +186,8 @@ def test_a_decision_on_the_knife_edge_marks_the_game(inside):
     assert not exact.knife_edge.any()
 
 
-def test_replay_many_plays_games_marked_on_the_knife_edge_again_alone(monkeypatch):
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_replay_many_plays_games_marked_on_the_knife_edge_again_alone(kernel, monkeypatch):
     """With every decided hit marked (a huge knife edge), replay_many plays every scoring game alone."""
     configs = [GameConfig(seed=s, time_limit=4.0, target_radius=0.25) for s in range(4)]
     timelines = [student_timeline(random.Random(s), configs[0].dt, 4.0, extras=False) for s in range(4)]
@@ -188,18 +200,19 @@ def test_replay_many_plays_games_marked_on_the_knife_edge_again_alone(monkeypatc
 
     monkeypatch.setattr(GameSession, "play", spy)
     with series_for_any_batch(KNIFE_EDGE=10.0):
-        results = replay_many(configs, timelines, kernel="numpy")
+        results = replay_many(configs, timelines, kernel=kernel)
     scorers = {c.seed for c, r in zip(configs, results, strict=True) if r.hits}
     assert len(scorers) >= 2 and scorers <= set(alone)  # every hit was decided, so marked
     alone.clear()
     with series_for_any_batch():
-        assert replay_many(configs, timelines, kernel="numpy") == results
+        assert replay_many(configs, timelines, kernel=kernel) == results
     assert alone == []
     assert results == [play(GameSession(c), t) for c, t in zip(configs, timelines, strict=True)]
 
 
+@pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("arm", ["vertical", "biarticular"])
-def test_gravity_and_two_joint_muscles_in_the_fast_kernel(arm):
+def test_gravity_and_two_joint_muscles_in_the_fast_kernel(kernel, arm):
     """Gravity's own cos terms and muscles acting on both joints, through the series."""
     from armgame.game.muscles import DEFAULT_MUSCLES, MuscleSpec
 
@@ -209,7 +222,7 @@ def test_gravity_and_two_joint_muscles_in_the_fast_kernel(arm):
     configs = [GameConfig(seed=s, time_limit=5.0, target_radius=0.15, **kwargs) for s in range(3)]
     timelines = [student_timeline(random.Random(s), configs[0].dt, 5.0) for s in range(3)]
     with series_for_any_batch():
-        batch = BatchGameSession(configs, exact=False, kernel="numpy")
+        batch = BatchGameSession(configs, exact=False, kernel=kernel)
         results = batch.play(timelines)
     for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
         single = GameSession(c)
@@ -217,13 +230,14 @@ def test_gravity_and_two_joint_muscles_in_the_fast_kernel(arm):
         assert_same_results(batch, i, single)
 
 
-def test_games_longer_than_the_fast_kernels_limit_run_the_exact_kernel():
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_games_longer_than_the_fast_kernels_limit_run_the_exact_kernel(kernel):
     """Round-off grows with the game's length: past FAST_MAX_SECONDS the batch keeps to the exact kernel."""
     short, long = (GameConfig(time_limit=batch_module.FAST_MAX_SECONDS + extra) for extra in (0.0, 0.004))
     timelines = [[InputEvent(0, "d", "down"), InputEvent(100, "k", "down")]] * 2
     with series_for_any_batch():
-        fast = BatchGameSession([short, short], exact=False, kernel="numpy")
-        kept = BatchGameSession([short, long], exact=False, kernel="numpy")
+        fast = BatchGameSession([short, short], exact=False, kernel=kernel)
+        kept = BatchGameSession([short, long], exact=False, kernel=kernel)
     exact = BatchGameSession([short, long])
     for batch in (fast, kept, exact):
         batch.play(timelines, [3000, 3000])

@@ -25,7 +25,7 @@ def arrays(n: int = 3) -> dict:
     kernel = compiled.CompiledKernel(batch)
     events = compiled.MuscleEvents.by_game(n, np.array([0, 5]), np.array([0, n + 1]), np.array([1.0, 1.0]),
                                            np.array([0.1, 0.1]))
-    return {"params": kernel.params, "mode": kernel.mode, "n": n, "x": batch._xs,
+    return {"params": kernel.params, "mode": kernel.mode, "fast": False, "n": n, "x": batch._xs,
             "act": batch._act, "goal": batch._goal, "rate": batch._rate, "slack": batch._slack,
             "tx": batch.target_x, "ty": batch.target_y, "steps": batch.steps,
             "halt": np.full(n, 50, dtype=np.int64), "cursor": events.cursor, "ev_end": events.end,

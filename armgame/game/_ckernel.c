@@ -22,7 +22,7 @@
 /* Layout of the ``params`` buffer (doubles), written by compiled.py's ``kernel_params``. */
 enum {
     P_DT, P_H, P_K, P_B, P_D, P_DET0, P_AMD, P_G1, P_G2, P_K1, P_K2,
-    P_L1, P_L2, P_RADIUS, P_NEAR, P_REACH1, P_REACH2,
+    P_L1, P_L2, P_RADIUS, P_NEAR, P_REACH1, P_REACH2, P_LIMIT2,
     P_S0, P_S1, P_S2, P_S3, P_E0, P_E1, P_E2, P_E3,
     P_COUNT
 };
@@ -35,15 +35,14 @@ typedef struct {
     int mode;
 } Arm;
 
-/* TwoJointArm's accel_unforced, accel_with_damping and accel_with_gravity_and_damping. */
-static inline void accel(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
-                         double *o1, double *o2)
+/* TwoJointArm's accel_unforced, accel_with_damping and accel_with_gravity_and_damping, given
+ * bc = b cos q2 and h = b sin q2. */
+static inline void accel_trig(const Arm *arm, double q1, double q2, double bc, double h, double w1, double w2,
+                              double t1, double t2, double *o1, double *o2)
 {
     double gc12 = 0.0, f1, f2;
     if (arm->mode == MODE_GRAVITY)
         gc12 = arm->g2 * cos(q1 + q2);
-    double bc = arm->b * cos(q2);
-    double h = arm->b * sin(q2);
     double m12 = arm->d + bc;
     if (arm->mode == MODE_UNFORCED) {
         f1 = t1 + h * (w1 + w1 + w2) * w2;
@@ -59,6 +58,45 @@ static inline void accel(const Arm *arm, double q1, double q2, double w1, double
     *o1 = (arm->d * f1 - m12 * f2) * r;
     *o2 = ((m12 + arm->amd + bc) * f2 - m12 * f1) * r;
 }
+
+/* The same with the elbow's cos and sin of its own (the exact kernel). */
+static inline void accel(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
+                         double *o1, double *o2)
+{
+    accel_trig(arm, q1, q2, arm->b * cos(q2), arm->b * sin(q2), w1, w2, t1, t2, o1, o2);
+}
+
+/* The fast kernel's elbow trig (batch._Kernel's, there in numpy): b cos and b sin of q2 + delta
+ * from those of q2 by angle addition, with cos and sin of the small delta from Taylor series
+ * in delta^2 (the first dropped terms below 3e-17 within SERIES_LIMIT). Returns 0, leaving the
+ * outputs alone, if |delta| is beyond the series' range. */
+static inline int turned(double bc, double bs, double delta, double limit2, double *oc, double *os)
+{
+    const double d2 = delta * delta;
+    if (!(d2 <= limit2))
+        return 0;
+    const double c = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0))));
+    const double s = delta * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0
+                                                                              + d2 * (1.0 / 362880.0)))));
+    *oc = bc * c - bs * s;
+    *os = bs * c + bc * s;
+    return 1;
+}
+
+/* One fast stage: its elbow trig turned from stage 1's by delta (full cos and sin if too far). */
+static inline void accel_turned(const Arm *arm, double q1, double q2, double delta, double bc, double bs,
+                                double limit2, double w1, double w2, double t1, double t2, double *o1, double *o2)
+{
+    double c, s;
+    if (!turned(bc, bs, delta, limit2, &c, &s)) {
+        c = arm->b * cos(q2);
+        s = arm->b * sin(q2);
+    }
+    accel_trig(arm, q1, q2, c, s, w1, w2, t1, t2, o1, o2);
+}
+
+/* Steps between full cos and sin of the elbow in the fast kernel (turned ones gather round-off). */
+#define REANCHOR 32
 
 typedef struct {
     Py_buffer view;
@@ -91,22 +129,24 @@ static int get(PyObject *obj, Buf *buf, Py_ssize_t count, Py_ssize_t itemsize, i
 }
 
 PyDoc_STRVAR(run_doc,
-"run(params, mode, n, x, act, goal, rate, slack, tx, ty, steps, halt, cursor, ev_end, ev_step, ev_muscle,\n"
+"run(params, mode, fast, n, x, act, goal, rate, slack, tx, ty, steps, halt, cursor, ev_end, ev_step, ev_muscle,\n"
 "    ev_goal, ev_rate, flags) -> int\n\n"
 "Step every game i from steps[i] up to halt[i], applying its muscle events on the way, and\n"
 "stop it early after a step that leaves its hand near its target (flags[i] = 1). Returns how\n"
 "many games were flagged. Arrays: x (4+, n) float64 rows q1 q2 w1 w2; act, goal, rate (4, n);\n"
 "slack, tx, ty (n,); steps, halt, cursor, ev_end (n,) int64; game i's events are\n"
 "cursor[i]:ev_end[i] of ev_step (int64), ev_muscle (int64, 0-3), ev_goal, ev_rate (float64),\n"
-"sorted by step; an event at step s applies before the step from s; flags (n,) uint8.");
+"sorted by step; an event at step s applies before the step from s; flags (n,) uint8.\n"
+"With fast true, RK4's elbow trig comes by angle addition (the numpy fast kernel's method):\n"
+"round-off, not bit for bit.");
 
 static PyObject *run(PyObject *self, PyObject *args)
 {
     (void)self;
     PyObject *obj[17];
-    int mode;
+    int mode, fast;
     Py_ssize_t n;
-    if (!PyArg_ParseTuple(args, "OinOOOOOOOOOOOOOOOO", &obj[0], &mode, &n, &obj[1], &obj[2], &obj[3], &obj[4],
+    if (!PyArg_ParseTuple(args, "OipnOOOOOOOOOOOOOOOO", &obj[0], &mode, &fast, &n, &obj[1], &obj[2], &obj[3], &obj[4],
                           &obj[5], &obj[6], &obj[7], &obj[8], &obj[9], &obj[10], &obj[11], &obj[12], &obj[13],
                           &obj[14], &obj[15], &obj[16]))
         return NULL;
@@ -165,7 +205,7 @@ static PyObject *run(PyObject *self, PyObject *args)
     const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], mode};
     const double dt = p[P_DT], h = p[P_H], k = p[P_K];
     const double l1 = p[P_L1], l2 = p[P_L2], radius = p[P_RADIUS], near = p[P_NEAR];
-    const double reach1 = p[P_REACH1], reach2 = p[P_REACH2];
+    const double reach1 = p[P_REACH1], reach2 = p[P_REACH2], limit2 = p[P_LIMIT2];
     const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
     const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
     Py_ssize_t flagged = 0;
@@ -178,6 +218,8 @@ static PyObject *run(PyObject *self, PyObject *args)
         if (s >= stop && (c >= end || ev_step[c] > s))
             continue;
         double q1 = x[i], q2 = x[n + i], w1 = x[2 * n + i], w2 = x[3 * n + i];
+        double bc = 0.0, bs = 0.0;  /* the fast kernel's b cos q2, b sin q2, carried from step to step */
+        int anchor = 0;  /* steps left before they are computed in full again; none at a game's start */
         double a[4], g[4], r[4];
         for (int m = 0; m < 4; m++) {
             a[m] = act[m * n + i];
@@ -201,14 +243,36 @@ static PyObject *run(PyObject *self, PyObject *args)
                 a[m] += (g[m] - a[m]) * r[m];
             /* integrators._rk4 */
             const double p1 = q1, p2 = q2;
-            double a1, a2, b1, b2, c1, c2, d1, d2;
-            accel(&arm, q1, q2, w1, w2, t1, t2, &a1, &a2);
-            const double v1 = w1 + h * a1, v2 = w2 + h * a2;
-            accel(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &b1, &b2);
-            const double u1 = w1 + h * b1, u2 = w2 + h * b2;
-            accel(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &c1, &c2);
-            const double z1 = w1 + dt * c1, z2 = w2 + dt * c2;
-            accel(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &d1, &d2);
+            double a1, a2, b1, b2, c1, c2, d1, d2, v1, v2, u1, u2, z1, z2;
+            if (!fast) {
+                accel(&arm, q1, q2, w1, w2, t1, t2, &a1, &a2);
+                v1 = w1 + h * a1;
+                v2 = w2 + h * a2;
+                accel(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &b1, &b2);
+                u1 = w1 + h * b1;
+                u2 = w2 + h * b2;
+                accel(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &c1, &c2);
+                z1 = w1 + dt * c1;
+                z2 = w2 + dt * c2;
+                accel(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &d1, &d2);
+            } else {
+                if (anchor <= 0) {
+                    bc = arm.b * cos(q2);
+                    bs = arm.b * sin(q2);
+                    anchor = REANCHOR;
+                }
+                anchor--;
+                accel_trig(&arm, q1, q2, bc, bs, w1, w2, t1, t2, &a1, &a2);
+                v1 = w1 + h * a1;
+                v2 = w2 + h * a2;
+                accel_turned(&arm, q1 + h * w1, q2 + h * w2, h * w2, bc, bs, limit2, v1, v2, t1, t2, &b1, &b2);
+                u1 = w1 + h * b1;
+                u2 = w2 + h * b2;
+                accel_turned(&arm, q1 + h * v1, q2 + h * v2, h * v2, bc, bs, limit2, u1, u2, t1, t2, &c1, &c2);
+                z1 = w1 + dt * c1;
+                z2 = w2 + dt * c2;
+                accel_turned(&arm, q1 + dt * u1, q2 + dt * u2, dt * u2, bc, bs, limit2, z1, z2, t1, t2, &d1, &d2);
+            }
             q1 = p1 + k * (w1 + z1 + 2.0 * (v1 + u1));
             q2 = p2 + k * (w2 + z2 + 2.0 * (v2 + u2));
             const double n1 = w1 + k * (a1 + d1 + 2.0 * (b1 + c1));
@@ -216,6 +280,9 @@ static PyObject *run(PyObject *self, PyObject *args)
             w1 = n1;
             w2 = n2;
             s++;
+            /* The next step's elbow trig: this one's turned by the step's change of q2. */
+            if (fast && !turned(bc, bs, q2 - p2, limit2, &bc, &bs))
+                anchor = 0;
             /* A lower bound on the hand's distance from the disc, lowered by a bound on its move;
              * measured only when it runs out (see _Kernel.run). */
             sl -= fabs(q1 - p1) * reach1 + fabs(q2 - p2) * reach2;
@@ -267,7 +334,7 @@ PyMODINIT_FUNC PyInit__ckernel(void)
     PyObject *m = PyModule_Create(&module);
     /* VERSION changes with the calling convention, so a stale build is refused, not misread. */
     if (m != NULL && (PyModule_AddIntConstant(m, "PARAMS", P_COUNT) < 0
-                      || PyModule_AddIntConstant(m, "VERSION", 1) < 0)) {
+                      || PyModule_AddIntConstant(m, "VERSION", 2) < 0)) {
         Py_DECREF(m);
         return NULL;
     }

@@ -1,10 +1,18 @@
 """Many games in lockstep: a class's scripts, a batch of replays, a vector of environments.
 
-``BatchGameSession`` runs N games at once with one numpy array per quantity (joint state,
-activations, targets, clocks), so a physics step costs about 130 numpy operations however
-many games there are. Each game of a batch equals the single ``GameSession`` fed the same
-inputs: hits, score, resets and steps exactly, and its joint state to round-off. How that
-holds:
+``BatchGameSession`` runs N games at once with one array per quantity (joint state,
+activations, targets, clocks). Each game of a batch equals the single ``GameSession`` fed the
+same inputs: hits, score, resets and steps exactly, and its joint state to round-off (bit for
+bit where stated below). Two kernels step them:
+
+* **compiled** (``compiled.py``, ``_ckernel.c``; the default where ``pip install`` could build
+  it, for RK4): each game runs its own steps in C, the single session's expressions operation
+  for operation with the C library's cos and sin, so bit for bit; ``play`` hands it each game's
+  muscle commands and it runs each game to its next reset, tab or stop, back in Python only to
+  judge a hand at a target. With ``exact=False`` (games of at most ``FAST_MAX_SECONDS``) it
+  takes the elbow's cos and sin by angle addition, as numpy's fast kernel below does.
+* **numpy** (``_Kernel``; the fallback, and the Euler schemes): a physics step costs about 130
+  numpy operations however many games there are. How it equals the single session:
 
 * The physics is the single session's own arithmetic: for RK4 (the game's integrator) its
   hot loop, step and accelerations written out operation for operation on arrays
@@ -25,15 +33,15 @@ holds:
   game's own ``GameRules`` (which draws the next target from the game's own random
   sequence). Given equal states the decision is identical, knife edge or not.
 * ``exact=False`` (the vector env, ``replay_many``: class scoring and verification) runs the
-  fast kernel from ``SERIES_MIN_GAMES`` games: RK4 stages 2-4 take the elbow's cos and sin
-  from stage 1's by angle addition, with Taylor series for the small increment (as
-  ``physics.batch.BatchRK4``; full sin and cos for any step whose increment exceeds
+  fast kernel (numpy's from ``SERIES_MIN_GAMES`` games, the compiled one's at any size): RK4
+  stages 2-4 take the elbow's cos and sin from stage 1's by angle addition, with Taylor series
+  for the small increment (as ``physics.batch.BatchRK4``; full sin and cos for any step whose increment exceeds
   ``SERIES_LIMIT``); stage 1's come from the previous step's, turned by the step's change of
   q2 (full sin and cos at the start of each run of steps and every 32 steps). That saves all
   but one in 32 of the steps' sin and cos of the whole batch, and costs round-off, which the
   arm's motion amplifies: over 1,000 games of 60 s with random keys the joint states stayed
-  within 1.7e-11 of the single session's, against ``STATE_TOLERANCE`` (games longer than
-  ``FAST_MAX_SECONDS`` run the exact kernel). Hits are still decided by the exact test on
+  within 1.7e-11 of the single session's (compiled: 9.6e-12), against ``STATE_TOLERANCE``
+  (games longer than ``FAST_MAX_SECONDS`` run the exact kernel). Hits are still decided by the exact test on
   Python floats, on the fast state; the hand is then within about 1.4e-11 m of the single
   session's, so a decision could differ only if the hand were that close to the edge, where it
   moves about 1e-3 m a step: about 3e-8 per crossing. A decision within ``KNIFE_EDGE`` (1e-8 m)
@@ -43,7 +51,7 @@ holds:
   sin and cos, and the exact kernel is also the faster one, whatever ``exact`` says.
 * Events (keys, resets, tab) are applied between physics steps exactly where the single
   session applies them; ``play`` advances every game to the next step at which any game has
-  an event, vectorised in between.
+  an event, vectorised in between (the compiled kernel needs no such common step).
 
 The implicit integrators (midpoint, gauss4) iterate until the largest change over the
 whole batch converges, so a game's iteration count would depend on the others: a batch
@@ -191,8 +199,9 @@ class BatchGameSession:
         #: The compiled kernel where built (and asked for) and the integrator is RK4; else None: numpy.
         self.compiled: CompiledKernel | None = None
         if kernel != "numpy" and compiled.AVAILABLE and c.integrator == "rk4":
-            self.compiled = CompiledKernel(self)
-            self._rounds = False
+            # Compiled, the series pay at any batch size: no numpy call overhead to outweigh.
+            self._rounds = not self.exact and int(self.total_steps.max()) * c.dt <= FAST_MAX_SECONDS
+            self.compiled = CompiledKernel(self, fast=self._rounds)
 
     def _start(self, i: int, config: GameConfig) -> None:
         self.configs[i] = config

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..physics.batch import SERIES_LIMIT
 from ..physics.integrators import _SIXTH
 
 try:
@@ -33,8 +34,8 @@ if TYPE_CHECKING:
     from .batch import BatchGameSession
 
 #: The calling convention this module speaks; a build of another (a stale ``.so``) is not used.
-KERNEL_VERSION = 1
-_PARAMS = 25
+KERNEL_VERSION = 2
+_PARAMS = 26
 
 
 
@@ -95,10 +96,12 @@ class MuscleEvents:
 class CompiledKernel:
     """Runs a ``BatchGameSession``'s games to given steps with ``_ckernel``, on the batch's own arrays."""
 
-    def __init__(self, batch: BatchGameSession) -> None:
+    def __init__(self, batch: BatchGameSession, fast: bool = False) -> None:
         if _ckernel is None:
             raise RuntimeError("the compiled kernel is not built (reinstall with a C compiler: pip install -e .)")
         self.batch = batch
+        #: RK4's elbow trig by angle addition (round-off, not bit for bit; see ``_ckernel.c``).
+        self.fast = bool(fast)
         model, config = batch.model, batch.config
         p = model.params
         dt, radius = config.dt, config.target_radius
@@ -107,7 +110,7 @@ class CompiledKernel:
         self.params = np.array([
             dt, 0.5 * dt, dt * _SIXTH, model.b, model.d, model.a * model.d - model.d * model.d, model.a - model.d,
             model.g1, model.g2, p.damping1, p.damping2,
-            p.l1, p.l2, radius, NEAR * radius * radius, *hand_move_bounds(p.l1, p.l2),
+            p.l1, p.l2, radius, NEAR * radius * radius, *hand_move_bounds(p.l1, p.l2), SERIES_LIMIT * SERIES_LIMIT,
             *batch._shoulder, *batch._elbow,
         ], dtype=float)
         assert len(self.params) == _PARAMS
@@ -121,8 +124,8 @@ class CompiledKernel:
         if events is None:
             ev.cursor.fill(0)
         halt = np.ascontiguousarray(halt, dtype=np.int64)
-        while _ckernel.run(self.params, self.mode, b.n, b._xs, b._act, b._goal, b._rate, b._slack, b.target_x,
-                           b.target_y, b.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal, ev.rate,
-                           self.flags):
+        while _ckernel.run(self.params, self.mode, self.fast, b.n, b._xs, b._act, b._goal, b._rate, b._slack,
+                           b.target_x, b.target_y, b.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal,
+                           ev.rate, self.flags):
             for i in np.flatnonzero(self.flags).tolist():
                 b._hit_test(i, b._x[:, i], int(b.steps[i]))

@@ -32,21 +32,22 @@ def _chunks(items: Iterable, size: int) -> Iterator[list]:
         yield chunk
 
 
-def verify_replays(replays: Sequence[Replay]) -> list[tuple[bool, GameResult]]:
+def verify_replays(replays: Sequence[Replay], kernel: str | None = None) -> list[tuple[bool, GameResult]]:
     """``[replay.verify() for replay in replays]``, the games of ranked rulesets recomputed in batches.
 
     Only those: their cost is known (the ruleset's steps) and they share a batch by construction.
     A lab run is compared trial by trial, and a custom game's ``verify`` stops as soon as it scores
     more than it claims (a rigged configuration could hit a target at every step), so both keep
-    their own ``verify``.
+    their own ``verify``. ``kernel`` is ``BatchGameSession``'s (None: compiled where built).
     """
     batched = [i for i, r in enumerate(replays) if r.task is None and ruleset_of(r.config) is not None]
     results = replay_many([replays[i].config for i in batched], [replays[i].timeline for i in batched],
-                          [replays[i].result.steps for i in batched])
+                          [replays[i].result.steps for i in batched], kernel=kernel)
     verdicts: list[tuple[bool, GameResult] | None] = [None] * len(replays)
     for i, got in zip(batched, results, strict=True):
-        # The batch's fast kernel agrees with the single session to round-off; a replay it finds
-        # wanting (a forgery, or a vanishingly rare split) gets the single session's own verdict.
+        # The compiled kernel is the single session bit for bit; numpy's fast kernel (no compiler)
+        # agrees to round-off, so a replay a batch finds wanting (a forgery, or a vanishingly rare
+        # split) gets the single session's own verdict.
         verdicts[i] = (True, got) if same_outcome(got, replays[i].result) else replays[i].verify()
     return [v if v is not None else r.verify() for r, v in zip(replays, verdicts, strict=True)]
 
