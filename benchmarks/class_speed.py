@@ -116,7 +116,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="games timed one after another, scaled to --games (default: 100)")
     parser.add_argument("--seconds", type=float, default=60.0, help="length of each game (default: 60)")
     parser.add_argument("--repeats", type=int, default=3, help="repeats, for the spread (default: 3)")
-    parser.add_argument("--exact", action="store_true", help="play the batch with the exact kernel")
+    parser.add_argument("--exact", action="store_true",
+                        help="play the batch with the exact kernel (verification runs as armgame verify does)")
     parser.add_argument("--kernel", choices=[k for k in KERNELS if k], default=None,
                         help="the batch's kernel (default: compiled where built, else numpy)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")

@@ -11,10 +11,10 @@ Sub-env ``i`` is the single env of the same arguments, seeded as ``SyncVectorEnv
 (``reset(seed=s)``: game ``i`` gets seed ``s + i``, and each later game of sub-env ``i`` draws its
 seed from a generator seeded ``s + i``, as the single env's ``reset()`` does). So the vector env
 equals N single envs: observations to the batch's round-off (``STATE_TOLERANCE``; the batches
-run the fast kernel, ``BatchGameSession(exact=False)``, which from 2,048 games a batch of games up to
-60 s rounds differently from the single session; otherwise bit for bit where numpy's sin and cos are
-the C library's), rewards, truncations and infos exactly (a hit decided within 1e-11 m of a target's
-edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``).
+run the fast kernel, ``BatchGameSession(exact=False)``, which for games up to 60 s rounds
+differently from the single session: the compiled kernel's at any size, numpy's from 2,048 games;
+otherwise bit for bit), rewards, truncations and infos exactly (a hit decided within 1e-11 m of a
+target's edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``).
 """
 
 from __future__ import annotations
