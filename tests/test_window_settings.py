@@ -185,6 +185,21 @@ def test_sounds_load_and_mute_under_the_dummy_driver(tmp_path):
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
 
 
+def test_the_sounds_are_found_in_a_checkout_or_where_a_wheel_installs_them(tmp_path):
+    from armgame.ui.sound import SOUND_NAMES, asset_folder
+
+    checkout, installed = tmp_path / "checkout", tmp_path / "share" / "armgame" / "assets"
+    installed.mkdir(parents=True)
+    for name in SOUND_NAMES:
+        (installed / f"{name}.wav").write_bytes(b"RIFF")
+    assert asset_folder((checkout, installed)) == installed  # a wheel: no checkout beside the package
+    checkout.mkdir()
+    (checkout / "hit.wav").write_bytes(b"RIFF")
+    assert asset_folder((checkout, installed)) == checkout
+    assert asset_folder((tmp_path / "none", tmp_path / "neither")) == tmp_path / "none"  # silence
+    assert (asset_folder() / "hit.wav").is_file()  # this checkout's own
+
+
 def test_mute_in_the_window_is_written_to_the_settings(tmp_path):
     path = tmp_path / "settings.toml"
     code = (

@@ -9,6 +9,9 @@
  * build (setup.py) turns off floating-point contraction, so no multiply-add is fused, and the
  * builtin sin and cos, so the compiler cannot merge them into a ``sincos`` of its own choosing.
  *
+ * With ``fast`` set, the elbow's cos and sin come by angle addition instead (the numpy fast
+ * kernel's method, see batch.py): round-off, not bit for bit, and the batch says so.
+ *
  * The kernel knows nothing of targets' rules: it stops a game whose hand may be on its target
  * (within a relative 1e-6 of the disc) and lets Python decide, with the single session's own
  * test and its ``GameRules``. See ``armgame/game/compiled.py`` for the calling side.
@@ -19,7 +22,7 @@
 #include <stdint.h>
 #include <string.h>
 
-/* Layout of the ``params`` buffer (doubles), written by compiled.py's ``kernel_params``. */
+/* Layout of the ``params`` buffer (doubles), as compiled.py's ``CompiledKernel`` writes it. */
 enum {
     P_DT, P_H, P_K, P_B, P_D, P_DET0, P_AMD, P_G1, P_G2, P_K1, P_K2,
     P_L1, P_L2, P_RADIUS, P_NEAR, P_REACH1, P_REACH2, P_LIMIT2,

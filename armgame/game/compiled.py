@@ -7,6 +7,9 @@ when its hand may be on its target, and the batch judges that with the single se
 test and rules (``BatchGameSession._hit_test``). Its arithmetic is the single session's,
 operation for operation, with the C library's cos and sin, which Python's ``math`` calls too:
 a batched game is the single game bit for bit (tests/test_batch.py checks states with ``==``).
+With ``fast`` (``BatchGameSession(exact=False)``, games up to 60 s) RK4's elbow cos and sin
+come by angle addition instead, as numpy's fast kernel takes them: round-off, within
+``batch.STATE_TOLERANCE`` (tests/test_batch_fast.py runs both kernels).
 
 Where it was not built (no compiler) or is stale, ``AVAILABLE`` is False and the batch runs
 its numpy kernel: the same results, slower. It runs RK4, the game's integrator; batches of the
