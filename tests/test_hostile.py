@@ -12,8 +12,10 @@ import subprocess
 import sys
 import threading
 import time
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import armgame.records.scores as scores_module
@@ -164,6 +166,32 @@ def test_a_run_that_goes_non_finite_stops_with_one_line():
     session.key_event("d", "down")
     with pytest.raises(NonFiniteStateError, match="non-finite"):
         session.advance(session.total_steps)
+
+
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+@pytest.mark.parametrize("integrator", ["rk4", "euler"])
+def test_a_batch_that_goes_non_finite_stops_with_one_line_as_the_single_game_does(kernel, integrator):
+    from armgame.game import compiled
+    from armgame.game.batch import BatchGameSession
+    from armgame.game.muscles import MuscleSpec
+    from armgame.game.session import InputEvent
+
+    if kernel == "compiled" and not (compiled.AVAILABLE or os.environ.get("ARMGAME_REQUIRE_COMPILED")):
+        pytest.skip("the compiled kernel is not built here")
+    muscles = tuple(MuscleSpec(f"m{i}", k, (50.0, -50.0), 0.02, 0.02) for i, k in enumerate("dfjk"))
+    wild = GameConfig(integrator=integrator, dt=0.02, muscles=muscles,
+                      arm=GameConfig().arm.replace(m1=0.01, m2=0.01, i1=1e-5, i2=1e-5))
+    single = GameSession(wild)
+    with pytest.raises(NonFiniteStateError):
+        single.play([InputEvent(0, "d", "down")])
+    calm: list[InputEvent] = []  # no torque: this arm stays where it is
+    for play in (lambda b: b.play([calm, [InputEvent(0, "d", "down")], calm]),
+                 lambda b: (b.set_held(np.array([[False] * 4, [True, False, False, False], [False] * 4])),
+                            b.advance(b.config.total_steps))):
+        batch = BatchGameSession([replace(wild, seed=s) for s in range(3)], kernel=kernel)
+        with pytest.raises(NonFiniteStateError, match=r"^game 1: .*non-finite.*blows up") as info:
+            play(batch)
+        assert "\n" not in str(info.value)
 
 
 def test_one_failing_entry_is_marked_and_the_others_are_still_checked(tmp_path, capsys, monkeypatch):

@@ -78,7 +78,7 @@ from . import compiled
 from .compiled import NEAR, CompiledKernel, MuscleEvents, hand_move_bounds
 from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
-from .session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent
+from .session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
 
 #: ``BatchGameSession(kernel=...)``: None, the compiled kernel where built (and RK4), else numpy.
 KERNELS = (None, "compiled", "numpy")
@@ -351,8 +351,33 @@ class BatchGameSession:
             self._start(int(i), replace(self.configs[i], seed=int(seed)))
 
     # ----------------------------------------------------------------- physics
+    def _stop_if_non_finite(self) -> None:
+        """``GameSession.advance``'s ``NonFiniteStateError``, naming the first game whose state blew up.
+
+        A single game stops at once; here the others ran on to the end of the call, which changes
+        nothing they report, since the error ends the batch.
+        """
+        if math.isfinite(float(np.sum(self._x))):  # one pass; a sum that overflows is checked below
+            return
+        bad = np.flatnonzero(~np.isfinite(self._x).all(axis=0))
+        if len(bad):
+            i, dt = int(bad[0]), self.config.dt
+            raise NonFiniteStateError(f"game {i}: the arm's state became non-finite by t = {self.steps[i] * dt:g} s: "
+                                      f"this game's physics blows up ({self.config.integrator}, dt {dt:g} s)")
+
     def advance(self, steps: int) -> None:
-        """Every game not over runs ``steps`` physics steps (or up to its end)."""
+        """Every game not over runs ``steps`` physics steps (or up to its end).
+
+        A game whose physics blows up raises ``NonFiniteStateError``, as ``GameSession.advance`` does.
+        """
+        try:
+            self._advance(steps)
+        except (ValueError, OverflowError, ZeroDivisionError):  # math.cos(inf) on the way to a hand
+            self._stop_if_non_finite()
+            raise
+        self._stop_if_non_finite()
+
+    def _advance(self, steps: int) -> None:
         left = int(steps)
         if left <= 0:
             return
@@ -443,8 +468,19 @@ class BatchGameSession:
         """Play every game from its timeline, as ``GameSession.play`` does for one.
 
         All games must be at the same step (fresh, typically). Game ``i`` stops at
-        ``stop_steps[i]`` (None: its time limit); events up to that step are applied.
+        ``stop_steps[i]`` (None: its time limit); events up to that step are applied. A game
+        whose physics blows up raises ``NonFiniteStateError``, as the single session does.
         """
+        try:
+            results = self._play(timelines, stop_steps)
+        except (ValueError, OverflowError, ZeroDivisionError):
+            self._stop_if_non_finite()
+            raise
+        self._stop_if_non_finite()
+        return results
+
+    def _play(self, timelines: Sequence[Sequence[InputEvent]],
+              stop_steps: Sequence[int | None] | None) -> list[GameResult]:
         if len(timelines) != self.n:
             raise ValueError(f"{self.n} games but {len(timelines)} timelines")
         stops = [None] * self.n if stop_steps is None else list(stop_steps)
