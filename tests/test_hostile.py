@@ -168,6 +168,7 @@ def test_a_run_that_goes_non_finite_stops_with_one_line():
         session.advance(session.total_steps)
 
 
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # numpy overflowing on the way to NaN: expected
 @pytest.mark.parametrize("kernel", ["compiled", "numpy"])
 @pytest.mark.parametrize("integrator", ["rk4", "euler"])
 def test_a_batch_that_goes_non_finite_stops_with_one_line_as_the_single_game_does(kernel, integrator):
