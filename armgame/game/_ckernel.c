@@ -62,13 +62,6 @@ static inline void accel_trig(const Arm *arm, double q1, double q2, double bc, d
     *o2 = ((m12 + arm->amd + bc) * f2 - m12 * f1) * r;
 }
 
-/* The same with the elbow's cos and sin of its own (the exact kernel). */
-static inline void accel(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
-                         double *o1, double *o2)
-{
-    accel_trig(arm, q1, q2, arm->b * cos(q2), arm->b * sin(q2), w1, w2, t1, t2, o1, o2);
-}
-
 /* The fast kernel's elbow trig (batch._Kernel's, there in numpy): b cos and b sin of q2 + delta
  * from those of q2 by angle addition, with cos and sin of the small delta from Taylor series
  * in delta^2 (the first dropped terms below 3e-17 within SERIES_LIMIT). Returns 0, leaving the
@@ -86,16 +79,15 @@ static inline int turned(double bc, double bs, double delta, double limit2, doub
     return 1;
 }
 
-/* One fast stage: its elbow trig turned from stage 1's by delta (full cos and sin if too far). */
-static inline void accel_turned(const Arm *arm, double q1, double q2, double delta, double bc, double bs,
-                                double limit2, double w1, double w2, double t1, double t2, double *o1, double *o2)
+/* A stage's b cos q2 and b sin q2: in full (the exact kernel), or turned by delta from stage 1's
+ * (bc, bs) in the fast kernel, in full there too if delta is beyond the series' range. */
+static inline void elbow(const Arm *arm, int fast, double q2, double delta, double bc, double bs, double limit2,
+                         double *oc, double *os)
 {
-    double c, s;
-    if (!turned(bc, bs, delta, limit2, &c, &s)) {
-        c = arm->b * cos(q2);
-        s = arm->b * sin(q2);
+    if (!fast || !turned(bc, bs, delta, limit2, oc, os)) {
+        *oc = arm->b * cos(q2);
+        *os = arm->b * sin(q2);
     }
-    accel_trig(arm, q1, q2, c, s, w1, w2, t1, t2, o1, o2);
 }
 
 /* Steps between full cos and sin of the elbow in the fast kernel (turned ones gather round-off). */
@@ -246,36 +238,30 @@ static PyObject *run(PyObject *self, PyObject *args)
                 a[m] += (g[m] - a[m]) * r[m];
             /* integrators._rk4 */
             const double p1 = q1, p2 = q2;
-            double a1, a2, b1, b2, c1, c2, d1, d2, v1, v2, u1, u2, z1, z2;
-            if (!fast) {
-                accel(&arm, q1, q2, w1, w2, t1, t2, &a1, &a2);
-                v1 = w1 + h * a1;
-                v2 = w2 + h * a2;
-                accel(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &b1, &b2);
-                u1 = w1 + h * b1;
-                u2 = w2 + h * b2;
-                accel(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &c1, &c2);
-                z1 = w1 + dt * c1;
-                z2 = w2 + dt * c2;
-                accel(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &d1, &d2);
-            } else {
-                if (anchor <= 0) {
-                    bc = arm.b * cos(q2);
-                    bs = arm.b * sin(q2);
-                    anchor = REANCHOR;
-                }
-                anchor--;
-                accel_trig(&arm, q1, q2, bc, bs, w1, w2, t1, t2, &a1, &a2);
-                v1 = w1 + h * a1;
-                v2 = w2 + h * a2;
-                accel_turned(&arm, q1 + h * w1, q2 + h * w2, h * w2, bc, bs, limit2, v1, v2, t1, t2, &b1, &b2);
-                u1 = w1 + h * b1;
-                u2 = w2 + h * b2;
-                accel_turned(&arm, q1 + h * v1, q2 + h * v2, h * v2, bc, bs, limit2, u1, u2, t1, t2, &c1, &c2);
-                z1 = w1 + dt * c1;
-                z2 = w2 + dt * c2;
-                accel_turned(&arm, q1 + dt * u1, q2 + dt * u2, dt * u2, bc, bs, limit2, z1, z2, t1, t2, &d1, &d2);
+            /* Stage 1's elbow trig: in full, or in the fast kernel carried from the last step. */
+            if (!fast || anchor <= 0) {
+                bc = arm.b * cos(q2);
+                bs = arm.b * sin(q2);
+                anchor = REANCHOR;
             }
+            anchor--;
+            double a1, a2, b1, b2, c1, c2, d1, d2, ec, es;
+            accel_trig(&arm, q1, q2, bc, bs, w1, w2, t1, t2, &a1, &a2);
+            const double v1 = w1 + h * a1;
+            const double v2 = w2 + h * a2;
+            const double q2b = q2 + h * w2;
+            elbow(&arm, fast, q2b, h * w2, bc, bs, limit2, &ec, &es);
+            accel_trig(&arm, q1 + h * w1, q2b, ec, es, v1, v2, t1, t2, &b1, &b2);
+            const double u1 = w1 + h * b1;
+            const double u2 = w2 + h * b2;
+            const double q2c = q2 + h * v2;
+            elbow(&arm, fast, q2c, h * v2, bc, bs, limit2, &ec, &es);
+            accel_trig(&arm, q1 + h * v1, q2c, ec, es, u1, u2, t1, t2, &c1, &c2);
+            const double z1 = w1 + dt * c1;
+            const double z2 = w2 + dt * c2;
+            const double q2d = q2 + dt * u2;
+            elbow(&arm, fast, q2d, dt * u2, bc, bs, limit2, &ec, &es);
+            accel_trig(&arm, q1 + dt * u1, q2d, ec, es, z1, z2, t1, t2, &d1, &d2);
             q1 = p1 + k * (w1 + z1 + 2.0 * (v1 + u1));
             q2 = p2 + k * (w2 + z2 + 2.0 * (v2 + u2));
             const double n1 = w1 + k * (a1 + d1 + 2.0 * (b1 + c1));

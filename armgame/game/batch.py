@@ -188,20 +188,19 @@ class BatchGameSession:
         #: Games whose hand came within ``KNIFE_EDGE`` of a target's edge in the fast kernel: their hits
         #: could differ from the single session's (``replay_many`` plays them again alone).
         self.knife_edge = np.zeros(n, dtype=bool)
-        # Whether the kernel may round differently from the single session, and from how many games.
+        use_compiled = kernel != "numpy" and compiled.AVAILABLE and c.integrator == "rk4"
+        # Whether the kernel may round differently from the single session: the fast stages, which
+        # compiled pay at any batch size, in numpy only from ``_series_from`` games (call overhead).
         self._series_from = SERIES_MIN_GAMES
-        self._rounds = (not self.exact and c.integrator == "rk4" and n >= self._series_from
-                        and int(self.total_steps.max()) * c.dt <= FAST_MAX_SECONDS)
+        self._rounds = (not self.exact and c.integrator == "rk4"
+                        and int(self.total_steps.max()) * c.dt <= FAST_MAX_SECONDS
+                        and (use_compiled or n >= self._series_from))
         self.rules: list[GameRules] = [None] * n  # type: ignore[list-item]
         self._kernels: dict[int, _Kernel] = {}
         for i in range(n):
             self._start(i, configs[i])
         #: The compiled kernel where built (and asked for) and the integrator is RK4; else None: numpy.
-        self.compiled: CompiledKernel | None = None
-        if kernel != "numpy" and compiled.AVAILABLE and c.integrator == "rk4":
-            # Compiled, the series pay at any batch size: no numpy call overhead to outweigh.
-            self._rounds = not self.exact and int(self.total_steps.max()) * c.dt <= FAST_MAX_SECONDS
-            self.compiled = CompiledKernel(self, fast=self._rounds)
+        self.compiled = CompiledKernel(self, fast=self._rounds) if use_compiled else None
 
     def _start(self, i: int, config: GameConfig) -> None:
         self.configs[i] = config
@@ -498,6 +497,10 @@ class BatchGameSession:
             for i, row in held.items():
                 self.held[i] = row
             return [self.result(i) for i in range(self.n)]
+        # Lockstep: every game's commands by step (stable: a game's order within a step is kept).
+        order = np.argsort(muscle_steps, kind="stable")
+        muscle_steps, flat, goal, rate = muscle_steps[order], flat[order], goal[order], rate[order]
+        specials.sort(key=lambda special: special[0])
         alive = np.flatnonzero(limits > now)
         # Games that stop while at least half the batch plays on stay in it, stepped for nothing:
         # cheaper than gathering the others every step. Their slack is infinite (no hits) and
@@ -548,7 +551,7 @@ class BatchGameSession:
         step's muscle commands, as ``play`` orders them) the key goes through ``key_event``.
         """
         pending: dict[int, list[tuple[int, str]]] = {}
-        for step, i, key in specials:  # sorted by step, and in timeline order within a step
+        for step, i, key in specials:  # in timeline order: by step within each game
             pending.setdefault(i, []).append((step, key))
         halt = limits.copy()
         for i, keys in pending.items():
@@ -576,9 +579,10 @@ class BatchGameSession:
         plain Python: events in list order up to the first beyond the game's stop, each at the
         later of its step and the game's clock; events at or after the game's end, repeats of a
         held key and unknown keys dropped. Muscle commands come back as flat indices into the
-        (4, n) goal and rate arrays with their new values, sorted by step (of several for one
-        muscle at one step, the last, which is what applying them all in order leaves); resets
-        and tab as (step, game, key); the muscle keys held at the end by game.
+        (4, n) goal and rate arrays with their new values (of several for one muscle at one
+        step, the last, which is what applying them all in order leaves); resets and tab as
+        (step, game, key); the muscle keys held at the end by game. Both lists are in timeline
+        order, so by game and within a game by step: each kernel orders them as it steps.
         """
         index = {key: m for m, key in enumerate(self.muscle_keys)}
         rise, decay = self._rise.tolist(), self._decay.tolist()
@@ -617,10 +621,8 @@ class BatchGameSession:
                 elif e.key in (RESET_KEY, TOGGLE_ARM_KEY) and e.action == DOWN:
                     specials.append((clock, i, e.key))
             held_at_end[i] = held
-        order = np.argsort(np.array(steps, dtype=np.int64), kind="stable")
-        specials.sort(key=lambda s: s[0])
-        return (np.array(steps, dtype=np.int64)[order], np.array(flat, dtype=np.intp)[order],
-                np.array(goal)[order], np.array(rate)[order], specials, held_at_end)
+        return (np.array(steps, dtype=np.int64), np.array(flat, dtype=np.intp), np.array(goal), np.array(rate),
+                specials, held_at_end)
 
 class _Kernel:
     """The session's hot loop for ``m`` games at once, every intermediate in preallocated arrays.

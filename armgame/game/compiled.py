@@ -86,14 +86,13 @@ class MuscleEvents:
     @classmethod
     def by_game(cls, n: int, steps: np.ndarray, flat: np.ndarray, goal: np.ndarray,
                 rate: np.ndarray) -> MuscleEvents:
-        """From ``BatchGameSession._schedule``'s commands: sorted by step, flat indices ``muscle * n + game``."""
+        """From ``BatchGameSession._schedule``'s commands: by game, within a game by step, flat
+        indices ``muscle * n + game``."""
         muscle, game = np.divmod(flat, n)
-        order = np.argsort(game, kind="stable")  # by game, and within a game still by step
-        end = np.cumsum(np.bincount(game, minlength=n)).astype(np.int64)
+        end = np.cumsum(np.bincount(game, minlength=n), dtype=np.int64)
         cursor = np.concatenate([[0], end[:-1]]).astype(np.int64)
-        return cls(cursor, end, np.ascontiguousarray(steps[order], dtype=np.int64),
-                   np.ascontiguousarray(muscle[order], dtype=np.int64), np.ascontiguousarray(goal[order], dtype=float),
-                   np.ascontiguousarray(rate[order], dtype=float))
+        return cls(cursor, end, steps.astype(np.int64), muscle.astype(np.int64), goal.astype(float),
+                   rate.astype(float))
 
 
 class CompiledKernel:
@@ -124,8 +123,6 @@ class CompiledKernel:
         """Every game ``i`` to step ``halt[i]`` (none past its end), its hits scored on the way."""
         b = self.batch
         ev = self.no_events if events is None else events
-        if events is None:
-            ev.cursor.fill(0)
         halt = np.ascontiguousarray(halt, dtype=np.int64)
         while _ckernel.run(self.params, self.mode, self.fast, b.n, b._xs, b._act, b._goal, b._rate, b._slack,
                            b.target_x, b.target_y, b.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal,
