@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import armgame.records.batch_verify as batch_verify
 import armgame.records.scores as scores_module
 from armgame.cli import main
 from armgame.game.rules import GameConfig
@@ -36,14 +37,15 @@ def _private_folders(tmp_path, monkeypatch):
     monkeypatch.setenv("ARMGAME_CACHE", str(tmp_path / "cache"))
 
 
-def game(player="ann", seed=10, **config) -> Replay:
-    """A finished game, standard unless ``config`` says otherwise, with a few key presses."""
+def game(player="ann", seed=10, driven="keyboard", **config) -> Replay:
+    """A finished game, standard unless ``config`` says otherwise, with a few key presses: a keyboard
+    game of the table's seed (ranked) unless told otherwise, each player's own (a game enters once)."""
     session = GameSession(GameConfig(seed=seed, **config))
     session.key_event("d", "down")
-    session.advance(session.total_steps // 3)
+    session.advance(session.total_steps // 3 + sum(map(ord, player)) % 50)
     session.key_event("d", "up")
     session.advance(session.total_steps)
-    return Replay.from_session(session, "script", "s.txt", player=player)
+    return Replay.from_session(session, driven, None if driven == "keyboard" else "s.txt", player=player)
 
 
 def armgame(*argv, timeout=20, env=None):
@@ -207,6 +209,11 @@ def test_one_failing_entry_is_marked_and_the_others_are_still_checked(tmp_path, 
         return real(self)
 
     monkeypatch.setattr(Replay, "verify", verify)
+
+    def no_batch(*args, **kwargs):
+        raise RuntimeError("the batch stops")  # so the listing falls back to one game at a time
+
+    monkeypatch.setattr(batch_verify, "replay_many", no_batch)
     assert table.check(bad).label == "BAD REPLAY"
     assert main(["scores", "--scores", str(tmp_path)]) == 0
     out = capsys.readouterr().out
@@ -248,8 +255,9 @@ def test_scores_replays_each_game_once_then_uses_the_per_user_cache(tmp_path, mo
     for i in range(4):
         table.add(game(f"p{i}", seed=i))
     calls = []
-    real = Replay.verify
-    monkeypatch.setattr(Replay, "verify", lambda self: calls.append(self.player) or real(self))
+    real = batch_verify.verify_replays
+    monkeypatch.setattr(batch_verify, "verify_replays",
+                        lambda replays, kernel=None: calls.extend(r.player for r in replays) or real(replays, kernel))
     assert main(["scores", "--scores", str(folder)]) == 0
     assert len(calls) == 4
     assert main(["scores", "--scores", str(folder)]) == 0
@@ -268,8 +276,9 @@ def test_scores_checks_at_most_top_custom_entries_flagged_or_not(tmp_path, monke
     for entry in table.all_entries():  # every custom replay planted broken
         table.replay_path(entry).write_text("{}")
     checked = []
-    real = ScoreTable.check
-    monkeypatch.setattr(ScoreTable, "check", lambda self, e: checked.append(e.name) or real(self, e))
+    real = ScoreTable.check_many
+    monkeypatch.setattr(ScoreTable, "check_many",
+                        lambda self, es, recompute=None: checked.extend(e.name for e in es) or real(self, es, recompute))
     assert main(["scores", "--scores", str(tmp_path), "--top", "2"]) == 0
     assert len(checked) == 2 and "2 flagged" in capsys.readouterr().out
 

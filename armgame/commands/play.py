@@ -181,7 +181,7 @@ def _keep(session, args: argparse.Namespace):
     from ..records.replay import Replay
     from ..records.scores import ScoreTable, VerificationCache
     from ..records.storage import check_output_path, user_path
-    from .scores import scores_dir
+    from .scores import scores_dir, where_it_went
 
     out = sys.stderr if args.json else sys.stdout
     bot = getattr(args, "bot", None)
@@ -198,17 +198,16 @@ def _keep(session, args: argparse.Namespace):
     if not replay.complete:
         print("the game was stopped before the end: not entered in the high-score table", file=out)
         return
-    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr),
-                       cache=VerificationCache())  # read only here: it knows older entries' rulesets
+    warn = lambda m: print(f"armgame play: {m}", file=sys.stderr)  # noqa: E731
+    table = ScoreTable(scores_dir(args), warn=warn,
+                       cache=VerificationCache(warn=warn))  # read only here: it knows older entries' rulesets
     try:
         entry = table.add(replay)
     except OSError as exc:
         raise UserError(f"cannot save the score in {table.folder}: {exc.strerror or exc}") from None
     except ValueError as exc:
         raise UserError(f"not entered in the high-score table: {exc}") from None
-    kind = "" if table.ruleset(entry) != "custom" else " among custom games (not ranked: not the standard game)"
-    print(f"saved to the high-score table as {entry.name}: #{table.rank(entry)}{kind} "
-          f"({table.path})", file=out)
+    print(f"saved to the high-score table as {entry.name}: {where_it_went(table, entry)}", file=out)
     return entry
 
 
@@ -230,8 +229,7 @@ def _standing(session, args: argparse.Namespace):
     """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
     import sys
 
-    from ..records.rulesets import ruleset_of
-    from ..records.scores import ScoreTable
+    from ..records.scores import LIST_TITLES, RANKED, ScoreTable
     from ..ui.render import Standing
     from .scores import scores_dir
 
@@ -241,13 +239,14 @@ def _standing(session, args: argparse.Namespace):
             entry = _keep(session, args)
             args.kept = True
             table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
-            entries = table.same_kind(entry) if entry is not None else \
-                table.of_kind(ruleset_of(session.config) is not None)
+            kind = table.list_of(entry) if entry is not None else RANKED  # not entered: the ranked table's top
+            entries = table.of_list(kind)
         except UserError as exc:
             print(f"armgame play: error: {exc}", file=sys.stderr)
             return None
         rank = next((i for i, e in enumerate(entries, 1) if entry is not None and e.id == entry.id), None)
-        return Standing(rank, len(entries), tuple((i, e.name, e.score) for i, e in enumerate(entries[:10], 1)))
+        return Standing(rank, len(entries), tuple((i, e.name, e.score) for i, e in enumerate(entries[:10], 1)),
+                        LIST_TITLES[kind].split(" (")[0])
 
     return standing
 

@@ -25,88 +25,180 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "scores",
         help="the high-score table, best first",
-        description="Print the high-score table, best first (equal scores: the earlier game first), with how "
-        "each game was driven. Only games of a ranked ruleset (standard: the default 60 s game, any seed) are "
-        "ranked; custom games are listed apart. Each entry's replay is played again (once: verdicts are cached "
-        "per user, by the replay's SHA-256 and the armgame version): an entry whose replay is missing, changed "
-        "or does not reproduce its score is flagged and not ranked.",
+        description="Print the high-score table, best first (equal scores: the earlier entry first). The ranked "
+        "table holds keyboard games of the standard rules (the default 60 s game) and the table's seed (10 unless "
+        "the table was started with --new --seed N); games of another seed are listed apart as practice, games a "
+        "program played (bots, scripts) apart as programs, games of other rules apart as custom games. A game "
+        "enters once, whatever name or date its copy carries. Each entry's replay is played again (once: "
+        "verdicts, failures too, are cached per user): an entry whose replay is missing, changed or does not "
+        "reproduce its score is flagged and not ranked.",
     )
     add_scores_option(p)
-    p.add_argument("--top", type=int, default=10, metavar="N", help="how many entries of each kind (default: 10)")
+    p.add_argument("--top", type=int, default=10, metavar="N", help="how many entries of each list (default: 10)")
     p.add_argument("--all", action="store_true", help="every entry")
     p.add_argument("--no-check", action="store_true", help="do not replay the games (faster, nothing flagged)")
     p.add_argument("--add", metavar="REPLAY", help="enter the game of a replay file (a game the table was too busy "
                    "to take, or one recorded with play --record); it is verified first")
     p.add_argument("--name", help="with --add: the player's name, if the replay has none")
+    p.add_argument("--new", action="store_true", help="start an empty table in the --scores folder (with --seed: "
+                   "the seed it ranks)")
+    p.add_argument("--seed", type=_seed_arg, metavar="N", help="with --new: the seed the table ranks (default: 10, "
+                   "the default game's)")
     p.add_argument("--cache", metavar="DIR", help="folder of the verification cache (default: $ARMGAME_CACHE, "
-                   "else ~/.cache/armgame)")
+                   "else the per-user cache folder, ~/.cache/armgame on Linux)")
     p.set_defaults(run=run)
 
 
-def verification_cache(args: argparse.Namespace):
-    from ..records.scores import VerificationCache
+def _seed_arg(text: str) -> int:
+    from .play import _seed
+
+    return _seed(text)
+
+
+def verification_cache(args: argparse.Namespace, warn=None):
+    from ..records.cache import VerificationCache
     from ..records.storage import user_path
 
-    return VerificationCache(user_path(args.cache, "--cache") if getattr(args, "cache", None) is not None else None)
+    folder = user_path(args.cache, "--cache") if getattr(args, "cache", None) is not None else None
+    return VerificationCache(folder, warn=warn)
 
 
 def run(args: argparse.Namespace) -> int:
     import sys
 
     from ..errors import UserError
-    from ..records.rulesets import RULESETS
     from ..records.scores import ScoreTable
 
     if args.top < 1:
         raise UserError(f"--top must be 1 or more, got {args.top}")
     if args.name is not None and args.add is None:
         raise UserError("--name goes with --add")
-    cache = None if args.no_check else verification_cache(args)
-    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame scores: {m}", file=sys.stderr), cache=cache)
+    if args.seed is not None and not args.new:
+        raise UserError("--seed goes with --new (a table ranks one seed, set when it is started)")
+    if args.new and args.add is not None:
+        raise UserError("--new starts an empty table: give --add in a second command")
+
+    def warn(message: str) -> None:
+        print(f"armgame scores: {message}", file=sys.stderr)
+
+    cache = None if args.no_check or args.new else verification_cache(args, warn)
+    table = ScoreTable(scores_dir(args), warn=warn, cache=cache)
+    if args.new:
+        from ..records.rulesets import DEFAULT_SEED
+
+        seed = DEFAULT_SEED if args.seed is None else args.seed
+        table.new(seed)
+        print(f"started an empty table in {table.folder}: it ranks standard games of seed {seed}")
+        return 0
     if args.add is not None:
         return _add(table, args)
     entries = table.all_entries()
     if not entries:
         print(f"no scores yet in {table.path}")
         return 0
-    limit = None if args.all else args.top
-    seen: set[str] = set()
-    ranked, custom, flagged = [], [], []
-    custom_checked = 0
-    # Best first. Ranked games: checked until --top of them pass (each costs exactly its ruleset,
-    # 15,000 steps, once per user thanks to the cache). Custom games cost up to MAX_GAME_STEPS each, so
-    # at most --top of them are checked, flagged ones included: planted entries cannot keep it busy.
-    for e in entries:
-        is_ranked = table.ruleset(e) in RULESETS
-        kind = ranked if is_ranked else custom
-        if limit is not None and (len(ranked) if is_ranked else custom_checked) >= limit:
-            continue
-        custom_checked += not is_ranked
-        if e.replay_sha256 in seen:
-            flagged.append((e, _check("DUPLICATE", "the same replay is entered more than once")))
-            continue
-        seen.add(e.replay_sha256)
-        c = None if args.no_check else table.check(e)
-        if c is not None and not c.ok:
-            flagged.append((e, c))
-        else:
-            kind.append((e, c))
+    lists, flagged = listing(table, entries, None if args.all else args.top, check=not args.no_check)
     if cache is not None:
         cache.save()
-    count = plural(len(entries), "entry")
-    names = ", ".join(RULESETS)
-    print(f"High scores in {table.path} ({count}; ranked: {names} games{'' if args.no_check else ', replays checked'})")
-    _print_rows(ranked, args.no_check)
-    if not ranked:
+    _print_listing(table, len(entries), lists, flagged, args.no_check)
+    return 0
+
+
+def listing(table, entries, limit: int | None, check: bool):
+    """Each list's rows ``(entry, check)`` best first, at most ``limit`` each, and the flagged entries.
+
+    Cost: no replay is read without ``check``. With it, entries are checked best first, in batches
+    (``records.batch_verify``), only while a list still wants rows: at most ``limit`` passing entries
+    of each list of standard games (each costs exactly its ruleset's steps, once per user: verdicts,
+    failures too, are cached), and at most ``limit`` custom games, flagged ones included (their cost
+    is their own). A game entered twice is flagged at its later entry.
+    """
+    from ..records.batch_verify import check_entries
+    from ..records.scores import CUSTOM_GAMES, LIST_TITLES, entry_order
+
+    first: dict[tuple[str, str], object] = {}
+    duplicate: dict[str, object] = {}
+    for e in sorted(entries, key=entry_order):  # what the table itself says: its replay and its game
+        keys = [("replay", e.replay_sha256)] + ([("game", e.game_sha256)] if e.game_sha256 else [])
+        twin = next((first[k] for k in keys if k in first), None)
+        if twin is not None:
+            duplicate[e.id] = twin
+        for k in keys:
+            first.setdefault(k, e)
+    lists: dict[str, list] = {name: [] for name in LIST_TITLES}
+    flagged: list = []
+    custom_checked = 0
+
+    def wants(e, custom_in_batch: int) -> bool:
+        name = table.list_of(e)
+        if limit is None:
+            return True
+        if name == CUSTOM_GAMES:  # each may cost up to MAX_GAME_STEPS: never more than --top of them
+            return custom_checked + custom_in_batch < limit
+        return len(lists[name]) < limit
+
+    pending = [e for e in entries if e.id not in duplicate]
+    for e in entries:
+        if e.id in duplicate:
+            flagged.append((e, _duplicate(duplicate[e.id])))
+    games: dict[str, object] = {}
+    while pending:
+        batch: list = []
+        custom_in_batch = 0
+        for e in pending:
+            if wants(e, custom_in_batch):
+                batch.append(e)
+                custom_in_batch += table.list_of(e) == CUSTOM_GAMES
+                if len(batch) >= (max(2 * limit, 256) if limit else len(pending)):
+                    break
+        if not batch:
+            break
+        done = {e.id for e in batch}
+        pending = [e for e in pending if e.id not in done]
+        results = check_entries(table, batch) if check else ((e, None) for e in batch)
+        for e, c in results:
+            name = table.list_of(e, c)
+            if limit is not None and (custom_checked >= limit if name == CUSTOM_GAMES else len(lists[name]) >= limit):
+                continue
+            custom_checked += name == CUSTOM_GAMES
+            if c is not None and c.game is not None and games.setdefault(c.game, e) is not e:
+                flagged.append((e, _duplicate(games[c.game])))
+            elif c is not None and not c.ok:
+                flagged.append((e, c))
+            else:
+                lists[name].append((e, c))
+    for rows in lists.values():
+        rows.sort(key=lambda row: _order(row[0]))
+    return lists, flagged
+
+
+def _order(e):
+    from ..records.scores import sort_key
+
+    return sort_key(e)
+
+
+def _duplicate(twin):
+    when = (twin.entered_at or twin.date)[:16].replace("T", " ")
+    return _check("DUPLICATE", f"the same game as {twin.name}'s entry of {when}, which counts")
+
+
+def _print_listing(table, count: int, lists, flagged, no_check: bool) -> None:
+    from ..records.scores import LIST_TITLES, RANKED
+
+    checked = "" if no_check else ", replays checked"
+    print(f"High scores in {table.path} ({plural(count, 'entry')}{checked})")
+    print(f"Ranked: keyboard games of the standard rules, seed {table.seed}")
+    _print_rows(lists[RANKED], no_check)
+    if not lists[RANKED]:
         print("  no ranked games yet")
-    if custom:
-        print(f"Custom games (their own rules: not ranked, not comparable with {names} games)")
-        _print_rows(custom, args.no_check)
+    for name, title in LIST_TITLES.items():
+        if name != RANKED and lists[name]:
+            print(title[0].upper() + title[1:])
+            _print_rows(lists[name], no_check)
     if flagged:
         print(f"{len(flagged)} flagged: the replay does not back the score (not ranked)")
         for e, c in flagged:
             print(f"  {e.name} ({e.score}, {e.date[:16].replace('T', ' ')}): {c.label}: {c.detail}")
-    return 0
 
 
 def _check(label: str, detail: str):
@@ -120,7 +212,8 @@ def _print_rows(rows_in, no_check: bool) -> None:
     for rank, (e, c) in enumerate(rows_in, 1):
         when = e.when.astimezone().strftime("%Y-%m-%d %H:%M")
         rows.append((str(rank), e.name, str(e.score), str(e.hits), str(e.resets), e.how, str(e.seed),
-                     f"{e.duration:g} s", when, e.version, "-" if c is None else c.label))
+                     f"{e.duration:g} s" if e.complete is not False else "stopped", when, e.version,
+                     "-" if c is None else c.label))
     if len(rows) == 1:
         return
     right = {0, 2, 3, 4, 6, 7}
@@ -158,6 +251,12 @@ def _add(table, args: argparse.Namespace) -> int:
         entry = table.add(replay, path if same_file else None)
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    kind = "ranked" if table.ruleset(entry) != "custom" else "custom game, not ranked"
-    print(f"entered {entry.name}'s game (score {entry.score}, {kind}): #{table.rank(entry)} in {table.path}")
+    print(f"entered {entry.name}'s game (score {entry.score}): {where_it_went(table, entry)}")
     return 0
+
+
+def where_it_went(table, entry) -> str:
+    """One line: the entry's place and the list it went to (``armgame scores`` and ``play`` say it)."""
+    from ..records.scores import LIST_TITLES
+
+    return f"#{table.rank(entry)} in {LIST_TITLES[table.list_of(entry)]} ({table.path})"

@@ -71,3 +71,6 @@ def ruleset_of(config: GameConfig) -> Ruleset | None:
 def ruleset_name(config: GameConfig) -> str:
     found = ruleset_of(config)
     return found.name if found else CUSTOM
+
+#: The seed a new table ranks (``play``'s default, the 2012 game's: every class sees the same targets).
+DEFAULT_SEED = 10

@@ -24,8 +24,23 @@ table with every valid entry it could find, and only that rename retires the dam
 if anything fails, the table stays as it was. A valid table is never set aside: one over
 the size limit is refused whole (no entry added) rather than dropped. An entry names its
 replay file and the file's SHA-256, so a score typed into the table, a replay edited, or
-replays swapped between entries all show up when ``check`` recomputes the game. Only games
-of a ranked ruleset (``armgame.records.rulesets``) rank; the others are listed apart.
+replays swapped between entries all show up when ``check`` recomputes the game.
+
+Which list an entry goes to (``ScoreTable.list_of``), the first that applies:
+
+* ``programs``: a game that says a program drove it (a bot, a script, or anything but the
+  keyboard with no driver named). A replay cannot prove a human pressed the keys: this only
+  keeps the games that declare themselves programs out of the people's ranking.
+* ``custom``: a game whose rules are not a ranked ruleset (``armgame.records.rulesets``).
+* ``practice``: a keyboard game of the standard rules with another seed than the table's
+  (``seed`` in the table's head, the default game's unless ``armgame scores --new --seed N``
+  set it): shopping for an easy seed does not pay.
+* ``ranked``: the rest, keyboard games of the standard rules and the table's seed.
+
+One game enters once: each entry holds its game's digest (``armgame.records.identity``), and a
+second entry of the same game is refused, whoever's name and whatever date it carries. Ties
+are broken by the order of entry, a counter the table keeps under its lock (``entered``),
+never by the date a player's file claims.
 """
 
 from __future__ import annotations
@@ -37,19 +52,20 @@ import os
 import re
 import stat
 import sys
-import time
 import uuid
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
 
-from .. import __version__
 from ..game.session import GameResult
 from ..limits import MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from ..words import plural
+from .cache import VerificationCache, default_cache_dir, file_signature  # noqa: F401 (the cache's old home)
+from .identity import game_digest
+from .locking import LockBusyError, LockError, file_lock
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
-from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_name
+from .rulesets import CUSTOM, DEFAULT_SEED, RULESETS, config_digest, ruleset_name
 from .storage import (
     STRICT_DECODER,
     DataFileError,
@@ -66,21 +82,28 @@ from .storage import (
 )
 
 SCORES_ENV = "ARMGAME_SCORES"
-CACHE_ENV = "ARMGAME_CACHE"
 TABLE_NAME = "scores.json"
 LOCK_NAME = "scores.lock"
 REPLAYS_DIR = "replays"
 FORMAT = "armgame-scores"
-#: 2 adds each entry's ruleset and config digest; format 1 tables are still read (and rewritten as 2).
-FORMAT_VERSION = 2
-READS_FORMATS = (1, 2)
+#: 2 adds each entry's ruleset and config digest; 3 the table's ranked seed and order-of-entry counter, and
+#: each entry's game digest, order of entry and whole-clock flag. Older tables are read (and rewritten as 3).
+FORMAT_VERSION = 3
+READS_FORMATS = (1, 2, 3)
+#: The lists an entry can go to (``ScoreTable.list_of``), in the order ``armgame scores`` prints them.
+RANKED, PRACTICE, PROGRAMS, CUSTOM_GAMES = "ranked", "practice", "programs", "custom"
+LIST_TITLES = {
+    RANKED: "the ranked table",
+    PRACTICE: "practice (another seed than the table's: not ranked)",
+    PROGRAMS: "programs (bots and scripts: listed apart, never ranked)",
+    CUSTOM_GAMES: "custom games (their own rules: not ranked)",
+}
 #: Seconds a writer waits for the table's lock before saying the table is busy.
 LOCK_WAIT = 5.0
 _COUNT_MAX = 10**9
 _REPLAY_FILE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,150}\.json")
 _HEX64 = re.compile(r"[0-9a-f]{64}")
 _HEX32 = re.compile(r"[0-9a-f]{32}")
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 
 
 class TableError(DataFileError):
@@ -91,8 +114,9 @@ def default_scores_dir() -> Path:
     """Where the table lives unless ``--scores`` says otherwise.
 
     ``$ARMGAME_SCORES`` if set; else the checkout's own ``scores/`` folder when armgame runs
-    from a checkout (an editable install included); else the per-user data folder:
-    ``$XDG_DATA_HOME/armgame/scores`` (``~/.local/share/armgame/scores``), or
+    from a checkout (an editable install included); else the platform's per-user data folder
+    (``platformdirs``): ``$XDG_DATA_HOME/armgame/scores`` (``~/.local/share/armgame/scores``) on
+    Linux, ``~/Library/Application Support/armgame/scores`` on macOS,
     ``%LOCALAPPDATA%\\armgame\\scores`` on Windows.
     """
     env = os.environ.get(SCORES_ENV)
@@ -101,10 +125,9 @@ def default_scores_dir() -> Path:
     root = Path(__file__).resolve().parents[2]
     if (root / "pyproject.toml").is_file() and (root / "scores").is_dir():
         return root / "scores"
-    if sys.platform == "win32" and os.environ.get("LOCALAPPDATA"):
-        return Path(os.environ["LOCALAPPDATA"]) / "armgame" / "scores"
-    data = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
-    return Path(data) / "armgame" / "scores"
+    import platformdirs
+
+    return Path(platformdirs.user_data_dir("armgame", appauthor=False)) / "scores"
 
 
 @dataclass(frozen=True)
@@ -127,6 +150,12 @@ class ScoreEntry:
     #: entries carried over from a format 1 table (their replay decides, see ``ScoreTable.ruleset``).
     ruleset: str | None = None
     config_sha256: str | None = None
+    #: The game's identity (``identity.game_digest``), its place in the order of entry (1, 2, ...), when the
+    #: table took it, and whether it ran its whole clock; None in entries carried over from older tables.
+    game_sha256: str | None = None
+    entered: int | None = None
+    entered_at: str | None = None
+    complete: bool | None = None
 
     def as_dict(self) -> dict[str, object]:
         return {name: getattr(self, name) for name in _ENTRY_FIELDS}  # dataclasses.asdict deep-copies: 10x slower
@@ -138,6 +167,11 @@ class ScoreEntry:
     @property
     def how(self) -> str:
         return f"{self.driven} ({self.driver})" if self.driver else self.driven
+
+    @property
+    def program(self) -> bool:
+        """Whether the game says a program played it: anything but the keyboard with no driver named."""
+        return self.driven != "keyboard" or self.driver is not None
 
     @classmethod
     def from_dict(cls, data: object) -> ScoreEntry:
@@ -164,6 +198,10 @@ class ScoreEntry:
             replay_sha256=_match("replay_sha256", d["replay_sha256"], _HEX64),
             ruleset=None if ruleset is None else check_word("ruleset", ruleset),
             config_sha256=None if digest is None else _match("config_sha256", digest, _HEX64),
+            game_sha256=None if d.get("game_sha256") is None else _match("game_sha256", d["game_sha256"], _HEX64),
+            entered=None if d.get("entered") is None else check_int("entered", d["entered"], 1, _COUNT_MAX),
+            entered_at=None if d.get("entered_at") is None else check_date("entered_at", d["entered_at"]),
+            complete=None if d.get("complete") is None else _bool("complete", d["complete"]),
         )
         if (entry.ruleset is None) != (entry.config_sha256 is None):
             raise ValueError("ruleset and config_sha256 come together")
@@ -175,7 +213,7 @@ class ScoreEntry:
 
 
 _ENTRY_FIELDS = tuple(f.name for f in fields(ScoreEntry))
-_OPTIONAL = frozenset({"ruleset", "config_sha256"})
+_OPTIONAL = frozenset({"ruleset", "config_sha256", "game_sha256", "entered", "entered_at", "complete"})
 _REQUIRED = set(_ENTRY_FIELDS) - _OPTIONAL
 
 
@@ -186,9 +224,24 @@ def _match(name: str, value: object, pattern: re.Pattern[str]) -> str:
     return value
 
 
-def sort_key(entry: ScoreEntry) -> tuple[int, datetime, str]:
-    """Best first; equal scores by date, the earlier game first."""
-    return (-entry.score, entry.when, entry.id)
+def _bool(name: str, value: object) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"{name} must be true or false, got {value!r}")
+    return value
+
+
+def sort_key(entry: ScoreEntry) -> tuple[int, int, datetime, str]:
+    """Best first; equal scores by the table's order of entry, the earlier entry first.
+
+    Entries carried over from a table older than format 3 have no place yet (they get one, in
+    the order of their dates, at the table's next write): among them the earlier date first.
+    """
+    return (-entry.score, entry.entered or 0, entry.when, entry.id)
+
+
+def entry_order(entry: ScoreEntry) -> tuple[int, datetime, str]:
+    """The order the table took its entries in: the first of two entries of one game is the one that counts."""
+    return (entry.entered or 0, entry.when, entry.id)
 
 
 @dataclass(frozen=True)
@@ -202,6 +255,8 @@ class Check:
     label: str
     detail: str = ""
     ruleset: str | None = None
+    #: The game's digest (``identity.game_digest``), when the replay could be read.
+    game: str | None = None
 
 
 @dataclass(frozen=True)
@@ -220,7 +275,7 @@ def replay_claims(replay: Replay) -> dict[str, object]:
     return {"name": replay.player, "driven": replay.driven, "driver": replay.driver, "score": r.score,
             "hits": r.hits, "resets": r.resets, "seed": r.seed, "scene": r.scene, "duration": r.duration,
             "date": replay.date, "config_sha256": config_digest(replay.config),
-            "ruleset": ruleset_name(replay.config)}
+            "ruleset": ruleset_name(replay.config), "game_sha256": game_digest(replay), "complete": replay.complete}
 
 
 class ScoreTable:
@@ -234,7 +289,10 @@ class ScoreTable:
         self.replays = self.folder / REPLAYS_DIR
         self.warn = warn or (lambda message: print(message, file=sys.stderr))
         self.cache = cache
-        self._legacy_rulesets: dict[str, str] = {}
+        if cache is not None:
+            cache.guard(self.folder)
+        #: The seed this table ranks (read from its head by ``read``).
+        self.seed = DEFAULT_SEED
 
     # ------------------------------------------------------------------ reading
     def _open_table(self) -> int | None:
@@ -265,38 +323,47 @@ class ScoreTable:
             return [], None
         with os.fdopen(fd, "rb") as f:
             data = f.read(MAX_TABLE_BYTES + 1)
-        return parse_table(data)
+        entries, damage, head = _parse(data)
+        self.seed = head.seed
+        return entries, damage
 
     def all_entries(self) -> list[ScoreEntry]:
-        """Every valid entry, ranked or not, best first; a damaged file is reported through ``warn``."""
+        """Every valid entry, in any list, best first; a damaged file is reported through ``warn``."""
         entries, damage = self.read()
         if damage:
             self.warn(damage.describe(self.path) + "; the file will be kept aside at the next save")
         return sorted(entries, key=sort_key)
 
     def entries(self) -> list[ScoreEntry]:
-        """The ranked entries (games of a ranked ruleset), best first."""
-        return [e for e in self.all_entries() if self.ruleset(e) in RULESETS]
+        """The ranked entries (keyboard games of a ranked ruleset and the table's seed), best first."""
+        return [e for e in self.all_entries() if self.list_of(e) == RANKED]
 
-    def ruleset(self, entry: ScoreEntry) -> str:
-        """The ruleset an entry plays: its own claim (checked against its replay by ``check``), or,
-        for an entry from a format 1 table, what its replay's configuration says."""
+    def ruleset(self, entry: ScoreEntry, check: Check | None = None) -> str:
+        """The ruleset an entry plays: its own claim (``check`` compares it with its replay).
+
+        An entry carried over from a format 1 table makes no claim: its check (or a cached one)
+        says what its replay plays; unchecked, it counts as a custom game. Its replay is never
+        read just to list it: a planted table of old entries cannot make listing read each replay.
+        """
         if entry.config_sha256 is not None:
             found = next((r for r in RULESETS.values() if r.digest == entry.config_sha256), None)
             return found.name if found and found.name == entry.ruleset else CUSTOM
-        if entry.replay_sha256 not in self._legacy_rulesets:
-            cached = self.cache.get(entry.replay_sha256) if self.cache is not None else None
-            if all((entry.duration, entry.scene) != (r.config.time_limit, r.config.scene) for r in RULESETS.values()):
-                name = CUSTOM  # no ranked ruleset has this length: no need to read the replay
-            elif cached is not None:  # a check already read this replay: its ruleset is known
-                name = cached["claims"]["ruleset"] if cached["claims"] else CUSTOM
-            else:  # read its configuration (no replaying: this serves the end screen too)
-                try:
-                    name = ruleset_name(Replay.load(self._replay_file(entry), follow=False).config)
-                except DataFileError:
-                    name = CUSTOM
-            self._legacy_rulesets[entry.replay_sha256] = name
-        return self._legacy_rulesets[entry.replay_sha256]
+        if check is not None and check.ruleset is not None:
+            return check.ruleset
+        cached = self.cache.get(entry.replay_sha256) if self.cache is not None else None
+        if cached is not None and cached["claims"] is not None:
+            return cached["claims"]["ruleset"]
+        return CUSTOM
+
+    def list_of(self, entry: ScoreEntry, check: Check | None = None) -> str:
+        """Which list the entry goes to: ``ranked``, ``practice``, ``programs`` or ``custom`` (module docstring)."""
+        if entry.program:
+            return PROGRAMS
+        if self.ruleset(entry, check) not in RULESETS:
+            return CUSTOM_GAMES
+        if entry.seed != self.seed:
+            return PRACTICE
+        return RANKED
 
     # ------------------------------------------------------------------ writing
     def _safe_folder(self) -> None:
@@ -318,30 +385,15 @@ class ScoreTable:
 
     @contextlib.contextmanager
     def _locked(self, wait: float | None = None) -> Iterator[None]:
-        import fcntl  # POSIX only; imported here so reading the table works everywhere
-
         wait = LOCK_WAIT if wait is None else wait
         try:
-            # Read-only is enough for flock, so classmates can share a lock file one of them created.
-            fd = os.open(self.lock_path, os.O_RDONLY | os.O_CREAT | _NOFOLLOW | os.O_NONBLOCK, 0o644)
-        except OSError as exc:
-            raise TableError(f"{self.lock_path}: cannot open the lock: {exc.strerror or exc}") from None
-        try:
-            if not stat.S_ISREG(os.fstat(fd).st_mode):
-                raise TableError(f"{self.lock_path}: is not a regular file")
-            deadline = time.monotonic() + wait
-            while True:
-                try:
-                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-                    break
-                except BlockingIOError:
-                    if time.monotonic() >= deadline:
-                        raise TableBusyError(f"the table in {self.folder} is busy (another program has held its "
-                                        f"lock for {wait:g} s)") from None
-                    time.sleep(0.05)
-            yield
-        finally:
-            os.close(fd)  # closing drops the lock
+            with file_lock(self.lock_path, wait):
+                yield
+        except LockBusyError:
+            raise TableBusyError(f"the table in {self.folder} is busy (another program has held its "
+                                 f"lock for {wait:g} s)") from None
+        except LockError as exc:
+            raise TableError(f"{self.lock_path}: cannot take the lock: {exc}") from None
 
     def save_replay(self, replay: Replay) -> Path:
         """Save the replay in replays/ (before the table is touched); returns its path."""
@@ -383,17 +435,24 @@ class ScoreTable:
             hits=r.hits, resets=r.resets, seed=r.seed, scene=r.scene, duration=r.duration,
             date=replay.date or now_iso(), version=replay.version, replay=path.name,
             replay_sha256=hashlib.sha256(data).hexdigest(), ruleset=claims["ruleset"],
-            config_sha256=claims["config_sha256"],
+            config_sha256=claims["config_sha256"], game_sha256=claims["game_sha256"], complete=True,
         ))
         try:
             with self._locked():
-                self._enter(entry)
+                return self._enter(entry)
         except TableBusyError as exc:
             raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with "
                             f"armgame scores --scores {self.folder} --add {path}") from None
-        return entry
 
-    def _enter(self, entry: ScoreEntry) -> None:
+    def new(self, seed: int) -> None:
+        """Start the table (empty) ranking ``seed``; refused if it already holds entries."""
+        self._safe_folder()
+        with self._locked():
+            self._enter(None, seed)
+
+    def _enter(self, entry: ScoreEntry | None, seed: int | None = None) -> ScoreEntry | None:
+        """Under the lock: write the table with ``entry`` added (its place in the order of entry and
+        the time given here), or, with ``seed``, an empty table ranking that seed. Returns the entry."""
         # Under the lock nobody else is writing the table: any temporary file of it was left by a
         # writer that died mid-write. Replays are written outside the lock, so theirs are left alone.
         for stale in self.folder.glob(f".{TABLE_NAME}.*.tmp"):
@@ -403,18 +462,24 @@ class ScoreTable:
         fd = self._open_table()
         try:
             if fd is None:
-                entries, damage = [], None
+                entries, damage, head = [], None, _Head()
             else:
                 data = _read_all(fd)
-                entries, damage = parse_table(data)
-            twin = next((e for e in entries if e.replay_sha256 == entry.replay_sha256), None)
-            if twin is not None:
-                raise TableError(f"this replay is already in the table (entered {twin.date[:16]} as {twin.name})")
-            if len(entries) >= MAX_TABLE_ENTRIES:
-                raise TableError(f"the table holds {len(entries)} entries, its limit: not entered (nothing was "
+                entries, damage, head = _parse(data)
+            if seed is not None:
+                if entries:
+                    raise TableError(f"{self.path} already holds {plural(len(entries), 'entry')}: a new table "
+                                     f"needs its own folder (--scores DIR); nothing was changed")
+                head = _Head(seed=seed, next_entry=head.next_entry)
+            entries, head = _numbered(entries, head)
+            if entry is not None:
+                entry = self._admit(entry, entries, head)
+                entries.append(entry)
+                head = _Head(head.seed, entry.entered + 1)  # type: ignore[operator]
+            if len(entries) > MAX_TABLE_ENTRIES:
+                raise TableError(f"the table holds {len(entries) - 1} entries, its limit: not entered (nothing was "
                                  f"dropped; start a new table with --scores)")
-            entries.append(entry)
-            new = table_bytes(entries)
+            new = table_bytes(entries, head.seed, head.next_entry)
             if len(new) > MAX_TABLE_BYTES:
                 raise TableError("the table would grow past its size limit: not entered (nothing was dropped)")
             kept = None
@@ -430,9 +495,22 @@ class ScoreTable:
             if damage is not None:
                 where = f"; the damaged file is kept as {kept.name}" if kept else ""
                 self.warn(f"{damage.describe(self.path)}{where}")
+            return entry
         finally:
             if fd is not None:
                 os.close(fd)
+
+    @staticmethod
+    def _admit(entry: ScoreEntry, entries: list[ScoreEntry], head: _Head) -> ScoreEntry:
+        """``entry`` with its place in the order of entry; refused if its game or replay is already in."""
+        twin = next((e for e in entries if e.replay_sha256 == entry.replay_sha256
+                     or (e.game_sha256 is not None and e.game_sha256 == entry.game_sha256)), None)
+        if twin is not None:
+            when = (twin.entered_at or twin.date)[:16].replace("T", " ")
+            raise TableError(f"this game is already in the table: entered by {twin.name} on {when} UTC "
+                             f"(entry #{twin.entered}); a game enters once, whoever's name it carries")
+        return ScoreEntry(**{**entry.as_dict(), "entered": head.next_entry,
+                             "entered_at": datetime.now(UTC).isoformat(timespec="seconds")})
 
     def _copy_aside(self, fd: int) -> Path:
         stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
@@ -448,19 +526,13 @@ class ScoreTable:
                                  f"changed") from None
         raise TableError("cannot name a copy of the damaged table; nothing was changed")
 
-    def of_kind(self, ranked: bool) -> list[ScoreEntry]:
-        """Ranked games, or else custom games, best first: the entries one game is compared with."""
-        if ranked:
-            return self.entries()
-        return [e for e in self.all_entries() if self.ruleset(e) not in RULESETS]
-
-    def same_kind(self, entry: ScoreEntry) -> list[ScoreEntry]:
-        """The entries ``entry`` is compared with, best first."""
-        return self.of_kind(self.ruleset(entry) in RULESETS)
+    def of_list(self, name: str) -> list[ScoreEntry]:
+        """The entries of one list (``list_of``), best first: the entries one game is compared with."""
+        return [e for e in self.all_entries() if self.list_of(e) == name]
 
     def rank(self, entry: ScoreEntry) -> int:
-        """The entry's place among the entries of its own kind (ranked games, or custom games)."""
-        ordered = self.same_kind(entry)
+        """The entry's place in its own list."""
+        ordered = self.of_list(self.list_of(entry))
         return next((i for i, e in enumerate(ordered, 1) if e.id == entry.id), len(ordered))
 
     # ------------------------------------------------------------------ trust
@@ -486,56 +558,74 @@ class ScoreTable:
         the batched one); if it fails, the games are recomputed one at a time, so one entry's
         failure still marks only that entry.
         """
-        found: list[Check | tuple[str, dict | Replay]] = []
+        found: list[Check | tuple[str, dict | Replay, list[int]]] = []
         for entry in entries:
             try:
                 found.append(self._claim(entry))
             except Exception as exc:  # one entry's failure never takes the table down
                 found.append(_bad(exc))
-        pending = {digest: item for f in found if not isinstance(f, Check)
-                   for digest, item in [f] if isinstance(item, Replay)}
-        verdicts = _recompute(list(pending.values()), recompute)
-        for (digest, replay), verdict in zip(pending.items(), verdicts, strict=True):
-            cached = {"claims": replay_claims(replay), **verdict}
-            if self.cache:
-                self.cache.put(digest, cached)
-            pending[digest] = cached  # type: ignore[assignment]
+        pending: dict[str, tuple[Replay, list[int]]] = {}
+        for f in found:
+            if not isinstance(f, Check) and isinstance(f[1], Replay):
+                pending[f[0]] = (f[1], f[2])
+        verdicts = _recompute([replay for replay, _ in pending.values()], recompute)
+        judged: dict[str, dict] = {}
+        for (digest, (replay, signature)), verdict in zip(pending.items(), verdicts, strict=True):
+            judged[digest] = {"claims": replay_claims(replay), **verdict, "file": signature}
+            if self.cache is not None:
+                self.cache.put(digest, judged[digest])
         checks = []
         for entry, f in zip(entries, found, strict=True):
             if isinstance(f, Check):
                 checks.append(f)
                 continue
-            digest, item = f
+            digest, item, _ = f
             try:
-                checks.append(self._judge(entry, pending[digest] if isinstance(item, Replay) else item))
+                checks.append(self._judge(entry, judged[digest] if isinstance(item, Replay) else item))
             except Exception as exc:
                 checks.append(_bad(exc))
         return checks
 
-    def _claim(self, entry: ScoreEntry) -> Check | tuple[str, dict | Replay]:
-        """A failed ``Check``; or the replay's digest with its cached verdict, or the replay still to recompute."""
+    def _claim(self, entry: ScoreEntry) -> Check | tuple[str, dict | Replay, list[int]]:
+        """A failed ``Check``; or the replay's digest with its cached verdict, or the replay still to
+        recompute, and the replay file's signature. A replay file whose signature a cached verdict
+        recorded is not read at all (``cache.file_signature``)."""
         try:
             path = self._replay_file(entry)
-            data = read_limited(path, MAX_REPLAY_BYTES, "replay file", follow=False)
+            fd = open_regular(path, "replay file", follow=False)
         except DataFileError as exc:
             missing = not self.replay_path(entry).exists() and not self.replay_path(entry).is_symlink()
             return Check(False, "REPLAY MISSING" if missing else "REPLAY UNREADABLE", str(exc))
+        with os.fdopen(fd, "rb") as f:
+            signature = file_signature(os.fstat(f.fileno()))
+            if self.cache is not None and self.cache.digest_of(signature) == entry.replay_sha256:
+                cached = self.cache.get(entry.replay_sha256)
+                if cached is not None:
+                    return entry.replay_sha256, cached, signature
+            try:
+                data = f.read(MAX_REPLAY_BYTES + 1)
+            except OSError as exc:
+                return Check(False, "REPLAY UNREADABLE", f"{path}: cannot read: {exc.strerror or exc}")
+        if len(data) > MAX_REPLAY_BYTES:
+            return Check(False, "REPLAY UNREADABLE", f"{path}: larger than a replay may be")
         digest = hashlib.sha256(data).hexdigest()
         if digest != entry.replay_sha256:
             return Check(False, "REPLAY CHANGED", f"{path.name} is not the replay this entry was saved with")
         cached = self.cache.get(digest) if self.cache else None
         if cached is not None:
-            return digest, cached
+            if self.cache is not None and cached.get("file") != signature:
+                self.cache.put(digest, {**cached, "file": signature})  # known unchanged without reading, next time
+            return digest, cached, signature
         try:
             replay = Replay.from_bytes(data, str(path))
         except DataFileError as exc:
-            cached = {"claims": None, "ok": False, "label": "BAD REPLAY", "detail": str(exc)}
+            cached = {"claims": None, "ok": False, "label": "BAD REPLAY", "detail": str(exc), "file": signature}
             if self.cache:
                 self.cache.put(digest, cached)
-            return digest, cached
+            return digest, cached, signature
         if replay.task is not None:
             return Check(False, "NOT A GAME", f"{path.name} is a lab run, which is never ranked")
-        return digest, replay
+        return digest, replay, signature
 
     @staticmethod
     def _judge(entry: ScoreEntry, cached: dict) -> Check:
@@ -547,11 +637,17 @@ class ScoreTable:
         if entry.config_sha256 is None:  # a format 1 entry makes no claim about its rules
             wanted.pop("config_sha256")
             wanted.pop("ruleset")
+        for key in ("game_sha256", "complete"):  # entries from older tables make no such claims
+            if getattr(entry, key) is None:
+                wanted.pop(key)
         for key, value in wanted.items():
             if getattr(entry, key) != value:
                 return Check(False, "NOT ITS REPLAY", f"the entry says {key} {getattr(entry, key)!r}, its replay "
-                             f"{value!r}", claims["ruleset"])
-        return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"])
+                             f"{value!r}", claims["ruleset"], claims["game_sha256"])
+        if not claims["complete"]:
+            return Check(False, "NOT A WHOLE GAME", "the game stopped before its clock ran out", claims["ruleset"],
+                         claims["game_sha256"])
+        return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"], claims["game_sha256"])
 
 
 def _bad(exc: Exception) -> Check:
@@ -601,83 +697,30 @@ def _judged(replay: Replay, ok: bool, recomputed: GameResult) -> dict[str, objec
                       f"({plural(recomputed.hits, 'hit')}, {plural(recomputed.resets, 'reset')})"}
 
 
-# ------------------------------------------------------------------ the verification cache
-
-def default_cache_dir() -> Path | None:
-    """``$ARMGAME_CACHE``, else ``$XDG_CACHE_HOME/armgame`` (``~/.cache/armgame``): written only by its user."""
-    env = os.environ.get(CACHE_ENV)
-    if env:
-        return user_path(env, f"${CACHE_ENV}")
-    base = os.environ.get("XDG_CACHE_HOME")
-    if not base:
-        try:
-            base = str(Path.home() / ".cache")
-        except RuntimeError:  # no home folder at all: no cache (a shared temporary folder could be planted)
-            return None
-    return Path(base) / "armgame"
-
-
-class VerificationCache:
-    """Verdicts of replays already recomputed, keyed by the replay's SHA-256 and the armgame version.
-
-    It lives in the per-user cache folder, never beside a shared table: a classmate who can write
-    the table's folder cannot plant an "ok". The file is read as hostile data like any other (a
-    damaged cache is ignored), and a failure to write it only costs time.
-    """
-
-    FORMAT = "armgame-verified"
-    MAX_BYTES = 64 * 1024 * 1024
-    MAX_ITEMS = 200_000
-
-    def __init__(self, folder: Path | None = None) -> None:
-        self.folder = Path(folder) if folder is not None else default_cache_dir()
-        self.path = self.folder / f"verified-{__version__}.json" if self.folder is not None else None
-        #: Without a folder the cache lives only as long as the command.
-        self._items: dict[str, dict] | None = None if self.path is not None else {}
-        self._new: dict[str, dict] = {}
-
-    def _load(self) -> dict[str, dict]:
-        if self._items is None:
-            self._items = {}
-            try:
-                data = parse_json(read_limited(self.path, self.MAX_BYTES, "cache file", follow=False))
-                if isinstance(data, dict) and data.get("format") == self.FORMAT \
-                        and data.get("version") == __version__ and isinstance(data.get("items"), dict):
-                    self._items = {k: v for k, v in data["items"].items() if _HEX64.fullmatch(k) and _valid(v)}
-            except (DataFileError, ValueError, UnicodeDecodeError):
-                pass  # no cache, or a damaged one: everything is verified afresh
-        return self._items
-
-    def get(self, digest: str) -> dict | None:
-        return self._new.get(digest) or self._load().get(digest)
-
-    def put(self, digest: str, verdict: dict) -> None:
-        self._new[digest] = verdict
-
-    def save(self) -> None:
-        if not self._new or self.folder is None or self.path is None:
-            return
-        items = {**self._load(), **self._new}
-        if len(items) > self.MAX_ITEMS:
-            items = dict(self._new)
-        with contextlib.suppress(OSError, DataFileError):
-            self.folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-            payload = {"format": self.FORMAT, "version": __version__, "items": items}
-            atomic_write_bytes(self.path, json.dumps(payload, sort_keys=True, allow_nan=False).encode(), "cache")
-        self._new = {}
-
-
-def _valid(v: object) -> bool:
-    if not (isinstance(v, dict) and isinstance(v.get("ok"), bool) and isinstance(v.get("label"), str)
-            and isinstance(v.get("detail"), str)):
-        return False
-    claims = v.get("claims")
-    return claims is None or (isinstance(claims, dict) and set(claims) == {
-        "name", "driven", "driver", "score", "hits", "resets", "seed", "scene", "duration", "date",
-        "config_sha256", "ruleset"})
-
-
 # ------------------------------------------------------------------ the file
+
+@dataclass(frozen=True)
+class _Head:
+    """The table's own fields: the seed it ranks and the next place in its order of entry."""
+
+    seed: int = DEFAULT_SEED
+    next_entry: int = 1
+
+
+def _numbered(entries: list[ScoreEntry], head: _Head) -> tuple[list[ScoreEntry], _Head]:
+    """Entries carried over from an older table get their places, in the order of their dates, once.
+
+    The counter never goes back, even past a hand-edited ``next_entry``: places are never reused.
+    """
+    start = max([head.next_entry, *((e.entered or 0) + 1 for e in entries)])
+    old = sorted((e for e in entries if e.entered is None), key=entry_order)
+    if not old:
+        return entries, _Head(head.seed, start)
+    places = {e.id: start + i for i, e in enumerate(old)}
+    numbered = [e if e.entered is not None else ScoreEntry(**{**e.as_dict(), "entered": places[e.id]})
+                for e in entries]
+    return numbered, _Head(head.seed, start + len(old))
+
 
 def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
     """Entries of a table file, and the damage if it is not a clean table.
@@ -685,27 +728,35 @@ def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
     A clean table yields all its entries. Otherwise every object in the text that passes
     the entry schema is recovered, wherever it sits (truncated tails, broken brackets).
     """
+    entries, damage, _ = _parse(data)
+    return entries, damage
+
+
+def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
+    """``parse_table`` and the table's head (a damaged table's head is the default one)."""
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         text = data.decode("utf-8", errors="replace")
-        return _salvage(text, "not UTF-8 text")
+        return (*_salvage(text, "not UTF-8 text"), _Head())
     try:
         table = parse_json(text)
     except ValueError as exc:
-        return _salvage(text, str(exc))
+        return (*_salvage(text, str(exc)), _Head())
     try:
         if not isinstance(table, dict) or table.get("format") != FORMAT:
             raise ValueError(f"not an armgame score table (no \"format\": \"{FORMAT}\")")
-        check_keys("table", table, {"format", "format_version", "entries"})
+        check_keys("table", table, {"format", "format_version", "entries"}, frozenset({"seed", "next_entry"}))
         version = check_int("format_version", table["format_version"], 1, 10**6)
         if version not in READS_FORMATS:
             raise ValueError(f"table format {version} is not one this armgame reads "
                              f"({', '.join(map(str, READS_FORMATS))})")
         if not isinstance(table["entries"], list):
             raise ValueError("entries must be a list")
+        head = _Head(check_int("seed", table.get("seed", DEFAULT_SEED), 0, 2**63 - 1),
+                     check_int("next_entry", table.get("next_entry", 1), 1, _COUNT_MAX))
     except ValueError as exc:
-        return _salvage(text, str(exc))
+        return (*_salvage(text, str(exc)), _Head())
     entries: list[ScoreEntry] = []
     seen: set[str] = set()
     problem = None
@@ -720,7 +771,7 @@ def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
         seen.add(entry.id)
         entries.append(entry)
     n = len(table["entries"])
-    return entries, (Damage(problem, len(entries), n) if problem else None)
+    return entries, (Damage(problem, len(entries), n) if problem else None), head
 
 
 #: A flat JSON object (an entry has no nested values), strings honoured. Possessive quantifiers
@@ -742,9 +793,15 @@ def _salvage(text: str, reason: str) -> tuple[list[ScoreEntry], Damage]:
     return entries, Damage(reason, len(entries), len(entries))
 
 
-def table_bytes(entries: list[ScoreEntry]) -> bytes:
-    """The table file: one entry a line, best first, so it reads (and diffs) as a list."""
-    lines = [json.dumps(e.as_dict(), sort_keys=True, ensure_ascii=False, allow_nan=False)
+def table_bytes(entries: list[ScoreEntry], seed: int = DEFAULT_SEED, next_entry: int | None = None) -> bytes:
+    """The table file: one entry a line, best first, so it reads (and diffs) as a list.
+
+    Fields an entry lacks (it came from an older table) are left out rather than written as null."""
+    lines = [json.dumps({k: v for k, v in e.as_dict().items() if v is not None or k not in _OPTIONAL},
+                        sort_keys=True, ensure_ascii=False, allow_nan=False)
              for e in sorted(entries, key=sort_key)]
-    head = json.dumps({"format": FORMAT, "format_version": FORMAT_VERSION})[:-1]
+    if next_entry is None:
+        next_entry = max([0, *(e.entered or 0 for e in entries)]) + 1
+    head = json.dumps({"format": FORMAT, "format_version": FORMAT_VERSION, "seed": seed,
+                       "next_entry": next_entry})[:-1]
     return (head + ', "entries": [\n' + ",\n".join(lines) + "\n]}\n").encode("utf-8")

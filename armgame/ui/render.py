@@ -130,6 +130,7 @@ class Standing:
     rank: int | None  # None: the game was not entered
     entries: int
     top: tuple[tuple[int, str, int], ...]  # (rank, name, score), best first
+    list_name: str = "the ranked table"  # the list the game went to: ranked, practice, programs, custom games
 
 
 @dataclass
@@ -401,7 +402,8 @@ class GameRenderer:
         standing = hud.standing
         if hud.name_entry is None and standing is not None:
             if standing.rank is not None:
-                lines.append((f"Rank {standing.rank} of {standing.entries} in the table", normal, p.ink, "end"))
+                lines.append((f"Rank {standing.rank} of {standing.entries} in {standing.list_name}", normal, p.ink,
+                              "end"))
             if standing.top:
                 lines.append(("Top 10", normal, p.ink, "end"))
         margin = max(8, round(24 * lay.unit))

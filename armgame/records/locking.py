@@ -1,0 +1,48 @@
+"""The table's lock, on every platform: ``filelock``, which picks the platform's own kind.
+
+On Linux and macOS that is ``fcntl.flock`` on the lock file (opened with ``O_NOFOLLOW``, never
+truncated): the kernel drops it when its holder exits, even by SIGKILL, so there is no stale
+lock to clean up. On Windows it is ``LockFileEx`` on a handle that refuses reparse points (a
+planted symlink or junction). Where neither exists, ``filelock`` falls back to a marker file
+created exclusively. The file is made readable and writable by everyone (``mode``), so that
+classmates sharing one table folder can all take the lock whoever created it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import warnings
+from collections.abc import Iterator
+from pathlib import Path
+
+
+class LockBusyError(Exception):
+    """The lock was not free within the wait."""
+
+
+class LockError(Exception):
+    """The lock file cannot be opened or locked (the reason is the message)."""
+
+
+@contextlib.contextmanager
+def file_lock(path: Path, wait: float) -> Iterator[None]:
+    """Hold the exclusive lock on ``path`` (created if need be) for the ``with`` block.
+
+    Raises ``LockBusyError`` after ``wait`` seconds, ``LockError`` if the lock file cannot be opened;
+    whatever the block raises passes through unchanged.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "only soft file lock is available": said in the docs, not at every save
+        import filelock
+
+    lock = filelock.FileLock(str(path), timeout=wait, mode=0o666, thread_local=False)
+    try:
+        lock.acquire(poll_interval=0.05)
+    except filelock.Timeout:
+        raise LockBusyError(str(path)) from None
+    except (OSError, NotImplementedError) as exc:  # NotImplementedError: a file system without flock
+        raise LockError(getattr(exc, "strerror", None) or str(exc) or type(exc).__name__) from None
+    try:
+        yield
+    finally:
+        lock.release()
