@@ -291,8 +291,7 @@ class ScoreTable:
         self.cache = cache
         if cache is not None:
             cache.guard(self.folder)
-        #: The seed this table ranks (read from its head by ``read``).
-        self.seed = DEFAULT_SEED
+        self._seed: int | None = None
 
     # ------------------------------------------------------------------ reading
     def _open_table(self) -> int | None:
@@ -324,8 +323,19 @@ class ScoreTable:
         with os.fdopen(fd, "rb") as f:
             data = f.read(MAX_TABLE_BYTES + 1)
         entries, damage, head = _parse(data)
-        self.seed = head.seed
+        self._seed = head.seed
         return entries, damage
+
+    @property
+    def seed(self) -> int:
+        """The seed this table ranks (its head's; the default game's for a table without one)."""
+        if self._seed is None:
+            try:
+                self.read()
+            except DataFileError:
+                pass
+            self._seed = DEFAULT_SEED if self._seed is None else self._seed
+        return self._seed
 
     def all_entries(self) -> list[ScoreEntry]:
         """Every valid entry, in any list, best first; a damaged file is reported through ``warn``."""
@@ -472,6 +482,7 @@ class ScoreTable:
                                      f"needs its own folder (--scores DIR); nothing was changed")
                 head = _Head(seed=seed, next_entry=head.next_entry)
             entries, head = _numbered(entries, head)
+            self._seed = head.seed
             if entry is not None:
                 entry = self._admit(entry, entries, head)
                 entries.append(entry)
