@@ -5,7 +5,6 @@ Classes: (1) only the standard game ranks, (2) one bad entry never takes the tab
 never a traceback or a hang. Everything is written under tmp_path.
 """
 
-import fcntl
 import json
 import os
 import subprocess
@@ -23,6 +22,7 @@ import armgame.records.scores as scores_module
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, NonFiniteStateError
+from armgame.records.locking import file_lock
 from armgame.records.replay import Replay, config_to_dict
 from armgame.records.rulesets import RULESETS, config_digest, ruleset_name
 from armgame.records.scores import ScoreTable, parse_table
@@ -278,7 +278,8 @@ def test_scores_checks_at_most_top_custom_entries_flagged_or_not(tmp_path, monke
     checked = []
     real = ScoreTable.check_many
     monkeypatch.setattr(ScoreTable, "check_many",
-                        lambda self, es, recompute=None: checked.extend(e.name for e in es) or real(self, es, recompute))
+                        lambda self, es, recompute=None: checked.extend(e.name for e in es)
+                        or real(self, es, recompute))
     assert main(["scores", "--scores", str(tmp_path), "--top", "2"]) == 0
     assert len(checked) == 2 and "2 flagged" in capsys.readouterr().out
 
@@ -436,14 +437,14 @@ def test_a_busy_table_keeps_the_game_and_says_how_to_enter_it(tmp_path, monkeypa
     monkeypatch.setattr(scores_module, "LOCK_WAIT", 0.3)
     folder = tmp_path / "t"
     ScoreTable(folder).add(game("first"))
-    fd = os.open(folder / "scores.lock", os.O_RDWR)
-    fcntl.flock(fd, fcntl.LOCK_EX)  # someone else holds the table
+    holder = file_lock(folder / "scores.lock", 1.0)
+    holder.__enter__()  # someone else holds the table
     try:
         start = time.perf_counter()
         code = main(["play", "--headless", "--duration", "0.5", "--name", "Late", "--scores", str(folder)])
         assert time.perf_counter() - start < 5
     finally:
-        os.close(fd)
+        holder.__exit__(None, None, None)
     err = capsys.readouterr().err
     assert code == 2 and "busy" in err and err.count("\n") == 1
     command = err[err.index("armgame scores"):].strip()
@@ -603,9 +604,9 @@ def test_slow_lock_holder_does_not_lose_entries(tmp_path):
     """Two writers, one holding the lock a while: the other waits (bounded) and both land."""
     folder = tmp_path / "t"
     ScoreTable(folder).add(game("a", time_limit=0.1, seed=1))
-    fd = os.open(folder / "scores.lock", os.O_RDWR)
-    fcntl.flock(fd, fcntl.LOCK_EX)
-    timer = threading.Timer(0.5, os.close, (fd,))
+    holder = file_lock(folder / "scores.lock", 1.0)
+    holder.__enter__()
+    timer = threading.Timer(0.5, holder.__exit__, (None, None, None))
     timer.start()
     ScoreTable(folder).add(game("b", time_limit=0.1, seed=2))
     timer.join()

@@ -3,19 +3,20 @@
 Storage, in one folder (see ``default_scores_dir``)::
 
     scores.json           the table: JSON, one entry a line
-    scores.lock           taken (flock) by whoever writes the table
+    scores.lock           locked by whoever writes the table (``records.locking``)
     replays/*.json        one replay per entry, named by the entry
 
 Why one file under a lock rather than an append-only log with a merge: the table stays
 one small, readable JSON file a teacher can open, and every change is all or nothing. A
-change is read-modify-write under an exclusive ``fcntl.flock`` on ``scores.lock``, so two
-games finishing at the same moment queue for a few milliseconds and both entries land;
-the kernel drops the lock when its holder exits, even by SIGKILL, so there is no stale
-lock to clean up. A writer waits at most ``LOCK_WAIT`` seconds for the lock, then says the
-table is busy; the game's replay is already saved and ``armgame scores --add`` enters it
-later. The new table is written to a temporary file in the same folder, fsynced and renamed
-over the old one (``armgame.records.storage``): readers need no lock, since they always see
-a whole table, old or new.
+change is read-modify-write under an exclusive lock on ``scores.lock`` (``flock`` on Linux and
+macOS, ``LockFileEx`` on Windows: ``armgame.records.locking``), so two games finishing at the
+same moment queue for a few milliseconds and both entries land; the kernel drops the lock
+when its holder exits, even by SIGKILL, so there is no stale lock to clean up. A writer waits
+at most ``LOCK_WAIT`` seconds for the lock, then says the table is busy; the game's replay
+is already saved and ``armgame scores --add`` enters it later. The new table is written to a
+temporary file in the same folder, fsynced and renamed over the old one
+(``armgame.records.storage``): readers need no lock, since they always see a whole table,
+old or new.
 
 Trust: the table is parsed as data with a schema check of every field. A damaged table
 (truncated, not JSON, an entry failing its checks) is never overwritten silently: the next
@@ -330,10 +331,8 @@ class ScoreTable:
     def seed(self) -> int:
         """The seed this table ranks (its head's; the default game's for a table without one)."""
         if self._seed is None:
-            try:
+            with contextlib.suppress(DataFileError):
                 self.read()
-            except DataFileError:
-                pass
             self._seed = DEFAULT_SEED if self._seed is None else self._seed
         return self._seed
 

@@ -44,8 +44,12 @@ def _read_umask() -> int:
 
 
 _UMASK = _read_umask()
+# POSIX flags, each optional: where the platform lacks one (Windows has none of these) the same
+# promise is kept another way, or is moot there (a FIFO or a terminal cannot sit at a file path).
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _NOCTTY = getattr(os, "O_NOCTTY", 0)
+_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
+_BINARY = getattr(os, "O_BINARY", 0)  # Windows: bytes as they are, no newline translation
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)
 
 
@@ -238,12 +242,24 @@ def open_regular(path: Path, what: str, follow: bool = True) -> int:
     """Open ``path`` for reading without blocking and return the descriptor of a regular file.
 
     ``O_NONBLOCK`` makes opening a FIFO return at once (no writer needed); ``fstat`` on the
-    open descriptor then refuses it, so there is no window between the check and the read.
-    ``follow=False`` refuses a symlink (files inside a folder armgame owns).
+    open descriptor then refuses it, so there is no window between the check and the read. A
+    platform without ``O_NONBLOCK`` (Windows, where no FIFO sits at a file path) checks the path
+    before opening it.
+    ``follow=False`` refuses a symlink (files inside a folder armgame owns): by ``O_NOFOLLOW``, or
+    where the platform has none, by ``lstat`` before the open and the same file (device and inode)
+    after it, so a symlink swapped in between is refused too.
     """
     path = Path(path)
-    flags = os.O_RDONLY | os.O_NONBLOCK | _NOCTTY | _CLOEXEC | (0 if follow else _NOFOLLOW)
+    flags = os.O_RDONLY | _NONBLOCK | _NOCTTY | _CLOEXEC | _BINARY | (0 if follow else _NOFOLLOW)
+    seen = None
     try:
+        if (not follow and not _NOFOLLOW) or not _NONBLOCK:
+            seen = os.stat(path, follow_symlinks=follow)
+            if stat.S_ISLNK(seen.st_mode):
+                raise OSError(errno.ELOOP, "is a symbolic link")
+            if not stat.S_ISREG(seen.st_mode) and not stat.S_ISDIR(seen.st_mode):
+                # No O_NONBLOCK: a FIFO would block the open itself, so it is refused before.
+                raise DataFileError(f"{show_path(path)}: is {_kind(seen.st_mode)}, not a {what}")
         fd = os.open(path, flags)
     except FileNotFoundError:
         raise DataFileError(f"{show_path(path)}: no such {what}") from None
@@ -256,9 +272,11 @@ def open_regular(path: Path, what: str, follow: bool = True) -> int:
         raise DataFileError(f"{show_path(path)}: cannot read: {exc.strerror or exc}") from None
     try:
         st = os.fstat(fd)
+        if seen is not None and (st.st_dev, st.st_ino) != (seen.st_dev, seen.st_ino):
+            raise DataFileError(f"{show_path(path)}: changed while it was opened (a symbolic link swapped in?)")
         if not stat.S_ISREG(st.st_mode):
             raise DataFileError(f"{show_path(path)}: is {_kind(st.st_mode)}, not a {what}")
-        if os.get_blocking(fd) is False:
+        if _NONBLOCK and os.get_blocking(fd) is False:
             os.set_blocking(fd, True)  # a regular file never blocks; plain reads from here on
     except BaseException:
         os.close(fd)

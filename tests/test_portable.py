@@ -1,0 +1,67 @@
+"""Saving works where POSIX's locking and open flags do not exist (Windows): the records tests run
+again in a subprocess with ``fcntl`` unimportable and ``O_NOFOLLOW``, ``O_NONBLOCK``, ``O_NOCTTY``
+absent (``tests/conftest.py``), and must pass there too."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+SIMULATED = os.environ.get("ARMGAME_TEST_NO_POSIX") == "1"
+
+#: The records tests that touch locking, opening and writing: cheap ones, each a promise kept.
+SELECTION = [
+    "tests/test_portable.py",
+    "tests/test_scores.py::test_add_saves_the_replay_beside_the_table_and_checks_out",
+    "tests/test_scores.py::test_concurrent_writers_all_keep_their_entries",
+    "tests/test_scores.py::test_a_truncated_table_is_kept_aside_and_its_valid_entries_recovered",
+    "tests/test_scores.py::test_tampering_is_flagged",
+    "tests/test_hostile.py::test_inputs_that_are_fifos_never_hang",
+    "tests/test_hostile.py::test_symlinked_replays_folder_or_lock_is_refused",
+    "tests/test_hostile.py::test_a_replay_planted_as_a_symlink_is_not_followed",
+    "tests/test_hostile.py::test_a_planted_temporary_symlink_is_never_written_through",
+    "tests/test_hostile.py::test_read_limited_refuses_special_files_without_blocking",
+    "tests/test_hostile.py::test_a_busy_table_keeps_the_game_and_says_how_to_enter_it",
+    "tests/test_hostile.py::test_slow_lock_holder_does_not_lose_entries",
+    "tests/test_table_identity.py::test_the_same_game_enters_once_however_it_is_copied",
+]
+
+
+@pytest.mark.skipif(SIMULATED, reason="runs the others; not itself again")
+def test_records_tests_pass_without_posix_locks_or_flags():
+    env = {**os.environ, "ARMGAME_TEST_NO_POSIX": "1"}
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-x", *SELECTION],
+                          cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
+    assert " passed" in proc.stdout and "failed" not in proc.stdout
+
+
+@pytest.mark.skipif(not SIMULATED, reason="only where POSIX is simulated away")
+def test_the_simulated_platform_really_lacks_them():
+    import armgame.records.storage as storage
+
+    with pytest.raises(ImportError):
+        import fcntl  # noqa: F401
+    assert storage._NOFOLLOW == storage._NONBLOCK == storage._NOCTTY == 0
+    assert not hasattr(os, "O_NOFOLLOW") and not hasattr(os, "O_NONBLOCK")
+
+
+@pytest.mark.skipif(not SIMULATED, reason="only where POSIX is simulated away")
+def test_a_symlink_swapped_in_after_the_check_is_refused(tmp_path, monkeypatch):
+    from armgame.records.storage import DataFileError, read_limited
+
+    (tmp_path / "real.json").write_text("{}")
+    (tmp_path / "other").write_text("secret")
+    real_open = os.open
+
+    def swap_then_open(path, *args, **kwargs):  # the race: a symlink replaces the file between lstat and open
+        if str(path).endswith("real.json"):
+            os.replace(tmp_path / "other", tmp_path / "real.json")
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(os, "open", swap_then_open)
+    with pytest.raises(DataFileError, match="changed while it was opened"):
+        read_limited(tmp_path / "real.json", 100, "replay file", follow=False)
