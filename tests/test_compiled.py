@@ -60,6 +60,10 @@ def test_a_valid_call_steps_the_games_to_their_halt_and_applies_their_events():
     ({"flags": np.zeros(2, dtype=np.uint8)}, "flags"),
     ({"mode": 3}, "mode"),
     ({"n": 0}, "at least one game"),
+    # Sizes n * 8 that wrap to 0 divided by zero (SIGFPE: the process gone, no message at all).
+    ({"n": 2**61}, "at most"),
+    ({"n": 2**62}, "at most"),
+    ({"n": 2**63 - 1}, "at most"),
 ])
 def test_bad_arguments_are_refused_before_any_step(change, message):
     args = arrays()

@@ -145,8 +145,11 @@ static PyObject *run(PyObject *self, PyObject *args)
                           &obj[5], &obj[6], &obj[7], &obj[8], &obj[9], &obj[10], &obj[11], &obj[12], &obj[13],
                           &obj[14], &obj[15], &obj[16]))
         return NULL;
-    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY || n < 1) {
-        PyErr_Format(PyExc_ValueError, "mode %d, %zd games: expected mode 0, 1 or 2 and at least one game", mode, n);
+    /* n bounded first: every size below is n times at most 4 * 8 bytes, which must not overflow (a wrapped
+       n * D of 0 would divide by zero below: SIGFPE, the process gone). */
+    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY || n < 1 || n > PY_SSIZE_T_MAX / (4 * (Py_ssize_t)sizeof(double))) {
+        PyErr_Format(PyExc_ValueError, "mode %d, %zd games: expected mode 0, 1 or 2 and at least one game, at most %zd", mode,
+                     n, PY_SSIZE_T_MAX / (4 * (Py_ssize_t)sizeof(double)));
         return NULL;
     }
     Buf b[17];
