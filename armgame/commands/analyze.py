@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import UserError
+from ..records.storage import user_path
 
 #: A class folder is read up to this many replays: the work is bounded before it starts.
 MAX_CLASS_FILES = 500
@@ -69,7 +70,7 @@ def verified_rows(path: Path):
 def _replays(args: argparse.Namespace) -> int:
     from ..lab.metrics import write_trials_csv
 
-    out = Path(args.out).expanduser()
+    out = user_path(args.out, "--out")
     one_table = out.suffix.lower() == ".csv"
     if one_table and not out.resolve().parent.is_dir():
         raise UserError(f"--out {args.out}: its folder does not exist")
@@ -112,7 +113,7 @@ def _class(args: argparse.Namespace) -> int:
     folder = Path(args.class_dir)
     if not folder.is_dir():
         raise UserError(f"--class {args.class_dir}: not a folder")
-    out = Path(args.out).expanduser()
+    out = user_path(args.out, "--out")
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {args.out}: not a folder")
     if not args.no_figures:

@@ -46,14 +46,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
 
     from ..bench import report
     from ..bench.run import Options, run_bench
 
     out = None
     if args.out is not None:
-        out = Path(args.out)
+        from ..records.storage import user_path
+
+        out = user_path(args.out, "--out")
         if out.exists() and not out.is_dir():
             raise UserError(f"--out {out} exists and is not a folder")
         from ..bench import figures

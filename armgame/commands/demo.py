@@ -50,12 +50,11 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.speed) and 0.01 <= args.speed <= 100):
         raise UserError(f"--speed must lie between 0.01 and 100, got {args.speed!r}")
     if args.name == "autopilot":
-        from pathlib import Path
-
         from ..demos import autopilot
+        from ..records.storage import user_path
 
         if args.headless:
-            print(autopilot.run_headless(None if args.out is None else Path(args.out), args.duration))
+            print(autopilot.run_headless(None if args.out is None else user_path(args.out, "--out"), args.duration))
         else:
             from ..ui.autopilot_window import run_window as autopilot_window
 
@@ -64,12 +63,11 @@ def run(args: argparse.Namespace) -> int:
     if args.headless:
         if args.out is None:
             raise UserError("--headless needs --out DIR, the folder to write the CSV and figure to")
-        from pathlib import Path
-
         from ..demos.catalog import run_headless
+        from ..records.storage import user_path
 
-        result = run_headless(args.name, Path(args.out), args.duration, args.integrator, args.dt, args.gravity,
-                              figures=not args.no_figures)
+        result = run_headless(args.name, user_path(args.out, "--out"), args.duration, args.integrator, args.dt,
+                              args.gravity, figures=not args.no_figures)
         print(f"{args.name}: {result.summary}")
         for path in result.files:
             print(f"wrote {path}")

@@ -23,13 +23,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+#: Random states ``derive`` compares at: plenty for a check, and a few seconds at most.
+MAX_STATES = 10_000
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         import sympy  # noqa: F401
     except ImportError:
         raise UserError("derive needs SymPy: pip install 'armgame[derive]'") from None
-    if args.states < 1:
-        raise UserError(f"--states must be at least 1, got {args.states}")
+    if not 1 <= args.states <= MAX_STATES:  # each state is a few evaluations: bounded before SymPy starts
+        raise UserError(f"--states must be from 1 to {MAX_STATES}, got {args.states}")
+    if not 0 <= args.seed < 2**63:
+        raise UserError(f"--seed must be a whole number from 0 to 2^63 - 1, got {args.seed}")
     from ..derive import MATCH_TOLERANCE, compare_with_core, derive, format_latex, format_text
 
     joints = 1 if args.arm == "one" else 2

@@ -19,11 +19,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
+    from ..records.storage import user_path
     from ..ui.settings import load
 
-    settings, path = load(Path(args.settings) if args.settings else None)
+    settings, path = load(user_path(args.settings, "--settings") if args.settings else None)
     print(f"{path}{'' if path.exists() else '  (no file yet: the defaults are in force)'}")
     for line in settings.describe():
         print(f"  {line}")

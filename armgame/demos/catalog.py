@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import UserError
+from ..limits import MAX_SIMULATE_ROWS, MAX_SIMULATE_STEPS
 from ..scenes import get_scene
 from ..simulation import Trajectory, write_csv, write_table
 from . import DEMO_NAMES
@@ -95,6 +96,18 @@ class HeadlessResult:
     summary: str
 
 
+def check_budget(duration: float, dt: float, sample_rate: float) -> None:
+    """Refuse a headless demo over ``simulate``'s budget (steps, and rows kept in memory) before any work."""
+    steps = duration / dt
+    if steps > MAX_SIMULATE_STEPS:
+        raise UserError(f"--duration {duration:g} s at --dt {dt:g} s is {steps:.3g} physics steps, more than a "
+                        f"demo runs ({MAX_SIMULATE_STEPS:,}): shorten --duration or raise --dt")
+    rows = steps / max(1, round(1.0 / (sample_rate * dt))) + 1
+    if rows > MAX_SIMULATE_ROWS:
+        raise UserError(f"--duration {duration:g} s keeps {rows:.3g} samples, more than a demo holds "
+                        f"({MAX_SIMULATE_ROWS:,}): shorten --duration")
+
+
 def run_headless(name: str, out_dir: Path, duration: float | None = None, integrator: str = "rk4",
                  dt: float = 0.001, gravity: bool = False, figures: bool = True) -> HeadlessResult:
     """Run demo ``name`` without a window; write ``NAME.csv`` and (with ``figures``) ``NAME.png`` to ``out_dir``."""
@@ -106,6 +119,7 @@ def run_headless(name: str, out_dir: Path, duration: float | None = None, integr
     if not (math.isfinite(duration) and duration > 0.0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {duration!r}")
     run = make_run(name, integrator, dt, gravity)
+    check_budget(duration, run.dt if hasattr(run, "dt") else dt, info.sample_rate)
     if figures:  # after the arguments are checked: a bad one is the first thing to hear about
         from .figures import require_matplotlib
 

@@ -32,11 +32,15 @@ CHAOS_START: State = (math.pi / 2, math.pi / 2, 0.0, 0.0)
 VISIBLY_APART = 0.01
 
 
+MIN_DEMO_DT = 1e-5
+
+
 def check_fixed_step(integrator: str, dt: float) -> None:
     if integrator not in SCHEMES:
         raise UserError(f"unknown integrator {integrator!r} for a demo: choose one of {', '.join(SCHEMES)}")
-    if not (math.isfinite(dt) and 0.0 < dt <= 0.05):
-        raise UserError(f"--dt must be a positive number of seconds no larger than 0.05, got {dt!r}")
+    # At least 1e-5 s: a window steps real time, and a frame of a smaller step is more work than a frame allows.
+    if not (math.isfinite(dt) and MIN_DEMO_DT <= dt <= 0.05):
+        raise UserError(f"--dt must be from {MIN_DEMO_DT:g} to 0.05 s, got {dt!r}")
 
 
 class PassiveRun:

@@ -37,8 +37,14 @@ from .reach import (
     wrap_angles,
 )
 
-#: The most games one vector env holds (about 1 KB of state each).
-MAX_ENVS = 1_000_000
+#: Memory one game of a vector env takes at its peak (reset and the first step): 5.1-5.2 KB measured at
+#: 20,000 and 60,000 games (peak RSS over the games), rounded up.
+BYTES_PER_ENV = 6 * 1024
+#: The memory one vector env may take, known before anything is allocated.
+MAX_ENV_MEMORY = 2 * 1024**3
+#: The most games one vector env holds: its memory budget over a game's (349,525; setting them up takes
+#: about 50 s of one core).
+MAX_ENVS = MAX_ENV_MEMORY // BYTES_PER_ENV
 #: Games per ``BatchGameSession``: larger vectors run as several batches, whose arrays stay
 #: small enough for the caches. Measured per CPU second under load (benchmarks/env_speed.py's
 #: runner): 8,192 envs as one batch 0.83 M env-steps against 0.79 M as two of 4,096; 32,768
@@ -71,8 +77,13 @@ class ReachVectorEnv(VectorEnv):
     def __init__(self, num_envs: int = 1, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  config: GameConfig | None = None, render_mode: str | None = None) -> None:
-        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) or not 1 <= num_envs <= MAX_ENVS:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) or num_envs < 1:
             raise EnvArgumentError(f"num_envs must be a whole number from 1 to {MAX_ENVS:,}, got {num_envs!r}")
+        if num_envs > MAX_ENVS:
+            raise EnvArgumentError(
+                f"num_envs {int(num_envs):,} would take about {num_envs * BYTES_PER_ENV / 1024**3:.1f} GiB "
+                f"({BYTES_PER_ENV // 1024} KiB a game), more than a vector env may ({MAX_ENV_MEMORY // 1024**3} GiB: "
+                f"at most {MAX_ENVS:,} games); run several envs in several processes")
         if render_mode is not None:
             raise EnvArgumentError(f"the vector env does not render (render_mode={render_mode!r}): "
                                    "render one game with gymnasium.make")

@@ -301,6 +301,8 @@ def load_protocol(path: Path) -> Protocol:
         raise UserError(f"{path}: not a text file (UTF-8 TOML expected)") from None
     except tomllib.TOMLDecodeError as exc:
         raise UserError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses into nested arrays and tables
+        raise UserError(f"{path}: not valid TOML: nested too deeply") from None
     try:
         return protocol_from_dict(data)
     except (ValueError, TypeError, UserError) as exc:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..records.storage import user_path
 from .settings import Settings, load, parse_size
 
 
@@ -36,7 +37,7 @@ def add_window_options(p: argparse.ArgumentParser, sound: bool = True, trail: bo
 
 def window_settings(args: argparse.Namespace) -> tuple[Settings, Path]:
     """The settings in force for this window: the file's, with this command line's options over them."""
-    settings, path = load(Path(args.settings) if getattr(args, "settings", None) else None)
+    settings, path = load(user_path(args.settings, "--settings") if getattr(args, "settings", None) else None)
     if getattr(args, "size", None) is not None:
         settings = settings.with_changes(size=args.size)
     if getattr(args, "mute", False):

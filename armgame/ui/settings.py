@@ -106,6 +106,8 @@ def from_toml(data: bytes, source: str) -> Settings:
         raise SettingsError(f"{source}: not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise SettingsError(f"{source}: not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses into nested arrays and tables
+        raise SettingsError(f"{source}: not valid TOML: nested too deeply") from None
     unknown = sorted(set(table) - {"keys", "mute", "palette", "size"})
     if unknown:
         raise SettingsError(f"{source}: unknown key {unknown[0]!r} (known: keys, mute, palette, size)")
