@@ -52,10 +52,12 @@ def verify_replays(replays: Sequence[Replay], kernel: str | None = None) -> list
     return [v if v is not None else r.verify() for r, v in zip(replays, verdicts, strict=True)]
 
 
-def check_entries(table: ScoreTable, entries: Iterable[ScoreEntry]) -> Iterator[tuple[ScoreEntry, Check]]:
-    """``(entry, table.check(entry))`` for each entry, in order, the games recomputed in batches."""
+def check_entries(table: ScoreTable, entries: Iterable[ScoreEntry],
+                  max_work: int | None = None) -> Iterator[tuple[ScoreEntry, Check]]:
+    """``(entry, table.check(entry))`` for each entry, in order, the games recomputed in batches
+    (``max_work``: see ``ScoreTable.check_many``)."""
     for chunk in _chunks(entries, CHUNK):
-        yield from zip(chunk, table.check_many(chunk, verify_replays), strict=True)
+        yield from zip(chunk, table.check_many(chunk, verify_replays, max_work), strict=True)
 
 
 def replay_files(folder: Path) -> list[Path]:

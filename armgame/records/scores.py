@@ -561,12 +561,13 @@ class ScoreTable:
 
     def check_many(self, entries: Sequence[ScoreEntry],
                    recompute: Callable[[Sequence[Replay]], list[tuple[bool, GameResult]]] | None = None,
-                   ) -> list[Check]:
+                   max_work: int | None = None) -> list[Check]:
         """``check`` for each entry; the games not in the cache are recomputed together.
 
         ``recompute`` maps replays to ``replay.verify()`` of each (``records.batch_verify`` passes
         the batched one); if it fails, the games are recomputed one at a time, so one entry's
-        failure still marks only that entry.
+        failure still marks only that entry. ``max_work``: a replay whose ``replay_work`` is more
+        is not recomputed (``NOT CHECKED``, not cached: ``armgame verify`` checks it whatever it costs).
         """
         found: list[Check | tuple[str, dict | Replay, list[int]]] = []
         for entry in entries:
@@ -575,9 +576,17 @@ class ScoreTable:
             except Exception as exc:  # one entry's failure never takes the table down
                 found.append(_bad(exc))
         pending: dict[str, tuple[Replay, list[int]]] = {}
-        for f in found:
+        for i, f in enumerate(found):
             if not isinstance(f, Check) and isinstance(f[1], Replay):
-                pending[f[0]] = (f[1], f[2])
+                work = replay_work(f[1])
+                if max_work is not None and work > max_work:
+                    r = f[1].result
+                    found[i] = Check(False, "NOT CHECKED", f"its replay claims {plural(r.steps, 'step')} and "
+                                     f"{plural(r.hits, 'hit')}, more work ({work:,}) than scores spends on one "
+                                     f"game ({max_work:,}): armgame verify checks it", ruleset_name(f[1].config),
+                                     game_digest(f[1]))
+                else:
+                    pending[f[0]] = (f[1], f[2])
         verdicts = _recompute([replay for replay, _ in pending.values()], recompute)
         judged: dict[str, dict] = {}
         for (digest, (replay, signature)), verdict in zip(pending.items(), verdicts, strict=True):
@@ -658,6 +667,17 @@ class ScoreTable:
             return Check(False, "NOT A WHOLE GAME", "the game stopped before its clock ran out", claims["ruleset"],
                          claims["game_sha256"])
         return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"], claims["game_sha256"])
+
+
+#: What recomputing one hit costs, in physics steps: drawing the next target tries up to 1,000 postures,
+#: each about a step's arithmetic (``GameRules._draw_target``).
+HIT_WORK = 1_000
+
+
+def replay_work(replay: Replay) -> int:
+    """The most work recomputing ``replay`` can take, in physics steps, known before running it:
+    its steps and its claimed hits (verification stops as soon as the game passes its claim)."""
+    return replay.result.steps + HIT_WORK * replay.result.hits
 
 
 def _bad(exc: Exception) -> Check:
