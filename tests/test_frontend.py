@@ -272,7 +272,7 @@ def test_end_screen_asks_the_name_then_shows_rank_and_top_ten_until_a_key(window
     assert asked == ["Ann"] and win.player_name == "Ann"
     lay = win.renderer.layout(win.screen.get_size(), win.session, win.hud())
     texts = [lab.text for lab in lay.labels]
-    assert "Rank 2 of 12 in the table" in texts and "P10" in texts and "Your score: 0" in texts
+    assert "Rank 2 of 12 in the ranked table" in texts and "P10" in texts and "Your score: 0" in texts
     post_key("x")  # too soon: a key still being mashed does not close it
     win.frame(0.1)
     assert win.running

@@ -270,9 +270,9 @@ def test_the_end_screen_callback_keeps_the_game_once_and_ranks_it(tmp_path, caps
     from armgame.game.session import GameSession
     from armgame.records.scores import ScoreTable
 
-    def finished_game(args):
+    def finished_game(args, key="d"):
         session = GameSession(game_config(args))
-        session.key_event("d", "down")
+        session.key_event(key, "down")
         session.advance(session.total_steps)
         return session
 
@@ -281,7 +281,7 @@ def test_the_end_screen_callback_keeps_the_game_once_and_ranks_it(tmp_path, caps
     earlier = parser.parse_args(["play", "--duration", "1", "--scores", str(scores), "--name", "Bob"])
     _keep(finished_game(earlier), earlier)
     args = parser.parse_args(["play", "--duration", "1", "--scores", str(scores)])
-    session = finished_game(args)
+    session = finished_game(args, "f")  # Ann's own game: Bob's again would be refused (a game enters once)
     standing = _standing(session, args)("Ann")
     assert args.kept and args.name == "Ann"
     assert standing.entries == 2 and standing.rank in (1, 2)

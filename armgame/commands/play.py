@@ -229,7 +229,7 @@ def _standing(session, args: argparse.Namespace):
     """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
     import sys
 
-    from ..records.scores import LIST_TITLES, RANKED, ScoreTable
+    from ..records.scores import LIST_TITLES, ScoreTable
     from ..ui.render import Standing
     from .scores import scores_dir
 
@@ -239,7 +239,7 @@ def _standing(session, args: argparse.Namespace):
             entry = _keep(session, args)
             args.kept = True
             table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
-            kind = table.list_of(entry) if entry is not None else RANKED  # not entered: the ranked table's top
+            kind = table.list_of(entry) if entry is not None else _list_it_would_join(session, args, table)
             entries = table.of_list(kind)
         except UserError as exc:
             print(f"armgame play: error: {exc}", file=sys.stderr)
@@ -249,6 +249,18 @@ def _standing(session, args: argparse.Namespace):
                         LIST_TITLES[kind].split(" (")[0])
 
     return standing
+
+
+def _list_it_would_join(session, args: argparse.Namespace, table) -> str:
+    """The list a game not entered would have gone to: its end screen shows that list's top."""
+    from ..records.rulesets import ruleset_of
+    from ..records.scores import CUSTOM_GAMES, PRACTICE, PROGRAMS, RANKED
+
+    if getattr(args, "bot", None):
+        return PROGRAMS
+    if ruleset_of(session.config) is None:
+        return CUSTOM_GAMES
+    return PRACTICE if session.config.seed != table.seed else RANKED
 
 
 def _play_in_window(session, args: argparse.Namespace, window):

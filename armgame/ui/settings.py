@@ -48,14 +48,15 @@ class Settings:
         return replace(self, **changes)  # type: ignore[arg-type]
 
     def to_toml(self) -> str:
-        lines = ["# armgame window settings: `armgame settings` shows them; the game rewrites this file when",
-                 "# you change something in the window (m mutes).",
-                 f'keys = "{self.keys}"',
-                 f"mute = {'true' if self.mute else 'false'}",
-                 f'palette = "{self.palette}"']
+        """The file's text. Values go through ``tomli_w``, which escapes quotes, backslashes and the
+        rest, so whatever ``from_toml`` accepted is written back as TOML it accepts again."""
+        import tomli_w
+
+        values: dict[str, object] = {"keys": self.keys, "mute": self.mute, "palette": self.palette}
         if self.size is not None:
-            lines.append(f'size = "{self.size[0]}x{self.size[1]}"')
-        return "\n".join(lines) + "\n"
+            values["size"] = f"{self.size[0]}x{self.size[1]}"
+        return ("# armgame window settings: `armgame settings` shows them; the game rewrites this file when\n"
+                "# you change something in the window (m mutes).\n" + tomli_w.dumps(values))
 
     def describe(self) -> list[str]:
         size = f"{self.size[0]}x{self.size[1]}" if self.size else "fit the desktop (default)"
