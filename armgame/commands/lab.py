@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from ..errors import UserError
-from .play import DEFAULT_SEED, _seed
+from .play import DEFAULT_SEED, _seed, check_recordable
 
 
 def _rate(text: str) -> float:
@@ -100,7 +100,8 @@ def run(args: argparse.Namespace) -> int:
     if args.no_figures and not args.out:
         raise UserError("--no-figures applies with --out only")
     _check_outputs(args)
-    config = lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys))
+    config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys)),
+                              str(args.protocol))
     session = LabSession(config, protocol)
     bot = None
     if args.bot:

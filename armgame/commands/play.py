@@ -78,6 +78,22 @@ def game_config(args: argparse.Namespace):
     if config.total_steps > MAX_GAME_STEPS:
         raise UserError(f"--duration {args.duration:g} is {config.total_steps} physics steps, more than a replay may "
                         f"hold ({MAX_GAME_STEPS})")
+    return check_recordable(config, "--keys")
+
+
+def check_recordable(config, what: str):
+    """``config``, if its replay would be read back; else one line before the game is played.
+
+    The replay reader's own checks on the configuration (``config_from_dict``), run on it now: a
+    key name with a control character or over 20 characters, or a clock past the longest game, is
+    refused here rather than saved and refused by ``verify`` and ``analyze`` later.
+    """
+    from ..records.replay import config_from_dict, config_to_dict
+
+    try:
+        config_from_dict(config_to_dict(config))
+    except (ValueError, UserError) as exc:
+        raise UserError(f"{what}: {exc} (its replay could not be read back): nothing was played") from None
     return config
 
 
