@@ -22,7 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "reaction_time, movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m, "
         "path_length_ratio, hit). A replay that does not verify is reported and left out. With --class DIR: "
         "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
-        "per trial of --metric: class_curve.csv and class_curve.png in --out. Exit status: 0 if every replay "
+        "per trial of --metric: class_curve.csv and class_curve.png in --out. The class's protocol is the one most "
+        "replays share (or the one --protocol names); each game counts once, however many copies of it there are; "
+        "what is left out is named, with why. Exit status: 0 if every replay "
         "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
     )
     p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
@@ -34,6 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="the class curve's measure (default: max_perpendicular_error_m for force fields, "
                    "initial_direction_error_deg for visual transforms)")
     p.add_argument("--no-figures", action="store_true", help="with --class: the CSV only (no matplotlib needed)")
+    p.add_argument("--protocol", metavar="NAME", default=None,
+                   help="with --class: the protocol (its name) whose replays make the curve (default: the one most "
+                   "replays share)")
     p.set_defaults(run=run)
 
 
@@ -51,20 +56,77 @@ def run(args: argparse.Namespace) -> int:
 
 def verified_rows(path: Path):
     """(rows, session) of a lab replay that reproduces its trials; raises UserError otherwise."""
-    from ..lab.analysis import trial_rows
-    from ..records.replay import Replay, same_outcome
+    return verified_run(path, lab_replay(path))
+
+
+def lab_replay(path: Path):
+    """The lab run in ``path`` (read and checked, not yet replayed); raises UserError otherwise."""
+    from ..records.replay import Replay
 
     if path.is_symlink() or not path.is_file():
         raise UserError(f"{path}: not a regular file")
     replay = Replay.load(path)
     if replay.task is None:
         raise UserError(f"{path}: a game, not a lab run: nothing to analyse")
+    return replay
+
+
+def verified_run(path: Path, replay):
+    """(rows, session) of ``replay`` (read from ``path``) if it reproduces its trials; else UserError."""
+    from ..lab.analysis import trial_rows
+    from ..records.replay import same_outcome
+
     ok, recomputed, session = replay.task.verify(replay.config, replay.timeline, replay.result)
     if not ok:
         same = same_outcome(recomputed, replay.result)
         why = "its trials differ" if same else f"its result differs ({recomputed.hits} hits, not {replay.result.hits})"
         raise UserError(f"{path}: DIFFERS: the replay does not reproduce its recording ({why}): not analysed")
     return trial_rows(session), session
+
+
+def class_members(runs: list, wanted: str | None) -> tuple[list, object, list[tuple[Path, str]]]:
+    """The class: ``(path, rows)`` of each run of the class's protocol, once per game; the protocol; and
+    ``(path, why)`` of each run left out.
+
+    The protocol is the one most runs share (ties: the one whose first file sorts first), or the one
+    named ``wanted``: one planted file sorting first cannot set it. A game is counted once, by its
+    digest (``records.identity``), so five copies of one replay are one student.
+    """
+    groups: list[tuple[object, list]] = []  # (protocol, its runs), protocols compared whole
+    for run in runs:
+        group = next((g for g in groups if g[0] == run[2].protocol), None)
+        if group is None:
+            groups.append((run[2].protocol, [run]))
+        else:
+            group[1].append(run)
+    if wanted is not None:
+        named = [g for g in groups if g[0].name == wanted]
+        if not named:
+            found = ", ".join(sorted({repr(g[0].name) for g in groups})) or "none"
+            raise UserError(f"--protocol {wanted!r}: no verified replay in the class has it (found: {found})")
+        groups_to_pick = named
+    else:
+        groups_to_pick = groups
+    if not groups_to_pick:
+        return [], None, []
+    protocol, chosen = max(groups_to_pick, key=lambda g: len({r[3] for r in g[1]}))  # max keeps the first of ties
+    shared = f"{protocol.name!r}, shared by {len(chosen)} replays"
+    left_out: list[tuple[Path, str]] = []
+    for other, members in groups:
+        if other is protocol:
+            continue
+        why = (f"its protocol is also named {other.name!r} but differs from the class's ({shared})"
+               if other.name == protocol.name else f"its protocol {other.name!r} differs from the class's ({shared})")
+        left_out += [(r[0], why) for r in members]
+    seen: dict[str, Path] = {}
+    students = []
+    for path, rows, _, digest in chosen:
+        if digest in seen:
+            left_out.append((path, f"the same game as {seen[digest].name} (a copy counts once)"))
+            continue
+        seen[digest] = path
+        students.append((path, rows))
+    return students, protocol, sorted(left_out, key=lambda item: str(item[0]))
 
 
 def _replays(args: argparse.Namespace) -> int:
@@ -125,20 +187,32 @@ def _class(args: argparse.Namespace) -> int:
         raise UserError(f"{folder}: no replays (*.json) there")
     if len(files) > MAX_CLASS_FILES:
         raise UserError(f"{folder}: {len(files)} replays, more than a class curve reads ({MAX_CLASS_FILES})")
-    students, protocol, skipped = [], None, 0
+    from ..records.identity import game_digest
+
+    runs, skipped, copies = [], 0, []
+    seen: dict[str, Path] = {}
     for path in files:
         try:
-            rows, session = verified_rows(path)
-            if protocol is not None and session.protocol != protocol:
-                raise UserError(f"{path}: protocol {session.protocol.name!r} differs from the class's "
-                                f"({protocol.name!r}, from {files[0].name}): not in the curve")
+            replay = lab_replay(path)
+            digest = game_digest(replay)
+            if digest in seen:  # a copy of a game already verified: counted once, never replayed again
+                copies.append((path, f"the same game as {seen[digest].name} (a copy counts once)"))
+                continue
+            rows, session = verified_run(path, replay)
         except UserError as exc:
             print(f"armgame analyze: {exc}", file=sys.stderr)
             skipped += 1
             continue
-        protocol = protocol or session.protocol
-        students.append(rows)
+        seen[digest] = path
+        runs.append((path, rows, session, digest))
+    students, protocol, left_out = class_members(runs, args.protocol)
+    left_out = sorted(left_out + copies, key=lambda item: str(item[0]))
+    for path, reason in left_out:
+        print(f"armgame analyze: {path}: {reason}: not in the curve", file=sys.stderr)
+    skipped += len(left_out)
+    for path, rows in students:
         print(f"{path.name}: verified: {len(rows)} reaches")
+    students = [rows for _, rows in students]
     if not students:
         raise UserError(f"{folder}: no replay could be analysed")
     metric = args.metric or figure_metric(protocol)
