@@ -103,8 +103,7 @@ def planted(folder: Path, kind: str, n: int) -> None:
             for key in ("ruleset", "config_sha256", "game_sha256", "complete", "entered", "entered_at"):
                 entry.pop(key, None)
             entries.append(entry)
-        rows = [e if isinstance(e, dict) else {k: v for k, v in e.as_dict().items() if v is not None}
-                for e in entries]
+        rows = [e if isinstance(e, dict) else json.loads(table_bytes([e]))["entries"][0] for e in entries]
         atomic_write_bytes(folder / "scores.json", json.dumps(
             {"format": "armgame-scores", "format_version": 1, "entries": rows}).encode(), "score table")
         return

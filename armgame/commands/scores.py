@@ -11,8 +11,9 @@ SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else s
 
 
 #: The most work ``scores`` spends recomputing one game, in physics steps (``records.scores.replay_work``:
-#: steps, and 1,000 a claimed hit). A standard game is 15,000 and its hits; a custom game of more (a long
-#: clock, or a "hit storm" claiming thousands of hits) is listed NOT CHECKED: ``armgame verify`` checks it.
+#: steps, 1,000 a claimed hit, 20 an input event). A standard game is 15,000 and its hits and events; a
+#: game of more (a long clock, a "hit storm" claiming thousands of hits, a replay of 100,000 events) is
+#: listed NOT CHECKED: ``armgame verify`` checks it, whatever it costs.
 MAX_CHECK_WORK = 300_000
 
 
@@ -121,15 +122,15 @@ def listing(table, entries, limit: int | None, check: bool):
     from ..records.batch_verify import check_entries
     from ..records.scores import CUSTOM_GAMES, LIST_TITLES, entry_order
 
-    first: dict[tuple[str, str], object] = {}
+    first: dict[str, object] = {}
     duplicate: dict[str, object] = {}
-    for e in sorted(entries, key=entry_order):  # what the table itself says: its replay and its game
-        keys = [("replay", e.replay_sha256)] + ([("game", e.game_sha256)] if e.game_sha256 else [])
-        twin = next((first[k] for k in keys if k in first), None)
-        if twin is not None:
-            duplicate[e.id] = twin
-        for k in keys:
-            first.setdefault(k, e)
+    # One replay file entered twice: the later entry is flagged unread (the same bytes check out or fail
+    # alike). Games are compared after their checks, among those that check out: a forged entry planted
+    # earlier with an honest game's digest never pushes the honest entry out.
+    for e in sorted(entries, key=entry_order):
+        if e.replay_sha256 in first:
+            duplicate[e.id] = first[e.replay_sha256]
+        first.setdefault(e.replay_sha256, e)
     lists: dict[str, list] = {name: [] for name in LIST_TITLES}
     flagged: list = []
     custom_checked = 0
@@ -158,18 +159,20 @@ def listing(table, entries, limit: int | None, check: bool):
                     break
         if not batch:
             break
+        custom_checked += custom_in_batch  # counted as listed before the check: an old entry's check may rank it
         done = {e.id for e in batch}
         pending = [e for e in pending if e.id not in done]
         results = check_entries(table, batch, MAX_CHECK_WORK) if check else ((e, None) for e in batch)
         for e, c in results:
             name = table.list_of(e, c)
-            if limit is not None and (custom_checked >= limit if name == CUSTOM_GAMES else len(lists[name]) >= limit):
+            if limit is not None and name != CUSTOM_GAMES and len(lists[name]) >= limit:
                 continue
-            custom_checked += name == CUSTOM_GAMES
-            if c is not None and c.game is not None and games.setdefault(c.game, e) is not e:
-                flagged.append((e, _duplicate(games[c.game])))
-            elif c is not None and not c.ok:
+            if c is not None and not c.ok:
                 flagged.append((e, c))
+            elif c is not None and c.game is not None and games.setdefault(c.game, e) is not e:
+                # Only games that check out count: a forged copy of a game never pushes out its honest entry.
+                # Two that check out have one score, so the earlier entry comes first (sort_key).
+                flagged.append((e, _duplicate(games[c.game])))
             else:
                 lists[name].append((e, c))
     for rows in lists.values():

@@ -581,10 +581,10 @@ class ScoreTable:
                 work = replay_work(f[1])
                 if max_work is not None and work > max_work:
                     r = f[1].result
-                    found[i] = Check(False, "NOT CHECKED", f"its replay claims {plural(r.steps, 'step')} and "
-                                     f"{plural(r.hits, 'hit')}, more work ({work:,}) than scores spends on one "
-                                     f"game ({max_work:,}): armgame verify checks it", ruleset_name(f[1].config),
-                                     game_digest(f[1]))
+                    found[i] = Check(False, "NOT CHECKED", f"its replay claims {plural(r.steps, 'step')}, "
+                                     f"{plural(r.hits, 'hit')} and {plural(len(f[1].timeline), 'event')}, more "
+                                     f"work ({work:,}) than scores spends on one game ({max_work:,}): armgame "
+                                     f"verify checks it", ruleset_name(f[1].config), game_digest(f[1]))
                 else:
                     pending[f[0]] = (f[1], f[2])
         verdicts = _recompute([replay for replay, _ in pending.values()], recompute)
@@ -672,12 +672,14 @@ class ScoreTable:
 #: What recomputing one hit costs, in physics steps: drawing the next target tries up to 1,000 postures,
 #: each about a step's arithmetic (``GameRules._draw_target``).
 HIT_WORK = 1_000
+#: What one input event costs, in physics steps: reading it, and applying it between steps.
+EVENT_WORK = 20
 
 
 def replay_work(replay: Replay) -> int:
-    """The most work recomputing ``replay`` can take, in physics steps, known before running it:
-    its steps and its claimed hits (verification stops as soon as the game passes its claim)."""
-    return replay.result.steps + HIT_WORK * replay.result.hits
+    """The most work recomputing ``replay`` can take, in physics steps, known before running it: its
+    steps, its claimed hits (verification stops as soon as the game passes its claim) and its events."""
+    return replay.result.steps + HIT_WORK * replay.result.hits + EVENT_WORK * len(replay.timeline)
 
 
 def _bad(exc: Exception) -> Check:
