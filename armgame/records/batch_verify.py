@@ -33,7 +33,9 @@ def _chunks(items: Iterable, size: int) -> Iterator[list]:
 
 
 def verify_replays(replays: Sequence[Replay], kernel: str | None = None) -> list[tuple[bool, GameResult]]:
-    """``[replay.verify() for replay in replays]``, the games of ranked rulesets recomputed in batches.
+    """``[replay.verify() for replay in replays]``, the games of ranked rulesets recomputed in batches
+    (a game that does not reproduce is recomputed to its end, where ``verify`` stops once it passes
+    its claim: the verdicts are the same).
 
     Only those: their cost is known (the ruleset's steps) and they share a batch by construction.
     A lab run is compared trial by trial, and a custom game's ``verify`` stops as soon as it scores
@@ -41,14 +43,14 @@ def verify_replays(replays: Sequence[Replay], kernel: str | None = None) -> list
     their own ``verify``. ``kernel`` is ``BatchGameSession``'s (None: compiled where built).
     """
     batched = [i for i, r in enumerate(replays) if r.task is None and ruleset_of(r.config) is not None]
+    # exact: the results are the single session's (numpy's fast kernel replays a game alone where a hit
+    # was decided within round-off of a target's edge), so the batch's verdict is final both ways: a
+    # planted pile of forgeries costs its batched steps, not one single-session game each.
     results = replay_many([replays[i].config for i in batched], [replays[i].timeline for i in batched],
-                          [replays[i].result.steps for i in batched], kernel=kernel)
+                          [replays[i].result.steps for i in batched], exact=True, kernel=kernel)
     verdicts: list[tuple[bool, GameResult] | None] = [None] * len(replays)
     for i, got in zip(batched, results, strict=True):
-        # The compiled kernel is the single session bit for bit; numpy's fast kernel (no compiler)
-        # agrees to round-off, so a replay a batch finds wanting (a forgery, or a vanishingly rare
-        # split) gets the single session's own verdict.
-        verdicts[i] = (True, got) if same_outcome(got, replays[i].result) else replays[i].verify()
+        verdicts[i] = (same_outcome(got, replays[i].result), got)
     return [v if v is not None else r.verify() for r, v in zip(replays, verdicts, strict=True)]
 
 
