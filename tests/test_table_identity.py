@@ -141,6 +141,9 @@ def test_a_copy_planted_in_the_table_is_flagged_and_ties_go_to_the_earlier_entry
     assert main(["scores", "--scores", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "thief (" in out and "DUPLICATE: the same game as second's entry" in out
+    assert main(["verify", str(tmp_path)]) == 1
+    out = capsys.readouterr().out
+    assert "thief: score" in out and "DUPLICATE: the same game as second's earlier entry" in out
 
 
 def test_an_old_table_gets_its_order_of_entry_once(tmp_path):

@@ -106,7 +106,7 @@ def _verify_table(folder) -> int:
 
     from ..errors import UserError
     from ..records.batch_verify import check_entries
-    from ..records.scores import ScoreTable, VerificationCache
+    from ..records.scores import ScoreTable, VerificationCache, entry_order
 
     cache = VerificationCache()
     table = ScoreTable(folder, cache=cache)
@@ -117,9 +117,13 @@ def _verify_table(folder) -> int:
         print(f"armgame verify: {damage.describe(table.path)}", file=sys.stderr)
     flagged = 0
     seen: set[str] = set()
-    for e, c in check_entries(table, sorted(entries, key=lambda e: e.when)):
+    games: dict[str, object] = {}
+    for e, c in check_entries(table, sorted(entries, key=entry_order)):  # the table's order, never a claimed date
         if c.ok and e.replay_sha256 in seen:
             c = type(c)(False, "DUPLICATE", "the same replay is entered more than once", c.ruleset)
+        elif c.ok and c.game is not None and games.setdefault(c.game, e) is not e:
+            first = games[c.game]
+            c = type(c)(False, "DUPLICATE", f"the same game as {first.name}'s earlier entry", c.ruleset)  # type: ignore[attr-defined]
         seen.add(e.replay_sha256)
         flagged += not c.ok
         rules = f", {c.ruleset} rules" if c.ruleset else ""

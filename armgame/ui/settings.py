@@ -1,7 +1,8 @@
 """The window's settings that persist between games: key map, mute, palette, window size.
 
 A small TOML file in the user's config folder (``$XDG_CONFIG_HOME/armgame/settings.toml``, normally
-``~/.config/armgame/settings.toml``; ``%APPDATA%\\armgame`` on Windows), or the file ``--settings``
+``~/.config/armgame/settings.toml``; ``%APPDATA%\\armgame`` on Windows, ``~/Library/Application
+Support/armgame`` on macOS), or the file ``--settings``
 names. It is read with ``tomllib`` through the storage module's size-limited reader, only when it is a
 regular file (never a symlink, a FIFO or a device), and every value is checked: a bad file is refused in
 one line naming the key. The window rewrites it atomically when the player changes something there
@@ -65,8 +66,12 @@ class Settings:
 
 
 def default_path() -> Path:
-    if sys.platform == "win32" and os.environ.get("APPDATA"):
-        base = Path(os.environ["APPDATA"])
+    """The platform's per-user config folder: ``platformdirs``' on Windows (``%APPDATA%``) and macOS
+    (``~/Library/Application Support``); elsewhere the XDG rule, which ignores a relative path."""
+    if sys.platform in ("win32", "darwin"):
+        import platformdirs
+
+        base = Path(platformdirs.user_config_dir(appauthor=False, roaming=True))
     else:
         xdg = os.environ.get("XDG_CONFIG_HOME", "")
         # The XDG spec: a relative path in $XDG_CONFIG_HOME is invalid and must be ignored.
