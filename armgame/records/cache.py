@@ -175,5 +175,7 @@ def _valid(v: object) -> bool:
     if "file" in v and not (isinstance(v["file"], list) and len(v["file"]) == 5
                             and all(type(x) is int for x in v["file"])):
         return False
+    if v["label"] == "NOT CHECKED" and type(v.get("work")) is not int:
+        return False
     claims = v.get("claims")
     return claims is None or (isinstance(claims, dict) and set(claims) == CLAIM_KEYS)

@@ -572,7 +572,7 @@ class ScoreTable:
         found: list[Check | tuple[str, dict | Replay, list[int]]] = []
         for entry in entries:
             try:
-                found.append(self._claim(entry))
+                found.append(self._claim(entry, max_work))
             except Exception as exc:  # one entry's failure never takes the table down
                 found.append(_bad(exc))
         pending: dict[str, tuple[Replay, list[int]]] = {}
@@ -581,10 +581,13 @@ class ScoreTable:
                 work = replay_work(f[1])
                 if max_work is not None and work > max_work:
                     r = f[1].result
-                    found[i] = Check(False, "NOT CHECKED", f"its replay claims {plural(r.steps, 'step')}, "
-                                     f"{plural(r.hits, 'hit')} and {plural(len(f[1].timeline), 'event')}, more "
-                                     f"work ({work:,}) than scores spends on one game ({max_work:,}): armgame "
-                                     f"verify checks it", ruleset_name(f[1].config), game_digest(f[1]))
+                    skipped = {"claims": replay_claims(f[1]), "ok": False, "label": "NOT CHECKED", "file": f[2],
+                               "work": work, "detail": f"its replay claims {plural(r.steps, 'step')}, "
+                               f"{plural(r.hits, 'hit')} and {plural(len(f[1].timeline), 'event')}, more work "
+                               f"({work:,}) than scores spends on one game ({max_work:,}): armgame verify checks it"}
+                    if self.cache is not None:  # remembered, so the next listing does not even read it
+                        self.cache.put(f[0], skipped)
+                    found[i] = (f[0], skipped, f[2])
                 else:
                     pending[f[0]] = (f[1], f[2])
         verdicts = _recompute([replay for replay, _ in pending.values()], recompute)
@@ -605,7 +608,7 @@ class ScoreTable:
                 checks.append(_bad(exc))
         return checks
 
-    def _claim(self, entry: ScoreEntry) -> Check | tuple[str, dict | Replay, list[int]]:
+    def _claim(self, entry: ScoreEntry, max_work: int | None = None) -> Check | tuple[str, dict | Replay, list[int]]:
         """A failed ``Check``; or the replay's digest with its cached verdict, or the replay still to
         recompute, and the replay file's signature. A replay file whose signature a cached verdict
         recorded is not read at all (``cache.file_signature``)."""
@@ -618,7 +621,7 @@ class ScoreTable:
         with os.fdopen(fd, "rb") as f:
             signature = file_signature(os.fstat(f.fileno()))
             if self.cache is not None and self.cache.digest_of(signature) == entry.replay_sha256:
-                cached = self.cache.get(entry.replay_sha256)
+                cached = _usable(self.cache.get(entry.replay_sha256), max_work)
                 if cached is not None:
                     return entry.replay_sha256, cached, signature
             try:
@@ -630,7 +633,7 @@ class ScoreTable:
         digest = hashlib.sha256(data).hexdigest()
         if digest != entry.replay_sha256:
             return Check(False, "REPLAY CHANGED", f"{path.name} is not the replay this entry was saved with")
-        cached = self.cache.get(digest) if self.cache else None
+        cached = _usable(self.cache.get(digest), max_work) if self.cache else None
         if cached is not None:
             if self.cache is not None and cached.get("file") != signature:
                 self.cache.put(digest, {**cached, "file": signature})  # known unchanged without reading, next time
@@ -680,6 +683,13 @@ def replay_work(replay: Replay) -> int:
     """The most work recomputing ``replay`` can take, in physics steps, known before running it: its
     steps, its claimed hits (verification stops as soon as the game passes its claim) and its events."""
     return replay.result.steps + HIT_WORK * replay.result.hits + EVENT_WORK * len(replay.timeline)
+
+
+def _usable(cached: dict | None, max_work: int | None) -> dict | None:
+    """A cached verdict, unless it is a game left unchecked for its cost that this caller would check."""
+    if cached is not None and cached["label"] == "NOT CHECKED" and (max_work is None or cached["work"] <= max_work):
+        return None
+    return cached
 
 
 def _bad(exc: Exception) -> Check:
