@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from armgame.errors import UserError
-from armgame.game import compiled
+from armgame.game.batch import compiled
 from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, replay_many
 from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet, MuscleSpec, remap_keys
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target

@@ -10,7 +10,7 @@ import types
 import numpy as np
 import pytest
 
-from armgame.game import compiled
+from armgame.game.batch import compiled
 from armgame.game.batch import BatchGameSession
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent

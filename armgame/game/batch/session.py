@@ -69,16 +69,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..errors import UserError
-from ..physics.batch import SERIES_LIMIT
-from ..physics.integrators import Integrator
-from ..physics.twojoint import TwoJointArm
+from ... import __version__
+from ...errors import UserError
+from ...physics.batch import SERIES_LIMIT
+from ...physics.integrators import Integrator
+from ...physics.twojoint import TwoJointArm
 from . import compiled
 from .compiled import NEAR, CompiledKernel, MuscleEvents, hand_move_bounds
-from .muscles import MuscleLevelError, MuscleSet
-from .rules import GameConfig, GameRules
-from .session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
+from ..muscles import MuscleLevelError, MuscleSet
+from ..rules import GameConfig, GameRules
+from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
 
 #: ``BatchGameSession(kernel=...)``: None, the compiled kernel where built (and RK4), else numpy.
 KERNELS = (None, "compiled", "numpy")
@@ -989,7 +989,7 @@ def play_scripts(config: GameConfig, paths: Sequence[Path]) -> list[GameResult]:
     Every script is read and checked before any game runs, and their events together are
     bounded by ``MAX_SCRIPT_EVENTS``.
     """
-    from .script import load_script
+    from ..script import load_script
 
     keys = (*(m.key for m in config.muscles), RESET_KEY, TOGGLE_ARM_KEY)
     timelines, total = [], 0

@@ -25,16 +25,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..physics.batch import SERIES_LIMIT
-from ..physics.integrators import _SIXTH
+from ...physics.batch import SERIES_LIMIT
+from ...physics.integrators import _SIXTH
 
 try:
-    from . import _ckernel
+    from .. import _ckernel
 except ImportError:  # built without a C compiler: numpy does the work
     _ckernel = None
 
 if TYPE_CHECKING:
-    from .batch import BatchGameSession
+    from .session import BatchGameSession
 
 #: The calling convention this module speaks; a build of another (a stale ``.so``) is not used.
 KERNEL_VERSION = 2
