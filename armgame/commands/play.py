@@ -7,6 +7,7 @@ import math
 
 from ..errors import UserError
 from ..words import plural
+from . import read_lab_replays
 
 DEFAULT_SEED = 10  # the 2012 game's: every class sees the same targets unless asked otherwise
 
@@ -183,6 +184,7 @@ def _keep(session, args: argparse.Namespace):
     from ..records.storage import check_output_path, user_path
     from .scores import scores_dir
 
+    read_lab_replays()  # the table's other entries are read too
     out = sys.stderr if args.json else sys.stdout
     bot = getattr(args, "bot", None)
     driven = "bot" if bot else "script" if args.headless else "keyboard"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
+from . import read_lab_replays
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -33,6 +34,7 @@ def run(args: argparse.Namespace) -> int:
     from ..records.replay import Replay
     from ..records.storage import user_path
 
+    read_lab_replays()
     replay = Replay.load(user_path(args.file, "FILE"))
     if args.headless:
         result = replay.replay()
