@@ -54,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
     _add_score_options(p)
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, without_window=without_window)
 
 
 def _add_score_options(p: argparse.ArgumentParser) -> None:
@@ -272,3 +272,10 @@ def _play_in_window(session, args: argparse.Namespace, window):
                          mode=f"AUTOPILOT: {args.bot}" if args.bot else f"PLAY   seed {args.seed}")
     args.name = args.name or played.player_name  # the name typed on the end screen
     return session.result()
+
+
+def without_window(args: argparse.Namespace, typed: list[str]) -> str:
+    """The game headless: a bot plays it (the player's keys need a window)."""
+    from . import command_line
+
+    return command_line(typed, "--headless", *([] if args.bot else ["--bot", "model"]))

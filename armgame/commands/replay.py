@@ -24,7 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, without_window=without_window)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -97,3 +97,10 @@ def _watch_lab(replay, args: argparse.Namespace, settings):
     finally:
         pygame.display.quit()
     return session
+
+
+def without_window(args: argparse.Namespace, typed: list[str]) -> str:
+    """The replay recomputed at once."""
+    from . import command_line
+
+    return command_line(typed, "--headless")
