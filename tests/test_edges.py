@@ -144,3 +144,24 @@ def test_closest_ignores_case_and_keeps_the_valid_spelling():
     assert closest("q", ("play", "replay")) is None
     assert unknown_name("bot", "Model", ("model", "naive")) == \
         "unknown bot 'Model': did you mean model? (choose one of model, naive)"
+
+
+def test_what_sdl_prints_while_starting_is_shown_only_if_a_window_opens(capfd, monkeypatch):
+    import pygame
+
+    noise = "error: XDG_RUNTIME_DIR is invalid or not set in the environment.\n"
+    real_init = pygame.display.init
+
+    def noisy_init() -> None:
+        os.write(2, noise.encode())  # as libwayland does, below Python's sys.stderr
+        real_init()
+
+    monkeypatch.setattr(pygame.display, "init", noisy_init)
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    armgame.ui.display.init_display()  # the driver asked for by name: a window may open
+    pygame.display.quit()
+    assert capfd.readouterr().err == noise
+    monkeypatch.setattr(pygame.display, "get_driver", lambda: "offscreen")  # SDL's own invisible fallback
+    with pytest.raises(NoDisplayError, match="invisible 'offscreen' driver"):
+        armgame.ui.display.init_display()
+    assert capfd.readouterr().err == ""
