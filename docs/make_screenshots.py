@@ -19,16 +19,16 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-import pygame  # noqa: E402
+import pygame
 
-from armgame.game.bots import Autopilot, make_bot  # noqa: E402
-from armgame.game.rules import GameConfig  # noqa: E402
-from armgame.game.session import GameSession  # noqa: E402
-from armgame.lab.bots import make_lab_bot  # noqa: E402
-from armgame.lab.protocol import preset  # noqa: E402
-from armgame.lab.session import LabSession, lab_config  # noqa: E402
-from armgame.ui.lab_window import LabRenderer  # noqa: E402
-from armgame.ui.render import GameRenderer, Hud  # noqa: E402
+from armgame.game.bots import Autopilot, make_bot
+from armgame.game.rules import GameConfig
+from armgame.game.session import GameSession
+from armgame.lab.bots import make_lab_bot
+from armgame.lab.protocol import preset
+from armgame.lab.session import LabSession, lab_config
+from armgame.ui.lab_window import LabRenderer
+from armgame.ui.render import GameRenderer, Hud
 
 HERE = Path(__file__).resolve().parent
 #: Drawn at a projector's size, saved at half of it: small files, text still legible on GitHub.
