@@ -33,7 +33,7 @@ SELECTION = [
 @pytest.mark.skipif(SIMULATED, reason="runs the others; not itself again")
 def test_records_tests_pass_without_posix_locks_or_flags():
     env = {**os.environ, "ARMGAME_TEST_NO_POSIX": "1"}
-    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-x", *SELECTION],
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider", "-x", *SELECTION],
                           cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
     assert " passed" in proc.stdout and "failed" not in proc.stdout

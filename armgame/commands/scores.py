@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
+from . import read_lab_replays
 
 SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else scores/ in a checkout, "
                "else ~/.local/share/armgame/scores)")
@@ -89,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"armgame scores: {message}", file=sys.stderr)
 
     cache = None if args.no_check or args.new else verification_cache(args, warn)
+    read_lab_replays()
     table = ScoreTable(scores_dir(args), warn=warn, cache=cache)
     if args.new:
         from ..records.rulesets import DEFAULT_SEED

@@ -18,6 +18,7 @@ from ..physics.integrators import SCHEMES, Integrator
 from ..physics.params import TUTORIAL_ARM
 from ..physics.twojoint import TwoJointArm
 from ..scenes import get_scene
+from ..words import unknown_name
 
 State = tuple[float, float, float, float]
 Point = tuple[float, float]
@@ -37,7 +38,7 @@ MIN_DEMO_DT = 1e-5
 
 def check_fixed_step(integrator: str, dt: float) -> None:
     if integrator not in SCHEMES:
-        raise UserError(f"unknown integrator {integrator!r} for a demo: choose one of {', '.join(SCHEMES)}")
+        raise UserError(unknown_name("integrator", integrator, SCHEMES))
     # At least 1e-5 s: a window steps real time, and a frame of a smaller step is more work than a frame allows.
     if not (math.isfinite(dt) and MIN_DEMO_DT <= dt <= 0.05):
         raise UserError(f"--dt must be from {MIN_DEMO_DT:g} to 0.05 s, got {dt!r}")

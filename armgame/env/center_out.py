@@ -26,6 +26,7 @@ from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
 from ..lab.protocol import MAX_TRIALS, PARAMETERS, PRESETS, Perturbation, Protocol, preset, with_perturbation
 from ..lab.session import HOLD, REACH, LabSession, lab_config
 from ..physics.twojoint import TwoJointArm
+from ..words import unknown_name
 from .base import EnvArgumentError, SessionEnv
 from .reach import (
     DEFAULT_DECISION_STEPS,
@@ -402,7 +403,7 @@ class CenterOutBotPolicy:
 
     def __init__(self, bot: str, env: Any) -> None:
         if bot not in LAB_BOT_NAMES:
-            raise UserError(f"unknown lab bot {bot!r}: choose one of {', '.join(LAB_BOT_NAMES)}")
+            raise UserError(unknown_name("lab bot", bot, LAB_BOT_NAMES))
         base = env.unwrapped
         if not isinstance(base, CenterOutEnv) or base.continuous:
             raise ValueError("a lab bot plays the keys of armgame/CenterOut-v0")

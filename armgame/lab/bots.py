@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 from ..errors import UserError
 from ..game.bots import ReachingBot
+from ..words import unknown_name
 from .learner import TwoRateLearner
 from .session import LabSession
 
@@ -83,8 +84,14 @@ class LabBot(ReachingBot):
         b = self.curl_estimate
         if b != 0.0:
             def load(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
-                fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
-                return curl_unit_torque(l1, l2, q1, q2, b * fx, b * fy)
+                # curl_unit_torque(b * curl_unit_force(...)) with the Jacobian formed once: the bot's
+                # forward model calls this at every predicted step, and the results are the same floats.
+                s12, c12 = math.sin(q1 + q2), math.cos(q1 + q2)
+                jx1, jy1 = -l1 * math.sin(q1) - l2 * s12, l1 * math.cos(q1) + l2 * c12
+                jx2, jy2 = -l2 * s12, l2 * c12
+                fx = b * (jy1 * w1 + jy2 * w2)
+                fy = b * -(jx1 * w1 + jx2 * w2)
+                return jx1 * fx + jy1 * fy, jx2 * fx + jy2 * fy
             self.load_estimate = load
         else:
             self.load_estimate = None
@@ -193,4 +200,4 @@ def make_lab_bot(name: str, rates: LearningRates | None = None) -> LabBot:
         return LabBot("naive", interaction=False)
     if name == "adaptive":
         return LabBot("adaptive", interaction=True, rates=rates or LearningRates())
-    raise UserError(f"unknown lab bot {name!r}: choose one of {', '.join(LAB_BOT_NAMES)}")
+    raise UserError(unknown_name("lab bot", name, LAB_BOT_NAMES))

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from ..errors import UserError
 from ..records.storage import check_float, check_int, check_keys, check_str, read_limited
+from ..words import unknown_name
 
 FORCE_KINDS = ("curl", "constant", "spring")
 VISUAL_KINDS = ("rotation", "mirror", "jointspace")
@@ -65,12 +66,12 @@ class Perturbation:
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
-            raise UserError(f"unknown perturbation {self.kind!r}: choose one of {', '.join(KINDS)}")
+            raise UserError(unknown_name("perturbation", self.kind, KINDS))
 
     @classmethod
     def make(cls, kind: str, **values: float) -> Perturbation:
         if kind not in KINDS:
-            raise UserError(f"unknown perturbation {kind!r}: choose one of {', '.join(KINDS)}")
+            raise UserError(unknown_name("perturbation", kind, KINDS))
         params = []
         for name, _low, _high, default, _unit in PARAMETERS[kind]:
             params.append((name, float(values.pop(name, default))))
@@ -194,7 +195,7 @@ def preset(name: str) -> Protocol:
         return Protocol("mirror", _blocks(Perturbation.make("mirror", axis=90.0)))
     if name == "jointspace":
         return Protocol("jointspace", _blocks(Perturbation.make("jointspace", gain=JOINTSPACE_GAIN)))
-    raise UserError(f"unknown lab preset {name!r}: choose one of {', '.join(PRESETS)}, or give a .toml file")
+    raise UserError(unknown_name("lab preset", name, PRESETS, "or give a .toml file"))
 
 
 PRESETS = ("null", "curl", "rotation", "mirror", "jointspace")

@@ -51,6 +51,7 @@ import hashlib
 import json
 import os
 import re
+import shlex
 import stat
 import sys
 import uuid
@@ -450,8 +451,8 @@ class ScoreTable:
             with self._locked():
                 return self._enter(entry)
         except TableBusyError as exc:
-            raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with "
-                            f"armgame scores --scores {self.folder} --add {path}") from None
+            later = shlex.join(["armgame", "scores", "--scores", str(self.folder), "--add", str(path)])
+            raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with {later}") from None
 
     def new(self, seed: int) -> None:
         """Start the table (empty) ranking ``seed``; refused if it already holds entries."""
