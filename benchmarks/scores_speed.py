@@ -18,7 +18,8 @@ busy, with 10 honest keyboard games below, and times ``scores`` cold and cached,
   (100,000 events);
 * ``hit-storm``: one custom game whose target covers the arm's whole reach, an hour long, claiming
   100,000 hits, each costing a full draw of 1,000 postures;
-* ``failing``: standard replays with a forged score of 99, above every honest game.
+* ``failing``: standard replays with a forged score of 99 (one busy game under many names, each its
+  own replay file), above every honest game.
 """
 
 from __future__ import annotations
@@ -118,10 +119,10 @@ def planted(folder: Path, kind: str, n: int) -> None:
             replay = Replay.from_dict(json.loads(json.dumps(forged)))
             entries.append(table_entry(table, replay, table.save_replay(replay)))
     elif kind == "failing":
-        for i in range(n):
-            forged = Replay.from_session(busy_session(1000 + i), "keyboard", None, f"forger {i}").as_dict()
-            forged["result"].update(score=99, hits=99)
-            replay = Replay.from_dict(forged)
+        base = Replay.from_session(busy_session(1000), "keyboard", None, "forger").as_dict()
+        base["result"].update(score=99, hits=99)
+        for i in range(n):  # one forged game under many names: each its own replay file, each replayed
+            replay = Replay.from_dict({**base, "player": f"forger {i}"})
             entries.append(table_entry(table, replay, table.save_replay(replay)))
     else:
         raise SystemExit(f"unknown --planted kind {kind!r}")
