@@ -65,3 +65,34 @@ def test_a_symlink_swapped_in_after_the_check_is_refused(tmp_path, monkeypatch):
     monkeypatch.setattr(os, "open", swap_then_open)
     with pytest.raises(DataFileError, match="changed while it was opened"):
         read_limited(tmp_path / "real.json", 100, "replay file", follow=False)
+
+
+@pytest.mark.skipif(SIMULATED, reason="needs flock")
+def test_a_lock_file_another_user_made_read_only_is_still_locked(tmp_path, monkeypatch):
+    """Older armgames created scores.lock 0644: a classmate cannot open it for writing, only for reading."""
+    import fcntl
+
+    import filelock
+
+    from armgame.records.locking import LockBusyError, file_lock
+
+    def denied(self, *args, **kwargs):  # what opening another user's 0644 file for writing gives
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(filelock.FileLock, "acquire", denied)
+    lock = tmp_path / "scores.lock"
+    lock.write_text("")
+    with file_lock(lock, 0.2):
+        fd = os.open(lock, os.O_RDONLY)
+        try:
+            with pytest.raises(BlockingIOError):
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # it is held
+        finally:
+            os.close(fd)
+    fd = os.open(lock, os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    try:
+        with pytest.raises(LockBusyError), file_lock(lock, 0.2):
+            pass
+    finally:
+        os.close(fd)
