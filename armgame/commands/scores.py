@@ -150,20 +150,9 @@ def listing(table, entries, limit: int | None, check: bool):
         if e.id in duplicate:
             flagged.append((e, _duplicate(duplicate[e.id])))
     games: dict[str, object] = {}
-    while pending:
-        batch: list = []
-        custom_in_batch = 0
-        for e in pending:
-            if wants(e, custom_in_batch):
-                batch.append(e)
-                custom_in_batch += table.list_of(e) == CUSTOM_GAMES
-                if len(batch) >= (max(2 * limit, 256) if limit else len(pending)):
-                    break
-        if not batch:
-            break
-        custom_checked += custom_in_batch  # counted as listed before the check: an old entry's check may rank it
-        done = {e.id for e in batch}
-        pending = [e for e in pending if e.id not in done]
+    size = max(2 * limit, 256) if limit else max(1, len(pending))
+
+    def check_batch(batch: list) -> None:
         results = check_entries(table, batch, MAX_CHECK_WORK) if check else ((e, None) for e in batch)
         for e, c in results:
             name = table.list_of(e, c)
@@ -177,6 +166,21 @@ def listing(table, entries, limit: int | None, check: bool):
                 flagged.append((e, _duplicate(games[c.game])))
             else:
                 lists[name].append((e, c))
+
+    # One pass, best first: an entry its list no longer wants now is never wanted later (lists only fill).
+    batch: list = []
+    custom_in_batch = 0
+    for e in pending:
+        if not wants(e, custom_in_batch):
+            continue
+        batch.append(e)
+        custom_in_batch += table.list_of(e) == CUSTOM_GAMES
+        if len(batch) >= size:
+            custom_checked += custom_in_batch  # counted as listed before the check: an old entry's may rank it
+            check_batch(batch)
+            batch, custom_in_batch = [], 0
+    if batch:
+        check_batch(batch)
     for rows in lists.values():
         rows.sort(key=lambda row: _order(row[0]))
     return lists, flagged
