@@ -68,6 +68,11 @@ def ruleset_of(config: GameConfig) -> Ruleset | None:
     return _BY_DIGEST.get(config_digest(config))
 
 
+def ruleset_by_digest(digest: str) -> Ruleset | None:
+    """The ranked ruleset whose configuration has ``digest`` (computed once, not per entry)."""
+    return _BY_DIGEST.get(digest)
+
+
 def ruleset_name(config: GameConfig) -> str:
     found = ruleset_of(config)
     return found.name if found else CUSTOM

@@ -67,7 +67,7 @@ from .cache import VerificationCache, default_cache_dir, file_signature  # noqa:
 from .identity import game_digest
 from .locking import LockBusyError, LockError, file_lock
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
-from .rulesets import CUSTOM, DEFAULT_SEED, RULESETS, config_digest, ruleset_name
+from .rulesets import CUSTOM, DEFAULT_SEED, RULESETS, config_digest, ruleset_by_digest, ruleset_name
 from .storage import (
     STRICT_DECODER,
     DataFileError,
@@ -356,7 +356,7 @@ class ScoreTable:
         read just to list it: a planted table of old entries cannot make listing read each replay.
         """
         if entry.config_sha256 is not None:
-            found = next((r for r in RULESETS.values() if r.digest == entry.config_sha256), None)
+            found = ruleset_by_digest(entry.config_sha256)
             return found.name if found and found.name == entry.ruleset else CUSTOM
         if check is not None and check.ruleset is not None:
             return check.ruleset
