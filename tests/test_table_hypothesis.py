@@ -51,7 +51,7 @@ def entry_of(replay: Replay, data: bytes, name: str, n: int, old: bool) -> dict:
     return entry
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
                                                                   HealthCheck.too_slow])
 @given(kinds=st.lists(st.tuples(KINDS, st.integers(0, 2)), min_size=1, max_size=6),
        cache=st.sampled_from(["none", "in the table", "others may write", "private ok for forgeries"]))
