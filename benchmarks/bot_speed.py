@@ -13,11 +13,10 @@ Both ways must press the same keys: the script checks the timelines are equal.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 
+from armgame.bench.run import machine_info
 from armgame.game import bots
 from armgame.game.bots import Autopilot, make_bot, play_bot
 from armgame.game.rules import GameConfig
@@ -54,8 +53,9 @@ def main() -> None:
     args = parser.parse_args()
     if bots._c_predict is None:
         raise SystemExit("the compiled forward model was not built (pip install -e . with a C compiler)")
-    print(f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"load average {os.getloadavg()[0]:.1f}, Python {platform.python_version()}")
+    info = machine_info(None)
+    print(f"{info['cpu']}, {info['cores']} cores, load average {info['load']}, Python {info['python']}, "
+          f"numpy {info['numpy']}")
     for name, case in (("model bot, 60 s game", game), ("adaptive bot, lab curl (120 trials)", lab)):
         c_times, py_times, ratios = [], [], []
         for _ in range(args.repeats):
