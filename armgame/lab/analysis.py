@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .metrics import Reach, reach_metrics
+from .metrics import NO_CHANNEL, ChannelMeasures, Reach, channel_measures, reach_metrics
+from .protocol import FORCE_KINDS
 from .session import LabSession, TrialOutcome
 
 #: The paths figure's groups: (label, block kind, which trials of the block).
@@ -25,8 +26,22 @@ PATH_GROUPS = (("baseline", 0, "late"), ("early exposure", 1, "early"), ("late e
 
 def perturbation_label(outcome: TrialOutcome) -> str:
     """The perturbation the trial ran with, by kind: ``none`` on a catch trial of a perturbed block (so a
-    catch trial is a row whose perturbation differs from its block's)."""
-    return outcome.plan.active.kind
+    catch trial is a row whose perturbation differs from its block's), ``channel`` on an error-clamp trial."""
+    return "channel" if outcome.plan.channel else outcome.plan.active.kind
+
+
+def channel_of(session: LabSession, outcome: TrialOutcome) -> ChannelMeasures:
+    """An error-clamp trial's channel force and adaptation index (NaN on other trials), against the field
+    ``Protocol.reference_field`` names for its block."""
+    if not outcome.plan.channel:
+        return NO_CHANNEL
+    hx, hy = session.home
+    tx, ty = outcome.plan.position
+    length = math.hypot(tx - hx, ty - hy)
+    reference = session.protocol.reference_field(outcome.plan.block)
+    return channel_measures(np.asarray(outcome.channel_force), np.column_stack([outcome.vxs, outcome.vys]),
+                            (-(ty - hy) / length, (tx - hx) / length),
+                            None if reference is None else reference.matrix)
 
 
 def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
@@ -57,6 +72,7 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
         "max_perpendicular_error_m": m.max_perpendicular_error_m,
         "path_length_ratio": m.path_length_ratio,
         "hit": o.hit,
+        **channel_of(session, o).as_dict(),
     }
 
 
@@ -100,7 +116,7 @@ def figure_metric(protocol) -> str:
     """What a learning curve plots: the perpendicular error for force fields (a velocity-dependent field
     bends the path after the first 100 ms), the initial direction error for visual transforms."""
     kinds = {b.perturbation.kind for b in protocol.blocks}
-    return "max_perpendicular_error_m" if kinds & {"curl", "constant", "spring"} else "initial_direction_error_deg"
+    return "max_perpendicular_error_m" if kinds & set(FORCE_KINDS) else "initial_direction_error_deg"
 
 
 def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> list[Path]:

@@ -21,7 +21,10 @@ Ghazizadeh & Shadmehr 2006, ``armgame.lab.learner``):
 
 So with the field on, errors start large and shrink as ``b^`` grows; on a catch trial or in
 washout, the bot still expects the field and errs the other way (the after-effect), and
-unlearns at the learner's rates. Mirror and joint-space displays are not learned by this bot (it
+unlearns at the learner's rates. On an error-clamp (channel) trial the channel holds the hand on
+the straight line, so there is no movement error to learn from: the learner's error is 0 and only
+its retentions act (Smith et al. 2006 model channel trials so), which is what lets spontaneous
+recovery show. Mirror and joint-space displays are not learned by this bot (it
 plays them as the model bot does): they need more than one parameter.
 """
 
@@ -66,6 +69,9 @@ class LabBot(ReachingBot):
                                                    rates.rate_slow)
         #: (trial, measured field b, estimate b^ it reached with; measured rotation, estimate) per trial.
         self.history: list[tuple[int, float, float, float, float]] = []
+        #: A hand field ``F = B v`` (N s/m) its internal model holds from the start, on top of what it learns:
+        #: the bot that knows the field (how the presets' fields are checked to be counterable with the keys).
+        self.known_field: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     # ------------------------------------------------------------- the estimates
     @property
@@ -81,7 +87,16 @@ class LabBot(ReachingBot):
         p = session.config.arm
         l1, l2 = p.l1, p.l2
         b = self.curl_estimate
-        if b != 0.0:
+        if self.known_field is not None:
+            (k11, k12), (k21, k22) = self.known_field
+            k12, k21 = k12 + b, k21 - b  # plus the learned curl b^ [[0, 1], [-1, 0]]
+
+            def known(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
+                vy, mvx = curl_unit_force(l1, l2, q1, q2, w1, w2)
+                vx = -mvx
+                return curl_unit_torque(l1, l2, q1, q2, k11 * vx + k12 * vy, k21 * vx + k22 * vy)
+            self.load_estimate = known
+        elif b != 0.0:
             def load(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
                 fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
                 return curl_unit_torque(l1, l2, q1, q2, b * fx, b * fy)
@@ -128,6 +143,10 @@ class LabBot(ReachingBot):
         b_seen = self._measure_curl(session, log)
         theta_seen = self._measure_rotation(session, log)
         self.history.append((outcome.plan.index, b_seen, b_hat, theta_seen, theta_hat))
+        if outcome.plan.channel:  # held on the line: no error to learn from
+            self.curl_learner.update(0.0)
+            self.rotation_learner.update(0.0)
+            return
         self.curl_learner.update(b_seen - b_hat)
         self.rotation_learner.update(theta_seen - theta_hat)
 
