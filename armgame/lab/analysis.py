@@ -112,6 +112,47 @@ def block_summary(rows: Sequence[Mapping[str, object]], metric: str = "max_perpe
              "early": mean(rs[:first]), "late": mean(rs[-first:])} for name, rs in blocks.items()]
 
 
+def channel_summary(rows: Sequence[Mapping[str, object]], first: int = 4) -> list[dict[str, object]]:
+    """Per block with channel trials that have an adaptation index: how many, the mean index of the first and
+    last ``first`` of them, and the largest (with its place among the block's channel trials, from 1)."""
+    blocks: dict[str, list[float]] = {}
+    for r in rows:
+        index = float(r["adaptation_index"])  # type: ignore[arg-type]
+        if r["perturbation"] == "channel" and math.isfinite(index):
+            blocks.setdefault(str(r["block"]), []).append(index)
+    return [{"block": name, "channels": len(v), "early": float(np.mean(v[:first])), "late": float(np.mean(v[-first:])),
+             "largest": max(v), "at": v.index(max(v)) + 1} for name, v in blocks.items()]
+
+
+def fit_schedule(session: LabSession) -> tuple[np.ndarray, np.ndarray]:
+    """Each finished trial's disturbance, in units of the run's first perturbation (the reference: +1 that
+    perturbation, -1 its opposite, 0 none and catch trials), and whether it was an error-clamp (channel)
+    trial: the schedule ``fit.fit_two_rate`` fits the learner to. Raises ValueError for a run with no
+    perturbation, or one whose perturbations are not multiples of each other (a curl and a rotation)."""
+    reference = next((b.perturbation for b in session.protocol.blocks if b.perturbation.kind != "none"), None)
+    if reference is None:
+        raise ValueError("the protocol has no perturbation: nothing to learn, nothing to fit")
+
+    def scale(p) -> float:
+        if p.kind == "none":
+            return 0.0
+        if p.kind in ("curl", "viscous") and reference.kind in ("curl", "viscous"):
+            b, r = np.asarray(p.matrix), np.asarray(reference.matrix)
+            along = float(np.sum(b * r)) / float(np.sum(r * r))
+            if np.allclose(b, along * r):
+                return along
+        elif p.kind == reference.kind == "rotation":
+            return p["angle"] / reference["angle"]
+        elif p == reference:
+            return 1.0
+        raise ValueError(f"{p.label()} is not a multiple of the run's first perturbation ({reference.label()}): "
+                         "one learner cannot be fitted to both")
+
+    disturbance = np.array([0.0 if o.plan.channel else scale(o.plan.active) for o in session.outcomes])
+    clamped = np.array([o.plan.channel for o in session.outcomes], dtype=bool)
+    return disturbance, clamped
+
+
 def figure_metric(protocol) -> str:
     """What a learning curve plots: the perpendicular error for force fields (a velocity-dependent field
     bends the path after the first 100 ms), the initial direction error for visual transforms."""

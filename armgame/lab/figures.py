@@ -378,3 +378,31 @@ def _save(fig: Any, path: Path) -> None:
         atomic_write_bytes(path, buffer.getvalue())
     except OSError as exc:
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+@_lab_style
+def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str) -> None:
+    """A two-rate fit (``armgame.lab.fit.TwoRateFit``) drawn over the data it was fitted to, blocks shaded,
+    the parameters in the title; ``metric`` the fitted column (``adaptation_index`` for indices)."""
+    label, scale = ("adaptation index (channel trials)", 1.0) if metric == "adaptation_index" else _measure(metric)
+    rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
+    fig = _figure()
+    ax = fig.add_subplot()
+    _shade_blocks(ax, blocks_of(rows))
+    trial = np.arange(1, len(rows) + 1, dtype=float)
+    seen = np.isfinite(fit.observed)
+    ax.plot(trial[seen], fit.observed[seen] * scale, "o", color=LINE, ms=_marker_size(len(rows)), label="data")
+    shown = np.isfinite(fit.predicted) & (seen | (fit.observed_kind == "index"))
+    ax.plot(trial[shown], fit.predicted[shown] * scale, "-", color=CATCH, lw=2.0, label="two-rate fit")
+    ax.axhline(0.0, color="black", lw=1.0)
+    ax.set_xlabel("trial")
+    ax.set_ylabel(label)
+    ax.set_xlim(0.5, len(rows) + 0.5)
+    _headroom(ax, np.concatenate([fit.observed[seen], fit.predicted[shown]]) * scale)
+    ax.grid(alpha=0.3, axis="y")
+    v = fit.values
+    ax.set_title(f"Two-rate fit: A_f {v['retention_fast']:.3g}, A_s {v['retention_slow']:.4g}, "
+                 f"B_f {v['rate_fast']:.3g}, B_s {v['rate_slow']:.3g}; rms residual {fit.rms * scale:.3g}, "
+                 f"R² {fit.r_squared:.2f}")
+    _legend_below(fig, ax)
+    _save(fig, path)

@@ -83,10 +83,10 @@ JOINTSPACE_GAIN = 0.25
 
 #: The paradigms' block lengths (README "Lab": chosen with the adaptive bot's default learner).
 SAVINGS_EXPOSURE = 80
-SAVINGS_COUNTER = 0
-SAVINGS_WASHOUT = 24
+SAVINGS_COUNTER = 4
+SAVINGS_WASHOUT = 160
 SPONTANEOUS_EXPOSURE = 160
-SPONTANEOUS_COUNTER = 12
+SPONTANEOUS_COUNTER = 4
 SPONTANEOUS_CLAMP = 48
 
 MAX_BLOCKS = 20
@@ -289,14 +289,14 @@ PRESETS = ("null", "curl", "rotation", "mirror", "jointspace", "viscous", "savin
 
 
 def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
-    """Exposure to the curl field, a counter-exposure to the opposite field, a null washout, re-exposure.
+    """Exposure to the curl field, de-adaptation, re-exposure: re-learning is faster (savings).
 
-    In the two-rate model savings needs a fast and a slow state of opposite signs when re-exposure begins:
-    after a plain null washout long enough to bring the net adaptation back to zero, both have decayed
-    together and re-learning is barely faster (README "Lab"). A short counter-exposure (``counter``
-    trials of ``-b``, Smith et al. 2006's de-adaptation) drives the fast state negative while the slow one
-    still holds the field; the two-trial washout after it lets the hand return to baseline and the field's
-    second exposure finds the slow state ready. ``counter = 0`` gives the plain washout for comparison.
+    In the two-rate model savings needs the fast and slow states apart when re-exposure begins. A null
+    washout long enough to bring the net adaptation back to zero lets both decay together, and re-learning
+    is barely faster than learning (README "Lab" measures it: ``counter = 0`` here gives that protocol, with
+    a ``SAVINGS_WASHOUT``-trial washout). So the preset de-adapts as Smith, Ghazizadeh & Shadmehr (2006) did:
+    ``counter`` trials of the opposite field bring the net adaptation back to about zero quickly, with the
+    fast state holding the counter-field and the slow state still holding the field, and re-exposure follows.
     """
     curl = Perturbation.make("curl", b=CURL_B)
     blocks = [Block("baseline", 16, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"]),
@@ -304,8 +304,9 @@ def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
     if counter:
         blocks.append(Block("counter", counter, Perturbation.make("curl", b=-CURL_B), 0,
                             DEFAULT_INSTRUCTIONS["exposure"]))
-    blocks += [Block("washout", SAVINGS_WASHOUT, NONE, 0, DEFAULT_INSTRUCTIONS["washout"]),
-               Block("re-exposure", SAVINGS_EXPOSURE, curl, 0, DEFAULT_INSTRUCTIONS["exposure"])]
+    else:
+        blocks.append(Block("washout", SAVINGS_WASHOUT, NONE, 0, DEFAULT_INSTRUCTIONS["washout"]))
+    blocks.append(Block("re-exposure", SAVINGS_EXPOSURE, curl, 0, DEFAULT_INSTRUCTIONS["exposure"]))
     return _checked(Protocol("savings", tuple(blocks)))
 
 
