@@ -160,8 +160,9 @@ def _report(session, args: argparse.Namespace) -> None:
             print(f"  {b['block']}: {b['trials']} trials, {b['hits']} hits; max perpendicular error "
                   f"first 8 {_cm(b['early'])}, last 8 {_cm(b['late'])}")
         for b in channel_summary(rows):
-            print(f"  {b['block']}: {b['channels']} channel trials; adaptation index first 4 {b['early']:+.2f}, "
-                  f"last 4 {b['late']:+.2f}, largest {b['largest']:+.2f} (channel trial {b['at']} of the block)")
+            print(f"  {b['block']}: {b['channels']} channel trials; adaptation index, mean of {b['cycle']}: first "
+                  f"{b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} (from channel trial "
+                  f"{b['at']})")
     if args.record:
         driven = "bot" if args.bot else "keyboard"
         replay = Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name,

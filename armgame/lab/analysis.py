@@ -112,24 +112,36 @@ def block_summary(rows: Sequence[Mapping[str, object]], metric: str = "max_perpe
              "early": mean(rs[:first]), "late": mean(rs[-first:])} for name, rs in blocks.items()]
 
 
-def channel_summary(rows: Sequence[Mapping[str, object]], first: int = 4) -> list[dict[str, object]]:
-    """Per block with channel trials that have an adaptation index: how many, the mean index of the first and
-    last ``first`` of them, and the largest (with its place among the block's channel trials, from 1)."""
+def channel_summary(rows: Sequence[Mapping[str, object]], cycle: int = 8) -> list[dict[str, object]]:
+    """Per block with channel trials that have an adaptation index: how many, the mean index of its first and
+    last ``cycle`` channel trials, and the largest mean over ``cycle`` consecutive ones (a cycle of targets
+    averages out each direction's own offset), with the place of that run's first trial (from 1)."""
     blocks: dict[str, list[float]] = {}
     for r in rows:
         index = float(r["adaptation_index"])  # type: ignore[arg-type]
         if r["perturbation"] == "channel" and math.isfinite(index):
             blocks.setdefault(str(r["block"]), []).append(index)
-    return [{"block": name, "channels": len(v), "early": float(np.mean(v[:first])), "late": float(np.mean(v[-first:])),
-             "largest": max(v), "at": v.index(max(v)) + 1} for name, v in blocks.items()]
+    out: list[dict[str, object]] = []
+    for name, v in blocks.items():
+        n = min(cycle, len(v))
+        runs = [float(np.mean(v[i:i + n])) for i in range(len(v) - n + 1)]
+        best = int(np.argmax(runs))
+        out.append({"block": name, "channels": len(v), "cycle": n, "early": runs[0], "late": runs[-1],
+                    "largest": runs[best], "at": best + 1})
+    return out
 
 
 def fit_schedule(session: LabSession) -> tuple[np.ndarray, np.ndarray]:
+    """``disturbance_schedule`` of a run's finished trials."""
+    return disturbance_schedule(session.protocol, [o.plan for o in session.outcomes])
+
+
+def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndarray]:
     """Each finished trial's disturbance, in units of the run's first perturbation (the reference: +1 that
     perturbation, -1 its opposite, 0 none and catch trials), and whether it was an error-clamp (channel)
     trial: the schedule ``fit.fit_two_rate`` fits the learner to. Raises ValueError for a run with no
     perturbation, or one whose perturbations are not multiples of each other (a curl and a rotation)."""
-    reference = next((b.perturbation for b in session.protocol.blocks if b.perturbation.kind != "none"), None)
+    reference = next((b.perturbation for b in protocol.blocks if b.perturbation.kind != "none"), None)
     if reference is None:
         raise ValueError("the protocol has no perturbation: nothing to learn, nothing to fit")
 
@@ -148,8 +160,8 @@ def fit_schedule(session: LabSession) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"{p.label()} is not a multiple of the run's first perturbation ({reference.label()}): "
                          "one learner cannot be fitted to both")
 
-    disturbance = np.array([0.0 if o.plan.channel else scale(o.plan.active) for o in session.outcomes])
-    clamped = np.array([o.plan.channel for o in session.outcomes], dtype=bool)
+    disturbance = np.array([0.0 if plan.channel else scale(plan.active) for plan in plans])
+    clamped = np.array([plan.channel for plan in plans], dtype=bool)
     return disturbance, clamped
 
 
