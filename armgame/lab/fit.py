@@ -16,8 +16,8 @@ observed is either
 ``0 < B_s < B_f < 1``, kept by fitting ``A_f = a``, ``A_s = a + (1 - a) u``, ``B_f = b``, ``B_s = b v``
 with ``a, b, u, v`` bounded in (0, 1). The 95% confidence intervals come from the Jacobian at the
 optimum (``cov = s^2 (J^T J)^-1`` with ``s^2`` the residual variance, mapped to the model's
-parameters by the delta method, +-1.96 standard errors): a local, large-sample approximation, wide
-(or infinite) where the data cannot tell a parameter apart, which is itself worth reading. The work is
+parameters by the delta method, +-1.96 standard errors, cut at 0 and 1): a local, large-sample
+approximation, wide where the data cannot tell a parameter apart, which is itself worth reading. The work is
 bounded: a fixed set of starting points, each with a bounded number of evaluations.
 """
 
@@ -163,5 +163,7 @@ def _intervals(theta: np.ndarray, jac: np.ndarray, s2: float, with_gain: bool) -
         errors = np.full(theta.size, np.inf)
     values = [*_parameters(theta), *((theta[4],) if with_gain else ())]
     names = (*PARAMETER_NAMES, *(("gain",) if with_gain else ()))
-    return {name: (float(value - 1.96 * e), float(value + 1.96 * e))
+    # The rates live in [0, 1]: a symmetric interval that reaches past an edge is cut there.
+    return {name: (float(value - 1.96 * e), float(value + 1.96 * e)) if name == "gain"
+            else (max(0.0, float(value - 1.96 * e)), min(1.0, float(value + 1.96 * e)))
             for name, value, e in zip(names, values, errors, strict=True)}
