@@ -66,3 +66,54 @@ def test_play_headless_bot_json():
     both = subprocess.run([sys.executable, "-m", "armgame", "play", "--headless", "--bot", "model", "--script", "x"],
                           capture_output=True, text=True)
     assert both.returncode != 0 and "--bot" in both.stderr
+
+
+@pytest.mark.parametrize("interaction", [True, False])
+@pytest.mark.parametrize("with_load", [True, False])
+def test_the_forward_model_written_out_equals_accel_step_by_step(interaction, with_load):
+    """``InternalModel.predict`` is ``accel`` and ``bias`` inlined for speed: it must give the same floats."""
+    import math
+    import random
+
+    from armgame.game.bots import InternalModel
+
+    model = InternalModel.of(GameConfig(), interaction)
+    rng = random.Random(5)
+    rows = [(None, None, rng.uniform(-1.5, 1.5), rng.uniform(-1.1, 1.1)) for _ in range(80)]
+
+    def load(q1, q2, w1, w2):
+        return 0.3 * math.sin(q1) * w2, -0.2 * math.cos(q1 + q2) * w1
+
+    start = (0.7, 1.4, 2.0, -3.0)
+    q1, q2, w1, w2 = start
+    for *_, t1, t2 in rows:
+        if with_load:
+            e1, e2 = load(q1, q2, w1, w2)
+            t1, t2 = t1 + e1, t2 + e2
+        a1, a2 = model.accel(q2, w1, w2, t1, t2)
+        w1 += a1 * 0.004
+        w2 += a2 * 0.004
+        q1 += w1 * 0.004
+        q2 += w2 * 0.004
+    assert model.predict(start, rows, 0.004, load if with_load else None) == (q1, q2, w1, w2)
+
+
+def test_the_adaptive_bots_fused_field_equals_the_unit_field_and_torque():
+    """The lab bot's load estimate forms the Jacobian once; it must equal the two documented functions."""
+    import random
+
+    from armgame.lab.bots import curl_unit_force, curl_unit_torque, make_lab_bot
+    from armgame.lab.protocol import preset
+    from armgame.lab.session import LabSession, lab_config
+
+    session = LabSession(lab_config(preset("curl"), 10), preset("curl"))
+    bot = make_lab_bot("adaptive")
+    bot.curl_learner.fast, bot.curl_learner.slow = 0.7, 1.1  # an estimate of b = 1.8 N s/m
+    bot._install(session)
+    l1, l2 = session.config.arm.l1, session.config.arm.l2
+    b = bot.curl_estimate
+    rng = random.Random(2)
+    for _ in range(200):
+        q1, q2, w1, w2 = (rng.uniform(-3, 3) for _ in range(4))
+        fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
+        assert bot.load_estimate(q1, q2, w1, w2) == curl_unit_torque(l1, l2, q1, q2, b * fx, b * fy)

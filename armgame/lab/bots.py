@@ -98,8 +98,14 @@ class LabBot(ReachingBot):
             self.load_estimate = known
         elif b != 0.0:
             def load(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
-                fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
-                return curl_unit_torque(l1, l2, q1, q2, b * fx, b * fy)
+                # curl_unit_torque(b * curl_unit_force(...)) with the Jacobian formed once: the bot's
+                # forward model calls this at every predicted step, and the results are the same floats.
+                s12, c12 = math.sin(q1 + q2), math.cos(q1 + q2)
+                jx1, jy1 = -l1 * math.sin(q1) - l2 * s12, l1 * math.cos(q1) + l2 * c12
+                jx2, jy2 = -l2 * s12, l2 * c12
+                fx = b * (jy1 * w1 + jy2 * w2)
+                fy = b * -(jx1 * w1 + jx2 * w2)
+                return jx1 * fx + jy1 * fy, jx2 * fx + jy2 * fy
             self.load_estimate = load
         else:
             self.load_estimate = None
