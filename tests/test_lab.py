@@ -601,3 +601,28 @@ def test_the_paradigms_presets_show_their_signatures_in_the_bots_learner():
     x, blocks = estimate(savings(counter=0))
     assert abs(x[blocks.index("re-exposure")]) < 0.05
     assert trials_to_half(x, blocks, "re-exposure") >= first - 3
+
+
+def test_the_adaptive_bot_measures_what_a_viscous_field_shows_along_each_reach():
+    """With a viscous field the bot's learner holds a matrix B^. A reach along u shows B u only: with its
+    learning off (B^ = 0) the correction it measures, dB u, is the field's B u within 20% (the field bends the
+    path, and the sideways velocity's share is read as if along u), and it learns
+    the matrix over the targets' directions: B^ moves toward B."""
+    from armgame.lab.bots import LearningRates
+
+    field = preset("viscous").blocks[1].perturbation
+    p = Protocol("v", (Block("exposure", 4, field),), targets=4, **QUICK)
+    still = make_lab_bot("adaptive", LearningRates(0.59, 0.992, 0.0, 0.0))
+    session = LabSession(lab_config(p, 2), p)
+    Autopilot(session, still).play()
+    b = np.asarray(VISCOUS_B)
+    for index, correction in still.matrix_history[:3]:
+        tx, ty = session.plans[index].position
+        u = np.array([tx - session.home[0], ty - session.home[1]]) / p.distance
+        np.testing.assert_allclose(correction.reshape(2, 2) @ u, b @ u, atol=0.2 * np.linalg.norm(b @ u))
+    assert still.matrix_estimate == ((0.0, 0.0), (0.0, 0.0)) and still.curl_estimate == 0.0
+    learning = make_lab_bot("adaptive", LearningRates(0.6, 0.99, 0.4, 0.1))
+    session = LabSession(lab_config(p, 2), p)
+    Autopilot(session, learning).play()
+    learned = np.asarray(learning.matrix_estimate)
+    assert np.sum(learned * b) > 0.2 * np.sum(b * b) and learning.curl_estimate == 0.0

@@ -160,9 +160,9 @@ def _report(session, args: argparse.Namespace) -> None:
             print(f"  {b['block']}: {b['trials']} trials, {b['hits']} hits; max perpendicular error "
                   f"first 8 {_cm(b['early'])}, last 8 {_cm(b['late'])}")
         for b in channel_summary(rows):
-            print(f"  {b['block']}: {b['channels']} channel trials; adaptation index, mean of {b['cycle']}: first "
-                  f"{b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} (from channel trial "
-                  f"{b['at']})")
+            print(f"  {b['block']}: {b['channels']} channel trials; adaptation index {b['first']:+.2f} on the first, "
+                  f"mean of {b['cycle']}: first {b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} "
+                  f"(from channel trial {b['at']})")
     if args.record:
         driven = "bot" if args.bot else "keyboard"
         replay = Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name,

@@ -113,7 +113,8 @@ def block_summary(rows: Sequence[Mapping[str, object]], metric: str = "max_perpe
 
 
 def channel_summary(rows: Sequence[Mapping[str, object]], cycle: int = 8) -> list[dict[str, object]]:
-    """Per block with channel trials that have an adaptation index: how many, the mean index of its first and
+    """Per block with channel trials that have an adaptation index: how many, the first one's index, the mean
+    index of its first and
     last ``cycle`` channel trials, and the largest mean over ``cycle`` consecutive ones (a cycle of targets
     averages out each direction's own offset), with the place of that run's first trial (from 1)."""
     blocks: dict[str, list[float]] = {}
@@ -126,7 +127,7 @@ def channel_summary(rows: Sequence[Mapping[str, object]], cycle: int = 8) -> lis
         n = min(cycle, len(v))
         runs = [float(np.mean(v[i:i + n])) for i in range(len(v) - n + 1)]
         best = int(np.argmax(runs))
-        out.append({"block": name, "channels": len(v), "cycle": n, "early": runs[0], "late": runs[-1],
+        out.append({"block": name, "channels": len(v), "cycle": n, "first": v[0], "early": runs[0], "late": runs[-1],
                     "largest": runs[best], "at": best + 1})
     return out
 
