@@ -336,6 +336,10 @@ def with_perturbation(protocol: Protocol, perturbation: Perturbation) -> Protoco
     with none (the ``null`` preset), in its blocks named ``exposure``. ``NONE`` switches the perturbed
     blocks off (and their catch trials, which would have nothing to switch off)."""
     perturbed = [b.perturbation.kind != "none" for b in protocol.blocks]
+    distinct = dict.fromkeys(b.perturbation for b, on in zip(protocol.blocks, perturbed, strict=True) if on)
+    if len(distinct) > 1:
+        raise UserError(f"protocol {protocol.name!r} has {len(distinct)} different perturbations "
+                        f"({', '.join(p.label() for p in distinct)}): one cannot stand for them all")
     if not any(perturbed):
         perturbed = [b.name == "exposure" for b in protocol.blocks]
     if not any(perturbed):
@@ -354,7 +358,7 @@ _TOP = {"name", "targets", "distance", "target_radius", "home_radius", "hold_tim
 _BLOCK = {"name", "trials", "catch_trials", "channel_trials", "instruction", "perturbation"}
 
 
-def _matrix(where: str, value: object) -> dict[str, float]:
+def viscous_matrix(where: str, value: object) -> dict[str, float]:
     """``matrix = [[b11, b12], [b21, b22]]`` (N s/m, each within the viscous field's range) as parameters."""
     if not (isinstance(value, list) and len(value) == 2
             and all(isinstance(row, list) and len(row) == 2 for row in value)):
@@ -388,7 +392,7 @@ def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
         param_names = {"matrix"} if kind == "viscous" else {p[0] for p in PARAMETERS[kind]}
         check_keys(w, b, {"trials"}, frozenset((_BLOCK - {"trials"}) | param_names))
         if kind == "viscous":
-            values = _matrix(f"{w}.matrix", b["matrix"]) if "matrix" in b else {}
+            values = viscous_matrix(f"{w}.matrix", b["matrix"]) if "matrix" in b else {}
         else:
             values = {p: check_float(f"{w}.{p}", b[p], low, high)
                       for p, low, high, _d, _u in PARAMETERS[kind] if p in b}
