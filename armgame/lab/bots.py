@@ -54,8 +54,9 @@ RIDGE = 0.01
 
 @dataclass(frozen=True)
 class LearningRates:
-    """The two-rate learner's retention (A) and learning (B) rates, fast and slow: Smith et al. 2006's values
-    by default. ``TwoRateLearner`` checks them (0 to 1, the fast process forgetting and learning faster)."""
+    """The two-rate learner's retention (A) and learning (B) rates, fast and slow; the defaults and what is known
+    of their source: ``armgame.lab.learner``. ``TwoRateLearner`` checks them (0 to 1, the fast process
+    forgetting and learning faster)."""
 
     retention_fast: float = 0.59
     retention_slow: float = 0.992
