@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
 import itertools
 import re
@@ -11,7 +12,8 @@ from collections.abc import Sequence
 from typing import NoReturn
 
 from . import __version__
-from .errors import UserError
+from .errors import NoDisplayError, UserError
+from .words import closest
 
 # Commands whose module exists; each module's register() adds its parser.
 COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "replay", "verify", "lab", "analyze",
@@ -27,7 +29,23 @@ class _Parser(argparse.ArgumentParser):
         return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> NoReturn:
+        message = _did_you_mean(message)
         self.exit(2, f"{self.prog}: error: {message}{_dash_value_hint(message, getattr(self, '_arg_strings', []))}\n")
+
+
+def _did_you_mean(message: str) -> str:
+    """argparse's "invalid choice: 'pley' (choose from ...)" with the closest valid name first."""
+    found = re.fullmatch(r"(argument \S+: invalid choice: )('.*?') \(choose from (.*)\)", message)
+    if not found:
+        return message
+    try:
+        value, choices = ast.literal_eval(found.group(2)), ast.literal_eval(f"[{found.group(3)}]")
+    except (ValueError, SyntaxError):
+        return message
+    close = closest(value, choices)
+    if close is None:
+        return message
+    return f"{found.group(1)}{found.group(2)}: did you mean {close}? (choose from {', '.join(choices)})"
 
 
 def _dash_value_hint(message: str, arg_strings: Sequence[str]) -> str:
@@ -66,6 +84,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     try:
         return int(args.run(args) or 0)
+    except NoDisplayError as exc:
+        # The same command without a window, as the user can run it: their arguments, and what it needs.
+        without = getattr(args, "without_window", None)
+        typed = list(sys.argv[1:] if argv is None else argv)
+        tail = f"; run it without one: {without(args, typed)}" if without else ""
+        print(f"armgame {args.command}: error: {exc}{tail}", file=sys.stderr)
+        return 2
     except UserError as exc:
         print(f"armgame {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -15,6 +15,7 @@ from .errors import UserError
 from .physics.onejoint import OneJointArm
 from .physics.params import GAME_ARM, PENDULUM, TUTORIAL_ARM
 from .physics.twojoint import TwoJointArm
+from .words import unknown_name
 
 
 @dataclass(frozen=True)
@@ -142,4 +143,4 @@ def get_scene(name: str) -> Scene:
     try:
         return SCENES[name]
     except KeyError:
-        raise UserError(f"unknown scene {name!r}: choose one of {', '.join(SCENES)}") from None
+        raise UserError(unknown_name("scene", name, SCENES)) from None

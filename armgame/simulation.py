@@ -22,6 +22,7 @@ from .physics.integrators import INTEGRATOR_NAMES, Integrator
 from .physics.reference import reference_trajectory
 from .records.storage import atomic_writer, check_output_path
 from .scenes import Scene
+from .words import unknown_name
 
 DEFAULT_SAMPLE_RATE = 200.0
 
@@ -94,7 +95,7 @@ def plan_run(scene: Scene, integrator: str, dt: float, duration: float | None = 
     if dt > duration:
         raise UserError(f"--dt ({dt} s) is longer than --duration ({duration} s)")
     if integrator not in INTEGRATOR_NAMES:
-        raise UserError(f"unknown integrator {integrator!r}: choose one of {', '.join(INTEGRATOR_NAMES)}")
+        raise UserError(unknown_name("integrator", integrator, INTEGRATOR_NAMES))
     state0 = scene.initial if initial is None else initial
     if not all(math.isfinite(v) for v in state0):
         raise UserError(f"the initial state must be finite, got {state0!r}")

@@ -1,9 +1,14 @@
-"""How counts read in anything armgame prints or draws: "1 hit", "2 hits", "1 entry", "3 entries".
+"""How counts read in anything armgame prints or draws: "1 hit", "2 hits", "1 entry", "3 entries";
+and how a name from a fixed set that is not in it is answered: with the closest valid one.
 
-The one place for it, so that no message says "1 hits". Pure Python, imports nothing.
+The one place for each, so that no message says "1 hits" and every mistyped name gets the same
+help. Pure Python, the standard library only.
 """
 
 from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
 
 _SIBILANT_ENDINGS = ("s", "x", "z", "ch", "sh")
 
@@ -38,3 +43,30 @@ def plural(count: int, noun: str, plural_form: str | None = None) -> str:
         head, _, last = noun.rpartition(" ")
         plural_form = f"{head} {plural_of(last)}" if head else plural_of(last)
     return f"{count} {plural_form}"
+
+
+def closest(name: str, choices: Iterable[str]) -> str | None:
+    """The valid name ``name`` most likely meant (``difflib``, ignoring case), or None if none is close.
+
+    >>> closest("pley", ("play", "replay", "simulate")), closest("CURL", ("curl", "null")), closest("zz", ("a",))
+    ('play', 'curl', None)
+    """
+    by_folded = {c.lower(): c for c in choices}
+    found = difflib.get_close_matches(name.lower(), list(by_folded), n=1, cutoff=0.6)
+    return by_folded[found[0]] if found else None
+
+
+def unknown_name(what: str, name: str, choices: Iterable[str], also: str = "") -> str:
+    """The one line that refuses ``name`` as a ``what``: the closest valid name first, then them all.
+
+    ``also`` ends the list with what else is accepted.
+
+    >>> unknown_name("bot", "modle", ("model", "naive"))
+    "unknown bot 'modle': did you mean model? (choose one of model, naive)"
+    >>> unknown_name("lab preset", "spiral", ("null", "curl"), "or give a .toml file")
+    "unknown lab preset 'spiral': choose one of null, curl, or give a .toml file"
+    """
+    choices = list(choices)
+    listed = f"choose one of {', '.join(choices)}{', ' + also if also else ''}"
+    close = closest(name, choices)
+    return f"unknown {what} {name!r}: " + (f"did you mean {close}? ({listed})" if close else listed)

@@ -36,8 +36,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from armgame.game import compiled
-from armgame.game.batch import KERNELS, replay_many
+from armgame.game.batch import KERNELS, compiled, replay_many
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
 from armgame.records.batch_verify import verify_replays

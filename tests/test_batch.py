@@ -17,8 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from armgame.errors import UserError
-from armgame.game import compiled
-from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, replay_many
+from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, batch_problem, compiled, replay_many
 from armgame.game.muscles import DEFAULT_MUSCLES, MuscleLevelError, MuscleSet, MuscleSpec, remap_keys
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
 from armgame.game.session import GameSession, InputEvent, TimelineInput
@@ -419,7 +418,7 @@ def test_options_for_one_game_are_refused_for_many_in_one_line(tmp_path, capsys,
 
 
 def test_a_class_run_is_bounded_and_checks_every_script_before_playing(tmp_path, capsys, monkeypatch):
-    import armgame.game.batch as batch_module
+    import armgame.game.batch.scripts as batch_module
     from armgame.cli import main
 
     paths = write_scripts(tmp_path / "class", 3)

@@ -16,9 +16,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_batch import KERNELS, KEYS, student_timeline
 
-import armgame.game.batch as batch_module
-from armgame.game import compiled
-from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, replay_many
+import armgame.game.batch.session as batch_module
+from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, compiled, replay_many
 from armgame.game.rules import GAME_PLAY_ARM, GameConfig, Target
 from armgame.game.session import GameSession, InputEvent
 

@@ -10,8 +10,7 @@ import types
 import numpy as np
 import pytest
 
-from armgame.game import compiled
-from armgame.game.batch import BatchGameSession
+from armgame.game.batch import BatchGameSession, compiled
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
 

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 import armgame.env
 import armgame.env.vector
-import armgame.game.batch
+import armgame.game.batch.session
 from armgame.env.policies import BotPolicy
 from armgame.env.reach import EnvArgumentError
 from armgame.env.vector import ReachVectorEnv
@@ -54,7 +54,7 @@ def test_the_vector_env_equals_single_envs_with_bots_playing_and_autoresets(kwar
     # Bots score, so rewards are not all zero; 1.5 s games end twice (with 4 physics steps a decision
     # the last decision of a game holds 3).
     if series == "series":  # the fast kernel of 2,048 and more envs, here on four
-        monkeypatch.setattr(armgame.game.batch, "SERIES_MIN_GAMES", 1)
+        monkeypatch.setattr(armgame.game.batch.session, "SERIES_MIN_GAMES", 1)
     native, singles = make_pair(REACH, 4, time_limit=1.5, **kwargs)
     keys_env = gym.make(REACH, time_limit=1.5, decision_steps=kwargs.get("decision_steps", 5))
     policies = [BotPolicy(name, keys_env) for name in ("model", "naive", "model", "naive")]
@@ -108,7 +108,7 @@ def test_any_vector_env_equals_its_single_envs(n, decision_steps, time_limit, co
     env_id = CONTINUOUS if continuous else REACH
     with pytest.MonkeyPatch.context() as mp:
         if series:  # the fast kernel of 2,048 and more envs
-            mp.setattr(armgame.game.batch, "SERIES_MIN_GAMES", 1)
+            mp.setattr(armgame.game.batch.session, "SERIES_MIN_GAMES", 1)
         native, singles = make_pair(env_id, n, time_limit=time_limit, decision_steps=decision_steps,
                                     reset_key=reset_key)
         native.reset(seed=seed)  # builds the batches (which keep their kernel) while the patch holds

@@ -172,8 +172,7 @@ def test_a_run_that_goes_non_finite_stops_with_one_line():
 @pytest.mark.parametrize("kernel", ["compiled", "numpy"])
 @pytest.mark.parametrize("integrator", ["rk4", "euler"])
 def test_a_batch_that_goes_non_finite_stops_with_one_line_as_the_single_game_does(kernel, integrator):
-    from armgame.game import compiled
-    from armgame.game.batch import BatchGameSession
+    from armgame.game.batch import BatchGameSession, compiled
     from armgame.game.muscles import MuscleSpec
     from armgame.game.session import InputEvent
 

@@ -86,3 +86,11 @@ def test_help_imports_no_heavy_package():
             "print(sorted(m for m in ('numpy', 'scipy', 'pygame') if m in sys.modules))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_simulate_imports_scipy_only_for_the_reference_solver():
+    """scipy.integrate costs about half a second to import: a fixed-step run must not pay it."""
+    code = ("import sys, armgame.simulation, armgame.physics.reference; "
+            "assert 'scipy.integrate' not in sys.modules, 'imported scipy.integrate'")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr

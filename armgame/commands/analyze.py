@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import UserError
+from . import read_lab_replays
 
 #: A class folder is read up to this many replays: the work is bounded before it starts.
 MAX_CLASS_FILES = 500
@@ -45,6 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    read_lab_replays()
     if args.class_dir is not None:
         if args.replays:
             raise UserError("give replays or --class DIR, not both")

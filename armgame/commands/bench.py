@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from ..errors import UserError
+from ..words import unknown_name
 
 CASE_NAMES = ("passive", "propeller", "upright", "stiff", "game")
 INTEGRATOR_NAMES = ("euler", "symplectic-euler", "rk4", "midpoint", "gauss4")
@@ -15,9 +16,10 @@ def _names(allowed: tuple[str, ...], what: str):
     def parse(text: str) -> tuple[str, ...]:
         names = tuple(n.strip() for n in text.split(",") if n.strip())
         unknown = [n for n in names if n not in allowed]
-        if unknown or not names:
-            raise argparse.ArgumentTypeError(
-                f"unknown {what} {', '.join(map(repr, unknown)) or '(none given)'}: choose from {', '.join(allowed)}")
+        if not names:
+            raise argparse.ArgumentTypeError(f"no {what} given: choose from {', '.join(allowed)}")
+        if unknown:
+            raise argparse.ArgumentTypeError(unknown_name(what, unknown[0], allowed))
         return names
 
     return parse

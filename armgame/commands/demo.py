@@ -41,7 +41,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="interaction only: the reach in a vertical plane, so gravity adds its torques")
     p.add_argument("--speed", type=float, default=1.0, help="window: initial playback rate (default: 1 = real time)")
     add_window_options(p, sound=False)
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, without_window=without_window)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -89,3 +89,10 @@ def _window_size(args: argparse.Namespace) -> tuple[int, int] | None:
     from ..ui.options import window_settings
 
     return window_settings(args)[0].size
+
+
+def without_window(args: argparse.Namespace, typed: list[str]) -> str:
+    """The demo headless, its CSV and figure written to a folder named after it (autopilot: printed)."""
+    from . import command_line
+
+    return command_line(typed, "--headless", *([] if args.name == "autopilot" else ["--out", args.name]))

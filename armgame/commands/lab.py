@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 from ..errors import UserError
+from ..words import unknown_name
 from .play import DEFAULT_SEED, _seed
 
 
@@ -64,7 +65,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     add_window_options(p, sound=False)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, without_window=without_window)
 
 
 def load_protocol_argument(text: str):
@@ -74,7 +75,7 @@ def load_protocol_argument(text: str):
         return preset(text)
     if text.endswith(".toml") or Path(text).exists():
         return load_protocol(Path(text))
-    raise UserError(f"unknown lab protocol {text!r}: choose a preset ({', '.join(PRESETS)}) or give a .toml file")
+    raise UserError(unknown_name("lab protocol", text, PRESETS, "or give a .toml file"))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -94,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     if args.headless and not args.bot:
         raise UserError("--headless needs a --bot to play (model, naive or adaptive); people play in the window")
     if args.bot and args.bot not in LAB_BOT_NAMES:
-        raise UserError(f"unknown lab bot {args.bot!r}: choose one of {', '.join(LAB_BOT_NAMES)}")
+        raise UserError(unknown_name("lab bot", args.bot, LAB_BOT_NAMES))
     if (args.retention or args.learning) and args.bot != "adaptive":
         raise UserError("--retention and --learning set the adaptive bot's learner: add --bot adaptive")
     if args.no_figures and not args.out:
@@ -187,6 +188,8 @@ def _cm(value: object) -> str:
 
 
 def _play_in_window(session, bot, args: argparse.Namespace) -> None:
+    from ..errors import NoDisplayError
+
     try:
         import pygame
 
@@ -206,9 +209,16 @@ def _play_in_window(session, bot, args: argparse.Namespace) -> None:
         settings, _ = window_settings(args)
         screen = open_window(settings.size, args.fullscreen, "armgame lab - reach from home to each target")
     except pygame.error as exc:
-        raise UserError(f"cannot open a window ({exc}); use --headless --bot NAME where there is no display") from None
+        raise NoDisplayError(f"cannot open a window ({exc})") from None
     try:
         LabWindow(session, screen, fps=args.fps, driver=driver,
                   mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}").run()
     finally:
         pygame.display.quit()
+
+
+def without_window(args: argparse.Namespace, typed: list[str]) -> str:
+    """The run headless: a bot plays it (the adapting one, unless the user chose one)."""
+    from . import command_line
+
+    return command_line(typed, "--headless", *([] if args.bot else ["--bot", "adaptive"]))

@@ -7,6 +7,7 @@ import math
 
 from ..errors import UserError
 from ..words import plural
+from . import read_lab_replays
 
 DEFAULT_SEED = 10  # the 2012 game's: every class sees the same targets unless asked otherwise
 
@@ -53,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
     _add_score_options(p)
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, without_window=without_window)
 
 
 def _add_score_options(p: argparse.ArgumentParser) -> None:
@@ -183,6 +184,7 @@ def _keep(session, args: argparse.Namespace):
     from ..records.storage import check_output_path, user_path
     from .scores import scores_dir
 
+    read_lab_replays()  # the table's other entries are read too
     out = sys.stderr if args.json else sys.stdout
     bot = getattr(args, "bot", None)
     driven = "bot" if bot else "script" if args.headless else "keyboard"
@@ -270,3 +272,10 @@ def _play_in_window(session, args: argparse.Namespace, window):
                          mode=f"AUTOPILOT: {args.bot}" if args.bot else f"PLAY   seed {args.seed}")
     args.name = args.name or played.player_name  # the name typed on the end screen
     return session.result()
+
+
+def without_window(args: argparse.Namespace, typed: list[str]) -> str:
+    """The game headless: a bot plays it (the player's keys need a window)."""
+    from . import command_line
+
+    return command_line(typed, "--headless", *([] if args.bot else ["--bot", "model"]))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
+from . import read_lab_replays
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -23,7 +24,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
-    p.set_defaults(run=run)
+    p.set_defaults(run=run, without_window=without_window)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -33,6 +34,7 @@ def run(args: argparse.Namespace) -> int:
     from ..records.replay import Replay
     from ..records.storage import user_path
 
+    read_lab_replays()
     replay = Replay.load(user_path(args.file, "FILE"))
     if args.headless:
         result = replay.replay()
@@ -95,3 +97,10 @@ def _watch_lab(replay, args: argparse.Namespace, settings):
     finally:
         pygame.display.quit()
     return session
+
+
+def without_window(args: argparse.Namespace, typed: list[str]) -> str:
+    """The replay recomputed at once."""
+    from . import command_line
+
+    return command_line(typed, "--headless")

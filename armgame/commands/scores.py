@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
+from . import read_lab_replays
 
 SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else scores/ in a checkout, "
                "else ~/.local/share/armgame/scores)")
@@ -62,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     if args.name is not None and args.add is None:
         raise UserError("--name goes with --add")
     cache = None if args.no_check else verification_cache(args)
+    read_lab_replays()
     table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame scores: {m}", file=sys.stderr), cache=cache)
     if args.add is not None:
         return _add(table, args)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
+from . import read_lab_replays
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -25,6 +26,7 @@ def run(args: argparse.Namespace) -> int:
     from ..records.scores import TABLE_NAME
     from ..records.storage import user_path
 
+    read_lab_replays()
     path = user_path(args.file, "FILE")
     if path.is_dir() and not (path / TABLE_NAME).exists() and not (path / TABLE_NAME).is_symlink():
         return _verify_folder(path)

@@ -12,6 +12,7 @@ import numpy as np
 from ..errors import UserError
 from ..scenes import get_scene
 from ..simulation import Trajectory, write_csv, write_table
+from ..words import unknown_name
 from . import DEMO_NAMES
 from .reach import COMPONENTS, ReachRun, reach_table
 from .runs import chaos_run, check_fixed_step, passive_run, pendulum_run, record
@@ -55,7 +56,7 @@ def get_info(name: str) -> DemoInfo:
     try:
         return INFO[name]
     except KeyError:
-        raise UserError(f"unknown demo {name!r}: choose one of {', '.join(DEMO_NAMES)}") from None
+        raise UserError(unknown_name("demo", name, DEMO_NAMES)) from None
 
 
 def make_run(name: str, integrator: str = "rk4", dt: float = 0.001, gravity: bool = False) -> Any:

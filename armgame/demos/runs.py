@@ -18,6 +18,7 @@ from ..physics.integrators import SCHEMES, Integrator
 from ..physics.params import TUTORIAL_ARM
 from ..physics.twojoint import TwoJointArm
 from ..scenes import get_scene
+from ..words import unknown_name
 
 State = tuple[float, float, float, float]
 Point = tuple[float, float]
@@ -34,7 +35,7 @@ VISIBLY_APART = 0.01
 
 def check_fixed_step(integrator: str, dt: float) -> None:
     if integrator not in SCHEMES:
-        raise UserError(f"unknown integrator {integrator!r} for a demo: choose one of {', '.join(SCHEMES)}")
+        raise UserError(unknown_name("integrator", integrator, SCHEMES))
     if not (math.isfinite(dt) and 0.0 < dt <= 0.05):
         raise UserError(f"--dt must be a positive number of seconds no larger than 0.05, got {dt!r}")
 

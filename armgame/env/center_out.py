@@ -35,6 +35,7 @@ from ..lab.protocol import (
 )
 from ..lab.session import HOLD, REACH, LabSession, lab_config
 from ..physics.twojoint import TwoJointArm
+from ..words import unknown_name
 from .base import EnvArgumentError, SessionEnv
 from .reach import (
     DEFAULT_DECISION_STEPS,
@@ -418,7 +419,7 @@ class CenterOutBotPolicy:
 
     def __init__(self, bot: str, env: Any) -> None:
         if bot not in LAB_BOT_NAMES:
-            raise UserError(f"unknown lab bot {bot!r}: choose one of {', '.join(LAB_BOT_NAMES)}")
+            raise UserError(unknown_name("lab bot", bot, LAB_BOT_NAMES))
         base = env.unwrapped
         if not isinstance(base, CenterOutEnv) or base.continuous:
             raise ValueError("a lab bot plays the keys of armgame/CenterOut-v0")

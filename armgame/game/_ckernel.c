@@ -10,11 +10,11 @@
  * builtin sin and cos, so the compiler cannot merge them into a ``sincos`` of its own choosing.
  *
  * With ``fast`` set, the elbow's cos and sin come by angle addition instead (the numpy fast
- * kernel's method, see batch.py): round-off, not bit for bit, and the batch says so.
+ * kernel's method, see batch/numpy_kernel.py): round-off, not bit for bit, and the batch says so.
  *
  * The kernel knows nothing of targets' rules: it stops a game whose hand may be on its target
  * (within a relative 1e-6 of the disc) and lets Python decide, with the single session's own
- * test and its ``GameRules``. See ``armgame/game/compiled.py`` for the calling side.
+ * test and its ``GameRules``. See ``armgame/game/batch/compiled.py`` for the calling side.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -62,7 +62,7 @@ static inline void accel_trig(const Arm *arm, double q1, double q2, double bc, d
     *o2 = ((m12 + arm->amd + bc) * f2 - m12 * f1) * r;
 }
 
-/* The fast kernel's elbow trig (batch._Kernel's, there in numpy): b cos and b sin of q2 + delta
+/* The fast kernel's elbow trig (batch.numpy_kernel's, there in numpy): b cos and b sin of q2 + delta
  * from those of q2 by angle addition, with cos and sin of the small delta from Taylor series
  * in delta^2 (the first dropped terms below 3e-17 within SERIES_LIMIT). Returns 0, leaving the
  * outputs alone, if |delta| is beyond the series' range. */
@@ -273,7 +273,7 @@ static PyObject *run(PyObject *self, PyObject *args)
             if (fast && !turned(bc, bs, q2 - p2, limit2, &bc, &bs))
                 anchor = 0;
             /* A lower bound on the hand's distance from the disc, lowered by a bound on its move;
-             * measured only when it runs out (see _Kernel.run). */
+             * measured only when it runs out (see NumpyKernel.run). */
             sl -= fabs(q1 - p1) * reach1 + fabs(q2 - p2) * reach2;
             if (sl < 0.0) {
                 const double dx = l1 * cos(q1) + l2 * cos(q1 + q2) - x0;
@@ -314,7 +314,7 @@ static PyMethodDef methods[] = {
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_ckernel",
-    "The batched game's hot loop, compiled (optional: armgame.game.compiled falls back to numpy).",
+    "The batched game's hot loop, compiled (optional: armgame.game.batch.compiled falls back to numpy).",
     -1, methods, NULL, NULL, NULL, NULL,
 };
 

@@ -42,6 +42,7 @@ from typing import Protocol
 
 from ..errors import UserError
 from ..physics.twojoint import TwoJointArm
+from ..words import unknown_name
 from .rules import GameConfig, Target
 from .session import DOWN, UP, GameResult, GameSession
 
@@ -358,7 +359,7 @@ def make_bot(name: str) -> ReachingBot:
         return ReachingBot("model", interaction=True)
     if name == "naive":
         return ReachingBot("naive", interaction=False)
-    raise UserError(f"unknown bot {name!r}: choose one of {', '.join(BOT_NAMES)}")
+    raise UserError(unknown_name("bot", name, BOT_NAMES))
 
 
 # ----------------------------------------------------------------- the driver

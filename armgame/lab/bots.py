@@ -44,6 +44,7 @@ import numpy as np
 
 from ..errors import UserError
 from ..game.bots import ReachingBot
+from ..words import unknown_name
 from .learner import TwoRateLearner
 from .session import LabSession
 
@@ -309,4 +310,4 @@ def make_lab_bot(name: str, rates: LearningRates | None = None) -> LabBot:
         return LabBot("naive", interaction=False)
     if name == "adaptive":
         return LabBot("adaptive", interaction=True, rates=rates or LearningRates())
-    raise UserError(f"unknown lab bot {name!r}: choose one of {', '.join(LAB_BOT_NAMES)}")
+    raise UserError(unknown_name("lab bot", name, LAB_BOT_NAMES))

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import UserError
 from ..records.storage import atomic_write_bytes
+from ..words import unknown_name
 from .metrics import METRIC_COLUMNS, check_regular_target
 
 P = ParamSpec("P")
@@ -115,7 +116,7 @@ def class_curve(students: Sequence[Sequence[Mapping[str, Any]]],
     seen, in order: ``trial, block, perturbation, mean, sem, n``.
     """
     if metric not in METRIC_COLUMNS:
-        raise UserError(f"unknown measure {metric!r}: choose one of {', '.join(METRIC_COLUMNS)}")
+        raise UserError(unknown_name("measure", metric, METRIC_COLUMNS))
     values: dict[int, list[float]] = {}
     labels: dict[int, Counter] = {}
     for s, rows in enumerate(students, start=1):
@@ -312,7 +313,7 @@ def class_figure(curve: Sequence[Mapping[str, Any]], path: Path, *,
 
 def _measure(metric: str) -> tuple[str, float]:
     if metric not in MEASURES:
-        raise UserError(f"unknown measure {metric!r}: choose one of {', '.join(MEASURES)}")
+        raise UserError(unknown_name("measure", metric, MEASURES))
     return MEASURES[metric]
 
 

@@ -38,6 +38,7 @@ from pathlib import Path
 
 from ..errors import UserError
 from ..records.storage import check_float, check_int, check_keys, check_str, read_limited
+from ..words import unknown_name
 
 FORCE_KINDS = ("curl", "constant", "spring", "viscous")
 #: Fields ``F = B v``: the adaptation index of a channel trial is measured against one of these.
@@ -58,17 +59,17 @@ PARAMETERS: dict[str, tuple[tuple[str, float, float, float, str], ...]] = {
     "jointspace": (("gain", 0.01, 2.0, 0.25, "m/rad"),),
 }
 
-#: The curl preset's field. Chosen by measurement (README "Lab", ``tests/test_lab.py``): the model
+#: The curl preset's field. Chosen by measurement (docs/lab.md, ``tests/test_lab.py``): the model
 #: bot, which knows the arm but not the field, is pushed 2-3 cm off its 10 cm reaches, and a bot
 #: that knows the field cancels it within its muscles' strength and reaches straight.
 CURL_B = 2.0
 #: Shadmehr & Mussa-Ivaldi's (1994) field (N s/m), and the ``viscous`` preset's: one eighth of it, which
 #: takes its largest gain (its spectral norm, 15.92 N s/m) to 1.99 N s/m, the curl preset's b. Checked
-#: by measurement as b was (README "Lab", ``tests/test_lab.py``).
+#: by measurement as b was (docs/lab.md, ``tests/test_lab.py``).
 PUBLISHED_VISCOUS_B = ((-10.1, -11.2), (-11.2, 11.1))
 VISCOUS_SCALE = 0.125
 VISCOUS_B = tuple(tuple(VISCOUS_SCALE * v for v in row) for row in PUBLISHED_VISCOUS_B)
-#: The force channel of error-clamp trials (README "Lab"): this arm's lightest endpoint mass is 0.77 kg
+#: The force channel of error-clamp trials (docs/lab.md): this arm's lightest endpoint mass is 0.77 kg
 #: (a human arm's), its fields push with about 1 N, so the low end of the robots' 2,000-6,000 N/m holds
 #: the hand within about 0.5 mm of the line (2% of the field's 2.9 cm deflection), and the robots' 50 N s/m
 #: damps it (damping ratio 0.64 at the lightest mass). ``LabSession`` checks a protocol's channel
@@ -81,7 +82,7 @@ MAX_CHANNEL_DAMPING = 500.0
 ROTATION_ANGLE = 30.0
 JOINTSPACE_GAIN = 0.25
 
-#: The paradigms' block lengths (README "Lab": chosen with the adaptive bot's default learner).
+#: The paradigms' block lengths (docs/lab.md: chosen with the adaptive bot's default learner).
 SAVINGS_EXPOSURE = 80
 SAVINGS_COUNTER = 4
 SAVINGS_WASHOUT = 160
@@ -103,12 +104,12 @@ class Perturbation:
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
-            raise UserError(f"unknown perturbation {self.kind!r}: choose one of {', '.join(KINDS)}")
+            raise UserError(unknown_name("perturbation", self.kind, KINDS))
 
     @classmethod
     def make(cls, kind: str, **values: float) -> Perturbation:
         if kind not in KINDS:
-            raise UserError(f"unknown perturbation {kind!r}: choose one of {', '.join(KINDS)}")
+            raise UserError(unknown_name("perturbation", kind, KINDS))
         params = []
         for name, _low, _high, default, _unit in PARAMETERS[kind]:
             params.append((name, float(values.pop(name, default))))
@@ -282,7 +283,7 @@ def preset(name: str) -> Protocol:
         return savings()
     if name == "spontaneous":
         return spontaneous()
-    raise UserError(f"unknown lab preset {name!r}: choose one of {', '.join(PRESETS)}, or give a .toml file")
+    raise UserError(unknown_name("lab preset", name, PRESETS, "or give a .toml file"))
 
 
 PRESETS = ("null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous")
@@ -293,7 +294,7 @@ def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
 
     In the two-rate model savings needs the fast and slow states apart when re-exposure begins. A null
     washout long enough to bring the net adaptation back to zero lets both decay together, and re-learning
-    is barely faster than learning (README "Lab" measures it: ``counter = 0`` here gives that protocol, with
+    is barely faster than learning (docs/lab.md measures it: ``counter = 0`` here gives that protocol, with
     a ``SAVINGS_WASHOUT``-trial washout). So the preset de-adapts as Smith, Ghazizadeh & Shadmehr (2006) did:
     ``counter`` trials of the opposite field bring the net adaptation back to about zero quickly, with the
     fast state holding the counter-field and the slow state still holding the field, and re-exposure follows.

@@ -1,7 +1,9 @@
 """The task section of a lab replay: the protocol a run played and the trials it produced.
 
 A lab run is recorded as any game is (``armgame.records.replay``: its ``GameConfig``, input
-timeline and result), plus this section. Verifying replays the timeline on a fresh
+timeline and result), plus this section, which this module reads and writes itself: records, a
+lower layer, knows no lab, and reads the section through the reader this module registers with it
+when imported (``register_task``). Verifying replays the timeline on a fresh
 ``LabSession`` of the same protocol and compares the result, every trial (target, go-cue
 step, end step, hit) and a SHA-256 of every trial's hand path (its floats' bytes): a timeline
 changed by one key one step is caught even when it ends the same trials at the same steps, so a
@@ -19,6 +21,7 @@ import numpy as np
 
 from ..game.rules import GameConfig
 from ..game.session import GameResult, InputEvent
+from ..records.replay import register_task, same_outcome
 from ..records.storage import check_int, check_keys, check_str
 from .protocol import Protocol, protocol_from_dict
 from .session import LAB_SCENE, LabSession
@@ -88,8 +91,6 @@ class LabTask:
 
     def verify(self, config: GameConfig, timeline: Sequence[InputEvent],
                result: GameResult) -> tuple[bool, GameResult, LabSession]:
-        from ..records.replay import same_outcome
-
         session = self.session(config, timeline, result.steps)
         recomputed = session.result()
         same_trials = tuple(tuple(t) for t in session.trial_records()) == self.trials
@@ -103,3 +104,11 @@ def paths_digest(session: LabSession) -> str:
         h.update(np.asarray(o.xs, dtype="<f8").tobytes())
         h.update(np.asarray(o.ys, dtype="<f8").tobytes())
     return h.hexdigest()
+
+
+def register() -> None:
+    """Let records read replays with a centre-out task section (done on import; again costs nothing)."""
+    register_task(TASK_KIND, LabTask.from_dict)
+
+
+register()

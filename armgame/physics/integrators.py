@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import UserError
+from ..words import unknown_name
 from .twojoint import ComponentDynamics
 
 # The implicit stages are solved by fixed-point iteration to round-off: a looser solve
@@ -179,7 +180,7 @@ def scheme(name: str) -> Scheme:
         return SCHEMES[name]
     except KeyError:
         raise UnknownIntegratorError(
-            f"unknown integrator {name!r}: choose one of {', '.join(SCHEMES)}"
+            unknown_name("integrator", name, SCHEMES)
         ) from None
 
 

@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 REFERENCE_TOLERANCE = 1e-12
 
@@ -31,6 +30,10 @@ def reference_trajectory(
     ``segments`` lists (start time, torque) pairs in increasing start order: the torque
     holds from its start until the next segment's. The first must start at or before 0.
     """
+    # scipy.integrate takes about half a second to import: only runs that ask for the reference pay it
+    # (every `armgame simulate` imports this module, most never call it).
+    from scipy.integrate import solve_ivp
+
     times, where = np.unique(np.asarray(t_eval, dtype=float), return_inverse=True)
     if len(times) and times[0] < 0.0:
         raise ValueError("reference times must be >= 0")

@@ -10,15 +10,21 @@ field, NaN/Infinity refused, sizes bounded. Nothing in it is ever executed or un
 
 What a replay cannot prove: that a human pressed the keys. A timeline written by a
 program replays like any other; the table shows how each game says it was driven.
+
+A run that is more than a game (the lab's centre-out runs) adds a task section, which its own
+layer reads, writes and verifies: that layer registers a reader for its kind of section
+(``register_task``; ``armgame.lab.record`` does when imported) and records never imports it, so
+this layer stays below the lab. The commands that read replays import the lab first.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from .. import __version__
 from ..errors import UserError
@@ -234,6 +240,56 @@ def same_outcome(a: GameResult, b: GameResult) -> bool:
         {k: v for k, v in b.as_dict().items() if k != "version"}
 
 
+# ------------------------------------------------------------------- task sections
+
+class ReplayTask(Protocol):
+    """A replay's task section, as its layer reads it: what records asks of one."""
+
+    def as_dict(self) -> dict[str, object]:
+        """The section as JSON data, with its ``"kind"``."""
+        ...
+
+    def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> Any:
+        """The run re-simulated from its timeline to ``steps``; its ``result()`` is the game's result."""
+        ...
+
+    def verify(self, config: GameConfig, timeline: Sequence[InputEvent],
+               result: GameResult) -> tuple[bool, GameResult, Any]:
+        """Replay and compare everything the section claims: (ok, the recomputed result, the session)."""
+        ...
+
+
+#: ``read(section, config, last_step)``: rebuild and check a task section, raising ValueError naming the field.
+TaskReader = Callable[[object, GameConfig, int], ReplayTask]
+
+#: The kinds of task section this program reads, filled by the layers that record them.
+_TASK_READERS: dict[str, TaskReader] = {}
+
+
+def register_task(kind: str, read: TaskReader) -> None:
+    """Let replays carry task sections whose ``"kind"`` is ``kind``, read by ``read``.
+
+    Called by the layer that records such runs (``armgame.lab.record`` registers ``"centre-out"``
+    when it is imported); registering the same reader again does nothing.
+    """
+    known = _TASK_READERS.get(kind)
+    if known is not None and known != read:
+        raise ValueError(f"task kind {kind!r} has a reader already")
+    _TASK_READERS[kind] = read
+
+
+def read_task(section: object, config: GameConfig, last_step: int) -> ReplayTask:
+    """A replay's task section, by the reader registered for its kind; raises ValueError naming the field."""
+    data = check_keys("task", section, {"kind"}, frozenset(section) if isinstance(section, dict) else frozenset())
+    kind = check_str("task.kind", data["kind"], 40)
+    read = _TASK_READERS.get(kind)
+    if read is None:
+        if not _TASK_READERS:
+            raise ValueError(f"task.kind {kind!r}: no kind of task section is registered to read it")
+        raise ValueError(f"task.kind must be {' or '.join(map(repr, sorted(_TASK_READERS)))}, got {kind!r}")
+    return read(data, config, last_step)
+
+
 # ------------------------------------------------------------------------ replay
 
 @dataclass(frozen=True)
@@ -248,8 +304,9 @@ class Replay:
     player: str | None = None
     date: str = ""
     version: str = __version__
-    #: A lab run's task section (``armgame.lab.record.LabTask``): the protocol and the trials; None for a game.
-    task: Any = None
+    #: The task section of a run that is more than a game (see ``register_task``; the lab's: its protocol
+    #: and trials); None for a game.
+    task: ReplayTask | None = None
 
     @property
     def steps(self) -> int:
@@ -351,11 +408,7 @@ class Replay:
         driver = None if d["driver"] is None else check_str("driver", d["driver"], 200)
         player = None if d["player"] is None else check_name(d["player"])
         timeline = _timeline_from_list(d["timeline"], config, result.steps)
-        task = None
-        if "task" in d:
-            from ..lab.record import LabTask
-
-            task = LabTask.from_dict(d["task"], config, result.steps)
+        task = read_task(d["task"], config, result.steps) if "task" in d else None
         return cls(config, timeline, result, driven, driver, player, check_date("date", d["date"]),
                    check_word("armgame_version", d["armgame_version"]), task)
 

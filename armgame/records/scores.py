@@ -35,6 +35,7 @@ import hashlib
 import json
 import os
 import re
+import shlex
 import stat
 import sys
 import time
@@ -389,8 +390,8 @@ class ScoreTable:
             with self._locked():
                 self._enter(entry)
         except TableBusyError as exc:
-            raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with "
-                            f"armgame scores --scores {self.folder} --add {path}") from None
+            later = shlex.join(["armgame", "scores", "--scores", str(self.folder), "--add", str(path)])
+            raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with {later}") from None
         return entry
 
     def _enter(self, entry: ScoreEntry) -> None:

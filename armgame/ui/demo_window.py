@@ -91,8 +91,7 @@ class DemoWindow:
 
     # ------------------------------------------------------------------ lifecycle
     def open(self) -> None:
-        self.screen = open_window(self.size, self.fullscreen, self.info.title, SCENE_SIZE,
-                                  hint="run with --headless --out DIR instead")
+        self.screen = open_window(self.size, self.fullscreen, self.info.title, SCENE_SIZE)
         self.size = self.windowed_size = self.screen.get_size()
         self.scene = pygame.Surface(SCENE_SIZE)
         # Sized so that the smallest text is still 14 px tall in a window 720 px high (the scene scaled 0.9).

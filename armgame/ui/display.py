@@ -3,7 +3,9 @@
 ``pygame.display.init`` and ``pygame.font.init`` only: ``pygame.init()`` would start every subsystem,
 the mixer too. Where there is no display (no X11 or Wayland session), SDL falls back to its invisible
 "offscreen" driver rather than failing, and a window would run unseen; unless that driver was asked
-for by name (``SDL_VIDEODRIVER``, as the tests ask for "dummy"), it is refused in one line.
+for by name (``SDL_VIDEODRIVER``, as the tests ask for "dummy"), it is refused in one line
+(``NoDisplayError``, to which the command line adds the command that runs without a window), with
+nothing SDL printed while probing before it.
 """
 
 from __future__ import annotations
@@ -11,56 +13,74 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import tempfile
 from collections.abc import Iterator
 
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame
 
-from ..errors import UserError
+from ..errors import NoDisplayError
 
 #: Drivers that draw nowhere a person can see.
 INVISIBLE_DRIVERS = ("offscreen", "dummy", "evdev")
 #: Room left for the title bar and a task bar when a window must fit the desktop.
 DECORATION = (0, 64)
+#: The most of SDL's held-back stderr shown again when a window opens after all.
+MAX_HELD_BYTES = 64 * 1024
+
+
+class HeldOutput:
+    """What was written to stderr (fd 2) inside ``held_stderr``: available once the block is left."""
+
+    text = ""
 
 
 @contextlib.contextmanager
-def quiet_stderr(quiet: bool = True) -> Iterator[None]:
-    """Hide what C libraries print to stderr (libwayland's "XDG_RUNTIME_DIR is invalid" while SDL probes
-    for a display that is not there): the user gets our one line instead."""
-    if not quiet:
-        yield
-        return
+def held_stderr() -> Iterator[HeldOutput]:
+    """Hold back what C libraries write to stderr inside the block, to show only if it matters.
+
+    SDL probing for a display that is not there makes libwayland print "error: XDG_RUNTIME_DIR is
+    invalid or not set in the environment" (with ``DISPLAY`` set to a server that is gone, or with
+    none), which would come before armgame's own one line. The caller shows ``text`` when the window
+    opens after all, so nothing is lost where there is a display. Where fd 2 cannot be duplicated
+    (a Windows GUI program has no stderr), nothing is held.
+    """
+    held = HeldOutput()
     try:
-        sys.stderr.flush()
+        if sys.stderr is not None:
+            sys.stderr.flush()
         saved = os.dup(2)
-        null = os.open(os.devnull, os.O_WRONLY)
-    except OSError:
-        yield
+    except (OSError, ValueError):
+        yield held
         return
     try:
-        os.dup2(null, 2)
-        yield
+        with tempfile.TemporaryFile() as sink:
+            os.dup2(sink.fileno(), 2)
+            try:
+                yield held
+            finally:
+                os.dup2(saved, 2)
+                sink.seek(0)
+                held.text = sink.read(MAX_HELD_BYTES).decode(errors="replace")
     finally:
-        os.dup2(saved, 2)
         os.close(saved)
-        os.close(null)
 
 
-def init_display(hint: str = "use --headless where there is no display") -> None:
-    no_display = sys.platform.startswith("linux") and not (
-        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or os.environ.get("SDL_VIDEODRIVER"))
-    try:
-        with quiet_stderr(no_display):
+def init_display() -> None:
+    """Start SDL's display (and fonts), or raise ``NoDisplayError`` in one line: nothing before it."""
+    with held_stderr() as noise:
+        try:
             pygame.display.init()
-        pygame.font.init()
-    except pygame.error as exc:
-        raise UserError(f"cannot open a window ({exc}); {hint}") from None
+            pygame.font.init()
+        except pygame.error as exc:
+            raise NoDisplayError(f"cannot open a window ({exc})") from None
     driver = (pygame.display.get_driver() or "").lower()
     asked = os.environ.get("SDL_VIDEODRIVER", "").lower()
     if driver in INVISIBLE_DRIVERS and driver not in asked:
         pygame.display.quit()
-        raise UserError(f"cannot open a window (no display: SDL chose its invisible {driver!r} driver); {hint}")
+        raise NoDisplayError(f"cannot open a window (no display: SDL chose its invisible {driver!r} driver)")
+    if noise.text and sys.stderr is not None:  # a display after all: whatever SDL said may matter
+        sys.stderr.write(noise.text)
 
 
 def desktop_size() -> tuple[int, int]:
@@ -80,10 +100,9 @@ def fit_size(wanted: tuple[int, int] | None, default: tuple[int, int], desktop: 
 
 
 def open_window(size: tuple[int, int] | None = None, fullscreen: bool = False, caption: str = "armgame",
-                default: tuple[int, int] = (1024, 720),
-                hint: str = "use --headless where there is no display") -> pygame.Surface:
+                default: tuple[int, int] = (1024, 720)) -> pygame.Surface:
     """A resizable window of ``size`` (fitted to the desktop), or the whole screen."""
-    init_display(hint)
+    init_display()
     pygame.display.set_caption(caption)
     try:
         if fullscreen:
@@ -91,7 +110,7 @@ def open_window(size: tuple[int, int] | None = None, fullscreen: bool = False, c
         return pygame.display.set_mode(fit_size(size, default, desktop_size()), pygame.RESIZABLE)
     except pygame.error as exc:
         pygame.display.quit()
-        raise UserError(f"cannot open a window ({exc}); {hint}") from None
+        raise NoDisplayError(f"cannot open a window ({exc})") from None
 
 
 def toggle_fullscreen(windowed_size: tuple[int, int]) -> pygame.Surface:

@@ -18,7 +18,7 @@ from pathlib import Path
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 import pygame
 
-from .display import quiet_stderr
+from .display import held_stderr
 
 SOUND_NAMES = ("hit", "reset", "tick", "go", "end")
 #: Where the sounds may be, in order: beside the package in a checkout (an editable install), then
@@ -43,7 +43,7 @@ class Sounds:
             # A short buffer: a hit's sound must come with the hit, not 100 ms after. ALSA prints its
             # complaints to stderr when there is no sound card: the game is silent, and says nothing.
             pygame.mixer.pre_init(22050, -16, 1, 512)
-            with quiet_stderr():
+            with held_stderr():  # what ALSA says is held back, and dropped
                 pygame.mixer.init()
         except (pygame.error, NotImplementedError):
             return

@@ -1,4 +1,9 @@
-"""The compiled batch kernel: the batched game's hot loop in C, optional, and exact.
+"""The compiled kernel's wrapper: the batched game's hot loop in C, optional, and exact.
+
+Owns the calling convention of ``armgame/game/_ckernel.c`` (built by ``pip install`` as
+``armgame.game._ckernel``; it stays beside the game package so the build does not move) and the
+way ``play`` runs on it. Invariant: a game run here is the single session's game bit for bit
+(``fast``: within ``session.STATE_TOLERANCE``); a build of another convention is never called.
 
 ``_ckernel`` (``_ckernel.c``, built by ``pip install`` where a C compiler exists) runs each
 game of a batch from its step to a halt step in registers: the muscles, RK4 and the hand's
@@ -9,7 +14,7 @@ operation for operation, with the C library's cos and sin, which Python's ``math
 a batched game is the single game bit for bit (tests/test_batch.py checks states with ``==``).
 With ``fast`` (``BatchGameSession(exact=False)``, games up to 60 s) RK4's elbow cos and sin
 come by angle addition instead, as numpy's fast kernel takes them: round-off, within
-``batch.STATE_TOLERANCE`` (tests/test_batch_fast.py runs both kernels).
+``session.STATE_TOLERANCE`` (tests/test_batch_fast.py runs both kernels).
 
 Where it was not built (no compiler) or is stale, ``AVAILABLE`` is False and the batch runs
 its numpy kernel: the same results, slower. It runs RK4, the game's integrator; batches of the
@@ -20,26 +25,27 @@ Speed (``python benchmarks/class_speed.py``): see the README's "Performance" sec
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..physics.batch import SERIES_LIMIT
-from ..physics.integrators import _SIXTH
+from ...physics.batch import SERIES_LIMIT
+from ...physics.integrators import _SIXTH
+from ..session import DOWN
+from .numpy_kernel import NEAR, hand_move_bounds
+from .schedule import MuscleEvents
 
 try:
-    from . import _ckernel
+    from .. import _ckernel
 except ImportError:  # built without a C compiler: numpy does the work
     _ckernel = None
 
 if TYPE_CHECKING:
-    from .batch import BatchGameSession
+    from .session import BatchGameSession
 
 #: The calling convention this module speaks; a build of another (a stale ``.so``) is not used.
 KERNEL_VERSION = 2
 _PARAMS = 26
-
 
 
 def speaks_our_convention(module: object) -> bool:
@@ -52,47 +58,6 @@ if _ckernel is not None and not speaks_our_convention(_ckernel):
 
 #: Whether the compiled kernel is here to use.
 AVAILABLE = _ckernel is not None
-
-#: A hand this close to a target's edge (relative to radius^2) goes to the exact scalar test.
-NEAR = 1.0 + 1e-6
-
-
-def hand_move_bounds(l1: float, l2: float) -> tuple[float, float]:
-    """(c1, c2) with |the hand's move| <= c1 |dq1| + c2 |dq2|: chords are shorter than arcs; a hair over."""
-    return (l1 + l2) * (1.0 + 1e-9), l2 * (1.0 + 1e-9)
-
-
-@dataclass
-class MuscleEvents:
-    """Muscle commands by game: game i's are ``cursor[i]:end[i]`` of the flat arrays, by step.
-
-    ``cursor`` advances as the kernel applies them (an event at step s applies before the
-    step from s, as ``BatchGameSession.play`` applies it).
-    """
-
-    cursor: np.ndarray  # int64 (n,)
-    end: np.ndarray  # int64 (n,)
-    step: np.ndarray  # int64 (events,)
-    muscle: np.ndarray  # int64 (events,), 0-3
-    goal: np.ndarray  # float64 (events,)
-    rate: np.ndarray  # float64 (events,)
-
-    @classmethod
-    def none(cls, n: int) -> MuscleEvents:
-        zeros = np.zeros(n, dtype=np.int64)
-        return cls(zeros, zeros.copy(), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
-                   np.zeros(0), np.zeros(0))
-
-    @classmethod
-    def by_game(cls, n: int, steps: np.ndarray, flat: np.ndarray, goal: np.ndarray,
-                rate: np.ndarray) -> MuscleEvents:
-        """From ``BatchGameSession._schedule``'s commands: by game, within a game by step, flat
-        indices ``muscle * n + game``."""
-        muscle, game = np.divmod(flat, n)
-        end = np.cumsum(np.bincount(game, minlength=n), dtype=np.int64)
-        cursor = np.concatenate([[0], end[:-1]]).astype(np.int64)
-        return cls(cursor, end, steps.astype(np.int64), muscle.astype(np.int64), goal.astype(float),
-                   rate.astype(float))
 
 
 class CompiledKernel:
@@ -129,3 +94,32 @@ class CompiledKernel:
                            ev.rate, self.flags):
             for i in np.flatnonzero(self.flags).tolist():
                 b._hit_test(i, b._x[:, i], int(b.steps[i]))
+
+    def play(self, events: MuscleEvents, specials: list[tuple[int, int, str]], limits: np.ndarray) -> None:
+        """``BatchGameSession.play`` here: each game runs on its own to its next reset or tab, or its stop.
+
+        The kernel applies the muscle commands itself; at a game's reset or tab step (after that
+        step's muscle commands, as ``play`` orders them) the key goes through ``key_event``.
+        """
+        b = self.batch
+        pending: dict[int, list[tuple[int, str]]] = {}
+        for step, i, key in specials:  # in timeline order: by step within each game
+            pending.setdefault(i, []).append((step, key))
+        halt = limits.copy()
+        for i, keys in pending.items():
+            keys.reverse()  # popped from the end
+            halt[i] = min(keys[-1][0], int(limits[i]))
+        while True:
+            self.run(halt, events)
+            if not pending:
+                return
+            for i in list(pending):
+                keys = pending[i]
+                at = keys[-1][0]  # where game i now is: its halt
+                while keys and keys[-1][0] == at:
+                    b.key_event(i, keys.pop()[1], DOWN)
+                if keys:
+                    halt[i] = min(keys[-1][0], int(limits[i]))
+                else:
+                    del pending[i]
+                    halt[i] = limits[i]

@@ -1,84 +1,61 @@
-"""Many games in lockstep: a class's scripts, a batch of replays, a vector of environments.
+"""The batched session: ``n`` games in lockstep, game ``i`` equal to ``GameSession(configs[i])``.
 
-``BatchGameSession`` runs N games at once with one array per quantity (joint state,
-activations, targets, clocks). Each game of a batch equals the single ``GameSession`` fed the
-same inputs: hits, score, resets and steps exactly, and its joint state to round-off (bit for
-bit where stated below). Two kernels step them:
+Owns the batch's state (one array per quantity: joint state, activations, targets, clocks), its
+input (keys, levels, resets, restarts), the choice of kernel and of when the fast arithmetic may
+run, the hit test and scoring, ``play`` (timelines) and ``replay_many`` (recorded games, in
+batches). The physics steps run in a kernel (``numpy_kernel`` or ``compiled``); timelines become
+commands in ``schedule``.
 
-* **compiled** (``compiled.py``, ``_ckernel.c``; the default where ``pip install`` could build
-  it, for RK4): each game runs its own steps in C, the single session's expressions operation
-  for operation with the C library's cos and sin, so bit for bit; ``play`` hands it each game's
-  muscle commands and it runs each game to its next reset, tab or stop, back in Python only to
-  judge a hand at a target. With ``exact=False`` (games of at most ``FAST_MAX_SECONDS``) it
-  takes the elbow's cos and sin by angle addition, as numpy's fast kernel below does.
-* **numpy** (``_Kernel``; the fallback, and the Euler schemes): a physics step costs about 130
-  numpy operations however many games there are. How it equals the single session:
+Invariant: each game of a batch equals the single ``GameSession`` fed the same inputs: hits,
+score, resets and steps exactly, and its joint state bit for bit (the compiled kernel, and numpy's
+where its sin and cos are the C library's) or within ``STATE_TOLERANCE`` (numpy's own sin and cos,
+and the fast kernels of ``exact=False``). It keeps it so:
 
-* The physics is the single session's own arithmetic: for RK4 (the game's integrator) its
-  hot loop, step and accelerations written out operation for operation on arrays
-  (``_Kernel``); for the Euler schemes the very closures of ``Integrator(name, model,
-  "numpy")``. Every array element goes through the same IEEE operations in the same order
-  as the Python floats of one game, with numpy's sin and cos for ``math``'s. Where
-  numpy's float64 sin and cos are the C library's (checked on x86-64 with AVX2, numpy 2.4:
-  identical on 6 million arguments), a batched game is bit for bit the single one. Where numpy
-  uses its own vectorised sin and cos (AVX-512 builds), they may differ by an ulp, and the
-  states differ by round-off: ``STATE_TOLERANCE`` bounds that over a 60 s game. A hit could
-  then differ only if the hand crossed a target's edge within about 1e-13 m of it, where it
-  moves about 1e-3 m a step: a chance of the order of 1e-10 per crossing.
-* The hit test never depends on numpy's round-off: numpy only flags games whose hand may
-  be within a relative 1e-6 of a target's edge (a conservative bound on how far each hand
-  has moved since it was last measured, so the batch does not pay four more sin and cos
-  per step), and for those (rare: the hand is on or at a target) the single session's own
-  test is evaluated on Python floats from the game's state, and the hit is scored by the
-  game's own ``GameRules`` (which draws the next target from the game's own random
-  sequence). Given equal states the decision is identical, knife edge or not.
-* ``exact=False`` (the vector env, ``replay_many``: class scoring and verification) runs the
-  fast kernel (numpy's from ``SERIES_MIN_GAMES`` games, the compiled one's at any size): RK4
-  stages 2-4 take the elbow's cos and sin from stage 1's by angle addition, with Taylor series
-  for the small increment (as ``physics.batch.BatchRK4``; full sin and cos for any step whose increment exceeds
-  ``SERIES_LIMIT``); stage 1's come from the previous step's, turned by the step's change of
-  q2 (full sin and cos at the start of each run of steps and every 32 steps). That saves all
-  but one in 32 of the steps' sin and cos of the whole batch, and costs round-off, which the
-  arm's motion amplifies: over 1,000 games of 60 s with random keys the joint states stayed
-  within 1.7e-11 of the single session's (compiled: 9.6e-12), against ``STATE_TOLERANCE``
-  (games longer than ``FAST_MAX_SECONDS`` run the exact kernel). Hits are still decided by the exact test on
-  Python floats, on the fast state; the hand is then within about 1.4e-11 m of the single
+* Events (keys, resets, tab) are applied between physics steps exactly where the single session
+  applies them (``schedule``); ``play`` advances every game to the next step at which any game has
+  an event, vectorised in between (the compiled kernel needs no such common step).
+* The hit test never depends on a kernel's round-off: the kernels only flag hands that may be at
+  a target's edge, and for those the single session's own test is evaluated here on Python floats
+  from the game's state, and the hit is scored by the game's own ``GameRules`` (which draws the
+  next target from the game's own random sequence). Given equal states the decision is identical,
+  knife edge or not.
+* ``exact=False`` (the vector env, ``replay_many``: class scoring and verification) lets the fast
+  kernels run (numpy's from ``SERIES_MIN_GAMES`` games, the compiled one's at any size; games
+  longer than ``FAST_MAX_SECONDS`` run the exact kernel). Hits are still decided by the exact test
+  on Python floats, on the fast state; the hand is then within about 1.4e-11 m of the single
   session's, so a decision could differ only if the hand were that close to the edge, where it
   moves about 1e-3 m a step: about 3e-8 per crossing. A decision within ``KNIFE_EDGE`` (1e-8 m)
   marks the game ``knife_edge`` (about 2e-5 per crossing), and ``replay_many`` plays marked games
   again alone, so its results are the single session's; the vector env, with no timeline to
-  replay, keeps the 3e-8 odds. Below ``SERIES_MIN_GAMES`` games numpy's call overhead outweighs
-  sin and cos, and the exact kernel is also the faster one, whatever ``exact`` says.
-* Events (keys, resets, tab) are applied between physics steps exactly where the single
-  session applies them; ``play`` advances every game to the next step at which any game has
-  an event, vectorised in between (the compiled kernel needs no such common step).
+  replay, keeps the 3e-8 odds.
+* The implicit integrators (midpoint, gauss4) iterate until the largest change over the whole
+  batch converges, so a game's iteration count would depend on the others: a batch refuses them
+  and ``replay_many`` plays such games one at a time.
 
-The implicit integrators (midpoint, gauss4) iterate until the largest change over the
-whole batch converges, so a game's iteration count would depend on the others: a batch
-refuses them and ``replay_many`` plays such games one at a time.
+The numbers tests lower (``SERIES_MIN_GAMES``, ``SERIES_LIMIT``, ``KNIFE_EDGE``) are read from this
+module, the first two when a batch is made (they hold for that batch).
 """
 
 from __future__ import annotations
 
 import math
-import os
-import stat
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import fields, replace
-from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..errors import UserError
-from ..physics.batch import SERIES_LIMIT
-from ..physics.integrators import Integrator
-from ..physics.twojoint import TwoJointArm
+from ... import __version__
+from ...errors import UserError
+from ...physics.batch import SERIES_LIMIT
+from ...physics.integrators import Integrator
+from ...physics.twojoint import TwoJointArm
+from ..muscles import MuscleLevelError, MuscleSet
+from ..rules import GameConfig, GameRules
+from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
 from . import compiled
-from .compiled import NEAR, CompiledKernel, MuscleEvents, hand_move_bounds
-from .muscles import MuscleLevelError, MuscleSet
-from .rules import GameConfig, GameRules
-from .session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
+from .compiled import CompiledKernel
+from .numpy_kernel import NumpyKernel
+from .schedule import MuscleEvents, schedule
 
 #: ``BatchGameSession(kernel=...)``: None, the compiled kernel where built (and RK4), else numpy.
 KERNELS = (None, "compiled", "numpy")
@@ -150,8 +127,8 @@ class BatchGameSession:
         if kernel == "compiled" and not compiled.AVAILABLE:
             raise ValueError("kernel 'compiled': the compiled kernel is not built here (no C compiler at install?)")
         self.configs = configs
-        #: True: the single session's arithmetic, bit for bit; False: the numpy kernel may use its fast RK4
-        #: stages (see ``_Kernel``). The compiled kernel is exact and the fastest, so it ignores this.
+        #: True: the single session's arithmetic, bit for bit; False: the kernels may use their fast RK4
+        #: stages (see ``numpy_kernel`` and ``compiled``), within ``STATE_TOLERANCE``.
         self.exact = bool(exact)
         self.config = c = configs[0]
         self.n = n = len(configs)
@@ -168,7 +145,7 @@ class BatchGameSession:
         self.total_steps = np.array([g.total_steps for g in configs], dtype=np.int64)
         # Rows of the state: q1, q2, w1, w2; rows of the muscle arrays: the four muscles. Rows
         # are contiguous, so each is one fast array for the step. Rows 4-5 of ``_xs`` are scratch
-        # for the first RK4 stage's accelerations (see _Kernel._build).
+        # for the first RK4 stage's accelerations (see NumpyKernel._build).
         self._xs = np.zeros((6, n))
         self._x = self._xs[:4]
         self._act = np.zeros((MuscleSet.COUNT, n))
@@ -192,11 +169,12 @@ class BatchGameSession:
         # Whether the kernel may round differently from the single session: the fast stages, which
         # compiled pay at any batch size, in numpy only from ``_series_from`` games (call overhead).
         self._series_from = SERIES_MIN_GAMES
+        self._series_limit = SERIES_LIMIT  # the largest elbow increment numpy's fast stages take by series
         self._rounds = (not self.exact and c.integrator == "rk4"
                         and int(self.total_steps.max()) * c.dt <= FAST_MAX_SECONDS
                         and (use_compiled or n >= self._series_from))
         self.rules: list[GameRules] = [None] * n  # type: ignore[list-item]
-        self._kernels: dict[int, _Kernel] = {}
+        self._kernels: dict[int, NumpyKernel] = {}
         for i in range(n):
             self._start(i, configs[i])
         #: The compiled kernel where built (and asked for) and the integrator is RK4; else None: numpy.
@@ -425,7 +403,7 @@ class BatchGameSession:
         if kernel is None:
             if len(self._kernels) > 2:  # keep the full batch's and a few others, not one per size ever seen
                 self._kernels = {k: v for k, v in self._kernels.items() if k == self.n}
-            kernel = self._kernels[m] = _Kernel(self, m)
+            kernel = self._kernels[m] = NumpyKernel(self, m)
         for k, near in kernel.run(x, act, goal, rate, tx, ty, slack, count):
             for j in near.tolist():
                 i = j if games is None else int(games[j])
@@ -489,11 +467,10 @@ class BatchGameSession:
             raise ValueError("play needs every game of the batch at the same step")
         now = int(self.steps[0])
         limit = [t if s is None else min(int(s), t) for s, t in zip(stops, self.total_steps.tolist(), strict=True)]
-        schedule = self._schedule(timelines, now, limit)
-        muscle_steps, flat, goal, rate, specials, held = schedule
+        muscle_steps, flat, goal, rate, specials, held = schedule(self, timelines, now, limit)
         limits = np.array(limit, dtype=np.int64)
         if self.compiled is not None:
-            self._play_compiled(MuscleEvents.by_game(self.n, muscle_steps, flat, goal, rate), specials, limits)
+            self.compiled.play(MuscleEvents.by_game(self.n, muscle_steps, flat, goal, rate), specials, limits)
             for i, row in held.items():
                 self.held[i] = row
             return [self.result(i) for i in range(self.n)]
@@ -544,350 +521,6 @@ class BatchGameSession:
             self.held[i] = row
         return [self.result(i) for i in range(self.n)]
 
-    def _play_compiled(self, events: MuscleEvents, specials: list[tuple[int, int, str]], limits: np.ndarray) -> None:
-        """``play`` on the compiled kernel: each game runs on its own to its next reset or tab, or its stop.
-
-        The kernel applies the muscle commands itself; at a game's reset or tab step (after that
-        step's muscle commands, as ``play`` orders them) the key goes through ``key_event``.
-        """
-        pending: dict[int, list[tuple[int, str]]] = {}
-        for step, i, key in specials:  # in timeline order: by step within each game
-            pending.setdefault(i, []).append((step, key))
-        halt = limits.copy()
-        for i, keys in pending.items():
-            keys.reverse()  # popped from the end
-            halt[i] = min(keys[-1][0], int(limits[i]))
-        while True:
-            self.compiled.run(halt, events)
-            if not pending:
-                return
-            for i in list(pending):
-                keys = pending[i]
-                at = keys[-1][0]  # where game i now is: its halt
-                while keys and keys[-1][0] == at:
-                    self.key_event(i, keys.pop()[1], DOWN)
-                if keys:
-                    halt[i] = min(keys[-1][0], int(limits[i]))
-                else:
-                    del pending[i]
-                    halt[i] = limits[i]
-
-    def _schedule(self, timelines: Sequence[Sequence[InputEvent]], now: int, limit: list[int]):
-        """What each timeline does and when, as ``TimelineInput`` and ``key_event`` would do it.
-
-        Key events do not depend on the motion, so their effect is worked out here once, in
-        plain Python: events in list order up to the first beyond the game's stop, each at the
-        later of its step and the game's clock; events at or after the game's end, repeats of a
-        held key and unknown keys dropped. Muscle commands come back as flat indices into the
-        (4, n) goal and rate arrays with their new values (of several for one muscle at one
-        step, the last, which is what applying them all in order leaves); resets and tab as
-        (step, game, key); the muscle keys held at the end by game. Both lists are in timeline
-        order, so by game and within a game by step: each kernel orders them as it steps.
-        """
-        index = {key: m for m, key in enumerate(self.muscle_keys)}
-        rise, decay = self._rise.tolist(), self._decay.tolist()
-        n, totals = self.n, self.total_steps.tolist()
-        steps: list[int] = []
-        flat: list[int] = []
-        goal: list[float] = []
-        rate: list[float] = []
-        specials: list[tuple[int, int, str]] = []
-        held_at_end: dict[int, list[bool]] = {}
-        for i, events in enumerate(timelines):
-            clock, stop, end = now, limit[i], totals[i]
-            held = self.held[i].tolist()
-            last = [(-1, -1)] * len(held)  # per muscle: (step, position in the lists) of its last command
-            for e in events:
-                if e.step > stop:
-                    break
-                clock = max(clock, e.step)
-                if clock >= end:
-                    continue
-                m = index.get(e.key)
-                if m is not None:
-                    down = e.action == DOWN
-                    if held[m] == down:
-                        continue
-                    held[m] = down
-                    values = (1.0, rise[m]) if down else (0.0, decay[m])
-                    if last[m][0] == clock:
-                        goal[last[m][1]], rate[last[m][1]] = values
-                    else:
-                        last[m] = (clock, len(steps))
-                        steps.append(clock)
-                        flat.append(m * n + i)
-                        goal.append(values[0])
-                        rate.append(values[1])
-                elif e.key in (RESET_KEY, TOGGLE_ARM_KEY) and e.action == DOWN:
-                    specials.append((clock, i, e.key))
-            held_at_end[i] = held
-        return (np.array(steps, dtype=np.int64), np.array(flat, dtype=np.intp), np.array(goal), np.array(rate),
-                specials, held_at_end)
-
-class _Kernel:
-    """The session's hot loop for ``m`` games at once, every intermediate in preallocated arrays.
-
-    Each expression is the single session's (``GameSession.advance``, ``integrators._rk4``,
-    ``TwoJointArm.component_dynamics``' accel) with the same operations in the same order,
-    one numpy call per operation written into scratch: IEEE arithmetic is elementwise, so
-    every game gets the bits its scalar loop would. At a thousand games a call costs about
-    as much as its arithmetic, so the calls are the cheapest kind (positional ``out``,
-    constants as 0-d arrays, no broadcasting, names bound once in a closure), and where the
-    scalar code does the same operation to a shoulder and an elbow quantity, one call does
-    both rows of a (2, m) array. Integrators other than rk4 go through the generic numpy
-    closures (which allocate).
-    """
-
-    def __init__(self, batch: BatchGameSession, m: int) -> None:
-        self.batch, self.m = batch, m
-        self._bound: tuple[tuple[int, ...], Callable[[], bool]] | None = None
-
-    def stepper(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray,
-                slack: np.ndarray) -> Callable[[], bool]:
-        """One physics step of these arrays (state rows 0-3 of ``x``, rows 4-5 scratch) as a function.
-
-        The function returns whether some hand's ``slack`` ran out (see ``run``).
-        """
-        # The bound closure holds these arrays, so their ids cannot be reused while it is kept.
-        key = tuple(id(a) for a in (x, act, goal, rate, slack))
-        if self._bound is None or self._bound[0] != key:
-            self._bound = (key, self._build(x, act, goal, rate, slack))
-        return self._bound[1]
-
-    def _build(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray,
-               slack: np.ndarray) -> Callable[[], bool]:
-        batch, m = self.batch, self.m
-        model, config = batch.model, batch.config
-        p = model.params
-        gravity, damping = p.has_gravity, p.has_gravity or p.has_damping
-        const = np.array
-        B, D, G1, G2 = const(model.b), const(model.d), const(model.g1), const(model.g2)
-        DET0, AMD = const(model.a * model.d - model.d * model.d), const(model.a - model.d)
-        ONE, TWO, ZERO = const(1.0), const(2.0), const(0.0)
-        dt = config.dt
-        H, DT, SIXTH = const(0.5 * dt), const(dt), const(dt * (1.0 / 6.0))
-        REACH1, REACH2 = (const(c) for c in hand_move_bounds(p.l1, p.l2))
-        mul, add, sub, div, cos, sin = np.multiply, np.add, np.subtract, np.divide, np.cos, np.sin
-        empty = np.empty
-        trig, force, inertia, pair = empty((2, m)), empty((2, m)), empty((2, m)), empty((2, m))
-        bc, hs = trig
-        f1, f2 = force
-        inertia[0] = model.d
-        i1 = inertia[1]
-        p0, p1 = pair
-        viscosity = empty((2, m))
-        viscosity[0], viscosity[1] = p.damping1, p.damping2
-        m12, r, tmp, gc12, move, move2 = (empty(m) for _ in range(6))
-        torque = empty((2, m))
-        t1, t2 = torque
-        change, previous, total, mid = empty((4, m)), empty((2, m)), empty((4, m)), empty((4, m))
-        head, state = x[:2], x[:4]
-        near_mask = empty(m, dtype=bool)
-        # Stages 2-4: rows 0-3 the stage's state (q1 q2 w1 w2), rows 4-5 its accelerations, so rows 2-5
-        # are the stage's slopes (velocities, accelerations) without a copy; stage 1 is x itself.
-        s2, s3, s4 = (empty((6, m)) for _ in range(3))
-        stages = [(x, (*x, x[2:4], x[4:6]))] + [(s, (*s, s[2:4], s[4:6])) for s in (s2, s3, s4)]
-        # Torque rows: (activation row, moment) pairs; a zero moment adds a +0.0 term, kept as one "+ 0.0".
-        rows = []
-        for out, moments in ((t1, batch._shoulder), (t2, batch._elbow)):
-            terms = [(act[i], const(c)) for i, c in enumerate(moments) if c != 0.0]
-            rows.append((out, terms, len(terms) < len(moments)))
-        generic = None if config.integrator == "rk4" else batch._physics_step
-        exact = generic is not None or not batch._rounds or m < batch._series_from
-
-        def elbow(q2):
-            cos(q2, bc)
-            sin(q2, hs)
-            mul(trig, B, trig)  # bc = b cos q2, h = b sin q2
-
-        # The fast kernel's elbow trig: stage 1's b cos q2, b sin q2 (``base``) and the same turned a
-        # quarter (``turn`` = b (-sin q2, cos q2)); a later stage's angle is q2 + delta, whose cos and sin
-        # come by angle addition with cos and sin of delta from Taylor series in delta^2 (``series``
-        # rows: cos, sin), evaluated for both rows at once. ``squares`` keeps each stage's delta^2 so one
-        # check per step sees whether every delta was within the series' range.
-        base, turn, series, squares = empty((2, m)), empty((2, m)), empty((2, m)), empty((4, m))
-        anchor = self.anchor = [0]  # steps left before full cos and sin again; run() sets it to 0
-        delta = empty(m)
-        c_row, s_row = series
-        K4, K3, K2, K1 = (const([[a], [b]]) for a, b in ((1.0 / 40320.0, 1.0 / 362880.0),
-                                                          (-1.0 / 720.0, -1.0 / 5040.0),
-                                                          (1.0 / 24.0, 1.0 / 120.0), (-0.5, -1.0 / 6.0)))
-        LIMIT2 = SERIES_LIMIT * SERIES_LIMIT
-        REANCHOR = 32
-
-        def accel(q1, q2, w1, w2, o1, o2, velocity, out):
-            add(bc, D, m12)
-            # f1 = t1 + h (w1 + w1 + w2) w2 [- g1 cos q1 - g2 cos(q1 + q2)] [- k1 w1]
-            add(w1, w1, tmp)
-            add(tmp, w2, tmp)
-            mul(tmp, hs, tmp)
-            mul(tmp, w2, tmp)
-            add(t1, tmp, f1)
-            # f2 = t2 - h w1 w1 [- g2 cos(q1 + q2)] [- k2 w2]
-            mul(hs, w1, tmp)
-            mul(tmp, w1, tmp)
-            sub(t2, tmp, f2)
-            if gravity:
-                add(q1, q2, gc12)
-                cos(gc12, gc12)
-                mul(gc12, G2, gc12)
-                cos(q1, tmp)
-                mul(tmp, G1, tmp)
-                sub(f1, tmp, f1)
-                sub(f1, gc12, f1)
-                sub(f2, gc12, f2)
-            if damping:
-                mul(velocity, viscosity, pair)
-                sub(force, pair, force)
-            # r = 1 / (det0 - bc^2); qdd1 = (d f1 - m12 f2) r; qdd2 = ((m12 + a - d + bc) f2 - m12 f1) r
-            mul(bc, bc, r)
-            sub(DET0, r, r)
-            div(ONE, r, r)
-            add(m12, AMD, i1)
-            add(i1, bc, i1)
-            mul(force, inertia, out)
-            mul(m12, f2, p0)
-            mul(m12, f1, p1)
-            sub(out, pair, out)
-            mul(o1, r, o1)
-            mul(o2, r, o2)
-
-        def turned(angle: np.ndarray, d2: np.ndarray, out: np.ndarray) -> None:
-            """b cos and b sin of q2 + angle into ``out`` (2, m), from ``base`` and ``turn``."""
-            mul(angle, angle, d2)
-            # Horner in delta^2: cos d = 1 - d^2/2! + ... + d^8/8!, sin d = d (1 - d^2/3! + ... + d^8/9!).
-            mul(K4, d2, series)
-            for k in (K3, K2, K1):
-                add(series, k, series)
-                mul(series, d2, series)
-            add(series, ONE, series)
-            mul(s_row, angle, s_row)
-            # b cos(q2 + d) = bc cos d - bs sin d; b sin(q2 + d) = bs cos d + bc sin d
-            mul(base, c_row, out)
-            mul(turn, s_row, pair)
-            add(out, pair, out)
-
-        def fast_stages() -> None:
-            # ``base`` carries over from the last step, turned by its change of q2 (see ``step``), for up
-            # to ``REANCHOR`` steps of one ``run``; then, and at the start of each run, full cos and sin.
-            if anchor[0] <= 0:
-                cos(x[1], base[0])
-                sin(x[1], base[1])
-                mul(base, B, base)
-                anchor[0] = REANCHOR
-            anchor[0] -= 1
-            np.copyto(trig, base)
-            np.negative(base[1], turn[0])
-            np.copyto(turn[1], base[0])
-            accel(*stages[0][1])
-            for (before, _), (stage, views), c, d2 in zip(stages, stages[1:], (H, H, DT), squares, strict=False):
-                mul(before[2:], c, stage[:4])
-                add(stage[:4], state, stage[:4])
-                mul(before[3], c, delta)  # stage q2 - q2, to round-off
-                turned(delta, d2, trig)
-                accel(*views)
-            if float(squares[:3].max()) > LIMIT2:  # a huge step or a wild spin: full trig for this step
-                for (before, _), (stage, views), c in zip(stages, stages[1:], (H, H, DT), strict=False):
-                    mul(before[2:], c, stage[:4])
-                    add(stage[:4], state, stage[:4])
-                    elbow(stage[1])
-                    accel(*views)
-
-        def step() -> bool:
-            # Torque from the activations (t1 = a0 s0 + a1 s1 + a2 s2 + a3 s3, left to right), then the muscles step.
-            for out, terms, has_zero in rows:
-                if not terms:
-                    out.fill(0.0)
-                    continue
-                mul(terms[0][0], terms[0][1], out)
-                for a, c in terms[1:]:
-                    mul(a, c, tmp)
-                    add(out, tmp, out)
-                if has_zero:
-                    add(out, ZERO, out)  # the a * 0.0 terms: +0.0 each, and x + 0.0 + 0.0 == x + 0.0
-            sub(goal, act, change)
-            mul(change, rate, change)
-            add(act, change, act)
-            np.copyto(previous, head)
-            if generic is None:
-                # integrators._rk4: stage i's state is x + c (stage i-1's slopes), i.e. the scalar
-                # code's q1 + h * w1 and v1 = w1 + h * a1 and so on; then
-                # x + dt/6 (k1 + k4 + 2 (k2 + k3)), the scalar q1 + k * (w1 + s1 + 2.0 * (v1 + u1)).
-                if exact:
-                    elbow(x[1])
-                    accel(*stages[0][1])
-                    for (before, _), (stage, views), c in zip(stages, stages[1:], (H, H, DT), strict=False):
-                        mul(before[2:], c, stage[:4])
-                        add(stage[:4], state, stage[:4])
-                        elbow(stage[1])
-                        accel(*views)
-                else:
-                    fast_stages()
-                add(s2[2:], s3[2:], mid)
-                mul(mid, TWO, mid)
-                add(x[2:], s4[2:], total)
-                add(total, mid, total)
-                mul(total, SIXTH, total)
-                add(state, total, state)
-            else:
-                x[0], x[1], x[2], x[3] = generic(x[0], x[1], x[2], x[3], t1, t2, dt)
-            sub(head, previous, previous)
-            if not exact:  # the next step's b cos q2, b sin q2: this step's, turned by its change of q2
-                turned(previous[1], squares[3], base)
-                if float(squares[3].max()) > LIMIT2:
-                    anchor[0] = 0
-            np.abs(previous, previous)
-            mul(previous[0], REACH1, move)
-            mul(previous[1], REACH2, move2)
-            add(move, move2, move)
-            sub(slack, move, slack)
-            np.less(slack, ZERO, near_mask)
-            return bool(near_mask.any())
-
-        self.near_mask = near_mask
-        return step
-
-    def run(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray, tx: np.ndarray,
-            ty: np.ndarray, slack: np.ndarray, count: int) -> Iterator[tuple[int, np.ndarray]]:
-        """Step ``count`` times; after step k + 1, yields (k, indices) of the hands near their targets.
-
-        Measuring every hand after every step would cost four more sin and cos of the whole
-        batch. Instead ``slack`` holds a lower bound on each hand's distance from its target's
-        disc, lowered every step by a bound on how far the hand moved; only hands whose slack
-        runs out are measured (a few per step), and only those near the edge go to the exact test.
-        """
-        step = self.stepper(x, act, goal, rate, slack)
-        self.anchor[0] = 0  # the states may have changed since the last run: the fast kernel's trig anew
-        config = self.batch.config
-        l1, l2, radius = config.arm.l1, config.arm.l2, config.target_radius
-        near = NEAR * radius * radius
-        cos, sin, sqrt = math.cos, math.sin, math.sqrt
-        for k in range(count):
-            if step():
-                where = np.flatnonzero(self.near_mask)
-                if len(where) <= 16:  # the usual few: plain floats cost less than numpy on tiny arrays
-                    angles = x[:2, where].tolist()
-                    gaps, close_list = [], []
-                    for j, a, b, x0, y0 in zip(where.tolist(), angles[0], angles[1], tx[where].tolist(),
-                                               ty[where].tolist(), strict=True):
-                        dx = l1 * cos(a) + l2 * cos(a + b) - x0
-                        dy = l1 * sin(a) + l2 * sin(a + b) - y0
-                        d2 = dx * dx + dy * dy
-                        gaps.append(sqrt(d2) - radius - 1e-9)
-                        if d2 <= near:
-                            close_list.append(j)
-                    slack[where] = gaps
-                    close = np.array(close_list, dtype=np.intp)
-                else:
-                    a, b = x[0, where], x[1, where]
-                    dx = l1 * np.cos(a) + l2 * np.cos(a + b) - tx[where]
-                    dy = l1 * np.sin(a) + l2 * np.sin(a + b) - ty[where]
-                    d2 = dx * dx + dy * dy
-                    slack[where] = np.sqrt(d2) - radius - 1e-9
-                    close = where[d2 <= near]
-                if len(close):
-                    yield k, close
-
 
 def replay_many(configs: Sequence[GameConfig], timelines: Sequence[Sequence[InputEvent]],
                 stop_steps: Sequence[int | None] | None = None, batch_size: int = 4096,
@@ -927,79 +560,3 @@ def replay_many(configs: Sequence[GameConfig], timelines: Sequence[Sequence[Inpu
             for i, r, edge in zip(part, played, batch.knife_edge.tolist(), strict=True):
                 results[i] = GameSession(configs[i]).play(timelines[i], stops[i]) if edge else r
     return results  # type: ignore[return-value]
-
-
-
-
-# ------------------------------------------------------------------ many scripts at once
-#: Bounds on one class run (``armgame play --headless --script A B ...``), checked before any game runs.
-MAX_SCRIPTS = 5000
-MAX_SCRIPT_EVENTS = 2_000_000
-MAX_SCRIPTS_BYTES = 256 * 1024 * 1024
-
-
-def files_in(folder: Path, suffix: str, limit: int, what: str) -> list[Path]:
-    """The regular files ``*suffix`` directly in ``folder``, sorted by name.
-
-    Symbolic links are skipped, never followed (a link could lead out of the folder), as
-    are hidden files and subfolders; more than ``limit`` files is refused before any is read.
-    """
-    try:
-        entries = sorted(os.scandir(folder), key=lambda e: e.name)
-    except OSError as exc:
-        raise UserError(f"{folder}: cannot list the folder: {exc.strerror or exc}") from None
-    found = [Path(e.path) for e in entries
-             if e.name.endswith(suffix) and not e.name.startswith(".") and e.is_file(follow_symlinks=False)]
-    if len(found) > limit:
-        raise UserError(f"{folder}: {len(found)} {what}, more than the {limit} one run takes")
-    return found
-
-
-def script_paths(names: Sequence[str | Path]) -> list[Path]:
-    """Script files from the command line: files as given, folders as their ``*.txt`` files in sorted order."""
-    paths: list[Path] = []
-    for name in names:
-        path = Path(name)
-        if path.is_dir():
-            inside = files_in(path, ".txt", MAX_SCRIPTS, "scripts")
-            if not inside:
-                raise UserError(f"{path}: no *.txt scripts in this folder")
-            paths += inside
-        else:
-            paths.append(path)
-        if len(paths) > MAX_SCRIPTS:
-            raise UserError(f"more than {MAX_SCRIPTS} scripts in one run: split the class into several runs")
-    total = 0
-    for path in paths:
-        try:
-            info = path.stat()
-        except OSError:
-            continue  # the reader names what is wrong with it
-        if stat.S_ISREG(info.st_mode):
-            total += info.st_size
-    if total > MAX_SCRIPTS_BYTES:
-        raise UserError(f"the scripts add up to {total // (1024 * 1024)} MiB, more than the "
-                        f"{MAX_SCRIPTS_BYTES // (1024 * 1024)} MiB one run takes")
-    return paths
-
-
-def play_scripts(config: GameConfig, paths: Sequence[Path]) -> list[GameResult]:
-    """Play one game per script (``config`` with each), all in one batch; results in order.
-
-    Every script is read and checked before any game runs, and their events together are
-    bounded by ``MAX_SCRIPT_EVENTS``.
-    """
-    from .script import load_script
-
-    keys = (*(m.key for m in config.muscles), RESET_KEY, TOGGLE_ARM_KEY)
-    timelines, total = [], 0
-    for path in paths:
-        if not path.is_file():
-            raise UserError(f"{path}: not a script file" if path.exists() else f"{path}: no such script file")
-        timeline = load_script(path, keys, config.dt)
-        total += len(timeline)
-        if total > MAX_SCRIPT_EVENTS:
-            raise UserError(f"the scripts hold more than {MAX_SCRIPT_EVENTS} events together (at {path}): "
-                            "split the class into several runs")
-        timelines.append(timeline)
-    return replay_many([config] * len(paths), timelines)

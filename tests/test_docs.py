@@ -1,0 +1,219 @@
+"""The README and docs/ say what is true: every shell example runs as printed or parses, links resolve.
+
+Each fenced block's info string says what it needs (docs/development.md, "The docs are tested"):
+``sh run`` blocks run in order, one temporary folder per file, through bash with the installed
+``armgame``; ``text file=NAME`` / ``toml file=NAME`` blocks are written there first; ``python run``
+blocks run with this Python; ``sh window``, ``sh setup`` and ``sh long`` blocks are not run, but every
+``armgame`` command in them must parse with the real parser.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+SHELL_TAGS = {"run", "window", "setup", "long"}
+FENCE = re.compile(r"^```([^\n`]*)\n(.*?)^```\s*$", re.S | re.M)
+
+
+@dataclass(frozen=True)
+class Block:
+    path: Path
+    line: int
+    language: str
+    tags: tuple[str, ...]
+    text: str
+
+    @property
+    def where(self) -> str:
+        return f"{self.path.relative_to(ROOT)}:{self.line}"
+
+    def tag(self, name: str) -> str | None:
+        return next((t.split("=", 1)[1] for t in self.tags if t.startswith(f"{name}=")), None)
+
+
+def blocks(path: Path) -> list[Block]:
+    text = path.read_text(encoding="utf-8")
+    found = []
+    for match in FENCE.finditer(text):
+        info = match.group(1).split()
+        line = text.count("\n", 0, match.start()) + 1
+        found.append(Block(path, line, info[0] if info else "", tuple(info[1:]), match.group(2)))
+    return found
+
+
+def commands(block: Block) -> list[str]:
+    """The block's command lines: comments dropped, continuation lines joined."""
+    lines, pending = [], ""
+    for raw in block.text.splitlines():
+        line = pending + raw
+        if line.rstrip().endswith("\\"):
+            pending = line.rstrip()[:-1] + " "
+            continue
+        pending = ""
+        if line.strip() and not line.lstrip().startswith("#"):
+            lines.append(line)
+    return lines
+
+
+def armgame_argvs(block: Block) -> list[list[str]]:
+    """Every ``armgame ...`` invocation in a shell block, split as the shell would (loops and && included)."""
+    argvs = []
+    for line in commands(block):
+        for part in re.split(r"&&|;|\|\||\|", line):
+            words = shlex.split(part, comments=True)
+            while words and words[0] in ("do", "then", "time"):
+                words = words[1:]
+            if words and words[0] == "armgame":
+                argvs.append(words[1:])
+            elif words[:3] == ["python", "-m", "armgame"]:
+                argvs.append(words[3:])
+    return argvs
+
+
+ALL_BLOCKS = [b for path in DOCS for b in blocks(path)]
+
+
+def test_the_docs_exist_and_the_readme_is_short():
+    names = {p.name for p in DOCS}
+    assert {"teaching.md", "game.md", "scores.md", "lab.md", "demos.md", "programs.md", "performance.md",
+            "development.md"} <= names
+    assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 300
+
+
+@pytest.mark.parametrize("block", [b for b in ALL_BLOCKS if b.language in ("sh", "console", "bash", "shell", "")],
+                         ids=lambda b: b.where)
+def test_every_shell_block_says_what_it_needs(block):
+    assert block.language == "sh", f"{block.where}: a command block is ```sh with a tag ({', '.join(SHELL_TAGS)})"
+    assert len(block.tags) == 1 and block.tags[0] in SHELL_TAGS, \
+        f"{block.where}: tag the block with one of {sorted(SHELL_TAGS)}, got {block.tags}"
+
+
+@pytest.mark.parametrize("block", [b for b in ALL_BLOCKS if b.language == "sh" and set(b.tags) & SHELL_TAGS],
+                         ids=lambda b: b.where)
+def test_every_documented_command_line_parses(block, capsys):
+    """A renamed command or option fails here, in the docs of windows and installs too."""
+    from armgame.cli import build_parser
+
+    parser = build_parser()
+    for argv in armgame_argvs(block):
+        try:
+            args, extra = parser.parse_known_args(argv)
+        except SystemExit as exc:  # argparse's one-line error, or --help/--version
+            pytest.fail(f"{block.where}: 'armgame {shlex.join(argv)}' does not parse (exit {exc.code}): "
+                        f"{capsys.readouterr().err.strip()}")
+        assert not extra, f"{block.where}: 'armgame {shlex.join(argv)}': unrecognized {extra}"
+        assert getattr(args, "run", None), f"{block.where}: 'armgame {shlex.join(argv)}' names no command"
+
+
+@pytest.mark.parametrize("block", [b for b in ALL_BLOCKS if b.language == "toml" and b.tag("file")],
+                         ids=lambda b: b.where)
+def test_every_toml_example_is_valid(block):
+    data = tomllib.loads(block.text)
+    if "blocks" in data:  # a lab protocol: the lab's own reader, every key checked
+        from armgame.lab.protocol import protocol_from_dict
+
+        protocol_from_dict(data)
+    else:  # a settings file
+        from armgame.ui.settings import from_toml
+
+        from_toml(block.text.encode(), block.where)
+
+
+def _isolated_env(home: Path) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("ARMGAME_", "XDG_"))}
+    bin_dir = str(Path(sys.executable).parent)
+    env.update({
+        "HOME": str(home), "USERPROFILE": str(home),
+        "XDG_CONFIG_HOME": str(home / ".config"), "XDG_DATA_HOME": str(home / ".local" / "share"),
+        "XDG_CACHE_HOME": str(home / ".cache"),
+        "ARMGAME_SCORES": str(home / "scores"), "ARMGAME_CACHE": str(home / ".cache" / "armgame"),
+        "PATH": bin_dir + os.pathsep + env.get("PATH", ""),
+        "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy", "MPLBACKEND": "Agg",
+    })
+    (home / "scores").mkdir(parents=True)
+    return env
+
+
+RUNNABLE = [p for p in DOCS if any(b.tags[:1] == ("run",) for b in blocks(p))]
+
+
+@pytest.mark.skipif(shutil.which("bash") is None, reason="the examples are POSIX shell")
+@pytest.mark.parametrize("path", RUNNABLE, ids=lambda p: p.name)
+def test_runnable_examples_run_as_printed(path, tmp_path):
+    """A file's ``run`` blocks, in order, in one folder, as a user would type them."""
+    if shutil.which("armgame", path=str(Path(sys.executable).parent)) is None:
+        pytest.skip("armgame is not installed beside this Python (pip install -e '.[test]')")
+    home = tmp_path / "home"
+    work = tmp_path / "work"
+    work.mkdir()
+    env = _isolated_env(home)
+    checkout_table = sorted((ROOT / "scores").iterdir())
+    for block in blocks(path):
+        if block.tag("file"):
+            (work / block.tag("file")).write_text(block.text, encoding="utf-8")
+            continue
+        if block.tags[:1] != ("run",):
+            continue
+        if block.language == "python":
+            argv = [sys.executable, "-c", block.text]
+        else:
+            assert block.language == "sh", block.where
+            argv = ["bash", "-e", "-o", "pipefail", "-c", block.text]
+        proc = subprocess.run(argv, cwd=work, env=env, capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0, (
+            f"{block.where} failed (exit {proc.returncode}):\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
+        assert "Traceback" not in proc.stderr, f"{block.where}:\n{proc.stderr[-2000:]}"
+    assert sorted((ROOT / "scores").iterdir()) == checkout_table  # examples never touch the checkout's table
+
+
+LINK = re.compile(r"\[[^\]]*\]\(([^)\s]+)\)")
+
+
+def _anchors(path: Path) -> set[str]:
+    """GitHub's heading anchors: lower case, punctuation dropped, spaces to hyphens."""
+    anchors = set()
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("#"):
+            title = line.lstrip("#").strip().lower()
+            anchors.add(re.sub(r"[^\w\- ]", "", title).replace(" ", "-"))
+    return anchors
+
+
+@pytest.mark.parametrize("path", DOCS, ids=lambda p: p.name)
+def test_every_relative_link_and_anchor_resolves(path):
+    text = FENCE.sub("", path.read_text(encoding="utf-8"))
+    for target in LINK.findall(text):
+        if re.match(r"[a-z]+://", target) or target.startswith("mailto:"):
+            continue
+        file, _, anchor = target.partition("#")
+        linked = (path.parent / file).resolve() if file else path
+        assert linked.exists(), f"{path.name}: link to {target} names no file"
+        if anchor and linked.suffix == ".md":
+            assert anchor in _anchors(linked), f"{path.name}: link to {target}: no such heading"
+
+
+def test_the_screenshot_script_draws_every_picture(tmp_path):
+    """docs/make_screenshots.py cannot rot: it runs here (dummy video driver) into a temporary folder."""
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
+    proc = subprocess.run([sys.executable, str(ROOT / "docs" / "make_screenshots.py"), "--out", str(tmp_path)],
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    pictures = sorted(p.name for p in tmp_path.iterdir())
+    assert pictures == sorted(p.name for p in (ROOT / "docs" / "img").glob("*.png"))
+    for name in pictures:
+        data = (tmp_path / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) < 200_000
+    referenced = set(re.findall(r"docs/img/([\w.-]+\.png)", (ROOT / "README.md").read_text(encoding="utf-8")))
+    assert referenced <= set(pictures)

@@ -1,0 +1,131 @@
+"""The layers never reach upward: physics <- game, lab rules <- records <- ui <- commands.
+
+Each layer's modules are imported in a fresh interpreter, and nothing above the layer may
+have been imported with them. Records in particular knows no lab: a lab replay's task
+section is read by the reader the lab registers, and every command that reads replays
+registers it first, whatever was imported before.
+"""
+
+import ast
+import json
+import subprocess
+import sys
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+import pytest
+
+import armgame
+from armgame.cli import main
+from armgame.errors import UserError
+from armgame.game.bots import Autopilot
+from armgame.lab.bots import make_lab_bot
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.protocol import Block, Protocol
+from armgame.lab.record import LabTask
+from armgame.lab.session import LabSession, lab_config
+from armgame.records import replay as replay_module
+from armgame.records.replay import Replay, now_iso
+
+ABOVE_LAB = ("armgame.ui", "armgame.commands", "armgame.cli", "armgame.demos", "armgame.env", "armgame.bench",
+             "pygame")
+#: What each layer must never import, anywhere in its files (inside functions too: a lazy import is a dependency).
+LAYERS = {
+    "armgame.physics": ("armgame.game", "armgame.lab", "armgame.records", *ABOVE_LAB),
+    "armgame.game": ("armgame.lab", *ABOVE_LAB),
+    "armgame.records": ("armgame.lab", *ABOVE_LAB),
+    "armgame.lab": ABOVE_LAB,
+}
+ROOT = Path(armgame.__file__).parent
+
+
+def imported_names(path: Path, module: str) -> Iterator[tuple[int, str]]:
+    """(line, absolute module name) of every import in the file, relative ones resolved."""
+    package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            yield from ((node.lineno, alias.name) for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = ".".join(package[:len(package) - node.level + 1]) if node.level else ""
+            name = ".".join(p for p in (base, node.module or "") if p)
+            # ``from . import x`` may name a module: check the names as modules too.
+            yield from ((node.lineno, f"{name}.{alias.name}") for alias in node.names)
+
+
+def reaches(name: str, tops: Sequence[str]) -> bool:
+    return any(name == top or name.startswith(top + ".") for top in tops)
+
+
+@pytest.mark.parametrize("layer", list(LAYERS))
+def test_no_file_of_a_layer_imports_from_above_it(layer):
+    files = sorted((ROOT / layer.split(".")[1]).rglob("*.py"))
+    assert files
+    found = []
+    for path in files:
+        module = ".".join(("armgame", *path.relative_to(ROOT).with_suffix("").parts))
+        found += [f"{path.relative_to(ROOT)}:{line} imports {name}" for line, name in imported_names(path, module)
+                  if reaches(name, LAYERS[layer])]
+    assert found == []
+
+
+def test_the_static_check_sees_relative_and_lazy_imports(tmp_path):
+    """The check above can fail: a lazy relative import of the lab from records is caught."""
+    path = tmp_path / "replay.py"
+    path.write_text("def f():\n    from ..lab.record import LabTask\n")
+    names = [name for _, name in imported_names(path, "armgame.records.replay")]
+    assert names == ["armgame.lab.record.LabTask"] and reaches(names[0], LAYERS["armgame.records"])
+
+
+def test_importing_every_records_module_loads_no_lab_window_or_command():
+    code = ("import importlib, json, pkgutil, sys\n"
+            "import armgame.records as package\n"
+            "for info in pkgutil.walk_packages(package.__path__, 'armgame.records.'):\n"
+            "    importlib.import_module(info.name)\n"
+            "print(json.dumps(sorted(sys.modules)))\n")
+    loaded = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                       check=True).stdout)
+    assert "armgame.records.scores" in loaded and "armgame.game.session" in loaded
+    assert [m for m in loaded if reaches(m, LAYERS["armgame.records"])] == []
+
+
+@pytest.fixture(scope="module")
+def lab_replay(tmp_path_factory):
+    """A short lab run's replay, alone in a folder."""
+    kinds = (Perturbation(), Perturbation.make("curl", b=2.0), Perturbation())
+    protocol = Protocol("short", tuple(Block(n, 1, k) for n, k in zip(("a", "b", "c"), kinds, strict=True)),
+                        timeout=0.5)
+    session = LabSession(lab_config(protocol, 3), protocol)
+    Autopilot(session, make_lab_bot("model")).play()
+    folder = tmp_path_factory.mktemp("lab") / "runs"
+    folder.mkdir()
+    path = folder / "run.json"
+    Replay(session.config, tuple(session.timeline), session.result(), "bot", "model", "Ann", now_iso(),
+           task=LabTask.of(session)).save(path)
+    return path
+
+
+@pytest.fixture
+def lab_unregistered(monkeypatch):
+    """As if the lab had never been imported: records reads no task section."""
+    monkeypatch.setattr(replay_module, "_TASK_READERS", {})
+
+
+def test_records_alone_reads_no_task_section(lab_replay, lab_unregistered):
+    with pytest.raises(UserError, match=r"task\.kind 'centre-out': no kind of task section is registered"):
+        Replay.load(lab_replay)
+
+
+@pytest.mark.parametrize("argv, code, expected", [
+    (["verify", "{file}"], 0, "matches"),
+    (["verify", "{folder}"], 0, "1 replay"),
+    (["replay", "{file}", "--headless"], 0, "as recorded"),
+    (["analyze", "{file}", "--out", "{tmp}/trials.csv"], 0, "trials.csv"),
+    (["analyze", "--class", "{folder}", "--out", "{tmp}", "--no-figures"], 0, "class_curve.csv"),
+    (["scores", "--scores", "{tmp}/table", "--add", "{file}"], 2, "only a whole game enters the table"),
+])
+def test_every_command_reads_a_lab_replay_whatever_was_imported_before(lab_replay, lab_unregistered, tmp_path,
+                                                                       capsys, argv, code, expected):
+    names = {"file": lab_replay, "folder": lab_replay.parent, "tmp": tmp_path}
+    assert main([a.format(**names) for a in argv]) == code
+    said = capsys.readouterr()
+    assert expected in said.out + said.err and "task.kind" not in said.err
