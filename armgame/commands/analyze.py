@@ -20,7 +20,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Re-simulate each lab replay from its input timeline, check that it reproduces its recorded "
         "trials, and measure every reach: one row per reach (block, trial, target_deg, perturbation, "
         "reaction_time, movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m, "
-        "path_length_ratio, hit). A replay that does not verify is reported and left out. With --class DIR: "
+        "path_length_ratio, hit, and on error-clamp trials channel_force_peak_n, channel_force_at_peak_speed_n, "
+        "adaptation_index). --fit two-rate fits the two-rate learner's rates to each run. A replay that does "
+        "not verify is reported and left out. With --class DIR: "
         "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
         "per trial of --metric: class_curve.csv and class_curve.png in --out. Exit status: 0 if every replay "
         "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
