@@ -78,11 +78,11 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
 
 def path_groups(session: LabSession, per_group: int | None = None) -> dict[str, list[np.ndarray]]:
     """Hand paths (n, 2) of late baseline, early and late exposure, early washout (one cycle of targets
-    each by default), for blocks the protocol has; catch trials left out."""
+    each by default), for blocks the protocol has; catch and channel trials left out."""
     per_group = per_group or session.protocol.targets
     by_block: dict[int, list[TrialOutcome]] = {}
     for o in session.outcomes:
-        if not o.plan.catch:
+        if not (o.plan.catch or o.plan.channel):
             by_block.setdefault(o.plan.block, []).append(o)
     groups: dict[str, list[np.ndarray]] = {}
     for label, block, which in PATH_GROUPS:
@@ -174,7 +174,8 @@ def figure_metric(protocol) -> str:
 
 
 def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> list[Path]:
-    """``trials.csv`` and, with matplotlib, ``learning.png`` and ``paths.png`` in ``out``; returns what was written."""
+    """``trials.csv`` and, with matplotlib, ``learning.png``, ``paths.png`` and, with channel trials,
+    ``adaptation.png`` in ``out``; returns what was written."""
     from .metrics import write_trials_csv
 
     out = Path(out)
@@ -192,4 +193,9 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
         paths_figure(path_groups(session), session.home, target_positions(session.protocol, session.home),
                      out / "paths.png", target_radius=session.protocol.target_radius, caption=caption)
         written += [out / "learning.png", out / "paths.png"]
+        if any(r["perturbation"] == "channel" and math.isfinite(float(r["adaptation_index"])) for r in rows):
+            from .figures import adaptation_figure
+
+            adaptation_figure(rows, out / "adaptation.png")
+            written.append(out / "adaptation.png")
     return written
