@@ -57,6 +57,20 @@ def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_pa
     assert_reads_on_a_slide(fig)
 
 
+def test_autopilot_runs_headless_and_writes_csv_and_figure_as_the_others(tmp_path, capsys, slides):
+    out = tmp_path / "figs"
+    assert main(["demo", "autopilot", "--headless", "--out", str(out), "--duration", "1"]) == 0
+    header, data = read_csv(out / "autopilot.csv")
+    assert header == ["seed", "duration", "model_hits", "naive_hits"] and len(data) == 10
+    assert (out / "autopilot.png").read_bytes()[:8] == PNG_MAGIC
+    assert f"wrote {out / 'autopilot.png'}" in capsys.readouterr().out
+    (fig,) = slides
+    assert_reads_on_a_slide(fig)
+    (ax,) = fig.get_axes()
+    heights = [round(p.get_height()) for p in ax.patches]  # the bars show the CSV's hits, model then naive
+    assert heights == [*data[:, 2].astype(int), *data[:, 3].astype(int)]
+
+
 def test_pendulum_figure_puts_angle_and_velocity_on_their_own_axes(tmp_path, slides):
     assert main(["demo", "pendulum", "--headless", "--out", str(tmp_path), "--duration", "2"]) == 0
     (fig,) = slides
