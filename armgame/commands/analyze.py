@@ -27,7 +27,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
     p.add_argument("--out", metavar="PATH", required=True,
-                   help="a .csv file (all reaches in one table, each row led by its player and replay), or a folder (one REPLAY.trials.csv each); "
+                   help="a .csv file (all reaches in one table, each row led by its player and replay), or a folder "
+                   "(one REPLAY.trials.csv each); "
                    "with --class, the folder for class_curve.csv and class_curve.png")
     p.add_argument("--class", dest="class_dir", metavar="DIR", help="a folder of students' lab replays")
     p.add_argument("--metric", default=None,

@@ -218,5 +218,6 @@ def autopilot_figure(rows: Any, duration: float, path: Path) -> Path:
     _legend_above(ax, 2)
     top = max(max(r.hits.values()) for r in rows)
     ax.set_ylim(0, max(top, 1) * 1.15)  # room for the printed values
+    ax.yaxis.get_major_locator().set_params(integer=True)
     fig.suptitle("Two autopilots play the same games: the one that knows the arm's interaction torques hits more")
     return _save(fig, path)
