@@ -340,9 +340,15 @@ def test_replay_speed_and_skips_match_a_fresh_replay(window):
     config = GameConfig(time_limit=20.0, seed=5)
     played = GameSession(config)
     Autopilot(played, make_bot("model")).play()
-    source = ReplaySource(config, tuple(played.timeline), played.steps)
+    source = ReplaySource(config, tuple(played.timeline), played.steps, "Ann")
     screen = open_window((1280, 720))
     win = GameWindow(GameSession(config), screen, clock=FakeClock(), fps=0, replay=source, mode="REPLAY")
+    # The help line names the player and lists exactly the keys that work.
+    assert win.help_items() == ("watching Ann's game", "p pause", "-/+ speed", "1 real speed", "left/right 5 s",
+                                "F11 fullscreen", "Esc quit")
+    post_key("up")  # not one of them: nothing happens
+    win.frame(0.0)
+    assert win.speed == 1.0
     assert win.countdown_left is None and not win.keyboard
     win.frame(0.2)
     assert win.session.steps == round(0.2 / config.dt)
@@ -375,9 +381,22 @@ def test_replay_speed_and_skips_match_a_fresh_replay(window):
     assert lay.progress is not None and lay.progress[1] == pytest.approx(0.25)
     assert any("left/right 5 s" in lab.text for lab in lay.labels if lab.role == "help")
     assert not any("shoulder" in lab.text for lab in lay.labels if lab.role == "help")
+    post_key("p")
+    win.frame(0.0)
+    assert "p resume" in win.help_items()
     win.skip_to(source.stop_step)
     win.frame(0.0)
     assert win.ended and win.session.result() == played.result()
+    win.frame(END_KEY_DELAY)
+    post_key("left")  # the replay's keys still work at its end: back 5 s, and it plays on
+    win.frame(0.0)
+    assert not win.ended and win.session.steps == source.stop_step - round(5.0 / config.dt)
+    win.skip_to(source.stop_step)
+    win.frame(0.0)
+    win.frame(END_KEY_DELAY)
+    post_key("return")  # Enter watches again
+    win.frame(0.0)
+    assert win.running and not win.ended and win.session.steps == 0
 
 
 # ------------------------------------------------------------------------------------------- layout

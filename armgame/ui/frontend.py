@@ -78,6 +78,7 @@ class ReplaySource:
     config: GameConfig
     timeline: Sequence[InputEvent]
     stop_step: int
+    player: str | None = None  # named on the help line: whose game is being watched
 
     def start(self, step: int = 0) -> tuple[GameSession, TimelineDriver]:
         """A fresh session replayed to ``step`` at once: how the window skips back, deterministically."""
@@ -188,9 +189,11 @@ class GameWindow:
         if self.keyboard:
             items += [f"{keys[0]}/{keys[1]} shoulder", f"{keys[2]}/{keys[3]} elbow",
                       f"space reset (-{self.session.config.reset_cost})", "tab hide arm"]
-        items.append("p pause")
         if self.replay is not None:
-            items += ["-/+ speed", "left/right 5 s"]
+            items.insert(0, f"watching {self.replay.player}'s game" if self.replay.player else "watching a game")
+        items.append("p resume" if self.paused else "p pause")
+        if self.replay is not None:
+            items += ["-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s"]
         if self.sounds is not None and getattr(self.sounds, "available", False) and self._mute_key_free():
             items.append("m unmute" if self.sounds.muted else "m mute")
         items += ["F11 fullscreen", "Esc quit"]
@@ -261,9 +264,9 @@ class GameWindow:
             self.session.key_event(name, DOWN)
 
     def _replay_key(self, name: str) -> None:
-        if name in ("+", "=", "up", "[+]", "keypad +"):
+        if name in ("+", "=", "[+]", "keypad +"):
             self.speed = next((s for s in REPLAY_SPEEDS if s > self.speed), self.speed)
-        elif name in ("-", "down", "[-]", "keypad -"):
+        elif name in ("-", "[-]", "keypad -"):
             self.speed = next((s for s in reversed(REPLAY_SPEEDS) if s < self.speed), self.speed)
         elif name == "1":
             self.speed = 1.0
