@@ -83,12 +83,12 @@ def main_page(launch: Callable[[Sequence[str]], int]):
 
     return Page("armgame", [
         Item("Play", "the game: hit the targets with d f j k, one minute", start=_start(launch, "play")),
-        Item("Lab", "adaptation experiments: reach in a force field or a changed display",
+        Item("Lab", "reach in a force field or a changed display, and adapt",
              page=lambda: lab_page(launch)),
         Item("Demos", "the arm's dynamics, one idea at a time", page=lambda: demos_page(launch)),
         Item("Replays and scores", "the high-score table and the games recorded", page=lambda: replays_page(launch)),
         Item("Settings", "sound, colours, where the settings file is", page=settings_page),
-        Item("Quit", "", quit=True),
+        Item("Quit", "close armgame", quit=True),
     ])
 
 
@@ -156,7 +156,7 @@ def replays_page(launch: Callable[[Sequence[str]], int]):
             continue
         when = replay.date[:16].replace("T", " ") if replay.date else "date unknown"
         items.append(Item(f"watch {replay.player or 'no name'}: score {replay.result.score}",
-                          f"{when}, seed {replay.config.seed}, {path.name}",
+                          f"{when}, seed {replay.config.seed}, {replay.result.duration:g} s",
                           start=_start(launch, "replay", str(path))))
     if not items:
         lines.append("No replays yet: play a game, and its replay is kept here.")

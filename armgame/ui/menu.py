@@ -50,7 +50,8 @@ class Page:
 @dataclass
 class MenuLayout:
     labels: list[Label] = field(default_factory=list)
-    rows: list[pygame.Rect] = field(default_factory=list)  # each item's clickable rectangle
+    #: The items shown (a long page scrolls to keep the chosen one in view): index and clickable rectangle.
+    rows: list[tuple[int, pygame.Rect]] = field(default_factory=list)
 
     def boxes(self) -> list[tuple[str, pygame.Rect]]:
         return [(f"{lab.role}: {lab.text}", lab.rect) for lab in self.labels]
@@ -144,11 +145,13 @@ class MenuWindow:
 
     def _row_at(self, pos: tuple[int, int]) -> int | None:
         rows = self.layout(self.screen.get_size()).rows
-        return next((i for i, r in enumerate(rows) if r.collidepoint(pos)), None)
+        return next((i for i, r in rows if r.collidepoint(pos)), None)
 
     def help_items(self) -> tuple[str, ...]:
         back = "Esc back" if len(self.stack) > 1 else "Esc quit"
-        return ("up/down choose", "Enter start", "1-9 start that one", back, "F11 fullscreen", "mouse: click")
+        count = min(len(self.page.items), 9)
+        number = (f"1-{count} start that one",) if count > 1 else ()
+        return ("up/down choose", "Enter start", *number, back, "F11 fullscreen", "click to start")
 
     # ----------------------------------------------------------------- layout
     def layout(self, size: tuple[int, int]) -> MenuLayout:
@@ -177,14 +180,16 @@ class MenuWindow:
             lay.labels.append(r.label(r.fit_text(line, small, width), small, p.faint, "line", midtop=(w // 2, y)))
             y = lay.labels[-1].rect.bottom + gap // 2
         y += gap
-        column = min(width, max(round(640 * u), 280))
+        column = min(width, max(round(800 * u), 280))
         left = (w - column) // 2
         row_h = r.font(normal).get_height() + r.font(small).get_height() + 2 * gap
-        for i, item in enumerate(self.page.items):
-            if y + row_h > bottom:  # a short window: the items that do not fit are reached by number
-                break
+        items = self.page.items
+        fit = max(1, (bottom - y) // (row_h + gap // 2))
+        first = min(max(0, self.page.selected - fit + 1), max(0, len(items) - fit))  # the chosen one in view
+        for i in range(first, min(len(items), first + fit)):
+            item = items[i]
             rect = pygame.Rect(left, y, column, row_h)
-            lay.rows.append(rect)
+            lay.rows.append((i, rect))
             colour = p.ink
             number = f"{i + 1}  " if i < 9 else "    "
             lay.labels.append(r.label(r.fit_text(number + item.label, normal, column - 2 * gap), normal, colour,
@@ -208,9 +213,9 @@ class MenuWindow:
         p = self.palette
         screen.fill(p.window)
         radius = max(4, round(10 * min(screen.get_size()) / 720))
-        for i, rect in enumerate(lay.rows):
+        for i, rect in lay.rows:
             selected = i == self.page.selected
-            pygame.draw.rect(screen, p.panel, rect, border_radius=radius)
+            pygame.draw.rect(screen, p.bar_back if selected else p.panel, rect, border_radius=radius)
             pygame.draw.rect(screen, p.ink if selected else p.edge, rect,
                              max(2, round(3 * min(screen.get_size()) / 720)) if selected else 1,
                              border_radius=radius)

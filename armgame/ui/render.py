@@ -178,6 +178,7 @@ class Layout:
     panels: list[pygame.Rect] = field(default_factory=list)
     progress: tuple[pygame.Rect, float] | None = None
     name_box: pygame.Rect | None = None
+    rules: list[tuple[int, int, int]] = field(default_factory=list)  # left, right, y: a table's heading line
 
     @property
     def unit(self) -> float:
@@ -419,16 +420,18 @@ class GameRenderer:
             rows = list(standing.top)
         margin = max(8, round(24 * lay.unit))
         panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
-        row_h = self.font(small).get_height() + gap // 2
         heading = bool(rows) and standing is not None
         content_h = sum(self.font(size).get_height() + gap for _, size, _ in lines)
         if heading:
-            content_h += self.font(normal).get_height() + gap
+            content_h += self.font(normal).get_height() + 2 * gap
         if hud.name_entry is not None:
             content_h += self.font(small).get_height() + gap // 2 + self.font(normal).get_height() + 3 * gap
         content_h += self.font(small).get_height() + 2 * gap  # the hint
         room = h - 2 * margin - content_h - 2 * margin
         own = standing.rank if standing is not None else None
+        # The table in the size of the lines above it where it fits (the back row reads it), else smaller.
+        row_size = normal if len(rows) * (self.font(normal).get_height() + gap // 2) <= room else small
+        row_h = self.font(row_size).get_height() + gap // 2
         while rows and len(rows) * row_h > room:  # too short a window: the table's last rows go first
             drop = next((i for i in range(len(rows) - 1, -1, -1) if rows[i][0] != own), None)
             if drop is None:
@@ -447,23 +450,25 @@ class GameRenderer:
         if heading:
             title = standing.list_name[:1].upper() + standing.list_name[1:]
             lab = self.label(self.fit_text(title, normal, inner.width), normal, p.ink, "heading",
-                             midtop=(inner.centerx, y))
+                             midtop=(inner.centerx, y + gap))
             lay.labels.append(lab)
+            lay.rules.append((inner.left, inner.right, lab.rect.bottom + gap // 2))
             y = lab.rect.bottom + gap
-            rank_w = self.text_size("999.", small)[0] + gap
-            score_w = self.text_size("9999", small)[0]
+            cell = row_size
+            rank_w = self.text_size("999.", cell)[0] + gap
+            score_w = self.text_size("9999", cell)[0]
             name_w = inner.width - rank_w - score_w - 2 * gap
             for rank, name, score in rows:
                 mine = rank == own
                 if mine and standing.pending:
                     name = hud.name_entry or "you"
                 colour = p.warn if mine else p.ink
-                lay.labels.append(self.label(f"{rank}.", small, colour, "table",
+                lay.labels.append(self.label(f"{rank}.", cell, colour, "table",
                                              topright=(inner.left + rank_w - gap, y)))
                 if name:
-                    lay.labels.append(self.label(self.fit_text(name, small, name_w), small, colour, "table",
+                    lay.labels.append(self.label(self.fit_text(name, cell, name_w), cell, colour, "table",
                                                  topleft=(inner.left + rank_w, y)))
-                lay.labels.append(self.label(str(score), small, colour, "table", topright=(inner.right, y)))
+                lay.labels.append(self.label(str(score), cell, colour, "table", topright=(inner.right, y)))
                 y += row_h
         if hud.name_entry is not None:
             y += gap
@@ -565,6 +570,8 @@ class GameRenderer:
         for panel in lay.panels:
             pygame.draw.rect(screen, p.panel, panel, border_radius=radius)
             pygame.draw.rect(screen, p.edge, panel, max(1, round(2 * lay.unit)), border_radius=radius)
+        for left, right, y in lay.rules:
+            pygame.draw.line(screen, p.faint, (left, y), (right, y), max(1, round(2 * lay.unit)))
         if lay.name_box is not None:
             pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2)
             pygame.draw.rect(screen, p.ink, lay.name_box, max(1, round(2 * lay.unit)), border_radius=radius // 2)
