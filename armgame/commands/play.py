@@ -203,7 +203,7 @@ def _keep(session, args: argparse.Namespace):
     if args.name is None or not replay.complete:
         if not args.headless and session.steps > 0:  # a window's game: nothing is lost (Esc on the end screen)
             _keep_replay(replay, args, out)
-        elif not replay.complete:
+        elif args.name is not None:
             print("the game was stopped before the end: not entered in the high-score table", file=out)
         return
     table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr),
