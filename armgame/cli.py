@@ -87,6 +87,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         except UserError as exc:
             print(f"armgame: error: {exc}", file=sys.stderr)
             return 2
+        except KeyboardInterrupt:
+            print("armgame: interrupted", file=sys.stderr)
+            return 130
     if not getattr(args, "run", None):
         parser.print_help()
         return 0

@@ -41,7 +41,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Hit the targets (rings) with the hand (a solid disc). d/f drive the shoulder flexor and "
         "extensor, j/k the elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, "
         "p pauses, m mutes, F11 toggles fullscreen, Esc quits. A 3-2-1 countdown (any key skips it) starts the "
-        "clock.",
+        "clock. The end screen shows your score, rank and the table at once: Enter saves your name, then Enter "
+        "plays again with the same options; Esc quits, keeping the game's replay.",
     )
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
