@@ -59,7 +59,7 @@ def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_pa
 
 def test_autopilot_runs_headless_and_writes_csv_and_figure_as_the_others(tmp_path, capsys, slides):
     out = tmp_path / "figs"
-    assert main(["demo", "autopilot", "--headless", "--out", str(out), "--duration", "1"]) == 0
+    assert main(["demo", "autopilot", "--headless", "--out", str(out), "--duration", "0.3"]) == 0
     header, data = read_csv(out / "autopilot.csv")
     assert header == ["seed", "duration", "model_hits", "naive_hits"] and len(data) == 10
     assert (out / "autopilot.png").read_bytes()[:8] == PNG_MAGIC
