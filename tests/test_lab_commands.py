@@ -85,7 +85,11 @@ def test_a_folder_of_replays_verifies_lab_runs_and_games_each_by_their_own_rules
 
 def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path):
     assert main(["analyze", str(curl_run / "curl.json"), "--out", str(tmp_path / "again.csv")]) == 0
-    assert (tmp_path / "again.csv").read_bytes() == (curl_run / "run" / "trials.csv").read_bytes()
+    # One table leads each row with whose run it is; the measures that follow are the lab's, byte for byte.
+    lines = (tmp_path / "again.csv").read_text().splitlines()
+    replay = str(curl_run / "curl.json")
+    assert lines[0].startswith("player,replay,") and all(line.startswith(f",{replay},") for line in lines[1:])
+    assert [line.split(",", 2)[2] for line in lines] == (curl_run / "run" / "trials.csv").read_text().splitlines()
     assert main(["analyze", str(curl_run / "curl.json"), "--out", str(tmp_path / "each")]) == 0
     assert (tmp_path / "each" / "curl.trials.csv").read_bytes() == (curl_run / "run" / "trials.csv").read_bytes()
 
@@ -113,6 +117,23 @@ def test_analyze_leaves_out_what_does_not_verify(tmp_path, capsys):
     assert "tampered.json: DIFFERS" in err and "no replay could be analysed" in err
     assert main(["analyze", str(good), str(bad), "--out", str(tmp_path / "t.csv")]) == 1
     assert len(read_trials_csv(tmp_path / "t.csv")) == 16
+
+
+def test_one_table_of_several_runs_says_whose_each_row_is(tmp_path):
+    import csv
+
+    folder = _short_runs(tmp_path, [1])
+    data = json.loads((folder / "student1.json").read_text())
+    data["player"] = "=HYPERLINK(1)"  # a name a spreadsheet would run as a formula (not part of the game)
+    (folder / "student2.json").write_text(json.dumps(data))
+    out = tmp_path / "all.csv"
+    assert main(["analyze", str(folder / "student1.json"), str(folder / "student2.json"), "--out", str(out)]) == 0
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 32
+    assert {(r["player"], r["replay"]) for r in rows[:16]} == {("Student 1", str(folder / "student1.json"))}
+    assert {(r["player"], r["replay"]) for r in rows[16:]} == {("'=HYPERLINK(1)", str(folder / "student2.json"))}
+    assert [r["trial"] for r in rows[16:]][:1] == ["1"]  # each run's trials restart: the columns tell them apart
+    assert len(read_trials_csv(out)) == 32  # the lab's own reader still reads it
 
 
 def test_class_curve_merges_verified_students(tmp_path, capsys):

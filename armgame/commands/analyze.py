@@ -29,7 +29,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
     p.add_argument("--out", metavar="PATH", required=True,
-                   help="a .csv file (all reaches in one table), or a folder (one REPLAY.trials.csv each); "
+                   help="a .csv file (all reaches in one table, each row led by its player and replay), or a folder "
+                   "(one REPLAY.trials.csv each); "
                    "with --class, the folder for class_curve.csv and class_curve.png")
     p.add_argument("--class", dest="class_dir", metavar="DIR", help="a folder of students' lab replays")
     p.add_argument("--metric", default=None,
@@ -90,8 +91,15 @@ def verified_rows(path: Path):
     return trial_rows(session), session
 
 
+def session_player(path: Path) -> str:
+    """The player named in a replay (read again: it is small and already verified), or ''."""
+    from ..records.replay import Replay
+
+    return Replay.load(path).player or ""
+
+
 def _replays(args: argparse.Namespace) -> int:
-    from ..lab.metrics import write_trials_csv
+    from ..lab.metrics import LABEL_COLUMNS, write_trials_csv
 
     out = Path(args.out).expanduser()
     one_table = out.suffix.lower() == ".csv"
@@ -119,8 +127,9 @@ def _replays(args: argparse.Namespace) -> int:
                 print(f"armgame analyze: {path}: {exc}", file=sys.stderr)
                 skipped += 1
                 continue
-        if one_table:
-            table += rows
+        if one_table:  # whose each row is: several runs' trials restart at 1
+            who = {"player": session_player(path), "replay": str(path)}
+            table += [{**who, **row} for row in rows]
         else:
             out.mkdir(parents=True, exist_ok=True)
             target = out / f"{path.stem}.trials.csv"
@@ -129,7 +138,7 @@ def _replays(args: argparse.Namespace) -> int:
     if skipped == len(args.replays):
         raise UserError("no replay could be analysed")
     if one_table:
-        write_trials_csv(out, table)
+        write_trials_csv(out, table, labels=LABEL_COLUMNS)
         written.append(out)
     for path in written:
         print(f"wrote {path}")

@@ -58,7 +58,7 @@ import io
 import math
 import os
 import stat
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from pathlib import Path
 
@@ -272,6 +272,8 @@ TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation"
                                   "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS)
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
 _TEXT_COLUMNS = ("block", "perturbation")
+#: Whose run a row is, in a table of several runs (``armgame analyze A.json B.json --out all.csv``).
+LABEL_COLUMNS: tuple[str, ...] = ("player", "replay")
 _NONNEGATIVE = ("movement_time", "peak_speed", "path_length_ratio")
 MAX_TRIALS_BYTES = 16 * 1024 * 1024
 MAX_TEXT = 64
@@ -282,8 +284,11 @@ class TrialsFileError(DataFileError):
     """A trials table that cannot be read: the message names the file, the line and the column."""
 
 
-def write_trials_csv(path: Path, rows: Iterable[Mapping[str, object]]) -> None:
+def write_trials_csv(path: Path, rows: Iterable[Mapping[str, object]], labels: Sequence[str] = ()) -> None:
     """Write one row per reach, the columns of ``TRIAL_COLUMNS``, atomically.
+
+    ``labels``: text columns written first (``analyze``'s ``player`` and ``replay``, so that rows of
+    several runs in one table stay attributable); each row then has them too, as text.
 
     Numbers are written exactly (the shortest text that reads back to the same float); an
     undefined measure (NaN) is an empty field; ``hit`` is 1 or 0. Only a regular file is written:
@@ -293,14 +298,16 @@ def write_trials_csv(path: Path, rows: Iterable[Mapping[str, object]]) -> None:
     path = Path(path)
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(TRIAL_COLUMNS)
+    writer.writerow([*labels, *TRIAL_COLUMNS])
+    expected = {*labels, *TRIAL_COLUMNS}
     for n, row in enumerate(rows, start=1):
         keys = set(row)
-        if keys != set(TRIAL_COLUMNS):
-            missing, unknown = set(TRIAL_COLUMNS) - keys, keys - set(TRIAL_COLUMNS)
+        if keys != expected:
+            missing, unknown = expected - keys, keys - expected
             what = f"lacks {', '.join(sorted(missing))}" if missing else f"has unknown {', '.join(sorted(unknown))}"
             raise ValueError(f"trial row {n} {what}")
-        writer.writerow([_format(name, row[name], n) for name in TRIAL_COLUMNS])
+        writer.writerow([*(_label(name, row[name], n) for name in labels),
+                         *(_format(name, row[name], n) for name in TRIAL_COLUMNS)])
     _write_text(path, out.getvalue())
 
 
@@ -309,7 +316,8 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
 
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
     with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``CHANNEL_COLUMNS``
-    may be absent, as in tables written before error-clamp trials existed, and read as NaN). Each row is
+    may be absent, as in tables written before error-clamp trials existed, and read as NaN;
+    ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a
     whole number from 0 to 1,000,000, ``target_deg`` a finite number, each measure a finite number
     or empty (read as NaN; times may be negative, speed, movement time and ratio may not), ``hit``
@@ -333,7 +341,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
         if len(set(header)) != len(header):
             raise TrialsFileError(f"{path}: line 1: a column is named twice")
         missing = [name for name in TRIAL_COLUMNS if name not in header and name not in CHANNEL_COLUMNS]
-        unknown = [name for name in header if name not in TRIAL_COLUMNS]
+        unknown = [name for name in header if name not in TRIAL_COLUMNS and name not in LABEL_COLUMNS]
         if missing or unknown:
             what = f"lacks column(s) {', '.join(missing)}" if missing else f"has unknown column(s) {_show(unknown)}"
             raise TrialsFileError(f"{path}: line 1: {what}")
@@ -384,6 +392,15 @@ def _write_text(path: Path, text: str) -> None:
         atomic_write_bytes(path, text.encode("utf-8"))
     except OSError as exc:
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+def _label(name: str, value: object, n: int) -> str:
+    """A label column's text, printable (anything else shown as '?'); text a spreadsheet would run as a
+    formula is quoted ('=...), since a player's name is whatever the player typed."""
+    if not isinstance(value, str):
+        raise ValueError(f"trial row {n}, {name}: must be text, got {value!r}")
+    value = "".join(c if c.isprintable() else "?" for c in value)
+    return "'" + value if value[:1] in ("=", "+", "-", "@") else value
 
 
 def _format(name: str, value: object, n: int) -> str:
