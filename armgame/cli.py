@@ -79,6 +79,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     if extra:  # left over by the command's parser: its error, under its name
         parser_of_command = args._commands.get(getattr(args, "command", None), parser)
         parser_of_command.error(f"unrecognized arguments: {' '.join(extra)}")
+    if getattr(args, "command", None) is None:  # `armgame` alone: the menu, or the commands without a display
+        from .commands import menu
+
+        try:
+            return menu.run(parser, main)
+        except UserError as exc:
+            print(f"armgame: error: {exc}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("armgame: interrupted", file=sys.stderr)
+            return 130
     if not getattr(args, "run", None):
         parser.print_help()
         return 0

@@ -57,6 +57,20 @@ def test_each_demo_runs_headless_and_writes_csv_and_figure(name, columns, tmp_pa
     assert_reads_on_a_slide(fig)
 
 
+def test_autopilot_runs_headless_and_writes_csv_and_figure_as_the_others(tmp_path, capsys, slides):
+    out = tmp_path / "figs"
+    assert main(["demo", "autopilot", "--headless", "--out", str(out), "--duration", "0.3"]) == 0
+    header, data = read_csv(out / "autopilot.csv")
+    assert header == ["seed", "duration", "model_hits", "naive_hits"] and len(data) == 10
+    assert (out / "autopilot.png").read_bytes()[:8] == PNG_MAGIC
+    assert f"wrote {out / 'autopilot.png'}" in capsys.readouterr().out
+    (fig,) = slides
+    assert_reads_on_a_slide(fig)
+    (ax,) = fig.get_axes()
+    heights = [round(p.get_height()) for p in ax.patches]  # the bars show the CSV's hits, model then naive
+    assert heights == [*data[:, 2].astype(int), *data[:, 3].astype(int)]
+
+
 def test_pendulum_figure_puts_angle_and_velocity_on_their_own_axes(tmp_path, slides):
     assert main(["demo", "pendulum", "--headless", "--out", str(tmp_path), "--duration", "2"]) == 0
     (fig,) = slides
@@ -260,11 +274,12 @@ def test_window_keys_pause_speed_restart_and_quit(dummy_sdl):
     tick(0.0)
     tick(0.1)
     assert window.run.t == pytest.approx(0.1, abs=1.5e-3)
-    key(pygame.K_SPACE)
+    key(pygame.K_p)
     tick(0.2)
     tick(0.2)
     assert window.run.t == pytest.approx(0.1, abs=1.5e-3)  # paused
-    key(pygame.K_SPACE)
+    assert any(text.startswith("p resume") for text, _ in window.text_boxes())  # the help line says the action
+    key(pygame.K_p)
     key(pygame.K_MINUS)
     assert window.speed == 0.5
     tick(0.0)
@@ -275,6 +290,22 @@ def test_window_keys_pause_speed_restart_and_quit(dummy_sdl):
     key(pygame.K_r)
     tick(0.0)
     assert window.run.t == 0.0
+    # The arrows skip 5 s either way, as in a replay; back lands where running on would have been.
+    key(pygame.K_RIGHT)
+    key(pygame.K_RIGHT)
+    assert window.run.steps == 10000
+    ahead = window.run.states
+    key(pygame.K_LEFT)
+    assert window.run.steps == 5000
+    key(pygame.K_RIGHT)
+    assert window.run.steps == 10000 and window.run.states == ahead
+    key(pygame.K_LEFT)
+    key(pygame.K_LEFT)
+    key(pygame.K_LEFT)
+    assert window.run.steps == 0 and window.speed == 0.5  # clamped at the start; the speed is not changed
+    tick(0.0)
+    help_line = window.text_boxes()[-1][0]
+    assert help_line == "p pause   r restart   -/+ speed   1 real speed   left/right 5 s   F11 fullscreen   Esc quit"
     window.handle(pygame.event.Event(pygame.VIDEORESIZE, w=1000, h=600, size=(1000, 600)))
     pygame.display.set_mode((1000, 600), pygame.RESIZABLE)
     tick(0.0)
@@ -344,3 +375,37 @@ def test_autopilot_window_fits_two_games(dummy_sdl, size):
     assert screen is not None
     window.handle(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_r))
     assert all(g.session.steps == 0 for g in window.games)
+
+
+def test_autopilot_window_speeds_up_and_skips_both_games_as_a_replay_does(dummy_sdl):
+    pygame = dummy_sdl
+    from armgame.game.bots import Autopilot, make_bot
+    from armgame.game.rules import GameConfig
+    from armgame.game.session import GameSession
+    from armgame.ui.autopilot_window import AutopilotWindow
+    from armgame.ui.display import open_window
+
+    open_window((800, 600))
+    window = AutopilotWindow(3, 12.0, pygame.display.get_surface(), clock=lambda: 0.0)
+
+    def key(k):
+        window.handle(pygame.event.Event(pygame.KEYDOWN, key=k))
+
+    key(pygame.K_EQUALS)
+    window.frame(0.1)
+    assert window.speed == 2.0 and all(g.session.steps == round(0.2 / g.session.config.dt) for g in window.games)
+    key(pygame.K_1)
+    key(pygame.K_RIGHT)
+    assert all(g.session.steps == round(5.2 / g.session.config.dt) for g in window.games)
+    key(pygame.K_LEFT)
+    assert window.speed == 1.0
+    for game in window.games:  # where the bot's own game is at 0.2 s, though the window went there and back
+        alone = GameSession(GameConfig(seed=3, time_limit=12.0))
+        Autopilot(alone, make_bot(game.name)).advance(game.session.steps)
+        assert game.session.steps == round(0.2 / game.session.config.dt) and game.session.state == alone.state
+    window.frame(0.0)
+    from armgame.ui.autopilot_window import HELP
+
+    footer = window.layout((800, 600))[2]
+    assert " ".join(lab.text for lab in footer).split() == " ".join(HELP).split()
+    assert HELP == ("p pause", "r restart", "-/+ speed", "1 real speed", "left/right 5 s", "F11 fullscreen", "Esc quit")

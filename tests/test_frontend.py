@@ -253,33 +253,86 @@ def test_escape_and_close_end_the_window(window):
     assert not win2.running
 
 
-def test_end_screen_asks_the_name_then_shows_rank_and_top_ten_until_a_key(window):
+def labels_of(win):
+    return win.renderer.layout(win.screen.get_size(), win.session, win.hud()).labels
+
+
+def test_end_screen_shows_rank_and_table_at_once_then_saves_the_name_then_enter_plays_again(window):
     asked = []
+    table = tuple((i, f"P{i}", 20 - i) for i in range(1, 11))
 
     def standing(name):
         asked.append(name)
-        return Standing(2, 12, tuple((i, f"P{i}", 20 - i) for i in range(1, 11)))
+        return Standing(2, 12, table, "custom games")
 
-    win, _ = window(time_limit=0.5, window_options={"ask_name": True, "standing": standing})
+    def preview():
+        return Standing(3, 12, ((1, "P1", 19), (2, "P2", 18), (3, "", 0)), "custom games", pending=True)
+
+    win, _ = window(time_limit=0.5, window_options={"ask_name": True, "standing": standing, "preview": preview})
     for _ in range(40):
         win.frame(1 / 60)
     assert win.session.over and win.ended and win.name_entry == ""
+    texts = [lab.text for lab in labels_of(win)]
+    # Score, rank, the list's heading and the table, before any name is typed; and the length limit.
+    assert "Your score: 0" in texts and "You would rank 3 of 12" in texts and "Custom games" in texts
+    assert "P2" in texts and "you" in texts and "0/24" in texts and asked == []
     for _ in range(40):
         win.frame(1 / 60)
     pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="Ann"))
+    win.frame(0.0)
+    texts = [lab.text for lab in labels_of(win)]
+    assert "Ann" in texts and "3/24" in texts  # the name typed shows in its row of the table, and its length
     post_key("return")
     win.frame(0.0)
     assert asked == ["Ann"] and win.player_name == "Ann"
-    lay = win.renderer.layout(win.screen.get_size(), win.session, win.hud())
-    texts = [lab.text for lab in lay.labels]
-    assert "Rank 2 of 12 in the ranked table" in texts and "P10" in texts and "Your score: 0" in texts
-    post_key("x")  # too soon: a key still being mashed does not close it
+    texts = [lab.text for lab in labels_of(win)]
+    assert "Rank 2 of 12" in texts and "P10" in texts and "Enter plays again    Esc quits" in texts
+    post_key("return")  # too soon: the Enter that saved, pressed twice, does not start a game
     win.frame(0.1)
     assert win.running
     win.frame(END_KEY_DELAY)
-    post_key("x")
+    post_key("x")  # not a key of the end screen
     win.frame(0.0)
-    assert not win.running
+    assert win.running and not win.play_again
+    post_key("return")
+    win.frame(0.0)
+    assert not win.running and win.play_again
+
+
+def test_keys_held_at_the_buzzer_never_reach_the_name(window):
+    win, _ = window(time_limit=1.0, window_options={"ask_name": True})
+    post_key("j")
+    while not win.ended:  # j held to the end: the game takes it, and its repeats follow
+        win.frame(1 / 60)
+    post_key("k")  # mashed as the end screen opens, and held
+    win.frame(0.1)
+    for _ in range(60):  # a second of the keyboard's repeats of both held keys
+        pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="j"))
+        pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="k"))
+        win.frame(1 / 60)
+    post_key("return")
+    win.frame(0.0)
+    assert win.name_entry == "" and not win.typing and win.running
+    post_key("j", down=False)
+    pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="k"))
+    win.frame(0.0)
+    assert win.name_entry == ""  # k is still held
+    post_key("k", down=False)
+    pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="Bo"))
+    win.frame(0.0)
+    assert win.typing and win.name_entry == "Bo"
+    pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="x" * 40))
+    win.frame(0.0)
+    assert len(win.name_entry) == 24 and "24/24" in [lab.text for lab in labels_of(win)]
+
+
+def test_escape_on_the_end_screen_quits_without_playing_again(window):
+    win, _ = window(time_limit=0.2, window_options={"ask_name": True})
+    while not win.ended:
+        win.frame(0.05)
+    post_key("escape")
+    win.frame(0.0)
+    assert not win.running and not win.play_again and win.player_name is None
 
 
 # ------------------------------------------------------------------------------------------ replays
@@ -287,9 +340,15 @@ def test_replay_speed_and_skips_match_a_fresh_replay(window):
     config = GameConfig(time_limit=20.0, seed=5)
     played = GameSession(config)
     Autopilot(played, make_bot("model")).play()
-    source = ReplaySource(config, tuple(played.timeline), played.steps)
+    source = ReplaySource(config, tuple(played.timeline), played.steps, "Ann")
     screen = open_window((1280, 720))
     win = GameWindow(GameSession(config), screen, clock=FakeClock(), fps=0, replay=source, mode="REPLAY")
+    # The help line names the player and lists exactly the keys that work.
+    assert win.help_items() == ("watching Ann's game", "p pause", "-/+ speed", "1 real speed", "left/right 5 s",
+                                "F11 fullscreen", "Esc quit")
+    post_key("up")  # not one of them: nothing happens
+    win.frame(0.0)
+    assert win.speed == 1.0
     assert win.countdown_left is None and not win.keyboard
     win.frame(0.2)
     assert win.session.steps == round(0.2 / config.dt)
@@ -322,9 +381,22 @@ def test_replay_speed_and_skips_match_a_fresh_replay(window):
     assert lay.progress is not None and lay.progress[1] == pytest.approx(0.25)
     assert any("left/right 5 s" in lab.text for lab in lay.labels if lab.role == "help")
     assert not any("shoulder" in lab.text for lab in lay.labels if lab.role == "help")
+    post_key("p")
+    win.frame(0.0)
+    assert "p resume" in win.help_items()
     win.skip_to(source.stop_step)
     win.frame(0.0)
     assert win.ended and win.session.result() == played.result()
+    win.frame(END_KEY_DELAY)
+    post_key("left")  # the replay's keys still work at its end: back 5 s, and it plays on
+    win.frame(0.0)
+    assert not win.ended and win.session.steps == source.stop_step - round(5.0 / config.dt)
+    win.skip_to(source.stop_step)
+    win.frame(0.0)
+    win.frame(END_KEY_DELAY)
+    post_key("return")  # Enter watches again
+    win.frame(0.0)
+    assert win.running and not win.ended and win.session.steps == 0
 
 
 # ------------------------------------------------------------------------------------------- layout
@@ -343,7 +415,11 @@ def screens(session, renderer):
         "replay": Hud(mode="REPLAY   Wolfgang Amadeus   2026-11-22 23:59", progress=(12.3, 60.0), speed=0.25,
                       help=("p pause", "-/+ speed", "left/right 5 s", "m mute", "F11 fullscreen", "Esc quit")),
         "name": Hud(mode="PLAY", ended=True, name_entry="W" * 24),
+        "name and table": Hud(mode="PLAY", ended=True, name_entry="W" * 24, end_hint="Enter saves    Esc quits (the "
+                              "game's replay is kept)", standing=Standing(3, 40, table.top, "custom games", True)),
         "end": Hud(mode="PLAY", ended=True, standing=table),
+        "end, ranked low": Hud(mode="PLAY", ended=True, standing=Standing(
+            38, 40, (*table.top, (38, "W" * 24, 0)), "the ranked table")),
         "end, no table": Hud(mode="REPLAY", ended=True),
     }
 
@@ -470,3 +546,60 @@ def test_a_resize_is_remembered_but_a_fullscreen_round_trip_is_not(window):
     pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, w=900, h=650, size=(900, 650)))
     win.frame(0.0)
     assert win.resized and win.windowed_size == (900, 650)
+
+
+# ------------------------------------------------------------------------------- the play command
+def scripted_games(monkeypatch, plans):
+    """``armgame play`` with each game's window driven by a plan: the game played out on a fake clock,
+    then each step's keys posted (text or key names) one second apart. Returns the windows' last labels."""
+    seen = []
+
+    def run(self, max_frames=None):
+        self.countdown_left = None
+        while not self.ended:
+            self.frame(0.05)
+        for step in plans.pop(0):
+            self.frame(1.0)
+            for kind, value in step:
+                if kind == "text":
+                    pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text=value))
+                else:
+                    post_key(value)
+            self.frame(0.0)
+            seen.append([lab.text for lab in labels_of(self)])
+            if not self.running:
+                break
+        return self.session
+
+    monkeypatch.setattr(GameWindow, "run", run)
+    return seen
+
+
+def test_play_enter_plays_again_with_the_same_options_and_esc_keeps_the_replay(tmp_path, monkeypatch, capsys):
+    from armgame.cli import main
+    from armgame.records.replay import Replay
+    from armgame.records.scores import ScoreTable
+
+    scores = tmp_path / "scores"
+    seen = scripted_games(monkeypatch, [
+        [[("text", "Ann"), ("key", "return")], [("key", "return")]],  # saved, then Enter: another game
+        [[("key", "escape")]],  # the second game: Esc on the name prompt
+    ])
+    options = ["--duration", "0.5", "--seed", "4", "--scores", str(scores), "--settings", str(tmp_path / "s.toml")]
+    assert main(["play", *options]) == 0
+    out = capsys.readouterr().out
+    assert out.count("your score is") == 2 and "saved to the high-score table as Ann" in out
+    assert "Custom games" in seen[0] and "Enter plays again    Esc quits" in seen[0]
+    table = ScoreTable(scores)
+    assert [e.name for e in table.all_entries()] == ["Ann"]
+    # The second game, not entered, is kept anyway; the line printed says how to enter it, and that works.
+    (kept,) = [p for p in table.replays.iterdir() if p.name != table.all_entries()[0].replay]
+    game = Replay.load(kept)
+    assert game.config.seed == 4 and game.config.time_limit == 0.5 and game.complete  # the same options
+    add = next(line for line in out.splitlines() if "to enter it later:" in line).split("later: ")[1]
+    assert add == f"armgame scores --add {kept} --name NAME --scores {scores}"
+    # Nothing was pressed in either game: the same game as Ann's, which enters once (issue 16).
+    capsys.readouterr()
+    assert main(add.replace("NAME", "Bo").split()[1:]) == 2
+    assert "already in the table: entered by Ann" in capsys.readouterr().err
+    assert [e.name for e in ScoreTable(scores).all_entries()] == ["Ann"]

@@ -354,9 +354,12 @@ def test_the_end_screen_asks_for_a_name(finished_window):
     window.frame(0.0)
     assert window.player_name == "Ann Lee" and window.running  # the end screen stays until a key
     window.frame(1.0)
-    post(("key", pygame.K_x))
+    post(("key", pygame.K_x))  # not a key of the end screen
     window.frame(0.0)
-    assert not window.running
+    assert window.running
+    post(("key", pygame.K_RETURN))
+    window.frame(0.0)
+    assert not window.running and window.play_again
 
 
 def test_keys_mashed_as_the_clock_ends_are_not_typed_and_esc_saves_nothing(finished_window):

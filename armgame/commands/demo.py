@@ -23,7 +23,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "arm), chaos (two passive arms 1e-6 rad apart), interaction (a fast minimum-jerk reach and the torques "
         "it needs, split into each joint's own and interaction torques), planning (one reach as minimum jerk beside "
         "minimum torque change, computed on the arm's own dynamics), autopilot (two bots play the game, one "
-        "knowing the interaction torques and one not; headless it prints their hits on seeds 0 to 9). "
+        "knowing the interaction torques and one not; headless it prints their hits on seeds 0 to 9, and with --out "
+        "writes autopilot.csv and autopilot.png). "
         "Figures need matplotlib: "
         "pip install 'armgame[plot]'.",
     )
@@ -54,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
         from ..records.storage import user_path
 
         if args.headless:
-            print(autopilot.run_headless(None if args.out is None else user_path(args.out, "--out"), args.duration))
+            print(autopilot.run_headless(None if args.out is None else user_path(args.out, "--out"), args.duration,
+                                         figures=not args.no_figures))
         else:
             from ..ui.autopilot_window import run_window as autopilot_window
 

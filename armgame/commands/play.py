@@ -41,7 +41,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Hit the targets (rings) with the hand (a solid disc). d/f drive the shoulder flexor and "
         "extensor, j/k the elbow flexor and extensor; space resets the arm (costs a point), tab hides the arm, "
         "p pauses, m mutes, F11 toggles fullscreen, Esc quits. A 3-2-1 countdown (any key skips it) starts the "
-        "clock.",
+        "clock. The end screen shows your score, rank and the table at once: Enter saves your name, then Enter "
+        "plays again with the same options; Esc quits, keeping the game's replay.",
     )
     add_game_options(p)
     p.add_argument("--headless", action="store_true", help="no window: run as fast as possible")
@@ -99,8 +100,6 @@ def check_recordable(config, what: str):
 
 
 def run(args: argparse.Namespace) -> int:
-    import json
-    import sys
     from pathlib import Path
 
     from ..game.script import load_script
@@ -128,7 +127,17 @@ def run(args: argparse.Namespace) -> int:
     else:
         if not 1 <= args.fps <= 1000:
             raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
-        result = _play_in_window(session, args, window)
+        session = _play_in_window(session, args, window)  # the last game, when Enter played again
+        result = session.result()
+    _report(session, result, args)
+    return 0
+
+
+def _report(session, result, args: argparse.Namespace) -> None:
+    """Print one game's result and keep it (the window's end screen may have kept it already)."""
+    import json
+    import sys
+
     if args.json:
         print(json.dumps(result.as_dict(), sort_keys=True))
     else:
@@ -139,7 +148,6 @@ def run(args: argparse.Namespace) -> int:
               f"most a replay holds", file=sys.stderr)
     if not getattr(args, "kept", False):  # the window's end screen may have kept it already
         _keep(session, args)
-    return 0
 
 
 def _play_class(args: argparse.Namespace) -> int:
@@ -209,12 +217,11 @@ def _keep(session, args: argparse.Namespace):
     if args.record:
         replay.save(check_output_path(user_path(args.record, "--record"), "replay"))
         print(f"replay saved to {args.record}", file=out)
-    if args.name is None:
-        if not args.headless and session.over:
-            print("no name given: the score was not saved to the high-score table", file=out)
-        return
-    if not replay.complete:
-        print("the game was stopped before the end: not entered in the high-score table", file=out)
+    if args.name is None or not replay.complete:
+        if not args.headless and session.steps > 0:  # a window's game: nothing is lost (Esc on the end screen)
+            _keep_replay(replay, args, out)
+        elif args.name is not None:
+            print("the game was stopped before the end: not entered in the high-score table", file=out)
         return
     warn = lambda m: print(f"armgame play: {m}", file=sys.stderr)  # noqa: E731
     table = ScoreTable(scores_dir(args), warn=warn,
@@ -227,6 +234,34 @@ def _keep(session, args: argparse.Namespace):
         raise UserError(f"not entered in the high-score table: {exc}") from None
     print(f"saved to the high-score table as {entry.name}: {where_it_went(table, entry)}", file=out)
     return entry
+
+
+def _keep_replay(replay, args: argparse.Namespace, out) -> None:
+    """A window's game not entered in the table: its replay is kept (beside the table's, or where
+    --record put it) and the line printed says how to enter it later, or to watch it."""
+    import shlex
+    from pathlib import Path
+
+    from ..records.scores import ScoreTable
+    from ..records.storage import DataFileError
+    from .scores import scores_dir
+
+    if args.record:
+        path = Path(args.record)
+    else:
+        try:
+            path = ScoreTable(scores_dir(args)).save_replay(replay)
+        except (OSError, DataFileError) as exc:
+            print(f"the game's replay could not be kept: {getattr(exc, 'strerror', None) or exc}", file=out)
+            return
+    scores = ["--scores", str(args.scores)] if getattr(args, "scores", None) else []
+    if replay.complete:
+        add = shlex.join(["armgame", "scores", "--add", str(path), "--name", "NAME", *scores])
+        print(f"not entered in the high-score table; the game's replay is kept: {path}\n"
+              f"  to enter it later: {add}", file=out)
+    else:
+        print(f"the game was stopped at {replay.steps * replay.config.dt:.1f} s (a game stopped early is never "
+              f"entered); its replay is kept: {shlex.join(['armgame', 'replay', str(path)])} watches it", file=out)
 
 
 def driver_name(file_name: str) -> str:
@@ -243,28 +278,51 @@ def _window_settings(args: argparse.Namespace):
     return settings, path
 
 
+def list_name(kind: str) -> str:
+    """The heading of a list (``records.scores.LIST_TITLES``) as the end screen shows it: "the ranked
+    table", "practice", "programs" or "custom games". One place: the scores layer decides the lists."""
+    from ..records.scores import LIST_TITLES
+
+    return LIST_TITLES[kind].split(" (")[0]
+
+
+def _table_of_list(session, args: argparse.Namespace, entry=None):
+    """The table, the entries of the list the game goes to (or would go to), best first, and that list."""
+    import sys
+
+    from ..records.scores import ScoreTable
+    from .scores import scores_dir
+
+    table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
+    kind = table.list_of(entry) if entry is not None else _list_it_would_join(session, args, table)
+    return table, table.of_list(kind), kind
+
+
+def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[int, str, int], ...]:
+    """The top 10 as (rank, name, score), and the game's own row after them if it ranks lower."""
+    rows = [(i, name, score) for i, (name, score) in enumerate(ranked[:10], 1)]
+    if own is not None and own > 10:
+        rows.append((own, *ranked[own - 1]))
+    return tuple(rows)
+
+
 def _standing(session, args: argparse.Namespace):
     """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
     import sys
 
-    from ..records.scores import LIST_TITLES, ScoreTable
     from ..ui.render import Standing
-    from .scores import scores_dir
 
     def standing(name: str | None) -> Standing | None:
         args.name = name or args.name
         try:
             entry = _keep(session, args)
             args.kept = True
-            table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
-            kind = table.list_of(entry) if entry is not None else _list_it_would_join(session, args, table)
-            entries = table.of_list(kind)
+            _, entries, kind = _table_of_list(session, args, entry)
         except UserError as exc:
             print(f"armgame play: error: {exc}", file=sys.stderr)
             return None
         rank = next((i for i, e in enumerate(entries, 1) if entry is not None and e.id == entry.id), None)
-        return Standing(rank, len(entries), tuple((i, e.name, e.score) for i, e in enumerate(entries[:10], 1)),
-                        LIST_TITLES[kind].split(" (")[0])
+        return Standing(rank, len(entries), _rows([(e.name, e.score) for e in entries], rank), list_name(kind))
 
     return standing
 
@@ -281,24 +339,71 @@ def _list_it_would_join(session, args: argparse.Namespace, table) -> str:
     return PRACTICE if session.config.seed != table.seed else RANKED
 
 
+def _preview(session, args: argparse.Namespace):
+    """The end screen's first look: where the score would rank, before any name is typed (nothing
+    is entered: an equal score already in the table stays ahead, as the earlier game)."""
+    import sys
+
+    from ..records.storage import DataFileError
+    from ..ui.render import Standing
+
+    def preview() -> Standing | None:
+        try:
+            _, entries, kind = _table_of_list(session, args)
+        except (UserError, DataFileError, OSError) as exc:
+            print(f"armgame play: {exc}", file=sys.stderr)
+            return None
+        score = session.rules.board.score
+        rank = 1 + sum(1 for e in entries if e.score >= score)
+        ranked = [(e.name, e.score) for e in entries]
+        ranked.insert(rank - 1, ("", score))
+        return Standing(rank, len(ranked), _rows(ranked, rank), list_name(kind), pending=True)
+
+    return preview
+
+
 def _play_in_window(session, args: argparse.Namespace, window):
+    from pathlib import Path
+
+    from ..game.session import GameSession
+
     try:
-        from ..ui.frontend import play_window
+        from ..ui.frontend import NextGame, play_window
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
-    driver = None
-    if args.bot:
-        from ..game.bots import Autopilot, make_bot
-        from ..game.session import RealTimeDriver
-
-        # The bot steps the game through the same Autopilot as headless: the keyboard only pauses and quits.
-        driver = RealTimeDriver(Autopilot(session, make_bot(args.bot)))  # type: ignore[arg-type]
     settings, path = window
-    played = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps, driver=driver,
-                         ask_name=args.name is None, trail=args.trail, standing=_standing(session, args),
+    named = args.name  # --name: every game of the window goes under it; else each is asked its own
+    record = args.record
+    games = [1]
+
+    def next_game(finished):
+        """Enter on the end screen: this game is kept and reported, the next has the same options."""
+        args.name = args.name or finished.player_name
+        _report(finished.session, finished.session.result(), args)
+        games[0] += 1
+        args.name, args.kept = named, False
+        if record:  # --record FILE: the next games beside it, FILE-2.json and on, none overwritten
+            path = Path(record)
+            args.record = str(path.with_name(f"{path.stem}-{games[0]}{path.suffix}"))
+        new = GameSession(game_config(args))
+        return NextGame(new, _bot_driver(new, args), _standing(new, args), _preview(new, args))
+
+    played = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps,
+                         driver=_bot_driver(session, args), ask_name=named is None, trail=args.trail,
+                         standing=_standing(session, args), preview=_preview(session, args), next_game=next_game,
                          mode=f"AUTOPILOT: {args.bot}" if args.bot else f"PLAY   seed {args.seed}")
     args.name = args.name or played.player_name  # the name typed on the end screen
-    return session.result()
+    return played.session
+
+
+def _bot_driver(session, args: argparse.Namespace):
+    """A bot at the keys (the same Autopilot as headless; the keyboard only pauses and quits), or None."""
+    if not args.bot:
+        return None
+    from ..game.bots import Autopilot, make_bot
+    from ..game.session import RealTimeDriver
+
+    return RealTimeDriver(Autopilot(session, make_bot(args.bot)))  # type: ignore[arg-type]
 
 
 def without_window(args: argparse.Namespace, typed: list[str]) -> str:

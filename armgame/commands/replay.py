@@ -15,8 +15,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "replay",
         help="play back a recorded game (a window, or --headless --json)",
         description="Play back a replay file (from play --record, or the replays/ folder beside the score "
-        "table) at real-time speed in a window: p pauses, - and + set the speed (0.25x to 8x), the left and right "
-        "arrows skip 5 s back and forth, Esc quits; the game keys do nothing. With "
+        "table) at real-time speed in a window: p pauses, - and + set the speed (0.25x to 8x), 1 back to real "
+        "speed, the left and right arrows skip 5 s back and forth, Enter at the end watches again, Esc quits; "
+        "the game keys do nothing. With "
         "--headless the game is recomputed at once; --json prints the same object as play --headless --json.",
     )
     p.add_argument("file", metavar="FILE", help="the replay file (JSON)")
@@ -73,7 +74,7 @@ def _watch(replay, args: argparse.Namespace):
     if replay.task is not None:  # a lab run is watched on its own task's session and window
         return _watch_lab(replay, args, settings)
     when = replay.date[:16].replace("T", " ") if replay.date else "date unknown"
-    source = ReplaySource(replay.config, replay.timeline, replay.steps)
+    source = ReplaySource(replay.config, replay.timeline, replay.steps, replay.player)
     session, _ = source.start()
     window = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps, replay=source,
                          trail=args.trail, mode=f"REPLAY   {replay.player or 'no name'}   {when}",

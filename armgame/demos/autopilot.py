@@ -46,8 +46,14 @@ def format_table(rows: list[Row], duration: float) -> str:
     return "\n".join(lines)
 
 
-def run_headless(out: Path | None, duration: float | None) -> str:
+def run_headless(out: Path | None, duration: float | None, figures: bool = True) -> str:
+    """The hits table, printed; with ``out``, written there as ``autopilot.csv`` and (with ``figures``)
+    the slide ``autopilot.png``, as every other demo writes its CSV and figure."""
     duration = 60.0 if duration is None else duration
+    if out is not None and figures:  # before ten games are played: a missing matplotlib is said first
+        from .figures import require_matplotlib
+
+        require_matplotlib()
     rows = hits_table(TABLE_SEEDS, duration)
     text = format_table(rows, duration)
     if out is not None:
@@ -61,4 +67,8 @@ def run_headless(out: Path | None, duration: float | None) -> str:
         except OSError as exc:
             raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
         text += f"\nwrote {path}"
+        if figures:
+            from .figures import autopilot_figure
+
+            text += f"\nwrote {autopilot_figure(rows, duration, out / 'autopilot.png')}"
     return text

@@ -197,3 +197,27 @@ def planning_figure(planning: Any, path: Path) -> Path:
     fig.suptitle("One reach planned two ways: minimum jerk (Flash & Hogan 1985) and minimum torque change "
                  "(Uno, Kawato & Suzuki 1989)")
     return _save(fig, path)
+
+
+@_slide
+def autopilot_figure(rows: Any, duration: float, path: Path) -> Path:
+    """Hits of the two bots on each seed, side by side: knowing the interaction torques pays on every one."""
+    fig = _figure(16, 9)
+    ax = fig.subplots()
+    seeds = np.arange(len(rows))
+    width = 0.4
+    for offset, name, colour, label in ((-width / 2, "model", ARM_A, "model: knows the interaction torques"),
+                                        (width / 2, "naive", ARM_B, "naive: drives each joint alone")):
+        hits = np.array([r.hits[name] for r in rows], dtype=float)
+        bars = ax.bar(seeds + offset, hits, width, color=colour, label=label)
+        ax.bar_label(bars, labels=[f"{h:g}" for h in hits], padding=3, fontsize=12)
+    ax.set_xticks(seeds, [str(r.seed) for r in rows])
+    ax.set_xlabel("seed (the game's target sequence)")
+    ax.set_ylabel(f"hits in {duration:g} s")
+    ax.grid(axis="x", visible=False)
+    _legend_above(ax, 2)
+    top = max(max(r.hits.values()) for r in rows)
+    ax.set_ylim(0, max(top, 1) * 1.15)  # room for the printed values
+    ax.yaxis.get_major_locator().set_params(integer=True)
+    fig.suptitle("Two autopilots play the same games: the one that knows the arm's interaction torques hits more")
+    return _save(fig, path)

@@ -25,7 +25,11 @@ from .render import PALETTES, GameRenderer, Hud, Label
 CAPTION = ("Same targets, same planner. {0}: the bot knows the interaction torques. "
            "{1}: it drives each joint as if the other did not move.")
 DEFAULT_SIZE = (1280, 720)
-HELP = ("p pause", "r restart", "F11 fullscreen", "Esc quit")
+SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
+SKIP_SECONDS = 5.0
+#: The keys, as the help line says them: the same set as the demos' and the replays'.
+HELP = ("p pause", "r restart", "-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s", "F11 fullscreen",
+        "Esc quit")
 WHO = {"model": "AUTOPILOT: model", "naive": "AUTOPILOT: naive"}
 
 
@@ -47,6 +51,7 @@ class AutopilotWindow:
         self.windowed_size = screen.get_size()
         self.paused = False
         self.running = True
+        self.speed = 1.0
         self.games: list[Game] = []
         self.restart()
 
@@ -54,7 +59,8 @@ class AutopilotWindow:
         self.games = []
         for name in BOT_NAMES:
             session = GameSession(GameConfig(seed=self.seed, time_limit=self.duration))
-            driver = RealTimeDriver(Autopilot(session, make_bot(name)))  # type: ignore[arg-type]
+            # Sped up 8 times, a frame covers up to 8 times the usual stall limit.
+            driver = RealTimeDriver(Autopilot(session, make_bot(name)), 0.25 * max(SPEEDS))  # type: ignore[arg-type]
             renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
             self.games.append(Game(name, session, driver, renderer))
 
@@ -74,16 +80,19 @@ class AutopilotWindow:
         for line in lines:
             labels.append(renderer.label(line, caption_h, self.palette.ink, "caption", midtop=(w // 2, y)))
             y = labels[-1].rect.bottom + gap // 2
-        help_label = renderer.label("    ".join(HELP), help_h, self.palette.faint, "help",
-                                    midbottom=(w // 2, h - pad))
-        top, bottom = y + gap, help_label.rect.top - gap
+        footer: list[Label] = []
+        bottom = h - pad
+        for line in reversed(renderer.wrap_items(self.help_items(), help_h, w - 2 * pad, gap)):
+            footer.append(renderer.label(line, help_h, self.palette.faint, "help", midbottom=(w // 2, bottom)))
+            bottom = footer[-1].rect.top - gap // 2
+        top, bottom = y + gap, bottom - gap
         if h > w:  # a tall screen: one game above the other, so neither gets narrow
             half = (bottom - top) // 2
             areas = [pygame.Rect(0, top + i * half, w, max(half, 10)) for i in range(2)]
         else:
             half = w // 2
             areas = [pygame.Rect(i * half, top, half, max(bottom - top, 10)) for i in range(2)]
-        return labels, areas, [help_label]
+        return labels, areas, footer
 
     def all_boxes(self, size: tuple[int, int]) -> list[tuple[str, pygame.Rect]]:
         """Every text and bar rectangle in window coordinates (for the tests)."""
@@ -93,6 +102,22 @@ class AutopilotWindow:
             lay = game.renderer.layout(area.size, game.session, self.hud(game))
             boxes += [(name, rect.move(area.topleft)) for name, rect in lay.boxes()]
         return boxes
+
+    def help_items(self) -> tuple[str, ...]:
+        return ("p resume", *HELP[1:]) if self.paused else HELP
+
+    def skip(self, seconds: float) -> None:
+        """Both games at once, ``seconds`` on (run at once) or back (replayed from the start: the bots
+        are deterministic, so the same moment comes back)."""
+        dt = self.games[0].session.config.dt
+        target = max(0, self.games[0].session.steps + round(seconds / dt))
+        if target < self.games[0].session.steps:
+            self.restart()
+        for game in self.games:
+            autopilot = game.driver.session
+            autopilot.advance(max(0, min(target, game.session.total_steps) - game.session.steps))
+            game.driver.steps_taken = game.session.steps
+            game.driver.clock = game.session.steps * dt
 
     def hud(self, game: Game) -> Hud:
         return Hud(mode=WHO[game.name], paused=self.paused, ended=game.session.over)
@@ -107,10 +132,18 @@ class AutopilotWindow:
             key = pygame.key.name(event.key).lower()
             if key == "escape":
                 self.running = False
-            elif key in ("p", "space"):
+            elif key == "p":
                 self.paused = not self.paused
             elif key == "r":
                 self.restart()
+            elif key in ("+", "=", "[+]", "keypad +"):
+                self.speed = next((s for s in SPEEDS if s > self.speed), self.speed)
+            elif key in ("-", "[-]", "keypad -"):
+                self.speed = next((s for s in reversed(SPEEDS) if s < self.speed), self.speed)
+            elif key == "1":
+                self.speed = 1.0
+            elif key in ("left", "right"):
+                self.skip(SKIP_SECONDS if key == "right" else -SKIP_SECONDS)
             elif key == "f11":
                 self.screen = toggle_fullscreen(self.windowed_size)
 
@@ -121,7 +154,8 @@ class AutopilotWindow:
         screen.fill(self.palette.window)
         labels, areas, footer = self.layout(screen.get_size())
         for game, area in zip(self.games, areas, strict=True):
-            alpha = game.driver.advance(0.0 if self.paused else elapsed) if not game.session.over else 1.0
+            alpha = game.driver.advance(0.0 if self.paused else min(max(elapsed, 0.0), 0.25) * self.speed) \
+                if not game.session.over else 1.0
             game.renderer.draw(screen.subsurface(area), game.session, alpha, self.hud(game))
         renderer = self.games[0].renderer
         for lab in labels + footer:

@@ -28,6 +28,12 @@ from .display import open_window, toggle_fullscreen
 
 SCENE_SIZE = (800, 800)
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
+#: The arrows skip this far in simulated time; a snapshot is kept every SKIP_SECONDS, so a skip back
+#: restores one and runs at most SKIP_SECONDS again, however long the demo has run.
+SKIP_SECONDS = 5.0
+#: The keys every demo window offers, as its help line says them (one set with the replays').
+HELP = ("p pause", "r restart", "-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s", "F11 fullscreen",
+        "Esc quit")
 #: Longest real time one frame may account for: after a stall (a dragged window) the demo skips ahead
 #: instead of running hundreds of catch-up steps in one frame.
 MAX_FRAME_TIME = 0.25
@@ -88,6 +94,7 @@ class DemoWindow:
         self.trails: list[deque[tuple[float, float]]] = []
         self.parted_at: float | None = None
         self.screen: Any = None
+        self._snapshots: dict[int, tuple[Any, Any]] = {}
 
     # ------------------------------------------------------------------ lifecycle
     def open(self) -> None:
@@ -109,8 +116,39 @@ class DemoWindow:
         self.accumulator = 0.0
         self.last_time = None
         self.parted_at = None
+        self._snapshots = {}
+        self._clear_trails()
+
+    def _clear_trails(self) -> None:
         keep = 2500 if self.name == "passive" else 90
         self.trails = [deque(maxlen=keep) for _ in self.run.states]
+
+    def _step(self) -> None:
+        """One physics step, keeping a snapshot every SKIP_SECONDS for the arrows to come back to."""
+        run = self.run
+        if run.steps % self._skip_steps() == 0:
+            self._snapshots[run.steps] = (run.states, run.previous)
+        run.step()
+
+    def _skip_steps(self) -> int:
+        return max(1, round(SKIP_SECONDS / self.run.dt))
+
+    def skip(self, seconds: float) -> None:
+        """Left and right: SKIP_SECONDS back (from the last snapshot before) or forth (run at once)."""
+        run = self.run
+        target = max(0, run.steps + round(seconds / run.dt))
+        if target < run.steps:
+            base = max(k for k in self._snapshots if k <= target)  # step 0 is always there once run
+            run.states, run.previous = self._snapshots[base]
+            run.steps = base
+            if self.parted_at is not None and self.parted_at > target * run.dt:
+                self.parted_at = None
+        while run.steps < target:
+            self._step()
+        self.accumulator = 0.0
+        self._clear_trails()
+        if self.name == "chaos" and self.parted_at is None and run.hand_distance() > VISIBLY_APART:
+            self.parted_at = run.t
 
     # --------------------------------------------------------------------- input
     def handle(self, event: Any) -> bool:
@@ -130,15 +168,17 @@ class DemoWindow:
             self.screen = toggle_fullscreen(self.windowed_size)
             self.fullscreen = bool(self.screen.get_flags() & pygame.FULLSCREEN)
             self.size = self.screen.get_size()
-        elif key in (pygame.K_SPACE, pygame.K_p):
+        elif key == pygame.K_p:
             self.paused = not self.paused
             self.last_time = None  # a pause must not count as elapsed time
         elif key == pygame.K_r:
             self.restart()
-        elif key in (pygame.K_RIGHT, pygame.K_UP, pygame.K_PLUS, pygame.K_EQUALS, pygame.K_KP_PLUS):
+        elif key in (pygame.K_PLUS, pygame.K_EQUALS, pygame.K_KP_PLUS):
             self.speed = next((s for s in SPEEDS if s > self.speed * 1.001), self.speed)
-        elif key in (pygame.K_LEFT, pygame.K_DOWN, pygame.K_MINUS, pygame.K_KP_MINUS):
+        elif key in (pygame.K_MINUS, pygame.K_KP_MINUS):
             self.speed = next((s for s in reversed(SPEEDS) if s < self.speed / 1.001), self.speed)
+        elif key in (pygame.K_LEFT, pygame.K_RIGHT):
+            self.skip(SKIP_SECONDS if key == pygame.K_RIGHT else -SKIP_SECONDS)
         elif key == pygame.K_1:
             self.speed = 1.0
         return True
@@ -154,7 +194,7 @@ class DemoWindow:
         self.accumulator += elapsed * self.speed
         dt = self.run.dt
         while self.accumulator >= dt:
-            self.run.step()
+            self._step()
             self.accumulator -= dt
         if self.name == "chaos" and self.parted_at is None and self.run.hand_distance() > VISIBLY_APART:
             self.parted_at = self.run.t
@@ -326,7 +366,7 @@ class DemoWindow:
         speed = f"{self.speed:g}x" + ("   PAUSED" if self.paused else "")
         self._text(f"t = {run.t:5.2f} s   speed {speed}", self.status_font, INK, (20, y + 8))
         self._text(self._status(), self.status_font, INK, (20, y + 36))
-        self._text("space pause   r restart   - + speed   F11 fullscreen   Esc quit", self.small_font, FAINT,
+        self._text("   ".join(("p resume", *HELP[1:]) if self.paused else HELP), self.small_font, FAINT,
                    (SCENE_SIZE[0] - 12, SCENE_SIZE[1] - 8), "bottomright")
         screen = pygame.display.get_surface()
         scale, offset = self.view()

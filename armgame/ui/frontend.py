@@ -35,10 +35,13 @@ from .settings import save as save_settings
 CAPTION = "armgame - hit the targets with the hand"
 DEFAULT_SIZE = (1200, 800)
 NAME_LENGTH = 24
-#: Keys still being mashed as the clock runs out must not type themselves into the name, nor close
-#: the end screen before the player has seen it.
+#: Keys still being mashed as the clock runs out must not type themselves into the name, nor play
+#: again before the player has seen the end screen: nothing typed in its first NAME_ENTRY_DELAY
+#: seconds counts, and a key held at the buzzer (or pressed in those first moments) types nothing,
+#: its repeats included, until it is let go.
 NAME_ENTRY_DELAY = 0.5
 END_KEY_DELAY = 0.8
+ENTER = ("return", "enter")
 COUNTDOWN = 3
 TRAIL_SECONDS = 1.0
 REPLAY_SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
@@ -75,6 +78,7 @@ class ReplaySource:
     config: GameConfig
     timeline: Sequence[InputEvent]
     stop_step: int
+    player: str | None = None  # named on the help line: whose game is being watched
 
     def start(self, step: int = 0) -> tuple[GameSession, TimelineDriver]:
         """A fresh session replayed to ``step`` at once: how the window skips back, deterministically."""
@@ -98,8 +102,11 @@ class GameWindow:
 
     ``driver``: the input when it is not the keyboard (a bot or a replay's timeline; keys then only
     pause and quit). ``replay``: a recorded game, which adds speed and skip keys. ``standing``: called
-    once when the end screen opens, with the name typed there (or None), returns the table's
-    standing to show (the command passes it in: the window knows nothing of score files).
+    once, with the name typed on the end screen (or None when none is asked), to keep the game and
+    return the table's standing to show; ``preview``: called when the end screen opens to ask a
+    name, returns where the score would stand without entering it, so that rank and table show at
+    once (the command passes both in: the window knows nothing of score files). On the end screen,
+    Enter saves the name, then Enter again sets ``play_again`` and closes (a replay: watches again).
     ``mode`` is the label that says what is on screen ("PLAY   seed 10", "AUTOPILOT: model",
     "REPLAY   Ann   2026-11-22 14:03"); ``countdown`` puts 3-2-1 before the clock (never for a
     replay); ``sounds`` plays hit, reset, tick, go and end; ``on_mute`` hears the m key (to persist it);
@@ -123,6 +130,7 @@ class GameWindow:
         standing: Callable[[str | None], Standing | None] | None = None,
         on_mute: Callable[[bool], None] | None = None,
         replay: ReplaySource | None = None,
+        preview: Callable[[], Standing | None] | None = None,
     ) -> None:
         self.session = session
         self.screen = screen
@@ -143,7 +151,13 @@ class GameWindow:
         self.sounds = sounds
         self.trail_on = trail
         self.standing_of = standing
+        self.preview = preview
         self.standing: Standing | None = None
+        #: Enter on the finished game's end screen: the command starts the next game with the same options.
+        self.play_again = False
+        #: Keys down now (from the events seen), and those that may not type into the name until let go.
+        self._down: set[int] = set()
+        self._blocked: set[int] = set()
         self.on_mute = on_mute
         self.ended = False
         self._over_for = 0.0
@@ -175,11 +189,13 @@ class GameWindow:
         if self.keyboard:
             items += [f"{keys[0]}/{keys[1]} shoulder", f"{keys[2]}/{keys[3]} elbow",
                       f"space reset (-{self.session.config.reset_cost})", "tab hide arm"]
-        items.append("p pause")
         if self.replay is not None:
-            items += ["-/+ speed", "left/right 5 s"]
+            items.insert(0, f"watching {self.replay.player}'s game" if self.replay.player else "watching a game")
+        items.append("p resume" if self.paused else "p pause")
+        if self.replay is not None:
+            items += ["-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s"]
         if self.sounds is not None and getattr(self.sounds, "available", False) and self._mute_key_free():
-            items.append("m sound on" if self.sounds.muted else "m mute")
+            items.append("m unmute" if self.sounds.muted else "m mute")
         items += ["F11 fullscreen", "Esc quit"]
         return tuple(items)
 
@@ -187,6 +203,7 @@ class GameWindow:
         return not (self.keyboard and "m" in self.session.muscles.keys)
 
     def handle(self, event: pygame.event.Event) -> None:
+        self._track(event)
         if event.type == pygame.QUIT:
             self.running = False
         elif event.type == pygame.VIDEORESIZE and not self.fullscreen:
@@ -203,6 +220,25 @@ class GameWindow:
         elif event.type == pygame.WINDOWFOCUSLOST and not self.finished:
             self.set_paused(True)
 
+    def _track(self, event: pygame.event.Event) -> None:
+        """Which keys are held, and which of them are the game's (held at the buzzer, or mashed as the
+        end screen opens): those type nothing into the name, repeats included, until released."""
+        if event.type == pygame.KEYDOWN:
+            self._down.add(event.key)
+            if self.name_entry is not None and self._over_for < NAME_ENTRY_DELAY:
+                self._blocked.add(event.key)
+        elif event.type == pygame.KEYUP:
+            self._down.discard(event.key)
+            self._blocked.discard(event.key)
+        elif event.type == pygame.WINDOWFOCUSLOST:  # the releases go elsewhere
+            self._down.clear()
+            self._blocked.clear()
+
+    @property
+    def typing(self) -> bool:
+        """The name box takes keys: the end screen has been up a moment and no game key is still held."""
+        return self.name_entry is not None and self._over_for >= NAME_ENTRY_DELAY and not self._blocked
+
     def _key_down(self, event: pygame.event.Event) -> None:
         name = key_name(event)
         if name == "escape":
@@ -210,8 +246,7 @@ class GameWindow:
         elif name == "f11":
             self._toggle_fullscreen()
         elif self.ended:
-            if self._over_for >= END_KEY_DELAY:
-                self.running = False
+            self._end_key(name)
         elif name == "m" and self.sounds is not None and self._mute_key_free():
             muted = self.sounds.toggle()
             if self.on_mute is not None:
@@ -229,9 +264,9 @@ class GameWindow:
             self.session.key_event(name, DOWN)
 
     def _replay_key(self, name: str) -> None:
-        if name in ("+", "=", "up", "[+]", "keypad +"):
+        if name in ("+", "=", "[+]", "keypad +"):
             self.speed = next((s for s in REPLAY_SPEEDS if s > self.speed), self.speed)
-        elif name in ("-", "down", "[-]", "keypad -"):
+        elif name in ("-", "[-]", "keypad -"):
             self.speed = next((s for s in reversed(REPLAY_SPEEDS) if s < self.speed), self.speed)
         elif name == "1":
             self.speed = 1.0
@@ -239,6 +274,17 @@ class GameWindow:
             dt = self.session.config.dt
             skip = round(SKIP_SECONDS / dt) * (1 if name == "right" else -1)
             self.skip_to(self.session.steps + skip)
+
+    def _end_key(self, name: str) -> None:
+        """The end screen: Enter plays again (a replay: watches again); a replay's keys still move it."""
+        if name in ENTER and self._over_for >= END_KEY_DELAY:
+            if self.replay is not None:
+                self.skip_to(0)
+            else:
+                self.play_again = True
+                self.running = False
+        elif self.replay is not None:
+            self._replay_key(name)
 
     def skip_to(self, step: int) -> None:
         """Show the replay at ``step``: forward by running on, back by replaying from the start."""
@@ -251,26 +297,30 @@ class GameWindow:
             seek(self.driver, step)  # type: ignore[arg-type]
         self.trail.clear()
         self.alpha = 1.0
+        if not self.finished:  # skipped back from the end: the replay plays on
+            self.ended = False
 
     def _type_name(self, event: pygame.event.Event) -> None:
         if event.type == pygame.TEXTINPUT:
-            if self._over_for >= NAME_ENTRY_DELAY:
+            if self.typing:
                 typed = "".join(c for c in event.text if c.isprintable())
                 self.name_entry = (self.name_entry + typed)[:NAME_LENGTH]
             return
         name = key_name(event)
         if name == "escape":
             self.running = False
+        elif name == "f11":
+            self._toggle_fullscreen()
+        elif not self.typing:
+            return
         elif name == "backspace":
             self.name_entry = self.name_entry[:-1]
-        elif name in ("return", "enter") and self.name_entry.strip():
+        elif name in ENTER and self.name_entry.strip():
             self.player_name = self.name_entry.strip()
             self.name_entry = None
             pygame.key.stop_text_input()
             self._over_for = 0.0
             self._show_standing(self.player_name)
-        elif name == "f11":
-            self._toggle_fullscreen()
 
     def set_paused(self, paused: bool) -> None:
         if paused and self.keyboard:
@@ -326,7 +376,10 @@ class GameWindow:
         self._play("end")
         if self.ask_name and self.player_name is None and self.session.over:
             self.name_entry = ""
+            self._blocked = set(self._down)  # held at the buzzer: typing waits for their release
             pygame.key.start_text_input()
+            if self.preview is not None:
+                self.standing = self.preview()
         else:
             self._show_standing(None)
 
@@ -335,7 +388,8 @@ class GameWindow:
         self.hits = [h for h in self.hits if 0.0 <= now - h[2] < PLUS_ONE_TIME]
         hud = Hud(mode=self.mode, help=self.help_items(), paused=self.paused,
                   countdown=None if self.countdown_left is None else math.ceil(self.countdown_left),
-                  name_entry=self.name_entry, standing=self.standing, ended=self.ended,
+                  name_entry=self.name_entry, name_limit=NAME_LENGTH, standing=self.standing, ended=self.ended,
+                  end_hint=self._end_hint(),
                   hits=[(x, y, now - t) for x, y, t in self.hits],
                   trail=[(x, y) for _, x, y in self.trail])
         if self.replay is not None:
@@ -343,6 +397,14 @@ class GameWindow:
             hud.progress = (self.session.steps * dt, self.replay.stop_step * dt)
             hud.speed = self.speed
         return hud
+
+    def _end_hint(self) -> str:
+        """The end screen's keys, as actions."""
+        if self.name_entry is not None:
+            return "Enter saves    Esc quits (the game's replay is kept)"
+        if self.replay is not None:
+            return "Enter watches again    left/right 5 s    Esc quits"
+        return "Enter plays again    Esc quits"
 
     def _update_trail(self) -> None:
         if not self.trail_on:
@@ -388,15 +450,29 @@ class GameWindow:
         return self.session
 
 
+@dataclass
+class NextGame:
+    """What the command hands the window for one more game (Enter on the end screen)."""
+
+    session: GameSession
+    driver: RealTimeDriver | None = None
+    standing: Callable[[str | None], Standing | None] | None = None
+    preview: Callable[[], Standing | None] | None = None
+
+
 def play_window(session: GameSession, settings: Settings, settings_path: Path, *, fullscreen: bool = False,
                 fps: int = 60, driver: RealTimeDriver | None = None, ask_name: bool = False, trail: bool = False,
                 standing: Callable[[str | None], Standing | None] | None = None, mode: str = "PLAY",
-                replay: ReplaySource | None = None, caption: str = CAPTION) -> GameWindow:
-    """Open the window, play until the player quits, close it; returns the window (its session, name).
+                replay: ReplaySource | None = None, caption: str = CAPTION,
+                preview: Callable[[], Standing | None] | None = None,
+                next_game: Callable[[GameWindow], NextGame | None] | None = None) -> GameWindow:
+    """Open the window, play until the player quits, close it; returns the last game's window.
 
     ``settings`` (``armgame.ui.settings.Settings``) give the size, palette and mute; a change made in
     the window (m, a resize) is written back to ``settings_path``, re-read first so that an edit made
-    meanwhile is kept. Sounds play only if the mixer opens.
+    meanwhile is kept. Sounds play only if the mixer opens. When the player asks to play again,
+    ``next_game`` is given the finished window (the command keeps that game) and returns the next
+    game, played in the same window with the same options (None: no more games).
     """
     import sys
 
@@ -412,11 +488,17 @@ def play_window(session: GameSession, settings: Settings, settings_path: Path, *
     screen = open_window(settings.size, fullscreen, caption)
     sounds = Sounds(muted=settings.mute)
     try:
-        window = GameWindow(session, screen, fps=fps, driver=driver, ask_name=ask_name, mode=mode,
-                            sounds=sounds, trail=trail, palette=settings.palette,
-                            standing=standing, on_mute=lambda muted: remember(mute=muted), replay=replay)
-        window.run()
-        if window.resized:
+        game: NextGame | None = NextGame(session, driver, standing, preview)
+        resized = False
+        while game is not None:
+            window = GameWindow(game.session, screen, fps=fps, driver=game.driver, ask_name=ask_name, mode=mode,
+                                sounds=sounds, trail=trail, palette=settings.palette, standing=game.standing,
+                                preview=game.preview, on_mute=lambda muted: remember(mute=muted), replay=replay)
+            window.run()
+            screen = window.screen
+            resized = resized or window.resized
+            game = next_game(window) if window.play_again and next_game is not None else None
+        if resized:
             w, h = window.windowed_size
             remember(size=(max(MIN_SIDE, w), max(MIN_SIDE, h)))
     finally:

@@ -125,12 +125,19 @@ class Viewport:
 
 @dataclass(frozen=True)
 class Standing:
-    """Where a finished game stands in the high-score table (from the command, never read here)."""
+    """Where a finished game stands in the high-score table (from the command, never read here).
+
+    ``list_name`` is the heading of the list the game went to (or would go to), as the scores layer
+    names it: the ranked table, custom games, programs, practice. ``pending``: the game is not entered
+    yet (its name is being typed): ``rank`` and ``entries`` say where it would stand, and its own row
+    in ``top`` has an empty name, drawn as the name being typed.
+    """
 
     rank: int | None  # None: the game was not entered
     entries: int
-    top: tuple[tuple[int, str, int], ...]  # (rank, name, score), best first
+    top: tuple[tuple[int, str, int], ...]  # (rank, name, score), best first; the game's own row may follow
     list_name: str = "the ranked table"  # the list the game went to: ranked, practice, programs, custom games
+    pending: bool = False
 
 
 @dataclass
@@ -142,7 +149,9 @@ class Hud:
     paused: bool = False
     countdown: int | None = None  # 3, 2, 1 before the clock starts
     name_entry: str | None = None  # the name being typed on the end screen
+    name_limit: int = 24
     standing: Standing | None = None
+    end_hint: str = "Esc quits"  # the end screen's keys
     ended: bool = False  # the end screen
     progress: tuple[float, float] | None = None  # a replay: seconds shown, seconds recorded
     speed: float | None = None
@@ -169,6 +178,7 @@ class Layout:
     panels: list[pygame.Rect] = field(default_factory=list)
     progress: tuple[pygame.Rect, float] | None = None
     name_box: pygame.Rect | None = None
+    rules: list[tuple[int, int, int]] = field(default_factory=list)  # left, right, y: a table's heading line
 
     @property
     def unit(self) -> float:
@@ -382,7 +392,10 @@ class GameRenderer:
 
     def _end_panel(self, lay: Layout, session: GameSession, hud: Hud, big: int, normal: int, small: int,
                    gap: int) -> None:
-        """The end screen: it covers the whole window, the game being over."""
+        """The end screen, over the whole window (the game being over): the score, where it stands and
+        the table's top under the list's heading, all at once; then the name box while a name is asked;
+        then the keys. Rows of the table are left out from the bottom (never the game's own) if the
+        window is too short for all of them."""
         p = self.palette
         w, h = lay.size
         # The HUD is hidden under the panel: only the panel's text is laid out.
@@ -390,63 +403,91 @@ class GameRenderer:
         lay.bars = []
         lay.progress = None
         board = session.rules.board
-        lines: list[tuple[str, int, RGB, str]] = [
-            (f"Your score: {board.score}" if hud.mode.startswith("PLAY") else f"Score: {board.score}", big, p.ink,
-             "end"),
-            (f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}", normal, p.ink, "end"),
-        ]
-        if not hud.mode.startswith("PLAY"):  # whose game it was: a bot's, a replay's
-            lines.insert(0, (hud.mode.split("   ")[0], normal, p.ink, "end"))
-        if hud.name_entry is not None:
-            lines.append(("Type your name for the high-score table", normal, p.ink, "end"))
+        playing = hud.mode.startswith("PLAY")
+        lines: list[tuple[str, int, RGB]] = []
+        if not playing:  # whose game it was: a bot's, a replay's
+            lines.append((hud.mode.split("   ")[0], normal, p.ink))
+        lines += [(f"Your score: {board.score}" if playing else f"Score: {board.score}", big, p.ink),
+                  (f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}", normal, p.ink)]
         standing = hud.standing
-        if hud.name_entry is None and standing is not None:
+        rows: list[tuple[int, str, int]] = []
+        if standing is not None:
             if standing.rank is not None:
-                lines.append((f"Rank {standing.rank} of {standing.entries} in {standing.list_name}", normal, p.ink,
-                              "end"))
-            if standing.top:
-                lines.append(("Top 10", normal, p.ink, "end"))
+                would = "You would rank" if standing.pending else "Rank"
+                lines.append((f"{would} {standing.rank} of {standing.entries}", normal, p.ink))
+            else:
+                lines.append(("Not entered in the table", normal, p.ink))
+            rows = list(standing.top)
         margin = max(8, round(24 * lay.unit))
         panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
-        row_h = self.font(small).get_height() + gap // 2
-        content_h = sum(self.font(s).get_height() + gap for _, s, _, _ in lines)
+        heading = bool(rows) and standing is not None
+        content_h = sum(self.font(size).get_height() + gap for _, size, _ in lines)
+        if heading:
+            content_h += self.font(normal).get_height() + 2 * gap
         if hud.name_entry is not None:
-            content_h += self.font(normal).get_height() + 3 * gap
-        elif standing is not None:
-            content_h += row_h * len(standing.top)
+            content_h += self.font(small).get_height() + gap // 2 + self.font(normal).get_height() + 3 * gap
         content_h += self.font(small).get_height() + 2 * gap  # the hint
+        room = h - 2 * margin - content_h - 2 * margin
+        own = standing.rank if standing is not None else None
+        # The table in the size of the lines above it where it fits (the back row reads it), else smaller.
+        row_size = normal if len(rows) * (self.font(normal).get_height() + gap // 2) <= room else small
+        row_h = self.font(row_size).get_height() + gap // 2
+        while rows and len(rows) * row_h > room:  # too short a window: the table's last rows go first
+            drop = next((i for i in range(len(rows) - 1, -1, -1) if rows[i][0] != own), None)
+            if drop is None:
+                break
+            del rows[drop]
+        content_h += len(rows) * row_h
         panel = pygame.Rect(0, 0, panel_w, min(h - 2 * margin, content_h + 2 * margin))
         panel.center = (w // 2, h // 2)
         lay.panels.append(panel)
         inner = panel.inflate(-2 * margin, -2 * margin)
         y = inner.top
-        for text, size, colour, role in lines:
-            lab = self.label(self.fit_text(text, size, inner.width), size, colour, role,
-                             midtop=(inner.centerx, y))
+        for text, size, colour in lines:
+            lab = self.label(self.fit_text(text, size, inner.width), size, colour, "end", midtop=(inner.centerx, y))
             lay.labels.append(lab)
             y = lab.rect.bottom + gap
+        if heading:
+            title = standing.list_name[:1].upper() + standing.list_name[1:]
+            lab = self.label(self.fit_text(title, normal, inner.width), normal, p.ink, "heading",
+                             midtop=(inner.centerx, y + gap))
+            lay.labels.append(lab)
+            lay.rules.append((inner.left, inner.right, lab.rect.bottom + gap // 2))
+            y = lab.rect.bottom + gap
+            cell = row_size
+            rank_w = self.text_size("999.", cell)[0] + gap
+            score_w = self.text_size("9999", cell)[0]
+            name_w = inner.width - rank_w - score_w - 2 * gap
+            for rank, name, score in rows:
+                mine = rank == own
+                if mine and standing.pending:
+                    name = hud.name_entry or "you"
+                colour = p.warn if mine else p.ink
+                lay.labels.append(self.label(f"{rank}.", cell, colour, "table",
+                                             topright=(inner.left + rank_w - gap, y)))
+                if name:
+                    lay.labels.append(self.label(self.fit_text(name, cell, name_w), cell, colour, "table",
+                                                 topleft=(inner.left + rank_w, y)))
+                lay.labels.append(self.label(str(score), cell, colour, "table", topright=(inner.right, y)))
+                y += row_h
         if hud.name_entry is not None:
+            y += gap
+            counter = f"{len(hud.name_entry)}/{hud.name_limit}"
+            ask = self.label(self.fit_text("Type your name for the table", small,
+                                           inner.width - self.text_size(counter, small)[0] - 2 * gap),
+                             small, p.ink, "end", topleft=(inner.left, y))
+            lay.labels.append(ask)
+            # The length limit, visible as the name is typed (the box takes no more).
+            lay.labels.append(self.label(counter, small, p.warn if len(hud.name_entry) >= hud.name_limit
+                                         else p.faint, "counter", topright=(inner.right, y)))
+            y = ask.rect.bottom + gap // 2
             box_h = self.font(normal).get_height() + 2 * gap
             lay.name_box = pygame.Rect(inner.left, y, inner.width, box_h)
             typed = self.fit_text(hud.name_entry + "|", normal, inner.width - 2 * gap)
             lay.labels.append(self.label(typed, normal, p.ink, "name",
                                          midleft=(inner.left + gap, lay.name_box.centery)))
-            y = lay.name_box.bottom + gap
-            hint = "Enter saves   Esc quits without saving"
-        else:
-            if standing is not None:
-                rank_w = self.font(small).size("10.")[0] + gap
-                score_w = self.font(small).size("9999")[0]
-                name_w = inner.width - rank_w - score_w - 2 * gap
-                for rank, name, score in standing.top:
-                    colour = p.warn if rank == standing.rank else p.ink
-                    lay.labels.append(self.label(f"{rank}.", small, colour, "table",
-                                                 topright=(inner.left + rank_w - gap, y)))
-                    lay.labels.append(self.label(self.fit_text(name, small, name_w), small, colour, "table",
-                                                 topleft=(inner.left + rank_w, y)))
-                    lay.labels.append(self.label(str(score), small, colour, "table", topright=(inner.right, y)))
-                    y += row_h
-            hint = "press any key to close"
+            y = lay.name_box.bottom
+        hint = self.fit_text(hud.end_hint, small, inner.width)
         lay.labels.append(self.label(hint, small, p.faint, "end", midtop=(inner.centerx, y + gap)))
 
     # ------------------------------------------------------------------ drawing
@@ -529,6 +570,8 @@ class GameRenderer:
         for panel in lay.panels:
             pygame.draw.rect(screen, p.panel, panel, border_radius=radius)
             pygame.draw.rect(screen, p.edge, panel, max(1, round(2 * lay.unit)), border_radius=radius)
+        for left, right, y in lay.rules:
+            pygame.draw.line(screen, p.faint, (left, y), (right, y), max(1, round(2 * lay.unit)))
         if lay.name_box is not None:
             pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2)
             pygame.draw.rect(screen, p.ink, lay.name_box, max(1, round(2 * lay.unit)), border_radius=radius // 2)

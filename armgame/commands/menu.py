@@ -1,0 +1,192 @@
+"""``armgame`` with no command: the menu window (``armgame.ui.menu``), or the commands where no window can open.
+
+Each entry runs the command a user would type (``armgame play``, ``armgame lab curl``, ...) through
+``armgame.cli.main`` in this process, so options, settings, errors and what is printed are exactly
+the command's own; its window closes back to the menu. Where there is no display (a terminal over
+ssh, a CI job), or pygame is missing, the commands are printed instead and the exit status is 0:
+``armgame`` alone is how a newcomer asks what there is.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+#: How many replays "Replays and scores" lists (newest first), and how many files it looks at to find them.
+RECENT_REPLAYS = 9
+MAX_SCANNED = 5000
+LAB_PRESETS = {
+    "null": "nothing changed: reaches as they are (a baseline)",
+    "curl": "a curl force field pushes the hand sideways",
+    "rotation": "the cursor turned 30 degrees from the hand",
+    "mirror": "the cursor mirrored left to right",
+    "jointspace": "the cursor driven by the joint angles, not the hand",
+}
+
+
+def commands_table(parser: argparse.ArgumentParser) -> str:
+    """Every command and what it does, one a line (what ``armgame`` prints where no window opens)."""
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    helps = {action.dest: action.help or "" for action in sub._choices_actions}
+    width = max(len(name) for name in helps)
+    lines = ["armgame: no display here for the menu; the commands (armgame COMMAND --help lists the options):"]
+    lines += [f"  armgame {name:<{width}}  {text}" for name, text in helps.items()]
+    return "\n".join(lines)
+
+
+def no_display_in_environment() -> bool:
+    """No X11 or Wayland session to open a window in, told without loading SDL (Linux and BSDs only:
+    elsewhere SDL is asked, through ``armgame.ui.display.init_display``)."""
+    if not sys.platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
+        return False
+    return not any(os.environ.get(name) for name in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"))
+
+
+def run(parser: argparse.ArgumentParser, launch: Callable[[Sequence[str]], int]) -> int:
+    """The menu until it is quit; ``launch`` runs one command line (``armgame.cli.main``)."""
+    from ..errors import NoDisplayError
+
+    if no_display_in_environment():
+        print(commands_table(parser))
+        return 0
+    try:
+        import pygame
+
+        from ..ui.display import init_display
+        from ..ui.menu import run_menu
+
+        init_display()
+    except (ImportError, NoDisplayError):
+        print(commands_table(parser))
+        return 0
+    pygame.display.quit()  # the menu opens its own window, and reopens it after each entry
+    from ..ui.options import window_settings
+
+    settings, _ = window_settings(argparse.Namespace())
+    run_menu(lambda: main_page(launch), palette=settings.palette, size=settings.size)
+    return 0
+
+
+def _start(launch: Callable[[Sequence[str]], int], *argv: str) -> Callable[[], str | None]:
+    def start() -> str | None:
+        code = launch(list(argv))
+        return None if code == 0 else f"armgame {' '.join(argv)} stopped (status {code}): the terminal says why"
+
+    return start
+
+
+def main_page(launch: Callable[[Sequence[str]], int]):
+    from ..ui.menu import Item, Page
+
+    return Page("armgame", [
+        Item("Play", "the game: hit the targets with d f j k, one minute", start=_start(launch, "play")),
+        Item("Lab", "reach in a force field or a changed display, and adapt",
+             page=lambda: lab_page(launch)),
+        Item("Demos", "the arm's dynamics, one idea at a time", page=lambda: demos_page(launch)),
+        Item("Replays and scores", "the high-score table and the games recorded", page=lambda: replays_page(launch)),
+        Item("Settings", "sound, colours, where the settings file is", page=settings_page),
+        Item("Quit", "close armgame", quit=True),
+    ])
+
+
+def lab_page(launch: Callable[[Sequence[str]], int]):
+    from ..ui.menu import Item, Page
+
+    return Page("Lab", [Item(name, detail, start=_start(launch, "lab", name)) for name, detail in LAB_PRESETS.items()],
+                lines=("Centre-out reaches: baseline, exposure, washout. The window says what to do.",))
+
+
+def demos_page(launch: Callable[[Sequence[str]], int]):
+    from ..demos import DEMO_NAMES
+    from ..demos.catalog import get_info
+    from ..ui.menu import Item, Page
+
+    items = [Item(name, get_info(name).title.removeprefix("armgame demo: "), start=_start(launch, "demo", name))
+             for name in DEMO_NAMES]
+    items.append(Item("autopilot", "two bots play the game: one knows the interaction torques",
+                      start=_start(launch, "demo", "autopilot")))
+    return Page("Demos", items)
+
+
+def recent_replays(folder: Path, limit: int = RECENT_REPLAYS) -> list[Path]:
+    """The newest regular ``*.json`` files in ``folder`` (no symlink followed), at most MAX_SCANNED looked at."""
+    found: list[tuple[float, Path]] = []
+    try:
+        with os.scandir(folder) as entries:
+            for n, entry in enumerate(entries):
+                if n >= MAX_SCANNED:
+                    break
+                if entry.name.endswith(".json") and entry.is_file(follow_symlinks=False):
+                    found.append((entry.stat(follow_symlinks=False).st_mtime, Path(entry.path)))
+    except OSError:
+        return []
+    return [path for _, path in sorted(found, reverse=True)[:limit]]
+
+
+def replays_page(launch: Callable[[Sequence[str]], int]):
+    """The ranked table's top five (as recorded: ``armgame scores`` checks them) and the newest replays."""
+    from ..records.replay import Replay
+    from ..records.scores import ScoreTable, default_scores_dir
+    from ..records.storage import DataFileError
+    from ..ui.menu import Item, Page
+    from . import read_lab_replays
+
+    read_lab_replays()
+    warnings: list[str] = []
+    lines: list[str] = []
+    try:
+        table = ScoreTable(default_scores_dir(), warn=warnings.append)
+        entries = table.entries()
+        lines.append(f"The ranked table ({table.path}):" if entries else f"No ranked scores yet in {table.path}")
+        lines += [f"{i}. {e.name}   {e.score}" for i, e in enumerate(entries[:5], 1)]
+        folder = table.replays
+    except (DataFileError, OSError) as exc:
+        lines.append(f"the table cannot be read: {exc}")
+        folder = None
+    lines += warnings[:1]
+    items = []
+    for path in recent_replays(folder) if folder is not None else []:
+        try:
+            replay = Replay.load(path, follow=False)
+        except (DataFileError, OSError, ValueError) as exc:
+            items.append(Item(path.name, f"cannot be read: {exc}"))
+            continue
+        when = replay.date[:16].replace("T", " ") if replay.date else "date unknown"
+        items.append(Item(f"watch {replay.player or 'no name'}: score {replay.result.score}",
+                          f"{when}, seed {replay.config.seed}, {replay.result.duration:g} s",
+                          start=_start(launch, "replay", str(path))))
+    if not items:
+        lines.append("No replays yet: play a game, and its replay is kept here.")
+    return Page("Replays and scores", items, lines=lines)
+
+
+def settings_page():
+    from ..ui.menu import Item, Page
+    from ..ui.settings import PALETTES, SettingsError, load, save
+
+    try:
+        settings, path = load()
+    except SettingsError as exc:
+        return Page("Settings", [], lines=(f"the settings file cannot be used: {exc}",))
+
+    def change(**changes: object) -> Callable[[], str | None]:
+        def act() -> str | None:
+            try:
+                current, _ = load(path)
+                save(current.with_changes(**changes), path)
+            except SettingsError as exc:
+                return f"not saved: {exc}"
+            return f"saved to {path}"
+
+        return act
+
+    following = PALETTES[(PALETTES.index(settings.palette) + 1) % len(PALETTES)] \
+        if settings.palette in PALETTES else PALETTES[0]
+    return Page("Settings", [
+        Item(f"Sound: {'off' if settings.mute else 'on'}", "Enter: unmute" if settings.mute else "Enter: mute",
+             act=change(mute=not settings.mute)),
+        Item(f"Colours: {settings.palette}", f"Enter: {following}", act=change(palette=following)),
+    ], lines=(f"{path}", *settings.describe()))

@@ -1,0 +1,258 @@
+"""The front door: a menu window from which each of armgame's windows starts and to which it returns.
+
+The menu knows nothing of commands, score files or settings files: the command line hands it pages
+(``Page``) whose items either open another page or start something (``Item.start``, called with the
+menu's window closed, since every armgame window opens and closes the display itself). When that
+window closes, the menu opens again where it was. Keys: up/down (or the item's number) choose,
+Enter starts, Esc goes back (and quits at the first page), F11 fills the screen; the mouse hovers
+and clicks. Like the game's renderer, every frame is laid out before it is drawn (``MenuWindow.layout``),
+so the tests check at every window size that no text is cut, overlaps another or is too small.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import pygame
+
+from .display import open_window, toggle_fullscreen
+from .render import MIN_TEXT_AT_720, PALETTES, GameRenderer, Label
+
+CAPTION = "armgame"
+DEFAULT_SIZE = (1024, 720)
+
+
+@dataclass
+class Item:
+    """One line of a page: ``label`` and a short ``detail``. Enter opens ``page()`` (a page built when
+    it is opened, so it shows the table and files as they are now), or calls ``start()`` with the
+    menu's window closed (a window of its own), or ``act()`` with it open (a setting changed: the
+    page is built again to show it). ``start`` and ``act`` return a line for the menu to show, or None."""
+
+    label: str
+    detail: str = ""
+    page: Callable[[], Page] | None = None
+    start: Callable[[], str | None] | None = None
+    act: Callable[[], str | None] | None = None
+    quit: bool = False
+
+
+@dataclass
+class Page:
+    title: str
+    items: list[Item]
+    #: Lines shown above the items (the table's top, the settings in force).
+    lines: Sequence[str] = ()
+    selected: int = 0
+
+
+@dataclass
+class MenuLayout:
+    labels: list[Label] = field(default_factory=list)
+    #: The items shown (a long page scrolls to keep the chosen one in view): index and clickable rectangle.
+    rows: list[tuple[int, pygame.Rect]] = field(default_factory=list)
+
+    def boxes(self) -> list[tuple[str, pygame.Rect]]:
+        return [(f"{lab.role}: {lab.text}", lab.rect) for lab in self.labels]
+
+
+class MenuWindow:
+    """The menu in ``screen``; ``frame()`` handles events and draws, ``run()`` loops until quit."""
+
+    def __init__(self, root: Callable[[], Page], palette: str = "okabe-ito", fullscreen: bool = False,
+                 size: tuple[int, int] | None = None) -> None:
+        #: The pages open, first to current, each with what builds it again.
+        self.stack: list[tuple[Callable[[], Page], Page]] = [(root, root())]
+        self.palette = PALETTES.get(palette, PALETTES["okabe-ito"])
+        self.renderer = GameRenderer((), (), self.palette)
+        self.fullscreen = fullscreen
+        self.windowed_size = size
+        self.running = True
+        self.status = ""
+        #: An item to start once the menu's window is closed (set by Enter or a click).
+        self.pending: Item | None = None
+        self.screen: pygame.Surface | None = None
+
+    @property
+    def page(self) -> Page:
+        return self.stack[-1][1]
+
+    # ------------------------------------------------------------------ input
+    def choose(self, index: int) -> None:
+        page = self.page
+        if not 0 <= index < len(page.items):
+            return
+        page.selected = index
+        item = page.items[index]
+        if item.page is not None:
+            self.stack.append((item.page, item.page()))
+            self.status = ""
+        elif item.start is not None:
+            self.pending = item
+        elif item.act is not None:
+            self.status = item.act() or ""
+            self.refresh()
+        elif item.quit:
+            self.running = False
+
+    def refresh(self) -> None:
+        """Build the current page again (after a change it shows), keeping the choice."""
+        build, old = self.stack[-1]
+        page = build()
+        page.selected = min(old.selected, max(len(page.items) - 1, 0))
+        self.stack[-1] = (build, page)
+
+    def back(self) -> None:
+        if len(self.stack) > 1:
+            self.stack.pop()
+            self.status = ""
+        else:
+            self.running = False
+
+    def handle(self, event: pygame.event.Event) -> None:
+        page = self.page
+        if event.type == pygame.QUIT:
+            self.running = False
+        elif event.type == pygame.VIDEORESIZE and not self.fullscreen:
+            self.windowed_size = (event.w, event.h)
+        elif event.type == pygame.KEYDOWN:
+            name = pygame.key.name(event.key).lower()
+            if name == "escape":
+                self.back()
+            elif name == "f11":
+                self.screen = toggle_fullscreen(self.windowed_size or self.screen.get_size())
+                self.fullscreen = bool(self.screen.get_flags() & pygame.FULLSCREEN)
+            elif name in ("up", "down") and page.items:
+                page.selected = (page.selected + (1 if name == "down" else -1)) % len(page.items)
+            elif name in ("return", "enter", "right"):
+                self.choose(page.selected)
+            elif name in ("left", "backspace"):
+                if len(self.stack) > 1:
+                    self.back()
+            elif name.isdigit() and name != "0":
+                self.choose(int(name) - 1)
+        elif event.type == pygame.MOUSEMOTION and self.screen is not None:
+            hit = self._row_at(event.pos)
+            if hit is not None:
+                page.selected = hit
+        elif event.type == pygame.MOUSEBUTTONDOWN and event.button == 1 and self.screen is not None:
+            hit = self._row_at(event.pos)
+            if hit is not None:
+                self.choose(hit)
+        elif event.type == pygame.MOUSEBUTTONDOWN and event.button == 3:
+            self.back()
+
+    def _row_at(self, pos: tuple[int, int]) -> int | None:
+        rows = self.layout(self.screen.get_size()).rows
+        return next((i for i, r in rows if r.collidepoint(pos)), None)
+
+    def help_items(self) -> tuple[str, ...]:
+        back = "Esc back" if len(self.stack) > 1 else "Esc quit"
+        count = min(len(self.page.items), 9)
+        number = (f"1-{count} start that one",) if count > 1 else ()
+        return ("up/down choose", "Enter start", *number, back, "F11 fullscreen", "click to start")
+
+    # ----------------------------------------------------------------- layout
+    def layout(self, size: tuple[int, int]) -> MenuLayout:
+        """Where every text goes in a window of ``size`` (pure geometry)."""
+        w, h = size
+        u = min(w, h) / 720.0
+        r, p = self.renderer, self.palette
+        small = max(round(MIN_TEXT_AT_720 * min(size) / 720), round(0.025 * h), round(20 * u))
+        normal = max(small + 2, round(30 * u))
+        big = max(normal + 4, round(56 * u))
+        pad, gap = max(8, round(28 * u)), max(4, round(10 * u))
+        lay = MenuLayout()
+        width = w - 2 * pad
+        y = pad
+        title = r.label(r.fit_text(self.page.title, big, width), big, p.ink, "title", midtop=(w // 2, y))
+        lay.labels.append(title)
+        y = title.rect.bottom + gap
+        help_lines = r.wrap_items(self.help_items(), small, width, gap)
+        line_h = r.font(small).get_height()
+        bottom = h - pad - len(help_lines) * (line_h + gap // 2)
+        if self.status:
+            bottom -= line_h + gap
+        for line in self.page.lines:
+            if y + line_h > bottom:
+                break
+            lay.labels.append(r.label(r.fit_text(line, small, width), small, p.faint, "line", midtop=(w // 2, y)))
+            y = lay.labels[-1].rect.bottom + gap // 2
+        y += gap
+        column = min(width, max(round(800 * u), 280))
+        left = (w - column) // 2
+        row_h = r.font(normal).get_height() + r.font(small).get_height() + 2 * gap
+        items = self.page.items
+        fit = max(1, (bottom - y) // (row_h + gap // 2))
+        first = min(max(0, self.page.selected - fit + 1), max(0, len(items) - fit))  # the chosen one in view
+        for i in range(first, min(len(items), first + fit)):
+            item = items[i]
+            rect = pygame.Rect(left, y, column, row_h)
+            lay.rows.append((i, rect))
+            colour = p.ink
+            number = f"{i + 1}  " if i < 9 else "    "
+            lay.labels.append(r.label(r.fit_text(number + item.label, normal, column - 2 * gap), normal, colour,
+                                      "item", topleft=(left + gap, y + gap // 2)))
+            if item.detail:
+                lay.labels.append(r.label(r.fit_text(item.detail, small, column - 2 * gap), small, p.faint,
+                                          "detail", topleft=(left + gap, lay.labels[-1].rect.bottom)))
+            y = rect.bottom + gap // 2
+        y = h - pad
+        for line in reversed(help_lines):
+            lay.labels.append(r.label(line, small, p.faint, "help", midbottom=(w // 2, y)))
+            y = lay.labels[-1].rect.top - gap // 2
+        if self.status:
+            lay.labels.append(r.label(r.fit_text(self.status, small, width), small, p.warn, "status",
+                                      midbottom=(w // 2, y - gap // 2)))
+        return lay
+
+    def draw(self) -> MenuLayout:
+        screen = self.screen = pygame.display.get_surface() or self.screen
+        lay = self.layout(screen.get_size())
+        p = self.palette
+        screen.fill(p.window)
+        radius = max(4, round(10 * min(screen.get_size()) / 720))
+        for i, rect in lay.rows:
+            selected = i == self.page.selected
+            pygame.draw.rect(screen, p.bar_back if selected else p.panel, rect, border_radius=radius)
+            pygame.draw.rect(screen, p.ink if selected else p.edge, rect,
+                             max(2, round(3 * min(screen.get_size()) / 720)) if selected else 1,
+                             border_radius=radius)
+        for lab in lay.labels:
+            screen.blit(self.renderer.text(lab.text, lab.height, lab.colour), lab.rect)
+        return lay
+
+    def frame(self) -> None:
+        for event in pygame.event.get():
+            self.handle(event)
+            if self.pending is not None or not self.running:
+                break
+        self.draw()
+        pygame.display.flip()
+
+
+def run_menu(root: Callable[[], Page], *, palette: str = "okabe-ito", size: tuple[int, int] | None = None,
+             fullscreen: bool = False, fps: int = 30, max_frames: int | None = None) -> MenuWindow:
+    """Show the menu until it is quit; each started item runs with the menu's window closed, then the
+    menu opens again on the same page, saying what the item returned."""
+    menu = MenuWindow(root, palette, fullscreen, size)
+    limiter = pygame.time.Clock()
+    frames = 0
+    while menu.running and (max_frames is None or frames < max_frames):
+        menu.screen = open_window(menu.windowed_size or size, menu.fullscreen, CAPTION, DEFAULT_SIZE)
+        try:
+            while menu.running and menu.pending is None and (max_frames is None or frames < max_frames):
+                menu.frame()
+                frames += 1
+                if fps:
+                    limiter.tick(fps)
+        finally:
+            if not menu.fullscreen:
+                menu.windowed_size = menu.screen.get_size()
+            pygame.display.quit()
+        item, menu.pending = menu.pending, None
+        if item is not None and item.start is not None:
+            menu.status = item.start() or ""
+            menu.refresh()  # what it did may show there (a new score, a new replay)
+    return menu

@@ -1,0 +1,185 @@
+"""`armgame` alone: the menu window under SDL's dummy driver (keys, mouse, each entry starting its
+window and coming back), its layout at every size, and the commands printed where no display is."""
+
+import os
+
+os.environ["SDL_VIDEODRIVER"] = "dummy"
+os.environ["SDL_AUDIODRIVER"] = "dummy"
+
+import subprocess
+import sys
+
+import pygame
+import pytest
+
+from armgame.commands import menu as menu_command
+from armgame.ui.menu import MenuWindow, run_menu
+from armgame.ui.render import MIN_TEXT_AT_720
+
+SIZES = [(640, 480), (1024, 768), (1280, 720), (1920, 1080), (720, 1280)]
+
+
+@pytest.fixture(autouse=True)
+def private_files(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
+    monkeypatch.setenv("ARMGAME_SCORES", str(tmp_path / "scores"))
+    yield
+    pygame.display.quit()
+
+
+def key(name):
+    return pygame.event.Event(pygame.KEYDOWN, key=pygame.key.key_code(name))
+
+
+def scripted(monkeypatch, script):
+    """Each frame of the menu first posts the next keys of ``script`` (Esc when it runs out).
+    Returns the pages' titles seen, frame by frame."""
+    real = MenuWindow.frame
+    seen = []
+
+    def frame(self):
+        assert pygame.display.get_surface() is not None  # the menu's own window is open
+        for name in script.pop(0) if script else ["escape"]:
+            pygame.event.post(key(name))
+        real(self)
+        seen.append(self.page.title)
+
+    monkeypatch.setattr(MenuWindow, "frame", frame)
+    return seen
+
+
+def test_each_entry_starts_its_window_and_the_menu_comes_back(monkeypatch):
+    launched = []
+
+    def launch(argv):
+        assert pygame.display.get_surface() is None  # the menu's window is closed while the command runs
+        launched.append(list(argv))
+        return 0 if argv[0] != "lab" else 2
+
+    seen = scripted(monkeypatch, [
+        ["return"],  # Play
+        ["down", "return"], ["2"],  # Lab, then its second preset
+        ["escape"], ["3"], ["6"],  # back; Demos, the sixth
+        ["escape"], ["4"], ["escape"], ["5"], ["escape"], ["6"],  # Replays and scores, Settings, Quit
+    ])
+    menu = run_menu(lambda: menu_command.main_page(launch), fps=0, max_frames=40)
+    assert launched == [["play"], ["lab", "curl"], ["demo", "autopilot"]]
+    assert not menu.running
+    # The page each frame showed: after each window, the menu is back on the page it started it from.
+    assert seen[:7] == ["armgame", "Lab", "Lab", "armgame", "Demos", "Demos", "armgame"]
+    assert "Replays and scores" in seen and "Settings" in seen
+
+
+def test_a_failed_entry_says_so_on_the_menu():
+    menu = MenuWindow(lambda: menu_command.main_page(lambda argv: 2))
+    menu.choose(0)
+    assert menu.pending is not None and menu.pending.start() == \
+        "armgame play stopped (status 2): the terminal says why"
+
+
+def test_the_mouse_chooses_and_clicks():
+    launched = []
+    menu = MenuWindow(lambda: menu_command.main_page(lambda argv: launched.append(argv) or 0))
+    pygame.display.init()
+    menu.screen = pygame.display.set_mode((1024, 768))
+    rows = dict(menu.layout((1024, 768)).rows)
+    assert sorted(rows) == list(range(6))
+    menu.handle(pygame.event.Event(pygame.MOUSEMOTION, pos=rows[2].center, rel=(0, 0), buttons=(0, 0, 0)))
+    assert menu.page.selected == 2
+    menu.handle(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=rows[2].center, button=1))
+    assert menu.page.title == "Demos"
+    menu.handle(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=(5, 5), button=3))  # right click: back
+    assert menu.page.title == "armgame"
+
+
+def test_play_from_the_menu_is_the_real_command_and_returns(monkeypatch, tmp_path, capsys):
+    """The whole path: the menu, `armgame play` in this process, its end screen's Esc, the menu again."""
+    from armgame.cli import main
+    from armgame.ui.frontend import GameWindow
+
+    def run(self, max_frames=None):
+        self.countdown_left = None
+        while not self.ended:
+            self.frame(0.25)
+        pygame.event.post(key("escape"))
+        self.frame(0.0)
+        return self.session
+
+    monkeypatch.setattr(GameWindow, "run", run)
+    seen = scripted(monkeypatch, [["return"], ["escape"]])
+    monkeypatch.setattr(menu_command, "_start", lambda launch, *argv: lambda: main([*argv, "--duration", "1"]) and
+                        "failed")
+    run_menu(lambda: menu_command.main_page(main), fps=0, max_frames=10)
+    out = capsys.readouterr().out
+    assert "your score is" in out and "to enter it later" in out
+    assert seen == ["armgame", "armgame"]
+
+
+def test_replays_and_scores_lists_the_table_and_watches_a_replay(tmp_path):
+    from armgame.game.bots import play_bot
+    from armgame.game.rules import GameConfig
+    from armgame.records.replay import Replay
+    from armgame.records.scores import ScoreTable
+
+    table = ScoreTable(tmp_path / "scores")
+    for name, seconds in (("Ann", 3.0), (None, 2.0)):
+        session = play_bot(GameConfig(time_limit=seconds, seed=2), "model")
+        table.save_replay(Replay.from_session(session, "bot", "model", name))
+    (tmp_path / "scores" / "replays" / "link.json").symlink_to(tmp_path / "elsewhere.json")
+    launched = []
+    page = menu_command.replays_page(lambda argv: launched.append(argv) or 0)
+    assert any("No ranked scores yet" in line for line in page.lines)
+    labels = sorted(item.label for item in page.items)
+    assert labels[0].startswith("watch Ann: score") and labels[1].startswith("watch no name: score")
+    assert len(page.items) == 2  # the symlink is not followed
+    page.items[0].start()
+    assert launched[0][0] == "replay" and launched[0][1].startswith(str(tmp_path / "scores" / "replays"))
+
+
+def test_settings_toggle_sound_and_colours_in_the_file(tmp_path):
+    from armgame.ui.settings import load
+
+    page = menu_command.settings_page()
+    assert page.items[0].label == "Sound: on" and page.items[0].detail == "Enter: mute"
+    assert page.items[0].act().startswith("saved to")
+    assert load()[0].mute
+    page = menu_command.settings_page()
+    assert page.items[0].label == "Sound: off" and page.items[0].detail == "Enter: unmute"
+    page.items[1].act()
+    assert load()[0].palette == menu_command.settings_page().items[1].label.split(": ")[1] != "okabe-ito"
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_every_page_fits_every_window(size):
+    pygame.display.init()
+    pygame.font.init()
+    min_height = int(MIN_TEXT_AT_720 * min(size) / 720)
+    window = pygame.Rect((0, 0), size)
+    pages = [lambda: menu_command.main_page(lambda argv: 0), lambda: menu_command.demos_page(lambda argv: 0),
+             lambda: menu_command.lab_page(lambda argv: 0), menu_command.settings_page]
+    for build in pages:
+        menu = MenuWindow(build)
+        menu.status = "armgame play stopped (status 2): the terminal says why"
+        lay = menu.layout(size)
+        boxes = lay.boxes()
+        assert len(lay.rows) == len(menu.page.items), (size, menu.page.title)  # every item reachable by mouse
+        if len(menu.page.items) > 3:  # a long page scrolls: the last item chosen is in view
+            menu.page.selected = len(menu.page.items) - 1
+            assert menu.layout(size).rows[-1][0] == menu.page.selected
+        for i, (name, rect) in enumerate(boxes):
+            assert window.contains(rect) and rect.height >= min_height, (size, name, rect)
+            for other, r in boxes[i + 1:]:
+                assert not rect.colliderect(r), (size, name, other)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the no-display check is Linux's here")
+def test_no_display_prints_the_commands_and_exits_0(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
+    code = "import sys\nfrom armgame.cli import main\ncode = main([])\nprint('pygame' in sys.modules)\nsys.exit(code)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=20)
+    assert out.returncode == 0 and out.stderr == ""
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("armgame: no display here for the menu")
+    assert any(line.split()[:2] == ["armgame", "play"] for line in lines)
+    assert any(line.split()[:2] == ["armgame", "analyze"] for line in lines)
+    assert lines[-1] == "False"  # pygame never loaded
