@@ -48,30 +48,44 @@ class Palette:
     bar_back: RGB
     muscles: tuple[RGB, RGB, RGB, RGB]
     panel: RGB
+    skin: RGB  # the body's fill (its outline is ``link``)
 
 
 PALETTES: dict[str, Palette] = {
     # Okabe & Ito (2008), "Color Universal Design": distinguishable with every common colour-vision
     # deficiency. Blue/orange for the shoulder pair, bluish green/reddish purple for the elbow pair.
+    # Lines (trail, edge) are at least 3:1 on the scene and the workspace: a projector washes out the rest.
     "okabe-ito": Palette(
         "okabe-ito", window=(232, 235, 240), scene=(251, 251, 249), workspace=(240, 243, 248),
-        edge=(200, 205, 214), ink=(22, 26, 34), faint=(70, 76, 88), link=(62, 68, 82), base=(120, 126, 138),
-        hand=(15, 15, 20), target=(213, 94, 0), flash=(240, 228, 66), trail=(86, 180, 233), warn=(176, 58, 0),
+        edge=(120, 126, 138), ink=(22, 26, 34), faint=(70, 76, 88), link=(62, 68, 82), base=(120, 126, 138),
+        hand=(15, 15, 20), target=(213, 94, 0), flash=(240, 228, 66), trail=(30, 136, 200), warn=(176, 58, 0),
         bar_back=(214, 219, 227), muscles=((0, 114, 178), (230, 159, 0), (0, 158, 115), (204, 121, 167)),
-        panel=(255, 255, 255),
+        panel=(255, 255, 255), skin=(236, 226, 214),
     ),
     # The 2012 game's colours (red target, black hand), on the same layout.
     "classic": Palette(
         "classic", window=(235, 235, 235), scene=(255, 255, 255), workspace=(246, 246, 246),
-        edge=(205, 205, 205), ink=(20, 20, 20), faint=(80, 80, 80), link=(70, 70, 80), base=(120, 120, 120),
-        hand=(0, 0, 0), target=(220, 30, 30), flash=(255, 200, 0), trail=(120, 160, 220), warn=(180, 0, 0),
+        edge=(125, 125, 125), ink=(20, 20, 20), faint=(80, 80, 80), link=(70, 70, 80), base=(120, 120, 120),
+        hand=(0, 0, 0), target=(220, 30, 30), flash=(255, 200, 0), trail=(50, 100, 190), warn=(180, 0, 0),
         bar_back=(225, 225, 230), muscles=((40, 110, 200), (40, 160, 120), (200, 120, 30), (150, 60, 170)),
-        panel=(255, 255, 255),
+        panel=(255, 255, 255), skin=(238, 232, 226),
+    ),
+    # For a large, bright room: black on white, every colour at least 4.5:1 on white, nothing pale.
+    "high-contrast": Palette(
+        "high-contrast", window=(255, 255, 255), scene=(255, 255, 255), workspace=(236, 236, 236),
+        edge=(0, 0, 0), ink=(0, 0, 0), faint=(0, 0, 0), link=(0, 0, 0), base=(0, 0, 0),
+        hand=(0, 0, 0), target=(200, 0, 0), flash=(255, 210, 0), trail=(90, 90, 90), warn=(170, 0, 0),
+        bar_back=(200, 200, 200), muscles=((0, 80, 220), (180, 90, 0), (0, 120, 60), (160, 0, 160)),
+        panel=(255, 255, 255), skin=(225, 225, 225),
     ),
 }
 
 #: Smallest text height at 720 lines, in pixels (a projector at the back of a classroom).
 MIN_TEXT_AT_720 = 14
+#: ... and never below this fraction of the window's height (19 px at 768 lines).
+MIN_TEXT_FRACTION = 0.025
+#: Lines a student must see (trails, paths, outlines) are at least this wide, in pixels.
+MIN_LINE = 3
 #: A hit's flash and "+1" last this long; the next target fades in over FADE_IN (seconds of game time).
 FLASH_TIME, PLUS_ONE_TIME, FADE_IN = 0.35, 0.9, 0.3
 WARN_SECONDS = 10.0
@@ -90,6 +104,22 @@ def relative_luminance(colour: Sequence[int]) -> float:
 def contrast_ratio(a: Sequence[int], b: Sequence[int]) -> float:
     la, lb = sorted((relative_luminance(a), relative_luminance(b)), reverse=True)
     return (la + 0.05) / (lb + 0.05)
+
+
+def min_text(size: tuple[int, int]) -> int:
+    """The smallest text height a window of ``size`` may show, in pixels."""
+    return max(round(MIN_TEXT_AT_720 * min(size) / 720), round(MIN_TEXT_FRACTION * size[1]))
+
+
+def text_heights(size: tuple[int, int], text_scale: float = 1.0) -> tuple[int, int, int]:
+    """Text heights (big, normal, small) for a window of ``size``, times the ``text_scale`` setting."""
+    small = round(max(min_text(size), round(18 * min(size) / 720)) * text_scale)
+    return round(small * 1.6), round(small * 1.2), small
+
+
+def blend(a: Sequence[int], b: Sequence[int], k: float) -> RGB:
+    """The colour a fraction ``k`` of the way from ``a`` to ``b``."""
+    return tuple(round(x + (y - x) * k) for x, y in zip(a[:3], b[:3], strict=True))  # type: ignore[return-value]
 
 
 def font_size_for(height: int) -> int:
@@ -192,8 +222,10 @@ class GameRenderer:
     """Lays out and draws frames; fonts, text and the static background are made once and cached."""
 
     def __init__(self, key_labels: tuple[str, ...], muscle_names: tuple[str, ...],
-                 palette: str | Palette = "okabe-ito") -> None:
+                 palette: str | Palette = "okabe-ito", text_scale: float = 1.0) -> None:
         self.key_labels = key_labels
+        #: The ``text_scale`` setting: every text this many times its usual size (a large room).
+        self.text_scale = text_scale
         self.muscle_names = muscle_names
         self.palette = PALETTES[palette] if isinstance(palette, str) else palette
         self._fonts: dict[int, pygame.font.Font] = {}
@@ -264,9 +296,10 @@ class GameRenderer:
         w, h = size
         u = min(w, h) / 720.0
         pad, gap = max(6, round(16 * u)), max(4, round(8 * u))
-        small = max(12, round(18 * u))
-        normal = max(13, round(22 * u))
-        big = max(18, round(40 * u))
+        k = self.text_scale
+        small = round(max(12, round(18 * u), min_text(size)) * k)
+        normal = max(round(max(13, round(22 * u)) * k), small + 2)
+        big = round(max(18, round(40 * u)) * k)
         p = self.palette
         landscape = w >= 1.15 * h
         if landscape:
