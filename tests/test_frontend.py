@@ -91,8 +91,8 @@ def test_arm_target_and_hud_are_drawn_where_the_state_says(window, size):
     ring_gap = view.to_screen(target.x + target.radius * 0.5, target.y)
     assert colour_at(win.screen, ring_gap) != PALETTE.target  # a ring around a dot: not the hand's disc
     assert colour_at(win.screen, view.to_screen(*hand)) == PALETTE.hand
-    assert colour_at(win.screen, view.to_screen(*mid_upper)) == PALETTE.link
-    assert colour_at(win.screen, view.to_screen(*mid_fore)) == PALETTE.link
+    assert colour_at(win.screen, view.to_screen(*mid_upper)) not in (PALETTE.scene, PALETTE.workspace)  # the body
+    assert colour_at(win.screen, view.to_screen(*mid_fore)) == PALETTE.skin
     assert colour_at(win.screen, view.to_screen(0.7, 1.1)) == PALETTE.scene  # outside the reachable workspace
     assert colour_at(win.screen, view.to_screen(-0.5, 0.3)) == PALETTE.workspace
     # The score is written where the layout puts it: dark text pixels in its rectangle.

@@ -15,7 +15,8 @@ import numpy as np
 import pygame
 
 from ..lab.analysis import LearningCurve
-from .render import MIN_LINE, RGB, Viewport, blend, text_heights
+from .body import blend
+from .render import MIN_LINE, RGB, Viewport, text_heights
 
 if TYPE_CHECKING:
     from ..lab.session import LabSession, TrialOutcome

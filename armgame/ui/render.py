@@ -23,6 +23,7 @@ import pygame
 
 from ..game.session import GameSession
 from ..words import plural
+from .body import blend, draw_arm, draw_torso
 
 RGB = tuple[int, int, int]
 
@@ -117,11 +118,6 @@ def text_heights(size: tuple[int, int], text_scale: float = 1.0) -> tuple[int, i
     return round(small * 1.6), round(small * 1.2), small
 
 
-def blend(a: Sequence[int], b: Sequence[int], k: float) -> RGB:
-    """The colour a fraction ``k`` of the way from ``a`` to ``b``."""
-    return tuple(round(x + (y - x) * k) for x, y in zip(a[:3], b[:3], strict=True))  # type: ignore[return-value]
-
-
 def font_size_for(height: int) -> int:
     """pygame's default font renders lines about 0.68 times its nominal size high."""
     return max(1, round(height / 0.68))
@@ -148,6 +144,11 @@ class Viewport:
     def to_screen(self, x: float, y: float) -> tuple[int, int]:
         xmin, _, _, ymax = self.world
         return round(self.left + (x - xmin) * self.scale), round(self.top + (ymax - y) * self.scale)
+
+    def origin(self) -> tuple[float, float]:
+        """Where the world's (0, 0) is, in (fractional) pixels."""
+        xmin, _, _, ymax = self.world
+        return self.left - xmin * self.scale, self.top + ymax * self.scale
 
     def length(self, metres: float) -> int:
         return max(1, round(metres * self.scale))
@@ -231,9 +232,11 @@ class GameRenderer:
         self._fonts: dict[int, pygame.font.Font] = {}
         self._text: dict[tuple[str, int, RGB], pygame.Surface] = {}
         self._sizes: dict[tuple[str, int], tuple[int, int]] = {}
-        self._trail_colours: dict[int, list[RGB]] = {}
         self._backgrounds: dict[tuple, pygame.Surface] = {}
         self._veils: dict[tuple[int, int], pygame.Surface] = {}
+        #: Where the last frame drew over its background (None: draw the next frame whole).
+        self._dirty: list[pygame.Rect] | None = None
+        self._frame_key: tuple | None = None
 
     # ------------------------------------------------------------------ text
     def font(self, height: int) -> pygame.font.Font:
@@ -502,12 +505,11 @@ class GameRenderer:
         outer, inner = view.length(arm.l1 + arm.l2), view.length(abs(arm.l1 - arm.l2))
         pygame.draw.circle(surface, p.workspace, centre, outer)
         pygame.draw.circle(surface, p.scene, centre, inner)
-        pygame.draw.aacircle(surface, p.edge, centre, outer, max(1, round(lay.unit)))
-        pygame.draw.aacircle(surface, p.edge, centre, inner, max(1, round(lay.unit)))
-        # The shoulder is fixed to the body: a mount, not a joint that moves.
-        mount = view.length(0.07)
-        pygame.draw.rect(surface, p.base, pygame.Rect(centre[0] - mount, centre[1] - mount // 5, 2 * mount,
-                                                      mount // 2), border_radius=max(2, mount // 6))
+        line = max(MIN_LINE, round(2 * lay.unit))
+        pygame.draw.aacircle(surface, p.edge, centre, outer, line)
+        pygame.draw.aacircle(surface, p.edge, centre, inner, line)
+        # The shoulder is fixed to the body: the torso and head, seen from above, never move.
+        draw_torso(surface, view.origin(), view.scale, p)
         surface.set_clip(clip)
         self._backgrounds[key] = surface
         return surface
@@ -520,12 +522,29 @@ class GameRenderer:
             self._veils = {size: veil}
         return veil
 
+    def invalidate(self) -> None:
+        """The next frame is drawn whole: call it after drawing anything else on the window."""
+        self._dirty = None
+
     def draw(self, screen: pygame.Surface, session: GameSession, alpha: float = 1.0, hud: Hud | None = None) -> Layout:
-        """One frame; returns its layout."""
+        """One frame; returns its layout.
+
+        On the window itself, only what the last frame drew over is restored from the cached background
+        (a 1920 x 1080 copy a frame would cost more than all the rest); elsewhere (a subsurface, an
+        off-screen surface) the whole background is drawn.
+        """
         hud = hud or Hud()
         lay = self.layout(screen.get_size(), session, hud)
         p, view = self.palette, lay.view
-        screen.blit(self._background(lay, session), (0, 0))
+        background = self._background(lay, session)
+        frame_key = (id(background), screen.get_size())
+        if self._dirty is not None and self._frame_key == frame_key and screen is pygame.display.get_surface():
+            for rect in self._dirty:
+                screen.blit(background, rect, rect)
+        else:
+            screen.blit(background, (0, 0))
+        self._frame_key = frame_key
+        dirty: list[pygame.Rect] = []
         arm = session.config.arm
         q1, q2 = session.interpolated_angles(alpha)
         elbow = (arm.l1 * math.cos(q1), arm.l1 * math.sin(q1))
@@ -533,58 +552,54 @@ class GameRenderer:
         clip = screen.get_clip()
         screen.set_clip(lay.scene)
         if len(hud.trail) > 1:
-            self._draw_trail(screen, view, hud.trail)
-        self._draw_target(screen, lay, session, hud)
+            dirty.append(self._draw_trail(screen, view, hud.trail))
+        dirty += self._draw_target(screen, lay, session, hud)
         if session.rules.arm_visible:
-            self._draw_arm(screen, view, elbow, hand)
-        self._draw_hand(screen, view, hand)
+            dirty += draw_arm(screen, view.origin(), view.scale, q1, q2, arm.l1, arm.l2,
+                              session.muscles.activation, p)
+        dirty.append(self._draw_hand(screen, view, hand))
         if hud.paused or hud.ended:
-            screen.blit(self._veil(screen.get_size()), (0, 0))
+            dirty.append(screen.blit(self._veil(screen.get_size()), (0, 0)))
             if hud.paused and not hud.ended:  # the veil dims the scene; hand and target stay clear
                 self._draw_target(screen, lay, session, hud)
                 self._draw_hand(screen, view, hand)
         screen.set_clip(clip)
         for rect, i, a in lay.bars:
-            pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2)
+            dirty.append(pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2))
             if a > 0.002:
                 fill = rect.copy()
                 fill.width = max(rect.height, round(rect.width * a))
                 pygame.draw.rect(screen, p.muscles[i], fill, border_radius=rect.height // 2)
         if lay.progress is not None:
             rect, fraction = lay.progress
-            pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2)
+            dirty.append(pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2))
             done = rect.copy()
             done.width = max(rect.height, round(rect.width * fraction))
             pygame.draw.rect(screen, p.link, done, border_radius=rect.height // 2)
         radius = max(4, round(12 * lay.unit))
         for panel in lay.panels:
-            pygame.draw.rect(screen, p.panel, panel, border_radius=radius)
-            pygame.draw.rect(screen, p.edge, panel, max(1, round(2 * lay.unit)), border_radius=radius)
+            dirty.append(pygame.draw.rect(screen, p.panel, panel, border_radius=radius))
+            pygame.draw.rect(screen, p.edge, panel, max(MIN_LINE, round(2 * lay.unit)), border_radius=radius)
         if lay.name_box is not None:
-            pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2)
+            dirty.append(pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2))
             pygame.draw.rect(screen, p.ink, lay.name_box, max(1, round(2 * lay.unit)), border_radius=radius // 2)
         for label in lay.labels:
             if label.role == "name":  # changes with every key: not worth caching
-                screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect)
+                dirty.append(screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect))
             else:
-                screen.blit(self.text(label.text, label.height, label.colour), label.rect)
+                dirty.append(screen.blit(self.text(label.text, label.height, label.colour), label.rect))
+        self._dirty = [r.inflate(2, 2) for r in dirty if r.width and r.height]
         return lay
 
-    def _draw_trail(self, screen: pygame.Surface, view: Viewport, trail: Sequence[tuple[float, float]]) -> None:
-        p = self.palette
+    def _draw_trail(self, screen: pygame.Surface, view: Viewport,
+                    trail: Sequence[tuple[float, float]]) -> pygame.Rect:
+        """The hand's last second: one colour with a contrast of 3:1 or more on the scene, 3 px or wider."""
         points = [view.to_screen(x, y) for x, y in trail]
-        n = len(points)
-        colours = self._trail_colours.get(n)
-        if colours is None:
-            # Older segments fade into the scene: the path reads as a motion, newest at the hand.
-            colours = self._trail_colours[n] = [
-                tuple(round(s + (t - s) * i / n) for s, t in zip(p.scene, p.trail, strict=True)) for i in range(n)]
-        width = max(2, view.length(0.008))
-        line = pygame.draw.line
-        for i in range(1, n):
-            line(screen, colours[i], points[i - 1], points[i], width)
+        width = max(MIN_LINE, view.length(0.008))
+        return pygame.draw.lines(screen, self.palette.trail, False, points, width)
 
-    def _draw_target(self, screen: pygame.Surface, lay: Layout, session: GameSession, hud: Hud) -> None:
+    def _draw_target(self, screen: pygame.Surface, lay: Layout, session: GameSession,
+                     hud: Hud) -> list[pygame.Rect]:
         """A bullseye (a ring around a dot): a different shape from the hand's solid disc."""
         p, view = self.palette, lay.view
         target = session.rules.target
@@ -592,29 +607,17 @@ class GameRenderer:
         r = view.length(target.radius)
         newest = min((age for _, _, age in hud.hits), default=None)
         fade = 1.0 if newest is None else min(max(newest / FADE_IN, 0.0), 1.0)
-        colour = tuple(round(s + (t - s) * fade) for s, t in zip(p.scene, p.target, strict=True))
-        pygame.draw.circle(screen, colour, centre, r, max(2, r // 3))
-        pygame.draw.circle(screen, colour, centre, max(2, r // 4))
+        colour = blend(p.scene, p.target, fade)
+        drawn = [pygame.draw.circle(screen, colour, centre, r, max(MIN_LINE, r // 3)),
+                 pygame.draw.circle(screen, colour, centre, max(2, r // 4))]
         for x, y, age in hud.hits:
             if age < FLASH_TIME:
                 k = age / FLASH_TIME
                 where = view.to_screen(x, y)
-                pygame.draw.circle(screen, p.flash, where, round(r * (1.0 + 0.8 * k)))
+                drawn.append(pygame.draw.circle(screen, p.flash, where, round(r * (1.0 + 0.8 * k))))
                 pygame.draw.aacircle(screen, p.target, where, round(r * (1.0 + 0.8 * k)), max(2, r // 5))
+        return drawn
 
-    def _draw_arm(self, screen: pygame.Surface, view: Viewport, elbow: tuple[float, float],
-                  hand: tuple[float, float]) -> None:
-        p = self.palette
-        shoulder_px, elbow_px, hand_px = (view.to_screen(*pt) for pt in ((0.0, 0.0), elbow, hand))
-        width = view.length(0.024)
-        end = max(1, width // 2)
-        for a, b in ((shoulder_px, elbow_px), (elbow_px, hand_px)):
-            pygame.draw.aaline(screen, p.link, a, b, width)
-        for joint in (shoulder_px, elbow_px):  # rounded ends, and the joints drawn as pins on them
-            pygame.draw.aacircle(screen, p.link, joint, end)
-            pygame.draw.circle(screen, p.scene, joint, max(1, end // 2))
-        pygame.draw.aacircle(screen, p.link, hand_px, end)
-
-    def _draw_hand(self, screen: pygame.Surface, view: Viewport, hand: tuple[float, float]) -> None:
+    def _draw_hand(self, screen: pygame.Surface, view: Viewport, hand: tuple[float, float]) -> pygame.Rect:
         # The one thing a player must see, arm hidden or not: a solid disc, larger than the link is wide.
-        pygame.draw.aacircle(screen, self.palette.hand, view.to_screen(*hand), view.length(0.02))
+        return pygame.draw.aacircle(screen, self.palette.hand, view.to_screen(*hand), view.length(0.02))
