@@ -119,5 +119,5 @@ def test_text_scale_and_the_high_contrast_palette_are_settings():
     assert from_toml(s.to_toml().encode(), "again") == s
     assert Settings().text_scale == 1.0
     for bad in ("text_scale = 9", "text_scale = \"big\"", "text_scale = true", "text_scale = nan"):
-        with pytest.raises(SettingsError, match="text_scale must be a number from 0.75 to 2.5"):
+        with pytest.raises(SettingsError, match=r"text_scale must be a number from 0\.75 to 2\.5"):
             from_toml(bad.encode(), "s.toml")
