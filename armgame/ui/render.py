@@ -241,9 +241,15 @@ class GameRenderer:
     # ------------------------------------------------------------------ text
     def font(self, height: int) -> pygame.font.Font:
         """pygame's default font at a line height of about ``height`` px (created once per size)."""
-        if height not in self._fonts:
-            self._fonts[height] = pygame.font.Font(None, font_size_for(height))
-        return self._fonts[height]
+        font = self._fonts.get(height)
+        if font is None:
+            size = font_size_for(height)
+            font = pygame.font.Font(None, size)
+            while font.get_height() < height and size < 4 * height:  # never shorter than asked: the size rules
+                size += 1
+                font = pygame.font.Font(None, size)
+            self._fonts[height] = font
+        return font
 
     def text(self, string: str, height: int, colour: RGB | None = None) -> pygame.Surface:
         colour = self.palette.ink if colour is None else colour
