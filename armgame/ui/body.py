@@ -151,11 +151,13 @@ def draw_torso(surface: pygame.Surface, origin: tuple[float, float], px_per_m: f
 
 def draw_arm(surface: pygame.Surface, origin: tuple[float, float], px_per_m: float, q1: float, q2: float,
              l1: float, l2: float, activation: Sequence[float], palette: Palette,
-             colours: Sequence[RGB] | None = None) -> list[pygame.Rect]:
+             colours: Sequence[RGB] | None = None, torso: bool = True) -> list[pygame.Rect]:
     """The arm at angles (q1, q2): limbs, joints, hand, and the four muscles at ``activation`` (0 to 1);
     returns the rectangles it drew in (for a window that redraws only what changed).
 
-    ``origin``: the shoulder in pixels; y points up the screen. Points stay fractional: pygame's
+    ``torso``: False where no torso is drawn (an arm hanging in a vertical plane): the shoulder pair, which
+    run to the torso, are left out. ``origin``: the shoulder in pixels; y points up the screen. Points stay
+    fractional: pygame's
     anti-aliased lines place them to the sub-pixel, and nothing is rounded twice.
     """
     ox, oy = origin
@@ -190,7 +192,7 @@ def draw_arm(surface: pygame.Surface, origin: tuple[float, float], px_per_m: flo
         aacircle(surface, skin, at(centre), r * k)
     polygon(surface, skin, px(_palm(wrist, hand, 0.0)))
     colours = colours or palette.muscles
-    for i in (1, 0, 3, 2):  # the shoulder pair under the elbow pair, where they cross near the shoulder
+    for i in (1, 0, 3, 2) if torso else (3, 2):  # the shoulder pair under the elbow pair, where they cross
         a = min(max(float(activation[i]), 0.0), 1.0)
         outline = px(muscle_outline(i, q1, q2, l1, l2, a))
         polygon(surface, blend(skin, colours[i], MUSCLE_TINT + (1.0 - MUSCLE_TINT) * a), outline)
