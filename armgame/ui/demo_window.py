@@ -15,6 +15,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import re
 import time
 from collections import deque
 from collections.abc import Callable
@@ -89,6 +90,7 @@ class DemoWindow:
         self.accumulator = 0.0
         self.last_time: float | None = None
         self.scene_size = SCENE_SIZE
+        self.help_extra = 0
         self.shoulder, self.pixels_per_metre = (400.0, 450.0), 400.0
         self.speed_plot = pygame.Rect((560, 290), SPEED_PLOT_SIZE)
         self.reach = self.content_box()
@@ -138,12 +140,13 @@ class DemoWindow:
         self.scene = pygame.Surface(self.scene_size)
         self.caption_lines = self._wrap(self.info.caption, self.caption_font, w - 40)
         top = 12 + 31 * len(self.caption_lines) + 76
-        bottom = h - 44
+        self.help_extra = 26 * (len(self.help_lines()) - 1)  # a help line that wraps pushes the rest up
+        bottom = h - 44 - self.help_extra
         right = w - 20
         if isinstance(self.run, ReachRun):
-            bottom = h - 58 - (len(self._bar_rows(self.run)) + 1) * self._row_height(self.run) - 40
+            bottom -= (len(self._bar_rows(self.run)) + 1) * self._row_height(self.run) + 54
         if self.name == "planning":
-            bottom = h - 104
+            bottom = h - 104 - self.help_extra
             right = w - SPEED_PLOT_SIZE[0] - 60
             self.speed_plot = pygame.Rect((w - SPEED_PLOT_SIZE[0] - 20, top + 40), SPEED_PLOT_SIZE)
         xmin, xmax, ymin, ymax = self.reach
@@ -275,6 +278,20 @@ class DemoWindow:
             pygame.draw.circle(self.scene, colour, p, width // 2 + 2)
         pygame.draw.circle(self.scene, INK if colour == LINK else colour, points[-1], hand_radius)
 
+    def help_text(self) -> str:
+        """The keys that work, as the help line says them."""
+        return "space pause   r restart   - + speed   F11 fullscreen   Esc quit"
+
+    def help_lines(self) -> list[str]:
+        """The help line's items on as few lines as the scene's width holds (a narrow window: two)."""
+        lines: list[str] = []
+        for item in re.split(r" {3,}", self.help_text()):
+            if lines and self.small_font.size(lines[-1] + "   " + item)[0] <= self.scene_size[0] - 24:
+                lines[-1] += "   " + item
+            else:
+                lines.append(item)
+        return lines
+
     def _draw_body(self, pose: tuple[float, float], points: list[tuple[int, int]]) -> None:
         """The game's arm (``armgame.ui.body``): seen from above with its torso in the horizontal demos,
         hanging from a fixed shoulder in the vertical ones; its muscles at rest (nothing drives them)."""
@@ -329,7 +346,7 @@ class DemoWindow:
                 if (k != "gravity" or run.gravity) and k != "damping"]
         rows.append(("TOTAL", total, INK))
         row_h, half = self._row_height(run), 120
-        top = self.scene_size[1] - 58 - (len(rows) + 1) * row_h
+        top = self.scene_size[1] - 58 - self.help_extra - (len(rows) + 1) * row_h
         centres = (400, 660)
         for x, joint in zip(centres, ("shoulder", "elbow"), strict=True):
             self._text(f"{joint} (N m)", self.small_font, INK, (x, top), "midtop")
@@ -374,7 +391,7 @@ class DemoWindow:
         pygame.draw.line(self.scene, FAINT, (cursor, box.top), (cursor, box.bottom), 1)
         self._text("out", self.small_font, FAINT, (box.left + box.width // 4, box.bottom + 4), "midtop")
         self._text("back", self.small_font, FAINT, (box.left + 3 * box.width // 4, box.bottom + 4), "midtop")
-        y = self.scene_size[1] - 92
+        y = self.scene_size[1] - 92 - self.help_extra
         for colour, text in ((LINK, "minimum jerk: straight, bell-shaped speed"),
                              (ARM_B, "minimum torque change: the arm's dynamics curve it")):
             pygame.draw.line(self.scene, colour, (20, y + 9), (48, y + 9), 5)
@@ -415,8 +432,10 @@ class DemoWindow:
         speed = f"{self.speed:g}x" + ("   PAUSED" if self.paused else "")
         self._text(f"t = {run.t:5.2f} s   speed {speed}", self.status_font, INK, (20, y + 8))
         self._text(self._status(), self.status_font, INK, (20, y + 36))
-        self._text("space pause   r restart   - + speed   F11 fullscreen   Esc quit", self.small_font, FAINT,
-                   (self.scene_size[0] - 12, self.scene_size[1] - 8), "bottomright")
+        y = self.scene_size[1] - 8
+        for line in reversed(self.help_lines()):
+            self._text(line, self.small_font, FAINT, (self.scene_size[0] - 12, y), "bottomright")
+            y -= 26
         screen = pygame.display.get_surface()
         scale, offset = self.view()
         size = (round(self.scene_size[0] * scale), round(self.scene_size[1] * scale))
