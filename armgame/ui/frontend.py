@@ -415,6 +415,7 @@ def play_window(session: GameSession, settings: Settings, settings_path: Path, *
         window = GameWindow(session, screen, fps=fps, driver=driver, ask_name=ask_name, mode=mode,
                             sounds=sounds, trail=trail, palette=settings.palette,
                             standing=standing, on_mute=lambda muted: remember(mute=muted), replay=replay)
+        window.renderer.text_scale = settings.text_scale
         window.run()
         if window.resized:
             w, h = window.windowed_size
