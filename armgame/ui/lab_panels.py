@@ -167,12 +167,15 @@ def draw_curve(renderer: GameRenderer, screen: pygame.Surface, rect: pygame.Rect
         trial, value = curve.after_effect
         centre = (x_of(trial), y_of(value))
         pygame.draw.circle(screen, p.warn, centre, radius + line + 2, line)
-        label_size = renderer.text_size("after-effect", small)
-        above = centre[1] - plot.top > plot.bottom - centre[1]
-        ly = centre[1] - 2 * small if above else centre[1] + 2 * small
-        lx = min(max(centre[0] + small, plot.left + label_size[0] // 2 + 4), plot.right - label_size[0] // 2 - 4)
-        box = _blit(renderer, screen, placed, "after-effect", small, p.warn, center=(lx, ly))
-        pygame.draw.line(screen, p.warn, centre, (box.centerx, box.bottom if above else box.top), 2)
+        # To the left, at the point's height (as the figure puts it): the perturbed block's points lie on
+        # the other side of zero there, so the label sits in empty space, clear of the washout's mean line.
+        width = renderer.text_size("after-effect", small)[0]
+        gap = radius + line + small // 2
+        if centre[0] - gap - width >= plot.left + 4:
+            box = _blit(renderer, screen, placed, "after-effect", small, p.warn, midright=(centre[0] - gap, centre[1]))
+            pygame.draw.line(screen, p.warn, (box.right + 2, centre[1]), (centre[0] - radius - line, centre[1]), 2)
+        else:  # no room on the left (a protocol that starts with its washout): on the right
+            _blit(renderer, screen, placed, "after-effect", small, p.warn, midleft=(centre[0] + gap, centre[1]))
     _blit(renderer, screen, placed, f"{curve.label} ({curve.unit}) by trial", small, p.ink,
           topleft=(plot.left, plot.bottom + small // 3))
 
