@@ -1,9 +1,10 @@
-"""The one thing pyproject.toml cannot say: how to build the optional compiled batch kernel.
+"""The one thing pyproject.toml cannot say: how to build the optional compiled loops.
 
-``armgame/game/_ckernel.c`` must compute exactly what the Python single session computes, so
-its build turns off floating-point contraction (no fused multiply-add) and the compiler's own
-sin and cos (no merging them into sincos): see the file's opening comment. The extension is
-optional: without a C compiler the install goes on and ``BatchGameSession`` runs numpy.
+``armgame/game/_ckernel.c`` (the batched games) and ``armgame/game/_cbots.c`` (the bots' forward
+model) must compute exactly what the Python code computes, so their build turns off floating-point
+contraction (no fused multiply-add) and the compiler's own sin and cos (no merging them into
+sincos): see each file's opening comment. Both are optional: without a C compiler the install goes
+on, ``BatchGameSession`` runs numpy and the bots run their Python loop, with the same results.
 """
 
 from setuptools import Extension, setup
@@ -22,6 +23,7 @@ class BuildExactExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c"], optional=True)],
+    ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c"], optional=True),
+                 Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},
 )

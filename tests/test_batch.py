@@ -5,6 +5,7 @@ The main tests run on both kernels: numpy, and the compiled one (bit for bit eve
 leaving the compiled kernel untested.
 """
 
+import functools
 import itertools
 import math
 import os
@@ -129,18 +130,28 @@ def test_every_arm_and_batchable_integrator_equals_the_single_session(kernel, ar
         assert_same_game(batch, i, single)
 
 
-@pytest.mark.parametrize("kernel", KERNELS)
-def test_many_long_games_equal_the_single_session(kernel):
-    """60 s games with a large target (many hits, many near misses): also the largest state difference."""
+@functools.cache
+def long_games() -> tuple[list, list, list]:
+    """16 games of 45 and 60 s played one by one, once for every kernel's test (only read after)."""
     rng = random.Random(7)
     configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(16)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
+    singles = []
+    for c, timeline in zip(configs, timelines, strict=True):
+        single = GameSession(c)
+        singles.append((single, single.play(timeline)))
+    return configs, timelines, singles
+
+
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_many_long_games_equal_the_single_session(kernel):
+    """60 s games with a large target (many hits, many near misses): also the largest state difference."""
+    configs, timelines, singles = long_games()
     batch = batch_of(configs, kernel)
     results = batch.play(timelines)
     worst = 0.0
-    for i, (c, timeline) in enumerate(zip(configs, timelines, strict=True)):
-        single = GameSession(c)
-        assert results[i] == single.play(timeline)
+    for i, (single, result) in enumerate(singles):
+        assert results[i] == result
         assert_same_game(batch, i, single)
         worst = max(worst, max(abs(a - b) for a, b in zip(batch.state(i), single.state, strict=True)))
     assert sum(r.hits for r in results) > 50 and sum(r.resets for r in results) > 0

@@ -95,13 +95,16 @@ def test_the_forward_model_written_out_equals_accel_step_by_step(interaction, wi
         w2 += a2 * 0.004
         q1 += w1 * 0.004
         q2 += w2 * 0.004
-    assert model.predict(start, rows, 0.004, load if with_load else None) == (q1, q2, w1, w2)
+    assert model.predict_in_python(start, rows, 0.004, load if with_load else None) == (q1, q2, w1, w2)
+    if not with_load:  # the compiled loop, where built, takes no Python load
+        assert model.predict(start, rows, 0.004) == (q1, q2, w1, w2)
 
 
-def test_the_adaptive_bots_fused_field_equals_the_unit_field_and_torque():
-    """The lab bot's load estimate forms the Jacobian once; it must equal the two documented functions."""
+def test_the_curl_load_equals_the_lab_bots_unit_field_and_torque():
+    """``CurlLoad`` forms the Jacobian once; it must equal the lab's two documented functions."""
     import random
 
+    from armgame.game.bots import CurlLoad
     from armgame.lab.bots import curl_unit_force, curl_unit_torque, make_lab_bot
     from armgame.lab.protocol import preset
     from armgame.lab.session import LabSession, lab_config
@@ -110,6 +113,7 @@ def test_the_adaptive_bots_fused_field_equals_the_unit_field_and_torque():
     bot = make_lab_bot("adaptive")
     bot.curl_learner.fast, bot.curl_learner.slow = 0.7, 1.1  # an estimate of b = 1.8 N s/m
     bot._install(session)
+    assert type(bot.load_estimate) is CurlLoad  # the type the compiled loop takes
     l1, l2 = session.config.arm.l1, session.config.arm.l2
     b = bot.curl_estimate
     rng = random.Random(2)
@@ -117,3 +121,43 @@ def test_the_adaptive_bots_fused_field_equals_the_unit_field_and_torque():
         q1, q2, w1, w2 = (rng.uniform(-3, 3) for _ in range(4))
         fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
         assert bot.load_estimate(q1, q2, w1, w2) == curl_unit_torque(l1, l2, q1, q2, b * fx, b * fy)
+
+
+def _compiled_predict_or_skip():
+    import os
+
+    from armgame.game import bots
+
+    if bots._c_predict is None:
+        if os.environ.get("ARMGAME_REQUIRE_COMPILED"):
+            pytest.fail("the compiled forward model (_cbots) was not built")
+        pytest.skip("the compiled forward model was not built (no C compiler at install)")
+    return bots
+
+
+@pytest.mark.parametrize("interaction", [True, False])
+@pytest.mark.parametrize("curl", [None, 2.3, -1.1])
+def test_the_compiled_forward_model_gives_the_python_loops_floats(interaction, curl):
+    import random
+
+    bots = _compiled_predict_or_skip()
+    model = bots.InternalModel.of(GameConfig(), interaction)
+    load = None if curl is None else bots.CurlLoad(0.3, 0.33, curl)
+    rng = random.Random(11)
+    for _ in range(40):
+        rows = [(None, None, rng.uniform(-1.5, 1.5), rng.uniform(-1.1, 1.1)) for _ in range(rng.randrange(0, 90))]
+        state = tuple(rng.uniform(-4, 4) for _ in range(4))
+        assert model.predict(state, rows, 0.004, load) == model.predict_in_python(state, rows, 0.004, load)
+
+
+def test_the_compiled_forward_model_refuses_bad_arguments_without_crashing():
+    bots = _compiled_predict_or_skip()
+    predict = bots._c_predict
+    with pytest.raises(ValueError):
+        predict((0.0, 1.0, 0.0), [], 0.004, 1.0, 1.0, 1.0, 0.1, 0.1, True, None, 0.3, 0.3)
+    with pytest.raises(ValueError):
+        predict((0.0, 1.0, 0.0, 0.0), [(1.0,)], 0.004, 1.0, 1.0, 1.0, 0.1, 0.1, True, None, 0.3, 0.3)
+    with pytest.raises(TypeError):
+        predict((0.0, 1.0, 0.0, "x"), [], 0.004, 1.0, 1.0, 1.0, 0.1, 0.1, True, None, 0.3, 0.3)
+    with pytest.raises(TypeError):
+        predict((0.0, 1.0, 0.0, 0.0), 5, 0.004, 1.0, 1.0, 1.0, 0.1, 0.1, True, None, 0.3, 0.3)

@@ -1,9 +1,23 @@
-"""armgame derive: the SymPy derivation printed as M, C, G and checked against the numeric core."""
+"""armgame derive: the SymPy derivation printed as M, C, G and checked against the numeric core, and M, C
+and G checked against the tutorial's method at many more states than the command does.
 
+One module, so one xdist worker derives the two-joint arm once (``derive_two_joint`` is cached).
+"""
+
+import numpy as np
 import pytest
+import sympy as sp
 
 from armgame.cli import main
-from armgame.derive import MATCH_TOLERANCE, compare_with_core, derive_one_joint, format_text
+from armgame.derive import (
+    MATCH_TOLERANCE,
+    compare_with_core,
+    derive_one_joint,
+    derive_two_joint,
+    format_text,
+    parameter_values,
+)
+from armgame.physics import TUTORIAL_ARM, TwoJointArm
 
 
 @pytest.mark.parametrize("arm", ["one", "two"])
@@ -43,3 +57,26 @@ def test_one_joint_derivation_is_exact():
 def test_bad_states_is_a_one_line_error(capsys):
     assert main(["derive", "two", "--states", "0"]) == 2
     assert "--states" in capsys.readouterr().err
+
+
+def test_mass_coriolis_gravity_equal_the_euler_lagrange_derivation():
+    d = derive_two_joint()
+    args = (*d.q, *d.qd, *d.params)
+    M_fn, C_fn, G_fn = (sp.lambdify(args, e, "numpy") for e in (d.M, d.C, d.G))
+    values = parameter_values(2)
+    arm = TwoJointArm(TUTORIAL_ARM)
+    rng = np.random.default_rng(7)
+    for q1, q2, w1, w2 in rng.uniform(-4, 4, (25, 4)):
+        q, qd = np.array([q1, q2]), np.array([w1, w2])
+        np.testing.assert_allclose(arm.mass_matrix(q), np.array(M_fn(q1, q2, w1, w2, *values), float), atol=1e-13)
+        np.testing.assert_allclose(arm.coriolis(q, qd), np.array(C_fn(q1, q2, w1, w2, *values), float).ravel(),
+                                   atol=1e-12)
+        np.testing.assert_allclose(arm.gravity(q), np.array(G_fn(q1, q2, w1, w2, *values), float).ravel(),
+                                   atol=1e-12)
+    # T and U as the tutorial forms them: U zero hanging straight down, T = 1/2 qd' M qd.
+    subs = dict(zip(d.params, values, strict=True))
+    assert sp.simplify(d.U.subs({d.q[0]: -sp.pi / 2, d.q[1]: 0}).subs(subs)) == 0
+    q, qd = (0.3, 1.1), (-0.7, 2.0)
+    point = {**subs, **dict(zip(d.q, q, strict=True)), **dict(zip(d.qd, qd, strict=True))}
+    assert float(d.T.subs(point)) == np.float64(arm.kinetic_energy(q, qd)).item() or np.isclose(
+        float(d.T.subs(point)), arm.kinetic_energy(q, qd), rtol=1e-13)

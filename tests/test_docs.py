@@ -217,3 +217,14 @@ def test_the_screenshot_script_draws_every_picture(tmp_path):
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) < 200_000
     referenced = set(re.findall(r"docs/img/([\w.-]+\.png)", (ROOT / "README.md").read_text(encoding="utf-8")))
     assert referenced <= set(pictures)
+
+
+def test_ci_installs_and_tests_as_the_readme_says():
+    """The README's two set-up commands are what CI runs: the install with the test extra, then pytest."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    setup = next(b for b in blocks(ROOT / "README.md") if b.tags == ("setup",))
+    install = re.search(r"pip install (-e '\.\[test\]')", setup.text)
+    assert install and "python -m pytest" in setup.text and "Quick start" in readme
+    ci = [line.strip() for line in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()]
+    assert any(line.endswith(f"pip install --quiet {install.group(1)}") for line in ci)
+    assert ci[-1] == "python -m pytest"  # exactly the README's test command, its options in pyproject.toml

@@ -277,3 +277,18 @@ print(json.dumps(report))
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
     assert json.loads(run.stdout.strip().splitlines()[-1]) == {"headless": False, "rgb_array": [None, False],
                                                                "human": [None, True]}
+
+
+def test_a_viscous_matrix_option_and_a_paradigm_it_cannot_stand_for():
+    """A viscous field by its matrix, as in a protocol file; the savings and spontaneous presets run two fields
+    (the field and its opposite), which one perturbation option cannot replace: one line saying so."""
+    from armgame.env.center_out import perturbation_option, run_protocol
+
+    p = perturbation_option({"perturbation": "viscous", "matrix": [[-1.0, 0.5], [0.5, 1.0]]})
+    assert p.matrix == ((-1.0, 0.5), (0.5, 1.0))
+    with pytest.raises(EnvArgumentError, match=r"matrix\[1\]\[0\] must be a finite number from -50 to 50"):
+        perturbation_option({"perturbation": "viscous", "matrix": [[-1.0, 0.5], [99.0, 1.0]]})
+    for name in ("savings", "spontaneous"):
+        with pytest.raises(EnvArgumentError, match=r"2 different perturbations \(curl b=2 N s/m, curl b=-2 N s/m\)"):
+            run_protocol(name, "curl")
+    assert run_protocol("spontaneous", None) == preset("spontaneous")

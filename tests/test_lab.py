@@ -3,6 +3,7 @@ perturbations per trial, determinism, and lab replays that verify."""
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -15,6 +16,7 @@ from armgame.lab.perturbations import joint_space, mirror, rotation
 from armgame.lab.protocol import (
     CURL_B,
     PRESETS,
+    VISCOUS_B,
     Block,
     Perturbation,
     Protocol,
@@ -56,8 +58,11 @@ def perpendicular(session: LabSession, outcome) -> float:
 @pytest.mark.parametrize("name", PRESETS)
 def test_presets_round_trip_through_plain_data(name):
     p = preset(name)
-    assert [b.name for b in p.blocks] == ["baseline", "exposure", "washout"]
     assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    if name in ("savings", "spontaneous"):
+        assert p.blocks[1].perturbation == Perturbation.make("curl", b=CURL_B)
+        return
+    assert [b.name for b in p.blocks] == ["baseline", "exposure", "washout"]
     assert p.blocks[1].perturbation.kind == ("none" if name == "null" else name)
 
 
@@ -369,7 +374,8 @@ def test_a_bot_that_does_not_learn_shows_no_after_effect():
 
 @pytest.mark.parametrize("perturbation", [
     Perturbation.make("constant", fx=1.0, fy=-0.5), Perturbation.make("spring", stiffness=20.0),
-    Perturbation.make("curl", b=-CURL_B), Perturbation.make("mirror", axis=90.0),
+    Perturbation.make("curl", b=-CURL_B), Perturbation.make("viscous", b11=-1.0, b12=-1.0, b21=-1.0, b22=1.0),
+    Perturbation.make("mirror", axis=90.0),
     Perturbation.make("jointspace", gain=0.25)], ids=lambda p: p.kind)
 def test_every_perturbation_changes_the_reach_it_is_on(perturbation, tmp_path):
     """The same target and bot with and without each perturbation: the shown path differs on the perturbed
@@ -409,3 +415,214 @@ def test_a_lab_run_whose_state_goes_non_finite_stops_in_one_line():
     session._step = lambda q1, q2, w1, w2, t1, t2, dt: (q1, q2, math.inf, w2)  # a physics that blows up
     with pytest.raises(NonFiniteStateError, match="non-finite"):
         session.advance(10)
+
+
+# ------------------------------------------------ the viscous field and error-clamp channels
+def test_viscous_matrix_in_a_protocol_file(tmp_path):
+    path = tmp_path / "v.toml"
+    path.write_text('[[blocks]]\ntrials = 4\nperturbation = "viscous"\nmatrix = [[-1.2625, -1.4], [-1.4, 1.3875]]\n')
+    p = load_protocol(path)
+    assert p.blocks[0].perturbation == preset("viscous").blocks[1].perturbation
+    assert p.blocks[0].perturbation.matrix == ((-1.2625, -1.4), (-1.4, 1.3875)) == VISCOUS_B
+    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    assert p.blocks[0].perturbation.label() == "viscous B=[[-1.2625, -1.4], [-1.4, 1.3875]] N s/m"
+
+
+@pytest.mark.parametrize("text, message", [
+    ("perturbation = 'viscous'\nmatrix = [1, 2, 3, 4]", "blocks[0].matrix must be [[b11, b12], [b21, b22]]"),
+    ("perturbation = 'viscous'\nmatrix = [[1, 2], [3]]", "blocks[0].matrix must be [[b11, b12], [b21, b22]]"),
+    ("perturbation = 'viscous'\nmatrix = [[1, 2], [3, 99]]", "blocks[0].matrix[1][1] must be a finite number from -50"),
+    ("perturbation = 'viscous'\nmatrix = [[1, 'x'], [3, 4]]", "blocks[0].matrix[0][1] must be a number"),
+    ("perturbation = 'viscous'\nb = 2", "blocks[0] has unknown field(s) b"),
+    ("perturbation = 'curl'\nmatrix = [[1, 2], [3, 4]]", "blocks[0] has unknown field(s) matrix"),
+    ("channel_trials = 13", "blocks[0].channel_trials must be at most the block's trials (12)"),
+    ("channel_trials = -1", "blocks[0].channel_trials must be from 0 to 2000"),
+    ("channel_trials = 5", "blocks[0].channel_trials must be at most trials - targets - catch_trials (4)"),
+    ("perturbation = 'curl'\ncatch_trials = 2\nchannel_trials = 3",
+     "channel_trials must be at most trials - targets - catch_trials (2)"),
+    ("perturbation = 'curl'\ncatch_trials = 2\nchannel_trials = 12", "is all channel trials: none to catch"),
+])
+def test_bad_viscous_and_channel_fields_get_one_line(tmp_path, text, message):
+    path = tmp_path / "p.toml"
+    path.write_text("[[blocks]]\ntrials = 12\n" + text + "\n")
+    with pytest.raises(UserError) as err:
+        load_protocol(path)
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("top, message", [
+    ("channel_stiffness = 0", "channel_stiffness must be a finite number above 0 and at most 20000, got 0.0"),
+    ("channel_stiffness = 1e9", "channel_stiffness must be a finite number above 0 and at most 20000"),
+    ("channel_damping = -1", "channel_damping must be a finite number from 0 to 500"),
+])
+def test_bad_channel_settings_get_one_line(tmp_path, top, message):
+    path = tmp_path / "p.toml"
+    path.write_text(top + "\n[[blocks]]\ntrials = 3\nchannel_trials = 3\n")
+    with pytest.raises(UserError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        load_protocol(path)
+
+
+def test_a_channel_too_stiff_for_the_physics_step_is_refused():
+    """Stiffness and damping are checked against dt: 20,000 N/m on 0.77 kg rings at 160/s, |s| dt = 0.65
+    at the game's 4 ms, but 500 N s/m damps at 650/s, |s| dt = 2.6, near RK4's edge: refused."""
+    ok = Protocol("c", (Block("c", 1, Perturbation(), channel_trials=1),), channel_stiffness=20000.0,
+                  channel_damping=150.0)
+    LabSession(lab_config(ok, 1), ok)
+    stiff = replace(ok, channel_damping=500.0)
+    with pytest.raises(UserError, match=r"too stiff for the physics step of 0.004 s.*must be at most 1") as err:
+        LabSession(lab_config(stiff, 1), stiff)
+    assert "\n" not in str(err.value)
+    LabSession(lab_config(stiff, 1, dt=0.001), stiff)  # a finer step takes it
+
+
+def test_channel_trials_are_drawn_after_the_first_cycle_and_apart_from_catch_trials():
+    p = Protocol("c", (Block("a", 40, Perturbation.make("curl", b=CURL_B), catch_trials=5, channel_trials=9),
+                       Block("b", 6, Perturbation(), channel_trials=6)))
+    plans = schedule(p, 7, 0.004, (0.0, 0.5))
+    first = [q for q in plans if q.block == 0]
+    assert sum(q.channel for q in first) == 9 and sum(q.catch for q in first) == 5
+    assert not any(q.channel and q.catch for q in plans)
+    assert not any(q.channel or q.catch for q in first[:8])
+    assert all(q.channel and q.active == Perturbation() for q in plans if q.block == 1)
+    # A protocol without channels draws nothing for them: its schedule is the one it always had.
+    plain = replace(p, blocks=(replace(p.blocks[0], channel_trials=0), replace(p.blocks[1], channel_trials=0)))
+    assert [q.channel for q in schedule(plain, 7, 0.004, (0.0, 0.5))] == [False] * 46
+
+
+def test_viscous_scaling_deflects_the_model_bot_and_a_bot_that_knows_it_counters_it():
+    """The preset's B (the published field / 8): the model bot is pushed by centimetres, to either side
+    by direction as in Shadmehr & Mussa-Ivaldi's figures; with B in its internal model it reaches straight."""
+    p = Protocol("scan", (Block("exposure", 8, preset("viscous").blocks[1].perturbation),), **QUICK)
+    pushed, _ = bot_run(p)
+    deflections = np.array([perpendicular(pushed, o) for o in pushed.outcomes])
+    assert 0.01 < np.mean(np.abs(deflections)) < 0.04 and (deflections > 0).any() and (deflections < 0).any()
+    knowing = make_lab_bot("model")
+    knowing.known_field = VISCOUS_B
+    session = LabSession(lab_config(p, 3), p)
+    Autopilot(session, knowing).play()
+    assert session.result().hits == 8
+    assert max(abs(perpendicular(session, o)) for o in session.outcomes) < 0.006
+
+
+QUICK = {"timeout": 1.5, "delay": (0.1, 0.1), "hold_time": 0.1}
+
+
+def channel_run(b_hat: float, trials: int = 8):
+    p = Protocol("clamp", (Block("clamp", trials, Perturbation.make("curl", b=CURL_B), channel_trials=trials),),
+                 **QUICK)
+    bot = make_lab_bot("model")
+    bot.known_field = ((0.0, b_hat), (-b_hat, 0.0))
+    session = LabSession(lab_config(p, 3), p)
+    Autopilot(session, bot).play()
+    return session
+
+
+def test_the_channel_holds_the_hand_on_the_line_and_the_index_reads_what_was_learned():
+    """A bot expecting the whole field (b^ = b) presses into the channel with the force that would cancel
+    it: index about 1; expecting none, about 0. The hand stays within a millimetre of the line."""
+    from armgame.lab.analysis import trial_rows
+
+    indices = {}
+    for b_hat in (0.0, CURL_B):
+        session = channel_run(b_hat)
+        assert session.result().hits == 8
+        assert max(abs(perpendicular(session, o)) for o in session.outcomes) < 0.0015
+        rows = trial_rows(session)
+        assert all(r["perturbation"] == "channel" for r in rows)
+        assert all(len(o.channel_force) == len(o.xs) for o in session.outcomes)
+        indices[b_hat] = np.median([r["adaptation_index"] for r in rows])
+        peak = np.array([r["channel_force_peak_n"] for r in rows])
+        assert np.all(np.isfinite(peak))
+    assert abs(indices[0.0]) < 0.1 and abs(indices[CURL_B] - 1.0) < 0.1, indices
+
+
+def test_the_adaptive_bot_learns_nothing_from_a_channel_trial():
+    """On a channel trial the learner's error is 0: only its retentions act. Replaying the bot's own history
+    through a fresh learner, with 0 on the channel trials, gives its estimate exactly; with what it
+    measured in the channel instead, it would not."""
+    from armgame.lab.learner import TwoRateLearner
+
+    p = Protocol("sr", (Block("exposure", 6, Perturbation.make("curl", b=CURL_B)),
+                        Block("clamp", 3, Perturbation.make("curl", b=CURL_B), channel_trials=3)), targets=2, **QUICK)
+    session = LabSession(lab_config(p, 4), p)
+    bot = make_lab_bot("adaptive")
+    Autopilot(session, bot).play()
+    channel = {o.plan.index for o in session.outcomes if o.plan.channel}
+    clamped, measured = TwoRateLearner(), TwoRateLearner()
+    for index, b_seen, b_hat, *_ in bot.history:
+        clamped.update(0.0 if index in channel else b_seen - b_hat)
+        measured.update(b_seen - b_hat)
+    assert clamped.estimate == bot.curl_estimate
+    assert abs(measured.estimate - bot.curl_estimate) > 0.01
+
+
+def test_a_lab_replay_with_channels_and_a_viscous_field_verifies_and_tampering_is_caught(tmp_path):
+    p = Protocol("mixed", (Block("a", 3, preset("viscous").blocks[1].perturbation, channel_trials=1),
+                           Block("b", 2, Perturbation(), channel_trials=2)), targets=2, **QUICK)
+    session, _ = bot_run(p)
+    path = _replay(session, tmp_path)
+    loaded = Replay.load(path)
+    assert loaded.task.protocol == p and loaded.verify()[0]
+    data = json.loads(path.read_text())
+    del data["task"]["protocol"]["blocks"][0]["channel_trials"]  # the channel trial said to be a field trial
+    path.write_text(json.dumps(data))
+    assert not Replay.load(path).verify()[0]
+    data["task"]["protocol"]["blocks"][0]["channel_trials"] = 1
+    data["task"]["protocol"]["channel_stiffness"] = 2500.0  # another channel than the one played
+    path.write_text(json.dumps(data))
+    assert not Replay.load(path).verify()[0]
+
+
+def test_the_paradigms_presets_show_their_signatures_in_the_bots_learner():
+    """The presets' block lengths, run through the adaptive bot's default learner (cheap: no arm): the
+    counter-field brings the adaptation back to about zero, after which the clamp block rebounds toward
+    the first field (spontaneous recovery) and re-exposure re-learns far faster (savings); after a plain
+    null washout long enough to zero the adaptation, re-learning is barely faster."""
+    from armgame.lab.analysis import disturbance_schedule
+    from armgame.lab.fit import run_model
+    from armgame.lab.protocol import savings
+
+    def estimate(protocol):
+        plans = schedule(protocol, 10, 0.004, (0.0, 0.5))
+        f, clamped = disturbance_schedule(protocol, plans)
+        return run_model(0.59, 0.992, 0.21, 0.02, f, clamped), [q.block_name for q in plans]
+
+    x, blocks = estimate(preset("spontaneous"))
+    clamp = x[[i for i, b in enumerate(blocks) if b == "clamp"]]
+    assert abs(clamp[0]) < 0.1 and clamp.max() > 0.35 and np.argmax(clamp) > 3
+
+    def trials_to_half(x, blocks, name):
+        block = np.array([x[i] for i, b in enumerate(blocks) if b == name])
+        return int(np.argmax(block >= 0.5))
+
+    x, blocks = estimate(preset("savings"))
+    first, again = trials_to_half(x, blocks, "exposure"), trials_to_half(x, blocks, "re-exposure")
+    assert first >= 20 and again <= 3, (first, again)
+    x, blocks = estimate(savings(counter=0))
+    assert abs(x[blocks.index("re-exposure")]) < 0.05
+    assert trials_to_half(x, blocks, "re-exposure") >= first - 3
+
+
+def test_the_adaptive_bot_measures_what_a_viscous_field_shows_along_each_reach():
+    """With a viscous field the bot's learner holds a matrix B^. A reach along u shows B u only: with its
+    learning off (B^ = 0) the correction it measures, dB u, is the field's B u within 20% (the field bends the
+    path, and the sideways velocity's share is read as if along u), and it learns
+    the matrix over the targets' directions: B^ moves toward B."""
+    from armgame.lab.bots import LearningRates
+
+    field = preset("viscous").blocks[1].perturbation
+    p = Protocol("v", (Block("exposure", 4, field),), targets=4, **QUICK)
+    still = make_lab_bot("adaptive", LearningRates(0.59, 0.992, 0.0, 0.0))
+    session = LabSession(lab_config(p, 2), p)
+    Autopilot(session, still).play()
+    b = np.asarray(VISCOUS_B)
+    for index, correction in still.matrix_history[:3]:
+        tx, ty = session.plans[index].position
+        u = np.array([tx - session.home[0], ty - session.home[1]]) / p.distance
+        np.testing.assert_allclose(correction.reshape(2, 2) @ u, b @ u, atol=0.2 * np.linalg.norm(b @ u))
+    assert still.matrix_estimate == ((0.0, 0.0), (0.0, 0.0)) and still.curl_estimate == 0.0
+    learning = make_lab_bot("adaptive", LearningRates(0.6, 0.99, 0.4, 0.1))
+    session = LabSession(lab_config(p, 2), p)
+    Autopilot(session, learning).play()
+    learned = np.asarray(learning.matrix_estimate)
+    assert np.sum(learned * b) > 0.2 * np.sum(b * b) and learning.curl_estimate == 0.0

@@ -186,3 +186,52 @@ def test_a_record_target_that_is_no_regular_file_is_refused_before_the_run(capsy
     assert main(["lab", "curl", "--headless", "--bot", "model", "--record", "/dev/null"]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and "is a device" in captured.err  # no trial was run only to be lost
+
+
+CHANNELS = SHORT.replace('b = 2.0\n', 'b = 2.0\nchannel_trials = 2\n') + """
+[[blocks]]
+name = "clamp"
+trials = 3
+channel_trials = 3
+"""
+
+
+def test_channel_trials_end_to_end(tmp_path, capsys):
+    """A run with channel trials: the lab prints the adaptation index, trials.csv carries the channel
+    columns, analyze recomputes them bit for bit from the replay, and --fit fits the errors or the indices."""
+    protocol = tmp_path / "channels.toml"
+    protocol.write_text(CHANNELS)
+    assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--out", str(tmp_path / "run"),
+                 "--no-figures", "--record", str(tmp_path / "run.json")]) == 0
+    out = capsys.readouterr().out
+    assert "exposure: 2 channel trials; adaptation index" in out and "clamp: 3 channel trials" in out
+    rows = read_trials_csv(tmp_path / "run" / "trials.csv")
+    channel = [r for r in rows if r["perturbation"] == "channel"]
+    assert len(channel) == 5 and all(np.isfinite(r["adaptation_index"]) for r in channel)
+    assert all(np.isnan(r["adaptation_index"]) for r in rows if r["perturbation"] != "channel")
+    assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "again.csv")]) == 0
+    assert (tmp_path / "again.csv").read_bytes() == (tmp_path / "run" / "trials.csv").read_bytes()
+    capsys.readouterr()
+    assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "fit"), "--fit", "two-rate"]) == 0
+    out = capsys.readouterr().out
+    assert "two-rate fit to max_perpendicular_error_m (14 trials)" in out and "A_s = " in out and "R^2" in out
+    assert (tmp_path / "fit" / "run.fit.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # 5 channel trials cannot pin four rates: one line saying so, the replay left out.
+    assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "fit"), "--fit", "two-rate",
+                 "--fit-on", "index", "--no-figures"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot fit the two-rate model to its adaptation_index: 5 trials with a value" in err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["analyze", "r.json", "--out", "x.csv", "--fit-on", "index"], "--fit-on applies with --fit only"),
+    (["analyze", "r.json", "--out", "x.csv", "--no-figures"], "--no-figures applies with --class or --fit only"),
+])
+def test_fit_argument_errors_are_one_line(argv, message, capsys, monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and "\n" not in err
+    with pytest.raises(SystemExit):  # argparse's own one line for a model it does not know
+        main(["analyze", "r.json", "--out", "x.csv", "--fit", "three-rate"])
+    assert "invalid choice: 'three-rate'" in capsys.readouterr().err

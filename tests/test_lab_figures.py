@@ -163,3 +163,13 @@ def test_trials_numbered_per_block_are_drawn_in_row_order(tmp_path, experiment, 
     learning_figure(rows, tmp_path / "per_block.png")
     assert [(s["first"], s["last"], s["catch"]) for s in drawn] == [(1, 16, []), (17, 80, [30, 46, 62]),
                                                                     (81, 104, [])]
+
+
+def test_the_adaptation_figure_draws_the_channel_trials(tmp_path):
+    rows = [{"block": "exposure" if n <= 12 else "clamp", "trial": n,
+             "perturbation": "channel" if n in (6, 9) or n > 12 else "curl",
+             "adaptation_index": 0.1 * n if n in (6, 9) or n > 12 else float("nan")} for n in range(1, 21)]
+    figures.adaptation_figure(rows, tmp_path / "a.png")
+    assert png_size(tmp_path / "a.png") == (1920, 1080)
+    with pytest.raises(UserError, match="no channel trial"):
+        figures.adaptation_figure([{**r, "perturbation": "curl"} for r in rows], tmp_path / "b.png")

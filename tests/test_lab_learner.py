@@ -10,7 +10,7 @@ from armgame.lab import learner as learner_module
 from armgame.lab.learner import LearnerParameterError, TwoRateLearner, simulate
 
 
-def test_defaults_are_the_papers_fit():
+def test_defaults_are_the_documented_values():
     learner = TwoRateLearner()
     assert (learner.retention_fast, learner.retention_slow, learner.rate_fast, learner.rate_slow) == \
         (0.59, 0.992, 0.21, 0.02)

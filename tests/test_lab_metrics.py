@@ -233,13 +233,16 @@ def row(number, **changes):
     base = {"block": "exposure", "trial": number, "target_deg": 45.0, "perturbation": "curl",
             "reaction_time": 0.3141592653589793, "movement_time": 0.45, "peak_speed": 0.375,
             "initial_direction_error_deg": -12.5, "max_perpendicular_error_m": 0.0123,
-            "path_length_ratio": 1.1, "hit": True}
+            "path_length_ratio": 1.1, "hit": True, "channel_force_peak_n": float("nan"),
+            "channel_force_at_peak_speed_n": float("nan"), "adaptation_index": float("nan")}
     base.update(changes)
     return base
 
 
 def test_trials_round_trip_exactly_with_nan_as_empty(tmp_path):
-    rows = [row(1), row(2, hit=False, reaction_time=float("nan"), path_length_ratio=np.float64(1 / 3)),
+    rows = [row(1, perturbation="channel", channel_force_peak_n=1.5, channel_force_at_peak_speed_n=-0.25,
+                adaptation_index=0.75),
+            row(2, hit=False, reaction_time=float("nan"), path_length_ratio=np.float64(1 / 3)),
             row(3, block="washout", perturbation="none", trial=np.int64(3), hit=np.bool_(True))]
     path = tmp_path / "trials.csv"
     write_trials_csv(path, rows)
@@ -277,7 +280,9 @@ def write_text(tmp_path, text, name="t.csv"):
     return path
 
 
-HEADER = ",".join(TRIAL_COLUMNS)
+#: A table without the error-clamp columns (as written before they existed): it still reads.
+BASE_COLUMNS = TRIAL_COLUMNS[:11]
+HEADER = ",".join(BASE_COLUMNS)
 GOOD = "exposure,1,45,curl,0.3,0.45,0.375,-12.5,0.0123,1.1,1"
 
 
@@ -305,12 +310,12 @@ def test_hostile_tables_get_one_line_naming_line_and_column(tmp_path, text, mess
 
 
 def test_reader_accepts_a_spreadsheets_table(tmp_path):
-    columns = list(reversed(TRIAL_COLUMNS))
-    values = dict(zip(TRIAL_COLUMNS, GOOD.split(","), strict=True)) | {"hit": "TRUE", "reaction_time": ""}
+    columns = list(reversed(BASE_COLUMNS))
+    values = dict(zip(BASE_COLUMNS, GOOD.split(","), strict=True)) | {"hit": "TRUE", "reaction_time": ""}
     text = "\ufeff" + ",".join(columns) + "\r\n" + ",".join(values[c] for c in columns) + "\r\n\r\n"
     (rows,) = read_trials_csv(write_text(tmp_path, text))
     assert rows["hit"] is True and math.isnan(rows["reaction_time"]) and rows["trial"] == 1
-    assert list(rows) == list(TRIAL_COLUMNS)
+    assert list(rows) == list(TRIAL_COLUMNS) and math.isnan(rows["adaptation_index"])  # absent: read as NaN
 
 
 def test_reader_refuses_non_regular_big_and_binary_files(tmp_path, monkeypatch):
@@ -366,7 +371,8 @@ text = st.text(st.characters(codec="utf-8", categories=("L", "N", "P", "S", "Zs"
     "block": text, "trial": st.integers(0, 1_000_000), "target_deg": st.floats(-1e6, 1e6),
     "perturbation": text, "reaction_time": measure, "movement_time": measure.map(abs),
     "peak_speed": measure.map(abs), "initial_direction_error_deg": measure, "max_perpendicular_error_m": measure,
-    "path_length_ratio": measure.map(abs), "hit": st.booleans()}), max_size=5))
+    "path_length_ratio": measure.map(abs), "hit": st.booleans(), "channel_force_peak_n": measure,
+    "channel_force_at_peak_speed_n": measure, "adaptation_index": measure}), max_size=5))
 def test_any_table_round_trips_exactly(tmp_path_factory, rows):
     path = tmp_path_factory.mktemp("round") / "trials.csv"
     write_trials_csv(path, rows)

@@ -12,18 +12,22 @@ from armgame.game.rules import GAME_PLAY_ARM, GameConfig
 from armgame.game.session import GameSession, InputEvent
 from armgame.physics import GAME_ARM, TUTORIAL_ARM, Integrator, TwoJointArm
 from armgame.physics.loads import (
+    ChannelField,
     ConstantForce,
     CurlField,
     JointLoad,
     LoadedArm,
     Loads,
     SpringField,
+    ViscousField,
     hand_force_torque,
     loaded_arm,
 )
 
 FIELDS = {
     "curl": CurlField(13.0),
+    "viscous": ViscousField(((-10.1, -11.2), (-11.2, 11.1))),
+    "channel": ChannelField(2000.0, 50.0, (0.1, 0.5), (0.6, 0.8)),
     "constant": ConstantForce(3.0, -2.0),
     "spring": SpringField(40.0, (0.1, 0.5)),
 }
@@ -175,3 +179,37 @@ def test_a_time_dependent_field_reads_the_clock():
     pushed = arm.forward_dynamics(state[:2], state[2:], hand_force_torque(arm, Pulse(), state[:2], state[2:], 1.5))
     np.testing.assert_allclose(accel(*state, 0.0, 0.0), pushed, rtol=1e-12)
     assert np.max(np.abs(pushed - free)) > 0.1
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "gauss4"])
+def test_viscous_field_does_the_work_of_its_symmetric_part(integrator):
+    """F = B v with Shadmehr & Mussa-Ivaldi's B: v . B v = v . sym(B) v is not zero, so the passive arm's
+    energy changes, by exactly the work the field did (the power v . B v integrated along the motion)."""
+    from armgame.lab.protocol import PUBLISHED_VISCOUS_B
+
+    arm = TwoJointArm(GAME_ARM)
+    field = ViscousField(PUBLISHED_VISCOUS_B)
+    start, dt, steps = (0.3, 1.4, 3.0, -2.0), 0.001, 300
+    states = Integrator(integrator, LoadedArm(arm, Loads(hand=field))).run(start, (0.0, 0.0), dt, steps)
+    energy = arm.energy(states[:, :2], states[:, 2:])
+    v = arm.hand_velocity(states[:, :2], states[:, 2:])
+    power = np.einsum("ni,ij,nj->n", v, np.asarray(PUBLISHED_VISCOUS_B), v)
+    work = np.concatenate([[0.0], np.cumsum((power[1:] + power[:-1]) * dt / 2.0)])  # trapezoid: O(dt^2)
+    change = energy - energy[0]
+    assert np.max(np.abs(change)) > 10.0 * energy[0]  # it pumps the arm: 1.4 J to 22 J in 0.3 s
+    np.testing.assert_allclose(change, work, atol=1e-3 * np.max(np.abs(change)))  # the trapezoid's error: 1e-4
+    # The antisymmetric part alone (a curl field) does none: the symmetric part does it all.
+    b = np.asarray(PUBLISHED_VISCOUS_B)
+    assert np.allclose(np.einsum("ni,ij,nj->n", v, (b - b.T) / 2.0, v), 0.0, atol=1e-12)
+
+
+def test_channel_holds_the_hand_on_its_line_and_lets_it_run_along():
+    """The channel's force is across the line only: zero on the line at rest or moving along it, a spring
+    and a damper across it."""
+    channel = ChannelField(2000.0, 50.0, (0.1, 0.5), (0.6, 0.8))
+    assert channel.force(0.1 + 0.06, 0.5 + 0.08, 0.3, 0.4, 0.0) == pytest.approx((0.0, 0.0), abs=1e-12)
+    fx, fy = channel.force(0.1 - 0.008, 0.5 + 0.006, 0.0, 0.0, 0.0)  # 1 cm to the left of the line, at rest
+    assert (fx, fy) == pytest.approx((2000.0 * 0.01 * 0.8, -2000.0 * 0.01 * 0.6))
+    fx, fy = channel.force(0.1, 0.5, -0.8, 0.6, 0.0)  # moving left across the line at 1 m/s
+    assert (fx, fy) == pytest.approx((50.0 * 0.8, -50.0 * 0.6))
+    assert channel.lateral(0.1, 0.5, -0.8, 0.6) == pytest.approx(-50.0)

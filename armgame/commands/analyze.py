@@ -20,7 +20,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Re-simulate each lab replay from its input timeline, check that it reproduces its recorded "
         "trials, and measure every reach: one row per reach (block, trial, target_deg, perturbation, "
         "reaction_time, movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m, "
-        "path_length_ratio, hit). A replay that does not verify is reported and left out. With --class DIR: "
+        "path_length_ratio, hit, and on error-clamp trials channel_force_peak_n, channel_force_at_peak_speed_n, "
+        "adaptation_index). --fit two-rate fits the two-rate learner's rates to each run. A replay that does "
+        "not verify is reported and left out. With --class DIR: "
         "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
         "per trial of --metric: class_curve.csv and class_curve.png in --out. Exit status: 0 if every replay "
         "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
@@ -33,7 +35,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--metric", default=None,
                    help="the class curve's measure (default: max_perpendicular_error_m for force fields, "
                    "initial_direction_error_deg for visual transforms)")
-    p.add_argument("--no-figures", action="store_true", help="with --class: the CSV only (no matplotlib needed)")
+    p.add_argument("--no-figures", action="store_true",
+                   help="with --class or --fit: no figures (no matplotlib needed)")
+    p.add_argument("--fit", choices=("two-rate",),
+                   help="fit the two-rate model's retention and learning rates (A_f, A_s, B_f, B_s) to each replay's "
+                   "per-trial errors: the values with 95%% confidence intervals and the residual, and NAME.fit.png "
+                   "(the fit over the data) next to --out")
+    p.add_argument("--fit-on", choices=("error", "index"), default="error",
+                   help="with --fit: the errors of the reaches that are not channel trials (default; the measure "
+                   "the learning figure plots), or the adaptation index of the channel trials")
     p.set_defaults(run=run)
 
 
@@ -45,8 +55,20 @@ def run(args: argparse.Namespace) -> int:
         return _class(args)
     if not args.replays:
         raise UserError("no replay given: armgame analyze REPLAY... --out trials.csv (or --class DIR)")
-    if args.no_figures or args.metric:
-        raise UserError("--no-figures and --metric apply with --class only")
+    if args.metric:
+        raise UserError("--metric applies with --class only")
+    if args.no_figures and not args.fit:
+        raise UserError("--no-figures applies with --class or --fit only")
+    if args.fit_on != "error" and not args.fit:
+        raise UserError("--fit-on applies with --fit only")
+    if args.fit and not args.no_figures:
+        from ..lab.figures import require_matplotlib
+
+        try:
+            require_matplotlib()
+        except UserError:
+            raise UserError("the fit's figure needs matplotlib: pip install 'armgame[plot]', or add --no-figures "
+                            "to print the fit only") from None
     return _replays(args)
 
 
@@ -89,6 +111,14 @@ def _replays(args: argparse.Namespace) -> int:
             skipped += 1
             continue
         print(f"{path}: verified: {session.protocol.name}, seed {session.config.seed}, {len(rows)} reaches")
+        if args.fit:
+            figure = None if args.no_figures else (out.parent if one_table else out) / f"{path.stem}.fit.png"
+            try:
+                written += _fit(session, rows, args.fit_on, figure)
+            except UserError as exc:
+                print(f"armgame analyze: {path}: {exc}", file=sys.stderr)
+                skipped += 1
+                continue
         if one_table:
             table += rows
         else:
@@ -104,6 +134,30 @@ def _replays(args: argparse.Namespace) -> int:
     for path in written:
         print(f"wrote {path}")
     return 1 if skipped else 0
+
+
+def _fit(session, rows, on: str, figure: Path | None) -> list[Path]:
+    """Fit the two-rate model to one verified run and print it; draw the fit to ``figure`` if given."""
+    from ..lab.analysis import figure_metric, fit_schedule
+    from ..lab.fit import fit_two_rate
+
+    metric = figure_metric(session.protocol) if on == "error" else "adaptation_index"
+    try:
+        disturbance, clamped = fit_schedule(session)
+        observed = [float(r[metric]) for r in rows]
+        fit = fit_two_rate(disturbance, clamped, observed, on)
+    except ValueError as exc:
+        raise UserError(f"cannot fit the two-rate model to its {metric}: {exc}") from None
+    print(f"  two-rate fit to {metric} ({fit.n} trials):")
+    for line in fit.lines():
+        print(line)
+    if figure is None:
+        return []
+    from ..lab.figures import fit_figure
+
+    figure.parent.mkdir(parents=True, exist_ok=True)
+    fit_figure(rows, fit, figure, metric)
+    return [figure]
 
 
 def _class(args: argparse.Namespace) -> int:

@@ -230,15 +230,20 @@ def _check_outputs(args: argparse.Namespace) -> None:
 
 
 def _report(session, args: argparse.Namespace) -> None:
-    from ..lab.analysis import block_summary, trial_rows
+    from ..lab.analysis import block_summary, channel_summary, trial_rows
 
     done, total = len(session.outcomes), len(session.plans)
     print(f"lab {session.protocol.name}: {done} of {total} trials, {session.result().hits} hits, seed "
           f"{session.config.seed}{'' if session.finished else ' (stopped before the end)'}")
     if session.outcomes:
-        for b in block_summary(trial_rows(session)):
+        rows = trial_rows(session)
+        for b in block_summary(rows):
             print(f"  {b['block']}: {b['trials']} trials, {b['hits']} hits; max perpendicular error "
                   f"first 8 {_cm(b['early'])}, last 8 {_cm(b['late'])}")
+        for b in channel_summary(rows):
+            print(f"  {b['block']}: {b['channels']} channel trials; adaptation index {b['first']:+.2f} on the first, "
+                  f"mean of {b['cycle']}: first {b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} "
+                  f"(from channel trial {b['at']})")
 
 
 def _home(path: Path) -> str:

@@ -23,7 +23,16 @@ from ..game.rules import Target
 from ..game.session import DOWN
 from ..lab.analysis import trial_row
 from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
-from ..lab.protocol import MAX_TRIALS, PARAMETERS, PRESETS, Perturbation, Protocol, preset, with_perturbation
+from ..lab.protocol import (
+    MAX_TRIALS,
+    PARAMETERS,
+    PRESETS,
+    Perturbation,
+    Protocol,
+    preset,
+    viscous_matrix,
+    with_perturbation,
+)
 from ..lab.session import HOLD, REACH, LabSession, lab_config
 from ..physics.twojoint import TwoJointArm
 from ..words import unknown_name
@@ -75,6 +84,11 @@ def perturbation_option(value: object) -> Perturbation:
         kind = values.pop("perturbation", None)
         if not isinstance(kind, str):
             raise EnvArgumentError("a perturbation mapping names its kind under 'perturbation'")
+        if kind == "viscous" and "matrix" in values:  # as in a protocol file: matrix = [[b11, b12], [b21, b22]]
+            try:
+                values.update(viscous_matrix("perturbation viscous: matrix", values.pop("matrix")))
+            except (ValueError, TypeError) as exc:
+                raise EnvArgumentError(str(exc)) from None
         for name, number in values.items():
             limits = {p[0]: (p[1], p[2]) for p in PARAMETERS.get(kind, ())}
             if name in limits and (isinstance(number, bool) or not isinstance(number, int | float)
@@ -183,7 +197,8 @@ class CenterOutEnv(SessionEnv):
     At each step in which trials ended, ``info["reaches"]`` lists their rows of the lab's trials table
     (``armgame.lab.metrics.TRIAL_COLUMNS``: block, trial, target_deg, perturbation, reaction_time,
     movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m,
-    path_length_ratio, hit; README "Lab measures"), measured on the cursor's path by
+    path_length_ratio, hit, channel_force_peak_n, channel_force_at_peak_speed_n, adaptation_index;
+    docs/lab.md "Measures"), measured on the cursor's path by
     ``armgame.lab.metrics.reach_metrics``. Every step's ``info`` has ``trials_done``, ``hits`` and
     ``block`` (the current block's name).
 
@@ -344,15 +359,17 @@ def observation_bounds(protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
 class _Outcome:
     __slots__ = ("plan",)
 
-    def __init__(self, index: int) -> None:
-        self.plan = _Plan(index)
+    def __init__(self, index: int, channel: bool) -> None:
+        self.plan = _Plan(index, channel)
 
 
 class _Plan:
-    __slots__ = ("index",)
+    __slots__ = ("channel", "index")
 
-    def __init__(self, index: int) -> None:
+    def __init__(self, index: int, channel: bool) -> None:
         self.index = index
+        #: Whether the finished trial was an error-clamp trial: the player felt the channel hold the hand.
+        self.channel = channel
 
 
 class _Rules:
@@ -430,7 +447,8 @@ class CenterOutBotPolicy:
             seen.rules.target = Target(tx, ty, radius)
         index = int(trial)
         while len(seen.outcomes) < index:
-            seen.outcomes.append(_Outcome(len(seen.outcomes)))
+            done = len(seen.outcomes)
+            seen.outcomes.append(_Outcome(done, self.env.session.outcomes[done].plan.channel))
         seen.trial_index = index
         seen.phase = REACH if phase == 1.0 else HOLD
         seen.state = (q1, q2, w1, w2)

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .metrics import Reach, reach_metrics
+from .metrics import NO_CHANNEL, ChannelMeasures, Reach, channel_measures, reach_metrics
+from .protocol import FORCE_KINDS
 from .session import LabSession, TrialOutcome
 
 #: The paths figure's groups: (label, block kind, which trials of the block).
@@ -26,8 +27,22 @@ PATH_GROUPS = (("baseline", 0, "late"), ("early exposure", 1, "early"), ("late e
 
 def perturbation_label(outcome: TrialOutcome) -> str:
     """The perturbation the trial ran with, by kind: ``none`` on a catch trial of a perturbed block (so a
-    catch trial is a row whose perturbation differs from its block's)."""
-    return outcome.plan.active.kind
+    catch trial is a row whose perturbation differs from its block's), ``channel`` on an error-clamp trial."""
+    return "channel" if outcome.plan.channel else outcome.plan.active.kind
+
+
+def channel_of(session: LabSession, outcome: TrialOutcome) -> ChannelMeasures:
+    """An error-clamp trial's channel force and adaptation index (NaN on other trials), against the field
+    ``Protocol.reference_field`` names for its block."""
+    if not outcome.plan.channel:
+        return NO_CHANNEL
+    hx, hy = session.home
+    tx, ty = outcome.plan.position
+    length = math.hypot(tx - hx, ty - hy)
+    reference = session.protocol.reference_field(outcome.plan.block)
+    return channel_measures(np.asarray(outcome.channel_force), np.column_stack([outcome.vxs, outcome.vys]),
+                            (-(ty - hy) / length, (tx - hx) / length),
+                            None if reference is None else reference.matrix)
 
 
 def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
@@ -58,16 +73,17 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
         "max_perpendicular_error_m": m.max_perpendicular_error_m,
         "path_length_ratio": m.path_length_ratio,
         "hit": o.hit,
+        **channel_of(session, o).as_dict(),
     }
 
 
 def path_groups(session: LabSession, per_group: int | None = None) -> dict[str, list[np.ndarray]]:
     """Hand paths (n, 2) of late baseline, early and late exposure, early washout (one cycle of targets
-    each by default), for blocks the protocol has; catch trials left out."""
+    each by default), for blocks the protocol has; catch and channel trials left out."""
     per_group = per_group or session.protocol.targets
     by_block: dict[int, list[TrialOutcome]] = {}
     for o in session.outcomes:
-        if not o.plan.catch:
+        if not (o.plan.catch or o.plan.channel):
             by_block.setdefault(o.plan.block, []).append(o)
     groups: dict[str, list[np.ndarray]] = {}
     for label, block, which in PATH_GROUPS:
@@ -97,15 +113,70 @@ def block_summary(rows: Sequence[Mapping[str, object]], metric: str = "max_perpe
              "early": mean(rs[:first]), "late": mean(rs[-first:])} for name, rs in blocks.items()]
 
 
+def channel_summary(rows: Sequence[Mapping[str, object]], cycle: int = 8) -> list[dict[str, object]]:
+    """Per block with channel trials that have an adaptation index: how many, the first one's index, the mean
+    index of its first and
+    last ``cycle`` channel trials, and the largest mean over ``cycle`` consecutive ones (a cycle of targets
+    averages out each direction's own offset), with the place of that run's first trial (from 1)."""
+    blocks: dict[str, list[float]] = {}
+    for r in rows:
+        index = float(r["adaptation_index"])  # type: ignore[arg-type]
+        if r["perturbation"] == "channel" and math.isfinite(index):
+            blocks.setdefault(str(r["block"]), []).append(index)
+    out: list[dict[str, object]] = []
+    for name, v in blocks.items():
+        n = min(cycle, len(v))
+        runs = [float(np.mean(v[i:i + n])) for i in range(len(v) - n + 1)]
+        best = int(np.argmax(runs))
+        out.append({"block": name, "channels": len(v), "cycle": n, "first": v[0], "early": runs[0], "late": runs[-1],
+                    "largest": runs[best], "at": best + 1})
+    return out
+
+
+def fit_schedule(session: LabSession) -> tuple[np.ndarray, np.ndarray]:
+    """``disturbance_schedule`` of a run's finished trials."""
+    return disturbance_schedule(session.protocol, [o.plan for o in session.outcomes])
+
+
+def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndarray]:
+    """Each finished trial's disturbance, in units of the run's first perturbation (the reference: +1 that
+    perturbation, -1 its opposite, 0 none and catch trials), and whether it was an error-clamp (channel)
+    trial: the schedule ``fit.fit_two_rate`` fits the learner to. Raises ValueError for a run with no
+    perturbation, or one whose perturbations are not multiples of each other (a curl and a rotation)."""
+    reference = next((b.perturbation for b in protocol.blocks if b.perturbation.kind != "none"), None)
+    if reference is None:
+        raise ValueError("the protocol has no perturbation: nothing to learn, nothing to fit")
+
+    def scale(p) -> float:
+        if p.kind == "none":
+            return 0.0
+        if p.kind in ("curl", "viscous") and reference.kind in ("curl", "viscous"):
+            b, r = np.asarray(p.matrix), np.asarray(reference.matrix)
+            along = float(np.sum(b * r)) / float(np.sum(r * r))
+            if np.allclose(b, along * r):
+                return along
+        elif p.kind == reference.kind == "rotation":
+            return p["angle"] / reference["angle"]
+        elif p == reference:
+            return 1.0
+        raise ValueError(f"{p.label()} is not a multiple of the run's first perturbation ({reference.label()}): "
+                         "one learner cannot be fitted to both")
+
+    disturbance = np.array([0.0 if plan.channel else scale(plan.active) for plan in plans])
+    clamped = np.array([plan.channel for plan in plans], dtype=bool)
+    return disturbance, clamped
+
+
 def figure_metric(protocol) -> str:
     """What a learning curve plots: the perpendicular error for force fields (a velocity-dependent field
     bends the path after the first 100 ms), the initial direction error for visual transforms."""
     kinds = {b.perturbation.kind for b in protocol.blocks}
-    return "max_perpendicular_error_m" if kinds & {"curl", "constant", "spring"} else "initial_direction_error_deg"
+    return "max_perpendicular_error_m" if kinds & set(FORCE_KINDS) else "initial_direction_error_deg"
 
 
 def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> list[Path]:
-    """``trials.csv`` and, with matplotlib, ``learning.png`` and ``paths.png`` in ``out``; returns what was written."""
+    """``trials.csv`` and, with matplotlib, ``learning.png``, ``paths.png`` and, with channel trials,
+    ``adaptation.png`` in ``out``; returns what was written."""
     from .metrics import write_trials_csv
 
     out = Path(out)
@@ -123,6 +194,11 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
         paths_figure(path_groups(session), session.home, target_positions(session.protocol, session.home),
                      out / "paths.png", target_radius=session.protocol.target_radius, caption=caption)
         written += [out / "learning.png", out / "paths.png"]
+        if any(r["perturbation"] == "channel" and math.isfinite(float(r["adaptation_index"])) for r in rows):
+            from .figures import adaptation_figure
+
+            adaptation_figure(rows, out / "adaptation.png")
+            written.append(out / "adaptation.png")
     return written
 
 

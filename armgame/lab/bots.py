@@ -15,13 +15,23 @@ Ghazizadeh & Shadmehr 2006, ``armgame.lab.learner``):
   the arm's motion needed (inverse dynamics, accelerations by central differences) minus its
   muscles' torque is the external torque, fitted as ``b`` times the unit field's torque. The
   learner's error is ``e = b_measured - b^``.
+* a full-matrix viscous field (a protocol with a ``viscous`` block): its internal model holds a
+  matrix ``B^`` (four numbers, learned by four learners at once) instead of ``b^``. After a trial it
+  fits the correction ``dB`` (the learner's error) by least squares on the same external torque less
+  the torque ``J^T B^ v`` it expected, with a small ridge toward ``dB = 0``: a reach along ``u``
+  shows ``B u`` and little else, and the ridge keeps the rest near zero. The targets' directions
+  together teach the whole matrix, more slowly than the curl's one number (each reach corrects about
+  half of it).
 * a visual rotation: it aims its true hand at the target rotated by ``-theta^`` about home.
   After a trial it measures the rotation as the angle from its true hand's displacement (felt)
   to the shown hand's (seen) at the trial's end; ``e = theta_measured - theta^``.
 
 So with the field on, errors start large and shrink as ``b^`` grows; on a catch trial or in
 washout, the bot still expects the field and errs the other way (the after-effect), and
-unlearns at the learner's rates. Mirror and joint-space displays are not learned by this bot (it
+unlearns at the learner's rates. On an error-clamp (channel) trial the channel holds the hand on
+the straight line, so there is no movement error to learn from: the learner's error is 0 and only
+its retentions act (Smith et al. 2006 model channel trials so), which is what lets spontaneous
+recovery show. Mirror and joint-space displays are not learned by this bot (it
 plays them as the model bot does): they need more than one parameter.
 """
 
@@ -30,19 +40,24 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..errors import UserError
-from ..game.bots import ReachingBot
+from ..game.bots import CurlLoad, ReachingBot
 from ..words import unknown_name
 from .learner import TwoRateLearner
 from .session import LabSession
 
 LAB_BOT_NAMES = ("model", "naive", "adaptive")
+#: The viscous field's fit: the ridge toward no correction, as a fraction of the fit's mean curvature.
+RIDGE = 0.01
 
 
 @dataclass(frozen=True)
 class LearningRates:
-    """The two-rate learner's retention (A) and learning (B) rates, fast and slow: Smith et al. 2006's values
-    by default. ``TwoRateLearner`` checks them (0 to 1, the fast process forgetting and learning faster)."""
+    """The two-rate learner's retention (A) and learning (B) rates, fast and slow; the defaults and what is known
+    of their source: ``armgame.lab.learner``. ``TwoRateLearner`` checks them (0 to 1, the fast process
+    forgetting and learning faster)."""
 
     retention_fast: float = 0.59
     retention_slow: float = 0.992
@@ -67,6 +82,14 @@ class LabBot(ReachingBot):
                                                    rates.rate_slow)
         #: (trial, measured field b, estimate b^ it reached with; measured rotation, estimate) per trial.
         self.history: list[tuple[int, float, float, float, float]] = []
+        #: With a viscous field in the protocol: the learner of ``B^`` (row by row, b11 b12 b21 b22), made at the
+        #: first trial.
+        self.matrix_learner: TwoRateLearner | None = None
+        #: (trial, the correction dB it measured: b11 b12 b21 b22) per trial, with a viscous field.
+        self.matrix_history: list[tuple[int, np.ndarray]] = []
+        #: A hand field ``F = B v`` (N s/m) its internal model holds from the start, on top of what it learns:
+        #: the bot that knows the field (how the presets' fields are checked to be counterable with the keys).
+        self.known_field: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     # ------------------------------------------------------------- the estimates
     @property
@@ -78,21 +101,44 @@ class LabBot(ReachingBot):
         """Radians, counter-clockwise."""
         return float(self.rotation_learner.estimate) if self.rotation_learner is not None else 0.0
 
+    @property
+    def matrix_estimate(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """``B^`` (N s/m) of a viscous field, or None when the bot learns ``b^`` (the curl) instead."""
+        if self.matrix_learner is None:
+            return None
+        b11, b12, b21, b22 = (float(v) for v in self.matrix_learner.estimate)  # type: ignore[union-attr]
+        return (b11, b12), (b21, b22)
+
+    def _expected_field(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """The matrix its internal model adds beyond the learned curl: the known field plus the learned ``B^``."""
+        learned = self.matrix_estimate
+        if learned is None:
+            return self.known_field
+        known = self.known_field or ((0.0, 0.0), (0.0, 0.0))
+        return tuple(tuple(k + e for k, e in zip(kr, er, strict=True))  # type: ignore[return-value]
+                     for kr, er in zip(known, learned, strict=True))
+
     def _install(self, session: LabSession) -> None:
         p = session.config.arm
         l1, l2 = p.l1, p.l2
         b = self.curl_estimate
-        if b != 0.0:
-            def load(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
-                # curl_unit_torque(b * curl_unit_force(...)) with the Jacobian formed once: the bot's
-                # forward model calls this at every predicted step, and the results are the same floats.
-                s12, c12 = math.sin(q1 + q2), math.cos(q1 + q2)
-                jx1, jy1 = -l1 * math.sin(q1) - l2 * s12, l1 * math.cos(q1) + l2 * c12
-                jx2, jy2 = -l2 * s12, l2 * c12
-                fx = b * (jy1 * w1 + jy2 * w2)
-                fy = b * -(jx1 * w1 + jx2 * w2)
-                return jx1 * fx + jy1 * fy, jx2 * fx + jy2 * fy
-            self.load_estimate = load
+        if self.rates is not None and self.matrix_learner is None \
+                and any(block.perturbation.kind == "viscous" for block in session.protocol.blocks):
+            r = self.rates
+            self.matrix_learner = TwoRateLearner(r.retention_fast, r.retention_slow, r.rate_fast, r.rate_slow,
+                                                 fast=np.zeros(4), slow=np.zeros(4))
+        expected = self._expected_field()
+        if expected is not None:
+            (k11, k12), (k21, k22) = expected
+            k12, k21 = k12 + b, k21 - b  # plus the learned curl b^ [[0, 1], [-1, 0]]
+
+            def known(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
+                vy, mvx = curl_unit_force(l1, l2, q1, q2, w1, w2)
+                vx = -mvx
+                return curl_unit_torque(l1, l2, q1, q2, k11 * vx + k12 * vy, k21 * vx + k22 * vy)
+            self.load_estimate = known
+        elif b != 0.0:
+            self.load_estimate = CurlLoad(l1, l2, b)
         else:
             self.load_estimate = None
         theta = self.rotation_estimate
@@ -135,6 +181,17 @@ class LabBot(ReachingBot):
         b_seen = self._measure_curl(session, log)
         theta_seen = self._measure_rotation(session, log)
         self.history.append((outcome.plan.index, b_seen, b_hat, theta_seen, theta_hat))
+        if self.matrix_learner is not None:
+            correction = self._measure_matrix(session, log)
+            self.matrix_history.append((outcome.plan.index, correction))
+            self.matrix_learner.update(0.0 if outcome.plan.channel else correction)
+        if outcome.plan.channel:  # held on the line: no error to learn from
+            self.curl_learner.update(0.0)
+            self.rotation_learner.update(0.0)
+            return
+        if self.matrix_learner is not None:
+            self.rotation_learner.update(theta_seen - theta_hat)
+            return  # the matrix holds the curl too
         self.curl_learner.update(b_seen - b_hat)
         self.rotation_learner.update(theta_seen - theta_hat)
 
@@ -162,6 +219,50 @@ class LabBot(ReachingBot):
             num += r1 * g1 + r2 * g2
             den += g1 * g1 + g2 * g2
         return num / den if den > 1e-12 else 0.0
+
+    def _external_torques(self, session: LabSession, log: list):
+        """Per control period inside the log: (q1, q2, w1, w2, external torque 1, 2) by inverse dynamics."""
+        assert self._setup is not None
+        period = self._setup[0]
+        arm = session.model
+        k1, k2 = arm.params.damping1, arm.params.damping2
+        for k in range(1, len(log) - 1):
+            q1, q2, w1, w2, t1, t2, *_ = log[k]
+            qd1 = (log[k + 1][2] - log[k - 1][2]) / (2.0 * period)
+            qd2 = (log[k + 1][3] - log[k - 1][3]) / (2.0 * period)
+            bc, h = arm.b * math.cos(q2), arm.b * math.sin(q2)
+            m11, m12 = arm.a + 2.0 * bc, arm.d + bc
+            need1 = m11 * qd1 + m12 * qd2 - h * (2.0 * w1 * w2 + w2 * w2) + k1 * w1
+            need2 = m12 * qd1 + arm.d * qd2 + h * w1 * w1 + k2 * w2
+            yield q1, q2, w1, w2, need1 - t1, need2 - t2
+
+    def _measure_matrix(self, session: LabSession, log: list) -> np.ndarray:
+        """The correction ``dB`` (b11 b12 b21 b22) the reach showed: the external torque felt less the torque
+        ``J^T B^ v`` it expected, fitted as ``J^T dB v`` by least squares with a small ridge
+        (``RIDGE`` of the fit's mean curvature) toward ``dB = 0``. A reach mostly along ``u`` shows ``B u``
+        well and the rest of ``B`` hardly at all: the ridge keeps what it cannot see near zero instead of
+        letting noise write it. Zeros if the hand did not move."""
+        if len(log) < 5:
+            return np.zeros(4)
+        l1, l2 = session.config.arm.l1, session.config.arm.l2
+        (e11, e12), (e21, e22) = self._expected_field() or ((0.0, 0.0), (0.0, 0.0))
+        b = self.curl_estimate
+        e12, e21 = e12 + b, e21 - b
+        g = np.zeros((4, 4))
+        h = np.zeros(4)
+        for q1, q2, w1, w2, r1, r2 in self._external_torques(session, log):
+            vy, mvx = curl_unit_force(l1, l2, q1, q2, w1, w2)
+            vx = -mvx
+            t1, t2 = curl_unit_torque(l1, l2, q1, q2, e11 * vx + e12 * vy, e21 * vx + e22 * vy)
+            # d torque / d (b11, b12, b21, b22): J^T applied to (vx, 0), (vy, 0), (0, vx), (0, vy).
+            design = np.array([curl_unit_torque(l1, l2, q1, q2, vx, 0.0), curl_unit_torque(l1, l2, q1, q2, vy, 0.0),
+                               curl_unit_torque(l1, l2, q1, q2, 0.0, vx), curl_unit_torque(l1, l2, q1, q2, 0.0, vy)]).T
+            g += design.T @ design
+            h += design.T @ np.array([r1 - t1, r2 - t2])
+        scale = np.trace(g) / 4.0
+        if scale < 1e-12:
+            return np.zeros(4)
+        return np.linalg.solve(g + RIDGE * scale * np.eye(4), h)
 
     @staticmethod
     def _measure_rotation(session: LabSession, log: list) -> float:

@@ -182,8 +182,13 @@ def learning_figure(rows: Sequence[Mapping[str, Any]], path: Path,
     if (normal & ~hit).any():
         ax.plot(trial[normal & ~hit], y[normal & ~hit], "o", mfc="white", mec=MISS, mew=1.5, ms=ms,
                 label="reach, target missed")
-    if is_catch.any():
-        ax.plot(trial[is_catch], y[is_catch], "D", color=CATCH, ms=max(8.0, ms * 1.5), label="catch trial")
+    channel = np.array([r["perturbation"] == "channel" for r in rows])
+    if (is_catch & ~channel).any():
+        ax.plot(trial[is_catch & ~channel], y[is_catch & ~channel], "D", color=CATCH, ms=max(8.0, ms * 1.5),
+                label="catch trial")
+    if (is_catch & channel).any():  # held on the line: their error is ~0 by construction
+        ax.plot(trial[is_catch & channel], y[is_catch & channel], "s", mfc="white", mec=CATCH, mew=1.5,
+                ms=max(8.0, ms * 1.5), label="error-clamp (channel) trial")
     _after_effect(ax, spans, metric, scale)
 
     ax.axhline(0.0, color="black", lw=1.0)
@@ -379,3 +384,58 @@ def _save(fig: Any, path: Path) -> None:
         atomic_write_bytes(path, buffer.getvalue())
     except OSError as exc:
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+@_lab_style
+def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str) -> None:
+    """A two-rate fit (``armgame.lab.fit.TwoRateFit``) drawn over the data it was fitted to, blocks shaded,
+    the parameters in the title; ``metric`` the fitted column (``adaptation_index`` for indices)."""
+    label, scale = ("adaptation index (channel trials)", 1.0) if metric == "adaptation_index" else _measure(metric)
+    rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
+    fig = _figure()
+    ax = fig.add_subplot()
+    _shade_blocks(ax, blocks_of(rows))
+    trial = np.arange(1, len(rows) + 1, dtype=float)
+    seen = np.isfinite(fit.observed)
+    ax.plot(trial[seen], fit.observed[seen] * scale, "o", color=LINE, ms=_marker_size(len(rows)), label="data")
+    shown = np.isfinite(fit.predicted) & (seen | (fit.observed_kind == "index"))
+    ax.plot(trial[shown], fit.predicted[shown] * scale, "-", color=CATCH, lw=2.0, label="two-rate fit")
+    ax.axhline(0.0, color="black", lw=1.0)
+    ax.set_xlabel("trial")
+    ax.set_ylabel(label)
+    ax.set_xlim(0.5, len(rows) + 0.5)
+    _headroom(ax, np.concatenate([fit.observed[seen], fit.predicted[shown]]) * scale)
+    ax.grid(alpha=0.3, axis="y")
+    v = fit.values
+    ax.set_title(f"Two-rate fit: A_f {v['retention_fast']:.3g}, A_s {v['retention_slow']:.4g}, "
+                 f"B_f {v['rate_fast']:.3g}, B_s {v['rate_slow']:.3g}; rms residual {fit.rms * scale:.3g}, "
+                 f"R² {fit.r_squared:.2f}")
+    _legend_below(fig, ax)
+    _save(fig, path)
+
+
+@_lab_style
+def adaptation_figure(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
+    """The adaptation index of the error-clamp (channel) trials, trial by trial, blocks shaded: what the
+    channel measured, learning without the error that taught it (0 nothing learned, 1 the field cancelled)."""
+    rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
+    points = [(r["trial"], float(r["adaptation_index"])) for r in rows
+              if r["perturbation"] == "channel" and math.isfinite(float(r["adaptation_index"]))]
+    if not points:
+        raise UserError("no channel trial with an adaptation index to draw")
+    fig = _figure()
+    ax = fig.add_subplot()
+    _shade_blocks(ax, blocks_of(rows))
+    trial, index = (np.array(v, dtype=float) for v in zip(*points, strict=True))
+    ax.plot(trial, index, "s", mfc="white", mec=CATCH, mew=1.5, ms=max(6.0, _marker_size(len(rows)) * 1.3),
+            label="channel trial")
+    ax.axhline(0.0, color="black", lw=1.0)
+    ax.axhline(1.0, color=LINE, lw=1.0, ls="--", label="field fully compensated")
+    ax.set_xlabel("trial")
+    ax.set_ylabel("adaptation index")
+    ax.set_xlim(0.5, len(rows) + 0.5)
+    _headroom(ax, np.concatenate([index, [0.0, 1.0]]))
+    ax.grid(alpha=0.3, axis="y")
+    ax.set_title("Adaptation index of the error-clamp trials")
+    _legend_below(fig, ax)
+    _save(fig, path)

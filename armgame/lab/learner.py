@@ -9,15 +9,24 @@ Two processes learn from the same error ``e(n)`` on trial n and add up to the ne
 with retentions ``A`` and learning rates ``B`` in [0, 1], ``A_f < A_s`` and ``B_f > B_s``. When the
 learner compensates a disturbance ``f(n)``, the error it sees is ``e(n) = f(n) - x(n)``; an
 error-clamp trial (the error held at zero whatever the learner does) is ``e(n) = 0``, so only the
-retentions act. The model reproduces fast early learning with a slow tail, savings (faster
-re-learning after a washout that returned the net adaptation, but not the slow state, to zero) and
-spontaneous recovery (after a brief counter-adaptation, error-clamp trials let the fast process
-decay and the slow one's older adaptation re-emerge). With ``rate_fast = 0`` the fast process never
-moves from zero and the model is a single-rate learner ``x(n+1) = A_s x(n) + B_s e(n)``.
+retentions act. The model reproduces fast early learning with a slow tail, spontaneous recovery
+(after a brief counter-adaptation, error-clamp trials let the fast process decay and the slow one's
+older adaptation re-emerge) and savings, but only under a condition: re-learning is faster when
+re-exposure finds the two processes apart (after a counter-adaptation that brought the net adaptation,
+but not the slow state, back to zero). After a plain null washout long enough to bring the net
+adaptation back to zero both processes have decayed together, and with the defaults re-learning is
+barely faster (half the field compensated in 22 trials the first time, 21 after a 160-trial washout;
+2 after a 4-trial counter-field: ``tests/test_lab.py`` checks both). With ``rate_fast = 0`` the fast
+process never moves from zero and the model is a single-rate learner ``x(n+1) = A_s x(n) + B_s e(n)``.
 
-Defaults: A_f = 0.59, A_s = 0.992, B_f = 0.21, B_s = 0.02, the values of Smith et al. (2006, PLoS
-Biol 4:e179) for force-field adaptation, as later model code reuses them (retention per trial: the
-fast process keeps 59% of its state, half-life 1.3 trials; the slow one 99.2%, half-life 86 trials).
+Defaults: A_f = 0.59, A_s = 0.992, B_f = 0.21, B_s = 0.02 (retention per trial: the fast process keeps
+59% of its state, half-life 1.3 trials; the slow one 99.2%, half-life 86 trials). Their source, and what
+is and is not verified: these four values are what model code in circulation labels "Smith et al. 2006"
+(next to Joiner & Smith 2008's A_f 0.85, A_s 0.998, B_f 0.11, B_s 0.021); a second set, A_f 0.92,
+A_s 0.996, B_f 0.03, B_s 0.004, is also quoted under the same citation. The paper itself (PLoS Biol
+4(6):e179) could not be read where this was written, so which of its figures or tables each set comes
+from is NOT verified here; check it before quoting either as the paper's fit. What the tests do verify is
+what these values do: the signatures above, with the numbers given.
 """
 
 from __future__ import annotations

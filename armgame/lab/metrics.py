@@ -37,6 +37,17 @@ measure but its peak speed; a record with fewer than two samples after the go cu
 position or times that do not increase has NaN for all of them. ``reach_metrics`` never raises on
 a trial's content; it raises ``ValueError`` only for a malformed ``Reach`` (a programming error).
 
+On an error-clamp (channel) trial ``channel_measures`` reads the force the arm pressed into the
+channel (sampled with the path, from the go cue to the trial's end, signed along the left normal
+of the home-to-target line):
+
+- **peak channel force** (N): the sampled force largest in magnitude, with its sign;
+- **channel force at peak speed** (N): the force at the sample of the hand's peak speed;
+- **adaptation index**: the least-squares slope, through the origin, of the channel force on the
+  force that would exactly cancel the field ``F = B v`` at the hand's velocity on that trial (its
+  component across the line, ``-n . B v``): 0 when nothing was learned, 1 when the field is
+  fully compensated (Smith, Ghazizadeh & Shadmehr 2006). NaN with no field to measure against.
+
 The trials table (``TRIAL_COLUMNS``) is CSV: one row per reach, NaN written as an empty field.
 """
 
@@ -92,6 +103,52 @@ class ReachMetrics:
 
 
 UNDEFINED = ReachMetrics(NAN, NAN, NAN, NAN, NAN, NAN)
+
+
+@dataclass(frozen=True)
+class ChannelMeasures:
+    """What an error-clamp trial measures (module docstring); NaN where undefined."""
+
+    channel_force_peak_n: float
+    channel_force_at_peak_speed_n: float
+    adaptation_index: float
+
+    def as_dict(self) -> dict[str, float]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+NO_CHANNEL = ChannelMeasures(NAN, NAN, NAN)
+
+
+def channel_measures(force: np.ndarray, velocity: np.ndarray, normal: tuple[float, float],
+                     field: tuple[tuple[float, float], tuple[float, float]] | None) -> ChannelMeasures:
+    """The channel trial's measures from the force pressed into the channel ``force`` (n,) N, the hand's
+    velocity ``velocity`` (n, 2) m/s at the same samples, the line's unit left ``normal`` and the field
+    ``F = B v`` (N s/m) the adaptation index is measured against (None: no index).
+
+    >>> v = np.array([[0.0, 0.0], [0.3, 0.0], [0.5, 0.0], [0.2, 0.0]])
+    >>> B = ((0.0, 2.0), (-2.0, 0.0))               # curl b = 2: F = (2 vy, -2 vx)
+    >>> ideal = 2.0 * v[:, 0]                       # cancelling it along n = (0, 1): -n . B v = 2 vx
+    >>> channel_measures(0.5 * ideal, v, (0.0, 1.0), B).adaptation_index
+    0.5
+    """
+    f = np.asarray(force, dtype=np.float64)
+    v = np.asarray(velocity, dtype=np.float64)
+    if f.ndim != 1 or v.shape != (f.size, 2):
+        raise ValueError(f"channel_measures wants force (n,) and velocity (n, 2), got {f.shape} and {v.shape}")
+    if f.size == 0 or not (np.isfinite(f).all() and np.isfinite(v).all()):
+        return NO_CHANNEL
+    peak = float(f[np.argmax(np.abs(f))])
+    at_speed = float(f[np.argmax(np.hypot(v[:, 0], v[:, 1]))])
+    index = NAN
+    if field is not None:
+        b = np.asarray(field, dtype=np.float64)
+        n = np.asarray(normal, dtype=np.float64)
+        ideal = -(v @ b.T) @ n
+        power = float(ideal @ ideal)
+        if power > 1e-12:
+            index = float(ideal @ f) / power
+    return ChannelMeasures(peak, at_speed, index)
 
 DIRECTION_AT = ("delay", "peak_acceleration")
 
@@ -207,9 +264,12 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
 
 # ------------------------------------------------------------------------------- the trials table
 
+#: The error-clamp columns, empty on other trials; a table without them (written before they existed)
+#: still reads, with them empty.
+CHANNEL_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ChannelMeasures))
 TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time",
                                   "movement_time", "peak_speed", "initial_direction_error_deg",
-                                  "max_perpendicular_error_m", "path_length_ratio", "hit")
+                                  "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS)
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
 _TEXT_COLUMNS = ("block", "perturbation")
 _NONNEGATIVE = ("movement_time", "peak_speed", "path_length_ratio")
@@ -248,7 +308,8 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
     """Read a trials table written by ``write_trials_csv`` (or a spreadsheet), trusting nothing.
 
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
-    with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order). Each row is
+    with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``CHANNEL_COLUMNS``
+    may be absent, as in tables written before error-clamp trials existed, and read as NaN). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a
     whole number from 0 to 1,000,000, ``target_deg`` a finite number, each measure a finite number
     or empty (read as NaN; times may be negative, speed, movement time and ratio may not), ``hit``
@@ -271,7 +332,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
         header = [name.strip() for name in header]
         if len(set(header)) != len(header):
             raise TrialsFileError(f"{path}: line 1: a column is named twice")
-        missing = [name for name in TRIAL_COLUMNS if name not in header]
+        missing = [name for name in TRIAL_COLUMNS if name not in header and name not in CHANNEL_COLUMNS]
         unknown = [name for name in header if name not in TRIAL_COLUMNS]
         if missing or unknown:
             what = f"lacks column(s) {', '.join(missing)}" if missing else f"has unknown column(s) {_show(unknown)}"
@@ -286,7 +347,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
             row: dict[str, object] = {}
             for name in TRIAL_COLUMNS:
                 try:
-                    row[name] = _parse(name, values[name])
+                    row[name] = _parse(name, values.get(name, ""))
                 except ValueError as exc:
                     raise TrialsFileError(f"{path}: line {line}, column {name}: {exc}") from None
             rows.append(row)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from ..physics.loads import ConstantForce, CurlField, Loads, SpringField
+from ..physics.loads import ConstantForce, CurlField, Loads, SpringField, ViscousField
 from .protocol import Perturbation
 
 Display = Callable[[float, float, float, float], tuple[float, float]]
@@ -22,6 +22,9 @@ def loads_for(p: Perturbation, home: tuple[float, float]) -> Loads | None:
         return Loads(hand=CurlField(p["b"])) if p["b"] != 0.0 else None
     if p.kind == "constant":
         return Loads(hand=ConstantForce(p["fx"], p["fy"])) if (p["fx"], p["fy"]) != (0.0, 0.0) else None
+    if p.kind == "viscous":
+        matrix = p.matrix
+        return Loads(hand=ViscousField(matrix)) if any(v != 0.0 for row in matrix for v in row) else None  # type: ignore[union-attr]
     if p.kind == "spring":
         return Loads(hand=SpringField(p["stiffness"], home)) if p["stiffness"] != 0.0 else None
     return None

@@ -11,12 +11,22 @@ Perturbation kinds (parameters in brackets, with their TOML names):
   ``b > 0`` pushes clockwise of the hand's motion;
 * ``constant`` (``fx``, ``fy``, N): a steady force at the hand;
 * ``spring`` (``stiffness``, N/m): a spring from the hand to the home position;
+* ``viscous`` (``matrix = [[b11, b12], [b21, b22]]``, N s/m): the field ``F = B v`` with a full
+  matrix, as Shadmehr & Mussa-Ivaldi (1994) used; its symmetric part does work on the arm;
 * ``rotation`` (``angle``, degrees): the hand is shown, and scored, rotated about home,
   counter-clockwise for ``angle > 0``;
 * ``mirror`` (``axis``, degrees): the hand is shown mirrored in the line through home at that
   angle from +x (90: left and right swap);
 * ``jointspace`` (``gain``, m/rad): Flanagan & Rao's display: the hand is shown at
   ``home + gain (q1 - q1_home, q2 - q2_home)``, shoulder angle across, elbow angle up.
+
+Error-clamp (force-channel) trials: ``channel_trials = N`` in a block makes N of its trials
+channels, drawn as catch trials are (never in the block's first cycle of targets, never a catch
+trial), or every trial of the block when N equals its trials (a channel block). A channel trial
+runs a stiff spring and damper across the straight home-to-target line instead of the block's
+perturbation (``channel_stiffness``, N/m, and ``channel_damping``, N s/m, in the protocol; the
+defaults are ``CHANNEL_STIFFNESS`` and ``CHANNEL_DAMPING``), so the hand is held on the line, and
+the force the arm presses into the channel is recorded.
 """
 
 from __future__ import annotations
@@ -30,7 +40,9 @@ from ..errors import UserError
 from ..records.storage import check_float, check_int, check_keys, check_str, read_limited
 from ..words import unknown_name
 
-FORCE_KINDS = ("curl", "constant", "spring")
+FORCE_KINDS = ("curl", "constant", "spring", "viscous")
+#: Fields ``F = B v``: the adaptation index of a channel trial is measured against one of these.
+VELOCITY_KINDS = ("curl", "viscous")
 VISUAL_KINDS = ("rotation", "mirror", "jointspace")
 KINDS = ("none", *FORCE_KINDS, *VISUAL_KINDS)
 
@@ -40,17 +52,43 @@ PARAMETERS: dict[str, tuple[tuple[str, float, float, float, str], ...]] = {
     "curl": (("b", -50.0, 50.0, 0.0, "N s/m"),),
     "constant": (("fx", -20.0, 20.0, 0.0, "N"), ("fy", -20.0, 20.0, 0.0, "N")),
     "spring": (("stiffness", 0.0, 500.0, 0.0, "N/m"),),
+    "viscous": (("b11", -50.0, 50.0, 0.0, "N s/m"), ("b12", -50.0, 50.0, 0.0, "N s/m"),
+                ("b21", -50.0, 50.0, 0.0, "N s/m"), ("b22", -50.0, 50.0, 0.0, "N s/m")),
     "rotation": (("angle", -180.0, 180.0, 0.0, "deg"),),
     "mirror": (("axis", -180.0, 180.0, 90.0, "deg"),),
     "jointspace": (("gain", 0.01, 2.0, 0.25, "m/rad"),),
 }
 
-#: The curl preset's field. Chosen by measurement (README "Lab", ``tests/test_lab.py``): the model
+#: The curl preset's field. Chosen by measurement (docs/lab.md, ``tests/test_lab.py``): the model
 #: bot, which knows the arm but not the field, is pushed 2-3 cm off its 10 cm reaches, and a bot
 #: that knows the field cancels it within its muscles' strength and reaches straight.
 CURL_B = 2.0
+#: Shadmehr & Mussa-Ivaldi's (1994) field (N s/m), and the ``viscous`` preset's: one eighth of it, which
+#: takes its largest gain (its spectral norm, 15.92 N s/m) to 1.99 N s/m, the curl preset's b. Checked
+#: by measurement as b was (docs/lab.md, ``tests/test_lab.py``).
+PUBLISHED_VISCOUS_B = ((-10.1, -11.2), (-11.2, 11.1))
+VISCOUS_SCALE = 0.125
+VISCOUS_B = tuple(tuple(VISCOUS_SCALE * v for v in row) for row in PUBLISHED_VISCOUS_B)
+#: The force channel of error-clamp trials (docs/lab.md): this arm's lightest endpoint mass is 0.77 kg
+#: (a human arm's), its fields push with about 1 N, so the low end of the robots' 2,000-6,000 N/m holds
+#: the hand within about 0.5 mm of the line (2% of the field's 2.9 cm deflection), and the robots' 50 N s/m
+#: damps it (damping ratio 0.64 at the lightest mass). ``LabSession`` checks a protocol's channel
+#: against the physics step: its fastest mode must satisfy |lambda| dt <= ``MAX_CHANNEL_LAMBDA_DT``.
+CHANNEL_STIFFNESS = 2000.0
+CHANNEL_DAMPING = 50.0
+MAX_CHANNEL_LAMBDA_DT = 1.0
+MAX_CHANNEL_STIFFNESS = 20000.0
+MAX_CHANNEL_DAMPING = 500.0
 ROTATION_ANGLE = 30.0
 JOINTSPACE_GAIN = 0.25
+
+#: The paradigms' block lengths (docs/lab.md: chosen with the adaptive bot's default learner).
+SAVINGS_EXPOSURE = 80
+SAVINGS_COUNTER = 4
+SAVINGS_WASHOUT = 160
+SPONTANEOUS_EXPOSURE = 160
+SPONTANEOUS_COUNTER = 4
+SPONTANEOUS_CLAMP = 48
 
 MAX_BLOCKS = 20
 MAX_TRIALS = 2000
@@ -92,11 +130,25 @@ class Perturbation:
 
     def label(self) -> str:
         """e.g. ``curl b=2 N s/m``; ``none`` for none."""
+        if self.kind == "viscous":
+            (b11, b12), (b21, b22) = self.matrix  # type: ignore[misc]
+            return f"viscous B=[[{b11:g}, {b12:g}], [{b21:g}, {b22:g}]] N s/m"
         units = {name: unit for name, _l, _h, _d, unit in PARAMETERS[self.kind]}
         parts = [f"{name}={value:g} {units[name]}" for name, value in self.params]
         return " ".join([self.kind, *parts])
 
+    @property
+    def matrix(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """``B`` of a velocity field ``F = B v`` (curl or viscous), else None."""
+        if self.kind == "curl":
+            return (0.0, self["b"]), (-self["b"], 0.0)
+        if self.kind == "viscous":
+            return (self["b11"], self["b12"]), (self["b21"], self["b22"])
+        return None
+
     def as_dict(self) -> dict[str, object]:
+        if self.kind == "viscous":
+            return {"perturbation": self.kind, "matrix": [list(row) for row in self.matrix]}  # type: ignore[union-attr]
         return {"perturbation": self.kind, **dict(self.params)}
 
 
@@ -111,12 +163,19 @@ class Block:
     #: Trials of this block run with the perturbation off, unannounced (never among its first cycle of targets).
     catch_trials: int = 0
     instruction: str = ""
+    #: Error-clamp trials: the channel instead of the perturbation (all of the block's when equal to ``trials``).
+    channel_trials: int = 0
+
+    @property
+    def channel_block(self) -> bool:
+        return self.channel_trials == self.trials
 
 
 DEFAULT_INSTRUCTIONS = {
     "baseline": "Reach straight to each target as soon as it appears, and hold it.",
     "exposure": "Something has changed: keep reaching straight to each target, and hold it.",
     "washout": "Back to normal: keep reaching straight to each target, and hold it.",
+    "clamp": "Keep reaching straight to each target, and hold it.",
 }
 
 
@@ -140,6 +199,9 @@ class Protocol:
     first_target_deg: float = 0.0
     #: The arm's posture at home (shoulder, elbow; degrees): the game's start posture.
     home_posture_deg: tuple[float, float] = (45.0, 90.0)
+    #: The error-clamp channel's spring (N/m) and damper (N s/m) across the home-to-target line.
+    channel_stiffness: float = CHANNEL_STIFFNESS
+    channel_damping: float = CHANNEL_DAMPING
     perturbations: tuple[Perturbation, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -149,10 +211,28 @@ class Protocol:
     def trials(self) -> int:
         return sum(b.trials for b in self.blocks)
 
+    @property
+    def has_channels(self) -> bool:
+        return any(b.channel_trials for b in self.blocks)
+
+    def reference_field(self, block: int) -> Perturbation | None:
+        """The field a channel trial of ``block`` is measured against (its adaptation index): the block's
+        own if it is a velocity field, else the protocol's first velocity field (baseline, washout and
+        clamp blocks are measured against the field the experiment is about); None if there is none."""
+        own = self.blocks[block].perturbation
+        if own.kind in VELOCITY_KINDS:
+            return own
+        return next((b.perturbation for b in self.blocks if b.perturbation.kind in VELOCITY_KINDS), None)
+
     def target_angles_deg(self) -> tuple[float, ...]:
         return tuple(self.first_target_deg + 360.0 * i / self.targets for i in range(self.targets))
 
     def as_dict(self) -> dict[str, object]:
+        # The channel's settings and a block's channel_trials are written only when used, so a protocol
+        # without channels is written as before.
+        custom = (self.channel_stiffness, self.channel_damping) != (CHANNEL_STIFFNESS, CHANNEL_DAMPING)
+        channel = {"channel_stiffness": self.channel_stiffness, "channel_damping": self.channel_damping} \
+            if self.has_channels or custom else {}
         return {
             "name": self.name,
             "targets": self.targets,
@@ -166,9 +246,10 @@ class Protocol:
             "first_target_deg": self.first_target_deg,
             "home_shoulder_deg": self.home_posture_deg[0],
             "home_elbow_deg": self.home_posture_deg[1],
+            **channel,
             "blocks": [
                 {"name": b.name, "trials": b.trials, "catch_trials": b.catch_trials, "instruction": b.instruction,
-                 **b.perturbation.as_dict()}
+                 **({"channel_trials": b.channel_trials} if b.channel_trials else {}), **b.perturbation.as_dict()}
                 for b in self.blocks
             ],
         }
@@ -195,10 +276,54 @@ def preset(name: str) -> Protocol:
         return Protocol("mirror", _blocks(Perturbation.make("mirror", axis=90.0)))
     if name == "jointspace":
         return Protocol("jointspace", _blocks(Perturbation.make("jointspace", gain=JOINTSPACE_GAIN)))
+    if name == "viscous":
+        (b11, b12), (b21, b22) = VISCOUS_B
+        return Protocol("viscous", _blocks(Perturbation.make("viscous", b11=b11, b12=b12, b21=b21, b22=b22)))
+    if name == "savings":
+        return savings()
+    if name == "spontaneous":
+        return spontaneous()
     raise UserError(unknown_name("lab preset", name, PRESETS, "or give a .toml file"))
 
 
-PRESETS = ("null", "curl", "rotation", "mirror", "jointspace")
+PRESETS = ("null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous")
+
+
+def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
+    """Exposure to the curl field, de-adaptation, re-exposure: re-learning is faster (savings).
+
+    In the two-rate model savings needs the fast and slow states apart when re-exposure begins. A null
+    washout long enough to bring the net adaptation back to zero lets both decay together, and re-learning
+    is barely faster than learning (docs/lab.md measures it: ``counter = 0`` here gives that protocol, with
+    a ``SAVINGS_WASHOUT``-trial washout). So the preset de-adapts as Smith, Ghazizadeh & Shadmehr (2006) did:
+    ``counter`` trials of the opposite field bring the net adaptation back to about zero quickly, with the
+    fast state holding the counter-field and the slow state still holding the field, and re-exposure follows.
+    """
+    curl = Perturbation.make("curl", b=CURL_B)
+    blocks = [Block("baseline", 16, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"]),
+              Block("exposure", SAVINGS_EXPOSURE, curl, 0, DEFAULT_INSTRUCTIONS["exposure"])]
+    if counter:
+        blocks.append(Block("counter", counter, Perturbation.make("curl", b=-CURL_B), 0,
+                            DEFAULT_INSTRUCTIONS["exposure"]))
+    else:
+        blocks.append(Block("washout", SAVINGS_WASHOUT, NONE, 0, DEFAULT_INSTRUCTIONS["washout"]))
+    blocks.append(Block("re-exposure", SAVINGS_EXPOSURE, curl, 0, DEFAULT_INSTRUCTIONS["exposure"]))
+    return _checked(Protocol("savings", tuple(blocks)))
+
+
+def spontaneous() -> Protocol:
+    """Smith, Ghazizadeh & Shadmehr's (2006) paradigm: a long exposure to the curl field, a brief exposure to
+    the opposite field (long enough to bring the adaptation back to about zero), then a block of error-clamp
+    trials, in which the adaptation rebounds toward the first field. Channel trials in baseline and
+    exposure measure the adaptation index along the way."""
+    curl = Perturbation.make("curl", b=CURL_B)
+    return _checked(Protocol("spontaneous", (
+        Block("baseline", 16, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"], channel_trials=4),
+        Block("exposure", SPONTANEOUS_EXPOSURE, curl, 0, DEFAULT_INSTRUCTIONS["exposure"], channel_trials=16),
+        Block("counter", SPONTANEOUS_COUNTER, Perturbation.make("curl", b=-CURL_B), 0,
+              DEFAULT_INSTRUCTIONS["exposure"]),
+        Block("clamp", SPONTANEOUS_CLAMP, curl, 0, DEFAULT_INSTRUCTIONS["clamp"], channel_trials=SPONTANEOUS_CLAMP),
+    )))
 
 
 def with_catch_trials(protocol: Protocol, catch: int) -> Protocol:
@@ -212,6 +337,10 @@ def with_perturbation(protocol: Protocol, perturbation: Perturbation) -> Protoco
     with none (the ``null`` preset), in its blocks named ``exposure``. ``NONE`` switches the perturbed
     blocks off (and their catch trials, which would have nothing to switch off)."""
     perturbed = [b.perturbation.kind != "none" for b in protocol.blocks]
+    distinct = dict.fromkeys(b.perturbation for b, on in zip(protocol.blocks, perturbed, strict=True) if on)
+    if len(distinct) > 1:
+        raise UserError(f"protocol {protocol.name!r} has {len(distinct)} different perturbations "
+                        f"({', '.join(p.label() for p in distinct)}): one cannot stand for them all")
     if not any(perturbed):
         perturbed = [b.name == "exposure" for b in protocol.blocks]
     if not any(perturbed):
@@ -226,8 +355,18 @@ def with_perturbation(protocol: Protocol, perturbation: Perturbation) -> Protoco
 # ----------------------------------------------------------------- from data
 MAX_PROTOCOL_BYTES = 256 * 1024
 _TOP = {"name", "targets", "distance", "target_radius", "home_radius", "hold_time", "delay_min", "delay_max",
-        "timeout", "first_target_deg", "home_shoulder_deg", "home_elbow_deg"}
-_BLOCK = {"name", "trials", "catch_trials", "instruction", "perturbation"}
+        "timeout", "first_target_deg", "home_shoulder_deg", "home_elbow_deg", "channel_stiffness", "channel_damping"}
+_BLOCK = {"name", "trials", "catch_trials", "channel_trials", "instruction", "perturbation"}
+
+
+def viscous_matrix(where: str, value: object) -> dict[str, float]:
+    """``matrix = [[b11, b12], [b21, b22]]`` (N s/m, each within the viscous field's range) as parameters."""
+    if not (isinstance(value, list) and len(value) == 2
+            and all(isinstance(row, list) and len(row) == 2 for row in value)):
+        raise ValueError(f"{where} must be [[b11, b12], [b21, b22]] (N s/m)")
+    limits = {name: (low, high) for name, low, high, _d, _u in PARAMETERS["viscous"]}
+    return {name: check_float(f"{where}[{i}][{j}]", value[i][j], *limits[name])
+            for (i, j), name in zip(((0, 0), (0, 1), (1, 0), (1, 1)), ("b11", "b12", "b21", "b22"), strict=True)}
 
 
 def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
@@ -251,9 +390,13 @@ def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
         kind = check_str(f"{w}.perturbation", b.get("perturbation", "none"), 20)
         if kind not in KINDS:
             raise ValueError(f"{w}.perturbation must be one of {', '.join(KINDS)}, got {kind!r}")
-        param_names = {p[0] for p in PARAMETERS[kind]}
+        param_names = {"matrix"} if kind == "viscous" else {p[0] for p in PARAMETERS[kind]}
         check_keys(w, b, {"trials"}, frozenset((_BLOCK - {"trials"}) | param_names))
-        values = {p: check_float(f"{w}.{p}", b[p], low, high) for p, low, high, _d, _u in PARAMETERS[kind] if p in b}
+        if kind == "viscous":
+            values = viscous_matrix(f"{w}.matrix", b["matrix"]) if "matrix" in b else {}
+        else:
+            values = {p: check_float(f"{w}.{p}", b[p], low, high)
+                      for p, low, high, _d, _u in PARAMETERS[kind] if p in b}
         block_name = check_str(f"{w}.name", b.get("name", f"block {i + 1}"), 40)
         blocks.append(Block(
             block_name,
@@ -261,6 +404,7 @@ def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
             Perturbation.make(kind, **values),
             check_int(f"{w}.catch_trials", b.get("catch_trials", 0), 0, MAX_TRIALS),
             check_str(f"{w}.instruction", b.get("instruction", DEFAULT_INSTRUCTIONS.get(block_name, "")), 200),
+            check_int(f"{w}.channel_trials", b.get("channel_trials", 0), 0, MAX_TRIALS),
         ))
     protocol = Protocol(
         name,
@@ -275,6 +419,8 @@ def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
         first_target_deg=number("first_target_deg", -360.0, 360.0, defaults.first_target_deg),
         home_posture_deg=(number("home_shoulder_deg", -180.0, 180.0, defaults.home_posture_deg[0]),
                           number("home_elbow_deg", 5.0, 175.0, defaults.home_posture_deg[1])),
+        channel_stiffness=number("channel_stiffness", 0.0, MAX_CHANNEL_STIFFNESS, CHANNEL_STIFFNESS, low_open=True),
+        channel_damping=number("channel_damping", 0.0, MAX_CHANNEL_DAMPING, CHANNEL_DAMPING),
     )
     return _checked(protocol)
 
@@ -287,9 +433,19 @@ def _checked(p: Protocol) -> Protocol:
     for i, b in enumerate(p.blocks):
         if b.catch_trials and b.perturbation.kind == "none":
             raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} has no perturbation to switch off")
+        if b.channel_trials > b.trials:
+            raise ValueError(f"blocks[{i}].channel_trials must be at most the block's trials ({b.trials})")
+        if b.channel_block:
+            if b.catch_trials:
+                raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} is all channel trials: none to catch")
+            continue
         if b.catch_trials > max(0, b.trials - p.targets):
             raise ValueError(f"blocks[{i}].catch_trials must be at most trials - targets "
                              f"({max(0, b.trials - p.targets)}): catch trials never fall in a block's first cycle")
+        if b.catch_trials + b.channel_trials > max(0, b.trials - p.targets):
+            raise ValueError(f"blocks[{i}].channel_trials must be at most trials - targets - catch_trials "
+                             f"({max(0, b.trials - p.targets - b.catch_trials)}), or all of the block's trials: "
+                             "channel trials never fall in a block's first cycle nor on a catch trial")
     return p
 
 

@@ -30,9 +30,9 @@ from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
 from ..game.rules import GameConfig, Target
 from ..game.session import GameResult, GameSession
 from ..physics.integrators import Integrator
-from ..physics.loads import loaded_arm
+from ..physics.loads import ChannelField, Loads, loaded_arm
 from .perturbations import Display, display_for, loads_for
-from .protocol import NONE, Perturbation, Protocol, target_positions
+from .protocol import MAX_CHANNEL_LAMBDA_DT, NONE, Perturbation, Protocol, target_positions
 
 HOLD, REACH = "hold", "reach"
 _WENT, _ENDED = 1, 2
@@ -52,11 +52,13 @@ class TrialPlan:
     delay_steps: int
     perturbation: Perturbation
     catch: bool
+    #: An error-clamp trial: the force channel along the home-to-target line instead of the perturbation.
+    channel: bool = False
 
     @property
     def active(self) -> Perturbation:
-        """The perturbation actually on: none on a catch trial."""
-        return NONE if self.catch else self.perturbation
+        """The perturbation actually on: none on a catch or channel trial."""
+        return NONE if self.catch or self.channel else self.perturbation
 
 
 @dataclass
@@ -68,11 +70,19 @@ class TrialOutcome:
     #: The shown hand (m) after every physics step from the go cue to the end, both included.
     xs: list[float] = field(default_factory=list, repr=False)
     ys: list[float] = field(default_factory=list, repr=False)
+    #: On a channel trial: the force (N) the arm pressed into the channel at the same steps as ``xs``, signed
+    #: along the left normal of the home-to-target line (+ = counter-clockwise side); empty otherwise.
+    channel_force: list[float] = field(default_factory=list, repr=False)
+    #: On a channel trial: the hand's true velocity (m/s) at those steps, for the adaptation index.
+    vxs: list[float] = field(default_factory=list, repr=False)
+    vys: list[float] = field(default_factory=list, repr=False)
 
 
 def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]) -> tuple[TrialPlan, ...]:
     """Every trial of the protocol: targets in shuffled cycles (each target once a cycle), go-cue delays,
-    catch trials, all drawn from one ``random.Random(seed)`` in a fixed order."""
+    catch trials and channel trials, all drawn from one ``random.Random(seed)`` in a fixed order (a block
+    without channel trials draws nothing for them, so the schedules of protocols without channels are
+    those they always were)."""
     rng = random.Random(seed)
     positions = target_positions(protocol, home)
     angles = protocol.target_angles_deg()
@@ -84,11 +94,18 @@ def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]
             rng.shuffle(cycle)
             order += cycle
         catch = set(rng.sample(range(protocol.targets, block.trials), block.catch_trials))
+        if block.channel_block:
+            channel = set(range(block.trials))
+        elif block.channel_trials:
+            free = [i for i in range(protocol.targets, block.trials) if i not in catch]
+            channel = set(rng.sample(free, block.channel_trials))
+        else:
+            channel = set()
         for i in range(block.trials):
             delay = rng.uniform(*protocol.delay)
             t = order[i]
             plans.append(TrialPlan(len(plans), b, block.name, t, angles[t] % 360.0, positions[t],
-                                   max(1, round(delay / dt)), block.perturbation, i in catch))
+                                   max(1, round(delay / dt)), block.perturbation, i in catch, i in channel))
     return tuple(plans)
 
 
@@ -121,7 +138,14 @@ class LabSession(GameSession):
         self.plans = schedule(protocol, config.seed, config.dt, self.home)
         self.hold_steps = max(1, round(protocol.hold_time / config.dt))
         self.timeout_steps = max(1, round(protocol.timeout / config.dt))
+        if protocol.has_channels:
+            self._check_channel()
         self._physics: dict[Perturbation, tuple[object, Display | None]] = {}
+        self._channels: dict[int, tuple[object, ChannelField]] = {}
+        self._channel: ChannelField | None = None
+        self._fs: list[float] = []
+        self._vxs: list[float] = []
+        self._vys: list[float] = []
         self.outcomes: list[TrialOutcome] = []
         self.trial_index = 0
         self.finished = False
@@ -189,7 +213,59 @@ class LabSession(GameSession):
             self._physics[perturbation] = (step, display_for(perturbation, self.home, self.home_q))
         return self._physics[perturbation]
 
+    def channel_for(self, target: int) -> tuple[object, ChannelField]:
+        """(step function, channel) of an error-clamp trial to ``target``, built once per target."""
+        if target not in self._channels:
+            hx, hy = self.home
+            tx, ty = target_positions(self.protocol, self.home)[target]
+            length = math.hypot(tx - hx, ty - hy)
+            channel = ChannelField(self.protocol.channel_stiffness, self.protocol.channel_damping, self.home,
+                                   ((tx - hx) / length, (ty - hy) / length))
+            step = Integrator(self.config.integrator, loaded_arm(self.model, Loads(hand=channel))).step_components
+            self._channels[target] = (step, channel)
+        return self._channels[target]
+
+    def _check_channel(self) -> None:
+        """Refuse a channel too stiff for the fixed physics step (as MotorNet checks delays against dt).
+
+        Across the line the hand is a mass ``m`` on the channel's spring ``k`` and damper ``c``: the modes
+        ``m s^2 + c s + k = 0``. ``m`` is taken as the arm's lightest endpoint mass (the smallest eigenvalue
+        of ``(J M^-1 J^T)^-1``) at home and at every target, the worst direction a channel can lie in. RK4 is
+        stable to |s| dt of about 2.8; the limit ``MAX_CHANNEL_LAMBDA_DT`` keeps a margin and the step's error
+        small.
+        """
+        import numpy as np
+
+        p, dt = self.protocol, self.config.dt
+        postures = [self.home_q] + [tuple(self.model.inverse_kinematics(xy)) for xy in target_positions(p, self.home)]
+        lightest = math.inf
+        for q in postures:
+            jac = self.model.jacobian(np.asarray(q, dtype=float))
+            inverse = jac @ np.linalg.inv(self.model.mass_matrix(np.asarray(q, dtype=float))) @ jac.T
+            lightest = min(lightest, 1.0 / float(np.max(np.linalg.eigvalsh(inverse))))
+        fastest = float(np.max(np.abs(np.roots([lightest, p.channel_damping, p.channel_stiffness]))))
+        if fastest * dt > MAX_CHANNEL_LAMBDA_DT:
+            raise UserError(
+                f"the force channel (channel_stiffness {p.channel_stiffness:g} N/m, channel_damping "
+                f"{p.channel_damping:g} N s/m) is too stiff for the physics step of {dt:g} s: on the arm's lightest "
+                f"endpoint mass ({lightest:.3g} kg) its fastest mode is {fastest:.4g}/s, and |s| dt must be at most "
+                f"{MAX_CHANNEL_LAMBDA_DT:g}")
+
+    def _record_channel(self, q1: float, q2: float, w1: float, w2: float) -> None:
+        """The force the arm presses into the channel at this state (minus the channel's on the hand)."""
+        channel = self._channel
+        assert channel is not None
+        l1, l2 = self.config.arm.l1, self.config.arm.l2
+        s1, c1, s12, c12 = math.sin(q1), math.cos(q1), math.sin(q1 + q2), math.cos(q1 + q2)
+        x, y = l1 * c1 + l2 * c12, l1 * s1 + l2 * s12
+        vx = (-l1 * s1 - l2 * s12) * w1 - l2 * s12 * w2
+        vy = (l1 * c1 + l2 * c12) * w1 + l2 * c12 * w2
+        self._fs.append(-channel.lateral(x, y, vx, vy))
+        self._vxs.append(vx)
+        self._vys.append(vy)
+
     def _enter_trial(self) -> None:
+        self._channel = None
         plan = self.plan
         if plan is None:
             self.finished = True
@@ -222,6 +298,7 @@ class LabSession(GameSession):
         q1, q2, w1, w2 = self.state
         previous = self.state
         step, show = self._step, self._show
+        channel = self._channel
         ran = 0
         while ran < n:
             t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
@@ -239,9 +316,14 @@ class LabSession(GameSession):
             hy = l1 * sin(q1) + l2 * sin(s12)
             if show is not None:
                 hx, hy = show(hx, hy, q1, q2)
+            if channel is not None:
+                self._record_channel(q1, q2, w1, w2)
             event = self._task_step(hx, hy)
             if event:
                 step, show = self._step, self._show  # the go cue switched the perturbation on, or the end off
+                channel = self._channel
+                if channel is not None:  # a channel trial's go cue: its first sample
+                    self._record_channel(q1, q2, w1, w2)
                 if event == _ENDED:
                     # The arm goes home at rest and the muscles relax.
                     q1, q2 = self.home_q
@@ -270,7 +352,12 @@ class LabSession(GameSession):
                 self._counter = 0
                 self._xs, self._ys = [x], [y]
                 self.rules.target = Target(*plan.position, self.protocol.target_radius)
-                self._step, self._show = self.physics_for(plan.active)
+                if plan.channel:
+                    self._step, self._channel = self.channel_for(plan.target)
+                    self._show = None
+                    self._fs, self._vxs, self._vys = [], [], []
+                else:
+                    self._step, self._show = self.physics_for(plan.active)
                 return _WENT
             return 0
         self._xs.append(x)
@@ -279,7 +366,10 @@ class LabSession(GameSession):
         hit = self._counter >= self.hold_steps
         if not hit and self.steps - self._go_step < self.timeout_steps:
             return 0
-        self.outcomes.append(TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys))
+        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys)
+        if plan.channel:
+            outcome.channel_force, outcome.vxs, outcome.vys = self._fs, self._vxs, self._vys
+        self.outcomes.append(outcome)
         if hit:
             self.rules.board.hits += 1
             self.rules.board.score += 1

@@ -14,6 +14,13 @@ y up):
   points 90 degrees clockwise from the hand's velocity (a reach bows clockwise).
 * ``ConstantForce(fx, fy)``: a steady pull, e.g. a weight hung on the hand.
 * ``SpringField(stiffness, anchor)``: ``F = -k (x - anchor)``, a spring to a point.
+* ``ViscousField(matrix)``: ``F = B v`` with any 2 x 2 ``B`` (N s/m), as Shadmehr & Mussa-Ivaldi
+  (1994) used. Its power is ``v . B v = v . sym(B) v``: only ``B``'s antisymmetric (curl) part does
+  no work, so a field with a symmetric part feeds the arm energy or drains it.
+* ``ChannelField(stiffness, damping, origin, direction)``: a force channel (error clamp): a spring
+  and damper acting only across the straight line through ``origin`` along ``direction``,
+  ``F = -(k d + c v_n) n`` with ``n`` the line's left normal, ``d`` the hand's signed distance
+  from the line and ``v_n`` its velocity across it. Motion along the line is free.
 
 ``loaded_arm(model, loads)`` returns an object with the arm's ``component_dynamics`` whose
 closures include the loads, for ``Integrator``. With no load it returns the arm itself, so a
@@ -74,6 +81,41 @@ class SpringField:
     def force(self, x: Any, y: Any, vx: Any, vy: Any, t: float) -> tuple[Any, Any]:
         k = self.stiffness
         return -k * (x - self.anchor[0]), -k * (y - self.anchor[1])
+
+
+@dataclass(frozen=True)
+class ViscousField:
+    """``F = B v`` (N s/m) for a full matrix ``B = ((b11, b12), (b21, b22))``; its symmetric part does work."""
+
+    matrix: tuple[tuple[float, float], tuple[float, float]]
+
+    def force(self, x: Any, y: Any, vx: Any, vy: Any, t: float) -> tuple[Any, Any]:
+        (b11, b12), (b21, b22) = self.matrix
+        return b11 * vx + b12 * vy, b21 * vx + b22 * vy
+
+
+@dataclass(frozen=True)
+class ChannelField:
+    """A force channel along the line through ``origin`` with unit ``direction`` (ux, uy): a spring
+    (``stiffness``, N/m) and a damper (``damping``, N s/m) across the line only, so the hand moves freely
+    along it and is held on it. ``lateral`` is the force's signed size along the left normal ``(-uy, ux)``."""
+
+    stiffness: float
+    damping: float
+    origin: tuple[float, float]
+    direction: tuple[float, float]
+
+    def lateral(self, x: Any, y: Any, vx: Any, vy: Any) -> Any:
+        """The channel's force on the hand across the line (N, + = to the left of the line's direction)."""
+        ux, uy = self.direction
+        d = -uy * (x - self.origin[0]) + ux * (y - self.origin[1])
+        vn = -uy * vx + ux * vy
+        return -(self.stiffness * d + self.damping * vn)
+
+    def force(self, x: Any, y: Any, vx: Any, vy: Any, t: float) -> tuple[Any, Any]:
+        ux, uy = self.direction
+        f = self.lateral(x, y, vx, vy)
+        return -uy * f, ux * f
 
 
 @dataclass(frozen=True)
