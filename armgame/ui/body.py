@@ -17,6 +17,7 @@ their own scale. Edges are anti-aliased (a filled polygon under its anti-aliased
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -41,6 +42,9 @@ BREADTH = (1.4, 1.4, 1.0, 1.0)
 #: Muscle fill: this far from the body's skin towards the muscle's colour at rest, the rest with activation.
 MUSCLE_TINT = 0.45
 SPINDLE_POINTS = 9
+#: Along a muscle (0 at its origin, 1 at its insertion): where each outline point is, and the belly's shape there.
+_SPINDLE = tuple((k / (SPINDLE_POINTS - 1), math.sin(math.pi * k / (SPINDLE_POINTS - 1)) ** 1.2)
+                 for k in range(SPINDLE_POINTS))
 #: The torso and head (top view, m): the torso's centre and half-sizes, the head's centre and radius.
 TORSO = ((-0.19, -0.035), (0.23, 0.11))
 HEAD = ((-0.19, -0.02), 0.085)
@@ -83,9 +87,8 @@ def muscle_outline(i: int, q1: float, q2: float, l1: float, l2: float, activatio
     belly = (MUSCLE_REST + MUSCLE_GAIN * a) * BREADTH[i]
     side: list[Point] = []
     other: list[Point] = []
-    for k in range(SPINDLE_POINTS):
-        s = k / (SPINDLE_POINTS - 1)
-        w = 0.002 + belly * math.sin(math.pi * s) ** 1.2
+    for s, shape in _SPINDLE:
+        w = 0.002 + belly * shape
         cx, cy = x0 + s * dx, y0 + s * dy
         side.append((cx + w * nx, cy + w * ny))
         other.append((cx - w * nx, cy - w * ny))
@@ -111,6 +114,17 @@ def area(points: Sequence[Point]) -> float:
 def blend(a: Sequence[int], b: Sequence[int], k: float) -> RGB:
     """The colour a fraction ``k`` of the way from ``a`` to ``b``."""
     return tuple(round(x + (y - x) * k) for x, y in zip(a[:3], b[:3], strict=True))  # type: ignore[return-value]
+
+
+@functools.lru_cache(maxsize=1024)
+def _muscle_colour(skin: RGB, colour: RGB, level: int) -> RGB:
+    """A muscle's fill at activation ``level`` / 64: from a tint of its colour at rest to the colour itself."""
+    return blend(skin, colour, MUSCLE_TINT + (1.0 - MUSCLE_TINT) * level / 64)
+
+
+@functools.lru_cache(maxsize=64)
+def _edge_colour(colour: RGB, ink: RGB) -> RGB:
+    return blend(colour, ink, 0.35)
 
 
 def _ring(surface: pygame.Surface, fill: RGB, edge: RGB, centre: tuple[int, int], radius: int, line: int) -> None:
@@ -188,16 +202,16 @@ def draw_arm(surface: pygame.Surface, origin: tuple[float, float], px_per_m: flo
     drawn.append(polygon(surface, edge, px(_palm(wrist, hand, grow))))
     for start, end, widths in ((shoulder, elbow, UPPER_ARM), (elbow, wrist, FOREARM)):
         polygon(surface, skin, px(limb_outline(start, end, widths)))
-    for centre, r in joint_r:
-        aacircle(surface, skin, at(centre), r * k)
+    for centre, r in joint_r:  # inside the joint's anti-aliased edge: a plain fill is smooth enough
+        pygame.draw.circle(surface, skin, at(centre), r * k)
     polygon(surface, skin, px(_palm(wrist, hand, 0.0)))
     colours = colours or palette.muscles
     for i in (1, 0, 3, 2) if torso else (3, 2):  # the shoulder pair under the elbow pair, where they cross
         a = min(max(float(activation[i]), 0.0), 1.0)
         outline = px(muscle_outline(i, q1, q2, l1, l2, a))
-        polygon(surface, blend(skin, colours[i], MUSCLE_TINT + (1.0 - MUSCLE_TINT) * a), outline)
-        drawn.append(aalines(surface, blend(colours[i], palette.ink, 0.35), True, outline))
-    return drawn
+        polygon(surface, _muscle_colour(skin, tuple(colours[i]), round(64 * a)), outline)
+        drawn.append(aalines(surface, _edge_colour(tuple(colours[i]), palette.ink), True, outline))
+    return [drawn[0].unionall(drawn[1:])]  # its parts overlap: one rectangle restores less than all of theirs
 
 
 def _palm(wrist: Point, hand: Point, grow: float) -> list[Point]:

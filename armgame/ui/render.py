@@ -211,6 +211,16 @@ class Layout:
             ([("progress", self.progress[0])] if self.progress else [])
 
 
+def _without_nested(rects: list[pygame.Rect]) -> list[pygame.Rect]:
+    """The rectangles, less any inside another (the hand inside the arm's): each pixel restored once."""
+    rects.sort(key=lambda r: r.width * r.height, reverse=True)
+    kept: list[pygame.Rect] = []
+    for r in rects:
+        if r.collidelist(kept) < 0 or not any(k.contains(r) for k in kept):
+            kept.append(r)
+    return kept
+
+
 def clock_text(seconds: float) -> str:
     """Seconds to a tenth under 100 s (a 60 s game counts 60.0, 59.9, ...), minutes and seconds above."""
     if seconds < 100:
@@ -594,7 +604,7 @@ class GameRenderer:
                 dirty.append(screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect))
             else:
                 dirty.append(screen.blit(self.text(label.text, label.height, label.colour), label.rect))
-        self._dirty = [r.inflate(2, 2) for r in dirty if r.width and r.height]
+        self._dirty = _without_nested([r.inflate(2, 2) for r in dirty if r.width and r.height])
         return lay
 
     def _draw_trail(self, screen: pygame.Surface, view: Viewport,
