@@ -111,6 +111,11 @@ def test_the_game_draws_the_same_frames_incrementally_as_whole(fonts):
     reference = pygame.Surface(PROJECTOR)
     whole.draw(reference, session, hud=Hud(help=("p pause",)))
     assert pygame.image.tobytes(screen, "RGB") == pygame.image.tobytes(reference.convert(screen), "RGB")
+    screen.fill((0, 0, 0))  # what a change of mode (F11) leaves: the next frame is drawn whole
+    session.advance(40)
+    r.draw(screen, session, hud=Hud(help=("p pause",)))
+    whole.draw(reference, session, hud=Hud(help=("p pause",)))
+    assert pygame.image.tobytes(screen, "RGB") == pygame.image.tobytes(reference.convert(screen), "RGB")
 
 
 def test_text_scale_and_the_high_contrast_palette_are_settings():

@@ -554,7 +554,10 @@ class GameRenderer:
         p, view = self.palette, lay.view
         background = self._background(lay, session)
         frame_key = (id(background), screen.get_size())
-        if self._dirty is not None and self._frame_key == frame_key and screen is pygame.display.get_surface():
+        # The corner is always background: if it is not (the window was cleared by a change of mode, or
+        # something else drew there), the last frame is not on the window any more.
+        if self._dirty is not None and self._frame_key == frame_key and screen is pygame.display.get_surface() \
+                and screen.get_at((0, 0)) == background.get_at((0, 0)):
             for rect in self._dirty:
                 screen.blit(background, rect, rect)
         else:
