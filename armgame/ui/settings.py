@@ -1,4 +1,4 @@
-"""The window's settings that persist between games: key map, mute, palette, window size.
+"""The window's settings that persist between games: key map, mute, palette, text scale, window size.
 
 A small TOML file in the user's config folder (``$XDG_CONFIG_HOME/armgame/settings.toml``, normally
 ``~/.config/armgame/settings.toml``; ``%APPDATA%\\armgame`` on Windows), or the file ``--settings``
@@ -25,7 +25,9 @@ from ..errors import UserError
 FILE_NAME = "settings.toml"
 #: A settings file is a few lines; anything larger is not one.
 MAX_BYTES = 64 * 1024
-PALETTES = ("okabe-ito", "classic")
+PALETTES = ("okabe-ito", "classic", "high-contrast")
+#: ``text_scale``: every text this many times its usual size (1.5 for the back of a large room).
+MIN_TEXT_SCALE, MAX_TEXT_SCALE = 0.75, 2.5
 MIN_SIDE, MAX_SIDE = 320, 10000
 DEFAULT_KEYS = "dfjk"
 #: Keys the windows use for themselves: a muscle cannot take them.
@@ -41,6 +43,7 @@ class Settings:
     keys: str = DEFAULT_KEYS
     mute: bool = False
     palette: str = PALETTES[0]
+    text_scale: float = 1.0
     #: Window size in pixels; None: a default that fits the desktop.
     size: tuple[int, int] | None = None
 
@@ -52,7 +55,8 @@ class Settings:
                  "# you change something in the window (m mutes).",
                  f'keys = "{self.keys}"',
                  f"mute = {'true' if self.mute else 'false'}",
-                 f'palette = "{self.palette}"']
+                 f'palette = "{self.palette}"',
+                 f"text_scale = {self.text_scale:g}"]
         if self.size is not None:
             lines.append(f'size = "{self.size[0]}x{self.size[1]}"')
         return "\n".join(lines) + "\n"
@@ -60,7 +64,7 @@ class Settings:
     def describe(self) -> list[str]:
         size = f"{self.size[0]}x{self.size[1]}" if self.size else "fit the desktop (default)"
         return [f"keys = {self.keys}", f"mute = {str(self.mute).lower()}", f"palette = {self.palette}",
-                f"size = {size}"]
+                f"text_scale = {self.text_scale:g}", f"size = {size}"]
 
 
 def default_path() -> Path:
@@ -106,9 +110,9 @@ def from_toml(data: bytes, source: str) -> Settings:
         raise SettingsError(f"{source}: not UTF-8 text") from None
     except tomllib.TOMLDecodeError as exc:
         raise SettingsError(f"{source}: not valid TOML: {exc}") from None
-    unknown = sorted(set(table) - {"keys", "mute", "palette", "size"})
+    unknown = sorted(set(table) - {"keys", "mute", "palette", "text_scale", "size"})
     if unknown:
-        raise SettingsError(f"{source}: unknown key {unknown[0]!r} (known: keys, mute, palette, size)")
+        raise SettingsError(f"{source}: unknown key {unknown[0]!r} (known: keys, mute, palette, text_scale, size)")
     settings = Settings()
     try:
         if "keys" in table:
@@ -119,8 +123,16 @@ def from_toml(data: bytes, source: str) -> Settings:
             settings = settings.with_changes(mute=table["mute"])
         if "palette" in table:
             if table["palette"] not in PALETTES:
-                raise ValueError(f"palette must be {' or '.join(PALETTES)}, got {str(table['palette'])[:40]!r}")
+                raise ValueError(f"palette must be {', '.join(PALETTES[:-1])} or {PALETTES[-1]}, "
+                                 f"got {str(table['palette'])[:40]!r}")
             settings = settings.with_changes(palette=table["palette"])
+        if "text_scale" in table:
+            scale = table["text_scale"]
+            if isinstance(scale, bool) or not isinstance(scale, int | float) or \
+                    not MIN_TEXT_SCALE <= scale <= MAX_TEXT_SCALE:
+                raise ValueError(f"text_scale must be a number from {MIN_TEXT_SCALE:g} to {MAX_TEXT_SCALE:g}, "
+                                 f"got {str(scale)[:40]!r}")
+            settings = settings.with_changes(text_scale=float(scale))
         if "size" in table:
             if not isinstance(table["size"], str):
                 raise ValueError(f"size must be text such as \"1280x720\", got {str(table['size'])[:40]!r}")
