@@ -4,7 +4,8 @@
     python docs/make_screenshots.py --out DIR  # somewhere else (the tests do, into a temporary folder)
 
 Each picture is a real frame of a real run: the game's model bot playing seed 10, the lab's adapting
-bot in the curl field, drawn by the windows' own renderers onto an off-screen surface (SDL's dummy
+bot in the curl field (mid-reach, and the window's last screen with its learning curve), drawn by the
+windows' own renderers onto an off-screen surface (SDL's dummy
 video driver: no display needed), then scaled down to a small PNG for the README.
 """
 
@@ -74,6 +75,27 @@ def lab_frame(out: Path) -> Path:
     return _save(surface, out / "lab.png")
 
 
+def lab_end_frame(out: Path) -> Path:
+    """The lab window's last screen: the learning curve of a shortened curl run by the adapting bot."""
+    from dataclasses import replace
+
+    from armgame.lab.analysis import figure_metric, learning_curve, trial_rows
+    from armgame.ui.lab_panels import draw_end
+
+    curl = preset("curl")
+    protocol = replace(curl, blocks=tuple(replace(b, trials=n) for b, n in zip(curl.blocks, (8, 32, 16), strict=True)))
+    session = LabSession(lab_config(protocol, 10), protocol)
+    Autopilot(session, make_lab_bot("adaptive")).play()
+    renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+    surface = pygame.Surface(DRAW_SIZE)
+    curve = learning_curve(trial_rows(session), figure_metric(protocol))
+    kept = ("Kept in ~/.local/share/armgame/lab/2026-11-23_101500_curl:", "   replay.json   trials.csv   "
+            "learning.png   paths.png")
+    draw_end(renderer, surface, f"curl (shortened): {len(session.outcomes)} trials, {session.result().hits} hits",
+             curve, kept, ("Esc quit",))
+    return _save(surface, out / "lab_end.png")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=HERE / "img", help="folder for the PNGs (default docs/img)")
@@ -82,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     pygame.display.init()
     pygame.font.init()
     try:
-        for draw in (game_frame, lab_frame):
+        for draw in (game_frame, lab_frame, lab_end_frame):
             print(f"wrote {draw(args.out)}")
     finally:
         pygame.quit()

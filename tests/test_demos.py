@@ -309,8 +309,8 @@ def test_window_keys_pause_speed_restart_and_quit(dummy_sdl):
     window.handle(pygame.event.Event(pygame.VIDEORESIZE, w=1000, h=600, size=(1000, 600)))
     pygame.display.set_mode((1000, 600), pygame.RESIZABLE)
     tick(0.0)
-    shoulder = window.to_window((0.0, 0.0))
-    assert shoulder[0] == 500  # scene scaled to 600 px high, centred
+    assert window.scene_size == (1333, 800) and window.view() == (0.75, (0, 0))  # the window's shape, filled
+    assert window.room.collidepoint(window.to_scene((0.0, 0.0)))
     assert key(pygame.K_ESCAPE) is False
     assert window.handle(pygame.event.Event(pygame.QUIT)) is False
 
@@ -409,3 +409,32 @@ def test_autopilot_window_speeds_up_and_skips_both_games_as_a_replay_does(dummy_
     footer = window.layout((800, 600))[2]
     assert " ".join(lab.text for lab in footer).split() == " ".join(HELP).split()
     assert HELP == ("p pause", "r restart", "-/+ speed", "1 real speed", "left/right 5 s", "F11 fullscreen", "Esc quit")
+
+
+@pytest.mark.parametrize("name", ["passive", "interaction"])
+def test_a_demo_frames_its_reach_and_fills_its_window(dummy_sdl, name):
+    """Made for a projector: the scene takes the window's shape (no empty bands), the arm's whole reach is
+    framed between the texts (the hanging arm never over the help line), and the lines are 3 px or more."""
+    pygame = dummy_sdl
+    from armgame.demos.catalog import make_run
+    from armgame.ui.demo_window import DemoWindow
+
+    now = [0.0]
+    window = DemoWindow(name, make_run(name), clock=lambda: now[0], size=(1024, 768))
+    window.open()
+    for size in ((1024, 768), (1920, 1080), (768, 1024)):
+        pygame.display.set_mode(size)
+        window.handle(pygame.event.Event(pygame.VIDEORESIZE, w=size[0], h=size[1], size=size))
+        now[0] += 0.1
+        window.frame()
+        scale = window.view()[0]
+        shown = (window.scene_size[0] * scale) * (window.scene_size[1] * scale)
+        assert shown >= 0.98 * size[0] * size[1], size  # at least 70% asked; the whole window given
+        reach = window.reach_rect()
+        assert pygame.Rect((0, 0), size).contains(reach), size
+        assert not any(reach.colliderect(box) for _, box in window.text_boxes()), size
+        assert max(reach.width / size[0], reach.height / size[1]) >= 0.45, size  # framed large, not a stamp
+        smallest = min(box.height for _, box in window.text_boxes())
+        if size[0] >= size[1]:
+            assert smallest >= 0.025 * size[1] - 1, size
+        assert 4 * scale >= 3  # the trails and paths (4 px in the scene) stay 3 px or more

@@ -91,8 +91,8 @@ def test_arm_target_and_hud_are_drawn_where_the_state_says(window, size):
     ring_gap = view.to_screen(target.x + target.radius * 0.5, target.y)
     assert colour_at(win.screen, ring_gap) != PALETTE.target  # a ring around a dot: not the hand's disc
     assert colour_at(win.screen, view.to_screen(*hand)) == PALETTE.hand
-    assert colour_at(win.screen, view.to_screen(*mid_upper)) == PALETTE.link
-    assert colour_at(win.screen, view.to_screen(*mid_fore)) == PALETTE.link
+    assert colour_at(win.screen, view.to_screen(*mid_upper)) not in (PALETTE.scene, PALETTE.workspace)  # the body
+    assert colour_at(win.screen, view.to_screen(*mid_fore)) == PALETTE.skin
     assert colour_at(win.screen, view.to_screen(0.7, 1.1)) == PALETTE.scene  # outside the reachable workspace
     assert colour_at(win.screen, view.to_screen(-0.5, 0.3)) == PALETTE.workspace
     # The score is written where the layout puts it: dark text pixels in its rectangle.
@@ -443,7 +443,7 @@ def test_every_screen_fits_every_window(size):
     session.key_event("d", "down")
     session.advance(100)
     renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
-    min_height = math.floor(MIN_TEXT_AT_720 * min(size) / 720)
+    min_height = max(math.floor(MIN_TEXT_AT_720 * min(size) / 720), round(0.025 * size[1]))
     for what, hud in screens(session, renderer).items():
         lay = renderer.layout(size, session, hud)
         assert lay.labels, what
@@ -475,8 +475,13 @@ def test_muscle_colours_are_okabe_ito():
 
 # ------------------------------------------------------------------------------------ window sizes
 def test_windows_fit_the_desktop():
-    assert fit_size(None, (1200, 800), (1920, 1080)) == (1200, 800)
-    assert fit_size(None, (1200, 800), (1280, 720)) == (984, 656)  # shrunk, same shape, room for a title bar
+    # Nothing asked: the default's shape, as large as the desktop allows (room for a title bar).
+    assert fit_size(None, (1200, 800), (1920, 1080)) == (1524, 1016)
+    assert fit_size(None, (1200, 800), (1280, 720)) == (984, 656)
+    for desktop in ((1024, 768), (1280, 720), (1920, 1080), (3840, 2160), (1080, 1920)):
+        for default in ((1200, 800), (1280, 720), (800, 800)):
+            w, h = fit_size(None, default, desktop)
+            assert w <= desktop[0] and h <= desktop[1] and max(w / desktop[0], h / desktop[1]) >= 0.9
     assert fit_size((3000, 3000), (800, 800), (1366, 768)) == (704, 704)
     assert fit_size((1024, 600), (800, 800), (1366, 768)) == (1024, 600)
     screen = open_window((5000, 4000))

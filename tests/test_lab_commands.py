@@ -230,8 +230,8 @@ def test_channel_trials_end_to_end(tmp_path, capsys):
     channel = [r for r in rows if r["perturbation"] == "channel"]
     assert len(channel) == 5 and all(np.isfinite(r["adaptation_index"]) for r in channel)
     assert all(np.isnan(r["adaptation_index"]) for r in rows if r["perturbation"] != "channel")
-    assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "again.csv")]) == 0
-    assert (tmp_path / "again.csv").read_bytes() == (tmp_path / "run" / "trials.csv").read_bytes()
+    assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "again")]) == 0
+    assert (tmp_path / "again" / "run.trials.csv").read_bytes() == (tmp_path / "run" / "trials.csv").read_bytes()
     capsys.readouterr()
     assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "fit"), "--fit", "two-rate"]) == 0
     out = capsys.readouterr().out

@@ -47,11 +47,18 @@ def view_of(win):
     return Viewport.fit(win.screen.get_size(), (hx - span, hx + span, hy - span, hy + 1.35 * span))
 
 
+def start(win):
+    """Past the instruction card (space), one frame drawn."""
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_SPACE))
+    win.frame(0.0)
+    assert win.card is None
+
+
 def test_keys_move_the_cursor_and_the_go_cue_shows_the_target(screen):
     session = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
     clock = FakeClock()
     win = LabWindow(session, screen, clock=clock, fps=0)
-    win.frame(0.0)
+    start(win)
     view = view_of(win)
     assert tuple(win.screen.get_at(view.to_screen(*session.cursor)))[:3] == CURSOR
     ring = view.to_screen(session.home[0] + 0.7 * session.protocol.home_radius, session.home[1])
@@ -108,6 +115,8 @@ def test_a_person_quitting_early_keeps_a_replay_that_verifies(tmp_path, monkeypa
 
     def play_a_little(self, max_frames=None):
         for i in range(200):
+            if i == 1:
+                pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_SPACE))
             if i == 40:
                 pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_j))
             if i == 44:
@@ -119,12 +128,143 @@ def test_a_person_quitting_early_keeps_a_replay_that_verifies(tmp_path, monkeypa
         return self.session
 
     monkeypatch.setattr(LabWindow, "run", play_a_little)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
     record = tmp_path / "me.json"
-    assert main(["lab", "curl", "--record", str(record), "--name", "Ann", "--size", "640x480"]) == 0
+    assert main(["lab", "curl", "--record", str(record), "--name", "Ann", "--size", "640x480",
+                 "--no-figures"]) == 0
     out = capsys.readouterr().out
     assert "(stopped before the end)" in out and f"replay saved to {record}" in out
+    kept = list((tmp_path / "data" / "armgame" / "lab").glob("*_curl/trials.csv"))
+    assert len(kept) == 1 and f"wrote {kept[0]}" in out  # a window run is always kept
     assert main(["verify", str(record)]) == 0
     assert "matches: Ann's lab run (curl, keyboard" in capsys.readouterr().out
     data = json.loads(record.read_text())
     assert data["driven"] == "keyboard" and [e[1] for e in data["timeline"]] == ["j", "j"]
     assert len(data["task"]["trials"]) >= 2
+
+
+THREE = Protocol("three", (Block("baseline", 2, Perturbation(), 0, "Reach straight."),
+                           Block("exposure", 2, Perturbation.make("rotation", angle=30.0), 0, "Keep reaching."),
+                           Block("washout", 2, Perturbation(), 0, "Back to normal.")), timeout=1.0)
+
+
+def key(k, down=True):
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=k))
+
+
+def test_the_lab_waits_for_space_before_the_first_trial(screen):
+    session = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0)
+    key(pygame.K_d)  # a muscle key does not start the lab, nor reach the arm
+    for _ in range(20):
+        win.frame(0.1)
+    assert win.card is not None and session.steps == 0 and session.timeline == []
+    assert "Hold the cursor" in " ".join(win.card.lines) and win.card.prompt == "space starts"
+    key(pygame.K_SPACE)
+    win.frame(0.1)
+    win.frame(0.1)
+    assert win.card is None and session.steps > 0
+
+
+def test_cards_and_paths_stop_the_window_clock_but_never_change_the_trials(screen):
+    """A person's window run with its cards and knowledge of results replays headless to the same trials:
+    the window only stops between steps, it never changes one."""
+    session = LabSession(lab_config(PROTOCOL, 3), PROTOCOL)
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0)
+    key(pygame.K_SPACE)
+    frames, feedback_seen, block_card, pressed = 0, 0, None, None
+    while not session.over and frames < 600:
+        if session.phase == "reach" and pressed is None:
+            key(pygame.K_j)  # a short push in each reach
+            pressed = frames
+        if pressed is not None and frames == pressed + 3:
+            key(pygame.K_j, down=False)
+        if session.phase == "hold":
+            pressed = None
+        if win.feedback is not None and feedback_seen < len(session.outcomes):
+            feedback_seen = len(session.outcomes)
+            steps = session.steps
+            assert steps == session.outcomes[-1].end_step  # stopped exactly at the trial's end
+            assert not any(session.held)  # the keys were let go as the clock stopped
+            win.frame(0.5)
+            assert session.steps == steps and ("off the line" in win.feedback.words or "aimed" in win.feedback.words
+                                               or "no reach" in win.feedback.words)
+        if win.card is not None and frames > 2:
+            block_card = win.card.title
+            steps = session.steps
+            win.frame(2.0)
+            assert session.steps == steps and win.card is not None  # a person's card waits
+            key(pygame.K_SPACE)
+        win.frame(0.05)
+        frames += 1
+    assert session.finished and block_card == "Block 2 of 2: exposure"
+    headless = LabSession(lab_config(PROTOCOL, 3), PROTOCOL)
+    headless.play(session.timeline, session.steps)
+    assert headless.trial_records() == session.trial_records() and headless.state == session.state
+    assert [o.xs for o in headless.outcomes] == [o.xs for o in session.outcomes]
+
+
+def test_the_end_shows_the_learning_curve_and_where_the_run_was_kept(screen):
+    session = LabSession(lab_config(THREE, 4), THREE)
+    driver = RealTimeDriver(Autopilot(session, make_lab_bot("model")))
+    kept = []
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0, driver=driver, mode="AUTOPILOT: model",
+                    on_finish=lambda s: kept.append(len(s.outcomes)) or ["Kept in ~/somewhere:", "   trials.csv"])
+    frames = 0
+    while not win.ended and frames < 400:
+        win.frame(0.1)  # a bot's cards go on by themselves
+        frames += 1
+    win.frame(0.1)
+    assert kept == [6]  # kept once, at the end
+    curve = win.curve
+    assert [b.name for b in curve.blocks] == ["baseline", "exposure", "washout"]
+    assert [b.perturbed for b in curve.blocks] == [False, True, False] and len(curve.points) == 6
+    assert curve.unit == "deg" and curve.after_effect is not None and curve.after_effect[0] == 5
+    from armgame.ui.lab_panels import draw_end
+
+    placed = draw_end(win.renderer, win.screen, win.summary, curve, win.saved, win.help_items())
+    texts = [t for t, _ in placed]
+    assert "after-effect" in texts and "   trials.csv" in texts and any(t.startswith("Block means") for t in texts)
+    rects = [r for _, r in placed]
+    small = win.renderer._text_heights(win.screen)[2]
+    assert small >= 0.025 * win.screen.get_height() - 0.5
+    for i, a in enumerate(rects):
+        assert win.screen.get_rect().contains(a), placed[i][0]
+        assert not any(a.colliderect(b) for b in rects[i + 1:]), placed[i][0]
+
+
+def test_lab_replay_keys_move_by_trials_and_change_speed(screen):
+    from armgame.lab.record import LabTask
+    from armgame.ui.lab_window import LabReplay
+
+    recorded = LabSession(lab_config(PROTOCOL, 5), PROTOCOL)
+    Autopilot(recorded, make_lab_bot("model")).play()
+    task = LabTask.of(recorded)
+    source = LabReplay(recorded.config, task.new_session, recorded.timeline, recorded.steps, "Ann")
+    win = LabWindow(source.new_session(recorded.config), screen, clock=FakeClock(), fps=0, mode="REPLAY   Ann",
+                    replay=source)
+    assert win.card is None  # a replay has no cards
+    ends = [o.end_step for o in recorded.outcomes]
+    key(pygame.K_RIGHT)
+    win.frame(0.0)
+    assert len(win.session.outcomes) == 1 and win.session.steps == ends[0]
+    key(pygame.K_RIGHT)
+    win.frame(0.0)
+    assert win.session.steps == ends[1]
+    key(pygame.K_LEFT)
+    win.frame(0.0)
+    assert win.session.steps == ends[0] and len(win.session.outcomes) == 1  # back to the previous trial's start
+    key(pygame.K_PLUS)
+    key(pygame.K_p)
+    win.frame(0.5)
+    assert win.speed == 2.0 and win.paused and win.session.steps == ends[0]
+    key(pygame.K_p)
+    win.frame(0.0)
+    win.frame(0.1)
+    assert win.session.steps == ends[0] + round(0.2 / recorded.config.dt)
+    items = win.help_items()
+    assert items == ("REPLAY of Ann", "p pause", "-/+ speed", "left/right trial", "F11 fullscreen", "Esc quit")
+    while not win.ended:
+        key(pygame.K_RIGHT)
+        win.frame(0.0)
+    assert win.session.trial_records() == recorded.trial_records() and win.curve is not None

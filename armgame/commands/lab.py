@@ -42,7 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         + ", ".join(PRESETS) + ") or a TOML protocol file. In a window you play with the muscle keys (d f j k); "
         "--bot lets a bot play (model, naive, or adaptive: the model bot learning the perturbation trial by "
         "trial with a two-rate learner). --out DIR writes trials.csv (one row per reach), learning.png and "
-        "paths.png; --record FILE saves the run as a replay that 'armgame verify' and 'armgame analyze' check.",
+        "paths.png; --record FILE saves the run as a replay that 'armgame verify' and 'armgame analyze' check. "
+        "A run in a window is always kept: without --out or --record, in a new folder of the per-user data "
+        "folder (~/.local/share/armgame/lab), which the window's last screen names.",
     )
     p.add_argument("protocol", metavar="PROTOCOL", help=f"a preset ({', '.join(PRESETS)}) or a .toml file")
     p.add_argument("--seed", type=_seed, default=DEFAULT_SEED,
@@ -50,7 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--bot", metavar="NAME", help="a bot plays: model, naive or adaptive")
     p.add_argument("--headless", action="store_true", help="no window (needs --bot): run as fast as possible")
     p.add_argument("--out", metavar="DIR", help="write trials.csv, learning.png and paths.png to DIR")
-    p.add_argument("--no-figures", action="store_true", help="with --out: trials.csv only (no matplotlib needed)")
+    p.add_argument("--no-figures", action="store_true", help="with --out, or in a window: trials.csv only (no figures)")
     p.add_argument("--record", metavar="FILE", help="save the run's replay to FILE (JSON)")
     p.add_argument("--name", help="the player's name, kept in the replay (never in the high-score table)")
     p.add_argument("--catch", type=_count, default=None, metavar="N",
@@ -98,8 +100,8 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(unknown_name("lab bot", args.bot, LAB_BOT_NAMES))
     if (args.retention or args.learning) and args.bot != "adaptive":
         raise UserError("--retention and --learning set the adaptive bot's learner: add --bot adaptive")
-    if args.no_figures and not args.out:
-        raise UserError("--no-figures applies with --out only")
+    if args.no_figures and not args.out and args.headless:
+        raise UserError("--no-figures applies with --out only (or to the run a window keeps)")
     _check_outputs(args)
     config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys)),
                               str(args.protocol))
@@ -114,12 +116,92 @@ def run(args: argparse.Namespace) -> int:
         from ..game.bots import Autopilot
 
         Autopilot(session, bot).play()  # type: ignore[arg-type]
-    else:
-        if not 1 <= args.fps <= 1000:
-            raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
-        _play_in_window(session, bot, args)
+        _report(session, args)
+        _keep(session, args)
+        return 0
+    if not 1 <= args.fps <= 1000:
+        raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
+    keeper = RunKeeper(args)
+    _play_in_window(session, bot, args, keeper)
     _report(session, args)
+    if not keeper.kept and (session.outcomes or args.record or args.out):
+        keeper(session)  # quit before the end: what was done is kept all the same
+    for line in keeper.lines:
+        print(line)
+    if keeper.error is not None:
+        raise keeper.error
     return 0
+
+
+def default_runs_dir() -> Path:
+    """Where a window run is kept unless --out or --record say otherwise: the per-user data folder, as
+    the high-score table's (``$XDG_DATA_HOME/armgame/lab``, normally ``~/.local/share/armgame/lab``;
+    ``%LOCALAPPDATA%\\armgame\\lab`` on Windows). The one place that chooses it."""
+    import os
+    import sys
+
+    if sys.platform == "win32" and os.environ.get("LOCALAPPDATA"):
+        return Path(os.environ["LOCALAPPDATA"]) / "armgame" / "lab"
+    data = os.environ.get("XDG_DATA_HOME", "")
+    # The XDG spec: a relative path in $XDG_DATA_HOME is invalid and must be ignored.
+    base = Path(data) if data and os.path.isabs(data) else Path.home() / ".local" / "share"
+    return base / "armgame" / "lab"
+
+
+def _new_run_folder(session) -> Path:
+    """A folder of its own for this run in ``default_runs_dir``: the date, time and protocol name."""
+    import re
+    import time as _time
+
+    name = re.sub(r"[^A-Za-z0-9_-]+", "-", session.protocol.name)[:40].strip("-") or "run"
+    base = default_runs_dir() / f"{_time.strftime('%Y-%m-%d_%H%M%S')}_{name}"
+    folder, n = base, 1
+    while folder.exists():
+        n += 1
+        folder = base.with_name(f"{base.name}_{n}")
+    return folder
+
+
+class RunKeeper:
+    """Keeps a window run (the replay, trials.csv and, with matplotlib, the figures), once; the window calls
+    it at the end to name where on its last screen, the command after the window when quit early."""
+
+    def __init__(self, args: argparse.Namespace) -> None:
+        self.args = args
+        self.kept = False
+        self.lines: list[str] = []
+        self.error: UserError | None = None
+
+    def __call__(self, session) -> list[str]:
+        self.kept = True
+        args = self.args
+        try:
+            folder = None
+            if not (args.record and args.out):
+                folder = _new_run_folder(session)
+                try:
+                    folder.mkdir(parents=True)
+                except OSError as exc:
+                    raise UserError(f"cannot create {folder}: {exc.strerror or exc}") from None
+            record = args.record or folder / "replay.json"
+            out = args.out or folder
+            figures = not args.no_figures
+            if figures and not args.out:
+                try:
+                    import matplotlib  # noqa: F401
+                except ImportError:
+                    figures = False
+            written = _save(session, args, record, out if session.outcomes or args.out else None, figures)
+        except UserError as exc:
+            self.error = exc
+            self.lines = [f"not kept: {exc}"]
+            return self.lines
+        self.lines = [f"replay saved to {path}" if path == record else f"wrote {path}" for path in written]
+        shown = [f"Kept in {_home(folder)}:" if folder is not None else "Kept:"] + \
+            [f"   {path.name if path.parent == folder else _home(path)}" for path in written]
+        if folder is not None and not figures and not args.no_figures:
+            shown.append("   (figures need matplotlib: pip install 'armgame[plot]')")
+        return shown
 
 
 def _check_outputs(args: argparse.Namespace) -> None:
@@ -149,9 +231,7 @@ def _check_outputs(args: argparse.Namespace) -> None:
 
 
 def _report(session, args: argparse.Namespace) -> None:
-    from ..lab.analysis import block_summary, channel_summary, trial_rows, write_run_outputs
-    from ..lab.record import LabTask
-    from ..records.replay import Replay, now_iso
+    from ..lab.analysis import block_summary, channel_summary, trial_rows
 
     done, total = len(session.outcomes), len(session.plans)
     print(f"lab {session.protocol.name}: {done} of {total} trials, {session.result().hits} hits, seed "
@@ -165,22 +245,44 @@ def _report(session, args: argparse.Namespace) -> None:
             print(f"  {b['block']}: {b['channels']} channel trials; adaptation index {b['first']:+.2f} on the first, "
                   f"mean of {b['cycle']}: first {b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} "
                   f"(from channel trial {b['at']})")
-    if args.record:
+
+
+def _home(path: Path) -> str:
+    """A path as a student would type it: the home folder as ~."""
+    try:
+        return "~/" + str(path.relative_to(Path.home()))
+    except ValueError:
+        return str(path)
+
+
+def _keep(session, args: argparse.Namespace) -> None:
+    """A headless run keeps what --record and --out ask for, and says where."""
+    for path in _save(session, args, args.record, args.out, not args.no_figures):
+        print(f"replay saved to {path}" if path == args.record else f"wrote {path}")
+
+
+def _save(session, args: argparse.Namespace, record: Path | None, out: Path | None, figures: bool) -> list[Path]:
+    """The replay to ``record`` and trials.csv (and the figures) to ``out``, each when given; what was written."""
+    from ..lab.analysis import write_run_outputs
+    from ..lab.record import LabTask
+    from ..records.replay import Replay, now_iso
+
+    written: list[Path] = []
+    if record:
         driven = "bot" if args.bot else "keyboard"
         replay = Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name,
                         now_iso(), task=LabTask.of(session))
-        replay.save(args.record)
-        print(f"replay saved to {args.record}")
-    if args.out:
+        replay.save(record)
+        written.append(record)
+    if out:
         if not session.outcomes:
             raise UserError("no trial was finished: nothing to write to --out")
-        out = args.out
         try:
             out.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
-        for path in write_run_outputs(session, out, figures=not args.no_figures):
-            print(f"wrote {path}")
+        written += write_run_outputs(session, out, figures=figures)
+    return written
 
 
 def _cm(value: object) -> str:
@@ -188,7 +290,7 @@ def _cm(value: object) -> str:
     return "n/a" if not math.isfinite(v) else f"{100.0 * v:+.2f} cm"
 
 
-def _play_in_window(session, bot, args: argparse.Namespace) -> None:
+def _play_in_window(session, bot, args: argparse.Namespace, keeper: RunKeeper) -> None:
     from ..errors import NoDisplayError
 
     try:
@@ -213,7 +315,8 @@ def _play_in_window(session, bot, args: argparse.Namespace) -> None:
         raise NoDisplayError(f"cannot open a window ({exc})") from None
     try:
         LabWindow(session, screen, fps=args.fps, driver=driver,
-                  mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}").run()
+                  mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}", on_finish=keeper,
+                  palette=settings.palette, text_scale=settings.text_scale).run()
     finally:
         pygame.display.quit()
 

@@ -85,19 +85,20 @@ def _watch(replay, args: argparse.Namespace):
 def _watch_lab(replay, args: argparse.Namespace, settings):
     import pygame
 
-    from ..game.timeline import TimelineDriver
     from ..ui.frontend import open_window
-    from ..ui.lab_window import LabWindow
+    from ..ui.lab_window import LabReplay, LabWindow
 
-    session = replay.task.new_session(replay.config)
+    player = replay.player or "no name"
+    source = LabReplay(replay.config, replay.task.new_session, replay.timeline, replay.steps, player)
     screen = open_window(settings.size, args.fullscreen,
                          f"armgame replay - {replay.player or 'a lab run'}, seed {replay.config.seed}")
     try:
-        driver = TimelineDriver(session, replay.timeline, replay.steps)
-        LabWindow(session, screen, fps=args.fps, driver=driver, mode=f"REPLAY   {replay.player or 'no name'}").run()
+        window = LabWindow(source.new_session(source.config), screen, fps=args.fps, mode=f"REPLAY   {player}",
+                           replay=source, palette=settings.palette, text_scale=settings.text_scale)
+        window.run()
     finally:
         pygame.display.quit()
-    return session
+    return window.session
 
 
 def without_window(args: argparse.Namespace, typed: list[str]) -> str:

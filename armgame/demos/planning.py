@@ -239,6 +239,10 @@ class PlanningRun:
         row = self.steps % len(self._rows[0])
         self.states = [tuple(rows[row]) for rows in self._rows]
 
+    def tabulated_states(self) -> list[FloatArray]:
+        """Each arm's cycle of states (n, 4), as a window frames the motion before showing it."""
+        return list(self._rows)
+
     def arm_points(self, q1: float, q2: float) -> list[Point]:
         elbow = self.arm.elbow((q1, q2))
         hand = self.arm.hand((q1, q2))

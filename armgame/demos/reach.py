@@ -181,6 +181,10 @@ class ReachRun:
         self.previous = self.states
         self.states = [tuple(self._rows[self.steps % len(self._rows)])]
 
+    def tabulated_states(self) -> list[np.ndarray]:
+        """The cycle's states (n, 4), as a window frames the motion before showing it."""
+        return [self._rows]
+
     def arm_points(self, q1: float, q2: float) -> list[Point]:
         elbow = self.arm.elbow((q1, q2))
         hand = self.arm.hand((q1, q2))

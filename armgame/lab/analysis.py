@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -199,3 +200,67 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
             adaptation_figure(rows, out / "adaptation.png")
             written.append(out / "adaptation.png")
     return written
+
+
+def result_words(session: LabSession, outcome: TrialOutcome) -> str:
+    """Knowledge of results for one reach, in the measure its learning curve plots: "1.9 cm off the line"
+    under a force field, "12 deg clockwise of the target" under a changed display."""
+    row = trial_row(session, outcome)
+    metric = figure_metric(session.protocol)
+    value = float(row[metric])  # type: ignore[arg-type]
+    if not math.isfinite(value):
+        return "no reach" if not outcome.hit else "on target"
+    if metric == "max_perpendicular_error_m":
+        side = "" if abs(value) < 0.0005 else (" (left)" if value > 0 else " (right)")
+        return f"{abs(value) * 100:.1f} cm off the line{side}"
+    if abs(value) < 0.5:
+        return "aimed straight at the target"
+    return f"aimed {abs(value):.0f} deg {'anticlockwise' if value > 0 else 'clockwise'} of the target"
+
+
+@dataclass(frozen=True)
+class CurveBlock:
+    name: str
+    first: int  # trial numbers, from 1
+    last: int
+    perturbed: bool
+    mean: float  # the block's mean of the curve's measure, catch trials left out (NaN: none measured)
+
+
+@dataclass(frozen=True)
+class LearningCurve:
+    """What the lab window draws at the end: one point per trial, the blocks and where the after-effect is."""
+
+    label: str  # the measure and its unit, for the axis
+    unit: str
+    points: tuple[tuple[int, float, bool], ...]  # trial, value (in unit), catch trial
+    blocks: tuple[CurveBlock, ...]
+    after_effect: tuple[int, float] | None  # the first measured washout trial after a perturbed block
+
+
+def learning_curve(rows: Sequence[Mapping[str, object]], metric: str) -> LearningCurve:
+    """The learning curve of a run's trial rows (``trial_rows``), in cm or degrees."""
+    from .figures import blocks_of
+
+    scale, label, unit = (100.0, "perpendicular error", "cm") if metric == "max_perpendicular_error_m" \
+        else (1.0, "initial direction error", "deg")
+    spans = blocks_of(rows) if rows else []
+    points, blocks = [], []
+    unperturbed = spans[0]["perturbation"] if spans else "none"
+    after: tuple[int, float] | None = None
+    previous_perturbed = False
+    for span in spans:
+        perturbed = span["perturbation"] != unperturbed
+        values = []
+        for r in span["rows"]:
+            v = float(r[metric]) * scale  # type: ignore[arg-type]
+            catch = r["trial"] in span["catch"]
+            points.append((int(r["trial"]), v, catch))  # type: ignore[arg-type]
+            if math.isfinite(v) and not catch:
+                values.append(v)
+                if after is None and previous_perturbed and not perturbed:
+                    after = (int(r["trial"]), v)  # type: ignore[arg-type]
+        blocks.append(CurveBlock(str(span["block"]), int(span["first"]), int(span["last"]), perturbed,
+                                 float(np.mean(values)) if values else math.nan))
+        previous_perturbed = perturbed
+    return LearningCurve(label, unit, tuple(points), tuple(blocks), after)

@@ -180,6 +180,20 @@ class LabSession(GameSession):
         plan = self.plan or self.plans[-1]
         return self.protocol.blocks[plan.block]
 
+    def steps_before_an_end(self) -> int:
+        """The fewest physics steps after which the current trial could end (at least 1; 0 once over).
+
+        A window that never advances further than this in one go stops exactly at a trial's end, to show
+        it before the next trial begins, without changing a single step: in a hold, the go cue comes a
+        step away at the soonest and a hit then needs a full hold; in a reach, the hold left or the
+        time-out, whichever is nearer.
+        """
+        if self.over:
+            return 0
+        if self.phase == HOLD:
+            return self.hold_steps
+        return max(1, min(self.hold_steps - self._counter, self.timeout_steps - (self.steps - self._go_step)))
+
     def result(self) -> GameResult:
         b, c = self.rules.board, self.config
         return GameResult(b.score, b.hits, b.resets, c.seed, c.time_limit, self.steps, c.scene, c.integrator, c.dt,

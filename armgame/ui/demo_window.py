@@ -2,16 +2,20 @@
 
 The only demo module that imports pygame. Physics advances in fixed steps from an accumulator of real
 time (``time.perf_counter``, injectable so tests never sleep), scaled by the playback speed; the drawing
-interpolates joint angles between the last two steps. The scene is drawn on an 800 x 800 surface and
-scaled to the (resizable) window, so a projector's resolution changes nothing but sharpness; the window
-opens no larger than the desktop, and F11 fills the screen. Every text drawn is recorded
+interpolates joint angles between the last two steps. The scene is drawn on a surface 800 px high and
+as wide as the window's shape (``scene_shape``), then scaled to the (resizable) window, so a projector's
+resolution changes nothing but sharpness and no band of the window is left empty; the arm's reach is
+framed in the room the texts leave (``frame_content``). The window opens as large as the desktop
+allows, and F11 fills the screen. The arm is the game's (``armgame.ui.body``). Every text drawn is recorded
 (``text_boxes``), so the tests check that none is cut or overlaps another at any window size.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
+import re
 import time
 from collections import deque
 from collections.abc import Callable
@@ -24,9 +28,13 @@ import pygame
 from ..demos.catalog import get_info
 from ..demos.reach import COMPONENTS, ReachRun
 from ..demos.runs import VISIBLY_APART
+from .body import draw_arm, draw_torso
 from .display import open_window, toggle_fullscreen
+from .render import PALETTES
 
 SCENE_SIZE = (800, 800)
+#: The scene's shorter side, in pixels: the longer one follows the window's shape.
+SCENE_SIDE = 800
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
 #: The arrows skip this far in simulated time; a snapshot is kept every SKIP_SECONDS, so a skip back
 #: restores one and runs at most SKIP_SECONDS again, however long the demo has run.
@@ -42,15 +50,14 @@ BACKGROUND = (255, 255, 255)
 INK = (20, 20, 28)
 FAINT = (85, 85, 95)  # help text: 7:1 on white, still 4.5:1 once smoothscaled
 LINK = (45, 50, 62)
-ARM_B = (255, 127, 14)
-TRAIL = (140, 180, 225)
-TRAIL_B = (255, 200, 150)
-PATH = (200, 200, 205)
-# Vertical-plane arms hang from a shoulder near the centre; the horizontal reach uses the game's layout.
-VERTICAL_LAYOUT = ((400, 450), 400.0)
-HORIZONTAL_LAYOUT = ((400, 570), 500.0)  # the game's scale, raised to leave room for the bars
-PLANNING_LAYOUT = ((330, 540), 450.0)  # the reach left of centre, its speed plot on the right
-SPEED_PLOT = pygame.Rect(560, 290, 220, 170)
+# Lines a class must see: 3:1 or more on white (WCAG's rule for graphics), 4 px in the scene.
+ARM_B = (213, 94, 0)
+TRAIL = (30, 136, 200)
+TRAIL_B = (213, 94, 0)
+PATH = (120, 126, 138)
+LINE = 4
+SPEED_PLOT_SIZE = (220, 170)
+BODY_PALETTE = PALETTES["okabe-ito"]
 SHORT_LABELS = {
     "own_inertial": "own inertia",
     "interaction_inertial": "interaction, inertial",
@@ -80,17 +87,19 @@ class DemoWindow:
         self.run = run
         self.speed = speed
         self.clock = clock
-        self.size = size or SCENE_SIZE
+        self.size = size
         self.fullscreen = fullscreen
-        self.windowed_size = self.size
+        self.windowed_size = self.size or SCENE_SIZE
         #: Every text of the last frame: (text, rectangle in scene pixels).
         self.placed: list[tuple[str, Any]] = []
         self.paused = False
         self.accumulator = 0.0
         self.last_time: float | None = None
-        self.shoulder, self.pixels_per_metre = VERTICAL_LAYOUT if self.info.vertical else HORIZONTAL_LAYOUT
-        if name == "planning":
-            self.shoulder, self.pixels_per_metre = PLANNING_LAYOUT
+        self.scene_size = SCENE_SIZE
+        self.help_extra = 0
+        self.shoulder, self.pixels_per_metre = (400.0, 450.0), 400.0
+        self.speed_plot = pygame.Rect((560, 290), SPEED_PLOT_SIZE)
+        self.reach = self.content_box()
         self.trails: list[deque[tuple[float, float]]] = []
         self.parted_at: float | None = None
         self.screen: Any = None
@@ -98,15 +107,61 @@ class DemoWindow:
 
     # ------------------------------------------------------------------ lifecycle
     def open(self) -> None:
-        self.screen = open_window(self.size, self.fullscreen, self.info.title, SCENE_SIZE)
+        self.screen = open_window(self.size, self.fullscreen, self.info.title, (1200, 800))
         self.size = self.windowed_size = self.screen.get_size()
-        self.scene = pygame.Surface(SCENE_SIZE)
-        # Sized so that the smallest text is still 14 px tall in a window 720 px high (the scene scaled 0.9).
-        self.caption_font = pygame.font.Font(None, 36)
-        self.status_font = pygame.font.Font(None, 32)
-        self.small_font = pygame.font.Font(None, 26)
-        self.caption_lines = self._wrap(self.info.caption, self.caption_font, SCENE_SIZE[0] - 40)
+        # Sized so that the smallest text is 2.5% of the window's height or more (20 px of the scene's 800).
+        self.caption_font = pygame.font.Font(None, 40)
+        self.status_font = pygame.font.Font(None, 34)
+        self.small_font = pygame.font.Font(None, 30)
+        self.frame_content()
         self.restart()
+
+    @staticmethod
+    def scene_shape(size: tuple[int, int]) -> tuple[int, int]:
+        """The scene's size for a window of ``size``: 800 px on its shorter side, the window's shape."""
+        w, h = max(size[0], 1), max(size[1], 1)
+        return (round(SCENE_SIDE * w / h), SCENE_SIDE) if w >= h else (SCENE_SIDE, round(SCENE_SIDE * h / w))
+
+    def content_box(self) -> tuple[float, float, float, float]:
+        """What the arm can cover, in metres (xmin, xmax, ymin, ymax) about the shoulder: the whole reach
+        for a swinging arm, the cycle's arm and paths for a prescribed reach; and the body's width."""
+        run = self.run
+        if self.info.vertical:
+            points = run.arm_points(*run.initials[0][:2])
+            reach = sum(math.dist(a, b) for a, b in itertools.pairwise(points))
+            return -reach - 0.06, reach + 0.06, -reach - 0.06, reach + 0.06
+        xs, ys = [0.0], [0.0]
+        for table in run.tabulated_states():
+            for q1, q2 in table[:: max(1, len(table) // 60), :2]:
+                for x, y in run.arm_points(float(q1), float(q2)):
+                    xs.append(x)
+                    ys.append(y)
+        pad = 0.06
+        return min(xs) - pad, max(xs) + pad, min(min(ys), -0.12) - pad, max(ys) + pad
+
+    def frame_content(self) -> None:
+        """Lay the scene out for the window's shape: the texts at the edges, and the arm's reach scaled
+        into the room they leave, centred."""
+        self.scene_size = self.scene_shape(self.size or SCENE_SIZE)
+        w, h = self.scene_size
+        self.scene = pygame.Surface(self.scene_size)
+        self.caption_lines = self._wrap(self.info.caption, self.caption_font, w - 40)
+        top = 12 + 31 * len(self.caption_lines) + 76
+        self.help_extra = 26 * (len(self.help_lines()) - 1)  # a help line that wraps pushes the rest up
+        bottom = h - 44 - self.help_extra
+        right = w - 20
+        if isinstance(self.run, ReachRun):
+            bottom -= (len(self._bar_rows(self.run)) + 1) * self._row_height(self.run) + 54
+        if self.name == "planning":
+            bottom = h - 104 - self.help_extra
+            right = w - SPEED_PLOT_SIZE[0] - 60
+            self.speed_plot = pygame.Rect((w - SPEED_PLOT_SIZE[0] - 20, top + 40), SPEED_PLOT_SIZE)
+        xmin, xmax, ymin, ymax = self.reach
+        room = pygame.Rect(20, top, right - 20, max(bottom - top, 40))
+        k = min(room.width / (xmax - xmin), room.height / (ymax - ymin))
+        self.pixels_per_metre = k
+        self.shoulder = (room.centerx - (xmin + xmax) / 2 * k, room.centery + (ymin + ymax) / 2 * k)
+        self.room = room
 
     def close(self) -> None:
         pygame.display.quit()
@@ -211,11 +266,18 @@ class DemoWindow:
         k = self.pixels_per_metre
         return round(self.shoulder[0] + x * k), round(self.shoulder[1] - y * k)
 
+    def reach_rect(self) -> Any:
+        """The framed reach, in window pixels (the tests check it against the texts and the window)."""
+        xmin, xmax, ymin, ymax = self.reach
+        (x0, y0), (x1, y1) = self.to_window((xmin, ymax)), self.to_window((xmax, ymin))
+        return pygame.Rect(x0, y0, x1 - x0, y1 - y0)
+
     def view(self) -> tuple[float, tuple[int, int]]:
         """Scale from scene to window and the scene's top-left corner in the window."""
-        w, h = self.size
-        scale = min(w / SCENE_SIZE[0], h / SCENE_SIZE[1])
-        return scale, (round((w - SCENE_SIZE[0] * scale) / 2), round((h - SCENE_SIZE[1] * scale) / 2))
+        w, h = self.size or SCENE_SIZE
+        sw, sh = self.scene_size
+        scale = min(w / sw, h / sh)
+        return scale, (round((w - sw * scale) / 2), round((h - sh * scale) / 2))
 
     def to_window(self, point: tuple[float, float]) -> tuple[int, int]:
         """Where a point (m) of the arm's plane appears in the window, in pixels."""
@@ -256,6 +318,39 @@ class DemoWindow:
             pygame.draw.circle(self.scene, colour, p, width // 2 + 2)
         pygame.draw.circle(self.scene, INK if colour == LINK else colour, points[-1], hand_radius)
 
+    def help_text(self) -> str:
+        """The keys that work, as the help line says them (actions: "p resume" while paused)."""
+        return "   ".join(("p resume", *HELP[1:]) if self.paused else HELP)
+
+    def help_lines(self) -> list[str]:
+        """The help line's items on as few lines as the scene's width holds (a narrow window: two)."""
+        lines: list[str] = []
+        for item in re.split(r" {3,}", self.help_text()):
+            if lines and self.small_font.size(lines[-1] + "   " + item)[0] <= self.scene_size[0] - 24:
+                lines[-1] += "   " + item
+            else:
+                lines.append(item)
+        return lines
+
+    def _draw_body(self, pose: tuple[float, float], points: list[tuple[int, int]]) -> None:
+        """The game's arm (``armgame.ui.body``): seen from above with its torso in the horizontal demos,
+        hanging from a fixed shoulder in the vertical ones; its muscles at rest (nothing drives them)."""
+        q1, q2 = pose
+        k = self.pixels_per_metre
+        world = self.run.arm_points(q1, q2)
+        if len(world) < 3:  # the pendulum: one link, no elbow
+            pygame.draw.circle(self.scene, FAINT, self.shoulder, 11)
+            self._draw_arm(points, LINK, 14, 12)
+            return
+        l1, l2 = math.dist(world[0], world[1]), math.dist(world[1], world[2])
+        if not self.info.vertical:
+            draw_torso(self.scene, self.shoulder, k, BODY_PALETTE)
+        else:
+            pygame.draw.circle(self.scene, FAINT, self.shoulder, max(11, round(0.06 * k)))
+        draw_arm(self.scene, self.shoulder, k, q1, q2, l1, l2, (0.0, 0.0, 0.0, 0.0), BODY_PALETTE,
+                 torso=not self.info.vertical)
+        pygame.draw.aacircle(self.scene, INK, points[-1], max(8, round(0.018 * k)))
+
     def _status(self) -> str:
         run = self.run
         if self.name == "pendulum":
@@ -275,6 +370,14 @@ class DemoWindow:
         return f"hand speed {run.hand_speed_now():.2f} m/s" + ("   (vertical plane, gravity on)" if run.gravity
                                                                else "   (horizontal plane)")
 
+    @staticmethod
+    def _bar_rows(run: ReachRun) -> list[str]:
+        return [k for k, _, _ in COMPONENTS if (k != "gravity" or run.gravity) and k != "damping"] + ["TOTAL"]
+
+    @classmethod
+    def _row_height(cls, run: ReachRun) -> int:
+        return 28 if len(cls._bar_rows(run)) <= 4 else 25
+
     def _draw_bars(self, run: ReachRun) -> None:
         parts, total = run.torques_now()
         # One N m scale for both joints, as in the figure, so the shoulder's larger torques look larger.
@@ -282,8 +385,8 @@ class DemoWindow:
         rows = [(SHORT_LABELS[k], parts[k], _rgb(c)) for k, _, c in COMPONENTS
                 if (k != "gravity" or run.gravity) and k != "damping"]
         rows.append(("TOTAL", total, INK))
-        row_h, half = (28 if len(rows) <= 4 else 25), 120
-        top = SCENE_SIZE[1] - 58 - (len(rows) + 1) * row_h
+        row_h, half = self._row_height(run), 120
+        top = self.scene_size[1] - 58 - self.help_extra - (len(rows) + 1) * row_h
         centres = (400, 660)
         for x, joint in zip(centres, ("shoulder", "elbow"), strict=True):
             self._text(f"{joint} (N m)", self.small_font, INK, (x, top), "midtop")
@@ -312,7 +415,7 @@ class DemoWindow:
             pygame.draw.lines(self.scene, colour, False, [self.to_scene(tuple(p)) for p in path[::5]], 4)
         for end in (run.planning.start, run.planning.target):
             pygame.draw.circle(self.scene, PATH, self.to_scene(end), 14, 3)
-        box = SPEED_PLOT
+        box = self.speed_plot
         top = max(float(np.max(s)) for s in run.speeds)
         pygame.draw.line(self.scene, FAINT, box.bottomleft, box.bottomright, 1)
         pygame.draw.line(self.scene, FAINT, box.bottomleft, box.topleft, 1)
@@ -328,7 +431,7 @@ class DemoWindow:
         pygame.draw.line(self.scene, FAINT, (cursor, box.top), (cursor, box.bottom), 1)
         self._text("out", self.small_font, FAINT, (box.left + box.width // 4, box.bottom + 4), "midtop")
         self._text("back", self.small_font, FAINT, (box.left + 3 * box.width // 4, box.bottom + 4), "midtop")
-        y = SCENE_SIZE[1] - 92
+        y = self.scene_size[1] - 92 - self.help_extra
         for colour, text in ((LINK, "minimum jerk: straight, bell-shaped speed"),
                              (ARM_B, "minimum torque change: the arm's dynamics curve it")):
             pygame.draw.line(self.scene, colour, (20, y + 9), (48, y + 9), 5)
@@ -336,6 +439,10 @@ class DemoWindow:
             y += 26
 
     def draw(self) -> None:
+        if self.scene_size != self.scene_shape(self.size or SCENE_SIZE):
+            self.frame_content()  # a new window shape: the scene laid out again for it
+            for trail in self.trails:
+                trail.clear()
         scene = self.scene
         scene.fill(BACKGROUND)
         self.placed = []
@@ -346,19 +453,18 @@ class DemoWindow:
             trail.append(arm[-1])
         if isinstance(run, ReachRun):
             path = [self.to_scene(tuple(p)) for p in run.table.hand[:: max(1, len(run.table.hand) // 200)]]
-            pygame.draw.lines(scene, PATH, False, path, 5)
+            pygame.draw.lines(scene, PATH, False, path, LINE)
             for end in (run.plan.home, run.plan.target):
-                pygame.draw.circle(scene, PATH, self.to_scene(end), 14, 3)
+                pygame.draw.circle(scene, PATH, self.to_scene(end), 14, LINE)
             self._draw_bars(run)
         if self.name == "planning":
             self._draw_planning(run)
         for trail, colour in zip(self.trails, (TRAIL, TRAIL_B), strict=False):
             if len(trail) > 1:
-                pygame.draw.lines(scene, colour, False, list(trail), 3)
-        pygame.draw.circle(scene, FAINT, self.shoulder, 11)
-        self._draw_arm(arms[0], LINK, 12, 10)
+                pygame.draw.lines(scene, colour, False, list(trail), LINE)
+        self._draw_body(poses[0], arms[0])
         if len(arms) > 1:
-            self._draw_arm(arms[1], ARM_B, 5, 6)
+            self._draw_arm(arms[1], ARM_B, 6, 7)
         y = 12
         for line in self.caption_lines:
             self._text(line, self.caption_font, INK, (20, y))
@@ -366,12 +472,14 @@ class DemoWindow:
         speed = f"{self.speed:g}x" + ("   PAUSED" if self.paused else "")
         self._text(f"t = {run.t:5.2f} s   speed {speed}", self.status_font, INK, (20, y + 8))
         self._text(self._status(), self.status_font, INK, (20, y + 36))
-        self._text("   ".join(("p resume", *HELP[1:]) if self.paused else HELP), self.small_font, FAINT,
-                   (SCENE_SIZE[0] - 12, SCENE_SIZE[1] - 8), "bottomright")
+        y = self.scene_size[1] - 8
+        for line in reversed(self.help_lines()):
+            self._text(line, self.small_font, FAINT, (self.scene_size[0] - 12, y), "bottomright")
+            y -= 26
         screen = pygame.display.get_surface()
         scale, offset = self.view()
-        size = (round(SCENE_SIZE[0] * scale), round(SCENE_SIZE[1] * scale))
-        shown = scene if size == SCENE_SIZE else pygame.transform.smoothscale(scene, size)
+        size = (round(self.scene_size[0] * scale), round(self.scene_size[1] * scale))
+        shown = scene if size == self.scene_size else pygame.transform.smoothscale(scene, size)
         # Shrinking turns white into 252 grey; margins of the same colour hide the scene's edge.
         screen.fill(shown.get_at((0, 0)))
         screen.blit(shown, offset)

@@ -92,10 +92,14 @@ def desktop_size() -> tuple[int, int]:
 
 
 def fit_size(wanted: tuple[int, int] | None, default: tuple[int, int], desktop: tuple[int, int]) -> tuple[int, int]:
-    """``wanted`` (or ``default``) shrunk, keeping its shape, to fit ``desktop`` less its decorations."""
+    """``wanted`` shrunk, keeping its shape, to fit ``desktop`` less its decorations; with nothing wanted,
+    ``default``'s shape as large as that room allows: a projector's window fills its width or its height
+    (whichever binds: 90% of the desktop or more), never a small box in the middle of the wall."""
     w, h = wanted or default
     room_w, room_h = max(320, desktop[0] - DECORATION[0]), max(240, desktop[1] - DECORATION[1])
-    scale = min(1.0, room_w / w, room_h / h)
+    scale = min(room_w / w, room_h / h)
+    if wanted is not None:
+        scale = min(1.0, scale)
     return max(1, round(w * scale)), max(1, round(h * scale))
 
 

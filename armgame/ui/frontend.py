@@ -494,6 +494,7 @@ def play_window(session: GameSession, settings: Settings, settings_path: Path, *
             window = GameWindow(game.session, screen, fps=fps, driver=game.driver, ask_name=ask_name, mode=mode,
                                 sounds=sounds, trail=trail, palette=settings.palette, standing=game.standing,
                                 preview=game.preview, on_mute=lambda muted: remember(mute=muted), replay=replay)
+            window.renderer.text_scale = settings.text_scale
             window.run()
             screen = window.screen
             resized = resized or window.resized

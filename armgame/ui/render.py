@@ -23,6 +23,7 @@ import pygame
 
 from ..game.session import GameSession
 from ..words import plural
+from .body import blend, draw_arm, draw_torso
 
 RGB = tuple[int, int, int]
 
@@ -48,30 +49,44 @@ class Palette:
     bar_back: RGB
     muscles: tuple[RGB, RGB, RGB, RGB]
     panel: RGB
+    skin: RGB  # the body's fill (its outline is ``link``)
 
 
 PALETTES: dict[str, Palette] = {
     # Okabe & Ito (2008), "Color Universal Design": distinguishable with every common colour-vision
     # deficiency. Blue/orange for the shoulder pair, bluish green/reddish purple for the elbow pair.
+    # Lines (trail, edge) are at least 3:1 on the scene and the workspace: a projector washes out the rest.
     "okabe-ito": Palette(
         "okabe-ito", window=(232, 235, 240), scene=(251, 251, 249), workspace=(240, 243, 248),
-        edge=(200, 205, 214), ink=(22, 26, 34), faint=(70, 76, 88), link=(62, 68, 82), base=(120, 126, 138),
-        hand=(15, 15, 20), target=(213, 94, 0), flash=(240, 228, 66), trail=(86, 180, 233), warn=(176, 58, 0),
+        edge=(120, 126, 138), ink=(22, 26, 34), faint=(70, 76, 88), link=(62, 68, 82), base=(120, 126, 138),
+        hand=(15, 15, 20), target=(213, 94, 0), flash=(240, 228, 66), trail=(30, 136, 200), warn=(176, 58, 0),
         bar_back=(214, 219, 227), muscles=((0, 114, 178), (230, 159, 0), (0, 158, 115), (204, 121, 167)),
-        panel=(255, 255, 255),
+        panel=(255, 255, 255), skin=(236, 226, 214),
     ),
     # The 2012 game's colours (red target, black hand), on the same layout.
     "classic": Palette(
         "classic", window=(235, 235, 235), scene=(255, 255, 255), workspace=(246, 246, 246),
-        edge=(205, 205, 205), ink=(20, 20, 20), faint=(80, 80, 80), link=(70, 70, 80), base=(120, 120, 120),
-        hand=(0, 0, 0), target=(220, 30, 30), flash=(255, 200, 0), trail=(120, 160, 220), warn=(180, 0, 0),
+        edge=(125, 125, 125), ink=(20, 20, 20), faint=(80, 80, 80), link=(70, 70, 80), base=(120, 120, 120),
+        hand=(0, 0, 0), target=(220, 30, 30), flash=(255, 200, 0), trail=(50, 100, 190), warn=(180, 0, 0),
         bar_back=(225, 225, 230), muscles=((40, 110, 200), (40, 160, 120), (200, 120, 30), (150, 60, 170)),
-        panel=(255, 255, 255),
+        panel=(255, 255, 255), skin=(238, 232, 226),
+    ),
+    # For a large, bright room: black on white, every colour at least 4.5:1 on white, nothing pale.
+    "high-contrast": Palette(
+        "high-contrast", window=(255, 255, 255), scene=(255, 255, 255), workspace=(236, 236, 236),
+        edge=(0, 0, 0), ink=(0, 0, 0), faint=(0, 0, 0), link=(0, 0, 0), base=(0, 0, 0),
+        hand=(0, 0, 0), target=(200, 0, 0), flash=(255, 210, 0), trail=(90, 90, 90), warn=(170, 0, 0),
+        bar_back=(200, 200, 200), muscles=((0, 80, 220), (180, 90, 0), (0, 120, 60), (160, 0, 160)),
+        panel=(255, 255, 255), skin=(225, 225, 225),
     ),
 }
 
 #: Smallest text height at 720 lines, in pixels (a projector at the back of a classroom).
 MIN_TEXT_AT_720 = 14
+#: ... and never below this fraction of the window's height (19 px at 768 lines).
+MIN_TEXT_FRACTION = 0.025
+#: Lines a student must see (trails, paths, outlines) are at least this wide, in pixels.
+MIN_LINE = 3
 #: A hit's flash and "+1" last this long; the next target fades in over FADE_IN (seconds of game time).
 FLASH_TIME, PLUS_ONE_TIME, FADE_IN = 0.35, 0.9, 0.3
 WARN_SECONDS = 10.0
@@ -90,6 +105,17 @@ def relative_luminance(colour: Sequence[int]) -> float:
 def contrast_ratio(a: Sequence[int], b: Sequence[int]) -> float:
     la, lb = sorted((relative_luminance(a), relative_luminance(b)), reverse=True)
     return (la + 0.05) / (lb + 0.05)
+
+
+def min_text(size: tuple[int, int]) -> int:
+    """The smallest text height a window of ``size`` may show, in pixels."""
+    return max(round(MIN_TEXT_AT_720 * min(size) / 720), round(MIN_TEXT_FRACTION * size[1]))
+
+
+def text_heights(size: tuple[int, int], text_scale: float = 1.0) -> tuple[int, int, int]:
+    """Text heights (big, normal, small) for a window of ``size``, times the ``text_scale`` setting."""
+    small = round(max(min_text(size), round(18 * min(size) / 720)) * text_scale)
+    return round(small * 1.6), round(small * 1.2), small
 
 
 def font_size_for(height: int) -> int:
@@ -118,6 +144,11 @@ class Viewport:
     def to_screen(self, x: float, y: float) -> tuple[int, int]:
         xmin, _, _, ymax = self.world
         return round(self.left + (x - xmin) * self.scale), round(self.top + (ymax - y) * self.scale)
+
+    def origin(self) -> tuple[float, float]:
+        """Where the world's (0, 0) is, in (fractional) pixels."""
+        xmin, _, _, ymax = self.world
+        return self.left - xmin * self.scale, self.top + ymax * self.scale
 
     def length(self, metres: float) -> int:
         return max(1, round(metres * self.scale))
@@ -191,6 +222,16 @@ class Layout:
             ([("progress", self.progress[0])] if self.progress else [])
 
 
+def _without_nested(rects: list[pygame.Rect]) -> list[pygame.Rect]:
+    """The rectangles, less any inside another (the hand inside the arm's): each pixel restored once."""
+    rects.sort(key=lambda r: r.width * r.height, reverse=True)
+    kept: list[pygame.Rect] = []
+    for r in rects:
+        if r.collidelist(kept) < 0 or not any(k.contains(r) for k in kept):
+            kept.append(r)
+    return kept
+
+
 def clock_text(seconds: float) -> str:
     """Seconds to a tenth under 100 s (a 60 s game counts 60.0, 59.9, ...), minutes and seconds above."""
     if seconds < 100:
@@ -203,23 +244,33 @@ class GameRenderer:
     """Lays out and draws frames; fonts, text and the static background are made once and cached."""
 
     def __init__(self, key_labels: tuple[str, ...], muscle_names: tuple[str, ...],
-                 palette: str | Palette = "okabe-ito") -> None:
+                 palette: str | Palette = "okabe-ito", text_scale: float = 1.0) -> None:
         self.key_labels = key_labels
+        #: The ``text_scale`` setting: every text this many times its usual size (a large room).
+        self.text_scale = text_scale
         self.muscle_names = muscle_names
         self.palette = PALETTES[palette] if isinstance(palette, str) else palette
         self._fonts: dict[int, pygame.font.Font] = {}
         self._text: dict[tuple[str, int, RGB], pygame.Surface] = {}
         self._sizes: dict[tuple[str, int], tuple[int, int]] = {}
-        self._trail_colours: dict[int, list[RGB]] = {}
         self._backgrounds: dict[tuple, pygame.Surface] = {}
         self._veils: dict[tuple[int, int], pygame.Surface] = {}
+        #: Where the last frame drew over its background (None: draw the next frame whole).
+        self._dirty: list[pygame.Rect] | None = None
+        self._frame_key: tuple | None = None
 
     # ------------------------------------------------------------------ text
     def font(self, height: int) -> pygame.font.Font:
         """pygame's default font at a line height of about ``height`` px (created once per size)."""
-        if height not in self._fonts:
-            self._fonts[height] = pygame.font.Font(None, font_size_for(height))
-        return self._fonts[height]
+        font = self._fonts.get(height)
+        if font is None:
+            size = font_size_for(height)
+            font = pygame.font.Font(None, size)
+            while font.get_height() < height and size < 4 * height:  # never shorter than asked: the size rules
+                size += 1
+                font = pygame.font.Font(None, size)
+            self._fonts[height] = font
+        return font
 
     def text(self, string: str, height: int, colour: RGB | None = None) -> pygame.Surface:
         colour = self.palette.ink if colour is None else colour
@@ -275,9 +326,10 @@ class GameRenderer:
         w, h = size
         u = min(w, h) / 720.0
         pad, gap = max(6, round(16 * u)), max(4, round(8 * u))
-        small = max(12, round(18 * u))
-        normal = max(13, round(22 * u))
-        big = max(18, round(40 * u))
+        k = self.text_scale
+        small = round(max(12, round(18 * u), min_text(size)) * k)
+        normal = max(round(max(13, round(22 * u)) * k), small + 2)
+        big = round(max(18, round(40 * u)) * k)
         p = self.palette
         landscape = w >= 1.15 * h
         if landscape:
@@ -512,12 +564,11 @@ class GameRenderer:
         outer, inner = view.length(arm.l1 + arm.l2), view.length(abs(arm.l1 - arm.l2))
         pygame.draw.circle(surface, p.workspace, centre, outer)
         pygame.draw.circle(surface, p.scene, centre, inner)
-        pygame.draw.aacircle(surface, p.edge, centre, outer, max(1, round(lay.unit)))
-        pygame.draw.aacircle(surface, p.edge, centre, inner, max(1, round(lay.unit)))
-        # The shoulder is fixed to the body: a mount, not a joint that moves.
-        mount = view.length(0.07)
-        pygame.draw.rect(surface, p.base, pygame.Rect(centre[0] - mount, centre[1] - mount // 5, 2 * mount,
-                                                      mount // 2), border_radius=max(2, mount // 6))
+        line = max(MIN_LINE, round(2 * lay.unit))
+        pygame.draw.aacircle(surface, p.edge, centre, outer, line)
+        pygame.draw.aacircle(surface, p.edge, centre, inner, line)
+        # The shoulder is fixed to the body: the torso and head, seen from above, never move.
+        draw_torso(surface, view.origin(), view.scale, p)
         surface.set_clip(clip)
         self._backgrounds[key] = surface
         return surface
@@ -530,12 +581,32 @@ class GameRenderer:
             self._veils = {size: veil}
         return veil
 
+    def invalidate(self) -> None:
+        """The next frame is drawn whole: call it after drawing anything else on the window."""
+        self._dirty = None
+
     def draw(self, screen: pygame.Surface, session: GameSession, alpha: float = 1.0, hud: Hud | None = None) -> Layout:
-        """One frame; returns its layout."""
+        """One frame; returns its layout.
+
+        On the window itself, only what the last frame drew over is restored from the cached background
+        (a 1920 x 1080 copy a frame would cost more than all the rest); elsewhere (a subsurface, an
+        off-screen surface) the whole background is drawn.
+        """
         hud = hud or Hud()
         lay = self.layout(screen.get_size(), session, hud)
         p, view = self.palette, lay.view
-        screen.blit(self._background(lay, session), (0, 0))
+        background = self._background(lay, session)
+        frame_key = (id(background), screen.get_size())
+        # The corner is always background: if it is not (the window was cleared by a change of mode, or
+        # something else drew there), the last frame is not on the window any more.
+        if self._dirty is not None and self._frame_key == frame_key and screen is pygame.display.get_surface() \
+                and screen.get_at((0, 0)) == background.get_at((0, 0)):
+            for rect in self._dirty:
+                screen.blit(background, rect, rect)
+        else:
+            screen.blit(background, (0, 0))
+        self._frame_key = frame_key
+        dirty: list[pygame.Rect] = []
         arm = session.config.arm
         q1, q2 = session.interpolated_angles(alpha)
         elbow = (arm.l1 * math.cos(q1), arm.l1 * math.sin(q1))
@@ -543,60 +614,56 @@ class GameRenderer:
         clip = screen.get_clip()
         screen.set_clip(lay.scene)
         if len(hud.trail) > 1:
-            self._draw_trail(screen, view, hud.trail)
-        self._draw_target(screen, lay, session, hud)
+            dirty.append(self._draw_trail(screen, view, hud.trail))
+        dirty += self._draw_target(screen, lay, session, hud)
         if session.rules.arm_visible:
-            self._draw_arm(screen, view, elbow, hand)
-        self._draw_hand(screen, view, hand)
+            dirty += draw_arm(screen, view.origin(), view.scale, q1, q2, arm.l1, arm.l2,
+                              session.muscles.activation, p)
+        dirty.append(self._draw_hand(screen, view, hand))
         if hud.paused or hud.ended:
-            screen.blit(self._veil(screen.get_size()), (0, 0))
+            dirty.append(screen.blit(self._veil(screen.get_size()), (0, 0)))
             if hud.paused and not hud.ended:  # the veil dims the scene; hand and target stay clear
                 self._draw_target(screen, lay, session, hud)
                 self._draw_hand(screen, view, hand)
         screen.set_clip(clip)
         for rect, i, a in lay.bars:
-            pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2)
+            dirty.append(pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2))
             if a > 0.002:
                 fill = rect.copy()
                 fill.width = max(rect.height, round(rect.width * a))
                 pygame.draw.rect(screen, p.muscles[i], fill, border_radius=rect.height // 2)
         if lay.progress is not None:
             rect, fraction = lay.progress
-            pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2)
+            dirty.append(pygame.draw.rect(screen, p.bar_back, rect, border_radius=rect.height // 2))
             done = rect.copy()
             done.width = max(rect.height, round(rect.width * fraction))
             pygame.draw.rect(screen, p.link, done, border_radius=rect.height // 2)
         radius = max(4, round(12 * lay.unit))
         for panel in lay.panels:
-            pygame.draw.rect(screen, p.panel, panel, border_radius=radius)
-            pygame.draw.rect(screen, p.edge, panel, max(1, round(2 * lay.unit)), border_radius=radius)
+            dirty.append(pygame.draw.rect(screen, p.panel, panel, border_radius=radius))
+            pygame.draw.rect(screen, p.edge, panel, max(MIN_LINE, round(2 * lay.unit)), border_radius=radius)
         for left, right, y in lay.rules:
-            pygame.draw.line(screen, p.faint, (left, y), (right, y), max(1, round(2 * lay.unit)))
+            dirty.append(pygame.draw.line(screen, p.faint, (left, y), (right, y), max(MIN_LINE, round(2 * lay.unit))))
         if lay.name_box is not None:
-            pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2)
+            dirty.append(pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2))
             pygame.draw.rect(screen, p.ink, lay.name_box, max(1, round(2 * lay.unit)), border_radius=radius // 2)
         for label in lay.labels:
             if label.role == "name":  # changes with every key: not worth caching
-                screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect)
+                dirty.append(screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect))
             else:
-                screen.blit(self.text(label.text, label.height, label.colour), label.rect)
+                dirty.append(screen.blit(self.text(label.text, label.height, label.colour), label.rect))
+        self._dirty = _without_nested([r.inflate(2, 2) for r in dirty if r.width and r.height])
         return lay
 
-    def _draw_trail(self, screen: pygame.Surface, view: Viewport, trail: Sequence[tuple[float, float]]) -> None:
-        p = self.palette
+    def _draw_trail(self, screen: pygame.Surface, view: Viewport,
+                    trail: Sequence[tuple[float, float]]) -> pygame.Rect:
+        """The hand's last second: one colour with a contrast of 3:1 or more on the scene, 3 px or wider."""
         points = [view.to_screen(x, y) for x, y in trail]
-        n = len(points)
-        colours = self._trail_colours.get(n)
-        if colours is None:
-            # Older segments fade into the scene: the path reads as a motion, newest at the hand.
-            colours = self._trail_colours[n] = [
-                tuple(round(s + (t - s) * i / n) for s, t in zip(p.scene, p.trail, strict=True)) for i in range(n)]
-        width = max(2, view.length(0.008))
-        line = pygame.draw.line
-        for i in range(1, n):
-            line(screen, colours[i], points[i - 1], points[i], width)
+        width = max(MIN_LINE, view.length(0.008))
+        return pygame.draw.lines(screen, self.palette.trail, False, points, width)
 
-    def _draw_target(self, screen: pygame.Surface, lay: Layout, session: GameSession, hud: Hud) -> None:
+    def _draw_target(self, screen: pygame.Surface, lay: Layout, session: GameSession,
+                     hud: Hud) -> list[pygame.Rect]:
         """A bullseye (a ring around a dot): a different shape from the hand's solid disc."""
         p, view = self.palette, lay.view
         target = session.rules.target
@@ -604,29 +671,17 @@ class GameRenderer:
         r = view.length(target.radius)
         newest = min((age for _, _, age in hud.hits), default=None)
         fade = 1.0 if newest is None else min(max(newest / FADE_IN, 0.0), 1.0)
-        colour = tuple(round(s + (t - s) * fade) for s, t in zip(p.scene, p.target, strict=True))
-        pygame.draw.circle(screen, colour, centre, r, max(2, r // 3))
-        pygame.draw.circle(screen, colour, centre, max(2, r // 4))
+        colour = blend(p.scene, p.target, fade)
+        drawn = [pygame.draw.circle(screen, colour, centre, r, max(MIN_LINE, r // 3)),
+                 pygame.draw.circle(screen, colour, centre, max(2, r // 4))]
         for x, y, age in hud.hits:
             if age < FLASH_TIME:
                 k = age / FLASH_TIME
                 where = view.to_screen(x, y)
-                pygame.draw.circle(screen, p.flash, where, round(r * (1.0 + 0.8 * k)))
+                drawn.append(pygame.draw.circle(screen, p.flash, where, round(r * (1.0 + 0.8 * k))))
                 pygame.draw.aacircle(screen, p.target, where, round(r * (1.0 + 0.8 * k)), max(2, r // 5))
+        return drawn
 
-    def _draw_arm(self, screen: pygame.Surface, view: Viewport, elbow: tuple[float, float],
-                  hand: tuple[float, float]) -> None:
-        p = self.palette
-        shoulder_px, elbow_px, hand_px = (view.to_screen(*pt) for pt in ((0.0, 0.0), elbow, hand))
-        width = view.length(0.024)
-        end = max(1, width // 2)
-        for a, b in ((shoulder_px, elbow_px), (elbow_px, hand_px)):
-            pygame.draw.aaline(screen, p.link, a, b, width)
-        for joint in (shoulder_px, elbow_px):  # rounded ends, and the joints drawn as pins on them
-            pygame.draw.aacircle(screen, p.link, joint, end)
-            pygame.draw.circle(screen, p.scene, joint, max(1, end // 2))
-        pygame.draw.aacircle(screen, p.link, hand_px, end)
-
-    def _draw_hand(self, screen: pygame.Surface, view: Viewport, hand: tuple[float, float]) -> None:
+    def _draw_hand(self, screen: pygame.Surface, view: Viewport, hand: tuple[float, float]) -> pygame.Rect:
         # The one thing a player must see, arm hidden or not: a solid disc, larger than the link is wide.
-        pygame.draw.aacircle(screen, self.palette.hand, view.to_screen(*hand), view.length(0.02))
+        return pygame.draw.aacircle(screen, self.palette.hand, view.to_screen(*hand), view.length(0.02))

@@ -1,4 +1,4 @@
-"""The window's settings that persist between games: key map, mute, palette, window size.
+"""The window's settings that persist between games: key map, mute, palette, text scale, window size.
 
 A small TOML file in the user's config folder (``$XDG_CONFIG_HOME/armgame/settings.toml``, normally
 ``~/.config/armgame/settings.toml``; ``%APPDATA%\\armgame`` on Windows, ``~/Library/Application
@@ -26,7 +26,9 @@ from ..errors import UserError
 FILE_NAME = "settings.toml"
 #: A settings file is a few lines; anything larger is not one.
 MAX_BYTES = 64 * 1024
-PALETTES = ("okabe-ito", "classic")
+PALETTES = ("okabe-ito", "classic", "high-contrast")
+#: ``text_scale``: every text this many times its usual size (1.5 for the back of a large room).
+MIN_TEXT_SCALE, MAX_TEXT_SCALE = 0.75, 2.5
 MIN_SIDE, MAX_SIDE = 320, 10000
 DEFAULT_KEYS = "dfjk"
 #: Keys the windows use for themselves: a muscle cannot take them.
@@ -42,6 +44,7 @@ class Settings:
     keys: str = DEFAULT_KEYS
     mute: bool = False
     palette: str = PALETTES[0]
+    text_scale: float = 1.0
     #: Window size in pixels; None: a default that fits the desktop.
     size: tuple[int, int] | None = None
 
@@ -53,7 +56,8 @@ class Settings:
         rest, so whatever ``from_toml`` accepted is written back as TOML it accepts again."""
         import tomli_w
 
-        values: dict[str, object] = {"keys": self.keys, "mute": self.mute, "palette": self.palette}
+        values: dict[str, object] = {"keys": self.keys, "mute": self.mute, "palette": self.palette,
+                                     "text_scale": self.text_scale}
         if self.size is not None:
             values["size"] = f"{self.size[0]}x{self.size[1]}"
         return ("# armgame window settings: `armgame settings` shows them; the game rewrites this file when\n"
@@ -62,7 +66,7 @@ class Settings:
     def describe(self) -> list[str]:
         size = f"{self.size[0]}x{self.size[1]}" if self.size else "fit the desktop (default)"
         return [f"keys = {self.keys}", f"mute = {str(self.mute).lower()}", f"palette = {self.palette}",
-                f"size = {size}"]
+                f"text_scale = {self.text_scale:g}", f"size = {size}"]
 
 
 def default_path() -> Path:
@@ -114,9 +118,9 @@ def from_toml(data: bytes, source: str) -> Settings:
         raise SettingsError(f"{source}: not valid TOML: {exc}") from None
     except RecursionError:  # tomllib recurses into nested arrays and tables
         raise SettingsError(f"{source}: not valid TOML: nested too deeply") from None
-    unknown = sorted(set(table) - {"keys", "mute", "palette", "size"})
+    unknown = sorted(set(table) - {"keys", "mute", "palette", "text_scale", "size"})
     if unknown:
-        raise SettingsError(f"{source}: unknown key {unknown[0]!r} (known: keys, mute, palette, size)")
+        raise SettingsError(f"{source}: unknown key {unknown[0]!r} (known: keys, mute, palette, text_scale, size)")
     settings = Settings()
     try:
         if "keys" in table:
@@ -127,8 +131,16 @@ def from_toml(data: bytes, source: str) -> Settings:
             settings = settings.with_changes(mute=table["mute"])
         if "palette" in table:
             if table["palette"] not in PALETTES:
-                raise ValueError(f"palette must be {' or '.join(PALETTES)}, got {str(table['palette'])[:40]!r}")
+                raise ValueError(f"palette must be {', '.join(PALETTES[:-1])} or {PALETTES[-1]}, "
+                                 f"got {str(table['palette'])[:40]!r}")
             settings = settings.with_changes(palette=table["palette"])
+        if "text_scale" in table:
+            scale = table["text_scale"]
+            if isinstance(scale, bool) or not isinstance(scale, int | float) or \
+                    not MIN_TEXT_SCALE <= scale <= MAX_TEXT_SCALE:
+                raise ValueError(f"text_scale must be a number from {MIN_TEXT_SCALE:g} to {MAX_TEXT_SCALE:g}, "
+                                 f"got {str(scale)[:40]!r}")
+            settings = settings.with_changes(text_scale=float(scale))
         if "size" in table:
             if not isinstance(table["size"], str):
                 raise ValueError(f"size must be text such as \"1280x720\", got {str(table['size'])[:40]!r}")
