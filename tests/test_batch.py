@@ -131,10 +131,11 @@ def test_every_arm_and_batchable_integrator_equals_the_single_session(kernel, ar
 
 
 @functools.cache
-def long_games() -> tuple[list, list, list]:
-    """16 games of 45 and 60 s played one by one, once for every kernel's test (only read after)."""
-    rng = random.Random(7)
-    configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(16)]
+def games_one_by_one(count: int, rng_seed: int) -> tuple[list, list, list]:
+    """``count`` games of 45 and 60 s with a large target, played one by one with ``GameSession``:
+    once for every kernel's test in a module (only read after)."""
+    rng = random.Random(rng_seed)
+    configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(count)]
     timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
     singles = []
     for c, timeline in zip(configs, timelines, strict=True):
@@ -146,7 +147,7 @@ def long_games() -> tuple[list, list, list]:
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_many_long_games_equal_the_single_session(kernel):
     """60 s games with a large target (many hits, many near misses): also the largest state difference."""
-    configs, timelines, singles = long_games()
+    configs, timelines, singles = games_one_by_one(16, 7)
     batch = batch_of(configs, kernel)
     results = batch.play(timelines)
     worst = 0.0

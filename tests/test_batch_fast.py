@@ -6,7 +6,6 @@ that to one game, so that a handful of games exercises the very arithmetic a lar
 The compiled kernel's run at any size.
 """
 
-import functools
 import math
 import random
 from contextlib import contextmanager
@@ -15,7 +14,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_batch import KERNELS, KEYS, student_timeline
+from test_batch import KERNELS, KEYS, games_one_by_one, student_timeline
 
 import armgame.game.batch.session as batch_module
 from armgame.game.batch import STATE_TOLERANCE, BatchGameSession, compiled, replay_many
@@ -79,23 +78,10 @@ def test_fast_batch_equals_single_sessions_on_random_timelines(kernel, seeds, du
         assert_same_results(batch, i, single)
 
 
-@functools.cache
-def full_games() -> tuple[list, list, list]:
-    """12 games of 45 and 60 s played one by one, once for every kernel's test (only read after)."""
-    rng = random.Random(11)
-    configs = [GameConfig(seed=s, time_limit=60.0 if s % 2 else 45.0, target_radius=0.12) for s in range(12)]
-    timelines = [student_timeline(rng, c.dt, c.time_limit) for c in configs]
-    singles = []
-    for c, timeline in zip(configs, timelines, strict=True):
-        single = GameSession(c)
-        singles.append((single, single.play(timeline)))
-    return configs, timelines, singles
-
-
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_full_games_stay_within_round_off_and_score_the_same(kernel):
     """60 s games with a large target (many hits and near misses): the largest state difference, measured."""
-    configs, timelines, singles = full_games()
+    configs, timelines, singles = games_one_by_one(12, 11)
     with series_for_any_batch():
         batch = BatchGameSession(configs, exact=False, kernel=kernel)
         results = batch.play(timelines)

@@ -199,21 +199,9 @@ class LabBot(ReachingBot):
         """The curl field's b that best explains the external torque felt over the reach (0 if none moved)."""
         if len(log) < 5:
             return 0.0
-        assert self._setup is not None
-        period = self._setup[0]
-        arm = session.model
-        l1, l2 = arm.params.l1, arm.params.l2
-        k1, k2 = arm.params.damping1, arm.params.damping2
+        l1, l2 = session.model.params.l1, session.model.params.l2
         num = den = 0.0
-        for k in range(1, len(log) - 1):
-            q1, q2, w1, w2, t1, t2, *_ = log[k]
-            qd1 = (log[k + 1][2] - log[k - 1][2]) / (2.0 * period)
-            qd2 = (log[k + 1][3] - log[k - 1][3]) / (2.0 * period)
-            bc, h = arm.b * math.cos(q2), arm.b * math.sin(q2)
-            m11, m12 = arm.a + 2.0 * bc, arm.d + bc
-            need1 = m11 * qd1 + m12 * qd2 - h * (2.0 * w1 * w2 + w2 * w2) + k1 * w1
-            need2 = m12 * qd1 + arm.d * qd2 + h * w1 * w1 + k2 * w2
-            r1, r2 = need1 - t1, need2 - t2
+        for q1, q2, w1, w2, r1, r2 in self._external_torques(session, log):
             fx, fy = curl_unit_force(l1, l2, q1, q2, w1, w2)
             g1, g2 = curl_unit_torque(l1, l2, q1, q2, fx, fy)
             num += r1 * g1 + r2 * g2
