@@ -79,36 +79,34 @@ def main(argv: Sequence[str] | None = None) -> int:
     if extra:  # left over by the command's parser: its error, under its name
         parser_of_command = args._commands.get(getattr(args, "command", None), parser)
         parser_of_command.error(f"unrecognized arguments: {' '.join(extra)}")
-    if getattr(args, "command", None) is None:  # `armgame` alone: the menu, or the commands without a display
+    command = getattr(args, "command", None)
+    if command is None:  # `armgame` alone: the menu, or the commands without a display
         from .commands import menu
 
-        try:
+        def run() -> object:
             return menu.run(parser, main)
-        except UserError as exc:
-            print(f"armgame: error: {exc}", file=sys.stderr)
-            return 2
-        except KeyboardInterrupt:
-            print("armgame: interrupted", file=sys.stderr)
-            return 130
-    if not getattr(args, "run", None):
+    elif getattr(args, "run", None):
+        def run() -> object:
+            return args.run(args)
+    else:
         parser.print_help()
         return 0
+    who = f"armgame {command}" if command else "armgame"
     try:
-        return int(args.run(args) or 0)
+        return int(run() or 0)
     except NoDisplayError as exc:
         # The same command without a window, as the user can run it: their arguments, and what it needs.
         without = getattr(args, "without_window", None)
         typed = list(sys.argv[1:] if argv is None else argv)
         tail = f"; run it without one: {without(args, typed)}" if without else ""
-        print(f"armgame {args.command}: error: {exc}{tail}", file=sys.stderr)
+        print(f"{who}: error: {exc}{tail}", file=sys.stderr)
         return 2
     except UserError as exc:
-        print(f"armgame {args.command}: error: {exc}", file=sys.stderr)
+        print(f"{who}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("armgame: interrupted", file=sys.stderr)
         return 130
-
 
 if __name__ == "__main__":
     sys.exit(main())
