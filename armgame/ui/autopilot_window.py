@@ -20,16 +20,14 @@ from ..game.bots import BOT_NAMES, Autopilot, make_bot
 from ..game.rules import GameConfig
 from ..game.session import GameSession, RealTimeDriver
 from .display import open_window, toggle_fullscreen
+from .playback import MAX_FRAME, PLAYBACK_HELP, REPLAY_SPEEDS, SKIP_SECONDS, skip_sign, speed_after
 from .render import PALETTES, GameRenderer, Hud, Label
 
 CAPTION = ("Same targets, same planner. {0}: the bot knows the interaction torques. "
            "{1}: it drives each joint as if the other did not move.")
 DEFAULT_SIZE = (1280, 720)
-SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
-SKIP_SECONDS = 5.0
 #: The keys, as the help line says them: the same set as the demos' and the replays'.
-HELP = ("p pause", "r restart", "-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s", "F11 fullscreen",
-        "Esc quit")
+HELP = ("p pause", "r restart", *PLAYBACK_HELP, "F11 fullscreen", "Esc quit")
 WHO = {"model": "AUTOPILOT: model", "naive": "AUTOPILOT: naive"}
 
 
@@ -60,7 +58,7 @@ class AutopilotWindow:
         for name in BOT_NAMES:
             session = GameSession(GameConfig(seed=self.seed, time_limit=self.duration))
             # Sped up 8 times, a frame covers up to 8 times the usual stall limit.
-            driver = RealTimeDriver(Autopilot(session, make_bot(name)), 0.25 * max(SPEEDS))  # type: ignore[arg-type]
+            driver = RealTimeDriver(Autopilot(session, make_bot(name)), MAX_FRAME * max(REPLAY_SPEEDS))  # type: ignore[arg-type]
             renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
             self.games.append(Game(name, session, driver, renderer))
 
@@ -136,14 +134,10 @@ class AutopilotWindow:
                 self.paused = not self.paused
             elif key == "r":
                 self.restart()
-            elif key in ("+", "=", "[+]", "keypad +"):
-                self.speed = next((s for s in SPEEDS if s > self.speed), self.speed)
-            elif key in ("-", "[-]", "keypad -"):
-                self.speed = next((s for s in reversed(SPEEDS) if s < self.speed), self.speed)
-            elif key == "1":
-                self.speed = 1.0
-            elif key in ("left", "right"):
-                self.skip(SKIP_SECONDS if key == "right" else -SKIP_SECONDS)
+            elif (speed := speed_after(key, self.speed)) is not None:
+                self.speed = speed
+            elif skip_sign(key):
+                self.skip(SKIP_SECONDS * skip_sign(key))
             elif key == "f11":
                 self.screen = toggle_fullscreen(self.windowed_size)
 
@@ -154,7 +148,7 @@ class AutopilotWindow:
         screen.fill(self.palette.window)
         labels, areas, footer = self.layout(screen.get_size())
         for game, area in zip(self.games, areas, strict=True):
-            alpha = game.driver.advance(0.0 if self.paused else min(max(elapsed, 0.0), 0.25) * self.speed) \
+            alpha = game.driver.advance(0.0 if self.paused else min(max(elapsed, 0.0), MAX_FRAME) * self.speed) \
                 if not game.session.over else 1.0
             game.renderer.draw(screen.subsurface(area), game.session, alpha, self.hud(game))
         renderer = self.games[0].renderer

@@ -15,7 +15,6 @@ from __future__ import annotations
 import itertools
 import math
 import os
-import re
 import time
 from collections import deque
 from collections.abc import Callable
@@ -30,21 +29,17 @@ from ..demos.reach import COMPONENTS, ReachRun
 from ..demos.runs import VISIBLY_APART
 from .body import draw_arm, draw_torso
 from .display import open_window, toggle_fullscreen
+from .playback import MAX_FRAME, PLAYBACK_HELP, SKIP_SECONDS, skip_sign, speed_after
 from .render import PALETTES
 
 SCENE_SIZE = (800, 800)
 #: The scene's shorter side, in pixels: the longer one follows the window's shape.
 SCENE_SIDE = 800
 SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
-#: The arrows skip this far in simulated time; a snapshot is kept every SKIP_SECONDS, so a skip back
+#: The arrows skip SKIP_SECONDS in simulated time; a snapshot is kept every SKIP_SECONDS, so a skip back
 #: restores one and runs at most SKIP_SECONDS again, however long the demo has run.
-SKIP_SECONDS = 5.0
 #: The keys every demo window offers, as its help line says them (one set with the replays').
-HELP = ("p pause", "r restart", "-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s", "F11 fullscreen",
-        "Esc quit")
-#: Longest real time one frame may account for: after a stall (a dragged window) the demo skips ahead
-#: instead of running hundreds of catch-up steps in one frame.
-MAX_FRAME_TIME = 0.25
+HELP = ("p pause", "r restart", *PLAYBACK_HELP, "F11 fullscreen", "Esc quit")
 
 BACKGROUND = (255, 255, 255)
 INK = (20, 20, 28)
@@ -228,14 +223,10 @@ class DemoWindow:
             self.last_time = None  # a pause must not count as elapsed time
         elif key == pygame.K_r:
             self.restart()
-        elif key in (pygame.K_PLUS, pygame.K_EQUALS, pygame.K_KP_PLUS):
-            self.speed = next((s for s in SPEEDS if s > self.speed * 1.001), self.speed)
-        elif key in (pygame.K_MINUS, pygame.K_KP_MINUS):
-            self.speed = next((s for s in reversed(SPEEDS) if s < self.speed / 1.001), self.speed)
-        elif key in (pygame.K_LEFT, pygame.K_RIGHT):
-            self.skip(SKIP_SECONDS if key == pygame.K_RIGHT else -SKIP_SECONDS)
-        elif key == pygame.K_1:
-            self.speed = 1.0
+        elif (speed := speed_after(pygame.key.name(key).lower(), self.speed, SPEEDS)) is not None:
+            self.speed = speed
+        elif skip_sign(pygame.key.name(key).lower()):
+            self.skip(SKIP_SECONDS * skip_sign(pygame.key.name(key).lower()))
         return True
 
     # ------------------------------------------------------------------- physics
@@ -244,7 +235,7 @@ class DemoWindow:
         if self.last_time is None or self.paused:
             self.last_time = now
             return
-        elapsed = min(max(now - self.last_time, 0.0), MAX_FRAME_TIME)
+        elapsed = min(max(now - self.last_time, 0.0), MAX_FRAME)
         self.last_time = now
         self.accumulator += elapsed * self.speed
         dt = self.run.dt
@@ -318,14 +309,11 @@ class DemoWindow:
             pygame.draw.circle(self.scene, colour, p, width // 2 + 2)
         pygame.draw.circle(self.scene, INK if colour == LINK else colour, points[-1], hand_radius)
 
-    def help_text(self) -> str:
-        """The keys that work, as the help line says them (actions: "p resume" while paused)."""
-        return "   ".join(("p resume", *HELP[1:]) if self.paused else HELP)
-
     def help_lines(self) -> list[str]:
-        """The help line's items on as few lines as the scene's width holds (a narrow window: two)."""
+        """The keys that work (actions: "p resume" while paused), on as few lines as the scene's width
+        holds (a narrow window: two)."""
         lines: list[str] = []
-        for item in re.split(r" {3,}", self.help_text()):
+        for item in ("p resume", *HELP[1:]) if self.paused else HELP:
             if lines and self.small_font.size(lines[-1] + "   " + item)[0] <= self.scene_size[0] - 24:
                 lines[-1] += "   " + item
             else:

@@ -27,6 +27,7 @@ from ..game.session import DOWN, UP, GameSession, InputEvent, RealTimeDriver
 from ..game.timeline import TimelineDriver
 from .display import open_window as _open_window
 from .display import toggle_fullscreen
+from .playback import MAX_FRAME, PLAYBACK_HELP, REPLAY_SPEEDS, SKIP_SECONDS, skip_sign, speed_after
 from .render import PLUS_ONE_TIME, GameRenderer, Hud, Standing
 from .settings import MIN_SIDE, Settings, SettingsError
 from .settings import load as load_settings
@@ -44,10 +45,6 @@ END_KEY_DELAY = 0.8
 ENTER = ("return", "enter")
 COUNTDOWN = 3
 TRAIL_SECONDS = 1.0
-REPLAY_SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0)
-SKIP_SECONDS = 5.0
-#: Longest real time one frame may account for (as RealTimeDriver's default): a stall skips ahead.
-MAX_FRAME = 0.25
 
 
 def open_window(size: tuple[int, int] | None = DEFAULT_SIZE, fullscreen: bool = False,
@@ -193,7 +190,7 @@ class GameWindow:
             items.insert(0, f"watching {self.replay.player}'s game" if self.replay.player else "watching a game")
         items.append("p resume" if self.paused else "p pause")
         if self.replay is not None:
-            items += ["-/+ speed", "1 real speed", f"left/right {SKIP_SECONDS:g} s"]
+            items += list(PLAYBACK_HELP)
         if self.sounds is not None and getattr(self.sounds, "available", False) and self._mute_key_free():
             items.append("m unmute" if self.sounds.muted else "m mute")
         items += ["F11 fullscreen", "Esc quit"]
@@ -264,16 +261,11 @@ class GameWindow:
             self.session.key_event(name, DOWN)
 
     def _replay_key(self, name: str) -> None:
-        if name in ("+", "=", "[+]", "keypad +"):
-            self.speed = next((s for s in REPLAY_SPEEDS if s > self.speed), self.speed)
-        elif name in ("-", "[-]", "keypad -"):
-            self.speed = next((s for s in reversed(REPLAY_SPEEDS) if s < self.speed), self.speed)
-        elif name == "1":
-            self.speed = 1.0
-        elif name in ("left", "right"):
-            dt = self.session.config.dt
-            skip = round(SKIP_SECONDS / dt) * (1 if name == "right" else -1)
-            self.skip_to(self.session.steps + skip)
+        speed = speed_after(name, self.speed)
+        if speed is not None:
+            self.speed = speed
+        elif skip_sign(name):
+            self.skip_to(self.session.steps + round(SKIP_SECONDS / self.session.config.dt) * skip_sign(name))
 
     def _end_key(self, name: str) -> None:
         """The end screen: Enter plays again (a replay: watches again); a replay's keys still move it."""
@@ -403,7 +395,7 @@ class GameWindow:
         if self.name_entry is not None:
             return "Enter saves    Esc quits (the game's replay is kept)"
         if self.replay is not None:
-            return "Enter watches again    left/right 5 s    Esc quits"
+            return f"Enter watches again    left/right {SKIP_SECONDS:g} s    Esc quits"
         return "Enter plays again    Esc quits"
 
     def _update_trail(self) -> None:

@@ -31,8 +31,9 @@ from ..lab.analysis import LearningCurve, figure_metric, learning_curve, result_
 from ..lab.protocol import target_positions
 from ..lab.session import HOLD, LabSession, TrialOutcome
 from ..words import plural
-from .frontend import MAX_FRAME, REPLAY_SPEEDS, GameWindow, key_name, seek
+from .frontend import GameWindow, key_name, seek
 from .lab_panels import draw_card, draw_end, draw_feedback
+from .playback import MAX_FRAME, REPLAY_SPEEDS, skip_sign, speed_after
 from .render import GameRenderer, Hud, Viewport, text_heights
 
 CAPTION = "armgame lab - reach from home to each target"
@@ -345,10 +346,10 @@ class LabWindow(GameWindow):
         super().handle(event)
 
     def _lab_replay_key(self, name: str) -> bool:
-        if name in ("+", "=", "up", "[+]", "keypad +", "-", "down", "[-]", "keypad -", "1"):
-            self._replay_key(name)  # the game window's speeds
-        elif name in ("left", "right"):
-            self.skip_trials(1 if name == "right" else -1)
+        if (speed := speed_after(name, self.speed)) is not None:
+            self.speed = speed
+        elif skip_sign(name):
+            self.skip_trials(skip_sign(name))
         else:
             return False
         return True
