@@ -165,7 +165,7 @@ def draw_torso(surface: pygame.Surface, origin: tuple[float, float], px_per_m: f
 
 def draw_arm(surface: pygame.Surface, origin: tuple[float, float], px_per_m: float, q1: float, q2: float,
              l1: float, l2: float, activation: Sequence[float], palette: Palette,
-             colours: Sequence[RGB] | None = None, torso: bool = True) -> list[pygame.Rect]:
+             torso: bool = True) -> list[pygame.Rect]:
     """The arm at angles (q1, q2): limbs, joints, hand, and the four muscles at ``activation`` (0 to 1);
     returns the rectangles it drew in (for a window that redraws only what changed).
 
@@ -205,7 +205,7 @@ def draw_arm(surface: pygame.Surface, origin: tuple[float, float], px_per_m: flo
     for centre, r in joint_r:  # inside the joint's anti-aliased edge: a plain fill is smooth enough
         pygame.draw.circle(surface, skin, at(centre), r * k)
     polygon(surface, skin, px(_palm(wrist, hand, 0.0)))
-    colours = colours or palette.muscles
+    colours = palette.muscles
     for i in (1, 0, 3, 2) if torso else (3, 2):  # the shoulder pair under the elbow pair, where they cross
         a = min(max(float(activation[i]), 0.0), 1.0)
         outline = px(muscle_outline(i, q1, q2, l1, l2, a))

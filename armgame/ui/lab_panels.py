@@ -120,7 +120,8 @@ def draw_curve(renderer: GameRenderer, screen: pygame.Surface, rect: pygame.Rect
     low, high = (min(float(finite.min()), 0.0), max(float(finite.max()), 0.0)) if finite.size else (-1.0, 1.0)
     margin = 0.08 * ((high - low) or 2.0)
     low, high = low - margin, high + margin
-    label_w = max(renderer.text_size(f"{t:g}", small)[0] for t in _ticks(low, high)) + small // 2
+    ticks = _ticks(low, high)
+    label_w = max(renderer.text_size(f"{t:g}", small)[0] for t in ticks) + small // 2
     head = renderer.font(small).get_height() + small // 3
     plot = pygame.Rect(rect.left + label_w, rect.top + head, rect.width - label_w,
                        rect.height - head - renderer.font(small).get_height() - small // 3)
@@ -148,7 +149,7 @@ def draw_curve(renderer: GameRenderer, screen: pygame.Surface, rect: pygame.Rect
         if math.isfinite(block.mean) and low <= block.mean <= high:
             mean_y = y_of(block.mean)
             pygame.draw.line(screen, p.warn, (area.left + line, mean_y), (area.right - line, mean_y), line)
-    for t in _ticks(low, high):
+    for t in ticks:
         y = y_of(t)
         pygame.draw.line(screen, p.edge, (plot.left - line, y), (plot.left, y), 2)
         _blit(renderer, screen, placed, f"{t:g}", small, p.ink, midright=(plot.left - line - 2, y))

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import pygame
 
 from .display import open_window, toggle_fullscreen
-from .render import MIN_TEXT_AT_720, PALETTES, GameRenderer, Label
+from .render import PALETTES, GameRenderer, Label, min_text
 
 CAPTION = "armgame"
 DEFAULT_SIZE = (1024, 720)
@@ -159,7 +159,7 @@ class MenuWindow:
         w, h = size
         u = min(w, h) / 720.0
         r, p = self.renderer, self.palette
-        small = max(round(MIN_TEXT_AT_720 * min(size) / 720), round(0.025 * h), round(20 * u))
+        small = max(min_text(size), round(20 * u))
         normal = max(small + 2, round(30 * u))
         big = max(normal + 4, round(56 * u))
         pad, gap = max(8, round(28 * u)), max(4, round(10 * u))
