@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import ast
 import importlib
 import itertools
 import re
@@ -28,24 +27,19 @@ class _Parser(argparse.ArgumentParser):
         self._arg_strings = list(sys.argv[1:] if args is None else args)  # for error()'s hint
         return super().parse_known_args(args, namespace)
 
+    def _check_value(self, action: argparse.Action, value: object) -> None:
+        # The closest valid name first. Asked of the parser rather than read back out of argparse's
+        # message, whose quoting of the choices changed in Python 3.12.8 and 3.13.1.
+        choices = action.choices
+        if choices is not None and isinstance(value, str) and value not in choices:
+            close = closest(value, [str(c) for c in choices])
+            if close is not None:
+                raise argparse.ArgumentError(action, f"invalid choice: {value!r}: did you mean {close}? "
+                                                     f"(choose from {', '.join(map(str, choices))})")
+        super()._check_value(action, value)
+
     def error(self, message: str) -> NoReturn:
-        message = _did_you_mean(message)
         self.exit(2, f"{self.prog}: error: {message}{_dash_value_hint(message, getattr(self, '_arg_strings', []))}\n")
-
-
-def _did_you_mean(message: str) -> str:
-    """argparse's "invalid choice: 'pley' (choose from ...)" with the closest valid name first."""
-    found = re.fullmatch(r"(argument \S+: invalid choice: )('.*?') \(choose from (.*)\)", message)
-    if not found:
-        return message
-    try:
-        value, choices = ast.literal_eval(found.group(2)), ast.literal_eval(f"[{found.group(3)}]")
-    except (ValueError, SyntaxError):
-        return message
-    close = closest(value, choices)
-    if close is None:
-        return message
-    return f"{found.group(1)}{found.group(2)}: did you mean {close}? (choose from {', '.join(choices)})"
 
 
 def _dash_value_hint(message: str, arg_strings: Sequence[str]) -> str:
