@@ -93,6 +93,10 @@ class VerificationCache:
         #: Without a (trusted) folder the cache lives only as long as the command.
         self._items: dict[str, dict] | None = None if self.path is not None else {}
         self._new: dict[str, dict] = {}
+        # A replay file's signature -> its digest, for the saved verdicts (built on first use) and the new
+        # ones: a verify of N entries asks once per entry, so a scan of the new verdicts would be N^2.
+        self._by_signature: dict[tuple, str] | None = None
+        self._new_by_signature: dict[tuple, str] = {}
         self._trusted: bool | None = None if self.path is not None else False
 
     def guard(self, table_folder: Path) -> None:
@@ -144,14 +148,15 @@ class VerificationCache:
 
     def put(self, digest: str, verdict: dict) -> None:
         self._new[digest] = verdict
+        if "file" in verdict:
+            self._new_by_signature.setdefault(tuple(verdict["file"]), digest)
 
     def digest_of(self, signature: list[int]) -> str | None:
         """The SHA-256 of a replay file whose signature is ``signature``, if a verdict recorded it."""
-        if not hasattr(self, "_by_signature"):
+        if self._by_signature is None:
             self._by_signature = {tuple(v["file"]): k for k, v in self._load().items() if "file" in v}
         found = self._by_signature.get(tuple(signature))
-        return found if found is not None else next(
-            (k for k, v in self._new.items() if v.get("file") == signature), None)
+        return found if found is not None else self._new_by_signature.get(tuple(signature))
 
     def save(self) -> None:
         if not self._new or self.folder is None or self.path is None or not self.trusted():
@@ -166,6 +171,7 @@ class VerificationCache:
                 atomic_write_bytes(self.path, json.dumps(payload, sort_keys=True, allow_nan=False).encode(), "cache")
                 os.chmod(self.path, 0o600)  # whatever the umask: a group-writable cache is not trusted next time
         self._new = {}
+        self._new_by_signature = {}
 
 
 def _valid(v: object) -> bool:
