@@ -7,7 +7,6 @@ help. Pure Python, the standard library only.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterable
 
 _SIBILANT_ENDINGS = ("s", "x", "z", "ch", "sh")
@@ -51,6 +50,8 @@ def closest(name: str, choices: Iterable[str]) -> str | None:
     >>> closest("pley", ("play", "replay", "simulate")), closest("CURL", ("curl", "null")), closest("zz", ("a",))
     ('play', 'curl', None)
     """
+    import difflib  # only a refusal needs it: every command line would pay it at start-up otherwise
+
     by_folded = {c.lower(): c for c in choices}
     found = difflib.get_close_matches(name.lower(), list(by_folded), n=1, cutoff=0.6)
     return by_folded[found[0]] if found else None

@@ -6,10 +6,9 @@ import argparse
 import math
 
 from ..errors import UserError
+from ..limits import DEFAULT_SEED
 from ..words import plural
 from . import read_lab_replays
-
-DEFAULT_SEED = 10  # the 2012 game's: every class sees the same targets unless asked otherwise
 
 
 def _seed(text: str) -> int:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..limits import DEFAULT_SEED
 from ..words import plural
 from . import read_lab_replays
 
@@ -34,9 +35,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "scores",
         help="the high-score table, best first",
         description="Print the high-score table, best first (equal scores: the earlier entry first). The ranked "
-        "table holds keyboard games of the standard rules (the default 60 s game) and the table's seed (10 unless "
-        "the table was started with --new --seed N); games of another seed are listed apart as practice, games a "
-        "program played (bots, scripts) apart as programs, games of other rules apart as custom games. A game "
+        "table holds keyboard games of the standard rules (the default 60 s game) and the table's seed "
+        f"({DEFAULT_SEED} unless the table was started with --new --seed N); games of another seed are listed "
+        "apart as practice, games a program played (bots, scripts) apart as programs, games of other rules apart "
+        "as custom games. A game "
         "enters once, whatever name or date its copy carries. Each entry's replay is played again (once: "
         "verdicts, failures too, are cached per user): an entry whose replay is missing, changed or does not "
         "reproduce its score is flagged and not ranked.",
@@ -50,8 +52,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--name", help="with --add: the player's name, if the replay has none")
     p.add_argument("--new", action="store_true", help="start an empty table in the --scores folder (with --seed: "
                    "the seed it ranks)")
-    p.add_argument("--seed", type=_seed_arg, metavar="N", help="with --new: the seed the table ranks (default: 10, "
-                   "the default game's)")
+    p.add_argument("--seed", type=_seed_arg, metavar="N", help="with --new: the seed the table ranks "
+                   f"(default: {DEFAULT_SEED}, the default game's)")
     p.add_argument("--cache", metavar="DIR", help="folder of the verification cache (default: $ARMGAME_CACHE, "
                    "else the per-user cache folder, ~/.cache/armgame on Linux)")
     p.set_defaults(run=run)
@@ -93,7 +95,6 @@ def run(args: argparse.Namespace) -> int:
     read_lab_replays()
     table = ScoreTable(scores_dir(args), warn=warn, cache=cache)
     if args.new:
-        from ..records.rulesets import DEFAULT_SEED
 
         seed = DEFAULT_SEED if args.seed is None else args.seed
         table.new(seed)

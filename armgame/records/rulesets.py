@@ -77,5 +77,3 @@ def ruleset_name(config: GameConfig) -> str:
     found = ruleset_of(config)
     return found.name if found else CUSTOM
 
-#: The seed a new table ranks (``play``'s default, the 2012 game's: every class sees the same targets).
-DEFAULT_SEED = 10

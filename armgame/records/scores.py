@@ -61,13 +61,13 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ..game.session import GameResult
-from ..limits import MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
+from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from ..words import plural
 from .cache import VerificationCache, default_cache_dir, file_signature  # noqa: F401 (the cache's old home)
 from .identity import game_digest
 from .locking import LockBusyError, LockError, file_lock
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
-from .rulesets import CUSTOM, DEFAULT_SEED, RULESETS, config_digest, ruleset_by_digest, ruleset_name
+from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_by_digest, ruleset_name
 from .storage import (
     STRICT_DECODER,
     DataFileError,
