@@ -195,6 +195,31 @@ class CurlLoad:
         return jx1 * fx + jy1 * fy, jx2 * fx + jy2 * fy
 
 
+@dataclass(frozen=True)
+class MatrixLoad:
+    """A viscous field at the hand as a bot believes it: ``J(q)^T K v`` N m, ``K`` = ((k11, k12), (k21, k22)).
+
+    The lab's adapting bot sets it when it learns a full matrix (a curl estimate is in ``K`` then too);
+    the Jacobian formed once, in ``CurlLoad``'s order of operations.
+    """
+
+    l1: float
+    l2: float
+    k11: float
+    k12: float
+    k21: float
+    k22: float
+
+    def __call__(self, q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
+        l1, l2 = self.l1, self.l2
+        s12, c12 = math.sin(q1 + q2), math.cos(q1 + q2)
+        jx1, jy1 = -l1 * math.sin(q1) - l2 * s12, l1 * math.cos(q1) + l2 * c12
+        jx2, jy2 = -l2 * s12, l2 * c12
+        vx, vy = jx1 * w1 + jx2 * w2, jy1 * w1 + jy2 * w2
+        fx, fy = self.k11 * vx + self.k12 * vy, self.k21 * vx + self.k22 * vy
+        return jx1 * fx + jy1 * fy, jx2 * fx + jy2 * fy
+
+
 # --------------------------------------------------------------------- planning
 @dataclass(frozen=True)
 class Quintic:

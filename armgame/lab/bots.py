@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UserError
-from ..game.bots import CurlLoad, ReachingBot
+from ..game.bots import CurlLoad, MatrixLoad, ReachingBot
 from ..words import unknown_name
 from .learner import TwoRateLearner
 from .session import LabSession
@@ -130,13 +130,8 @@ class LabBot(ReachingBot):
         expected = self._expected_field()
         if expected is not None:
             (k11, k12), (k21, k22) = expected
-            k12, k21 = k12 + b, k21 - b  # plus the learned curl b^ [[0, 1], [-1, 0]]
-
-            def known(q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
-                vy, mvx = curl_unit_force(l1, l2, q1, q2, w1, w2)
-                vx = -mvx
-                return curl_unit_torque(l1, l2, q1, q2, k11 * vx + k12 * vy, k21 * vx + k22 * vy)
-            self.load_estimate = known
+            # plus the learned curl b^ [[0, 1], [-1, 0]]
+            self.load_estimate = MatrixLoad(l1, l2, k11, k12 + b, k21 - b, k22)
         elif b != 0.0:
             self.load_estimate = CurlLoad(l1, l2, b)
         else:
@@ -233,15 +228,16 @@ class LabBot(ReachingBot):
         if len(log) < 5:
             return np.zeros(4)
         l1, l2 = session.config.arm.l1, session.config.arm.l2
-        (e11, e12), (e21, e22) = self._expected_field() or ((0.0, 0.0), (0.0, 0.0))
-        b = self.curl_estimate
-        e12, e21 = e12 + b, e21 - b
+        # What it expected is what it predicted with this trial: _install's load (the matrix learner,
+        # when there is one, always gives it one), unchanged until this trial is learned from.
+        expected = self.load_estimate
+        assert isinstance(expected, MatrixLoad)
         g = np.zeros((4, 4))
         h = np.zeros(4)
         for q1, q2, w1, w2, r1, r2 in self._external_torques(session, log):
             vy, mvx = curl_unit_force(l1, l2, q1, q2, w1, w2)
             vx = -mvx
-            t1, t2 = curl_unit_torque(l1, l2, q1, q2, e11 * vx + e12 * vy, e21 * vx + e22 * vy)
+            t1, t2 = expected(q1, q2, w1, w2)
             # d torque / d (b11, b12, b21, b22): J^T applied to (vx, 0), (vy, 0), (0, vx), (0, vy).
             design = np.array([curl_unit_torque(l1, l2, q1, q2, vx, 0.0), curl_unit_torque(l1, l2, q1, q2, vy, 0.0),
                                curl_unit_torque(l1, l2, q1, q2, 0.0, vx), curl_unit_torque(l1, l2, q1, q2, 0.0, vy)]).T
