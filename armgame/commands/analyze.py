@@ -79,11 +79,6 @@ def run(args: argparse.Namespace) -> int:
     return _replays(args)
 
 
-def verified_rows(path: Path):
-    """(rows, session) of a lab replay that reproduces its trials; raises UserError otherwise."""
-    return verified_run(path, lab_replay(path))
-
-
 def lab_replay(path: Path):
     """The lab run in ``path`` (read and checked, not yet replayed); raises UserError otherwise."""
     from ..records.replay import Replay
@@ -154,13 +149,6 @@ def class_members(runs: list, wanted: str | None) -> tuple[list, object, list[tu
     return students, protocol, sorted(left_out, key=lambda item: str(item[0]))
 
 
-def session_player(path: Path) -> str:
-    """The player named in a replay (read again: it is small and already verified), or ''."""
-    from ..records.replay import Replay
-
-    return Replay.load(path).player or ""
-
-
 def _replays(args: argparse.Namespace) -> int:
     from ..lab.metrics import LABEL_COLUMNS, write_trials_csv
 
@@ -176,7 +164,8 @@ def _replays(args: argparse.Namespace) -> int:
     for name in args.replays:
         path = Path(name)
         try:
-            rows, session = verified_rows(path)
+            replay = lab_replay(path)
+            rows, session = verified_run(path, replay)
         except UserError as exc:
             print(f"armgame analyze: {exc}", file=sys.stderr)
             skipped += 1
@@ -191,7 +180,7 @@ def _replays(args: argparse.Namespace) -> int:
                 skipped += 1
                 continue
         if one_table:  # whose each row is: several runs' trials restart at 1
-            who = {"player": session_player(path), "replay": str(path)}
+            who = {"player": replay.player or "", "replay": str(path)}  # the file verified, not read again
             table += [{**who, **row} for row in rows]
         else:
             out.mkdir(parents=True, exist_ok=True)

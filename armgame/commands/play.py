@@ -293,8 +293,9 @@ def _table_of_list(session, args: argparse.Namespace, entry=None):
     from .scores import scores_dir
 
     table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
+    everything = table.all_entries()  # read once: it also gives the table's seed, which the lists need
     kind = table.list_of(entry) if entry is not None else _list_it_would_join(session, args, table)
-    return table, table.of_list(kind), kind
+    return table, table.of_list(kind, everything), kind
 
 
 def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[int, str, int], ...]:

@@ -537,9 +537,10 @@ class ScoreTable:
                                  f"changed") from None
         raise TableError("cannot name a copy of the damaged table; nothing was changed")
 
-    def of_list(self, name: str) -> list[ScoreEntry]:
-        """The entries of one list (``list_of``), best first: the entries one game is compared with."""
-        return [e for e in self.all_entries() if self.list_of(e) == name]
+    def of_list(self, name: str, entries: list[ScoreEntry] | None = None) -> list[ScoreEntry]:
+        """The entries of one list (``list_of``), best first: the entries one game is compared with.
+        ``entries``: ``all_entries()`` already read (the table is not read again)."""
+        return [e for e in (self.all_entries() if entries is None else entries) if self.list_of(e) == name]
 
     def rank(self, entry: ScoreEntry) -> int:
         """The entry's place in its own list."""
