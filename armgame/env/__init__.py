@@ -32,6 +32,8 @@ import gymnasium
 
 ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
 CENTER_OUT_IDS = ("armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0")
+V1_IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1")
+CENTER_OUT_V1_IDS = ("armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1")
 
 
 def _register() -> None:
@@ -47,10 +49,22 @@ def _register() -> None:
             max_episode_steps=None,
             nondeterministic=False,
         )
+    for env_id, continuous in zip(V1_IDS, (False, True), strict=True):
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
+                               vector_entry_point="armgame.env.vector:ReachV1VectorEnv",
+                               kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
     for env_id, continuous in zip(CENTER_OUT_IDS, (False, True), strict=True):
         if env_id not in gymnasium.registry:
             # One episode is one protocol run; it ends itself (terminated, or truncated by the lab's clock).
             gymnasium.register(id=env_id, entry_point="armgame.env.center_out:CenterOutEnv",
+                               kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
+
+    for env_id, continuous in zip(CENTER_OUT_V1_IDS, (False, True), strict=True):
+        if env_id not in gymnasium.registry:
+            # An episode is a few trials or a block: it ends itself (terminated).
+            gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
+                               vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
 
 
