@@ -25,7 +25,6 @@ import armgame.env.vector
 from armgame.env.base import EnvArgumentError
 from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.env.vector import ReachV1VectorEnv
-from armgame.game.batch import STATE_TOLERANCE
 from armgame.lab.protocol import Block, Protocol
 
 REACH, CONTINUOUS = "armgame/Reach-v1", "armgame/ReachContinuous-v1"
@@ -284,8 +283,8 @@ def test_disabled_autoreset_asks_for_a_masked_reset():
 
 
 def test_the_vector_env_renders_each_games_frame_as_the_single_env_does():
-    envs = gym.make_vec("armgame/Reach-v0", num_envs=2, vectorization_mode="vector_entry_point", render_mode="rgb_array",
-                        render_size=(120, 90))
+    envs = gym.make_vec("armgame/Reach-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                        render_mode="rgb_array", render_size=(120, 90))
     singles = SyncVectorEnv([lambda: gym.make("armgame/Reach-v0", render_mode="rgb_array", render_size=(120, 90))
                              for _ in range(2)])
     envs.reset(seed=3)
@@ -308,7 +307,7 @@ def test_a_random_policy_starts_center_out_trials_and_episodes_end_after_their_t
     obs, info = env.reset(seed=2)
     trials, episodes, reaches, steps = [], 0, [], 0
     while episodes < 2:
-        obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        obs, _, terminated, truncated, info = env.step(env.action_space.sample())
         steps += 1
         assert obs in env.observation_space and not truncated
         reaches += info.get("reaches", [])
@@ -402,7 +401,7 @@ def test_the_sb3_adapter_trains_ppo():
     assert obs.shape == (4, 15)
     dones = np.zeros(4, dtype=bool)
     for _ in range(10):
-        obs, rewards, dones, infos = envs.step(np.ones((4, 4), dtype=np.int8))
+        obs, _, dones, infos = envs.step(np.ones((4, 4), dtype=np.int8))
     assert dones.all() and all("terminal_observation" in i and i["TimeLimit.truncated"] for i in infos)
     assert obs[:, 14].tolist() == [1.0] * 4  # the next games already began
     PPO("MlpPolicy", envs, n_steps=16, batch_size=32, device="cpu").learn(64)
