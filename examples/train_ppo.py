@@ -8,7 +8,9 @@ The heart of it is five lines: make the native vector env through the SB3 adapte
 PPO, learn, and play deterministic games. Every ``--eval-every`` steps it plays 10 whole games (game
 seeds 0 to 9, the deterministic policy) and prints their mean hits, the number to compare with the
 game's bots (``armgame play --bot naive``: about 22 a game) and with players. ``--out`` keeps the
-curve (``curve.csv``: env steps, wall seconds, mean/min/max hits) and the model (``model.zip``).
+curve (``curve.csv``: env steps, wall seconds, mean/min/max hits), the model (``model.zip``) and, for
+the keys env, the policy's game of seed 0 as a replay anyone can watch (``armgame replay
+ppo-run/game.json``) or check (``armgame verify``): the game's own rules recount its hits.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from stable_baselines3.common.vec_env import VecMonitor
 
 import armgame.env  # noqa: F401  (registers the ids)
 from armgame.env.sb3 import make_sb3_vec_env
+from armgame.records.replay import Replay
 
 EVAL_SEEDS = list(range(10))
 
@@ -41,6 +44,17 @@ def evaluate(model: PPO, env_id: str) -> np.ndarray:
         obs, _, terminated, truncated, info = envs.step(actions)
         if (terminated | truncated).all():
             return info["hits"].copy()
+
+
+def keep_a_game(model: PPO, env_id: str, path: Path) -> int:
+    """Plays game seed 0 with the deterministic policy in a single env and saves its replay; its hits."""
+    env = gym.make(env_id)
+    obs, _ = env.reset(seed=0)
+    truncated = False
+    while not truncated:
+        obs, _, _, truncated, info = env.step(model.predict(obs, deterministic=True)[0])
+    Replay.from_session(env.unwrapped.session, "script", driver="ppo").save(path)
+    return int(info["hits"])
 
 
 class Curve(BaseCallback):
@@ -94,6 +108,9 @@ def main(argv: list[str] | None = None) -> int:
     curve.record()
     if args.out is not None:
         model.save(args.out / "model.zip")
+        if isinstance(envs.action_space, gym.spaces.MultiBinary):  # a levels game has no key timeline
+            hits = keep_a_game(model, args.env, args.out / "game.json")
+            print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")
     best = max(row[2] for row in curve.rows)
     print(f"best mean hits per game: {best:.1f} (the naive bot: about 22)")
     return 0
