@@ -201,6 +201,11 @@ def test_bad_v1_arguments_are_refused_in_one_line():
     for kwargs in ({"trial_start": "now"}, {"episode_trials": 0}, {"episode_trials": "run"}):
         with pytest.raises(EnvArgumentError, match=next(iter(kwargs))):
             gym.make(CENTER_OUT, **kwargs)
+    center_out = gym.make(CENTER_OUT)
+    with pytest.raises(EnvArgumentError, match="jointspace"):  # its cursor would leave the bounded space
+        center_out.reset(seed=0, options={"protocol": "jointspace"})
+    center_out.reset(seed=0, options={"protocol": "rotation"})  # a rotated cursor stays within bounds
+    assert gym.make(CENTER_OUT, protocol="jointspace").observation_space.high[8] == np.inf
     env = gym.make(CONTINUOUS)
     env.reset(seed=0)
     with pytest.raises(ValueError, match=r"\[-1, 1\]"):

@@ -25,7 +25,7 @@ from ..lab.analysis import trial_row
 from ..lab.protocol import Protocol
 from ..lab.session import REACH, LabSession, lab_config
 from .base import EnvArgumentError
-from .center_out import MAX_RUN_SECONDS, CenterOutEnv, run_protocol
+from .center_out import MAX_RUN_SECONDS, CenterOutEnv
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_reward, hand_velocity, wrap_angles
 from .reach import DEFAULT_DECISION_STEPS, SEED_LIMIT, check_seed, speed_bound
 from .vector_common import AutoresetBook
@@ -227,21 +227,8 @@ class CenterOutV1Env(CenterOutEnv):
         except UserError as exc:  # a target out of the arm's reach, in the lab's words
             raise EnvArgumentError(str(exc)) from None
 
-    def _take_options(self, options: Mapping[str, Any]) -> None:
-        if not isinstance(options, Mapping):
-            raise EnvArgumentError(f"options must be a dict, got {type(options).__name__}")
-        unknown = set(options) - {"protocol", "perturbation"}
-        if unknown:
-            raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, unknown)))}: "
-                                   "choose protocol, perturbation")
-        protocol = run_protocol(options.get("protocol", self.protocol), options.get("perturbation"))
-        low, high = observation_bounds_v1(protocol, self.trial_start)
-        space = self.observation_space
-        if np.any(low.astype(np.float32) < space.low) or np.any(high.astype(np.float32) > space.high):
-            raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
-                                   "spring force (unbounded speeds) needs an env made with it, e.g. "
-                                   "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
-        self.protocol = protocol
+    def _bounds(self, protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
+        return observation_bounds_v1(protocol, self.trial_start)
 
     def _episode_over(self) -> bool:
         s = self.session
