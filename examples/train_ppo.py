@@ -1,7 +1,7 @@
 """Train PPO (Stable-Baselines3) to play armgame: ``armgame/Reach-v1``, SB3's defaults but the batch.
 
     pip install -e '.[rl]'
-    python examples/train_ppo.py                  # 30 minutes, then the policy's hits per game
+    python examples/train_ppo.py                  # 10 minutes, then the policy's hits per game
     python examples/train_ppo.py --minutes 2 --out ppo-run
 
 The heart of it is five lines: make the native vector env through the SB3 adapter, hand it to
@@ -89,7 +89,7 @@ class Curve(BaseCallback):
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--env", default="armgame/Reach-v1", help="an armgame id with a vector entry point")
-    parser.add_argument("--minutes", type=float, default=30.0, help="wall-clock budget (default 30)")
+    parser.add_argument("--minutes", type=float, default=10.0, help="wall-clock budget (default 10)")
     parser.add_argument("--steps", type=int, default=50_000_000, help="env steps at most")
     parser.add_argument("--envs", type=int, default=32, help="games stepped together (default 32)")
     parser.add_argument("--seed", type=int, default=0, help="training seed")
