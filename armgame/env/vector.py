@@ -307,8 +307,11 @@ class ReachVectorEnv(VectorEnv):
     def _infos(self, games: np.ndarray) -> dict[str, Any]:
         """The games' infos, as ``SyncVectorEnv`` gathers them: values where ``games`` is true, 0 elsewhere."""
         info: dict[str, Any] = {}
+        every = games.all()
         for name in ("score", "hits", "resets"):
-            info[name] = np.where(games, np.concatenate([getattr(batch, name) for _, batch in self.parts]), 0)
+            values = [getattr(batch, name) for _, batch in self.parts]
+            values = np.concatenate(values) if len(values) > 1 else values[0].copy()
+            info[name] = values if every else np.where(games, values, 0)
             info[f"_{name}"] = games.copy()
         return info
 
