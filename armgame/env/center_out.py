@@ -235,6 +235,8 @@ class CenterOutEnv(SessionEnv):
     """
 
     family = "CenterOut"
+    #: The lab's rule: a trial's go cue waits for the cursor to stay in home (v1 may start without).
+    hold_at_home = True
 
     def __init__(self, render_mode: str | None = None, *, protocol: str | Protocol = "null",
                  perturbation: object | None = None, decision_steps: int = DEFAULT_DECISION_STEPS,
@@ -268,16 +270,7 @@ class CenterOutEnv(SessionEnv):
 
     # ----------------------------------------------------------------- the API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
-        if seed is not None:
-            seed = check_seed(seed)
-        if options:
-            self._take_options(options)
-        super().reset(seed=seed)
-        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
-        try:
-            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol)
-        except UserError as exc:  # a target out of the arm's reach, in the lab's words
-            raise EnvArgumentError(str(exc)) from None
+        self._start_episode(seed, options)
         if self.render_mode == "human":
             self.render()
         return self._observation(), self._info()
@@ -286,23 +279,48 @@ class CenterOutEnv(SessionEnv):
         session = self.session
         if session is None:
             raise gym.error.ResetNeeded("call reset() before step()")
-        if session.over:
-            raise gym.error.ResetNeeded("the run is over: call reset() before another step()")
+        if self._episode_over():
+            raise gym.error.ResetNeeded("the episode is over: call reset() before another step()")
         if self.continuous:
             self._set_levels(action, 4)
         else:
             self._press_keys(action, 4)
         done, hits = len(session.outcomes), session.rules.board.hits
         ran = session.advance(self.decision_steps)
-        reward = float(session.rules.board.hits - hits) - self.time_cost * ran * session.config.dt
+        reward = self._reward(session.rules.board.hits - hits) - self.time_cost * ran * session.config.dt
         info = self._info()
         if len(session.outcomes) > done:
             info["reaches"] = [trial_row(session, o) for o in session.outcomes[done:]]
         if self.render_mode == "human":
             self.render()
-        return self._observation(), reward, session.finished, session.over and not session.finished, info
+        truncated = session.over and not session.finished  # the run's clock ran out
+        return self._observation(), reward, self._episode_over() and not truncated, truncated, info
 
     # --------------------------------------------------------------- internals
+    def _start_episode(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
+        """v0: every episode is a new run."""
+        self._new_run(seed, options)
+
+    def _new_run(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
+        if seed is not None:
+            seed = check_seed(seed)
+        if options:
+            self._take_options(options)
+        super().reset(seed=seed)
+        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
+        try:
+            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol,
+                                      hold_at_home=self.hold_at_home)
+        except UserError as exc:  # a target out of the arm's reach, in the lab's words
+            raise EnvArgumentError(str(exc)) from None
+
+    def _episode_over(self) -> bool:
+        assert self.session is not None
+        return self.session.over
+
+    def _reward(self, hits: int) -> float:
+        return float(hits)
+
     def _take_options(self, options: Mapping[str, Any]) -> None:
         """A reset's ``protocol`` and ``perturbation``, refused if the observation space cannot bound them."""
         if not isinstance(options, Mapping):

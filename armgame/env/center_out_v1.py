@@ -20,14 +20,12 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
-from ..errors import UserError
-from ..lab.analysis import trial_row
 from ..lab.protocol import Protocol
-from ..lab.session import REACH, LabSession, lab_config
+from ..lab.session import REACH, lab_config
 from .base import EnvArgumentError
 from .center_out import MAX_RUN_SECONDS, CenterOutEnv
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_reward, hand_velocity, wrap_angles
-from .reach import DEFAULT_DECISION_STEPS, SEED_LIMIT, check_seed, speed_bound
+from .reach import DEFAULT_DECISION_STEPS, speed_bound
 from .vector_common import AutoresetBook
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "cursor_from_home_x", "cursor_from_home_y",
@@ -164,6 +162,7 @@ class CenterOutV1Env(CenterOutEnv):
                                    f"got {episode_trials!r}")
         self.reward_kind, self.progress_weight, self.hit_bonus = check_reward(reward, progress_weight, hit_bonus)
         self.trial_start = trial_start
+        self.hold_at_home = trial_start == "hold"
         self.episode_trials = episode_trials if episode_trials == "block" else int(episode_trials)
         if self.continuous:
             self.action_space = spaces.Box(-1.0, 1.0, (4,), np.float32)
@@ -174,8 +173,8 @@ class CenterOutV1Env(CenterOutEnv):
         self._edge = 0.0
         self._shown = (0, 0)
 
-    # ----------------------------------------------------------------- the API
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+    # --------------------------------------------------------------- internals
+    def _start_episode(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
         session = self.session
         if seed is None and not options and session is not None and not session.over:
             gym.Env.reset(self)  # an episode of the same run: its next trial
@@ -187,45 +186,6 @@ class CenterOutV1Env(CenterOutEnv):
         self._first_block = (session.plan or session.plans[-1]).block
         self._shown = (session.trial_index, session.phase)
         self._edge = self._edge_now()
-        if self.render_mode == "human":
-            self.render()
-        return self._observation(), self._info()
-
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        session = self.session
-        if session is None:
-            raise gym.error.ResetNeeded("call reset() before step()")
-        if self._episode_over():
-            raise gym.error.ResetNeeded("the episode is over: call reset() before another step()")
-        if self.continuous:
-            self._set_levels(action, 4)
-        else:
-            self._press_keys(action, 4)
-        done, hits = len(session.outcomes), session.rules.board.hits
-        ran = session.advance(self.decision_steps)
-        hits = session.rules.board.hits - hits
-        reward = self._reward(hits) - self.time_cost * ran * session.config.dt
-        info = self._info()
-        if len(session.outcomes) > done:
-            info["reaches"] = [trial_row(session, o) for o in session.outcomes[done:]]
-        if self.render_mode == "human":
-            self.render()
-        terminated = self._episode_over() and not (session.over and not session.finished)
-        return self._observation(), reward, terminated, session.over and not session.finished, info
-
-    # --------------------------------------------------------------- internals
-    def _new_run(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
-        if seed is not None:
-            seed = check_seed(seed)
-        if options:
-            self._take_options(options)
-        gym.Env.reset(self, seed=seed)
-        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
-        try:
-            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol,
-                                      hold_at_home=self.trial_start == "hold")
-        except UserError as exc:  # a target out of the arm's reach, in the lab's words
-            raise EnvArgumentError(str(exc)) from None
 
     def _bounds(self, protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
         return observation_bounds_v1(protocol, self.trial_start)
