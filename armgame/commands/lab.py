@@ -134,18 +134,13 @@ def run(args: argparse.Namespace) -> int:
 
 
 def default_runs_dir() -> Path:
-    """Where a window run is kept unless --out or --record say otherwise: the per-user data folder, as
-    the high-score table's (``$XDG_DATA_HOME/armgame/lab``, normally ``~/.local/share/armgame/lab``;
-    ``%LOCALAPPDATA%\\armgame\\lab`` on Windows). The one place that chooses it."""
-    import os
-    import sys
+    """Where a window run is kept unless --out or --record say otherwise: ``lab`` in the per-user data
+    folder, beside the high-score table's (``~/.local/share/armgame/lab`` or ``$XDG_DATA_HOME/armgame/lab``
+    on Linux, ``~/Library/Application Support/armgame/lab`` on macOS, ``%LOCALAPPDATA%\\armgame\\lab`` on
+    Windows). The one place that chooses it."""
+    from ..records.scores import user_data_dir
 
-    if sys.platform == "win32" and os.environ.get("LOCALAPPDATA"):
-        return Path(os.environ["LOCALAPPDATA"]) / "armgame" / "lab"
-    data = os.environ.get("XDG_DATA_HOME", "")
-    # The XDG spec: a relative path in $XDG_DATA_HOME is invalid and must be ignored.
-    base = Path(data) if data and os.path.isabs(data) else Path.home() / ".local" / "share"
-    return base / "armgame" / "lab"
+    return user_data_dir() / "lab"
 
 
 def _new_run_folder(session) -> Path:

@@ -127,9 +127,15 @@ def default_scores_dir() -> Path:
     root = Path(__file__).resolve().parents[2]
     if (root / "pyproject.toml").is_file() and (root / "scores").is_dir():
         return root / "scores"
+    return user_data_dir() / "scores"
+
+
+def user_data_dir() -> Path:
+    """armgame's per-user data folder by each platform's convention (``platformdirs``): the table's
+    and the lab's runs live in it, so they are found side by side on every platform."""
     import platformdirs
 
-    return Path(platformdirs.user_data_dir("armgame", appauthor=False)) / "scores"
+    return Path(platformdirs.user_data_dir("armgame", appauthor=False))
 
 
 @dataclass(frozen=True)
