@@ -59,8 +59,11 @@ def run(args: argparse.Namespace) -> int:
                                          figures=not args.no_figures))
         else:
             from ..ui.autopilot_window import run_window as autopilot_window
+            from ..ui.options import window_settings
 
-            autopilot_window(autopilot.WINDOW_SEED, size=_window_size(args), fullscreen=args.fullscreen)
+            settings = window_settings(args)[0]
+            autopilot_window(autopilot.WINDOW_SEED, size=settings.size, fullscreen=args.fullscreen,
+                             palette=settings.palette, text_scale=settings.text_scale)
         return 0
     if args.headless:
         if args.out is None:

@@ -41,11 +41,14 @@ class Game:
 
 class AutopilotWindow:
     def __init__(self, seed: int, duration: float, screen: pygame.Surface,
-                 clock: Callable[[], float] = time.perf_counter) -> None:
+                 clock: Callable[[], float] = time.perf_counter, palette: str = "okabe-ito",
+                 text_scale: float = 1.0) -> None:
         self.seed, self.duration = seed, duration
         self.screen = screen
         self.clock = clock
-        self.palette = PALETTES["okabe-ito"]
+        # The settings' palette and text scale, as every other window takes them (a projector's room).
+        self.palette_name, self.text_scale = palette, text_scale
+        self.palette = PALETTES[palette]
         self.windowed_size = screen.get_size()
         self.paused = False
         self.running = True
@@ -59,7 +62,8 @@ class AutopilotWindow:
             session = GameSession(GameConfig(seed=self.seed, time_limit=self.duration))
             # Sped up 8 times, a frame covers up to 8 times the usual stall limit.
             driver = RealTimeDriver(Autopilot(session, make_bot(name)), MAX_FRAME * max(REPLAY_SPEEDS))  # type: ignore[arg-type]
-            renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+            renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles),
+                                    self.palette_name, self.text_scale)
             self.games.append(Game(name, session, driver, renderer))
 
     # ---------------------------------------------------------------- layout
@@ -69,7 +73,8 @@ class AutopilotWindow:
         u = min(w, h) / 720.0
         pad, gap = max(6, round(12 * u)), max(4, round(6 * u))
         renderer = self.games[0].renderer
-        caption_h, help_h = max(14, round(22 * u)), max(12, round(18 * u))
+        k = self.text_scale
+        caption_h, help_h = round(max(14, round(22 * u)) * k), round(max(12, round(18 * u)) * k)
         # Side by side on a wide screen, one above the other on a tall one (where neither would fit beside).
         caption = CAPTION.format(*(("Top", "Bottom") if h > w else ("Left", "Right")))
         lines = renderer.wrap_items(re.split(r"(?<=\.) ", caption), caption_h, w - 2 * pad, gap)
@@ -164,10 +169,11 @@ class AutopilotWindow:
 
 
 def run_window(seed: int, duration: float = 60.0, size: tuple[int, int] | None = None, fullscreen: bool = False,
-               max_frames: int | None = None, screenshot: Path | None = None) -> dict[str, int]:
+               max_frames: int | None = None, screenshot: Path | None = None, palette: str = "okabe-ito",
+               text_scale: float = 1.0) -> dict[str, int]:
     """Two bot games side by side at real time until Esc or close; returns the hits of each bot."""
     screen = open_window(size, fullscreen, "armgame demo: autopilot, model against naive", DEFAULT_SIZE)
-    window = AutopilotWindow(seed, duration, screen)
+    window = AutopilotWindow(seed, duration, screen, palette=palette, text_scale=text_scale)
     limiter = pygame.time.Clock()
     last = window.clock()
     frames = 0
