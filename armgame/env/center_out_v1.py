@@ -24,8 +24,8 @@ from ..lab.protocol import Protocol
 from ..lab.session import REACH, lab_config
 from .base import EnvArgumentError
 from .center_out import MAX_RUN_SECONDS, CenterOutEnv
-from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_reward, hand_velocity, wrap_angles
-from .reach import DEFAULT_DECISION_STEPS, speed_bound
+from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_reward, hand_and_velocity
+from .reach import DEFAULT_DECISION_STEPS, speed_bound, wrap_angle
 from .vector_common import AutoresetBook
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "cursor_from_home_x", "cursor_from_home_y",
@@ -220,11 +220,10 @@ class CenterOutV1Env(CenterOutEnv):
         s = self.session
         assert s is not None
         q1, q2, w1, w2 = s.state
-        vx, vy = hand_velocity(s.config.arm, q1, q2, w1, w2)
-        angles = wrap_angles(np.array((q1, q2)))
+        _, _, vx, vy = hand_and_velocity(s.config.arm, q1, q2, w1, w2)
         target = s.rules.target
         (cx, cy), (hx, hy) = s.cursor, s.home
-        return np.array((angles[0], angles[1], w1, w2, *s.muscles.activation, cx - hx, cy - hy, vx, vy,
+        return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *s.muscles.activation, cx - hx, cy - hy, vx, vy,
                          target.x - cx, target.y - cy, 1.0 if s.phase == REACH else 0.0,
                          (s.steps - s.phase_start_step) * s.config.dt), dtype=np.float32)
 

@@ -8,19 +8,14 @@ in a float32 observation, a dense reward (``armgame.env.features``), and centred
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 from ..game.rules import GameConfig
-from .features import (
-    DEFAULT_HIT_BONUS,
-    DEFAULT_PROGRESS_WEIGHT,
-    edge_distance,
-    hand_position,
-    reach_observations_v1,
-)
-from .reach import DEFAULT_DECISION_STEPS, ReachEnv, ReachSettings
+from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, hand_and_velocity
+from .reach import DEFAULT_DECISION_STEPS, ReachEnv, ReachSettings, wrap_angle
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
                         "to_target_x", "to_target_y", "time_left_fraction")
@@ -138,10 +133,9 @@ class ReachV1Env(ReachEnv):
     def _edge_now(self) -> float:
         session = self.session
         assert session is not None
-        q1, q2 = np.array(session.state[:1]), np.array(session.state[1:2])
-        hx, hy = hand_position(self.config.arm, q1, q2)
+        hx, hy, _, _ = hand_and_velocity(self.config.arm, *session.state)
         target = session.rules.target
-        return float(edge_distance(hx, hy, target.x, target.y, target.radius)[0])
+        return max(0.0, math.hypot(hx - target.x, hy - target.y) - target.radius)
 
     def _reward(self, hits: int, resets: int) -> float:
         s = self.settings
@@ -154,8 +148,10 @@ class ReachV1Env(ReachEnv):
     def _observation(self) -> np.ndarray:
         session = self.session
         assert session is not None
-        q1, q2, w1, w2 = (np.array((v,)) for v in session.state)
+        q1, q2, w1, w2 = session.state
+        hx, hy, vx, vy = hand_and_velocity(self.config.arm, q1, q2, w1, w2)
         target = session.rules.target
-        left = (self.config.total_steps - min(session.steps, self.config.total_steps)) / self.config.total_steps
-        return reach_observations_v1(self.config.arm, q1, q2, w1, w2, np.array((session.muscles.activation,)),
-                                     np.array((target.x,)), np.array((target.y,)), np.array((left,)))[0]
+        total = self.config.total_steps
+        left = (total - min(session.steps, total)) / total
+        return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *session.muscles.activation, hx, hy, vx, vy,
+                         target.x - hx, target.y - hy, left), dtype=np.float32)
