@@ -8,7 +8,8 @@ Env steps per second (one env step = one decision: 5 physics steps of the game, 
 RK4 step of 0.2 s for Acrobot) with random actions drawn before the clock starts, episodes
 reset as they end:
 
-* single env, both through ``gymnasium.make`` (with its checker and order wrappers);
+* single env, both through ``gymnasium.make`` (with its checker and order wrappers), and Reach-v1
+  against Reach-v0 (what the v1 observation and reward cost);
 * vector env at 1, 64, 1,024 and 8,192 envs: armgame's native ``ReachVectorEnv``
   (``make_vec(..., vectorization_mode="vector_entry_point")``) and Acrobot's ``SyncVectorEnv``.
 
@@ -106,11 +107,13 @@ def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float |
     seconds = seconds or (0.3 if quick else 1.0)
     repeats = repeats or (3 if quick else 5)
     load_before = os.getloadavg()[0]
-    single_runners = {"reach": single_runner("armgame/Reach-v0"), "acrobot": single_runner("Acrobot-v1")}
+    single_runners = {"reach": single_runner("armgame/Reach-v0"), "acrobot": single_runner("Acrobot-v1"),
+                      "reach_v1": single_runner("armgame/Reach-v1")}
     for run in single_runners.values():
         run(min(0.2, seconds))  # warm up
     single = paired(single_runners, seconds, repeats)
     ratios = [a / b for a, b in zip(single["reach"]["wall_rates"], single["acrobot"]["wall_rates"], strict=True)]
+    v1_ratios = [a / b for a, b in zip(single["reach_v1"]["wall_rates"], single["reach"]["wall_rates"], strict=True)]
     vector = {}
     for n in sizes:
         vector[n] = paired({"reach": vector_runner("armgame/Reach-v0", n, "vector_entry_point"),
@@ -122,6 +125,7 @@ def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float |
         "seconds_per_repeat": seconds,
         "single": single,
         "single_ratio": spread(ratios),
+        "v1_ratio": spread(v1_ratios),
         "vector": vector,
     }
 
@@ -163,6 +167,9 @@ def report(result: dict) -> None:
           f"({s['acrobot']['cpu']['median']:,.0f} per CPU s)")
     print(f"  Reach-v0 / Acrobot-v1, paired: {r['median']:.2f} [{r['min']:.2f} - {r['max']:.2f}] "
           f"(goal >= {SINGLE_GOAL:g})")
+    v1 = result["v1_ratio"]
+    print(f"  armgame/Reach-v1 (the hand in its observation, the dense reward) {fmt(s['reach_v1']['wall'])}: "
+          f"{v1['median']:.2f} [{v1['min']:.2f} - {v1['max']:.2f}] times Reach-v0's rate, paired")
     cpu = "per CPU s"
     print(f"{'envs':>6}  {'Reach-v0 vector env':>32} {cpu:>11}  {'Acrobot-v1 SyncVectorEnv':>30} {cpu:>11}")
     for n, rates in result["vector"].items():
