@@ -319,12 +319,24 @@ def test_a_planted_cache_beside_the_table_is_not_trusted(tmp_path, capsys):
     assert "NOT REPRODUCED" in capsys.readouterr().out
 
 
-def test_play_refuses_up_front_what_it_could_not_replay(tmp_path):
-    assert "--duration" in one_line_error(armgame("play", "--headless", "--duration", "86400"))
+def in_process_error(capsys, *argv) -> str:
+    """``main(argv)``'s one line on stderr and exit 2, as ``one_line_error`` checks a subprocess's."""
+    assert main([str(a) for a in argv]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]
+
+
+def test_play_refuses_up_front_what_it_could_not_replay(tmp_path, monkeypatch, capsys):
+    """Counted, not timed: neither refusal plays a single step."""
+    ran = []
+    monkeypatch.setattr(GameSession, "_advance", lambda self, n: ran.append(n) or 0)
+    assert "--duration" in in_process_error(capsys, "play", "--headless", "--duration", "86400")
     script = tmp_path / "many.txt"
     script.write_text("".join(f"{i * 0.004:.3f} d {'down' if i % 2 == 0 else 'up'}\n" for i in range(200_001)))
-    assert "more than 200000 events" in one_line_error(
-        armgame("play", "--headless", "--script", script, "--duration", "900"))
+    assert "more than 200000 events" in in_process_error(capsys, "play", "--headless", "--script", script,
+                                                         "--duration", "900")
+    assert ran == []
 
 
 def test_a_game_that_reaches_the_event_limit_stops_there_and_replays(tmp_path, monkeypatch, capsys):
@@ -619,14 +631,17 @@ def test_a_hostile_script_name_still_saves_the_game_under_a_clean_driver(tmp_pat
     assert ScoreTable(tmp_path / "t").check(entry).ok
 
 
-def test_no_such_user_home_gives_one_line(tmp_path):
-    assert "home folder" in one_line_error(armgame("play", "--headless", "--name", "a", "--duration", "0.1",
-                                                   env={"ARMGAME_SCORES": "~nosuchuser/x"}))
-    assert "home folder" in one_line_error(armgame("scores", env={"ARMGAME_SCORES": "~nosuchuser/x"}))
+def test_no_such_user_home_gives_one_line(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    with monkeypatch.context() as patch:
+        patch.setenv("ARMGAME_SCORES", "~nosuchuser/x")
+        assert "home folder" in in_process_error(capsys, "play", "--headless", "--name", "a", "--duration", "0.1")
+        assert "home folder" in in_process_error(capsys, "scores")
     for option in ("--scores", "--record"):
-        line = one_line_error(armgame("play", "--headless", "--name", "a", "--duration", "0.1", option,
-                                      "~nosuchuser/x"))
+        line = in_process_error(capsys, "play", "--headless", "--name", "a", "--duration", "0.1", option,
+                                "~nosuchuser/x")
         assert option in line and "home folder" in line
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_an_unwritable_scores_folder_is_found_before_the_game(tmp_path, monkeypatch, capsys):
