@@ -211,16 +211,19 @@ def _assert_bench_slides(slides, cases):
     assert legend[-3:] == ["slope 1 (reference)", "slope 2 (reference)", "slope 4 (reference)"]
 
 
-def test_bench_figures_read_on_a_slide(tmp_path, bench_slides):
-    """The fullest grid, five cases and every method; the one-case grid is checked on a real run's
-    figures in test_bench_quick_json_runs_end_to_end."""
+def test_bench_figures_read_on_a_slide(tmp_path, monkeypatch):
+    """The fullest grid, five cases and every method, laid out as saving lays it out (not painted
+    into a PNG: test_bench_quick_json_runs_end_to_end saves a real run's one-case figures and checks
+    them on a slide too)."""
     from armgame.bench import figures
 
+    slides = []
+    monkeypatch.setattr(figures, "save", lambda fig, path: slides.append(fig))
     rows = _synthetic_rows()
     figures.work_precision(rows, tmp_path / "wp.png")
     figures.convergence(rows, tmp_path / "conv.png")
-    assert (tmp_path / "wp.png").stat().st_size > 0 and (tmp_path / "conv.png").stat().st_size > 0
-    _assert_bench_slides(bench_slides, ["passive", "propeller", "upright", "stiff", "game"])
+    assert len(slides) == 2
+    _assert_bench_slides(slides, ["passive", "propeller", "upright", "stiff", "game"])
 
 
 def test_the_slide_check_catches_a_legend_on_the_data_and_overlapping_labels():
