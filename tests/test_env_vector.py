@@ -157,7 +157,8 @@ def test_gymnasiums_vector_wrappers_read_the_episodes():
 
 
 def test_bad_vector_arguments_and_actions_are_refused():
-    for kwargs in ({"num_envs": 0}, {"num_envs": True}, {"render_mode": "rgb_array"}, {"decision_steps": -2}):
+    for kwargs in ({"num_envs": 0}, {"num_envs": True}, {"render_mode": "human"}, {"decision_steps": -2},
+                   {"autoreset_mode": "sometimes"}):
         with pytest.raises(EnvArgumentError):
             ReachVectorEnv(**{"num_envs": 2, **kwargs})
     envs = ReachVectorEnv(2)

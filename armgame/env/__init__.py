@@ -1,28 +1,31 @@
 """Gymnasium environments over the game: how programs play armgame (optional extra ``[gym]``).
 
 This package owns the Gymnasium face of the game and nothing of the game itself: the env
-classes (``reach.ReachEnv`` for one game, ``vector.ReachVectorEnv`` for many in lockstep on
-``BatchGameSession``), their spaces and reward, the registration of their ids, and
+classes, their spaces and rewards, the registration of their ids, the vector envs, and
 ``policies.BotPolicy``, which lets the game's own bots play through an env. The rules, the
 muscles and the physics stay in ``armgame.game``; frames come from ``armgame.ui``'s renderer.
 
 Importing this package registers, with ``gymnasium.register``:
 
-* ``armgame/Reach-v0``: the standard game, the four muscle keys as ``MultiBinary(4)``;
-* ``armgame/ReachContinuous-v0``: the same game driven by four muscle levels, ``Box(0, 1, (4,))``;
-* ``armgame/CenterOut-v0`` and ``armgame/CenterOutContinuous-v0``: a run of the lab's centre-out
-  task (``center_out.CenterOutEnv`` on ``armgame.lab``'s ``LabSession``), keys or muscle levels.
+* ``armgame/Reach-v1`` and ``armgame/ReachContinuous-v1`` (``reach_v1.ReachV1Env``): the game for
+  learners: the hand, its velocity and the hand-to-target vector observed (float32, bounded), a
+  dense reward (``features``), keys as ``MultiBinary(4)`` or muscle levels as ``Box(-1, 1, (4,))``;
+* ``armgame/CenterOut-v1`` and ``armgame/CenterOutContinuous-v1`` (``center_out_v1.CenterOutV1Env``):
+  the lab's centre-out task, trials that start on their own, episodes of a few trials;
+* ``armgame/Reach-v0``, ``armgame/ReachContinuous-v0``, ``armgame/CenterOut-v0``,
+  ``armgame/CenterOutContinuous-v0``: the first versions, unchanged (``reach``, ``center_out``).
 
-The two Reach envs have a native vector entry point, so ``gymnasium.make_vec(id, num_envs=N)`` gives one
-``ReachVectorEnv`` stepping N games as numpy arrays (next-step autoreset). ``import armgame``
-imports neither gymnasium nor this package, and nothing here imports pygame until an env
-renders::
+Every id but the two CenterOut-v0 ones has a vector entry point, so ``gymnasium.make_vec(id,
+num_envs=N)`` gives one vector env: for Reach, ``vector.ReachVectorEnv`` stepping N games as numpy
+arrays on ``BatchGameSession``; for CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
+them to Stable-Baselines3 (and is the only module that imports it). ``import armgame`` imports neither
+gymnasium nor this package, and nothing here imports pygame until an env renders::
 
     import gymnasium as gym
     import armgame.env  # noqa: F401  (registers the ids)
-    env = gym.make("armgame/Reach-v0")
+    env = gym.make("armgame/Reach-v1")
 
-Gymnasium also imports the module named before a colon, so ``gym.make("armgame.env:armgame/Reach-v0")``
+Gymnasium also imports the module named before a colon, so ``gym.make("armgame.env:armgame/Reach-v1")``
 works without the import line.
 """
 
@@ -32,6 +35,8 @@ import gymnasium
 
 ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
 CENTER_OUT_IDS = ("armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0")
+V1_IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1")
+CENTER_OUT_V1_IDS = ("armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1")
 
 
 def _register() -> None:
@@ -47,10 +52,22 @@ def _register() -> None:
             max_episode_steps=None,
             nondeterministic=False,
         )
+    for env_id, continuous in zip(V1_IDS, (False, True), strict=True):
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
+                               vector_entry_point="armgame.env.vector:ReachV1VectorEnv",
+                               kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
     for env_id, continuous in zip(CENTER_OUT_IDS, (False, True), strict=True):
         if env_id not in gymnasium.registry:
             # One episode is one protocol run; it ends itself (terminated, or truncated by the lab's clock).
             gymnasium.register(id=env_id, entry_point="armgame.env.center_out:CenterOutEnv",
+                               kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
+
+    for env_id, continuous in zip(CENTER_OUT_V1_IDS, (False, True), strict=True):
+        if env_id not in gymnasium.registry:
+            # An episode is a few trials or a block: it ends itself (terminated).
+            gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
+                               vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
 
 

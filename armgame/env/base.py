@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import UserError
 from ..game.session import DOWN, RESET_KEY, UP, GameSession
+from .features import muscle_levels
 
 
 class EnvArgumentError(UserError, ValueError):
@@ -30,13 +31,14 @@ class SessionEnv(gym.Env):
     # Gymnasium's own annotation; each env gives itself the render_fps of its decision step.
     metadata: dict[str, Any] = {"render_modes": ["human", "rgb_array"], "render_fps": 50}  # noqa: RUF012
     family = "armgame"
+    version = 0
     continuous = False
     session: GameSession | None = None
 
     @property
     def env_name(self) -> str:
         """The registered id's name, for messages: "Reach-v0", "CenterOutContinuous-v0", ..."""
-        return f"{self.family}{'Continuous' if self.continuous else ''}-v0"
+        return f"{self.family}{'Continuous' if self.continuous else ''}-v{self.version}"
 
     def _check_render_mode(self, render_mode: str | None) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -60,11 +62,14 @@ class SessionEnv(gym.Env):
             session.key_event(RESET_KEY, DOWN)
 
     def _set_levels(self, action: Any, n: int) -> None:
-        """Drive the four muscles toward the action's levels (a fifth entry >= 0.5 presses reset)."""
+        """Drive the four muscles toward the action's levels (a fifth entry >= 0.5 presses reset).
+
+        v1's actions are centred: ``a`` in [-1, 1] is the level ``(a + 1) / 2``."""
         levels = np.asarray(action, dtype=np.float64)
         if levels.shape != (n,) or not np.isfinite(levels).all():
-            raise ValueError(f"a {self.env_name} action is {n} finite numbers in [0, 1], got {action!r}")
-        levels = np.clip(levels, 0.0, 1.0)
+            span = "[-1, 1]" if self.version else "[0, 1]"
+            raise ValueError(f"a {self.env_name} action is {n} finite numbers in {span}, got {action!r}")
+        levels = muscle_levels(levels, centred=self.version > 0)
         session = self.session
         assert session is not None
         session.set_muscle_levels(levels[:4].tolist())

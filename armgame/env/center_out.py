@@ -271,20 +271,7 @@ class CenterOutEnv(SessionEnv):
         if seed is not None:
             seed = check_seed(seed)
         if options:
-            if not isinstance(options, Mapping):
-                raise EnvArgumentError(f"options must be a dict, got {type(options).__name__}")
-            unknown = set(options) - {"protocol", "perturbation"}
-            if unknown:
-                raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, unknown)))}: "
-                                       "choose protocol, perturbation")
-            protocol = run_protocol(options.get("protocol", self.protocol), options.get("perturbation"))
-            low, high = observation_bounds(protocol)
-            space = self.observation_space
-            if np.any(low < space.low) or np.any(high > space.high):
-                raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
-                                       "spring force (unbounded speeds) needs an env made with it, e.g. "
-                                       "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
-            self.protocol = protocol
+            self._take_options(options)
         super().reset(seed=seed)
         lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
         try:
@@ -316,6 +303,26 @@ class CenterOutEnv(SessionEnv):
         return self._observation(), reward, session.finished, session.over and not session.finished, info
 
     # --------------------------------------------------------------- internals
+    def _take_options(self, options: Mapping[str, Any]) -> None:
+        """A reset's ``protocol`` and ``perturbation``, refused if the observation space cannot bound them."""
+        if not isinstance(options, Mapping):
+            raise EnvArgumentError(f"options must be a dict, got {type(options).__name__}")
+        unknown = set(options) - {"protocol", "perturbation"}
+        if unknown:
+            raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, unknown)))}: "
+                                   "choose protocol, perturbation")
+        protocol = run_protocol(options.get("protocol", self.protocol), options.get("perturbation"))
+        low, high = self._bounds(protocol)
+        space = self.observation_space
+        if np.any(low.astype(space.dtype) < space.low) or np.any(high.astype(space.dtype) > space.high):
+            raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
+                                   "spring force (unbounded speeds) needs an env made with it, e.g. "
+                                   "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
+        self.protocol = protocol
+
+    def _bounds(self, protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
+        return observation_bounds(protocol)
+
     def _new_view(self) -> Any:
         from ..ui.lab_env_view import LabEnvView  # pygame is imported here and only here
 

@@ -21,6 +21,7 @@ from ..errors import UserError
 from ..game.rules import GameConfig
 from ..game.session import GameSession
 from .base import EnvArgumentError, SessionEnv
+from .features import check_reward, reach_bounds_v1
 
 #: Decision step of the standard envs in physics steps: 5 x 4 ms = 20 ms, a 50 Hz controller.
 DEFAULT_DECISION_STEPS = 5
@@ -38,10 +39,16 @@ class ReachSettings:
     decision_steps: int
     continuous: bool
     reset_key: bool
+    #: 0: ``Reach-v0``'s spaces and reward; 1: ``Reach-v1``'s (``armgame.env.reach_v1``).
+    version: int = 0
+    reward: str = "sparse"
+    progress_weight: float = 0.0
+    hit_bonus: float = 1.0
 
     @classmethod
     def of(cls, config: GameConfig | None, time_limit: float | None, decision_steps: int, continuous: bool,
-           reset_key: bool) -> ReachSettings:
+           reset_key: bool, version: int = 0, reward: str = "sparse", progress_weight: float = 0.0,
+           hit_bonus: float = 1.0) -> ReachSettings:
         if config is None:
             config = GameConfig()
         elif not isinstance(config, GameConfig):
@@ -60,7 +67,11 @@ class ReachSettings:
         for name, flag in (("continuous", continuous), ("reset_key", reset_key)):
             if not isinstance(flag, bool | np.bool_):
                 raise EnvArgumentError(f"{name} must be True or False, got {flag!r}")
-        return cls(config, int(decision_steps), bool(continuous), bool(reset_key))
+        if version == 0:
+            return cls(config, int(decision_steps), bool(continuous), bool(reset_key))
+        reward, progress_weight, hit_bonus = check_reward(reward, progress_weight, hit_bonus)
+        return cls(config, int(decision_steps), bool(continuous), bool(reset_key), 1, reward, progress_weight,
+                   hit_bonus)
 
     @property
     def decision_time(self) -> float:
@@ -75,13 +86,21 @@ class ReachSettings:
     def game(self, seed: int) -> GameConfig:
         return dataclasses.replace(self.config, seed=seed)
 
+    @property
+    def action_width(self) -> int:
+        return 5 if self.reset_key else 4
+
     def action_space(self) -> spaces.Space:
-        n = 5 if self.reset_key else 4
+        n = self.action_width
         if self.continuous:
-            return spaces.Box(0.0, 1.0, (n,), np.float32)
+            # v1: centred on 0, as SB3's Gaussian policies (and their squashing) expect by default.
+            return spaces.Box(-1.0 if self.version else 0.0, 1.0, (n,), np.float32)
         return spaces.MultiBinary(n)
 
     def observation_space(self) -> spaces.Box:
+        if self.version:
+            low, high = reach_bounds_v1(self.config, speed_bound(self.config))
+            return spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
         low, high = observation_bounds(self.config)
         return spaces.Box(low, high, dtype=np.float64)
 
@@ -129,13 +148,6 @@ def wrap_angle(q: float) -> float:
     if -math.pi <= q <= math.pi:
         return q
     return min(max(q - math.tau * round(q / math.tau), -math.pi), math.pi)
-
-
-def wrap_angles(q: np.ndarray) -> np.ndarray:
-    """``wrap_angle`` on an array, with the same floating-point operations, so a vector env equals single envs."""
-    wrapped = q - math.tau * np.rint(q / math.tau)
-    np.clip(wrapped, -math.pi, math.pi, out=wrapped)
-    return np.where(np.abs(q) <= math.pi, q, wrapped)
 
 
 def check_seed(seed: object) -> int:
@@ -257,8 +269,13 @@ class ReachEnv(SessionEnv):
     def __init__(self, render_mode: str | None = None, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  config: GameConfig | None = None, render_size: tuple[int, int] = (600, 600)) -> None:
+        self._configure(ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key), render_mode,
+                        render_size)
+
+    def _configure(self, settings: ReachSettings, render_mode: str | None, render_size: tuple[int, int]) -> None:
         self._check_render_mode(render_mode)
-        self.settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key)
+        self.settings = settings
+        self.version = settings.version
         self.continuous = self.settings.continuous
         self.config = self.settings.config
         self.decision_steps = self.settings.decision_steps
@@ -295,12 +312,16 @@ class ReachEnv(SessionEnv):
         else:
             self._press_keys(action, self.action_space.n)
         session.advance(self.decision_steps)
-        reward = float((board.hits - hits) - self.config.reset_cost * (board.resets - resets))
+        reward = self._reward(board.hits - hits, board.resets - resets)
         if self.render_mode == "human":
             self.render()
         return self._observation(), reward, False, session.over, self._info()
 
     # --------------------------------------------------------------- internals
+    def _reward(self, hits: int, resets: int) -> float:
+        """The step's reward from its hits and reset presses (v0: the game's score change, never floored)."""
+        return float(hits - self.config.reset_cost * resets)
+
     def _new_view(self) -> Any:
         from ..ui.env_view import EnvView  # pygame is imported here and only here
 

@@ -19,6 +19,7 @@ target's edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``).
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -28,14 +29,24 @@ from gymnasium.vector.utils import batch_space
 
 from ..game.batch import BatchGameSession
 from ..game.rules import GameConfig
+from .features import (
+    DEFAULT_HIT_BONUS,
+    DEFAULT_PROGRESS_WEIGHT,
+    edge_distance,
+    hand_position,
+    muscle_levels,
+    reach_observations_v1,
+    wrap_angles,
+)
 from .reach import (
     DEFAULT_DECISION_STEPS,
     SEED_LIMIT,
     EnvArgumentError,
     ReachSettings,
+    _check_size,
     check_seed,
-    wrap_angles,
 )
+from .vector_common import AutoresetBook, check_reset_mask
 
 #: Memory one game of a vector env takes at its peak (reset and the first step): 5.1-5.2 KB measured at
 #: 20,000 and 60,000 games (peak RSS over the games), rounded up.
@@ -53,13 +64,19 @@ GAMES_PER_BATCH = 8192
 
 
 class ReachVectorEnv(VectorEnv):
-    """``num_envs`` Reach games in lockstep; the arguments are the single env's (see ``ReachEnv``).
+    """``num_envs`` Reach-v0 games in lockstep; the arguments are the single env's (see ``ReachEnv``).
 
-    ``reset(seed=s)`` seeds game ``i`` with ``s + i`` (or ``seed[i]`` from a list); ``step(actions)``
-    takes a ``(num_envs, 4)`` array (5 with ``reset_key``) of keys held (0 or 1) or, for the
-    continuous env, muscle levels (clipped to [0, 1]). ``info`` holds the games' ``score``, ``hits``
-    and ``resets`` as arrays (with Gymnasium's ``_score`` ... masks, all true). No rendering: render
-    one game with the single env.
+    ``reset(seed=s)`` seeds game ``i`` with ``s + i`` (or ``seed[i]`` from a list);
+    ``reset(options={"reset_mask": mask})`` restarts only the masked games (the others play on), as
+    ``SyncVectorEnv`` does. ``step(actions)`` takes a ``(num_envs, 4)`` array (5 with ``reset_key``)
+    of keys held (0 or 1) or, for the continuous env, muscle levels. ``info`` holds the games'
+    ``score``, ``hits`` and ``resets`` as arrays (with Gymnasium's ``_score`` ... masks).
+
+    ``autoreset_mode``: ``"NextStep"`` (the default), ``"SameStep"`` (a game that ends starts its
+    next one in the same step; its last observation and info are in ``info["final_obs"]`` and
+    ``info["final_info"]``) or ``"Disabled"`` (restart ended games with a ``reset_mask``); the mode is
+    ``metadata["autoreset_mode"]``. ``render_mode="rgb_array"``: ``render()`` returns a tuple of
+    frames, one per game, as ``SyncVectorEnv`` does.
 
     >>> import gymnasium as gym
     >>> import armgame.env
@@ -72,11 +89,19 @@ class ReachVectorEnv(VectorEnv):
     (dtype('float64'), np.False_, np.False_)
     """
 
-    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}  # noqa: RUF012
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP,  # noqa: RUF012
+                                "render_modes": ["rgb_array"]}
 
     def __init__(self, num_envs: int = 1, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
-                 config: GameConfig | None = None, render_mode: str | None = None) -> None:
+                 config: GameConfig | None = None, render_mode: str | None = None,
+                 render_size: tuple[int, int] = (600, 600),
+                 autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
+        self._configure(num_envs, ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key),
+                        render_mode, render_size, autoreset_mode)
+
+    def _configure(self, num_envs: int, settings: ReachSettings, render_mode: str | None,
+                   render_size: tuple[int, int], autoreset_mode: str | AutoresetMode) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) or num_envs < 1:
             raise EnvArgumentError(f"num_envs must be a whole number from 1 to {MAX_ENVS:,}, got {num_envs!r}")
         if num_envs > MAX_ENVS:
@@ -84,48 +109,62 @@ class ReachVectorEnv(VectorEnv):
                 f"num_envs {int(num_envs):,} would take about {num_envs * BYTES_PER_ENV / 1024**3:.1f} GiB "
                 f"({BYTES_PER_ENV // 1024} KiB a game), more than a vector env may ({MAX_ENV_MEMORY // 1024**3} GiB: "
                 f"at most {MAX_ENVS:,} games); run several envs in several processes")
-        if render_mode is not None:
-            raise EnvArgumentError(f"the vector env does not render (render_mode={render_mode!r}): "
-                                   "render one game with gymnasium.make")
-        self.settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key)
-        self.config = self.settings.config
+        if render_mode not in (None, "rgb_array"):
+            raise EnvArgumentError(f"a vector env renders with render_mode='rgb_array' (a frame per game) or None, "
+                                   f"got {render_mode!r}: for a window, render one game with gymnasium.make")
+        self.settings = settings
+        self.config = settings.config
         self.num_envs = n = int(num_envs)
-        self.decision_steps = self.settings.decision_steps
-        self.decision_time = self.settings.decision_time
-        self.render_mode = None
-        self.single_action_space = self.settings.action_space()
-        self.single_observation_space = self.settings.observation_space()
+        self.decision_steps = settings.decision_steps
+        self.decision_time = settings.decision_time
+        self.render_mode = render_mode
+        self.render_size = _check_size(render_size)
+        self._book = AutoresetBook(n, autoreset_mode)
+        self.metadata = {**self.metadata, "autoreset_mode": self._book.mode,
+                         "render_fps": 1.0 / self.decision_time}
+        self.single_action_space = settings.action_space()
+        self.single_observation_space = settings.observation_space()
         self.action_space = batch_space(self.single_action_space, n)
         self.observation_space = batch_space(self.single_observation_space, n)
-        self._width = (self.single_action_space.shape or (0,))[0]
+        self._width = settings.action_width
         #: The games as consecutive slices of ``GAMES_PER_BATCH``, each one ``BatchGameSession``.
         self.parts: list[tuple[slice, BatchGameSession]] = []
         # One generator per game, as each single env of a SyncVectorEnv has its own np_random.
         self._generators: list[np.random.Generator | None] = [None] * n
-        self._autoreset = np.zeros(n, dtype=bool)
+        self._views: Any = None  # armgame.ui.env_view.EnvView per game, made on the first frame
 
     # ----------------------------------------------------------------- the API
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         n = self.num_envs
+        options = dict(options or {})
+        mask = check_reset_mask(options.pop("reset_mask", None), n, have_games=bool(self.parts))
+        if options:
+            raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, options)))}: "
+                                   "a Reach vector env takes reset_mask")
         if seed is None or isinstance(seed, int | np.integer):
-            super().reset(seed=None if seed is None else check_seed(seed))
+            if mask is None:
+                super().reset(seed=None if seed is None else check_seed(seed))
             seeds: list[int | None] = [None] * n if seed is None else [int(seed) + i for i in range(n)]
         elif isinstance(seed, list | tuple) and len(seed) == n:
             seeds = list(seed)
         else:
             raise EnvArgumentError(f"seed must be None, a whole number or a list of {n} seeds, got {seed!r}")
-        game_seeds = [self._game_seed(i, s) for i, s in enumerate(seeds)]
+        chosen = np.ones(n, dtype=bool) if mask is None else mask
+        game_seeds = {int(i): self._game_seed(int(i), seeds[i]) for i in np.flatnonzero(chosen)}
         if not self.parts:
             for start in range(0, n, GAMES_PER_BATCH):
                 part = slice(start, min(n, start + GAMES_PER_BATCH))
-                self.parts.append((part, BatchGameSession([self.settings.game(s) for s in game_seeds[part]],
-                                                                   exact=False)))
+                self.parts.append((part, BatchGameSession(
+                    [self.settings.game(game_seeds[i]) for i in range(part.start, part.stop)], exact=False)))
         else:
             for part, batch in self.parts:
-                batch.restart(np.ones(batch.n, dtype=bool), game_seeds[part])
-        self._autoreset[:] = False
-        return self._observations(), self._infos()
+                here = chosen[part]
+                if here.any():
+                    batch.restart(here, [game_seeds[int(i) + part.start] for i in np.flatnonzero(here)])
+        self._started(chosen)
+        self._book.reset(chosen)
+        return self._observations(), self._infos(chosen)
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self.parts:
@@ -133,31 +172,89 @@ class ReachVectorEnv(VectorEnv):
 
             raise ResetNeeded("call reset() before step()")
         actions = self._check(actions)
+        book = self._book
+        book.before_step()
         n = self.num_envs
-        rewards = np.empty(n)
-        truncated = np.empty(n, dtype=bool)
+        rewards = np.zeros(n)
+        truncated = np.zeros(n, dtype=bool)
+        restart = book.restart_now.copy()  # next-step mode: the games that ended last step
         for part, batch in self.parts:
-            self._step_part(part, batch, actions, rewards, truncated)
-        self._autoreset = truncated.copy()
-        return self._observations(), rewards, np.zeros(n, dtype=bool), truncated, self._infos()
+            self._step_part(part, batch, actions, rewards, truncated, restart[part])
+        infos = self._infos(np.ones(n, dtype=bool))
+        if book.mode is AutoresetMode.SAME_STEP and truncated.any():
+            final_obs = self._observations()
+            infos["final_obs"] = np.full(n, None, dtype=object)
+            for i in np.flatnonzero(truncated):
+                infos["final_obs"][i] = final_obs[i]
+            infos["_final_obs"] = truncated.copy()
+            infos["final_info"] = self._infos(truncated)
+            infos["_final_info"] = truncated.copy()
+            self._restart(truncated)
+            infos.update(self._infos(np.ones(n, dtype=bool)))
+        book.after_step(truncated)
+        return self._observations(), rewards, np.zeros(n, dtype=bool), truncated, infos
+
+    def render(self) -> tuple[np.ndarray, ...] | None:
+        """Each game's frame now, as the single env draws it (a tuple of (height, width, 3) arrays)."""
+        if self.render_mode is None:
+            from gymnasium import logger
+
+            logger.warn("render() needs render_mode='rgb_array': make the vector env with it")
+            return None
+        if not self.parts:
+            from gymnasium.error import ResetNeeded
+
+            raise ResetNeeded("call reset() before render()")
+        if self._views is None:
+            from ..ui.env_view import EnvView  # pygame is imported here and only here
+
+            self._views = [EnvView("rgb_array", self.render_size, self.metadata["render_fps"])
+                           for _ in range(self.num_envs)]
+        return tuple(view.frame(game) for view, game in zip(self._views, self._games(), strict=True))
+
+    def close_extras(self, **kwargs: Any) -> None:
+        for view in self._views or ():
+            view.close()
+        self._views = None
 
     # --------------------------------------------------------------- internals
+    def _games(self) -> list[_BatchGame]:
+        return [_BatchGame(batch, i) for _, batch in self.parts for i in range(batch.n)]
+
     def _step_part(self, part: slice, batch: BatchGameSession, actions: np.ndarray, rewards: np.ndarray,
-                   truncated: np.ndarray) -> None:
+                   truncated: np.ndarray, restart: np.ndarray) -> None:
         # Games that ended at the last step are over, so neither their actions (the batch ignores
         # input to a game that is over) nor the physics touch them here; they start their next
         # game after the others have stepped.
-        restart = self._autoreset[part]
         hits, resets = batch.hits.copy(), batch.resets.copy()  # before the actions: a reset key costs
         self._apply(batch, actions[part])
         batch.advance(self.decision_steps)
-        rewards[part] = batch.hits - hits
-        if self.config.reset_cost:
-            rewards[part] -= self.config.reset_cost * (batch.resets - resets)
+        rewards[part] = self._rewards(part, batch, batch.hits - hits, batch.resets - resets)
         if restart.any():
-            chosen = np.flatnonzero(restart) + part.start
-            batch.restart(restart, [self._game_seed(int(i), None) for i in chosen])
+            self._restart_part(part, batch, restart)
+            rewards[part] = np.where(restart, 0.0, rewards[part])
         truncated[part] = batch.over  # a restarted game is not over
+
+    def _restart(self, games: np.ndarray) -> None:
+        for part, batch in self.parts:
+            if games[part].any():
+                self._restart_part(part, batch, games[part])
+
+    def _restart_part(self, part: slice, batch: BatchGameSession, games: np.ndarray) -> None:
+        chosen = np.flatnonzero(games) + part.start
+        batch.restart(games, [self._game_seed(int(i), None) for i in chosen])
+        mask = np.zeros(self.num_envs, dtype=bool)
+        mask[chosen] = True
+        self._started(mask)
+
+    def _started(self, games: np.ndarray) -> None:
+        """Games ``games`` (a mask over all) have just begun: v1 measures their first distances here."""
+
+    def _rewards(self, part: slice, batch: BatchGameSession, hits: np.ndarray, resets: np.ndarray) -> np.ndarray:
+        rewards = hits.astype(np.float64)
+        if self.config.reset_cost:
+            rewards -= self.config.reset_cost * resets
+        return rewards
 
     def _game_seed(self, i: int, seed: int | None) -> int:
         """Game ``i``'s next seed, exactly as single env ``i``'s ``reset(seed=seed)`` chooses it."""
@@ -176,7 +273,7 @@ class ReachVectorEnv(VectorEnv):
             levels = np.asarray(actions, dtype=np.float64)
             if levels.shape != shape or not np.isfinite(levels).all():
                 raise ValueError(f"actions must be a {shape} array of finite muscle levels, got shape {levels.shape}")
-            return np.clip(levels, 0.0, 1.0)
+            return muscle_levels(levels, centred=self.settings.version > 0)
         pressed = np.asarray(actions)
         if pressed.shape != shape or not ((pressed == 0) | (pressed == 1)).all():
             raise ValueError(f"actions must be a {shape} array of zeros and ones (keys held), "
@@ -207,9 +304,73 @@ class ReachVectorEnv(VectorEnv):
             rows[:, 10] = batch.time_left
         return obs
 
-    def _infos(self) -> dict[str, Any]:
+    def _infos(self, games: np.ndarray) -> dict[str, Any]:
+        """The games' infos, as ``SyncVectorEnv`` gathers them: values where ``games`` is true, 0 elsewhere."""
         info: dict[str, Any] = {}
         for name in ("score", "hits", "resets"):
-            info[name] = np.concatenate([getattr(batch, name) for _, batch in self.parts])
-            info[f"_{name}"] = np.ones(self.num_envs, dtype=bool)
+            info[name] = np.where(games, np.concatenate([getattr(batch, name) for _, batch in self.parts]), 0)
+            info[f"_{name}"] = games.copy()
         return info
+
+
+class _BatchGame:
+    """One game of a batch, read as the renderer reads a ``GameSession`` (the batch keeps its rules current)."""
+
+    def __init__(self, batch: BatchGameSession, i: int) -> None:
+        self.config = batch.configs[i]
+        self.rules = batch.rules[i]
+        self.muscles = SimpleNamespace(keys=batch.muscle_keys, activation=batch.activation[i].tolist())
+        self.time_left = float(batch.time_left[i])
+        self._angles = float(batch.q1[i]), float(batch.q2[i])
+
+    def interpolated_angles(self, alpha: float) -> tuple[float, float]:
+        return self._angles
+
+
+class ReachV1VectorEnv(ReachVectorEnv):
+    """``num_envs`` Reach-v1 games in lockstep: ``ReachVectorEnv`` with v1's observations and reward
+    (see ``armgame.env.reach_v1.ReachV1Env``; the arguments are its).
+
+    >>> import gymnasium as gym
+    >>> import armgame.env
+    >>> envs = gym.make_vec("armgame/ReachContinuous-v1", num_envs=4)
+    >>> obs, info = envs.reset(seed=0)
+    >>> obs.shape, obs.dtype, envs.single_action_space
+    ((4, 15), dtype('float32'), Box(-1.0, 1.0, (4,), float32))
+    """
+
+    def __init__(self, num_envs: int = 1, *, time_limit: float | None = None,
+                 decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
+                 reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
+                 hit_bonus: float = DEFAULT_HIT_BONUS, config: GameConfig | None = None,
+                 render_mode: str | None = None, render_size: tuple[int, int] = (600, 600),
+                 autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
+        settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
+                                    progress_weight, hit_bonus)
+        self._configure(num_envs, settings, render_mode, render_size, autoreset_mode)
+        self._edges = np.zeros(self.num_envs)
+
+    def _edges_now(self, part: slice, batch: BatchGameSession) -> np.ndarray:
+        hx, hy = hand_position(self.config.arm, batch.q1, batch.q2)
+        return edge_distance(hx, hy, batch.target_x, batch.target_y, self.config.target_radius)
+
+    def _started(self, games: np.ndarray) -> None:
+        for part, batch in self.parts:
+            self._edges[part] = np.where(games[part], self._edges_now(part, batch), self._edges[part])
+
+    def _rewards(self, part: slice, batch: BatchGameSession, hits: np.ndarray, resets: np.ndarray) -> np.ndarray:
+        s = self.settings
+        if s.reward == "sparse":
+            return super()._rewards(part, batch, hits, resets)
+        before = self._edges[part].copy()
+        self._edges[part] = now = self._edges_now(part, batch)
+        progress = before - np.where(hits > 0, 0.0, now)
+        return s.progress_weight * progress + s.hit_bonus * hits - self.config.reset_cost * resets
+
+    def _observations(self) -> np.ndarray:
+        obs = np.empty((self.num_envs, 15), dtype=np.float32)
+        for part, batch in self.parts:
+            left = (batch.total_steps - np.minimum(batch.steps, batch.total_steps)) / batch.total_steps
+            obs[part] = reach_observations_v1(self.config.arm, batch.q1, batch.q2, batch.w1, batch.w2,
+                                              batch.activation, batch.target_x, batch.target_y, left)
+        return obs

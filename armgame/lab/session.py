@@ -123,8 +123,12 @@ def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = 
 class LabSession(GameSession):
     """A centre-out experiment on the game's session: see the module's docstring."""
 
-    def __init__(self, config: GameConfig, protocol: Protocol) -> None:
+    def __init__(self, config: GameConfig, protocol: Protocol, hold_at_home: bool = True) -> None:
         super().__init__(config)
+        #: True (the lab's rule): the go cue waits for the cursor to stay in home for the trial's delay.
+        #: False (for agents, ``armgame/CenterOut-v1``): it comes that delay after the trial began, wherever
+        #: the cursor is, so a policy that cannot yet hold still still starts trials.
+        self.hold_at_home = bool(hold_at_home)
         if config.scene != LAB_SCENE:
             raise UserError(f"a lab run's scene is {LAB_SCENE!r}, got {config.scene!r}")
         if tuple(config.start_posture) != tuple(math.radians(a) for a in protocol.home_posture_deg):
@@ -345,7 +349,7 @@ class LabSession(GameSession):
         plan = self.plans[self.trial_index]
         if self.phase == HOLD:
             home = self.home_target
-            self._counter = self._counter + 1 if home.contains(x, y) else 0
+            self._counter = self._counter + 1 if not self.hold_at_home or home.contains(x, y) else 0
             if self._counter >= plan.delay_steps:
                 self.phase = REACH
                 self._go_step = self.steps

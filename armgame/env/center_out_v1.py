@@ -1,0 +1,303 @@
+"""``armgame/CenterOut-v1`` and ``armgame/CenterOutContinuous-v1``: the lab's task, shaped so an agent can start.
+
+v0 is a whole 120-trial lab run with the human's rule that a trial waits for the cursor to stay in
+home: random keys never hold still, so no trial starts and nothing is learned. v1 starts each trial
+after its delay wherever the cursor is (``LabSession(hold_at_home=False)``; the human lab keeps its
+hold), ends an episode after a set number of trials or a block, observes what a learner needs
+(float32, bounded) and rewards progress toward the shown target. The task, its perturbations and its
+per-reach measures are still the lab's (``armgame.lab``), so an agent's reaches are measured as a
+student's are. ``CenterOutVectorEnv`` is the vector entry point.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+
+from ..errors import UserError
+from ..lab.analysis import trial_row
+from ..lab.protocol import Protocol
+from ..lab.session import REACH, LabSession, lab_config
+from .base import EnvArgumentError
+from .center_out import MAX_RUN_SECONDS, CenterOutEnv
+from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_reward, hand_velocity, wrap_angles
+from .reach import DEFAULT_DECISION_STEPS, SEED_LIMIT, check_seed, speed_bound
+from .vector_common import AutoresetBook
+
+OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "cursor_from_home_x", "cursor_from_home_y",
+                        "hand_vx", "hand_vy", "to_target_x", "to_target_y", "phase", "time_in_phase")
+#: Trials in an episode by default: one of each of the eight targets, about 15 to 30 s of the task.
+DEFAULT_EPISODE_TRIALS = 8
+TRIAL_STARTS = ("delay", "hold")
+
+
+def observation_bounds_v1(protocol: Protocol, trial_start: str) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds of a CenterOut-v1 observation for runs of ``protocol`` (float64; see ``CenterOutV1Env``)."""
+    kinds = {p.kind for p in protocol.perturbations}
+    config = lab_config(protocol, 0)
+    reach = config.arm.l1 + config.arm.l2
+    w = math.inf if kinds & {"constant", "spring"} else speed_bound(config)
+    v = (config.arm.l1 + 2.0 * config.arm.l2) * w
+    # The cursor is the hand, or the hand rotated or mirrored about home: within 2 reaches of home and
+    # 3 of the shoulder; a shown target (home or a target) lies within reach of the shoulder.
+    c, t = (math.inf, math.inf) if "jointspace" in kinds else (2.0 * reach, 4.0 * reach)
+    # A phase lasts at most the longest delay (a hold, when the go cue does not wait) or the time-out.
+    phase = max(protocol.delay[1], protocol.timeout) + config.dt if trial_start == "delay" else MAX_RUN_SECONDS
+    pi = math.pi
+    low = np.array([-pi, -pi, -w, -w, 0, 0, 0, 0, -c, -c, -v, -v, -t, -t, 0, 0])
+    high = np.array([pi, pi, w, w, 1, 1, 1, 1, c, c, v, v, t, t, 1, phase])
+    return low, high
+
+
+class CenterOutV1Env(CenterOutEnv):
+    r"""
+    ## Description
+
+    The lab's centre-out reaching task (docs/lab.md; ``armgame/CenterOut-v0``): the game's arm and
+    muscles, a home circle and targets 10 cm from it in 8 directions. A trial: a hold at home for
+    the trial's delay (0.5-1.0 s), the go cue (the target appears), then 3 s to bring the cursor
+    into the target and keep it there 0.2 s (a hit); then the arm goes home at rest and the next
+    trial begins. A block's perturbation (a force field at the hand, or a transform of the cursor)
+    is on from a trial's go cue to its end.
+
+    By default (``trial_start="delay"``) the go cue comes the trial's delay after the trial began,
+    wherever the cursor is: a policy that cannot hold still yet still meets targets. With
+    ``trial_start="hold"`` the cue waits, as for a person, for the cursor to stay in home that long.
+
+    ## Action Space
+
+    ``armgame/CenterOut-v1``: ``MultiBinary(4)``, the muscle keys d, f, j, k held (shoulder flexor
+    and extensor, elbow flexor and extensor). ``armgame/CenterOutContinuous-v1``: ``Box(-1, 1, (4,),
+    float32)``, muscle level ``(a + 1) / 2``, as ``armgame/ReachContinuous-v1``.
+
+    ## Observation Space
+
+    ``Box(low, high, (16,), float32)``:
+
+    | Num   | Observation                                      | Min    | Max   | Unit  |
+    |-------|--------------------------------------------------|--------|-------|-------|
+    | 0-1   | shoulder and elbow angles, wrapped               | -pi    | pi    | rad   |
+    | 2-3   | joint angular velocities                         | -34.4  | 34.4  | rad/s |
+    | 4-7   | activations of d, f, j, k                        | 0      | 1     |       |
+    | 8-9   | the cursor (the hand as shown) from home's centre | -1.6   | 1.6   | m     |
+    | 10-11 | the hand's velocity (as felt, not as shown)      | -43.3  | 43.3  | m/s   |
+    | 12-13 | from the cursor to the shown target's centre     | -3.2   | 3.2   | m     |
+    | 14    | phase: 0 hold (home shown), 1 reach (after go)   | 0      | 1     |       |
+    | 15    | time since the phase began                       | 0      | 3.004 | s     |
+
+    The shown target is home during a hold. A protocol with a ``jointspace`` display leaves the
+    cursor unbounded, and a constant force or a spring the speeds, as in v0; with
+    ``trial_start="hold"`` a hold has no end, so time in phase is bounded by a day.
+
+    ## Rewards
+
+    ``reward="dense"`` (default): ``w (e_prev - e) + bonus * hits - time_cost * seconds``, with ``e``
+    the cursor's distance to the shown target's edge at the end of the step. On a step in which the
+    shown target changes (the go cue, a trial's end) the progress term is 0 and restarts from the
+    new target, so neither a far target nor the return home costs anything. ``w =
+    progress_weight`` (10 per metre), ``bonus = hit_bonus`` (1), ``time_cost`` 0 by default.
+    ``reward="sparse"``: ``hits - time_cost * seconds``, as v0.
+
+    ## Starting State and Episodes
+
+    ``reset(seed=s)`` starts a run of the protocol with lab seed ``s`` (its trials' order and
+    delays), the arm at rest at home. An episode is ``episode_trials`` trials (default 8), or
+    with ``episode_trials="block"`` the rest of the current block; it ends **terminated** after its
+    last trial. A ``reset()`` without a seed (an autoreset) continues the same run at its next
+    trial, so a protocol's blocks follow one another over episodes, as a participant's do; once the
+    run's last trial is done, it starts a new run with a seed from the env's generator.
+    ``reset(options={"protocol": ..., "perturbation": ...})`` starts a new run of those. The episode
+    is truncated if the run's clock runs out (only possible with ``trial_start="hold"``).
+
+    ``info``: ``trial`` (the index in the run of the trial under way, or of the next), ``trials_done``,
+    ``hits``, ``block`` and, on a step in which trials ended, ``reaches``: their rows of the lab's
+    trials table (``armgame.lab.metrics.TRIAL_COLUMNS``), measured on the cursor's path.
+
+    ## Arguments
+
+    ```python
+    >>> import gymnasium as gym
+    >>> import armgame.env
+    >>> env = gym.make("armgame/CenterOut-v1", protocol="curl", episode_trials="block")
+    >>> obs, info = env.reset(seed=10)
+    >>> obs.shape, obs.dtype, info
+    ((16,), dtype('float32'), {'trial': 0, 'trials_done': 0, 'hits': 0, 'block': 'baseline'})
+
+    ```
+
+    * ``protocol``, ``perturbation``, ``decision_steps``, ``render_mode``, ``render_size``: as v0.
+    * ``trial_start``: ``"delay"`` (default) or ``"hold"`` (the lab's rule for people).
+    * ``episode_trials``: trials per episode, 1 to 2000, or ``"block"`` (default 8).
+    * ``reward`` (``"dense"`` or ``"sparse"``), ``progress_weight``, ``hit_bonus``: as
+      ``armgame/Reach-v1``; ``time_cost``: reward lost per second, 0 to 10 (default 0).
+
+    ## Version History
+
+    * v1: trials start after their delay; episodes of a few trials or a block; the cursor, the
+      hand's velocity and the cursor-to-target vector observed, float32, with no run clock or trial
+      count; a dense reward; continuous actions in [-1, 1]; ``info["trial"]`` (armgame 0.2).
+    * v0: Initial version (armgame 0.1).
+    """
+
+    version = 1
+
+    def __init__(self, render_mode: str | None = None, *, protocol: str | Protocol = "null",
+                 perturbation: object | None = None, decision_steps: int = DEFAULT_DECISION_STEPS,
+                 continuous: bool = False, trial_start: str = "delay",
+                 episode_trials: int | str = DEFAULT_EPISODE_TRIALS, reward: str = "dense",
+                 progress_weight: float = DEFAULT_PROGRESS_WEIGHT, hit_bonus: float = DEFAULT_HIT_BONUS,
+                 time_cost: float = 0.0, render_size: tuple[int, int] = (600, 600)) -> None:
+        super().__init__(render_mode, protocol=protocol, perturbation=perturbation, decision_steps=decision_steps,
+                         continuous=continuous, time_cost=time_cost, render_size=render_size)
+        if trial_start not in TRIAL_STARTS:
+            raise EnvArgumentError(f"trial_start must be 'delay' or 'hold', got {trial_start!r}")
+        if episode_trials != "block" and (isinstance(episode_trials, bool)
+                                          or not isinstance(episode_trials, int | np.integer)
+                                          or not 1 <= episode_trials <= 2000):
+            raise EnvArgumentError(f"episode_trials must be a whole number from 1 to 2000 or 'block', "
+                                   f"got {episode_trials!r}")
+        self.reward_kind, self.progress_weight, self.hit_bonus = check_reward(reward, progress_weight, hit_bonus)
+        self.trial_start = trial_start
+        self.episode_trials = episode_trials if episode_trials == "block" else int(episode_trials)
+        if self.continuous:
+            self.action_space = spaces.Box(-1.0, 1.0, (4,), np.float32)
+        low, high = observation_bounds_v1(self.protocol, trial_start)
+        self.observation_space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
+        self._first_trial = 0
+        self._first_block = 0
+        self._edge = 0.0
+        self._shown = (0, 0)
+
+    # ----------------------------------------------------------------- the API
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+        session = self.session
+        if seed is None and not options and session is not None and not session.over:
+            gym.Env.reset(self)  # an episode of the same run: its next trial
+        else:
+            self._new_run(seed, options)
+        session = self.session
+        assert session is not None
+        self._first_trial = session.trial_index
+        self._first_block = (session.plan or session.plans[-1]).block
+        self._shown = (session.trial_index, session.phase)
+        self._edge = self._edge_now()
+        if self.render_mode == "human":
+            self.render()
+        return self._observation(), self._info()
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
+        session = self.session
+        if session is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        if self._episode_over():
+            raise gym.error.ResetNeeded("the episode is over: call reset() before another step()")
+        if self.continuous:
+            self._set_levels(action, 4)
+        else:
+            self._press_keys(action, 4)
+        done, hits = len(session.outcomes), session.rules.board.hits
+        ran = session.advance(self.decision_steps)
+        hits = session.rules.board.hits - hits
+        reward = self._reward(hits) - self.time_cost * ran * session.config.dt
+        info = self._info()
+        if len(session.outcomes) > done:
+            info["reaches"] = [trial_row(session, o) for o in session.outcomes[done:]]
+        if self.render_mode == "human":
+            self.render()
+        terminated = self._episode_over() and not (session.over and not session.finished)
+        return self._observation(), reward, terminated, session.over and not session.finished, info
+
+    # --------------------------------------------------------------- internals
+    def _new_run(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
+        if seed is not None:
+            seed = check_seed(seed)
+        if options:
+            self._take_options(options)
+        gym.Env.reset(self, seed=seed)
+        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
+        try:
+            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol,
+                                      hold_at_home=self.trial_start == "hold")
+        except UserError as exc:  # a target out of the arm's reach, in the lab's words
+            raise EnvArgumentError(str(exc)) from None
+
+    def _bounds(self, protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
+        return observation_bounds_v1(protocol, self.trial_start)
+
+    def _episode_over(self) -> bool:
+        s = self.session
+        assert s is not None
+        if s.over:
+            return True
+        if self.episode_trials == "block":
+            return s.plans[s.trial_index].block != self._first_block
+        return s.trial_index - self._first_trial >= self.episode_trials
+
+    def _edge_now(self) -> float:
+        s = self.session
+        assert s is not None
+        target = s.rules.target
+        return max(0.0, math.hypot(s.cursor[0] - target.x, s.cursor[1] - target.y) - target.radius)
+
+    def _reward(self, hits: int) -> float:
+        s = self.session
+        assert s is not None
+        if self.reward_kind == "sparse":
+            return float(hits)
+        shown = (s.trial_index, s.phase)
+        before, self._edge = self._edge, self._edge_now()
+        progress = before - self._edge if shown == self._shown else 0.0
+        self._shown = shown
+        return self.progress_weight * progress + self.hit_bonus * hits
+
+    def _observation(self) -> np.ndarray:
+        s = self.session
+        assert s is not None
+        q1, q2, w1, w2 = s.state
+        vx, vy = hand_velocity(s.config.arm, q1, q2, w1, w2)
+        angles = wrap_angles(np.array((q1, q2)))
+        target = s.rules.target
+        (cx, cy), (hx, hy) = s.cursor, s.home
+        return np.array((angles[0], angles[1], w1, w2, *s.muscles.activation, cx - hx, cy - hy, vx, vy,
+                         target.x - cx, target.y - cy, 1.0 if s.phase == REACH else 0.0,
+                         (s.steps - s.phase_start_step) * s.config.dt), dtype=np.float32)
+
+    def _info(self) -> dict[str, Any]:
+        s = self.session
+        assert s is not None
+        return {"trial": s.trial_index, "trials_done": len(s.outcomes), "hits": s.rules.board.hits,
+                "block": s.block.name}
+
+
+class CenterOutVectorEnv(SyncVectorEnv):
+    """``num_envs`` CenterOut-v1 envs as one vector env: the vector entry point of the v1 ids.
+
+    The lab's session has no batch kernel (each run's trials, perturbations and measures are per
+    run), so the games step one after another, exactly as ``SyncVectorEnv`` steps them: it *is*
+    Gymnasium's ``SyncVectorEnv`` (reset masks, the three autoreset modes, ``render()`` a tuple of
+    frames), made from the env's arguments, so that ``gymnasium.make_vec`` and the SB3 adapter
+    (``armgame.env.sb3``) take the CenterOut ids as they take the Reach ones.
+
+    >>> import gymnasium as gym
+    >>> import armgame.env
+    >>> envs = gym.make_vec("armgame/CenterOut-v1", num_envs=2, autoreset_mode="SameStep")
+    >>> obs, info = envs.reset(seed=0)
+    >>> obs.shape, envs.metadata["autoreset_mode"].value
+    ((2, 16), 'SameStep')
+    """
+
+    def __init__(self, num_envs: int = 1, *, autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
+                 **kwargs: Any) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) or not 1 <= num_envs <= 4096:
+            raise EnvArgumentError(f"num_envs must be a whole number from 1 to 4096, got {num_envs!r}")
+        mode = AutoresetBook(1, autoreset_mode).mode  # checked in one line
+        # The first env checks the arguments (one line for a bad one) before the others are made.
+        first = CenterOutV1Env(**kwargs)
+        envs = iter([first] + [CenterOutV1Env(**kwargs) for _ in range(int(num_envs) - 1)])
+        super().__init__([lambda: next(envs) for _ in range(int(num_envs))], autoreset_mode=mode)

@@ -1,0 +1,132 @@
+"""What the v1 envs add for learners: the hand's kinematics, observation bounds that hold, the dense reward.
+
+One place for each formula, written on numpy arrays so that the single envs (one game: arrays of
+one element) and the vector envs (N games) compute their observations and rewards with the same
+floating-point operations. The game's state stays in joint coordinates; a learner gets the hand
+and the hand-to-target vector here rather than deriving them, which every user of v0 had to do.
+
+The dense reward is progress toward the current target plus a bonus per hit::
+
+    r_t = w (e_{t-1} - e_t) + bonus h_t - c resets_t
+
+with ``e = max(0, |hand - target| - radius)``, the hand's distance to the target's edge, taken at the
+end of each step; ``h_t`` the hits and ``resets_t`` the reset-key presses in step ``t``; ``c`` the
+game's reset cost. On a step with a hit, ``e_t`` is 0 (the old target's edge was reached) and the
+progress term restarts from the new target at the next step, so a new target far away costs
+nothing. Summed over a game the progress telescopes, target by target::
+
+    return = w (sum_k e0_k - e_end) + bonus H - c R
+
+``e0_k`` the distance to target ``k``'s edge when it appeared (at the reset or at the end of the
+step that hit the previous one), ``e_end`` the last target's at the end, ``H`` hits, ``R`` resets.
+It is a potential-based shaping per target, so it pays no more for wandering and the best policy
+still hits as many targets as it can (``tests/test_env_v1.py`` checks the sum).
+
+>>> import numpy as np
+>>> float(edge_distance(np.float64(0.3), np.float64(0.4), 0.0, 0.0, 0.05))  # 0.5 m from the centre
+0.45
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..game.rules import GameConfig
+from ..physics.params import TwoJointParams
+
+#: Reward per metre of progress toward the current target's edge (1 per 10 cm).
+DEFAULT_PROGRESS_WEIGHT = 10.0
+#: Reward per hit, on top of the progress that reached it.
+DEFAULT_HIT_BONUS = 1.0
+REWARDS = ("dense", "sparse")
+
+
+def hand_position(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The hand (m): ``(l1 cos q1 + l2 cos(q1 + q2), l1 sin q1 + l2 sin(q1 + q2))``."""
+    s12 = q1 + q2
+    return arm.l1 * np.cos(q1) + arm.l2 * np.cos(s12), arm.l1 * np.sin(q1) + arm.l2 * np.sin(s12)
+
+
+def hand_velocity(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray,
+                  w2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The hand's velocity (m/s), the Jacobian times the joint velocities."""
+    s12, w12 = q1 + q2, w1 + w2
+    return (-arm.l1 * np.sin(q1) * w1 - arm.l2 * np.sin(s12) * w12,
+            arm.l1 * np.cos(q1) * w1 + arm.l2 * np.cos(s12) * w12)
+
+
+def hand_speed_bound(arm: TwoJointParams, joint_speed: float) -> float:
+    """A bound on either component of the hand's velocity when each joint speed is within ``joint_speed``.
+
+    ``|vx| <= l1 |w1| + l2 |w1 + w2| <= (l1 + 2 l2) w``, and the same for ``vy``.
+    """
+    return (arm.l1 + 2.0 * arm.l2) * joint_speed
+
+
+def edge_distance(hx: np.ndarray, hy: np.ndarray, tx: np.ndarray, ty: np.ndarray, radius: float) -> np.ndarray:
+    """The hand's distance to the target's edge (m), 0 inside it."""
+    return np.maximum(0.0, np.hypot(hx - tx, hy - ty) - radius)
+
+
+def muscle_levels(action: np.ndarray, centred: bool) -> np.ndarray:
+    """A continuous action as muscle levels in [0, 1]: v0's action is the level (clipped), v1's ``a`` in
+    [-1, 1] is ``(a + 1) / 2`` (clipped), so a policy's zero is a half-active muscle."""
+    if centred:
+        action = (action + 1.0) * 0.5
+    return np.clip(action, 0.0, 1.0)
+
+
+def check_reward(reward: object, progress_weight: object, hit_bonus: object) -> tuple[str, float, float]:
+    """The reward arguments of a v1 env, checked: one line naming a bad one."""
+    from .base import EnvArgumentError
+
+    if reward not in REWARDS:
+        raise EnvArgumentError(f"reward must be 'dense' or 'sparse', got {reward!r}")
+    for name, value in (("progress_weight", progress_weight), ("hit_bonus", hit_bonus)):
+        if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value <= 1000.0:
+            raise EnvArgumentError(f"{name} must be a number from 0 to 1000, got {value!r}")
+    return str(reward), float(progress_weight), float(hit_bonus)  # type: ignore[arg-type]
+
+
+def reach_bounds_v1(config: GameConfig, joint_speed: float) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds of a Reach-v1 observation (see ``ReachV1Env``), in float64."""
+    arm = config.arm
+    reach = arm.l1 + arm.l2
+    xmin, xmax, ymin, ymax = config.view
+    r, w, pi = config.target_radius, joint_speed, math.pi
+    v = hand_speed_bound(arm, w)
+    # A target's centre lies within the view less its radius; the hand within the arm's reach.
+    low = np.array([-pi, -pi, -w, -w, 0, 0, 0, 0, -reach, -reach, -v, -v, xmin + r - reach, ymin + r - reach, 0.0])
+    high = np.array([pi, pi, w, w, 1, 1, 1, 1, reach, reach, v, v, xmax - r + reach, ymax - r + reach, 1.0])
+    return low, high
+
+
+def wrap_angles(q: np.ndarray) -> np.ndarray:
+    """Angles in [-pi, pi]: themselves when already there, else ``q - 2 pi round(q / 2 pi)``."""
+    wrapped = q - math.tau * np.rint(q / math.tau)
+    np.clip(wrapped, -math.pi, math.pi, out=wrapped)
+    return np.where(np.abs(q) <= math.pi, q, wrapped)
+
+
+def reach_observations_v1(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray, w2: np.ndarray,
+                          activation: np.ndarray, target_x: np.ndarray, target_y: np.ndarray,
+                          time_left_fraction: np.ndarray) -> np.ndarray:
+    """Reach-v1 observations, one row per game (float32); ``activation`` is (n, 4)."""
+    hx, hy = hand_position(arm, q1, q2)
+    vx, vy = hand_velocity(arm, q1, q2, w1, w2)
+    obs = np.empty((len(q1), 15), dtype=np.float32)
+    obs[:, 0] = wrap_angles(q1)
+    obs[:, 1] = wrap_angles(q2)
+    obs[:, 2] = w1
+    obs[:, 3] = w2
+    obs[:, 4:8] = activation
+    obs[:, 8] = hx
+    obs[:, 9] = hy
+    obs[:, 10] = vx
+    obs[:, 11] = vy
+    obs[:, 12] = target_x - hx
+    obs[:, 13] = target_y - hy
+    obs[:, 14] = time_left_fraction
+    return obs

@@ -1,0 +1,161 @@
+"""``armgame/Reach-v1`` and ``armgame/ReachContinuous-v1``: the game, with what a learner needs to start.
+
+v0 gave the joint state and the target, and one point per hit: every learner had to compute the hand
+and shape its own reward before anything learned. v1 is the same game (an episode is still the
+game of its seed, its score in ``info``) with the hand, its velocity and the hand-to-target vector
+in a float32 observation, a dense reward (``armgame.env.features``), and centred continuous actions.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..game.rules import GameConfig
+from .features import (
+    DEFAULT_HIT_BONUS,
+    DEFAULT_PROGRESS_WEIGHT,
+    edge_distance,
+    hand_position,
+    reach_observations_v1,
+)
+from .reach import DEFAULT_DECISION_STEPS, ReachEnv, ReachSettings
+
+OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
+                        "to_target_x", "to_target_y", "time_left_fraction")
+
+
+class ReachV1Env(ReachEnv):
+    r"""
+    ## Description
+
+    The armgame game (see ``armgame/Reach-v0`` and docs/programs.md): a two-joint arm in the
+    horizontal plane, four muscles, red targets to hit with the hand within 60 s; each hit scores a
+    point and the next target appears at once. An episode is the game of ``armgame play --seed S``.
+
+    ## Action Space
+
+    ``armgame/Reach-v1``: ``MultiBinary(4)``, the muscle keys d, f, j, k held during the coming
+    decision step (shoulder flexor, shoulder extensor, elbow flexor, elbow extensor: +1.5, -1.5,
+    +1.125 and -1.125 N m at full activation).
+
+    ``armgame/ReachContinuous-v1``: ``Box(-1, 1, (4,), float32)``: action ``a`` commands muscle level
+    ``(a + 1) / 2``, so 0 is half activation, -1 relaxed, 1 full; outside [-1, 1] is clipped, NaN
+    refused. A Gaussian policy's defaults (SB3's PPO and SAC) fit it with no wrapper.
+
+    ``reset_key=True`` adds a fifth entry that presses the reset key (space): 1, or for the
+    continuous env 0 or more.
+
+    ## Observation Space
+
+    ``Box(low, high, (15,), float32)``; every bound holds (tested), so an agent needs no
+    normalisation wrapper to start:
+
+    | Num   | Observation                                   | Min   | Max   | Unit  |
+    |-------|-----------------------------------------------|-------|-------|-------|
+    | 0     | shoulder angle q1 (from +x), wrapped          | -pi   | pi    | rad   |
+    | 1     | elbow angle q2 (relative), wrapped            | -pi   | pi    | rad   |
+    | 2-3   | joint angular velocities                      | -34.4 | 34.4  | rad/s |
+    | 4-7   | activations of d, f, j, k                     | 0     | 1     |       |
+    | 8-9   | hand x (forward), y (left) from the shoulder  | -0.8  | 0.8   | m     |
+    | 10-11 | hand velocity x, y                            | -43.3 | 43.3  | m/s   |
+    | 12    | hand to target centre, x                      | -1.55 | 1.55  | m     |
+    | 13    | hand to target centre, y                      | -1.15 | 1.95  | m     |
+    | 14    | fraction of the game's time left              | 0     | 1     |       |
+
+    The speed bounds are proven, not observed (``reach.speed_bound``; the hand's from the joints':
+    ``(l1 + 2 l2) w``); in play the hand moves at up to about 3 m/s. The target's radius is 0.05 m.
+
+    ## Rewards
+
+    ``reward="dense"`` (the default): ``r = w (e_prev - e) + bonus * hits - c * resets``, with ``e``
+    the hand's distance to the current target's edge at the end of the step (0 on a step with a
+    hit: the progress term restarts with each new target, so a far new target costs nothing),
+    ``w = progress_weight`` (10 per metre), ``bonus = hit_bonus`` (1) and ``c`` the reset cost (1).
+    Summed over a game it is ``w (sum of each target's starting distance - the last target's final
+    distance) + bonus H - c R`` (``armgame.env.features``). ``reward="sparse"``: one per hit less the
+    reset cost, as v0. Either way ``info`` carries the game's ``score``, ``hits`` and ``resets``:
+    compare agents with players and bots by ``info["hits"]`` at the episode's end.
+
+    ## Starting State
+
+    The arm at rest at q1 = 45 deg, q2 = 90 deg, muscles relaxed, the seed's first target shown.
+    ``reset(seed=s)`` plays game seed ``s``; without a seed the game's seed comes from the env's
+    generator.
+
+    ## Episode End
+
+    Never terminated; truncated when the game's clock runs out (60 s: 3,000 steps of 20 ms).
+
+    ## Arguments
+
+    ```python
+    >>> import gymnasium as gym
+    >>> import armgame.env
+    >>> env = gym.make("armgame/Reach-v1")
+    >>> obs, info = env.reset(seed=10)
+    >>> obs.dtype, obs.shape, info
+    (dtype('float32'), (15,), {'score': 0, 'hits': 0, 'resets': 0})
+    >>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    >>> env.unwrapped.reward_kind, env.unwrapped.settings.progress_weight
+    ('dense', 10.0)
+
+    ```
+
+    * ``reward``: ``"dense"`` (default) or ``"sparse"``; ``progress_weight`` (0 to 1000 per metre,
+      default 10) and ``hit_bonus`` (0 to 1000, default 1) weigh the dense one.
+    * ``time_limit``, ``decision_steps`` (default 5: a 20 ms step), ``reset_key``, ``config``,
+      ``render_mode`` (``"rgb_array"`` or ``"human"``), ``render_size``: as ``armgame/Reach-v0``.
+
+    ## Version History
+
+    * v1: hand position and velocity and the hand-to-target vector observed, float32; the
+      fraction of time left instead of seconds; the target's position only relative to the hand;
+      a dense reward by default; continuous actions in [-1, 1] (armgame 0.2).
+    * v0: Initial version (armgame 0.1).
+    """
+
+    def __init__(self, render_mode: str | None = None, *, time_limit: float | None = None,
+                 decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
+                 reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
+                 hit_bonus: float = DEFAULT_HIT_BONUS, config: GameConfig | None = None,
+                 render_size: tuple[int, int] = (600, 600)) -> None:
+        settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
+                                    progress_weight, hit_bonus)
+        self._configure(settings, render_mode, render_size)
+        self._edge = 0.0
+
+    @property
+    def reward_kind(self) -> str:
+        return self.settings.reward
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+        observation, info = super().reset(seed=seed, options=options)
+        self._edge = self._edge_now()
+        return observation, info
+
+    def _edge_now(self) -> float:
+        session = self.session
+        assert session is not None
+        q1, q2 = np.array(session.state[:1]), np.array(session.state[1:2])
+        hx, hy = hand_position(self.config.arm, q1, q2)
+        target = session.rules.target
+        return float(edge_distance(hx, hy, target.x, target.y, target.radius)[0])
+
+    def _reward(self, hits: int, resets: int) -> float:
+        s = self.settings
+        if s.reward == "sparse":
+            return super()._reward(hits, resets)
+        before, self._edge = self._edge, self._edge_now()
+        progress = before - (0.0 if hits else self._edge)
+        return s.progress_weight * progress + s.hit_bonus * hits - self.config.reset_cost * resets
+
+    def _observation(self) -> np.ndarray:
+        session = self.session
+        assert session is not None
+        q1, q2, w1, w2 = (np.array((v,)) for v in session.state)
+        target = session.rules.target
+        left = (self.config.total_steps - min(session.steps, self.config.total_steps)) / self.config.total_steps
+        return reach_observations_v1(self.config.arm, q1, q2, w1, w2, np.array((session.muscles.activation,)),
+                                     np.array((target.x,)), np.array((target.y,)), np.array((left,)))[0]

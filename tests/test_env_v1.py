@@ -1,0 +1,412 @@
+"""The v1 envs: checkers, observations that are the session's, the dense reward's formula, vector == single
+under reset masks and every autoreset mode, CenterOut trials a random policy starts, and learnability."""
+
+import doctest
+import importlib.util
+import math
+import os
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env, data_equivalence
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+
+import armgame.env
+import armgame.env.center_out_v1
+import armgame.env.features
+import armgame.env.reach_v1
+import armgame.env.vector
+from armgame.env.base import EnvArgumentError
+from armgame.env.center_out_v1 import CenterOutVectorEnv
+from armgame.env.vector import ReachV1VectorEnv
+from armgame.lab.protocol import Block, Protocol
+
+REACH, CONTINUOUS = "armgame/Reach-v1", "armgame/ReachContinuous-v1"
+CENTER_OUT, CENTER_OUT_CONTINUOUS = "armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1"
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def example(name):
+    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize(("env_id", "kwargs"), [
+    (REACH, {}), (REACH, {"reset_key": True, "reward": "sparse"}), (CONTINUOUS, {}),
+    (CENTER_OUT, {}), (CENTER_OUT_CONTINUOUS, {"episode_trials": "block", "protocol": "rotation"}),
+    (CENTER_OUT, {"trial_start": "hold", "reward": "sparse", "time_cost": 0.1})])
+def test_gymnasiums_checker_passes_on_every_v1_env(env_id, kwargs):
+    env = gym.make(env_id, **kwargs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped)
+    assert env.observation_space.dtype == np.float32
+    if env.unwrapped.continuous:
+        assert env.action_space == gym.spaces.Box(-1.0, 1.0, env.action_space.shape, np.float32)
+    env.close()
+
+
+def test_the_v1_ids_and_their_vector_entry_points_are_registered():
+    assert set(armgame.env.V1_IDS + armgame.env.CENTER_OUT_V1_IDS) <= set(gym.registry)
+    assert isinstance(gym.make_vec(REACH, num_envs=2).unwrapped, ReachV1VectorEnv)
+    assert isinstance(gym.make_vec(CENTER_OUT, num_envs=2).unwrapped, CenterOutVectorEnv)
+
+
+@pytest.mark.parametrize("module", [armgame.env.features, armgame.env.reach_v1, armgame.env.center_out_v1,
+                                    armgame.env.vector])
+def test_the_docstrings_examples_run(module):
+    failed, attempted = doctest.testmod(module)
+    assert failed == 0 and attempted > 0
+
+
+def test_observations_are_the_sessions_hand_and_target():
+    env = gym.make(REACH, time_limit=2.0)
+    env.action_space.seed(3)
+    obs, _ = env.reset(seed=3)
+    session = env.unwrapped.session
+    arm = session.config.arm
+    for _ in range(100):
+        obs, *_ = env.step(env.action_space.sample())
+        q1, q2, w1, w2 = session.state
+        hx, hy = session.hand()
+        # The hand's velocity by finite differences of the session's own hand, over a tiny step in time.
+        eps = 1e-7
+        ax = arm.l1 * math.cos(q1 + w1 * eps) + arm.l2 * math.cos(q1 + q2 + (w1 + w2) * eps)
+        ay = arm.l1 * math.sin(q1 + w1 * eps) + arm.l2 * math.sin(q1 + q2 + (w1 + w2) * eps)
+        target = session.rules.target
+        expected = [hx, hy, (ax - hx) / eps, (ay - hy) / eps, target.x - hx, target.y - hy]
+        assert np.allclose(obs[8:14], expected, rtol=1e-5, atol=2e-5)
+        assert obs[4:8].tolist() == pytest.approx(session.muscles.activation, abs=1e-7)
+        assert obs[14] == pytest.approx(session.time_left / 2.0, abs=1e-7)
+        assert obs in env.observation_space
+
+
+def test_observations_stay_within_their_bounds_at_full_effort():
+    env = gym.make(REACH, time_limit=4.0)
+    obs, _ = env.reset(seed=0)
+    speeds = []
+    for step in range(200):  # both flexors on: the arm swings to its fastest, then alternates
+        action = np.array([1, 0, 1, 0] if (step // 40) % 2 == 0 else [0, 1, 0, 1])
+        obs, *_ = env.step(action)
+        assert obs in env.observation_space
+        speeds.append(abs(obs[10:12]).max())
+    assert 0.5 < max(speeds) < env.observation_space.high[10]
+
+
+def game_return_by_formula(env_id, seed, steps, action_seed, **kwargs):
+    """The dense return summed step by step, and the formula's total from each target's starting
+    distance (float64, from the session), the last target's final distance, hits and resets."""
+    env = gym.make(env_id, **kwargs)
+    base = env.unwrapped
+    env.action_space.seed(action_seed)
+    env.reset(seed=seed)
+    session = base.session
+
+    def edge():
+        hx, hy = session.hand()
+        t = session.rules.target
+        return max(0.0, math.hypot(hx - t.x, hy - t.y) - t.radius)
+
+    starts, total, info = [edge()], 0.0, {}
+    for _ in range(steps):
+        action = env.action_space.sample()
+        if base.settings.reset_key:
+            action[4] = action[4] * (np.random.default_rng(len(starts) + _).random() < 0.03)
+        hits = session.rules.board.hits
+        _, reward, _, truncated, info = env.step(action)
+        total += reward
+        starts += [edge()] * (session.rules.board.hits - hits)
+        if truncated:
+            break
+    s = base.settings
+    formula = s.progress_weight * (sum(starts[:-1]) + starts[-1] - edge()) + s.hit_bonus * info["hits"] \
+        - base.config.reset_cost * info["resets"]
+    return total, formula, info
+
+
+@pytest.mark.parametrize(("env_id", "kwargs"), [(REACH, {}), (CONTINUOUS, {"reset_key": True}),
+                                               (REACH, {"progress_weight": 3.0, "hit_bonus": 0.5})])
+def test_the_dense_rewards_sum_over_a_game_is_its_formula(env_id, kwargs):
+    from armgame.env.policies import BotPolicy
+
+    # A bot hits targets (so the restart at each new target is exercised); random play moves away too.
+    env = gym.make("armgame/Reach-v0", time_limit=6.0)
+    policy, obs = BotPolicy("model", env), env.reset(seed=4)[0]
+    v1 = gym.make(REACH, time_limit=6.0, **{k: v for k, v in kwargs.items() if k != "reset_key"})
+    v1.reset(seed=4)
+    total, starts, session = 0.0, [v1.unwrapped._edge], v1.unwrapped.session
+    while True:
+        action = policy(obs)
+        obs, *_ = env.step(action)
+        hits = session.rules.board.hits
+        _, reward, _, truncated, info = v1.step(action)
+        total += reward
+        starts += [v1.unwrapped._edge] * (session.rules.board.hits - hits)
+        if truncated:
+            break
+    s = v1.unwrapped.settings
+    assert info["hits"] >= 3
+    assert total == pytest.approx(s.progress_weight * (sum(starts) - v1.unwrapped._edge) + s.hit_bonus * info["hits"],
+                                  abs=1e-9)
+    total, formula, info = game_return_by_formula(env_id, seed=8, steps=300, action_seed=1, time_limit=6.0, **kwargs)
+    assert total == pytest.approx(formula, abs=1e-9)
+    if kwargs.get("reset_key"):
+        assert info["resets"] >= 1
+
+
+def test_sparse_reward_is_one_per_hit():
+    env = gym.make(REACH, reward="sparse", time_limit=6.0)
+    from armgame.env.policies import BotPolicy
+
+    keys = gym.make("armgame/Reach-v0", time_limit=6.0)
+    policy = BotPolicy("model", keys)
+    obs, _ = keys.reset(seed=4)
+    env.reset(seed=4)
+    total = 0.0
+    for _ in range(300):
+        action = policy(obs)
+        obs, *_ = keys.step(action)
+        _, reward, _, _, info = env.step(action)
+        total += reward
+    assert total == info["hits"] == info["score"] >= 3
+
+
+def test_seeded_rollouts_repeat_bit_for_bit():
+    def rollout():
+        env = gym.make(CONTINUOUS, time_limit=1.0)
+        env.action_space.seed(5)
+        out = [env.reset(seed=5)[0].tobytes()]
+        for _ in range(60):
+            obs, reward, _, truncated, info = env.step(env.action_space.sample())
+            out.append((obs.tobytes(), reward, truncated, tuple(info.items())))
+            if truncated:
+                out.append(env.reset()[0].tobytes())
+        return out
+
+    assert rollout() == rollout()
+
+
+def test_bad_v1_arguments_are_refused_in_one_line():
+    for kwargs in ({"reward": "shaped"}, {"progress_weight": -1.0}, {"hit_bonus": True}):
+        with pytest.raises(EnvArgumentError, match=next(iter(kwargs))):
+            gym.make(REACH, **kwargs)
+    for kwargs in ({"trial_start": "now"}, {"episode_trials": 0}, {"episode_trials": "run"}):
+        with pytest.raises(EnvArgumentError, match=next(iter(kwargs))):
+            gym.make(CENTER_OUT, **kwargs)
+    center_out = gym.make(CENTER_OUT)
+    with pytest.raises(EnvArgumentError, match="jointspace"):  # its cursor would leave the bounded space
+        center_out.reset(seed=0, options={"protocol": "jointspace"})
+    center_out.reset(seed=0, options={"protocol": "rotation"})  # a rotated cursor stays within bounds
+    assert gym.make(CENTER_OUT, protocol="jointspace").observation_space.high[8] == np.inf
+    env = gym.make(CONTINUOUS)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"\[-1, 1\]"):
+        env.step(np.full(4, np.nan))
+
+
+# ------------------------------------------------------------------ vector == single
+def same_step(a, b, exact_obs):
+    (oa, ra, ta, ua, ia), (ob, rb, tb, ub, ib) = a, b
+    if exact_obs:
+        assert data_equivalence(oa, ob, exact=True)
+    else:  # the batch's fast kernel rounds differently (STATE_TOLERANCE); float32 rounds on top
+        assert np.abs(oa - ob).max() <= 1e-5
+    assert np.allclose(ra, rb, rtol=0, atol=1e-9) and ta.tolist() == tb.tolist() and ua.tolist() == ub.tolist()
+    finals = {k for k in ia if "final_obs" in k}
+    rest = {k: v for k, v in ia.items() if k not in finals}
+    assert data_equivalence(rest, {k: v for k, v in ib.items() if k not in finals}, exact=True), (ia, ib)
+    if "final_obs" in ia:
+        assert ia["_final_obs"].tolist() == ib["_final_obs"].tolist()
+        for x, y in zip(ia["final_obs"], ib["final_obs"], strict=True):
+            assert (x is None) == (y is None) and (x is None or np.abs(x - y).max() <= 1e-5)
+
+
+@pytest.mark.parametrize("mode", list(AutoresetMode))
+@pytest.mark.parametrize("env_id", [REACH, CONTINUOUS, "armgame/Reach-v0"])
+def test_the_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, mode):
+    n, rng = 4, np.random.default_rng(7)
+    kwargs = {"time_limit": 0.3, "decision_steps": 4}  # 19 steps a game, the last one of 3 physics steps
+    native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode,
+                          **kwargs)
+    singles = SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(n)], autoreset_mode=mode)
+    assert native.metadata["autoreset_mode"] is mode
+    native.action_space.seed(1)
+    a, b = native.reset(seed=11), singles.reset(seed=11)
+    # v0's float64 observation is the single env's bit for bit where the batch runs the exact numpy kernel.
+    exact = env_id.endswith("v0") and native.unwrapped.parts[0][1].compiled is None
+    assert data_equivalence(a, b, exact=True)
+    resets = ended = 0
+    for step in range(90):
+        if step % 13 == 6 or (mode is AutoresetMode.DISABLED and singles._autoreset_envs.any()):
+            mask = rng.random(n) < 0.5
+            if mode is AutoresetMode.DISABLED:
+                mask |= singles._autoreset_envs
+            if mask.any():
+                seed = [int(s) if rng.random() < 0.5 else None for s in rng.integers(0, 1000, n)]
+                ra = native.reset(seed=seed, options={"reset_mask": mask})
+                rb = singles.reset(seed=seed, options={"reset_mask": mask})
+                assert data_equivalence(ra[1], rb[1], exact=True)
+                assert np.abs(ra[0] - rb[0]).max() <= 1e-5
+                resets += 1
+        actions = native.action_space.sample()
+        a, b = native.step(actions), singles.step(actions)
+        same_step(a, b, exact)
+        ended += int(a[3].sum())
+    assert resets >= 7 and ended >= 4
+
+
+def test_a_reset_mask_is_checked_as_gymnasium_checks_it():
+    envs = ReachV1VectorEnv(3)
+    with pytest.raises(EnvArgumentError, match="first reset"):
+        envs.reset(options={"reset_mask": np.array([True, False, False])})
+    envs.reset(seed=0)
+    for mask in ([True, False, True], np.array([1, 0, 1]), np.zeros(3, dtype=bool), np.ones(2, dtype=bool)):
+        with pytest.raises(EnvArgumentError, match="reset_mask"):
+            envs.reset(options={"reset_mask": mask})
+    with pytest.raises(EnvArgumentError, match="unknown reset option"):
+        envs.reset(options={"protocol": "curl"})
+
+
+def test_disabled_autoreset_asks_for_a_masked_reset():
+    envs = ReachV1VectorEnv(2, time_limit=0.1, autoreset_mode="Disabled")
+    envs.reset(seed=0)
+    for _ in range(5):
+        *_, truncated, _ = envs.step(np.zeros((2, 4)))
+    assert truncated.all()
+    with pytest.raises(gym.error.ResetNeeded, match="reset_mask"):
+        envs.step(np.zeros((2, 4)))
+    envs.reset(options={"reset_mask": np.array([True, True])})
+    envs.step(np.zeros((2, 4)))
+
+
+def test_the_vector_env_renders_each_games_frame_as_the_single_env_does():
+    envs = gym.make_vec("armgame/Reach-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                        render_mode="rgb_array", render_size=(120, 90))
+    singles = SyncVectorEnv([lambda: gym.make("armgame/Reach-v0", render_mode="rgb_array", render_size=(120, 90))
+                             for _ in range(2)])
+    envs.reset(seed=3)
+    singles.reset(seed=3)
+    for _ in range(10):
+        actions = np.array([[1, 0, 1, 0], [0, 1, 0, 0]])
+        envs.step(actions)
+        singles.step(actions)
+    frames, expected = envs.render(), singles.render()
+    assert len(frames) == 2 and frames[0].shape == (90, 120, 3)
+    assert all(np.array_equal(f, g) for f, g in zip(frames, expected, strict=True))
+    assert not np.array_equal(frames[0], frames[1])  # two games, two pictures
+    envs.close()
+
+
+# ------------------------------------------------------------------ CenterOut-v1
+def test_a_random_policy_starts_center_out_trials_and_episodes_end_after_their_trials():
+    env = gym.make(CENTER_OUT)
+    env.action_space.seed(0)
+    obs, info = env.reset(seed=2)
+    trials, episodes, reaches, steps = [], 0, [], 0
+    while episodes < 2:
+        obs, _, terminated, truncated, info = env.step(env.action_space.sample())
+        steps += 1
+        assert obs in env.observation_space and not truncated
+        reaches += info.get("reaches", [])
+        if terminated:
+            episodes += 1
+            trials.append(info["trial"])
+            obs, info = env.reset()  # the same run goes on at its next trial
+            assert info["trial"] == trials[-1] and obs[14] == 0.0
+    assert trials == [8, 16] and len(reaches) == 16
+    assert steps < 16 * (1.0 + 3.0 + 0.1) / 0.02  # each trial starts after its delay and ends by its time-out
+    assert env.unwrapped.session.config.seed == 2  # one run
+
+
+def test_block_episodes_follow_the_protocols_blocks():
+    protocol = Protocol("short", (Block("baseline", 2), Block("exposure", 3)))
+    env = gym.make(CENTER_OUT, protocol=protocol, episode_trials="block")
+    env.action_space.seed(1)
+    env.reset(seed=5)
+    blocks = []
+    for _ in range(3):
+        start, terminated = env.unwrapped.session.block.name, False
+        while not terminated:
+            *_, terminated, _, info = env.step(env.action_space.sample())
+        blocks.append((start, info["trials_done"]))
+        env.reset()
+    # The run's last trial ends it: the third episode is a new run, drawn from the env's generator.
+    assert blocks == [("baseline", 2), ("exposure", 5), ("baseline", 2)]
+    assert env.unwrapped.session.config.seed != 5
+
+
+def test_center_out_dense_reward_is_progress_toward_the_shown_target():
+    env = gym.make(CENTER_OUT, time_cost=0.5)
+    base = env.unwrapped
+    env.reset(seed=4)
+    session = base.session
+    total, starts, action = 0.0, [], np.array([0, 0, 0, 0])
+    for step in range(400):
+        shown = (session.trial_index, session.phase)
+        edge = base._edge
+        _, reward, *_ = env.step(np.array([1, 0, 0, 1]) if step % 50 < 10 else action)
+        hits_bonus = sum(r["hit"] for r in _[-1].get("reaches", []))
+        expected = (10.0 * (edge - base._edge) if (session.trial_index, session.phase) == shown else 0.0) \
+            + hits_bonus - 0.5 * 0.02
+        assert reward == pytest.approx(expected, abs=1e-12)
+        total += reward
+        starts.append(shown)
+    assert len(set(starts)) >= 4  # go cues and trial ends were crossed
+
+
+def test_the_center_out_vector_env_is_sync_vector_env_of_v1_envs():
+    envs = gym.make_vec(CENTER_OUT_CONTINUOUS, num_envs=3, autoreset_mode="SameStep", episode_trials=1)
+    singles = SyncVectorEnv([lambda: gym.make(CENTER_OUT_CONTINUOUS, episode_trials=1) for _ in range(3)],
+                            autoreset_mode="SameStep")
+    envs.action_space.seed(0)
+    a, b = envs.reset(seed=9), singles.reset(seed=9)
+    assert data_equivalence(a, b, exact=True)
+    ended = 0
+    for _ in range(300):
+        actions = envs.action_space.sample()
+        a, b = envs.step(actions), singles.step(actions)
+        assert data_equivalence(a[:4], b[:4], exact=True)
+        assert repr(a[4]) == repr(b[4])  # a reach's measures hold NaN where they do not apply: NaN != NaN
+        ended += int(a[2].sum())
+    assert ended >= 3
+    with pytest.raises(EnvArgumentError):
+        gym.make_vec(CENTER_OUT, num_envs=2, autoreset_mode="Later")
+    with pytest.raises(EnvArgumentError, match="trial_start"):
+        gym.make_vec(CENTER_OUT, num_envs=2, trial_start="never")
+
+
+# ------------------------------------------------------------------ learnable
+def test_a_small_evolution_strategy_clearly_beats_random_play():
+    es = example("train_es")
+    policy, history = es.cem(generations=20, population=32, seconds=3.0, seed=0)
+    learned = es.hits_per_game(policy, games=8, seconds=20.0, seed=100)
+    random = es.hits_per_game(None, games=8, seconds=20.0, seed=100)
+    assert history[-1][1] > history[0][1]  # the population's return rose
+    assert learned.mean() >= 1.0 and learned.mean() >= 4 * random.mean(), (learned, random)
+
+
+def test_the_sb3_adapter_trains_ppo():
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    from armgame.env.sb3 import make_sb3_vec_env
+
+    sb3_check_env(gym.make(REACH).unwrapped, warn=True)
+    envs = make_sb3_vec_env(REACH, 4, seed=0, time_limit=0.2)
+    obs = envs.reset()
+    assert obs.shape == (4, 15)
+    dones = np.zeros(4, dtype=bool)
+    for _ in range(10):
+        obs, _, dones, infos = envs.step(np.ones((4, 4), dtype=np.int8))
+    assert dones.all() and all("terminal_observation" in i and i["TimeLimit.truncated"] for i in infos)
+    assert obs[:, 14].tolist() == [1.0] * 4  # the next games already began
+    PPO("MlpPolicy", envs, n_steps=16, batch_size=32, device="cpu").learn(64)
