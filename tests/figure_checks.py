@@ -18,7 +18,7 @@ def assert_reads_on_a_slide(fig) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     canvas = FigureCanvasAgg(fig)
-    canvas.draw()  # lays the figure out as savefig did
+    fig.draw_without_rendering()  # lays the figure out as savefig did (without painting the pixels again)
     renderer = canvas.get_renderer()
     page = fig.bbox
     panels = [ax for ax in fig.get_axes() if ax.axison]

@@ -3,10 +3,6 @@ integrator, the counters count, and ``armgame bench`` runs end to end."""
 
 import json
 import math
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,7 +13,6 @@ from armgame.physics import GAME_ARM, SCHEMES, TUTORIAL_ARM, Integrator, TwoJoin
 from armgame.physics.batch import BatchRK4
 from armgame.scenes import SCENES
 
-ROOT = Path(__file__).resolve().parent.parent
 ARMS = {
     "game": GAME_ARM,
     "tutorial": TUTORIAL_ARM,
@@ -130,16 +125,16 @@ def test_game_scene_is_deterministic_and_switches_on_the_bench_grid():
     assert game_torque_script() == game.torque_segments
 
 
-def test_bench_quick_json_runs_end_to_end(tmp_path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+def test_bench_quick_json_runs_end_to_end(tmp_path, monkeypatch, capsys, bench_slides):
+    """In-process (the subprocess proved only that Python starts): the real command, parser to JSON,
+    and its one-case figures (the smallest grid, two cells) read on a slide."""
+    from armgame.cli import main
+
+    monkeypatch.chdir(tmp_path)
     out = tmp_path / "out"
-    proc = subprocess.run(
-        [sys.executable, "-m", "armgame", "bench", "--quick", "--json", "--cases", "stiff",
-         "--integrators", "rk4,euler", "--out", str(out)],
-        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120,
-    )
-    assert proc.returncode == 0, proc.stderr
-    payload = json.loads(proc.stdout)
+    code = main(["bench", "--quick", "--json", "--cases", "stiff", "--integrators", "rk4,euler", "--out", str(out)])
+    assert code in (0, None)
+    payload = json.loads(capsys.readouterr().out)
     ours = [r for r in payload["rows"] if r["family"] == "armgame"]
     assert {r["method"] for r in ours} == {"rk4", "euler"}
     assert all(r["case"] == "stiff" for r in payload["rows"])
@@ -149,14 +144,20 @@ def test_bench_quick_json_runs_end_to_end(tmp_path):
     assert (out / "bench.csv").read_text().startswith("case,method,family")
     assert (out / "work_precision.png").stat().st_size > 0 and (out / "convergence.png").stat().st_size > 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # nothing else written, no MUJOCO_LOG.TXT
+    assert len(bench_slides) == 2
+    _assert_bench_slides(bench_slides, ["stiff"])
 
 
-def test_bench_refuses_an_unknown_case_in_one_line(tmp_path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    proc = subprocess.run([sys.executable, "-m", "armgame", "bench", "--cases", "nope"], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=60)
-    assert proc.returncode == 2
-    assert "unknown case 'nope'" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+def test_bench_refuses_an_unknown_case_in_one_line(tmp_path, monkeypatch, capsys):
+    from armgame.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:  # argparse's own exit, as `armgame bench --cases nope` gives
+        main(["bench", "--cases", "nope"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "unknown case 'nope'" in err and len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
 
 
 # ------------------------------------------------------------------- figures and the printed report
@@ -193,28 +194,36 @@ def bench_slides(monkeypatch):
     return captured
 
 
-@pytest.mark.parametrize("cases", [5, 1])
-def test_bench_figures_read_on_a_slide(cases, tmp_path, bench_slides):
+def _assert_bench_slides(slides, cases):
     from figure_checks import assert_reads_on_a_slide
 
-    from armgame.bench import figures
-
-    rows = [r for r in _synthetic_rows() if r.case in ("passive", "propeller", "upright", "stiff", "game")[:cases]]
-    figures.work_precision(rows, tmp_path / "wp.png")
-    figures.convergence(rows, tmp_path / "conv.png")
-    assert (tmp_path / "wp.png").stat().st_size > 0 and (tmp_path / "conv.png").stat().st_size > 0
-    for fig in bench_slides:
+    for fig in slides:
         assert_reads_on_a_slide(fig)
         panels = [ax for ax in fig.get_axes() if ax.axison]
-        assert [ax.get_title() for ax in panels] == list(dict.fromkeys(r.case for r in rows))
+        assert [ax.get_title() for ax in panels] == cases
         assert len(fig.get_axes()) == len(panels) + 1  # and one cell for the legend
         colours = {}  # a method keeps its colour in every panel
         for ax in panels:
             for line in ax.get_lines():
                 if not line.get_label().startswith("_"):
                     assert colours.setdefault(line.get_label(), line.get_color()) == line.get_color()
-    legend = [t.get_text() for ax in bench_slides[1].get_axes() if ax.get_legend() for t in ax.get_legend().texts]
+    legend = [t.get_text() for ax in slides[1].get_axes() if ax.get_legend() for t in ax.get_legend().texts]
     assert legend[-3:] == ["slope 1 (reference)", "slope 2 (reference)", "slope 4 (reference)"]
+
+
+def test_bench_figures_read_on_a_slide(tmp_path, monkeypatch):
+    """The fullest grid, five cases and every method, laid out as saving lays it out (not painted
+    into a PNG: test_bench_quick_json_runs_end_to_end saves a real run's one-case figures and checks
+    them on a slide too)."""
+    from armgame.bench import figures
+
+    slides = []
+    monkeypatch.setattr(figures, "save", lambda fig, path: slides.append(fig))
+    rows = _synthetic_rows()
+    figures.work_precision(rows, tmp_path / "wp.png")
+    figures.convergence(rows, tmp_path / "conv.png")
+    assert len(slides) == 2
+    _assert_bench_slides(slides, ["passive", "propeller", "upright", "stiff", "game"])
 
 
 def test_the_slide_check_catches_a_legend_on_the_data_and_overlapping_labels():

@@ -1,10 +1,13 @@
 """The README and docs/ say what is true: every shell example runs as printed or parses, links resolve.
 
 Each fenced block's info string says what it needs (docs/development.md, "The docs are tested"):
-``sh run`` blocks run in order, one temporary folder per file, through bash with the installed
-``armgame``; ``text file=NAME`` / ``toml file=NAME`` blocks are written there first; ``python run``
-blocks run with this Python; ``sh window``, ``sh setup`` and ``sh long`` blocks are not run, but every
-``armgame`` command in them must parse with the real parser.
+``sh run`` blocks run in order, one temporary folder per file: a line that is one plain ``armgame``
+command through ``armgame.cli.main`` in this process (what the installed console script calls, without
+a new Python per line), every other line through bash, a block with shell state across its lines
+(a loop over lines, a variable, ``cd``) through one bash; ``text file=NAME`` / ``toml file=NAME``
+blocks are written there first; ``python run`` blocks run with this Python; ``sh window``, ``sh setup``
+and ``sh long`` blocks are not run, but every ``armgame`` command in them must parse with the real
+parser.
 """
 
 from __future__ import annotations
@@ -149,10 +152,64 @@ def _isolated_env(home: Path) -> dict[str, str]:
 RUNNABLE = [p for p in DOCS if any(b.tags[:1] == ("run",) for b in blocks(p))]
 
 
+#: A line with any of these runs through bash: pipes, lists, redirections, expansions, globs, loops.
+SHELL_SYNTAX = re.compile(r"[|&;<>()$`*?\[\]{}~=!]|^\s*(for|if|while|time|cd|export)\b")
+
+
+def _plain_armgame_line(line: str) -> list[str] | None:
+    """The argv of a line that is one plain ``armgame`` command (words and quotes, no shell syntax
+    outside a trailing comment), else None: that line runs in bash."""
+    try:
+        words = shlex.split(line, comments=True)
+    except ValueError:
+        return None
+    if not words or words[0] != "armgame":
+        return None
+    code = shlex.join(words)
+    return words[1:] if not SHELL_SYNTAX.search(code) else None
+
+
+#: A block with any of these keeps one shell for all its lines: a compound command over several
+#: lines, a here-document, a variable, a function or a change of folder that later lines rely on.
+ONE_SHELL = re.compile(r"^\s*(for|while|until|if|case|select)\b(?!.*\b(done|fi|esac)\b)|<<|^\s*\w+=|"
+                       r"^\s*(cd|export|source|\.|function|alias|set|pushd|popd)\b|[{(]\s*$")
+
+
+def _run_in_process(argv: list[str], where: str, work: Path, env: dict[str, str], monkeypatch, capfd) -> None:
+    """``armgame ARGV`` as ``armgame.cli.main`` runs it for the console script, in this process: the
+    same parser, commands and exit code, without starting a Python (and numpy) for every line."""
+    from armgame.cli import main
+
+    with monkeypatch.context() as patch:
+        for name in [k for k in os.environ if k not in env]:
+            patch.delenv(name)
+        for name, value in env.items():
+            patch.setenv(name, value)
+        patch.chdir(work)
+        patch.setattr(sys, "argv", ["armgame", *argv])
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse's errors and --help
+            code = exc.code if isinstance(exc.code, int) else 1
+    out, err = capfd.readouterr()
+    assert not code, f"{where}: 'armgame {shlex.join(argv)}' failed (exit {code}):\n{out[-2000:]}\n{err[-2000:]}"
+    assert "Traceback" not in err, f"{where}:\n{err[-2000:]}"
+
+
+def _run_in_bash(script: str, where: str, work: Path, env: dict[str, str], python: bool = False) -> None:
+    argv = [sys.executable, "-c", script] if python else ["bash", "-e", "-o", "pipefail", "-c", script]
+    proc = subprocess.run(argv, cwd=work, env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, (
+        f"{where} failed (exit {proc.returncode}):\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
+    assert "Traceback" not in proc.stderr, f"{where}:\n{proc.stderr[-2000:]}"
+
+
 @pytest.mark.skipif(shutil.which("bash") is None, reason="the examples are POSIX shell")
 @pytest.mark.parametrize("path", RUNNABLE, ids=lambda p: p.name)
-def test_runnable_examples_run_as_printed(path, tmp_path):
-    """A file's ``run`` blocks, in order, in one folder, as a user would type them."""
+def test_runnable_examples_run_as_printed(path, tmp_path, monkeypatch, capfd):
+    """A file's ``run`` blocks, in order, in one folder, as a user would type them: each line that is
+    one plain ``armgame`` command through ``armgame.cli.main`` (what the console script calls), in
+    this process; every other line (pipes, loops, mkdir, head) through bash as printed."""
     if shutil.which("armgame", path=str(Path(sys.executable).parent)) is None:
         pytest.skip("armgame is not installed beside this Python (pip install -e '.[test]')")
     home = tmp_path / "home"
@@ -167,15 +224,43 @@ def test_runnable_examples_run_as_printed(path, tmp_path):
         if block.tags[:1] != ("run",):
             continue
         if block.language == "python":
-            argv = [sys.executable, "-c", block.text]
-        else:
-            assert block.language == "sh", block.where
-            argv = ["bash", "-e", "-o", "pipefail", "-c", block.text]
-        proc = subprocess.run(argv, cwd=work, env=env, capture_output=True, text=True, timeout=120)
-        assert proc.returncode == 0, (
-            f"{block.where} failed (exit {proc.returncode}):\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}")
-        assert "Traceback" not in proc.stderr, f"{block.where}:\n{proc.stderr[-2000:]}"
+            _run_in_bash(block.text, block.where, work, env, python=True)
+            continue
+        assert block.language == "sh", block.where
+        lines = commands(block)
+        if any(ONE_SHELL.search(line) for line in lines):
+            _run_in_bash(block.text, block.where, work, env)
+            continue
+        for line in lines:
+            argv = _plain_armgame_line(line)
+            if argv is None:
+                _run_in_bash(line, block.where, work, env)
+            else:
+                _run_in_process(argv, block.where, work, env, monkeypatch, capfd)
     assert sorted((ROOT / "scores").iterdir()) == checkout_table  # examples never touch the checkout's table
+
+
+def test_plain_armgame_lines_are_told_from_shell_syntax():
+    assert _plain_armgame_line('armgame lab a.toml --name "Bot 1"   # a comment') == ["lab", "a.toml", "--name",
+                                                                                     "Bot 1"]
+    assert _plain_armgame_line("armgame simulate --initial=-60,0") is None  # '=' and the rest: bash decides
+    for line in ("armgame play --json | head -1", "armgame verify a && armgame verify b", "armgame verify *.json",
+                 "armgame scores > out.txt", "mkdir x", "for f in a; do armgame verify $f; done",
+                 "time armgame play --headless", "armgame play --name ~me"):
+        assert _plain_armgame_line(line) is None, line
+    for line in ("for f in a b; do", "if true; then", "X=1", "cd folder", "cat <<EOF", "run() {"):
+        assert ONE_SHELL.search(line), line
+    for line in ("for f in a/*.json; do armgame verify \"$f\"; done", "armgame play --headless", "mkdir -p a b"):
+        assert not ONE_SHELL.search(line), line
+
+
+def test_an_armgame_line_that_fails_fails_the_example(tmp_path, monkeypatch, capfd):
+    env = _isolated_env(tmp_path / "home")
+    with pytest.raises(AssertionError, match="exit 2"):
+        _run_in_process(["verify", "missing.json"], "here", tmp_path, env, monkeypatch, capfd)
+    with pytest.raises(AssertionError, match="exit 2"):
+        _run_in_process(["play", "--no-such-option"], "here", tmp_path, env, monkeypatch, capfd)
+    _run_in_process(["--version"], "here", tmp_path, env, monkeypatch, capfd)
 
 
 LINK = re.compile(r"\[[^\]]*\]\(([^)\s]+)\)")
