@@ -410,3 +410,21 @@ def test_the_sb3_adapter_trains_ppo():
     assert dones.all() and all("terminal_observation" in i and i["TimeLimit.truncated"] for i in infos)
     assert obs[:, 14].tolist() == [1.0] * 4  # the next games already began
     PPO("MlpPolicy", envs, n_steps=16, batch_size=32, device="cpu").learn(64)
+
+
+@pytest.mark.parametrize("env_id", [REACH, CONTINUOUS, CENTER_OUT])
+def test_float64_observations_on_request_are_the_float32_ones_unrounded(env_id):
+    wide, narrow = gym.make(env_id, observation_dtype="float64"), gym.make(env_id)
+    assert wide.observation_space.dtype == np.float64 and narrow.observation_space.dtype == np.float32
+    wide.action_space.seed(2)
+    a, b = wide.reset(seed=2)[0], narrow.reset(seed=2)[0]
+    for _ in range(50):
+        action = wide.action_space.sample()
+        a, b = wide.step(action)[0], narrow.step(action)[0]
+        assert a.dtype == np.float64 and a in wide.observation_space
+        assert a.astype(np.float32).tobytes() == b.tobytes()
+    if env_id != CENTER_OUT:
+        envs = gym.make_vec(env_id, num_envs=2, observation_dtype=np.float64)
+        assert envs.reset(seed=0)[0].dtype == np.float64
+    with pytest.raises(EnvArgumentError, match="observation_dtype"):
+        gym.make(env_id, observation_dtype="float16")

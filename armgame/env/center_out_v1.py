@@ -24,7 +24,7 @@ from ..lab.protocol import Protocol
 from ..lab.session import REACH, lab_config
 from .base import EnvArgumentError
 from .center_out import MAX_RUN_SECONDS, CenterOutEnv
-from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_reward, hand_and_velocity
+from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_dtype, check_reward, hand_and_velocity
 from .reach import DEFAULT_DECISION_STEPS, speed_bound, wrap_angle
 from .vector_common import AutoresetBook
 
@@ -132,8 +132,9 @@ class CenterOutV1Env(CenterOutEnv):
     * ``protocol``, ``perturbation``, ``decision_steps``, ``render_mode``, ``render_size``: as v0.
     * ``trial_start``: ``"delay"`` (default) or ``"hold"`` (the lab's rule for people).
     * ``episode_trials``: trials per episode, 1 to 2000, or ``"block"`` (default 8).
-    * ``reward`` (``"dense"`` or ``"sparse"``), ``progress_weight``, ``hit_bonus``: as
-      ``armgame/Reach-v1``; ``time_cost``: reward lost per second, 0 to 10 (default 0).
+    * ``reward`` (``"dense"`` or ``"sparse"``), ``progress_weight``, ``hit_bonus``,
+      ``observation_dtype`` (``"float32"`` or ``"float64"``): as ``armgame/Reach-v1``; ``time_cost``:
+      reward lost per second, 0 to 10 (default 0).
 
     ## Version History
 
@@ -150,7 +151,8 @@ class CenterOutV1Env(CenterOutEnv):
                  continuous: bool = False, trial_start: str = "delay",
                  episode_trials: int | str = DEFAULT_EPISODE_TRIALS, reward: str = "dense",
                  progress_weight: float = DEFAULT_PROGRESS_WEIGHT, hit_bonus: float = DEFAULT_HIT_BONUS,
-                 time_cost: float = 0.0, render_size: tuple[int, int] = (600, 600)) -> None:
+                 time_cost: float = 0.0, observation_dtype: str = "float32",
+                 render_size: tuple[int, int] = (600, 600)) -> None:
         super().__init__(render_mode, protocol=protocol, perturbation=perturbation, decision_steps=decision_steps,
                          continuous=continuous, time_cost=time_cost, render_size=render_size)
         if trial_start not in TRIAL_STARTS:
@@ -167,7 +169,8 @@ class CenterOutV1Env(CenterOutEnv):
         if self.continuous:
             self.action_space = spaces.Box(-1.0, 1.0, (4,), np.float32)
         low, high = observation_bounds_v1(self.protocol, trial_start)
-        self.observation_space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
+        self.observation_dtype = dtype = np.dtype(check_dtype(observation_dtype))
+        self.observation_space = spaces.Box(low.astype(dtype), high.astype(dtype), dtype=dtype)
         self._first_trial = 0
         self._first_block = 0
         self._edge = 0.0
@@ -225,7 +228,7 @@ class CenterOutV1Env(CenterOutEnv):
         (cx, cy), (hx, hy) = s.cursor, s.home
         return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *s.muscles.activation, cx - hx, cy - hy, vx, vy,
                          target.x - cx, target.y - cy, 1.0 if s.phase == REACH else 0.0,
-                         (s.steps - s.phase_start_step) * s.config.dt), dtype=np.float32)
+                         (s.steps - s.phase_start_step) * s.config.dt), dtype=self.observation_dtype)
 
     def _info(self) -> dict[str, Any]:
         s = self.session

@@ -87,6 +87,19 @@ def muscle_levels(action: np.ndarray, centred: bool) -> np.ndarray:
     return np.clip(action, 0.0, 1.0)
 
 
+OBSERVATION_DTYPES = ("float32", "float64")
+
+
+def check_dtype(value: object) -> str:
+    """``observation_dtype``: float32 (the default: what networks take) or float64 (the game's state exactly)."""
+    from .base import EnvArgumentError
+
+    name = np.dtype(value).name if isinstance(value, type) and issubclass(value, np.floating) else value
+    if name not in OBSERVATION_DTYPES:
+        raise EnvArgumentError(f"observation_dtype must be 'float32' or 'float64', got {value!r}")
+    return str(name)
+
+
 def check_reward(reward: object, progress_weight: object, hit_bonus: object) -> tuple[str, float, float]:
     """The reward arguments of a v1 env, checked: one line naming a bad one."""
     from .base import EnvArgumentError
@@ -121,11 +134,11 @@ def wrap_angles(q: np.ndarray) -> np.ndarray:
 
 def reach_observations_v1(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray, w2: np.ndarray,
                           activation: np.ndarray, target_x: np.ndarray, target_y: np.ndarray,
-                          time_left_fraction: np.ndarray) -> np.ndarray:
-    """Reach-v1 observations, one row per game (float32); ``activation`` is (n, 4)."""
+                          time_left_fraction: np.ndarray, dtype: str = "float32") -> np.ndarray:
+    """Reach-v1 observations, one row per game; ``activation`` is (n, 4)."""
     hx, hy = hand_position(arm, q1, q2)
     vx, vy = hand_velocity(arm, q1, q2, w1, w2)
-    obs = np.empty((len(q1), 15), dtype=np.float32)
+    obs = np.empty((len(q1), 15), dtype=dtype)
     obs[:, 0] = wrap_angles(q1)
     obs[:, 1] = wrap_angles(q2)
     obs[:, 2] = w1

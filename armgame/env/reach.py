@@ -21,7 +21,7 @@ from ..errors import UserError
 from ..game.rules import GameConfig
 from ..game.session import GameSession
 from .base import EnvArgumentError, SessionEnv
-from .features import check_reward, reach_bounds_v1
+from .features import check_dtype, check_reward, reach_bounds_v1
 
 #: Decision step of the standard envs in physics steps: 5 x 4 ms = 20 ms, a 50 Hz controller.
 DEFAULT_DECISION_STEPS = 5
@@ -44,11 +44,12 @@ class ReachSettings:
     reward: str = "sparse"
     progress_weight: float = 0.0
     hit_bonus: float = 1.0
+    observation_dtype: str = "float64"
 
     @classmethod
     def of(cls, config: GameConfig | None, time_limit: float | None, decision_steps: int, continuous: bool,
            reset_key: bool, version: int = 0, reward: str = "sparse", progress_weight: float = 0.0,
-           hit_bonus: float = 1.0) -> ReachSettings:
+           hit_bonus: float = 1.0, observation_dtype: object = "float32") -> ReachSettings:
         if config is None:
             config = GameConfig()
         elif not isinstance(config, GameConfig):
@@ -71,7 +72,7 @@ class ReachSettings:
             return cls(config, int(decision_steps), bool(continuous), bool(reset_key))
         reward, progress_weight, hit_bonus = check_reward(reward, progress_weight, hit_bonus)
         return cls(config, int(decision_steps), bool(continuous), bool(reset_key), 1, reward, progress_weight,
-                   hit_bonus)
+                   hit_bonus, check_dtype(observation_dtype))
 
     @property
     def decision_time(self) -> float:
@@ -100,7 +101,8 @@ class ReachSettings:
     def observation_space(self) -> spaces.Box:
         if self.version:
             low, high = reach_bounds_v1(self.config, speed_bound(self.config))
-            return spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
+            dtype = np.dtype(self.observation_dtype)
+            return spaces.Box(low.astype(dtype), high.astype(dtype), dtype=dtype)
         low, high = observation_bounds(self.config)
         return spaces.Box(low, high, dtype=np.float64)
 

@@ -98,6 +98,8 @@ class ReachV1Env(ReachEnv):
 
     ```
 
+    * ``observation_dtype``: ``"float32"`` (default) or ``"float64"`` (the game's state exactly, for
+      a controller that models the arm; the bounds are the same).
     * ``reward``: ``"dense"`` (default) or ``"sparse"``; ``progress_weight`` (0 to 1000 per metre,
       default 10) and ``hit_bonus`` (0 to 1000, default 1) weigh the dense one.
     * ``time_limit``, ``decision_steps`` (default 5: a 20 ms step), ``reset_key``, ``config``,
@@ -114,10 +116,10 @@ class ReachV1Env(ReachEnv):
     def __init__(self, render_mode: str | None = None, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
-                 hit_bonus: float = DEFAULT_HIT_BONUS, config: GameConfig | None = None,
-                 render_size: tuple[int, int] = (600, 600)) -> None:
+                 hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
+                 config: GameConfig | None = None, render_size: tuple[int, int] = (600, 600)) -> None:
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
-                                    progress_weight, hit_bonus)
+                                    progress_weight, hit_bonus, observation_dtype)
         self._configure(settings, render_mode, render_size)
         self._edge = 0.0
 
@@ -154,4 +156,4 @@ class ReachV1Env(ReachEnv):
         total = self.config.total_steps
         left = (total - min(session.steps, total)) / total
         return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *session.muscles.activation, hx, hy, vx, vy,
-                         target.x - hx, target.y - hy, left), dtype=np.float32)
+                         target.x - hx, target.y - hy, left), dtype=self.settings.observation_dtype)

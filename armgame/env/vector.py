@@ -345,11 +345,12 @@ class ReachV1VectorEnv(ReachVectorEnv):
     def __init__(self, num_envs: int = 1, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
-                 hit_bonus: float = DEFAULT_HIT_BONUS, config: GameConfig | None = None,
-                 render_mode: str | None = None, render_size: tuple[int, int] = (600, 600),
+                 hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
+                 config: GameConfig | None = None, render_mode: str | None = None,
+                 render_size: tuple[int, int] = (600, 600),
                  autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
-                                    progress_weight, hit_bonus)
+                                    progress_weight, hit_bonus, observation_dtype)
         self._configure(num_envs, settings, render_mode, render_size, autoreset_mode)
         self._edges = np.zeros(self.num_envs)
 
@@ -371,9 +372,10 @@ class ReachV1VectorEnv(ReachVectorEnv):
         return s.progress_weight * progress + s.hit_bonus * hits - self.config.reset_cost * resets
 
     def _observations(self) -> np.ndarray:
-        obs = np.empty((self.num_envs, 15), dtype=np.float32)
+        dtype = self.settings.observation_dtype
+        obs = np.empty((self.num_envs, 15), dtype=dtype)
         for part, batch in self.parts:
             left = (batch.total_steps - np.minimum(batch.steps, batch.total_steps)) / batch.total_steps
             obs[part] = reach_observations_v1(self.config.arm, batch.q1, batch.q2, batch.w1, batch.w2,
-                                              batch.activation, batch.target_x, batch.target_y, left)
+                                              batch.activation, batch.target_x, batch.target_y, left, dtype)
         return obs
