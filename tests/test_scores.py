@@ -378,3 +378,81 @@ def test_keys_mashed_as_the_clock_ends_are_not_typed_and_esc_saves_nothing(finis
 def test_no_prompt_when_the_name_is_known(finished_window):
     window = finished_window(ask_name=False)
     assert window.name_entry is None
+
+
+def _entry_by_the_generic_checks(data: object) -> ScoreEntry:
+    """What ``ScoreEntry.from_dict`` did before it was written out field by field: the reference its
+    fast paths must agree with, value for value and first error for first error."""
+    from armgame.records.replay import DRIVEN, check_date, check_name, check_word
+    from armgame.records.storage import check_float, check_int, check_keys, check_str
+
+    m, big = scores_module._match, 10**9
+    d = check_keys("entry", data, scores_module._REQUIRED, scores_module._OPTIONAL)
+    driven = check_str("driven", d["driven"], 20)
+    if driven not in DRIVEN:
+        raise ValueError(f"driven must be one of {', '.join(DRIVEN)}, got {driven!r}")
+    h32, h64 = scores_module._HEX32, scores_module._HEX64
+    ruleset, digest, game, entered, entered_at, complete = (
+        d.get(k) for k in ("ruleset", "config_sha256", "game_sha256", "entered", "entered_at", "complete"))
+    entry = ScoreEntry(
+        id=m("id", d["id"], h32), name=check_name(d["name"]), driven=driven,
+        driver=None if d["driver"] is None else check_str("driver", d["driver"], 200),
+        score=check_int("score", d["score"], 0, big), hits=check_int("hits", d["hits"], 0, big),
+        resets=check_int("resets", d["resets"], 0, big), seed=check_int("seed", d["seed"], 0, 2**63 - 1),
+        scene=check_word("scene", d["scene"]),
+        duration=check_float("duration", d["duration"], 0.0, 86400.0, low_open=True),
+        date=check_date("date", d["date"]), version=check_word("version", d["version"]),
+        replay=m("replay", d["replay"], scores_module._REPLAY_FILE),
+        replay_sha256=m("replay_sha256", d["replay_sha256"], h64),
+        ruleset=None if ruleset is None else check_word("ruleset", ruleset),
+        config_sha256=None if digest is None else m("config_sha256", digest, h64),
+        game_sha256=None if game is None else m("game_sha256", game, h64),
+        entered=None if entered is None else check_int("entered", entered, 1, big),
+        entered_at=None if entered_at is None else check_date("entered_at", entered_at),
+        complete=None if complete is None else scores_module._bool("complete", complete),
+    )
+    if (entry.ruleset is None) != (entry.config_sha256 is None):
+        raise ValueError("ruleset and config_sha256 come together")
+    if entry.score > entry.hits:
+        raise ValueError(f"score {entry.score} is more than the hits {entry.hits}")
+    if entry.name != d["name"]:
+        raise ValueError(f"name {d['name']!r} has surrounding spaces")
+    return entry
+
+
+class _Text(str):
+    pass
+
+
+def test_entry_checks_written_out_agree_with_the_generic_checks():
+    words = ["game", "", " game", "game ", "a" * 40, "a" * 41, "g\u00e9", "x\ny", "\u00e9t\u00e9", _Text("game"),
+             "ok.1+2_-", "-a", 7, None, True, 1.5, ["game"]]
+    hexes = ["0" * 32, "0" * 64, "A" * 64, "0" * 63, "0" * 65, "g" * 64, "0" * 63 + "\n", _Text("0" * 64), 0, None]
+    numbers = [0, 1, -1, 10**9, 10**9 + 1, 2**63 - 1, 2**63, True, False, 1.0, 60.0, 86400.0, 86400.5, 0.0, -0.0,
+               1e-300, float("nan"), float("inf"), "9", None, 3]
+    values = {
+        "id": [*hexes, "0" * 31 + "g"],
+        "name": [*words, "a" * 39 + " ", " " * 3, "\u00a0ann", "ann\u00a0", "a" * 200],
+        "driven": ["keyboard", "script", "bot", "psychic", _Text("bot"), None, 1, "x" * 30, "bot\n"],
+        "driver": [*words, "d" * 200, "d" * 201], "score": numbers, "hits": numbers, "resets": numbers,
+        "seed": numbers, "scene": words, "duration": numbers, "version": words,
+        "date": ["2025-03-01T10:00:00+00:00", "2025-03-01T10:00:00", "yesterday", 1, None],
+        "replay": ["r.json", "../r.json", "r" * 151 + ".json", "r" * 150 + ".json", "r.JSON", _Text("r.json"), 1],
+        "replay_sha256": hexes, "ruleset": words, "config_sha256": hexes, "game_sha256": hexes, "entered": numbers,
+        "entered_at": ["2025-03-01T10:00:00+00:00", "now", None], "complete": [True, False, None, 1, "true"],
+    }
+    base = fake_entry(1, 3, ruleset="standard", config_sha256="1" * 64, game_sha256="2" * 64, entered=1,
+                      entered_at="2025-03-01T10:00:01+00:00", complete=True)
+
+    def outcome(read, data):
+        try:
+            entry = read(data)
+        except ValueError as exc:
+            return str(exc)
+        return [(k, type(v), v) for k, v in vars(entry).items()]
+
+    cases = [{**base, field: value} for field, vs in values.items() for value in vs]
+    cases += [{k: v for k, v in base.items() if k != field} for field in base]
+    cases += [{**base, "extra": 1}, {**fake_entry(1, 3)}, [base], "entry", None]
+    for data in cases:
+        assert str(outcome(ScoreEntry.from_dict, data)) == str(outcome(_entry_by_the_generic_checks, data)), data
