@@ -94,19 +94,30 @@ def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path):
     assert (tmp_path / "each" / "curl.trials.csv").read_bytes() == (curl_run / "run" / "trials.csv").read_bytes()
 
 
-def _short_runs(tmp_path, seeds):
-    protocol = tmp_path / "short.toml"
+@pytest.fixture(scope="module")
+def short_class(tmp_path_factory):
+    """Three students' short lab runs (seeds 1, 2, 3), recorded once for the tests that analyse them."""
+    where = tmp_path_factory.mktemp("short")
+    protocol = where / "short.toml"
     protocol.write_text(SHORT)
+    for seed in (1, 2, 3):
+        assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--seed", str(seed),
+                     "--record", str(where / f"student{seed}.json"), "--name", f"Student {seed}"]) == 0
+    return where
+
+
+def _short_runs(short_class, tmp_path, seeds):
+    """A fresh folder of the given students' recorded runs, the test's own to change."""
     folder = tmp_path / "class"
     folder.mkdir()
     for seed in seeds:
-        assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--seed", str(seed),
-                     "--record", str(folder / f"student{seed}.json"), "--name", f"Student {seed}"]) == 0
+        name = f"student{seed}.json"
+        (folder / name).write_bytes((short_class / name).read_bytes())
     return folder
 
 
-def test_analyze_leaves_out_what_does_not_verify(tmp_path, capsys):
-    folder = _short_runs(tmp_path, [1])
+def test_analyze_leaves_out_what_does_not_verify(short_class, tmp_path, capsys):
+    folder = _short_runs(short_class, tmp_path, [1])
     good = folder / "student1.json"
     data = json.loads(good.read_text())
     data["timeline"][5][0] += 1  # a key pressed one step later than recorded
@@ -119,10 +130,10 @@ def test_analyze_leaves_out_what_does_not_verify(tmp_path, capsys):
     assert len(read_trials_csv(tmp_path / "t.csv")) == 16
 
 
-def test_one_table_of_several_runs_says_whose_each_row_is(tmp_path):
+def test_one_table_of_several_runs_says_whose_each_row_is(short_class, tmp_path):
     import csv
 
-    folder = _short_runs(tmp_path, [1])
+    folder = _short_runs(short_class, tmp_path, [1])
     data = json.loads((folder / "student1.json").read_text())
     data["player"] = "=HYPERLINK(1)"  # a name a spreadsheet would run as a formula (not part of the game)
     (folder / "student2.json").write_text(json.dumps(data))
@@ -136,8 +147,8 @@ def test_one_table_of_several_runs_says_whose_each_row_is(tmp_path):
     assert len(read_trials_csv(out)) == 32  # the lab's own reader still reads it
 
 
-def test_class_curve_merges_verified_students(tmp_path, capsys):
-    folder = _short_runs(tmp_path, [1, 2, 3])
+def test_class_curve_merges_verified_students(short_class, tmp_path, capsys):
+    folder = _short_runs(short_class, tmp_path, [1, 2, 3])
     data = json.loads((folder / "student3.json").read_text())
     data["task"]["trials"][0][3] = not data["task"]["trials"][0][3]  # a miss recorded as a hit, or back
     (folder / "cheat.json").write_text(json.dumps(data))
