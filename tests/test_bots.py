@@ -1,10 +1,9 @@
 """The autopilots: deterministic, keyboard-only, replayable, and knowing the interaction torques pays."""
 
 import json
-import subprocess
-import sys
 
 import pytest
+from test_simulate_cli import in_process
 
 from armgame.errors import UserError
 from armgame.game.bots import Autopilot, make_bot, play_bot
@@ -57,15 +56,15 @@ def test_unknown_bot_is_refused():
         make_bot("oracle")
 
 
-def test_play_headless_bot_json():
-    run = subprocess.run([sys.executable, "-m", "armgame", "play", "--headless", "--bot", "model", "--json",
-                          "--duration", "5", "--seed", "3"], capture_output=True, text=True, check=True)
-    result = json.loads(run.stdout)
+def test_play_headless_bot_json(capsys):
+    code, out, err = in_process(capsys, ["play", "--headless", "--bot", "model", "--json", "--duration", "5",
+                                         "--seed", "3"])
+    assert code in (0, None), err
+    result = json.loads(out)
     expected = play_bot(GameConfig(seed=3, time_limit=5.0), "model").result()
     assert result["seed"] == 3 and result["hits"] == expected.hits
-    both = subprocess.run([sys.executable, "-m", "armgame", "play", "--headless", "--bot", "model", "--script", "x"],
-                          capture_output=True, text=True)
-    assert both.returncode != 0 and "--bot" in both.stderr
+    code, _, err = in_process(capsys, ["play", "--headless", "--bot", "model", "--script", "x"])
+    assert code not in (0, None) and "--bot" in err
 
 
 @pytest.mark.parametrize("interaction", [True, False])

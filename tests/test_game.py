@@ -219,7 +219,7 @@ def test_headless_run_does_not_import_pygame(tmp_path):
      (("--script", "missing.txt"), "no such script")],
 )
 def test_headless_cli_bad_input_is_one_line(tmp_path, args, message, capsys):
-    code, err = in_process(capsys, ["play", "--headless", *args])
+    code, _, err = in_process(capsys, ["play", "--headless", *args])
     assert code not in (0, None)
     assert len(err.strip().splitlines()) == 1 and message in err
 
@@ -229,6 +229,6 @@ def test_unreadable_script_files_are_one_line(tmp_path, capsys):
     binary.write_bytes(b"\xff\xfe\x00 d down\n")
     (tmp_path / "empty").mkdir()
     for path, message in ((binary, "not a text file"), (tmp_path / "empty", "no *.txt scripts")):
-        code, err = in_process(capsys, ["play", "--headless", "--script", str(path)])
+        code, _, err = in_process(capsys, ["play", "--headless", "--script", str(path)])
         assert code == 2
         assert len(err.strip().splitlines()) == 1 and message in err

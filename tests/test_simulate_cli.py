@@ -52,7 +52,7 @@ def test_fixed_step_matches_reference_in_csv(tmp_path):
 
 def in_process(capsys, argv):
     """``armgame`` on ``argv`` in this process, as a subprocess would see it: the exit code (argparse's
-    own exit included) and stderr, with any warning Python would print there (a subprocess shows them;
+    own exit included), stdout, and stderr with any warning Python would print there (a subprocess shows them;
     pytest would otherwise collect them out of sight). A traceback fails the test by itself."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
@@ -60,8 +60,8 @@ def in_process(capsys, argv):
             code = main(argv)
         except SystemExit as exc:
             code = exc.code
-    err = capsys.readouterr().err + "".join(f"{w.category.__name__}: {w.message}\n" for w in caught)
-    return code, err
+    out, err = capsys.readouterr()
+    return code, out, err + "".join(f"{w.category.__name__}: {w.message}\n" for w in caught)
 
 
 @pytest.mark.parametrize(
@@ -80,7 +80,7 @@ def in_process(capsys, argv):
 )
 def test_bad_arguments_give_one_line_and_nonzero_exit(tmp_path, args, message, capsys):
     out = tmp_path / "x.csv"
-    code, err = in_process(capsys, ["simulate", *args, "--out", str(out)])
+    code, _, err = in_process(capsys, ["simulate", *args, "--out", str(out)])
     assert code not in (0, None)
     lines = err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], err
@@ -88,7 +88,7 @@ def test_bad_arguments_give_one_line_and_nonzero_exit(tmp_path, args, message, c
 
 
 def test_unwritable_output_is_reported(tmp_path, capsys):
-    code, err = in_process(capsys, ["simulate", "--scene", "passive", "--duration", "0.1",
+    code, _, err = in_process(capsys, ["simulate", "--scene", "passive", "--duration", "0.1",
                                     "--out", str(tmp_path / "missing" / "x.csv")])
     assert code == 2 and "does not exist" in err
 
