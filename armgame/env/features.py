@@ -43,12 +43,6 @@ DEFAULT_HIT_BONUS = 1.0
 REWARDS = ("dense", "sparse")
 
 
-def hand_position(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The hand (m): ``(l1 cos q1 + l2 cos(q1 + q2), l1 sin q1 + l2 sin(q1 + q2))``."""
-    s12 = q1 + q2
-    return arm.l1 * np.cos(q1) + arm.l2 * np.cos(s12), arm.l1 * np.sin(q1) + arm.l2 * np.sin(s12)
-
-
 def hand_velocity(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray,
                   w2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The hand's velocity (m/s), the Jacobian times the joint velocities."""
@@ -59,8 +53,9 @@ def hand_velocity(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.nd
 
 def hand_and_velocity(arm: TwoJointParams, q1: float, q2: float, w1: float,
                       w2: float) -> tuple[float, float, float, float]:
-    """``hand_position`` and ``hand_velocity`` of one arm in plain floats: a single env steps 3 times as
-    fast as through numpy's one-element arrays, and agrees with them to round-off (the vector tests)."""
+    """The hand (as ``GameSession.hand``) and ``hand_velocity`` of one arm in plain floats, their trig shared:
+    a single env steps 3 times as fast as through numpy's one-element arrays, and agrees with them to
+    round-off (the vector tests)."""
     c1, s1, c12, s12, w12 = math.cos(q1), math.sin(q1), math.cos(q1 + q2), math.sin(q1 + q2), w1 + w2
     return (arm.l1 * c1 + arm.l2 * c12, arm.l1 * s1 + arm.l2 * s12,
             -arm.l1 * s1 * w1 - arm.l2 * s12 * w12, arm.l1 * c1 * w1 + arm.l2 * c12 * w12)
@@ -132,11 +127,12 @@ def wrap_angles(q: np.ndarray) -> np.ndarray:
     return np.where(np.abs(q) <= math.pi, q, wrapped)
 
 
-def reach_observations_v1(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray, w2: np.ndarray,
-                          activation: np.ndarray, target_x: np.ndarray, target_y: np.ndarray,
-                          time_left_fraction: np.ndarray, dtype: str = "float32") -> np.ndarray:
-    """Reach-v1 observations, one row per game; ``activation`` is (n, 4)."""
-    hx, hy = hand_position(arm, q1, q2)
+def reach_observations_v1(arm: TwoJointParams, hand: tuple[np.ndarray, np.ndarray], q1: np.ndarray,
+                          q2: np.ndarray, w1: np.ndarray, w2: np.ndarray, activation: np.ndarray,
+                          target_x: np.ndarray, target_y: np.ndarray, time_left_fraction: np.ndarray,
+                          dtype: str = "float32") -> np.ndarray:
+    """Reach-v1 observations, one row per game; ``hand`` is ``BatchGameSession.hand()``, ``activation`` (n, 4)."""
+    hx, hy = hand
     vx, vy = hand_velocity(arm, q1, q2, w1, w2)
     obs = np.empty((len(q1), 15), dtype=dtype)
     obs[:, 0] = wrap_angles(q1)

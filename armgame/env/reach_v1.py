@@ -135,7 +135,7 @@ class ReachV1Env(ReachEnv):
     def _edge_now(self) -> float:
         session = self.session
         assert session is not None
-        hx, hy, _, _ = hand_and_velocity(self.config.arm, *session.state)
+        hx, hy = session.hand()
         target = session.rules.target
         return max(0.0, math.hypot(hx - target.x, hy - target.y) - target.radius)
 

@@ -33,7 +33,6 @@ from .features import (
     DEFAULT_HIT_BONUS,
     DEFAULT_PROGRESS_WEIGHT,
     edge_distance,
-    hand_position,
     muscle_levels,
     reach_observations_v1,
     wrap_angles,
@@ -354,20 +353,20 @@ class ReachV1VectorEnv(ReachVectorEnv):
         self._configure(num_envs, settings, render_mode, render_size, autoreset_mode)
         self._edges = np.zeros(self.num_envs)
 
-    def _edges_now(self, part: slice, batch: BatchGameSession) -> np.ndarray:
-        hx, hy = hand_position(self.config.arm, batch.q1, batch.q2)
+    def _edges_now(self, batch: BatchGameSession) -> np.ndarray:
+        hx, hy = batch.hand()
         return edge_distance(hx, hy, batch.target_x, batch.target_y, self.config.target_radius)
 
     def _started(self, games: np.ndarray) -> None:
         for part, batch in self.parts:
-            self._edges[part] = np.where(games[part], self._edges_now(part, batch), self._edges[part])
+            self._edges[part] = np.where(games[part], self._edges_now(batch), self._edges[part])
 
     def _rewards(self, part: slice, batch: BatchGameSession, hits: np.ndarray, resets: np.ndarray) -> np.ndarray:
         s = self.settings
         if s.reward == "sparse":
             return super()._rewards(part, batch, hits, resets)
         before = self._edges[part].copy()
-        self._edges[part] = now = self._edges_now(part, batch)
+        self._edges[part] = now = self._edges_now(batch)
         progress = before - np.where(hits > 0, 0.0, now)
         return s.progress_weight * progress + s.hit_bonus * hits - self.config.reset_cost * resets
 
@@ -376,6 +375,6 @@ class ReachV1VectorEnv(ReachVectorEnv):
         obs = np.empty((self.num_envs, 15), dtype=dtype)
         for part, batch in self.parts:
             left = (batch.total_steps - np.minimum(batch.steps, batch.total_steps)) / batch.total_steps
-            obs[part] = reach_observations_v1(self.config.arm, batch.q1, batch.q2, batch.w1, batch.w2,
+            obs[part] = reach_observations_v1(self.config.arm, batch.hand(), batch.q1, batch.q2, batch.w1, batch.w2,
                                               batch.activation, batch.target_x, batch.target_y, left, dtype)
         return obs
