@@ -1,18 +1,24 @@
-"""The compiled kernel's boundary: what it refuses, and when it is used.
+"""The compiled loops' boundary: what they refuse, when they are used, and that they are exact.
 
-Its results are tested against the single session in tests/test_batch.py (both kernels).
+The batch kernel's results are tested against the single session in tests/test_batch.py (both
+kernels). The single session's own compiled loop (``_ckernel.game_steps``) is held here to its
+Python loop, ``GameSession(compiled=False)``, with ``==``.
 """
 
+import math
 import os
 import random
 import types
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from armgame.game import session as session_module
 from armgame.game.batch import BatchGameSession, compiled
-from armgame.game.rules import GameConfig
-from armgame.game.session import GameSession, InputEvent
+from armgame.game.muscles import MuscleSpec
+from armgame.game.rules import GameConfig, Target
+from armgame.game.session import GameSession, InputEvent, NonFiniteStateError
 
 needs_build = pytest.mark.skipif(not (compiled.AVAILABLE or os.environ.get("ARMGAME_REQUIRE_COMPILED")),
                                  reason="the compiled kernel is not built here")
@@ -133,3 +139,144 @@ def test_a_batch_of_many_games_equals_the_numpy_kernel_and_the_single_session_bi
         assert single.play(timelines[i]) == results[i]
         assert fast.state(i) == single.state
     assert sum(r.hits for r in results) >= 5 and sum(r.resets for r in results) > 0  # hits and resets ran
+
+
+# ------------------------------------------------------------- the single session's compiled loop
+needs_loop = pytest.mark.skipif(not (session_module._c_game_steps or os.environ.get("ARMGAME_REQUIRE_COMPILED")),
+                                reason="the compiled loop is not built here")
+
+GAME = GameConfig()
+#: One arm per accel the loop must copy (TwoJointArm._build_components): damped (the game's), neither
+#: damped nor under gravity, and under gravity with damping (a weak one: the game's muscles cannot
+#: lift the arm against 9.81 m/s^2 to any target).
+ARMS = {"damped": GAME.arm, "unforced": GAME.arm.replace(damping1=0.0, damping2=0.0),
+        "gravity": GAME.arm.replace(gravity=0.5)}
+
+
+def keys_resets_and_levels(rng: random.Random, config: GameConfig) -> list[tuple[int, object]]:
+    """(step, input) pairs: muscle keys every 0.05-0.4 s, resets, tab and a few muscle-level commands."""
+    inputs, t = [], 0.0
+    while (t := t + rng.uniform(0.05, 0.4)) < config.time_limit:
+        step = round(t / config.dt)
+        r = rng.random()
+        if r < 0.05:
+            inputs.append((step, ("space", "down")))
+        elif r < 0.07:
+            inputs.append((step, ("tab", "down")))
+        elif r < 0.15:
+            inputs.append((step, [rng.choice((0.0, 0.3, 1.0)) for _ in range(4)]))
+        else:
+            inputs.append((step, (rng.choice("dfjk"), rng.choice(("down", "up")))))
+    return inputs
+
+
+def run_both(config: GameConfig, inputs: list[tuple[int, object]]) -> tuple[GameSession, GameSession]:
+    """The same inputs into a compiled and a Python session, compared after every call."""
+    fast, slow = GameSession(config), GameSession(config, compiled=False)
+    assert fast._compiled is not None and slow._compiled is None
+    for step, given in [*inputs, (config.total_steps, None)]:
+        for s in (fast, slow):
+            s.advance(step - s.steps)
+            if isinstance(given, tuple):
+                s.key_event(*given)
+            elif given is not None:
+                s.set_muscle_levels(given)
+        assert fast.state == slow.state and fast.previous_state == slow.previous_state
+        assert fast.muscles.activation == slow.muscles.activation and fast.steps == slow.steps
+    assert fast.rules.board == slow.rules.board and fast.rules.target == slow.rules.target
+    assert fast.result() == slow.result() and fast.timeline == slow.timeline
+    return fast, slow
+
+
+@needs_loop
+@pytest.mark.parametrize("arm", list(ARMS))
+def test_the_compiled_loop_is_the_python_loop_bit_for_bit(arm):
+    """Every state, activation, hit time and target equal with ``==``, for each accel, over whole games."""
+    rng = random.Random(arm)
+    hits = 0
+    for seed in range(3):
+        config = GameConfig(seed=seed, time_limit=20.0, target_radius=0.2, arm=ARMS[arm])
+        fast, _ = run_both(config, keys_resets_and_levels(rng, config))
+        hits += fast.rules.board.hits
+    assert hits >= 3  # the hit path ran, not just the steps
+
+
+@needs_loop
+def test_a_bots_game_steps_one_period_at_a_time_as_the_python_loop_does():
+    from armgame.game.bots import Autopilot, make_bot
+
+    config = GameConfig(time_limit=15.0)
+    fast, slow = GameSession(config), GameSession(config, compiled=False)
+    assert Autopilot(fast, make_bot("model")).play() == Autopilot(slow, make_bot("model")).play()
+    assert fast.state == slow.state and fast.rules.board.hit_times == slow.rules.board.hit_times
+    assert fast.rules.board.hits >= 5
+
+
+@needs_loop
+@pytest.mark.parametrize("inside", [True, False])
+def test_a_hit_on_the_knife_edge_is_decided_by_the_python_loops_own_test(inside):
+    """A target whose edge passes within an ulp or so of where the hand will be: the loop's looser
+    "near" stops there and the session's own ``**`` test decides, as the Python loop does."""
+    script = [InputEvent(0, "d", "down"), InputEvent(10, "j", "down"), InputEvent(40, "d", "up")]
+    config = GameConfig(time_limit=1.0)
+    probe = GameSession(config, compiled=False)
+    probe.play(script, stop_step=59)
+    px, py = probe.hand()
+    probe.advance(1)
+    hx, hy = probe.hand()
+    r = config.target_radius * (1.0 - 1e-15 if inside else 1.0 + 1e-15)
+    ux, uy = (hx - px) / math.dist((hx, hy), (px, py)), (hy - py) / math.dist((hx, hy), (px, py))
+    edge = Target(hx + r * ux, hy + r * uy, config.target_radius)
+    results = []
+    for compiled_loop in (True, False):
+        single = GameSession(config, compiled=compiled_loop)
+        single.rules.target = edge
+        results.append(single.play(script))
+        assert (60 * config.dt in single.rules.board.hit_times) == inside
+    assert results[0] == results[1]
+
+
+@needs_loop
+def test_a_state_gone_non_finite_stops_in_one_line_as_the_python_loop_does():
+    muscles = tuple(MuscleSpec(f"m{i}", k, (50.0, -50.0), 0.02, 0.02) for i, k in enumerate("dfjk"))
+    wild = GameConfig(dt=0.02, muscles=muscles, arm=GAME.arm.replace(m1=0.01, m2=0.01, i1=1e-5, i2=1e-5))
+    messages = []
+    for compiled_loop in (True, False):
+        single = GameSession(wild, compiled=compiled_loop)
+        with pytest.raises(NonFiniteStateError) as info:
+            single.play([InputEvent(0, "d", "down")])
+        messages.append(str(info.value))
+    assert messages[0] == messages[1] and "\n" not in messages[0]
+
+
+@needs_loop
+def test_the_compiled_loop_runs_rk4_and_steps_it_is_given_run_in_python():
+    assert GameSession(GAME)._compiled is not None
+    for integrator in ("euler", "symplectic-euler", "midpoint", "gauss4"):
+        assert GameSession(replace(GAME, integrator=integrator))._compiled is None
+    # A step swapped in (as tests/test_batch.py does to perturb round-off) is the one that runs.
+    session = GameSession(GAME)
+    calls = []
+    real = session._physics_step
+
+    def counted(*args):
+        calls.append(1)
+        return real(*args)
+
+    session._physics_step = counted
+    session.advance(10)
+    assert len(calls) == 10
+
+
+@needs_loop
+@pytest.mark.parametrize(("args", "message"), [
+    ((), "22 arguments"),
+    ((b"short", 1, 5, *[0.0] * 19), "params"),
+    (("not bytes", 1, 5, *[0.0] * 19), "params"),
+    ((bytes(26 * 8), 3, 5, *[0.0] * 19), "mode 3"),
+    ((bytes(26 * 8), 1, -1, *[0.0] * 19), "steps >= 0"),
+    ((bytes(26 * 8), 1, 5, "q1", *[0.0] * 18), "must be real number"),
+])
+def test_game_steps_refuses_bad_arguments_before_any_step(args, message):
+    with pytest.raises((TypeError, ValueError), match=message):
+        session_module._c_game_steps(*args)

@@ -1,4 +1,5 @@
-/* The batched game's hot loop, compiled: muscles, RK4 and the hand's slack for many games.
+/* The game's hot loop, compiled: muscles, RK4 and the hand's slack for many games (``run``), and
+ * the single session's loop for one game (``game_steps``).
  *
  * Why C: a batch of a thousand games in numpy pays about 140 calls of call overhead per
  * physics step, and Python floats pay the interpreter per operation; here each game runs its
@@ -310,8 +311,137 @@ done:
     return result;
 }
 
+/* A stage of RK4 in full: GameSession's accel with its own b cos q2 and b sin q2. */
+static inline void accel_full(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
+                              double *o1, double *o2)
+{
+    accel_trig(arm, q1, q2, arm->b * cos(q2), arm->b * sin(q2), w1, w2, t1, t2, o1, o2);
+}
+
+static int arg_double(PyObject *obj, double *out)
+{
+    if (PyFloat_CheckExact(obj)) {
+        *out = PyFloat_AS_DOUBLE(obj);
+        return 0;
+    }
+    *out = PyFloat_AsDouble(obj);
+    return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+/* The relative margin of game_steps' "near" test over the exact one (which Python makes): far above
+ * the round-off of squaring by multiplication instead of ``**``. */
+#define NEAR_MARGIN 1e-9
+
+PyDoc_STRVAR(game_steps_doc,
+"game_steps(params, mode, n, q1, q2, w1, w2, a0, a1, a2, a3, g0, g1, g2, g3, r0, r1, r2, r3, tx, ty, rr)\n"
+"    -> (ran, near, q1, q2, w1, w2, p1, p2, p3, p4, a0, a1, a2, a3, hx, hy)\n\n"
+"GameSession._advance for one game, exactly: up to n steps of the muscles (activations a, goals g,\n"
+"rates r) and RK4 from state (q1, q2, w1, w2), stopping early after a step that leaves the hand\n"
+"(hx, hy) within a relative 1e-9 of the target disc (tx, ty, radius squared rr): near is then true,\n"
+"and the caller decides the hit with the session's own test. p1-p4 is the state before the last\n"
+"step run. params is a bytes object of the P_* doubles (only the arm's, dt's and moments' are read).");
+
+static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 22) {
+        PyErr_Format(PyExc_TypeError, "game_steps takes 22 arguments, got %zd", nargs);
+        return NULL;
+    }
+    if (!PyBytes_Check(args[0]) || PyBytes_GET_SIZE(args[0]) != P_COUNT * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "params: expected bytes of the P_* doubles");
+        return NULL;
+    }
+    double p[P_COUNT];
+    memcpy(p, PyBytes_AS_STRING(args[0]), sizeof p);
+    const long mode = PyLong_AsLong(args[1]);
+    const Py_ssize_t n = PyLong_AsSsize_t(args[2]);
+    if (PyErr_Occurred())
+        return NULL;
+    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY || n < 0) {
+        PyErr_Format(PyExc_ValueError, "mode %ld, %zd steps: expected mode 0, 1 or 2 and steps >= 0", mode, n);
+        return NULL;
+    }
+    double v[19];
+    for (int i = 0; i < 19; i++)
+        if (arg_double(args[3 + i], &v[i]) < 0)
+            return NULL;
+    double q1 = v[0], q2 = v[1], w1 = v[2], w2 = v[3];
+    double a0 = v[4], a1 = v[5], a2 = v[6], a3 = v[7];
+    const double g0 = v[8], g1 = v[9], g2 = v[10], g3 = v[11];
+    const double r0 = v[12], r1 = v[13], r2 = v[14], r3 = v[15];
+    const double x0 = v[16], y0 = v[17], rr = v[18];
+    const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], (int)mode};
+    const double dt = p[P_DT], h = p[P_H], k = p[P_K], l1 = p[P_L1], l2 = p[P_L2];
+    const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
+    const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
+    const double near = rr * (1.0 + NEAR_MARGIN);
+    double p1 = q1, p2 = q2, p3 = w1, p4 = w2, hx = 0.0, hy = 0.0;
+    Py_ssize_t ran = 0;
+    int flagged = 0;
+    while (ran < n) {
+        /* GameSession._advance: torque from the activations, then the muscles step. */
+        const double t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
+        const double t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
+        a0 += (g0 - a0) * r0;
+        a1 += (g1 - a1) * r1;
+        a2 += (g2 - a2) * r2;
+        a3 += (g3 - a3) * r3;
+        p1 = q1;
+        p2 = q2;
+        p3 = w1;
+        p4 = w2;
+        /* integrators._rk4 */
+        double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
+        accel_full(&arm, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
+        const double v1 = w1 + h * ka1;
+        const double v2 = w2 + h * ka2;
+        accel_full(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
+        const double u1 = w1 + h * kb1;
+        const double u2 = w2 + h * kb2;
+        accel_full(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
+        const double z1 = w1 + dt * kc1;
+        const double z2 = w2 + dt * kc2;
+        accel_full(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
+        q1 = p1 + k * (w1 + z1 + 2.0 * (v1 + u1));
+        q2 = p2 + k * (w2 + z2 + 2.0 * (v2 + u2));
+        w1 = p3 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1));
+        w2 = p4 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
+        ran++;
+        const double s12 = q1 + q2;
+        hx = l1 * cos(q1) + l2 * cos(s12);
+        hy = l1 * sin(q1) + l2 * sin(s12);
+        const double dx = hx - x0, dy = hy - y0;
+        if (dx * dx + dy * dy <= near) {
+            flagged = 1;
+            break;
+        }
+    }
+    PyObject *out = PyTuple_New(16);
+    if (out == NULL)
+        return NULL;
+    const double values[14] = {q1, q2, w1, w2, p1, p2, p3, p4, a0, a1, a2, a3, hx, hy};
+    PyObject *item = PyLong_FromSsize_t(ran);
+    if (item == NULL)
+        goto fail;
+    PyTuple_SET_ITEM(out, 0, item);
+    item = PyBool_FromLong(flagged);
+    PyTuple_SET_ITEM(out, 1, item);
+    for (int i = 0; i < 14; i++) {
+        item = PyFloat_FromDouble(values[i]);
+        if (item == NULL)
+            goto fail;
+        PyTuple_SET_ITEM(out, 2 + i, item);
+    }
+    return out;
+fail:
+    Py_DECREF(out);
+    return NULL;
+}
+
 static PyMethodDef methods[] = {
     {"run", run, METH_VARARGS, run_doc},
+    {"game_steps", (PyCFunction)(void (*)(void))game_steps, METH_FASTCALL, game_steps_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -326,7 +456,7 @@ PyMODINIT_FUNC PyInit__ckernel(void)
     PyObject *m = PyModule_Create(&module);
     /* VERSION changes with the calling convention, so a stale build is refused, not misread. */
     if (m != NULL && (PyModule_AddIntConstant(m, "PARAMS", P_COUNT) < 0
-                      || PyModule_AddIntConstant(m, "VERSION", 2) < 0)) {
+                      || PyModule_AddIntConstant(m, "VERSION", 3) < 0)) {
         Py_DECREF(m);
         return NULL;
     }

@@ -17,10 +17,19 @@ from dataclasses import asdict, dataclass
 from .. import __version__
 from ..errors import UserError
 from ..limits import MAX_EVENTS
-from ..physics.integrators import Integrator
+from ..physics.integrators import _SIXTH, Integrator
 from ..physics.twojoint import TwoJointArm
 from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
+
+try:  # the compiled loop (setup.py builds it where a C compiler is found)
+    from . import _ckernel
+except ImportError:
+    _ckernel = None
+#: ``_ckernel.game_steps``, if built in the convention this module speaks (a stale build is not used).
+_c_game_steps = _ckernel.game_steps if getattr(_ckernel, "VERSION", None) == 3 else None
+#: How many doubles ``game_steps`` reads from its params (``_ckernel.c``'s P_* layout).
+_C_PARAMS = 26
 
 DOWN, UP = "down", "up"
 RESET_KEY, TOGGLE_ARM_KEY = "space", "tab"
@@ -57,11 +66,20 @@ class GameResult:
 
 
 class GameSession:
-    def __init__(self, config: GameConfig) -> None:
+    """One game: ``key_event`` and ``set_muscle_levels`` take input, ``advance`` runs physics steps.
+
+    ``compiled`` (the default) runs RK4 games through ``_ckernel.game_steps`` where the install
+    built it: the same floats as the Python loop in ``_advance``, operation for operation, some
+    ten times faster. ``compiled=False`` runs the Python loop, the reference the tests hold the
+    compiled one to (``==``); other integrators always run it.
+    """
+
+    def __init__(self, config: GameConfig, *, compiled: bool = True) -> None:
         self.config = config
         self.model = TwoJointArm(config.arm)
         self._physics_step = Integrator(config.integrator, self.model).step_components
         self.muscles = MuscleSet(config.muscles, config.dt)
+        self._compiled = self._compiled_loop() if compiled else None
         self.rules = GameRules(config)
         self.keys = (*self.muscles.keys, RESET_KEY, TOGGLE_ARM_KEY)
         self.steps = 0
@@ -145,6 +163,22 @@ class GameSession:
         for i, level in enumerate(values):
             self.muscles.set_level(i, level)
 
+    def _compiled_loop(self) -> tuple[bytes, int, object] | None:
+        """(params, mode, the step it replaces) for ``_ckernel.game_steps``, or None where it cannot run."""
+        if _c_game_steps is None or self.config.integrator != "rk4":
+            return None
+        import struct
+
+        model, p, dt = self.model, self.model.params, self.config.dt
+        moments = self.muscles.moments
+        # The order of _ckernel.c's P_* enum; the batch's own entries (radius, slack bounds) unread here.
+        values = [dt, 0.5 * dt, dt * _SIXTH, model.b, model.d, model.a * model.d - model.d * model.d,
+                  model.a - model.d, model.g1, model.g2, p.damping1, p.damping2, p.l1, p.l2, 0.0, 0.0, 0.0, 0.0, 0.0,
+                  *(m[0] for m in moments), *(m[1] for m in moments)]
+        assert len(values) == _C_PARAMS
+        mode = 2 if p.has_gravity else 1 if p.has_damping else 0
+        return struct.pack(f"={_C_PARAMS}d", *values), mode, self._physics_step
+
     def _reset_arm(self) -> None:
         q1, q2 = self.config.start_posture
         self.state = self.previous_state = (q1, q2, 0.0, 0.0)
@@ -182,6 +216,9 @@ class GameSession:
         if n <= 0:
             return 0
         step = self._physics_step
+        compiled = self._compiled
+        if compiled is not None and compiled[2] is step:  # a step swapped in (tests do) runs in Python
+            return self._advance_compiled(n, compiled[0], compiled[1])
         dt = self.config.dt
         arm = self.config.arm
         l1, l2 = arm.l1, arm.l2
@@ -211,6 +248,36 @@ class GameSession:
             hy = l1 * sin(q1) + l2 * sin(s12)
             if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
                 rules.hand_moved(hx, hy, (start + k + 1) * dt)
+                target = rules.target
+                tx, ty, rr = target.x, target.y, target.radius * target.radius
+        muscles.activation = [a0, a1, a2, a3]
+        self.steps = start + n
+        self.state = (q1, q2, w1, w2)
+        self.previous_state = previous
+        return n
+
+    def _advance_compiled(self, n: int, params: bytes, mode: int) -> int:
+        """``_advance``'s loop in C: it stops after each step that brings the hand near the target,
+        and the hit is decided here, by the Python loop's own test on the same floats."""
+        dt = self.config.dt
+        rules = self.rules
+        target = rules.target
+        tx, ty, rr = target.x, target.y, target.radius * target.radius
+        muscles = self.muscles
+        a0, a1, a2, a3 = muscles.activation
+        g0, g1, g2, g3 = muscles.goal
+        r0, r1, r2, r3 = muscles.rate
+        q1, q2, w1, w2 = self.state
+        previous = self.state
+        start, done = self.steps, 0
+        game_steps = _c_game_steps
+        while done < n:
+            (ran, near, q1, q2, w1, w2, p1, p2, p3, p4, a0, a1, a2, a3, hx, hy) = game_steps(
+                params, mode, n - done, q1, q2, w1, w2, a0, a1, a2, a3, g0, g1, g2, g3, r0, r1, r2, r3, tx, ty, rr)
+            previous = (p1, p2, p3, p4)
+            done += ran
+            if near and (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
+                rules.hand_moved(hx, hy, (start + done) * dt)
                 target = rules.target
                 tx, ty, rr = target.x, target.y, target.radius * target.radius
         muscles.activation = [a0, a1, a2, a3]

@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     from .session import BatchGameSession
 
 #: The calling convention this module speaks; a build of another (a stale ``.so``) is not used.
-KERNEL_VERSION = 2
+KERNEL_VERSION = 3
 _PARAMS = 26
 
 
