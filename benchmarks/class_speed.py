@@ -8,14 +8,16 @@ The scripts are seeded random key timelines like a student's: every 0.1-0.5 s on
 four muscle keys changes (pressed if up, released if down), and one switch in a hundred is
 followed by a reset. Every game is the standard one (seed 10, 60 s), as in a class.
 
-"One after another" is today's rate: ``GameSession(config).play(timeline)`` per game, timed
-on the first ``--sample`` games and scaled to all of them (the games cost the same to a few
-per cent). "Batched" is ``replay_many`` for all the games, as ``armgame play --headless --script``
-plays a class: one ``BatchGameSession(exact=False)``, whose games decided on a knife edge are
-played again alone (``--exact``: the exact kernel, bit for bit the single session), timed whole;
-the results of the sampled games are checked equal to the sequential ones. Verification is
-the same comparison for replays: ``Replay.verify`` one by one against
-``records.batch_verify.verify_replays`` (recomputation only, files already read).
+"One after another" is ``GameSession(config).play(timeline)`` per game, timed on the first
+``--sample`` games and scaled to all of them (the games cost the same to a few per cent), twice:
+with the session's compiled loop (where built) and with its Python loop (as an install without a
+C compiler runs, and as every game ran before the loop was compiled). "Batched" is
+``replay_many`` for all the games, as ``armgame play --headless --script`` plays a class: one
+``BatchGameSession(exact=False)``, whose games decided on a knife edge are played again alone
+(``--exact``: the exact kernel, bit for bit the single session), timed whole; the results of
+the sampled games are checked equal to the sequential ones. Verification is the same comparison
+for replays: ``Replay.verify`` one by one against ``records.batch_verify.verify_replays``
+(recomputation only, files already read).
 
 Each ratio is measured within one repeat, so both sides see the same machine load; the
 spread over repeats is printed beside the median. CPU-time ratios are printed too: on a
@@ -25,6 +27,7 @@ loaded machine they move less than wall-clock ones.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import platform
@@ -32,10 +35,11 @@ import random
 import statistics
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
+from armgame.game import session as session_module
 from armgame.game.batch import KERNELS, compiled, replay_many
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
@@ -81,31 +85,53 @@ def machine() -> dict[str, object]:
             "compiled_kernel_built": compiled.AVAILABLE}
 
 
+#: The single session's loops built here: the compiled one first, where it was built.
+LOOPS = ("compiled", "python") if session_module._c_game_steps is not None else ("python",)
+
+
+@contextlib.contextmanager
+def single_loop(loop: str) -> Iterator[None]:
+    """Sessions made inside run ``loop``: "python" as on an install without a C compiler."""
+    built = session_module._c_game_steps
+    if loop == "python":
+        session_module._c_game_steps = None
+    try:
+        yield
+    finally:
+        session_module._c_game_steps = built
+
+
 def one_repeat(configs: list[GameConfig], timelines: list[list[InputEvent]], sample: int,
                kernel: str | None, exact: bool) -> dict[str, float]:
     n = len(configs)
     scale = n / sample
-    # Games: one after another (a sample, scaled) and in one batch.
-    seq_wall, seq_cpu, seq_results = timed(lambda: [GameSession(c).play(t)
-                                                    for c, t in zip(configs[:sample], timelines[:sample],
-                                                                    strict=True)])
+    out: dict[str, float] = {}
     batch_wall, batch_cpu, batch_results = timed(lambda: replay_many(configs, timelines, exact=exact, kernel=kernel))
-    if batch_results[:sample] != seq_results:
-        sys.exit("class_speed: the batch and the single sessions disagree: a bug")
-    # Verification of the same games as replays.
     replays = [Replay(c, tuple(t), r, "script", f"student{i:04d}.txt", f"student {i}")
                for i, (c, t, r) in enumerate(zip(configs, timelines, batch_results, strict=True))]
-    vseq_wall, vseq_cpu, vseq = timed(lambda: [r.verify() for r in replays[:sample]])
     vbatch_wall, vbatch_cpu, vbatch = timed(lambda: verify_replays(replays, kernel=kernel))
-    if vbatch[:sample] != vseq or not all(ok for ok, _ in vbatch):
-        sys.exit("class_speed: batched verification disagrees with Replay.verify: a bug")
-    return {
-        "sequential_wall_s": seq_wall * scale, "batched_wall_s": batch_wall,
-        "ratio_wall": seq_wall * scale / batch_wall, "ratio_cpu": seq_cpu * scale / batch_cpu,
-        "verify_sequential_wall_s": vseq_wall * scale, "verify_batched_wall_s": vbatch_wall,
-        "verify_ratio_wall": vseq_wall * scale / vbatch_wall, "verify_ratio_cpu": vseq_cpu * scale / vbatch_cpu,
-        "mean_score": float(np.mean([r.score for r in batch_results])),
-    }
+    if not all(ok for ok, _ in vbatch):
+        sys.exit("class_speed: batched verification refused a game the batch played: a bug")
+    out |= {"batched_wall_s": batch_wall, "verify_batched_wall_s": vbatch_wall}
+    for loop in LOOPS:
+        with single_loop(loop):
+            # Games one after another (a sample, scaled), then the same games verified as replays one by one.
+            seq_wall, seq_cpu, seq_results = timed(lambda: [GameSession(c).play(t) for c, t in
+                                                            zip(configs[:sample], timelines[:sample], strict=True)])
+            vseq_wall, vseq_cpu, vseq = timed(lambda: [r.verify() for r in replays[:sample]])
+        if batch_results[:sample] != seq_results:
+            sys.exit(f"class_speed: the batch and the single sessions ({loop} loop) disagree: a bug")
+        if vbatch[:sample] != vseq:
+            sys.exit(f"class_speed: batched verification disagrees with Replay.verify ({loop} loop): a bug")
+        out |= {
+            f"sequential_{loop}_wall_s": seq_wall * scale, f"ratio_{loop}_wall": seq_wall * scale / batch_wall,
+            f"ratio_{loop}_cpu": seq_cpu * scale / batch_cpu,
+            f"verify_sequential_{loop}_wall_s": vseq_wall * scale,
+            f"verify_ratio_{loop}_wall": vseq_wall * scale / vbatch_wall,
+            f"verify_ratio_{loop}_cpu": vseq_cpu * scale / vbatch_cpu,
+        }
+    out["mean_score"] = float(np.mean([r.score for r in batch_results]))
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -145,12 +171,14 @@ def main(argv: list[str] | None = None) -> int:
           f"{args.repeats} repeats; {m['cpu']}, {m['cores']} cores, load {m['load_average_1min']}, "
           f"Python {m['python']}, numpy {m['numpy']}; batch kernel: {kernel}")
     for label, prefix in (("play", ""), ("verify", "verify_")):
-        seq, batch = report[f"{prefix}sequential_wall_s"], report[f"{prefix}batched_wall_s"]
-        wall, cpu = report[f"{prefix}ratio_wall"], report[f"{prefix}ratio_cpu"]
-        print(f"{label:>6}: one after another {seq['median']:6.1f} s (first {args.sample} timed, scaled); "
-              f"batched {batch['median']:5.2f} s [{batch['min']:.2f}-{batch['max']:.2f}]; "
-              f"{wall['median']:.1f}x wall [{wall['min']:.1f}-{wall['max']:.1f}], "
-              f"{cpu['median']:.1f}x CPU [{cpu['min']:.1f}-{cpu['max']:.1f}]")
+        batch = report[f"{prefix}batched_wall_s"]
+        print(f"{label:>6}: batched {batch['median']:5.2f} s [{batch['min']:.2f}-{batch['max']:.2f}]")
+        for loop in LOOPS:
+            seq = report[f"{prefix}sequential_{loop}_wall_s"]
+            wall, cpu = report[f"{prefix}ratio_{loop}_wall"], report[f"{prefix}ratio_{loop}_cpu"]
+            print(f"        one after another, {loop} loop: {seq['median']:6.1f} s (first {args.sample} timed, "
+                  f"scaled); batched is {wall['median']:.1f}x wall [{wall['min']:.1f}-{wall['max']:.1f}], "
+                  f"{cpu['median']:.1f}x CPU [{cpu['min']:.1f}-{cpu['max']:.1f}]")
     return 0
 
 
