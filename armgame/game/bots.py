@@ -54,6 +54,8 @@ except ImportError:
 _c_predict = _cbots.predict if getattr(_cbots, "VERSION", None) == 1 else None
 
 CONTROL_PERIOD = 0.004
+#: The cost of keys down in a decision, per key (``ReachingBot.act``).
+_NO_PRESS, _ONE_PRESS, _TWO_PRESSES = 1e-4 * 0, 1e-4 * 1, 1e-4 * 2
 
 
 class Bot(Protocol):
@@ -405,18 +407,34 @@ class ReachingBot:
             # Predicted activations one period on, with each muscle's key down or up.
             ap_on, ap_off = ap + (1.0 - ap) * rp, ap - ap * dp
             an_on, an_off = an + (1.0 - an) * rn, an - an * dn
-            best, best_cost, best_net = (False, False), math.inf, 0.0
-            for on_p, on_n in ((False, False), (True, False), (False, True), (True, True)):
-                net = mp * (ap_on if on_p else ap_off) + mn * (an_on if on_n else an_off)
-                # A little cost on co-contraction: pushing against oneself is wasted effort.
-                cost = (net - want) ** 2 + 1e-4 * (on_p + on_n)
-                if cost < best_cost:
-                    best, best_cost, best_net = (on_p, on_n), cost, net
+            # The four choices (neither key, agonist, antagonist, both) in that order, the first cheapest
+            # kept, with a little cost on each key down: pushing against oneself is wasted effort. Written
+            # out rather than looped: this runs twice a decision, a decision every physics step.
+            n0 = mp * ap_off + mn * an_off
+            n1 = mp * ap_on + mn * an_off
+            n2 = mp * ap_off + mn * an_on
+            n3 = mp * ap_on + mn * an_on
+            k0 = (n0 - want) ** 2 + _NO_PRESS
+            k1 = (n1 - want) ** 2 + _ONE_PRESS
+            k2 = (n2 - want) ** 2 + _ONE_PRESS
+            k3 = (n3 - want) ** 2 + _TWO_PRESSES
+            best, best_cost, best_net = 0, math.inf, 0.0
+            if k0 < best_cost:
+                best, best_cost, best_net = 0, k0, n0
+            if k1 < best_cost:
+                best, best_cost, best_net = 1, k1, n1
+            if k2 < best_cost:
+                best, best_cost, best_net = 2, k2, n2
+            if k3 < best_cost:
+                best, best_net = 3, n3
             # The torque over the coming period, for the forward model: between now's and the end's.
             applied.append(0.5 * (mp * ap + mn * an + best_net))
-            for index, on in zip((pos, neg), best, strict=True):
-                if on != held[index]:
-                    events.append((keys[index], DOWN if on else UP))
+            on = best == 1 or best == 3
+            if on != held[pos]:
+                events.append((keys[pos], DOWN if on else UP))
+            on = best >= 2
+            if on != held[neg]:
+                events.append((keys[neg], DOWN if on else UP))
         self._history.append((session.state, session.rules.target, applied[0], applied[1]))
         return events
 
