@@ -280,3 +280,52 @@ def test_the_compiled_loop_runs_rk4_and_steps_it_is_given_run_in_python():
 def test_game_steps_refuses_bad_arguments_before_any_step(args, message):
     with pytest.raises((TypeError, ValueError), match=message):
         session_module._c_game_steps(*args)
+
+
+@needs_loop
+@pytest.mark.parametrize("arm", list(ARMS))
+def test_the_compiled_rk4_step_is_the_python_step_bit_for_bit(arm):
+    """``_ckernel.rk4_step`` (the lab's unloaded step) against ``Integrator("rk4")``'s, with ``==``."""
+    session = GameSession(GameConfig(arm=ARMS[arm]))
+    fast, slow = session.unloaded_step(), session._physics_step
+    assert fast is not slow
+    rng = random.Random(arm)
+    for _ in range(2000):
+        x = (rng.uniform(-4, 4), rng.uniform(-4, 4), rng.uniform(-30, 30), rng.uniform(-30, 30),
+             rng.uniform(-3, 3), rng.uniform(-3, 3), rng.choice((0.001, 0.004, 0.02)))
+        assert fast(*x) == slow(*x)
+
+
+@needs_loop
+def test_a_lab_run_with_the_compiled_step_is_the_python_loops_bit_for_bit():
+    """A curl field (loaded steps in Python) between unloaded blocks (the compiled step), the adapting bot."""
+    from armgame.game.bots import Autopilot
+    from armgame.lab.bots import make_lab_bot
+    from armgame.lab.protocol import CURL_B, Block, Perturbation, Protocol
+    from armgame.lab.session import LabSession, lab_config
+
+    kinds = (Perturbation(), Perturbation.make("curl", b=CURL_B), Perturbation())
+    protocol = Protocol("short", tuple(Block(n, 4, k) for n, k in zip(("baseline", "exposure", "washout"), kinds,
+                                                                          strict=True)))
+    runs = []
+    for compiled_loop in (True, False):
+        session = LabSession(lab_config(protocol, 3), protocol, compiled=compiled_loop)
+        Autopilot(session, make_lab_bot("adaptive")).play()
+        runs.append(session)
+    fast, slow = runs
+    assert fast.unloaded_step() is not slow.unloaded_step()
+    assert fast.trial_records() == slow.trial_records() and fast.state == slow.state
+    assert all(a.xs == b.xs and a.ys == b.ys for a, b in zip(fast.outcomes, slow.outcomes, strict=True))
+    assert len(fast.outcomes) == 12
+
+
+@needs_loop
+@pytest.mark.parametrize(("args", "message"), [
+    ((), "9 arguments"),
+    ((b"short", 1, *[0.0] * 7), "params"),
+    ((bytes(26 * 8), -1, *[0.0] * 7), "mode -1"),
+    ((bytes(26 * 8), 1, "q1", *[0.0] * 6), "must be real number"),
+])
+def test_rk4_step_refuses_bad_arguments(args, message):
+    with pytest.raises((TypeError, ValueError), match=message):
+        session_module._c_rk4_step(*args)

@@ -1,5 +1,5 @@
 /* The game's hot loop, compiled: muscles, RK4 and the hand's slack for many games (``run``), and
- * the single session's loop for one game (``game_steps``).
+ * the single session's loop for one game (``game_steps``) and one RK4 step (``rk4_step``, the lab's).
  *
  * Why C: a batch of a thousand games in numpy pays about 140 calls of call overhead per
  * physics step, and Python floats pay the interpreter per operation; here each game runs its
@@ -439,9 +439,59 @@ fail:
     return NULL;
 }
 
+PyDoc_STRVAR(rk4_step_doc,
+"rk4_step(params, mode, q1, q2, w1, w2, t1, t2, dt) -> (q1, q2, w1, w2)\n\n"
+"One step of integrators._rk4 on TwoJointArm's accel (mode 0, 1 or 2, as game_steps), torques t1, t2\n"
+"held over dt: the Python step's operations in order. params as game_steps' (only the arm's read).");
+
+static PyObject *rk4_step(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 9) {
+        PyErr_Format(PyExc_TypeError, "rk4_step takes 9 arguments, got %zd", nargs);
+        return NULL;
+    }
+    if (!PyBytes_Check(args[0]) || PyBytes_GET_SIZE(args[0]) != P_COUNT * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "params: expected bytes of the P_* doubles");
+        return NULL;
+    }
+    double p[P_COUNT];
+    memcpy(p, PyBytes_AS_STRING(args[0]), sizeof p);
+    const long mode = PyLong_AsLong(args[1]);
+    if (mode == -1 && PyErr_Occurred())
+        return NULL;
+    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY) {
+        PyErr_Format(PyExc_ValueError, "mode %ld: expected mode 0, 1 or 2", mode);
+        return NULL;
+    }
+    double v[7];
+    for (int i = 0; i < 7; i++)
+        if (arg_double(args[2 + i], &v[i]) < 0)
+            return NULL;
+    const double q1 = v[0], q2 = v[1], w1 = v[2], w2 = v[3], t1 = v[4], t2 = v[5], dt = v[6];
+    const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], (int)mode};
+    /* integrators._rk4, h and k from this dt as the Python step takes them. */
+    const double h = 0.5 * dt;
+    double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
+    accel_full(&arm, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
+    const double v1 = w1 + h * ka1;
+    const double v2 = w2 + h * ka2;
+    accel_full(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
+    const double u1 = w1 + h * kb1;
+    const double u2 = w2 + h * kb2;
+    accel_full(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
+    const double z1 = w1 + dt * kc1;
+    const double z2 = w2 + dt * kc2;
+    accel_full(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
+    const double k = dt * (1.0 / 6.0);
+    return Py_BuildValue("(dddd)", q1 + k * (w1 + z1 + 2.0 * (v1 + u1)), q2 + k * (w2 + z2 + 2.0 * (v2 + u2)),
+                         w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1)), w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2)));
+}
+
 static PyMethodDef methods[] = {
     {"run", run, METH_VARARGS, run_doc},
     {"game_steps", (PyCFunction)(void (*)(void))game_steps, METH_FASTCALL, game_steps_doc},
+    {"rk4_step", (PyCFunction)(void (*)(void))rk4_step, METH_FASTCALL, rk4_step_doc},
     {NULL, NULL, 0, NULL},
 };
 

@@ -10,8 +10,9 @@ the window.
 
 from __future__ import annotations
 
+import functools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass
 
 from .. import __version__
@@ -28,6 +29,7 @@ except ImportError:
     _ckernel = None
 #: ``_ckernel.game_steps``, if built in the convention this module speaks (a stale build is not used).
 _c_game_steps = _ckernel.game_steps if getattr(_ckernel, "VERSION", None) == 3 else None
+_c_rk4_step = _ckernel.rk4_step if _c_game_steps is not None else None
 #: How many doubles ``game_steps`` reads from its params (``_ckernel.c``'s P_* layout).
 _C_PARAMS = 26
 
@@ -178,6 +180,15 @@ class GameSession:
         assert len(values) == _C_PARAMS
         mode = 2 if p.has_gravity else 1 if p.has_damping else 0
         return struct.pack(f"={_C_PARAMS}d", *values), mode, self._physics_step
+
+    def unloaded_step(self) -> Callable[..., tuple[float, float, float, float]]:
+        """The physics step of the arm with nothing added: ``_physics_step`` itself, or its operations in C
+        (``_ckernel.rk4_step``, the same floats) where the compiled loop runs. For loops of their own
+        (the lab's), which step the arm one step at a time."""
+        compiled = self._compiled
+        if compiled is None or compiled[2] is not self._physics_step or _c_rk4_step is None:
+            return self._physics_step
+        return functools.partial(_c_rk4_step, compiled[0], compiled[1])
 
     def _reset_arm(self) -> None:
         q1, q2 = self.config.start_posture

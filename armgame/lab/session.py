@@ -123,8 +123,9 @@ def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = 
 class LabSession(GameSession):
     """A centre-out experiment on the game's session: see the module's docstring."""
 
-    def __init__(self, config: GameConfig, protocol: Protocol, hold_at_home: bool = True) -> None:
-        super().__init__(config)
+    def __init__(self, config: GameConfig, protocol: Protocol, hold_at_home: bool = True, *,
+                 compiled: bool = True) -> None:
+        super().__init__(config, compiled=compiled)
         #: True (the lab's rule): the go cue waits for the cursor to stay in home for the trial's delay.
         #: False (for agents, ``armgame/CenterOut-v1``): it comes that delay after the trial began, wherever
         #: the cursor is, so a policy that cannot yet hold still still starts trials.
@@ -212,7 +213,7 @@ class LabSession(GameSession):
         """(step function, shown-hand transform) of a perturbation, built once per run."""
         if perturbation not in self._physics:
             loads = loads_for(perturbation, self.home)
-            step = self._physics_step if loads is None else \
+            step = self.unloaded_step() if loads is None else \
                 Integrator(self.config.integrator, loaded_arm(self.model, loads)).step_components
             self._physics[perturbation] = (step, display_for(perturbation, self.home, self.home_q))
         return self._physics[perturbation]
