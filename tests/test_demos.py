@@ -8,7 +8,6 @@ import sys
 import numpy as np
 import pytest
 from figure_checks import assert_reads_on_a_slide
-from scipy.integrate import solve_ivp
 
 from armgame.cli import main
 from armgame.demos.reach import ReachPlan, joint_motion, reach_arm, reach_table, torque_split
@@ -96,6 +95,8 @@ def test_interaction_figure_shares_one_newton_metre_scale_and_prints_each_bar(tm
 
 
 def test_pendulum_reproduces_the_tutorials_run(tmp_path):
+    from scipy.integrate import solve_ivp  # here, not at collection: only the worker running it pays
+
     assert main(["demo", "pendulum", "--headless", "--out", str(tmp_path), "--no-figures"]) == 0
     _, data = read_csv(tmp_path / "pendulum.csv")
     t = np.linspace(0.0, 10.0, 1001)  # the tutorial's 10 s at 100 Hz
@@ -112,6 +113,8 @@ def test_pendulum_reproduces_the_tutorials_run(tmp_path):
 
 
 def test_passive_reproduces_the_tutorials_run(tmp_path):
+    from scipy.integrate import solve_ivp  # here, not at collection: only the worker running it pays
+
     assert main(["demo", "passive", "--headless", "--out", str(tmp_path), "--no-figures"]) == 0
     _, data = read_csv(tmp_path / "passive.csv")
     t = np.linspace(0.0, 10.0, 2001)  # 10 s at 200 Hz, as twojointarm_passive.py

@@ -1,22 +1,14 @@
 """armgame derive: the SymPy derivation printed as M, C, G and checked against the numeric core, and M, C
 and G checked against the tutorial's method at many more states than the command does.
 
-One module, so one xdist worker derives the two-joint arm once (``derive_two_joint`` is cached).
+One module, so one xdist worker derives the two-joint arm once (``derive_two_joint`` is cached), and
+SymPy is imported in the tests, not at collection: only that worker pays its half second.
 """
 
 import numpy as np
 import pytest
-import sympy as sp
 
 from armgame.cli import main
-from armgame.derive import (
-    MATCH_TOLERANCE,
-    compare_with_core,
-    derive_one_joint,
-    derive_two_joint,
-    format_text,
-    parameter_values,
-)
 from armgame.physics import TUTORIAL_ARM, TwoJointArm
 
 
@@ -49,6 +41,8 @@ def test_a_wrong_core_is_reported_as_differing(monkeypatch, capsys):
 
 
 def test_one_joint_derivation_is_exact():
+    from armgame.derive import MATCH_TOLERANCE, compare_with_core, derive_one_joint, format_text
+
     d = derive_one_joint()
     assert compare_with_core(d, states=10, seed=3) <= MATCH_TOLERANCE
     assert "qd1" in format_text(d)
@@ -60,6 +54,10 @@ def test_bad_states_is_a_one_line_error(capsys):
 
 
 def test_mass_coriolis_gravity_equal_the_euler_lagrange_derivation():
+    import sympy as sp
+
+    from armgame.derive import derive_two_joint, parameter_values
+
     d = derive_two_joint()
     args = (*d.q, *d.qd, *d.params)
     M_fn, C_fn, G_fn = (sp.lambdify(args, e, "numpy") for e in (d.M, d.C, d.G))

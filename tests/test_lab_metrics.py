@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy.integrate import quad
 
 from armgame.errors import UserError
 from armgame.lab import metrics
@@ -117,6 +116,8 @@ def test_sine_bump_path_has_its_known_deviation_length_and_initial_direction(bum
     speed = dp * np.hypot(D, bump * np.pi * np.cos(np.pi * p))
     above = np.flatnonzero(speed >= 0.05 * speed.max())
     p_on, p_end = p[above[0]], p[above[-1]]
+    from scipy.integrate import quad  # here, not at collection: only the worker running it pays
+
     arc = quad(lambda q: math.hypot(D, bump * math.pi * math.cos(math.pi * q)), p_on, p_end, epsabs=1e-14)[0]
     chord = float(np.hypot(*(curved(np.array([p_end])) - curved(np.array([p_on])))[0]))
     assert m.path_length_ratio == pytest.approx(arc / chord, rel=1e-5)
