@@ -188,21 +188,31 @@ def test_round_off_in_sin_and_cos_stays_well_within_the_stated_tolerance():
     assert 0.0 < worst < STATE_TOLERANCE / 100
 
 
+#: A short game whose hand crosses ``knife_edge_target``'s edge at step 60.
+KNIFE_SCRIPT = [InputEvent(0, "d", "down"), InputEvent(10, "j", "down"), InputEvent(40, "d", "up")]
+
+
+def knife_edge_target(config: GameConfig, inside: bool) -> Target:
+    """A target whose edge passes within a few ulps of where ``KNIFE_SCRIPT``'s hand is after step 60:
+    its centre just ahead of the hand along its motion, so the hand is outside before and, by a hair,
+    inside (or outside) after."""
+    probe = GameSession(config, compiled=False)
+    probe.play(KNIFE_SCRIPT, stop_step=59)
+    px, py = probe.hand()
+    probe.advance(1)
+    hx, hy = probe.hand()
+    r = config.target_radius * (1.0 - 1e-15 if inside else 1.0 + 1e-15)
+    ux, uy = (hx - px) / math.dist((hx, hy), (px, py)), (hy - py) / math.dist((hx, hy), (px, py))
+    return Target(hx + r * ux, hy + r * uy, config.target_radius)
+
+
 @pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("inside", [True, False])
 def test_a_hit_on_the_knife_edge_is_decided_as_the_single_session_decides(kernel, inside):
     """A target whose edge passes within a few ulps of where the hand will be."""
-    script = [InputEvent(0, "d", "down"), InputEvent(10, "j", "down"), InputEvent(40, "d", "up")]
+    script = KNIFE_SCRIPT
     config = GameConfig(time_limit=1.0)
-    probe = GameSession(config)
-    probe.play(script, stop_step=59)
-    px, py = probe.hand()
-    probe.advance(1)
-    hx, hy = probe.hand()
-    # The centre just ahead of the hand along its motion: outside before step 60, inside after.
-    r = config.target_radius * (1.0 - 1e-15 if inside else 1.0 + 1e-15)
-    ux, uy = (hx - px) / math.dist((hx, hy), (px, py)), (hy - py) / math.dist((hx, hy), (px, py))
-    edge = Target(hx + r * ux, hy + r * uy, config.target_radius)
+    edge = knife_edge_target(config, inside)
     single = GameSession(config)
     single.rules.target = edge
     batch = batch_of([config, config], kernel)

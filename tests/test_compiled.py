@@ -5,7 +5,6 @@ kernels). The single session's own compiled loop (``_ckernel.game_steps``) is he
 Python loop, ``GameSession(compiled=False)``, with ``==``.
 """
 
-import math
 import os
 import random
 import types
@@ -17,7 +16,7 @@ import pytest
 from armgame.game import session as session_module
 from armgame.game.batch import BatchGameSession, compiled
 from armgame.game.muscles import MuscleSpec
-from armgame.game.rules import GameConfig, Target
+from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent, NonFiniteStateError
 
 needs_build = pytest.mark.skipif(not (compiled.AVAILABLE or os.environ.get("ARMGAME_REQUIRE_COMPILED")),
@@ -217,21 +216,15 @@ def test_a_bots_game_steps_one_period_at_a_time_as_the_python_loop_does():
 def test_a_hit_on_the_knife_edge_is_decided_by_the_python_loops_own_test(inside):
     """A target whose edge passes within an ulp or so of where the hand will be: the loop's looser
     "near" stops there and the session's own ``**`` test decides, as the Python loop does."""
-    script = [InputEvent(0, "d", "down"), InputEvent(10, "j", "down"), InputEvent(40, "d", "up")]
+    from test_batch import KNIFE_SCRIPT, knife_edge_target
+
     config = GameConfig(time_limit=1.0)
-    probe = GameSession(config, compiled=False)
-    probe.play(script, stop_step=59)
-    px, py = probe.hand()
-    probe.advance(1)
-    hx, hy = probe.hand()
-    r = config.target_radius * (1.0 - 1e-15 if inside else 1.0 + 1e-15)
-    ux, uy = (hx - px) / math.dist((hx, hy), (px, py)), (hy - py) / math.dist((hx, hy), (px, py))
-    edge = Target(hx + r * ux, hy + r * uy, config.target_radius)
+    edge = knife_edge_target(config, inside)
     results = []
     for compiled_loop in (True, False):
         single = GameSession(config, compiled=compiled_loop)
         single.rules.target = edge
-        results.append(single.play(script))
+        results.append(single.play(KNIFE_SCRIPT))
         assert (60 * config.dt in single.rules.board.hit_times) == inside
     assert results[0] == results[1]
 

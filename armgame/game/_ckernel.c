@@ -318,6 +318,30 @@ static inline void accel_full(const Arm *arm, double q1, double q2, double w1, d
     accel_trig(arm, q1, q2, arm->b * cos(q2), arm->b * sin(q2), w1, w2, t1, t2, o1, o2);
 }
 
+/* integrators._rk4, exactly: x (q1, q2, w1, w2) one step of dt on, torques t1, t2 held. h and k are
+ * taken from dt as the Python step takes them (0.5 dt and dt times _SIXTH, 1/6 rounded once). */
+static inline void rk4_exact(const Arm *arm, double t1, double t2, double dt, double x[4])
+{
+    const double q1 = x[0], q2 = x[1], w1 = x[2], w2 = x[3];
+    const double h = 0.5 * dt;
+    double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
+    accel_full(arm, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
+    const double v1 = w1 + h * ka1;
+    const double v2 = w2 + h * ka2;
+    accel_full(arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
+    const double u1 = w1 + h * kb1;
+    const double u2 = w2 + h * kb2;
+    accel_full(arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
+    const double z1 = w1 + dt * kc1;
+    const double z2 = w2 + dt * kc2;
+    accel_full(arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
+    const double k = dt * (1.0 / 6.0);
+    x[0] = q1 + k * (w1 + z1 + 2.0 * (v1 + u1));
+    x[1] = q2 + k * (w2 + z2 + 2.0 * (v2 + u2));
+    x[2] = w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1));
+    x[3] = w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
+}
+
 static int arg_double(PyObject *obj, double *out)
 {
     if (PyFloat_CheckExact(obj)) {
@@ -326,6 +350,35 @@ static int arg_double(PyObject *obj, double *out)
     }
     *out = PyFloat_AsDouble(obj);
     return (*out == -1.0 && PyErr_Occurred()) ? -1 : 0;
+}
+
+/* The calls of one game (game_steps, rk4_step): ``expected`` arguments, the first two the params bytes
+ * (P_* doubles, into p) and the mode, then ``count`` doubles from ``first`` on (into v). */
+static int one_game_args(const char *name, PyObject *const *args, Py_ssize_t nargs, Py_ssize_t expected,
+                         double *p, Arm *arm, Py_ssize_t first, int count, double *v)
+{
+    if (nargs != expected) {
+        PyErr_Format(PyExc_TypeError, "%s takes %zd arguments, got %zd", name, expected, nargs);
+        return -1;
+    }
+    if (!PyBytes_Check(args[0]) || PyBytes_GET_SIZE(args[0]) != P_COUNT * (Py_ssize_t)sizeof(double)) {
+        PyErr_SetString(PyExc_ValueError, "params: expected bytes of the P_* doubles");
+        return -1;
+    }
+    memcpy(p, PyBytes_AS_STRING(args[0]), P_COUNT * sizeof(double));
+    const long mode = PyLong_AsLong(args[1]);
+    if (mode == -1 && PyErr_Occurred())
+        return -1;
+    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY) {
+        PyErr_Format(PyExc_ValueError, "mode %ld: expected mode 0, 1 or 2", mode);
+        return -1;
+    }
+    for (int i = 0; i < count; i++)
+        if (arg_double(args[first + i], &v[i]) < 0)
+            return -1;
+    const Arm value = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], (int)mode};
+    *arm = value;
+    return 0;
 }
 
 /* The relative margin of game_steps' "near" test over the exact one (which Python makes): far above
@@ -344,73 +397,43 @@ PyDoc_STRVAR(game_steps_doc,
 static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    if (nargs != 22) {
-        PyErr_Format(PyExc_TypeError, "game_steps takes 22 arguments, got %zd", nargs);
+    double p[P_COUNT], v[19];
+    Arm arm;
+    if (one_game_args("game_steps", args, nargs, 22, p, &arm, 3, 19, v) < 0)
         return NULL;
-    }
-    if (!PyBytes_Check(args[0]) || PyBytes_GET_SIZE(args[0]) != P_COUNT * (Py_ssize_t)sizeof(double)) {
-        PyErr_SetString(PyExc_ValueError, "params: expected bytes of the P_* doubles");
-        return NULL;
-    }
-    double p[P_COUNT];
-    memcpy(p, PyBytes_AS_STRING(args[0]), sizeof p);
-    const long mode = PyLong_AsLong(args[1]);
     const Py_ssize_t n = PyLong_AsSsize_t(args[2]);
-    if (PyErr_Occurred())
+    if (n == -1 && PyErr_Occurred())
         return NULL;
-    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY || n < 0) {
-        PyErr_Format(PyExc_ValueError, "mode %ld, %zd steps: expected mode 0, 1 or 2 and steps >= 0", mode, n);
+    if (n < 0) {
+        PyErr_Format(PyExc_ValueError, "%zd steps: expected steps >= 0", n);
         return NULL;
     }
-    double v[19];
-    for (int i = 0; i < 19; i++)
-        if (arg_double(args[3 + i], &v[i]) < 0)
-            return NULL;
-    double q1 = v[0], q2 = v[1], w1 = v[2], w2 = v[3];
+    double x[4] = {v[0], v[1], v[2], v[3]};
     double a0 = v[4], a1 = v[5], a2 = v[6], a3 = v[7];
     const double g0 = v[8], g1 = v[9], g2 = v[10], g3 = v[11];
     const double r0 = v[12], r1 = v[13], r2 = v[14], r3 = v[15];
     const double x0 = v[16], y0 = v[17], rr = v[18];
-    const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], (int)mode};
-    const double dt = p[P_DT], h = p[P_H], k = p[P_K], l1 = p[P_L1], l2 = p[P_L2];
+    const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
     const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
     const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
     const double near = rr * (1.0 + NEAR_MARGIN);
-    double p1 = q1, p2 = q2, p3 = w1, p4 = w2, hx = 0.0, hy = 0.0;
+    double previous[4] = {x[0], x[1], x[2], x[3]}, hx = 0.0, hy = 0.0;
     Py_ssize_t ran = 0;
     int flagged = 0;
     while (ran < n) {
-        /* GameSession._advance: torque from the activations, then the muscles step. */
+        /* GameSession._advance: torque from the activations, then the muscles step, then RK4. */
         const double t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
         const double t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
         a0 += (g0 - a0) * r0;
         a1 += (g1 - a1) * r1;
         a2 += (g2 - a2) * r2;
         a3 += (g3 - a3) * r3;
-        p1 = q1;
-        p2 = q2;
-        p3 = w1;
-        p4 = w2;
-        /* integrators._rk4 */
-        double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
-        accel_full(&arm, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
-        const double v1 = w1 + h * ka1;
-        const double v2 = w2 + h * ka2;
-        accel_full(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
-        const double u1 = w1 + h * kb1;
-        const double u2 = w2 + h * kb2;
-        accel_full(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
-        const double z1 = w1 + dt * kc1;
-        const double z2 = w2 + dt * kc2;
-        accel_full(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
-        q1 = p1 + k * (w1 + z1 + 2.0 * (v1 + u1));
-        q2 = p2 + k * (w2 + z2 + 2.0 * (v2 + u2));
-        w1 = p3 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1));
-        w2 = p4 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
+        memcpy(previous, x, sizeof previous);
+        rk4_exact(&arm, t1, t2, dt, x);
         ran++;
-        const double s12 = q1 + q2;
-        hx = l1 * cos(q1) + l2 * cos(s12);
-        hy = l1 * sin(q1) + l2 * sin(s12);
+        const double s12 = x[0] + x[1];
+        hx = l1 * cos(x[0]) + l2 * cos(s12);
+        hy = l1 * sin(x[0]) + l2 * sin(s12);
         const double dx = hx - x0, dy = hy - y0;
         if (dx * dx + dy * dy <= near) {
             flagged = 1;
@@ -420,13 +443,13 @@ static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t na
     PyObject *out = PyTuple_New(16);
     if (out == NULL)
         return NULL;
-    const double values[14] = {q1, q2, w1, w2, p1, p2, p3, p4, a0, a1, a2, a3, hx, hy};
+    const double values[14] = {x[0], x[1], x[2], x[3], previous[0], previous[1], previous[2], previous[3],
+                               a0, a1, a2, a3, hx, hy};
     PyObject *item = PyLong_FromSsize_t(ran);
     if (item == NULL)
         goto fail;
     PyTuple_SET_ITEM(out, 0, item);
-    item = PyBool_FromLong(flagged);
-    PyTuple_SET_ITEM(out, 1, item);
+    PyTuple_SET_ITEM(out, 1, PyBool_FromLong(flagged));
     for (int i = 0; i < 14; i++) {
         item = PyFloat_FromDouble(values[i]);
         if (item == NULL)
@@ -447,45 +470,13 @@ PyDoc_STRVAR(rk4_step_doc,
 static PyObject *rk4_step(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
-    if (nargs != 9) {
-        PyErr_Format(PyExc_TypeError, "rk4_step takes 9 arguments, got %zd", nargs);
+    double p[P_COUNT], v[7];
+    Arm arm;
+    if (one_game_args("rk4_step", args, nargs, 9, p, &arm, 2, 7, v) < 0)
         return NULL;
-    }
-    if (!PyBytes_Check(args[0]) || PyBytes_GET_SIZE(args[0]) != P_COUNT * (Py_ssize_t)sizeof(double)) {
-        PyErr_SetString(PyExc_ValueError, "params: expected bytes of the P_* doubles");
-        return NULL;
-    }
-    double p[P_COUNT];
-    memcpy(p, PyBytes_AS_STRING(args[0]), sizeof p);
-    const long mode = PyLong_AsLong(args[1]);
-    if (mode == -1 && PyErr_Occurred())
-        return NULL;
-    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY) {
-        PyErr_Format(PyExc_ValueError, "mode %ld: expected mode 0, 1 or 2", mode);
-        return NULL;
-    }
-    double v[7];
-    for (int i = 0; i < 7; i++)
-        if (arg_double(args[2 + i], &v[i]) < 0)
-            return NULL;
-    const double q1 = v[0], q2 = v[1], w1 = v[2], w2 = v[3], t1 = v[4], t2 = v[5], dt = v[6];
-    const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], (int)mode};
-    /* integrators._rk4, h and k from this dt as the Python step takes them. */
-    const double h = 0.5 * dt;
-    double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
-    accel_full(&arm, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
-    const double v1 = w1 + h * ka1;
-    const double v2 = w2 + h * ka2;
-    accel_full(&arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
-    const double u1 = w1 + h * kb1;
-    const double u2 = w2 + h * kb2;
-    accel_full(&arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
-    const double z1 = w1 + dt * kc1;
-    const double z2 = w2 + dt * kc2;
-    accel_full(&arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
-    const double k = dt * (1.0 / 6.0);
-    return Py_BuildValue("(dddd)", q1 + k * (w1 + z1 + 2.0 * (v1 + u1)), q2 + k * (w2 + z2 + 2.0 * (v2 + u2)),
-                         w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1)), w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2)));
+    double x[4] = {v[0], v[1], v[2], v[3]};
+    rk4_exact(&arm, v[4], v[5], v[6], x);
+    return Py_BuildValue("(dddd)", x[0], x[1], x[2], x[3]);
 }
 
 static PyMethodDef methods[] = {
