@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import math
+import struct
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass
 
@@ -19,19 +20,51 @@ from .. import __version__
 from ..errors import UserError
 from ..limits import MAX_EVENTS
 from ..physics.integrators import _SIXTH, Integrator
+from ..physics.params import TwoJointParams
 from ..physics.twojoint import TwoJointArm
 from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
 
-try:  # the compiled loop (setup.py builds it where a C compiler is found)
+try:  # the compiled loops (setup.py builds them where a C compiler is found)
     from . import _ckernel
 except ImportError:
     _ckernel = None
-#: ``_ckernel.game_steps``, if built in the convention this module speaks (a stale build is not used).
-_c_game_steps = _ckernel.game_steps if getattr(_ckernel, "VERSION", None) == 3 else None
-_c_rk4_step = _ckernel.rk4_step if _c_game_steps is not None else None
-#: How many doubles ``game_steps`` reads from its params (``_ckernel.c``'s P_* layout).
-_C_PARAMS = 26
+
+#: The calling convention of ``_ckernel.c`` this package speaks: this module's one game and
+#: ``batch/compiled.py``'s batches. A build of another (a stale ``.so``) is not used.
+KERNEL_VERSION = 3
+#: How many doubles the kernel's params hold (its P_* enum).
+KERNEL_PARAMS = 26
+
+
+def speaks_our_convention(module: object) -> bool:
+    """Whether a built ``_ckernel`` is the one this package calls (not a stale build of another)."""
+    return getattr(module, "VERSION", None) == KERNEL_VERSION and getattr(module, "PARAMS", None) == KERNEL_PARAMS
+
+
+if _ckernel is not None and not speaks_our_convention(_ckernel):
+    _ckernel = None
+_c_game_steps = None if _ckernel is None else _ckernel.game_steps
+_c_rk4_step = None if _ckernel is None else _ckernel.rk4_step
+
+
+def kernel_params(model: TwoJointArm, dt: float, shoulder: Sequence[float], elbow: Sequence[float],
+                  radius: float = 0.0, near: float = 0.0, reach: tuple[float, float] = (0.0, 0.0),
+                  limit2: float = 0.0) -> list[float]:
+    """The kernel's params in the order of ``_ckernel.c``'s P_* enum: the arm, dt and the muscles'
+    moment arms (``shoulder``, ``elbow``: each muscle's), then what only a batch reads (its targets'
+    radius and "near" bound, its hands' move bounds, the fast stages' series limit)."""
+    p = model.params
+    values = [dt, 0.5 * dt, dt * _SIXTH, model.b, model.d, model.a * model.d - model.d * model.d, model.a - model.d,
+              model.g1, model.g2, p.damping1, p.damping2, p.l1, p.l2, radius, near, *reach, limit2, *shoulder, *elbow]
+    assert len(values) == KERNEL_PARAMS
+    return values
+
+
+def kernel_mode(params: TwoJointParams) -> int:
+    """Which accel the kernel runs for arm parameters ``params`` (``TwoJointArm._build_components``'s)."""
+    return 2 if params.has_gravity else 1 if params.has_damping else 0
+
 
 DOWN, UP = "down", "up"
 RESET_KEY, TOGGLE_ARM_KEY = "space", "tab"
@@ -169,24 +202,16 @@ class GameSession:
         """(params, mode, the step it replaces) for ``_ckernel.game_steps``, or None where it cannot run."""
         if _c_game_steps is None or self.config.integrator != "rk4":
             return None
-        import struct
-
-        model, p, dt = self.model, self.model.params, self.config.dt
         moments = self.muscles.moments
-        # The order of _ckernel.c's P_* enum; the batch's own entries (radius, slack bounds) unread here.
-        values = [dt, 0.5 * dt, dt * _SIXTH, model.b, model.d, model.a * model.d - model.d * model.d,
-                  model.a - model.d, model.g1, model.g2, p.damping1, p.damping2, p.l1, p.l2, 0.0, 0.0, 0.0, 0.0, 0.0,
-                  *(m[0] for m in moments), *(m[1] for m in moments)]
-        assert len(values) == _C_PARAMS
-        mode = 2 if p.has_gravity else 1 if p.has_damping else 0
-        return struct.pack(f"={_C_PARAMS}d", *values), mode, self._physics_step
+        values = kernel_params(self.model, self.config.dt, [m[0] for m in moments], [m[1] for m in moments])
+        return struct.pack(f"={KERNEL_PARAMS}d", *values), kernel_mode(self.model.params), self._physics_step
 
     def unloaded_step(self) -> Callable[..., tuple[float, float, float, float]]:
         """The physics step of the arm with nothing added: ``_physics_step`` itself, or its operations in C
         (``_ckernel.rk4_step``, the same floats) where the compiled loop runs. For loops of their own
         (the lab's), which step the arm one step at a time."""
         compiled = self._compiled
-        if compiled is None or compiled[2] is not self._physics_step or _c_rk4_step is None:
+        if compiled is None or compiled[2] is not self._physics_step:
             return self._physics_step
         return functools.partial(_c_rk4_step, compiled[0], compiled[1])
 

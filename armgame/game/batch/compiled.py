@@ -1,9 +1,11 @@
 """The compiled kernel's wrapper: the batched game's hot loop in C, optional, and exact.
 
-Owns the calling convention of ``armgame/game/_ckernel.c`` (built by ``pip install`` as
-``armgame.game._ckernel``; it stays beside the game package so the build does not move) and the
-way ``play`` runs on it. Invariant: a game run here is the single session's game bit for bit
-(``fast``: within ``session.STATE_TOLERANCE``); a build of another convention is never called.
+Owns the way a batch runs on ``armgame/game/_ckernel.c`` (built by ``pip install`` as
+``armgame.game._ckernel``; it stays beside the game package so the build does not move), and
+``play`` there; the kernel's calling convention (its version, its params' layout) is
+``game/session.py``'s, whose single game runs on the same file. Invariant: a game run here is
+the single session's game bit for bit (``fast``: within ``session.STATE_TOLERANCE``); a build of
+another convention is never called.
 
 ``_ckernel`` (``_ckernel.c``, built by ``pip install`` where a C compiler exists) runs each
 game of a batch from its step to a halt step in registers: the muscles, RK4 and the hand's
@@ -30,31 +32,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...physics.batch import SERIES_LIMIT
-from ...physics.integrators import _SIXTH
-from ..session import DOWN
+from ..session import DOWN, KERNEL_VERSION, _ckernel, kernel_mode, kernel_params, speaks_our_convention
 from .numpy_kernel import NEAR, hand_move_bounds
 from .schedule import MuscleEvents
-
-try:
-    from .. import _ckernel
-except ImportError:  # built without a C compiler: numpy does the work
-    _ckernel = None
 
 if TYPE_CHECKING:
     from .session import BatchGameSession
 
-#: The calling convention this module speaks; a build of another (a stale ``.so``) is not used.
-KERNEL_VERSION = 3
-_PARAMS = 26
-
-
-def speaks_our_convention(module: object) -> bool:
-    """Whether a built ``_ckernel`` is the one this module calls (not a stale build of another)."""
-    return getattr(module, "VERSION", None) == KERNEL_VERSION and getattr(module, "PARAMS", None) == _PARAMS
-
-
-if _ckernel is not None and not speaks_our_convention(_ckernel):
-    _ckernel = None
+__all__ = ["AVAILABLE", "KERNEL_VERSION", "CompiledKernel", "speaks_our_convention"]
 
 #: Whether the compiled kernel is here to use.
 AVAILABLE = _ckernel is not None
@@ -72,15 +57,10 @@ class CompiledKernel:
         model, config = batch.model, batch.config
         p = model.params
         dt, radius = config.dt, config.target_radius
-        self.mode = 2 if p.has_gravity else 1 if p.has_damping else 0
-        # The order of _ckernel.c's P_* enum.
-        self.params = np.array([
-            dt, 0.5 * dt, dt * _SIXTH, model.b, model.d, model.a * model.d - model.d * model.d, model.a - model.d,
-            model.g1, model.g2, p.damping1, p.damping2,
-            p.l1, p.l2, radius, NEAR * radius * radius, *hand_move_bounds(p.l1, p.l2), SERIES_LIMIT * SERIES_LIMIT,
-            *batch._shoulder, *batch._elbow,
-        ], dtype=float)
-        assert len(self.params) == _PARAMS
+        self.mode = kernel_mode(p)
+        self.params = np.array(kernel_params(model, dt, batch._shoulder, batch._elbow, radius,
+                                             NEAR * radius * radius, hand_move_bounds(p.l1, p.l2),
+                                             SERIES_LIMIT * SERIES_LIMIT), dtype=float)
         self.flags = np.zeros(batch.n, dtype=np.uint8)
         self.no_events = MuscleEvents.none(batch.n)
 
