@@ -16,7 +16,7 @@ from .words import closest
 
 # Commands whose module exists; each module's register() adds its parser.
 COMMAND_MODULES = ("play", "simulate", "demo", "derive", "bench", "scores", "replay", "verify", "lab", "analyze",
-                   "settings")
+                   "settings", "classroom")
 
 
 class _Parser(argparse.ArgumentParser):

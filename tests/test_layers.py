@@ -28,13 +28,15 @@ from armgame.records import replay as replay_module
 from armgame.records.replay import Replay, now_iso
 
 ABOVE_LAB = ("armgame.ui", "armgame.commands", "armgame.cli", "armgame.demos", "armgame.env", "armgame.bench",
-             "pygame")
+             "armgame.classroom", "pygame")
 #: What each layer must never import, anywhere in its files (inside functions too: a lazy import is a dependency).
 LAYERS = {
     "armgame.physics": ("armgame.game", "armgame.lab", "armgame.records", *ABOVE_LAB),
     "armgame.game": ("armgame.lab", *ABOVE_LAB),
     "armgame.records": ("armgame.lab", *ABOVE_LAB),
     "armgame.lab": ABOVE_LAB,
+    # The live class: above records, lab and game, below the commands; pygame only through ui (class show).
+    "armgame.classroom": tuple(name for name in ABOVE_LAB if name != "armgame.classroom"),
 }
 ROOT = Path(armgame.__file__).parent
 

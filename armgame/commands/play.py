@@ -64,6 +64,9 @@ def _add_score_options(p: argparse.ArgumentParser) -> None:
                    "otherwise; a headless game enters the table only with --name)")
     p.add_argument("--record", metavar="FILE", help="save the game's replay to FILE (JSON)")
     add_scores_option(p)
+    from .classroom import add_join_options
+
+    add_join_options(p)
 
 
 def game_config(args: argparse.Namespace):
@@ -106,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.script and (len(args.script) > 1 or Path(args.script[0]).is_dir()):
         return _play_class(args)
+    args.membership = _join(args)
     if args.script:
         args.script = args.script[0]
     window = None if args.headless else _window_settings(args)  # before the game: its keys may come from there
@@ -130,6 +134,33 @@ def run(args: argparse.Namespace) -> int:
         result = session.result()
     _report(session, result, args)
     return 0
+
+
+def _join(args: argparse.Namespace):
+    """With --join: the class joined, and the game set to the class's (its seed, the standard clock)."""
+    from .classroom import join_class
+
+    if args.join is not None:
+        if args.duration != 60.0:
+            raise UserError("a class plays the standard 60 s game: leave out --duration")
+        if args.name is not None:
+            _check_score_options(args)  # the name is checked before it is sent
+    membership = join_class(args)
+    if membership is not None:
+        if args.seed not in (DEFAULT_SEED, membership.seed):
+            raise UserError(f"the class plays seed {membership.seed}: leave out --seed")
+        args.seed = membership.seed
+    return membership
+
+
+def _hand_in(replay, membership, out) -> object:
+    """Hand a finished game in to the class; one line on what became of it (kept in the outbox if the
+    class could not be reached)."""
+    from ..classroom.client import hand_in
+
+    result = hand_in(membership, replay.to_bytes())
+    print(result.message, file=out)
+    return result
 
 
 def _report(session, result, args: argparse.Namespace) -> None:
@@ -216,7 +247,13 @@ def _keep(session, args: argparse.Namespace):
     if args.record:
         replay.save(check_output_path(user_path(args.record, "--record"), "replay"))
         print(f"replay saved to {args.record}", file=out)
-    if args.name is None or not replay.complete:
+    membership = getattr(args, "membership", None)
+    if membership is not None and replay.complete:
+        _hand_in(replay, membership, out)
+        return None
+    if args.name is None or not replay.complete or membership is not None:
+        if membership is not None:
+            print("the game was stopped before the end: not handed in to the class", file=out)
         if not args.headless and session.steps > 0:  # a window's game: nothing is lost (Esc on the end screen)
             _keep_replay(replay, args, out)
         elif args.name is not None:
@@ -312,6 +349,10 @@ def _standing(session, args: argparse.Namespace):
 
     from ..ui.render import Standing
 
+    membership = getattr(args, "membership", None)
+    if membership is not None:
+        return _class_standing(session, args, membership)
+
     def standing(name: str | None) -> Standing | None:
         args.name = name or args.name
         try:
@@ -325,6 +366,52 @@ def _standing(session, args: argparse.Namespace):
         return Standing(rank, len(entries), _rows([(e.name, e.score) for e in entries], rank), list_name(kind))
 
     return standing
+
+
+def _class_standing(session, args: argparse.Namespace, membership):
+    """The end screen in a live class: the game is handed in on a thread (the window never waits for
+    the network), and the screen shows what became of it, and the class's top, when the answer comes."""
+    import threading
+
+    from ..records.replay import Replay
+    from ..ui.render import Standing
+
+    def standing(name: str | None) -> Standing | None:
+        args.kept = True
+        if not session.over:
+            return Standing(None, 0, (), "the class", note="Stopped before the end: not handed in")
+        replay = Replay.from_session(session, "bot" if args.bot else "keyboard", args.bot, membership.name)
+        done: list = []
+        thread = threading.Thread(target=lambda: done.append(_quiet_hand_in(replay, membership)), daemon=True)
+        thread.start()
+
+        def later() -> Standing | None:
+            if not done:
+                return None
+            result = done[0]
+            answer = result.answer
+            if answer is None:
+                return Standing(None, 0, (), "the class", note=_screen_line(result.message))
+            top = tuple((int(r), str(n), int(v)) for r, n, v in answer.get("top", ()))
+            where = "the class" if answer.get("list") == "students" else "the programs"
+            return Standing(int(answer["rank"]), int(answer["of"]), top, where,
+                            note=_screen_line(result.message))
+
+        return Standing(None, 0, (), "the class", note="Handing your game in...", later=later)
+
+    return standing
+
+
+def _quiet_hand_in(replay, membership):
+    from ..classroom.client import hand_in
+
+    return hand_in(membership, replay.to_bytes())
+
+
+def _screen_line(message: str) -> str:
+    """A hand-in's message for the end screen: its first clause, then the rest on a line of its own."""
+    first, _, rest = message.partition(": ")
+    return f"{first[:1].upper()}{first[1:]}:\n{rest}" if rest else message
 
 
 def _list_it_would_join(session, args: argparse.Namespace, table) -> str:
@@ -386,11 +473,13 @@ def _play_in_window(session, args: argparse.Namespace, window):
             path = Path(record)
             args.record = str(path.with_name(f"{path.stem}-{games[0]}{path.suffix}"))
         new = GameSession(game_config(args))
-        return NextGame(new, _bot_driver(new, args), _standing(new, args), _preview(new, args))
+        return NextGame(new, _bot_driver(new, args), _standing(new, args),
+                        None if getattr(args, "membership", None) else _preview(new, args))
 
     played = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps,
                          driver=_bot_driver(session, args), ask_name=named is None, trail=args.trail,
-                         standing=_standing(session, args), preview=_preview(session, args), next_game=next_game,
+                         standing=_standing(session, args), next_game=next_game,
+                         preview=None if getattr(args, "membership", None) else _preview(session, args),
                          mode=f"AUTOPILOT: {args.bot}" if args.bot else f"PLAY   seed {args.seed}")
     args.name = args.name or played.player_name  # the name typed on the end screen
     return played.session

@@ -376,6 +376,8 @@ class GameWindow:
             self._show_standing(None)
 
     def hud(self) -> Hud:
+        if self.standing is not None and self.standing.later is not None:
+            self.standing = self.standing.later() or self.standing
         now = self.session.time
         self.hits = [h for h in self.hits if 0.0 <= now - h[2] < PLUS_ONE_TIME]
         hud = Hud(mode=self.mode, help=self.help_items(), paused=self.paused,

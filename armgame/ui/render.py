@@ -16,7 +16,7 @@ arm's workspace except the panels that say the game is paused or over.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import pygame
@@ -169,6 +169,11 @@ class Standing:
     top: tuple[tuple[int, str, int], ...]  # (rank, name, score), best first; the game's own row may follow
     list_name: str = "the ranked table"  # the list the game went to: ranked, practice, programs, custom games
     pending: bool = False
+    #: A line shown instead of "Rank N of M" (a live class's: "Handed in: 3rd of 12 in the class").
+    note: str | None = None
+    #: Asked every frame while the standing is still on its way (a hand-in over the network): returns
+    #: the standing to show once it has arrived, None until then. The window never waits for it.
+    later: Callable[[], Standing | None] | None = None
 
 
 @dataclass
@@ -464,7 +469,9 @@ class GameRenderer:
         standing = hud.standing
         rows: list[tuple[int, str, int]] = []
         if standing is not None:
-            if standing.rank is not None:
+            if standing.note is not None:
+                lines += [(part, normal, p.ink) for part in standing.note.split("\n")]
+            elif standing.rank is not None:
                 would = "You would rank" if standing.pending else "Rank"
                 lines.append((f"{would} {standing.rank} of {standing.entries}", normal, p.ink))
             else:

@@ -1,0 +1,349 @@
+"""The class's ASGI application: Starlette routes in front of the clerk thread.
+
+Every request is hostile until checked, and what it can cost is bounded before any work starts:
+
+* a join code or a teacher's secret that does not match counts against the client's address;
+  past ``MAX_FAILURES`` in ``FAILURE_WINDOW`` seconds the address is refused (429) until the
+  window passes, so a four-letter code cannot be guessed by trying;
+* a body over its limit is refused from its declared length, or cut off as it arrives (413);
+  a body slower than ``BODY_SECONDS`` is cut off (408); at most ``UPLOADS`` bodies are read at
+  once, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES`` whatever arrives;
+* changes go to one worker thread (the ``Clerk``), never the event loop; at most ``QUEUE_LIMIT``
+  wait for it, and past that a client is told to come back (503 with Retry-After): its replay
+  stays on its machine, and the client hands it in again;
+* a hand-in is answered only after the clerk has written it durably (fsynced file and folder);
+* the projector's event stream sends the latest standings, never a backlog, to at most
+  ``MAX_STREAMS`` pages.
+
+Responses are JSON (``{"ok": false, "error": "one line"}`` when refused) or the static pages,
+served with a content security policy that allows no inline script: names reach a page only as
+data that its script sets as text.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from collections import OrderedDict, deque
+from collections.abc import AsyncIterator, Callable
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import asynccontextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from starlette.applications import Starlette
+from starlette.requests import ClientDisconnect, Request
+from starlette.responses import Response, StreamingResponse
+from starlette.routing import Route
+
+from ..errors import UserError
+from . import page
+from .intake import MAX_HANDIN_BYTES, Clerk, RefusedError
+
+QUEUE_LIMIT = 64
+UPLOADS = 8
+BODY_SECONDS = 30.0
+MAX_JSON_BYTES = 4096
+MAX_STREAMS = 64
+HEARTBEAT_SECONDS = 15.0
+MAX_FAILURES = 10
+FAILURE_WINDOW = 60.0
+MAX_TRACKED_ADDRESSES = 10_000
+SECURITY_HEADERS = {
+    "Content-Security-Policy": "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
+                               "img-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'",
+    "X-Content-Type-Options": "nosniff",
+    "Referrer-Policy": "no-referrer",
+    "Cache-Control": "no-store",
+}
+
+
+class Failures:
+    """Wrong codes and secrets per client address, in a sliding window; bounded in addresses kept."""
+
+    def __init__(self, limit: int = MAX_FAILURES, window: float = FAILURE_WINDOW,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.limit, self.window, self.clock = limit, window, clock
+        self.seen: OrderedDict[str, deque[float]] = OrderedDict()
+
+    def _recent(self, address: str) -> deque[float]:
+        now = self.clock()
+        times = self.seen.setdefault(address, deque())
+        self.seen.move_to_end(address)
+        while times and times[0] <= now - self.window:
+            times.popleft()
+        while len(self.seen) > MAX_TRACKED_ADDRESSES:
+            self.seen.popitem(last=False)
+        return times
+
+    def blocked(self, address: str) -> bool:
+        return len(self._recent(address)) >= self.limit
+
+    def failed(self, address: str) -> None:
+        self._recent(address).append(self.clock())
+
+
+@dataclass
+class ClassState:
+    """What the routes share: the clerk and its thread, and what the pages read (built on that thread)."""
+
+    clerk: Clerk
+    join_line: str
+    executor: ThreadPoolExecutor = field(default_factory=lambda: ThreadPoolExecutor(1, "armgame-clerk"))
+    waiting: int = 0
+    failures: Failures = field(default_factory=Failures)
+    uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(UPLOADS))
+    streams: int = 0
+    snapshot: bytes = b"{}"
+    lab: bytes = b"{}"
+    seen_version: int = -1
+    changed: asyncio.Event = field(default_factory=asyncio.Event)
+    stopping: asyncio.Event = field(default_factory=asyncio.Event)
+
+    def publish(self) -> None:
+        """On the clerk's thread: the pages' data, rebuilt after a change (never read half-built)."""
+        if self.clerk.version != self.seen_version:
+            self.seen_version = self.clerk.version
+            standings = self.clerk.standings()
+            standings["join"] = self.join_line
+            self.snapshot = json.dumps(standings, ensure_ascii=True).encode()
+            self.lab = json.dumps(self.clerk.lab_curve(), ensure_ascii=True, allow_nan=False).encode()
+
+    async def run(self, job: Callable[[], Any]) -> Any:
+        """``job`` on the clerk's thread, if the queue has room; the pages are told of any change."""
+        if self.waiting >= QUEUE_LIMIT:
+            raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
+        self.waiting += 1
+        try:
+            def work() -> Any:
+                try:
+                    return job()
+                finally:
+                    self.publish()
+            return await asyncio.get_running_loop().run_in_executor(self.executor, work)
+        finally:
+            self.waiting -= 1
+            self.changed.set()
+            self.changed = asyncio.Event()
+
+
+def _json(data: object, status: int = 200, headers: dict[str, str] | None = None) -> Response:
+    body = json.dumps(data, ensure_ascii=True, allow_nan=False).encode()
+    return Response(body, status, {**SECURITY_HEADERS, **(headers or {})}, media_type="application/json")
+
+
+def _refusal(exc: RefusedError) -> Response:
+    headers = {"Retry-After": "2"} if exc.status in (429, 503) else {}
+    return _json({"ok": False, "error": exc.message}, exc.status, headers)
+
+
+def _address(request: Request) -> str:
+    return request.client.host if request.client else "unknown"
+
+
+def _bearer(request: Request) -> str | None:
+    value = request.headers.get("authorization", "")
+    scheme, _, token = value.partition(" ")
+    return token.strip() or None if scheme.lower() == "bearer" and len(token) <= 200 else None
+
+
+async def _body(request: Request, limit: int) -> bytes:
+    """The request's body, at most ``limit`` bytes, within ``BODY_SECONDS``; else RefusedError."""
+    declared = request.headers.get("content-length")
+    if declared is not None and (not declared.isdigit() or int(declared) > limit):
+        raise RefusedError(413, f"the body is larger than a class takes ({limit:,} bytes)")
+    chunks, size = [], 0
+    try:
+        async with asyncio.timeout(BODY_SECONDS):
+            async for chunk in request.stream():
+                size += len(chunk)
+                if size > limit:
+                    raise RefusedError(413, f"the body is larger than a class takes ({limit:,} bytes)")
+                chunks.append(chunk)
+    except TimeoutError:
+        raise RefusedError(408, f"the body took longer than {BODY_SECONDS:g} s to arrive") from None
+    except ClientDisconnect:
+        raise RefusedError(400, "the client went away before its body arrived") from None
+    return b"".join(chunks)
+
+
+async def _json_body(request: Request) -> dict[str, Any]:
+    data = await _body(request, MAX_JSON_BYTES)
+    try:
+        value = json.loads(data)
+    except (ValueError, RecursionError):
+        raise RefusedError(400, "the body is not JSON") from None
+    if not isinstance(value, dict):
+        raise RefusedError(400, "the body must be a JSON object")
+    return value
+
+
+def _check_code(state: ClassState, request: Request, typed: object) -> None:
+    address = _address(request)
+    if state.failures.blocked(address):
+        raise RefusedError(429, "too many wrong codes from this machine: wait a minute, then check the code on the "
+                           "projector")
+    if not isinstance(typed, str) or len(typed) > 20 or not state.clerk.roster.code_matches(typed):
+        state.failures.failed(address)
+        raise RefusedError(403, "wrong class code: check the code on the projector")
+
+
+def _check_secret(state: ClassState, request: Request) -> None:
+    address = _address(request)
+    if state.failures.blocked(address):
+        raise RefusedError(429, "too many wrong secrets from this machine: wait a minute")
+    secret = _bearer(request)
+    if secret is None or not state.clerk.roster.secret_matches(secret):
+        state.failures.failed(address)
+        raise RefusedError(403, "the teacher's secret is needed for this (it is printed in the teacher's terminal)")
+
+
+def _refusals(handler: Callable[[Request], Any]) -> Callable[[Request], Any]:
+    async def wrapped(request: Request) -> Response:
+        try:
+            return await handler(request)
+        except RefusedError as exc:
+            return _refusal(exc)
+        except UserError as exc:  # a file the clerk could not write: one line, nothing entered
+            return _refusal(RefusedError(503, str(exc)))
+    return wrapped
+
+
+def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None = None,
+              say: Callable[[str], None] = lambda line: None) -> Starlette:
+    """The class's app over ``clerk`` (already open on its folder); ``join_line`` is what students type;
+    ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher."""
+    state = ClassState(clerk, join_line)
+
+    async def load_lab() -> None:
+        for problem in await state.run(clerk.load_lab):
+            say(f"left out of the class curve: {problem}")
+
+    @asynccontextmanager
+    async def lifespan(app: Starlette) -> AsyncIterator[None]:
+        await state.run(lambda: None)  # the first snapshot
+        if on_ready is not None:
+            on_ready()
+        # The lab runs already in the folder are checked again in the background: the page is up at once.
+        loading = asyncio.ensure_future(load_lab())
+        try:
+            yield
+        finally:
+            state.stopping.set()
+            state.changed.set()
+            loading.cancel()
+            state.executor.shutdown(wait=True)  # a hand-in being written is finished, never cut
+
+    async def home(request: Request) -> Response:
+        return page.response("standings.html", SECURITY_HEADERS)
+
+    async def lab_page(request: Request) -> Response:
+        return page.response("lab.html", SECURITY_HEADERS)
+
+    async def teacher_page(request: Request) -> Response:
+        return page.response("teacher.html", SECURITY_HEADERS)
+
+    async def asset(request: Request) -> Response:
+        return page.response(request.path_params["name"], SECURITY_HEADERS)
+
+    async def standings(request: Request) -> Response:
+        return Response(state.snapshot, 200, SECURITY_HEADERS, media_type="application/json")
+
+    async def lab(request: Request) -> Response:
+        return Response(state.lab, 200, SECURITY_HEADERS, media_type="application/json")
+
+    async def events(request: Request) -> Response:
+        if state.streams >= MAX_STREAMS:
+            raise RefusedError(503, "too many pages are open on this class")
+        state.streams += 1
+
+        async def stream() -> AsyncIterator[bytes]:
+            try:
+                sent = None
+                while not state.stopping.is_set():
+                    if state.snapshot is not sent:
+                        sent = state.snapshot
+                        yield b"event: standings\ndata: " + sent + b"\n\n"
+                        yield b"event: lab\ndata: " + state.lab + b"\n\n"
+                    changed = state.changed
+                    try:
+                        await asyncio.wait_for(changed.wait(), HEARTBEAT_SECONDS)
+                    except TimeoutError:
+                        yield b": still here\n\n"
+            finally:
+                state.streams -= 1
+
+        return StreamingResponse(stream(), headers={**SECURITY_HEADERS, "X-Accel-Buffering": "no"},
+                                 media_type="text/event-stream")
+
+    async def join(request: Request) -> Response:
+        body = await _json_body(request)
+        _check_code(state, request, body.get("code"))
+        token = body.get("token")
+        if token is not None and (not isinstance(token, str) or len(token) > 200):
+            raise RefusedError(400, "token must be a string")
+        player, new_token = await state.run(lambda: clerk.join(body.get("name"), token))
+        return _json({"ok": True, "name": player.name, "token": new_token or token, "seed": clerk.roster.seed,
+                      "closed": clerk.roster.closed,
+                      "message": f"joined the class as {player.name}" if new_token is None
+                      else f"joined the class as {player.name} (the name is now this machine's)"})
+
+    async def hand_in(request: Request) -> Response:
+        _check_code(state, request, request.headers.get("x-armgame-code"))
+        token = _bearer(request)
+        if state.uploads.locked():
+            raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
+        async with state.uploads:
+            data = await _body(request, MAX_HANDIN_BYTES)
+        return _json(await state.run(lambda: clerk.hand_in(token, data)))
+
+    async def teacher_hide(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.hide(body.get("name"), bool(body.get("hidden", True))))
+        return _json({"ok": True, "message": message})
+
+    async def teacher_close(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.close(bool(body.get("closed", True))))
+        return _json({"ok": True, "message": message})
+
+    async def teacher_standings(request: Request) -> Response:
+        _check_secret(state, request)
+        return _json(await state.run(lambda: clerk.standings(teacher=True)))
+
+    def csv_route(make: Callable[[], str], filename: str) -> Callable[[Request], Any]:
+        async def route(request: Request) -> Response:
+            _check_secret(state, request)
+            text = await state.run(make)
+            return Response(text.encode("utf-8"), 200, {**SECURITY_HEADERS, "Content-Disposition":
+                                                        f'attachment; filename="{filename}"'},
+                            media_type="text/csv; charset=utf-8")
+        return route
+
+    routes = [
+        Route("/", _refusals(home)),
+        Route("/lab", _refusals(lab_page)),
+        Route("/teacher", _refusals(teacher_page)),
+        Route("/static/{name}", _refusals(asset)),
+        Route("/api/standings", _refusals(standings)),
+        Route("/api/lab", _refusals(lab)),
+        Route("/events", _refusals(events)),
+        Route("/api/join", _refusals(join), methods=["POST"]),
+        Route("/api/handin", _refusals(hand_in), methods=["POST"]),
+        Route("/api/teacher/hide", _refusals(teacher_hide), methods=["POST"]),
+        Route("/api/teacher/close", _refusals(teacher_close), methods=["POST"]),
+        Route("/api/teacher/standings", _refusals(teacher_standings)),
+        Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),
+        Route("/api/teacher/lab.csv", _refusals(csv_route(clerk.lab_csv, "class-lab-reaches.csv"))),
+    ]
+    app = Starlette(routes=routes, lifespan=lifespan)
+    app.state.armgame = state
+    return app
+
+
+def folder_of(app: Starlette) -> Path:
+    return app.state.armgame.clerk.folder

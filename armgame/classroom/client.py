@@ -1,0 +1,332 @@
+"""The student's side of a live class: join, hand in, and keep what could not be handed in.
+
+Kept in the user's own folder (``client_folder``)::
+
+    memberships.json          per class (by its code): the name joined under, its token, the class's seed
+    outbox/<code>/*.json      replays the class could not be reached for, handed in at the next join
+
+A class is known by its code, not its address: the teacher's laptop has another address in
+another room, and a game kept in one lesson is handed in when the student joins the next.
+
+The token is what makes a name this machine's: the class keeps only its hash, and the first
+machine to join under a name gets it. Plain HTTP through the standard library (``urllib``): a
+student's laptop needs nothing beyond armgame's own install. Every call has a timeout; a class
+that is busy (503) or asks to slow down (429) is asked again after the wait it names, a bounded
+number of times; a class that cannot be reached leaves the replay in the outbox and says so in
+one line that names the likely cause (a school network that keeps laptops apart).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import ipaddress
+import json
+import os
+import re
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import UserError
+from ..records.storage import DataFileError, atomic_write_bytes, parse_json, read_limited, user_path
+from .intake import MAX_HANDIN_BYTES
+from .roster import CODE_ALPHABET, CODE_LENGTH, normal_code
+
+CLIENT_ENV = "ARMGAME_CLASS_CLIENT"
+DEFAULT_PORT = 8765
+TIMEOUT = 15.0
+#: How long a hand-in keeps asking a busy class, in all.
+BUSY_PATIENCE = 60.0
+MAX_OUTBOX = 200
+_HOST = re.compile(r"[A-Za-z0-9]([A-Za-z0-9.-]{0,252})")
+
+
+def client_folder() -> Path:
+    """``$ARMGAME_CLASS_CLIENT``, else ``class`` in armgame's per-user data folder."""
+    env = os.environ.get(CLIENT_ENV)
+    if env:
+        return user_path(env, f"${CLIENT_ENV}")
+    from ..records.scores import user_data_dir
+
+    return user_data_dir() / "class"
+
+
+@dataclass(frozen=True)
+class ClassAddress:
+    host: str
+    port: int
+
+    @classmethod
+    def parse(cls, text: str, what: str = "--join") -> ClassAddress:
+        """``HOST:PORT`` (or ``HOST``, the default port; ``[v6]:PORT`` for an IPv6 address)."""
+        text = text.strip()
+        for prefix in ("http://", "https://"):
+            text = text.removeprefix(prefix)
+        text = text.rstrip("/")
+        host, port_text = text, str(DEFAULT_PORT)
+        if text.startswith("["):
+            host, _, rest = text[1:].partition("]")
+            if rest.startswith(":"):
+                port_text = rest[1:]
+            elif rest:
+                raise UserError(f"{what} {text!r}: expected HOST:PORT, e.g. 192.168.1.20:{DEFAULT_PORT}")
+        elif text.count(":") == 1:
+            host, port_text = text.split(":")
+        try:
+            port = int(port_text)
+        except ValueError:
+            port = -1
+        if not 1 <= port <= 65535:
+            raise UserError(f"{what} {text!r}: the port must be a number from 1 to 65535 (HOST:PORT, as the "
+                            f"projector shows)")
+        try:
+            ipaddress.ip_address(host)
+        except ValueError:
+            if not _HOST.fullmatch(host):
+                raise UserError(f"{what} {text!r}: {host!r} is not an address or a machine's name") from None
+        return cls(host, port)
+
+    @property
+    def label(self) -> str:
+        return f"[{self.host}]:{self.port}" if ":" in self.host else f"{self.host}:{self.port}"
+
+    def url(self, path: str) -> str:
+        return f"http://{self.label}{path}"
+
+
+def check_code(text: str, what: str = "--code") -> str:
+    code = normal_code(text)
+    if len(code) != CODE_LENGTH or any(c not in CODE_ALPHABET for c in code):
+        raise UserError(f"{what} {text!r}: a class code is {CODE_LENGTH} letters, as the projector shows it")
+    return code
+
+
+class UnreachableError(UserError):
+    """The class could not be reached; the message names the address and the likely cause."""
+
+
+class RefusalError(UserError):
+    """The class answered no; the message is its one line."""
+
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def _request(address: ClassAddress, path: str, body: bytes, headers: dict[str, str],
+             sleep: Callable[[float], None] = time.sleep) -> dict:
+    """POST ``body``; the JSON answer. Asks a busy class again (bounded); raises UnreachableError or RefusalError."""
+    waited = 0.0
+    while True:
+        req = urllib.request.Request(address.url(path), data=body, method="POST", headers=headers)
+        try:
+            with urllib.request.urlopen(req, timeout=TIMEOUT) as response:
+                return _answer(response.read(1 << 20))
+        except urllib.error.HTTPError as exc:
+            answer = _answer(exc.read(1 << 20), quiet=True)
+            message = str(answer.get("error") or f"the class answered {exc.code} {exc.reason}")
+            if exc.code == 503 and waited < BUSY_PATIENCE:
+                pause = _retry_after(exc.headers.get("Retry-After"))
+                sleep(pause)
+                waited += pause
+                continue
+            raise RefusalError(exc.code, message) from None
+        except (urllib.error.URLError, OSError) as exc:
+            reason = getattr(exc, "reason", exc)
+            raise UnreachableError(
+                f"cannot reach the class at {address.label} ({getattr(reason, 'strerror', None) or reason}): is the "
+                f"class started, and is this machine on the teacher's network? (school Wi-Fi often keeps laptops "
+                f"apart: docs/teaching.md, 'When students cannot join')") from None
+
+
+def _retry_after(value: str | None) -> float:
+    try:
+        return min(max(float(value or 2), 0.5), 10.0)
+    except ValueError:
+        return 2.0
+
+
+def _answer(data: bytes, quiet: bool = False) -> dict:
+    try:
+        value = json.loads(data)
+    except (ValueError, RecursionError):
+        value = None
+    if not isinstance(value, dict):
+        if quiet:
+            return {}
+        raise RefusalError(502, "the class's answer is not armgame's (is that address an armgame class?)")
+    return value
+
+
+# ------------------------------------------------------------------ memberships
+
+@dataclass(frozen=True)
+class Membership:
+    """This machine in a class: where, the code, the name it joined under, its token, the class's seed."""
+
+    address: ClassAddress
+    code: str
+    name: str
+    token: str
+    seed: int
+
+    @property
+    def key(self) -> str:
+        return self.code
+
+
+def _memberships_path() -> Path:
+    return client_folder() / "memberships.json"
+
+
+def remembered() -> dict[str, dict[str, str]]:
+    """Every class this machine joined: ``{CODE: {"name", "token", "seed", "address"}}`` (unreadable: none)."""
+    path = _memberships_path()
+    try:
+        data = parse_json(read_limited(path, 1 << 20, "class memberships", follow=False))
+    except (DataFileError, ValueError, OSError):
+        return {}
+    if not isinstance(data, dict):
+        return {}
+    return {k: v for k, v in data.items() if isinstance(k, str) and isinstance(v, dict)
+            and isinstance(v.get("name"), str) and isinstance(v.get("token"), str)}
+
+
+def last_class() -> tuple[str, str, str] | None:
+    """The class this machine joined last, as (address, code, name), for the menu to offer again."""
+    data = remembered()
+    if not data:
+        return None
+    code, value = max(data.items(), key=lambda kv: str(kv[1].get("at", "")))
+    return str(value.get("address", "")), code, value["name"]
+
+
+def _remember(m: Membership) -> None:
+    data = remembered()
+    data[m.key] = {"name": m.name, "token": m.token, "seed": str(m.seed), "address": m.address.label,
+                   "at": f"{time.time():.3f}"}
+    folder = client_folder()
+    folder.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(_memberships_path(), json.dumps(data, indent=1, ensure_ascii=False).encode(),
+                       "class memberships")
+
+
+def join(address: ClassAddress, code: str, name: str | None) -> Membership:
+    """Join the class (or rejoin: the token kept from the last time proves the name is this machine's).
+
+    ``name`` None: the name this machine joined under last time. Raises UnreachableError or RefusalError."""
+    from ..records.replay import check_name
+    from ..records.standings import player_key
+
+    code = check_code(code)
+    known = remembered().get(code)
+    if name is None:
+        if known is None:
+            raise UserError("--join needs --name the first time this machine joins a class")
+        name = known["name"]
+    try:
+        name = check_name(name, "--name")
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    token = known["token"] if known is not None and player_key(known["name"]) == player_key(name) else None
+    body = json.dumps({"code": code, "name": name, **({"token": token} if token else {})}).encode()
+    answer = _request(address, "/api/join", body, {"Content-Type": "application/json"})
+    try:
+        membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]))
+    except (KeyError, TypeError, ValueError):
+        raise RefusalError(502, "the class's answer is not armgame's (is that address an armgame class?)") from None
+    _remember(membership)
+    return membership
+
+
+def offline(address: ClassAddress, code: str, name: str | None) -> Membership | None:
+    """The membership this machine had in the class, to play while it cannot be reached (its games wait
+    in the outbox); None if it never joined under that name."""
+    from ..records.standings import player_key
+
+    known = remembered().get(check_code(code))
+    if known is None or (name is not None and player_key(name) != player_key(known["name"])):
+        return None
+    try:
+        return Membership(address, check_code(code), known["name"], known["token"], int(known.get("seed", "")))
+    except ValueError:
+        return None
+
+
+# ------------------------------------------------------------------ handing in
+
+@dataclass(frozen=True)
+class HandIn:
+    """What became of a replay: handed in (``answer``), refused (``refused``), or kept to hand in later."""
+
+    message: str
+    answer: dict | None = None
+    kept: Path | None = None
+    refused: bool = False
+
+
+def outbox(m: Membership) -> Path:
+    slug = re.sub(r"[^A-Za-z0-9]+", "-", m.key).strip("-")
+    return client_folder() / "outbox" / slug
+
+
+def hand_in(m: Membership, data: bytes, keep: bool = True) -> HandIn:
+    """Hand ``data`` (a replay's bytes) in. UnreachableError: kept in the outbox (``keep``) for the next join."""
+    if len(data) > MAX_HANDIN_BYTES:
+        return HandIn(f"not handed in: the replay is larger than a class takes ({MAX_HANDIN_BYTES:,} bytes)",
+                      refused=True)
+    headers = {"Content-Type": "application/json", "Authorization": f"Bearer {m.token}", "X-Armgame-Code": m.code}
+    try:
+        answer = _request(m.address, "/api/handin", data, headers)
+    except RefusalError as exc:
+        if exc.status == 503 and keep:  # still busy after a minute: nothing lost, it goes at the next join
+            return _kept(m, data, str(exc))
+        return HandIn(f"not handed in: {exc}", refused=True)
+    except UnreachableError as exc:
+        if not keep:
+            raise
+        return _kept(m, data, str(exc))
+    return HandIn(str(answer.get("message", "handed in")), answer)
+
+
+def _kept(m: Membership, data: bytes, why: str) -> HandIn:
+    folder = outbox(m)
+    path = folder / f"{hashlib.sha256(data).hexdigest()[:20]}.json"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        if len(list(folder.glob("*.json"))) >= MAX_OUTBOX:
+            raise DataFileError(f"{folder} already holds {MAX_OUTBOX} replays")
+        atomic_write_bytes(path, data, "replay")
+    except (OSError, DataFileError) as exc:
+        return HandIn(f"not handed in ({why}); and the replay could not be kept: {exc}", refused=True)
+    return HandIn(f"not handed in yet: {why}. Your game is kept and is handed in the next time you join", kept=path)
+
+
+def send_outbox(m: Membership) -> list[str]:
+    """Hand in what the outbox holds for this class; a line for each. What is handed in or refused leaves
+    the outbox (a refusal is final: the file is kept beside, renamed .refused); unreachable stays."""
+    folder = outbox(m)
+    if not folder.is_dir():
+        return []
+    lines = []
+    for path in sorted(folder.glob("*.json")):
+        try:
+            data = read_limited(path, MAX_HANDIN_BYTES, "kept replay", follow=False)
+        except DataFileError as exc:
+            lines.append(f"{path.name}: {exc}")
+            continue
+        try:
+            result = hand_in(m, data, keep=False)
+        except UnreachableError:
+            break
+        lines.append(f"a game kept from before: {result.message}")
+        with contextlib.suppress(OSError):
+            if result.refused:
+                path.replace(path.with_suffix(".refused"))
+            else:
+                path.unlink()
+    return lines

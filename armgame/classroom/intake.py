@@ -1,0 +1,391 @@
+"""One hand-in, from arrival to answer, and the class's standings built from what was entered.
+
+The ``Clerk`` is the class's one writer: the server runs every change (a join, a hand-in, the
+teacher's hide and close) through it on a single worker thread, so the table, the roster and the
+lab folder never see two writers, and a hand-in is answered only once it is durably on disk (the
+table's own atomic, fsynced write). Everything a request carries is checked here before it costs
+anything: the replay is parsed with the replay reader's schema, its work bounded before it is
+re-simulated, its player taken from the token (never from the file), its game identified by its
+content (``records.identity``), so the same game from two machines is one game.
+
+The class's folder::
+
+    class.json, teacher.secret   the roster (``roster``)
+    scores.json, replays/        an ordinary armgame table: ``armgame scores --scores DIR`` reads it
+    lab/                         each student's first lab run of each protocol (``analyze --class``)
+    lab-more/                    their later runs, kept, not in the class curve
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..errors import UserError
+from ..records.identity import game_digest
+from ..records.replay import Replay, check_name, now_iso
+from ..records.rulesets import RULESETS, ruleset_name
+from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
+from ..records.standings import one_row_per_player, player_key
+from ..records.storage import DataFileError, atomic_write_bytes, read_limited
+from .roster import MAX_PLAYERS, Player, Roster, token_digest
+
+#: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
+#: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
+MAX_HANDIN_BYTES = 4 * 1024 * 1024
+#: The most re-simulation one hand-in may ask for, in physics steps (``records.scores.replay_work``).
+#: A standard game costs 15,000 steps and its hits and events; a lab run, its protocol's steps.
+#: A game claiming more (a "hit storm") is refused before anything is replayed.
+MAX_HANDIN_WORK = 1_500_000
+#: Rows of each list the standings carry: the projector shows the top, the CSV has everything.
+STANDINGS_ROWS = 60
+LAB_DIR, LAB_MORE_DIR = "lab", "lab-more"
+
+
+class RefusedError(Exception):
+    """A request the class turns down: an HTTP status and one line saying why (sent as it is)."""
+
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+        self.message = message
+
+
+@dataclass(frozen=True)
+class Arrival:
+    """A game just entered, as the projector announces it."""
+
+    seq: int
+    name: str
+    score: int
+    note: str
+    program: bool
+
+
+@dataclass
+class LabRun:
+    player: str
+    program: bool
+    protocol: Any
+    rows: list[dict[str, object]]
+    path: Path
+
+
+def ordinal(n: int) -> str:
+    suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{suffix}"
+
+
+class Clerk:
+    """The class's state and its one writer. Not thread-safe by design: call it from one thread."""
+
+    def __init__(self, folder: Path, roster: Roster) -> None:
+        self.folder = Path(folder)
+        self.roster = roster
+        self.table = ScoreTable(self.folder, warn=lambda message: None)
+        if not self.table.path.exists():
+            self.table.new(roster.seed)
+        elif self.table.seed != roster.seed:
+            raise DataFileError(f"{self.table.path} ranks seed {self.table.seed}, the class seed {roster.seed}: "
+                                f"this folder's table is not the class's (nothing was changed)")
+        self.entries: list[ScoreEntry] = self.table.all_entries()
+        self.games: dict[str, ScoreEntry] = {e.game_sha256: e for e in self.entries if e.game_sha256}
+        self.lab_runs: list[LabRun] = []
+        self.lab_digests: set[str] = set()
+        self.arrival: Arrival | None = None
+        self.version = 0  # bumped at every change the projector should see
+
+    # ------------------------------------------------------------------ joining
+    def join(self, name: object, token: str | None) -> tuple[Player, str | None]:
+        """The player ``name`` for this client: (player, a new token) for a new name, (player, None)
+        when ``token`` proves the name is already theirs. RefusedError if another client holds the name."""
+        try:
+            name = check_name(name)
+        except ValueError as exc:
+            raise RefusedError(400, str(exc)) from None
+        key = player_key(name)
+        player = self.roster.players.get(key)
+        if player is not None:
+            if token is not None and token_digest(token) == player.token_sha256:
+                return player, None
+            raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
+                               f"name (or join from the machine that took it)")
+        if self.roster.closed:
+            raise RefusedError(403, "the class is closed to new players")
+        if len(self.roster.players) >= MAX_PLAYERS:
+            raise RefusedError(403, f"the class has {MAX_PLAYERS} players, as many as it takes")
+        import secrets
+
+        new_token = secrets.token_urlsafe(24)
+        player = Player(name, token_digest(new_token), now_iso())
+        self.roster.players[key] = player
+        try:
+            self.roster.save()
+        except (OSError, DataFileError):
+            del self.roster.players[key]
+            raise
+        self.version += 1
+        return player, new_token
+
+    def player(self, token: str | None) -> Player:
+        player = self.roster.player_of(token) if token else None
+        if player is None:
+            raise RefusedError(401, "this machine has not joined the class under that name: join first "
+                               "(armgame play --join HOST:PORT --code CODE --name NAME)")
+        return player
+
+    # ------------------------------------------------------------------ handing in
+    def hand_in(self, token: str | None, data: bytes) -> dict[str, object]:
+        """Check, verify and enter one replay; the answer the student's machine shows. Raises RefusedError."""
+        player = self.player(token)
+        if self.roster.closed:
+            raise RefusedError(403, "the class is closed: no more games are taken (your replay stays on your machine)")
+        try:
+            replay = Replay.from_bytes(data, "the replay")
+        except DataFileError as exc:
+            raise RefusedError(400, str(exc)) from None
+        work = replay_work(replay)
+        if work > MAX_HANDIN_WORK:
+            raise RefusedError(413, f"the replay claims {replay.result.hits} hits in {replay.result.steps} steps, more "
+                               f"to check ({work:,}) than a class checks for one hand-in ({MAX_HANDIN_WORK:,})")
+        if replay.task is not None:
+            return self._lab_run(player, replay)
+        return self._game(player, replay)
+
+    def _game(self, player: Player, replay: Replay) -> dict[str, object]:
+        r = replay.result
+        if not replay.complete:
+            raise RefusedError(400, "the game stopped before its clock ran out: only a whole game is handed in")
+        rules = ruleset_name(replay.config)
+        if rules not in RULESETS or r.seed != self.roster.seed:
+            raise RefusedError(400, f"this class plays the standard game of seed {self.roster.seed}; this game is "
+                               f"{rules} rules, seed {r.seed} (play it with --join to get the class's game)")
+        digest = game_digest(replay)
+        twin = self.games.get(digest)
+        if twin is not None:
+            if player_key(twin.name) == player_key(player.name):
+                return self._answer(twin, already=True)
+            raise RefusedError(409, f"this game was already handed in by {twin.name}: a game counts once, whoever "
+                               f"hands it in")
+        ok, recomputed = replay.verify()
+        if not ok:
+            raise RefusedError(422, f"the replay does not reproduce its score (recorded {r.score}, it replays to "
+                               f"{recomputed.score}): not entered")
+        try:
+            entry = self.table.add(replay.with_player(player.name))
+        except ValueError as exc:  # TableError included: nothing was entered
+            raise RefusedError(503, f"the class's table could not take the game: {exc}") from None
+        self.entries.append(entry)
+        self.entries.sort(key=sort_key)
+        self.games[digest] = entry
+        answer = self._answer(entry)
+        self.version += 1
+        self.arrival = Arrival(self.version, entry.name, entry.score, str(answer["note"]), entry.program)
+        return answer
+
+    def _answer(self, entry: ScoreEntry, already: bool = False) -> dict[str, object]:
+        """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""
+        rows = self._rows(entry.program)
+        key = player_key(entry.name)
+        rank = next(i for i, row in enumerate(rows, 1) if player_key(row.name) == key)
+        best = rows[rank - 1].best
+        where = "in the class" if not entry.program else "among the programs"
+        if best.id == entry.id:
+            note = "first game" if rows[rank - 1].games == 1 else "new personal best"
+            line = f"{ordinal(rank)} of {len(rows)} {where} (your best so far)"
+        else:
+            note = f"best {best.score}"
+            line = f"score {entry.score}; your best, {best.score}, is {ordinal(rank)} of {len(rows)} {where}"
+        top = [[i, row.name, row.best.score] for i, row in enumerate(rows, 1)
+               if (i <= 10 and not self.roster.is_hidden(row.name)) or i == rank]
+        return {"ok": True, "already": already, "name": entry.name, "score": entry.score, "rank": rank,
+                "of": len(rows), "best": best.score, "list": "programs" if entry.program else "students",
+                "note": note, "top": top, "message": ("already handed in: " if already else "handed in: ") + line}
+
+    def _rows(self, programs: bool) -> list:
+        return one_row_per_player(e for e in self.entries if e.program == programs)
+
+    # ------------------------------------------------------------------ the lab
+    def _lab_run(self, player: Player, replay: Replay) -> dict[str, object]:
+        from ..lab.analysis import trial_rows
+
+        replay = replay.with_player(player.name)
+        digest = hashlib.sha256(repr((player_key(player.name), _lab_identity(replay))).encode()).hexdigest()
+        ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)  # type: ignore[union-attr]
+        if not ok:
+            raise RefusedError(422, "the lab run does not reproduce its trials: not taken")
+        protocol = replay.task.protocol  # type: ignore[union-attr]
+        game = _lab_identity(replay)
+        if game in self.lab_digests:
+            return {"ok": True, "already": True, "message": "already handed in: this lab run is in the class"}
+        first = not any(run.protocol == protocol and player_key(run.player) == player_key(player.name)
+                        for run in self.lab_runs)
+        slug = re.sub(r"[^A-Za-z0-9]+", "-", player.name).strip("-")[:24] or "player"
+        path = self.folder / (LAB_DIR if first else LAB_MORE_DIR) / f"{slug}-{digest[:12]}.json"
+        path.parent.mkdir(exist_ok=True)
+        atomic_write_bytes(path, replay.to_bytes(), "lab run")
+        self.lab_digests.add(game)
+        if first:
+            self.lab_runs.append(LabRun(player.name, replay.driven != "keyboard", protocol, trial_rows(session),
+                                        path))
+            self.version += 1
+        counted = "in the class curve" if first else "kept (your first run of this protocol is the one in the curve)"
+        return {"ok": True, "already": False, "message": f"lab run handed in: {counted}"}
+
+    def load_lab(self) -> list[str]:
+        """Re-verify the lab runs already in the folder (at a restart); returns a line per run left out."""
+        from ..lab.analysis import trial_rows
+
+        problems = []
+        folder = self.folder / LAB_DIR
+        paths = sorted(p for p in folder.glob("*.json") if p.is_file() and not p.is_symlink()) \
+            if folder.is_dir() else []
+        for path in paths:
+            try:
+                replay = Replay.from_bytes(read_limited(path, MAX_HANDIN_BYTES, "lab run", follow=False), str(path))
+                if replay.task is None or replay.player is None:
+                    raise UserError(f"{path}: not a lab run with a player's name")
+                ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)
+                if not ok:
+                    raise UserError(f"{path}: does not reproduce its trials")
+            except UserError as exc:
+                problems.append(str(exc))
+                continue
+            self.lab_digests.add(_lab_identity(replay))
+            self.lab_runs.append(LabRun(replay.player, replay.driven != "keyboard", replay.task.protocol,
+                                        trial_rows(session), path))
+        for path in sorted((self.folder / LAB_MORE_DIR).glob("*.json")) if (self.folder / LAB_MORE_DIR).is_dir() \
+                else []:
+            try:
+                replay = Replay.from_bytes(read_limited(path, MAX_HANDIN_BYTES, "lab run", follow=False), str(path))
+                self.lab_digests.add(_lab_identity(replay))
+            except UserError:
+                continue
+        if self.lab_runs:
+            self.version += 1
+        return problems
+
+    def lab_curve(self) -> dict[str, object]:
+        """The class curve of the protocol most students ran (people's runs; programs' counted apart)."""
+        from ..lab.analysis import figure_metric
+        from ..lab.figures import class_curve
+
+        people = [run for run in self.lab_runs if not run.program and not self.roster.is_hidden(run.player)]
+        groups: list[tuple[Any, list[LabRun]]] = []
+        for run in people:
+            group = next((g for g in groups if g[0] == run.protocol), None)
+            if group is None:
+                groups.append((run.protocol, [run]))
+            else:
+                group[1].append(run)
+        programs = sum(run.program for run in self.lab_runs)
+        if not groups:
+            return {"protocol": None, "students": 0, "programs": programs, "metric": None, "trials": []}
+        protocol, runs = max(groups, key=lambda g: len(g[1]))
+        metric = figure_metric(protocol)
+        curve = class_curve([run.rows for run in runs], metric)
+        scale, unit = (1000.0, "mm") if metric.endswith("_m") else (1.0, "deg")
+        trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
+                   "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
+                  for row in curve]
+        return {"protocol": protocol.name, "students": len(runs), "programs": programs,
+                "metric": metric, "unit": unit, "trials": trials}
+
+    # ------------------------------------------------------------------ the teacher
+    def hide(self, name: object, hidden: bool) -> str:
+        if not isinstance(name, str) or player_key(name) not in {player_key(e.name) for e in self.entries} | \
+                set(self.roster.players):
+            raise RefusedError(404, "no such name in this class")
+        key = player_key(name)
+        (self.roster.hidden.add if hidden else self.roster.hidden.discard)(key)
+        self.roster.save()
+        self.version += 1
+        return f"{name} is {'hidden from' if hidden else 'shown on'} the projector"
+
+    def close(self, closed: bool) -> str:
+        self.roster.closed = bool(closed)
+        self.roster.save()
+        self.version += 1
+        return "the class is closed to new games" if closed else "the class takes games again"
+
+    # ------------------------------------------------------------------ what the page shows
+    def standings(self, teacher: bool = False) -> dict[str, object]:
+        """The class as the projector shows it (hidden names left out), or as the teacher sees it."""
+
+        def rows(programs: bool) -> list[dict[str, object]]:
+            out = []
+            for row in self._rows(programs):
+                hidden = self.roster.is_hidden(row.name)
+                if hidden and not teacher:
+                    continue
+                e = row.best
+                out.append({"rank": len(out) + 1, "name": row.name, "score": e.score, "hits": e.hits,
+                            "games": row.games, "driver": e.how if programs else None,
+                            **({"hidden": hidden} if teacher else {})})
+                if len(out) >= STANDINGS_ROWS and not teacher:
+                    break
+            return out
+
+        arrival = self.arrival
+        shown = arrival is not None and not self.roster.is_hidden(arrival.name)
+        return {"version": self.version, "seed": self.roster.seed, "closed": self.roster.closed,
+                "joined": len(self.roster.players), "games": len(self.entries),
+                "students": rows(False), "programs": rows(True),
+                "arrival": None if not shown else {"seq": arrival.seq, "name": arrival.name,  # type: ignore[union-attr]
+                                                   "score": arrival.score, "note": arrival.note,  # type: ignore[union-attr]
+                                                   "program": arrival.program}}  # type: ignore[union-attr]
+
+    def games_csv(self) -> str:
+        columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_at",
+                   "hidden", "replay")
+        ordered = sorted(self.entries, key=lambda e: e.entered or 0)
+        return _csv(columns, ([e.entered, e.name, "programs" if e.program else "students", e.driven, e.driver or "",
+                               e.score, e.hits, e.resets, e.seed, e.entered_at or "",
+                               self.roster.is_hidden(e.name), e.replay] for e in ordered))
+
+    def lab_csv(self) -> str:
+        from ..lab.metrics import TRIAL_COLUMNS
+
+        columns = ("player", "program", "protocol", "replay", *TRIAL_COLUMNS)
+        return _csv(columns, ([run.player, run.program, run.protocol.name, run.path.name,
+                               *(row[c] for c in TRIAL_COLUMNS)] for run in self.lab_runs for row in run.rows))
+
+
+def _lab_identity(replay: Replay) -> str:
+    """A lab run's identity: its game's (``records.identity``) and its protocol, whoever's name it carries."""
+    return hashlib.sha256((game_digest(replay) + repr(replay.task.as_dict())).encode()).hexdigest()  # type: ignore[union-attr]
+
+
+def _finite(value: object, scale: float) -> float | None:
+    value = float(value)  # type: ignore[arg-type]
+    return round(value * scale, 6) if math.isfinite(value) else None
+
+
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_cell(value: object) -> str:
+    """A cell a spreadsheet shows as text: a leading = + - @ would make it a formula (OWASP's advice:
+    prefix a quote). Numbers are written as they are, so they stay numbers."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return "" if isinstance(value, float) and not math.isfinite(value) else repr(value)
+    text = str(value)
+    return "'" + text if text.startswith(_FORMULA) else text
+
+
+def _csv(columns: Sequence[str], rows) -> str:
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([csv_cell(v) for v in row])
+    return out.getvalue()

@@ -1,0 +1,200 @@
+"""The class's own record: its join code, the seed it ranks, who joined, and what the teacher decided.
+
+Kept in the class's folder beside its table, written only by the server (one writer: the clerk
+thread), atomically and fsynced before a join is acknowledged::
+
+    class.json        {"format": "armgame-class", "code": "FROG", "seed": 10, "closed": false,
+                       "players": {key: {"name", "token_sha256", "joined"}}, "hidden": [key, ...]}
+    teacher.secret    the teacher's secret, created once with owner-only permissions
+
+A student's name is theirs: the first client to take it receives a random token, and only the
+token's SHA-256 is kept here, so the folder itself never holds what would let someone else hand
+in under that name. Names are compared by ``records.standings.player_key`` ("alice" is "Alice").
+
+The join code is four letters from an alphabet with nothing a projector font confuses (no O/0,
+I/l/1, S/5, Z/2, B/8): short to type from the back row, and read case-insensitively.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import hmac
+import os
+import re
+import secrets
+import stat
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..limits import DEFAULT_SEED
+from ..records.replay import check_date, check_name, now_iso
+from ..records.standings import player_key
+from ..records.storage import (
+    DataFileError,
+    atomic_write_bytes,
+    check_int,
+    check_keys,
+    check_str,
+    dump_json,
+    parse_json,
+    read_limited,
+)
+
+ROSTER_NAME = "class.json"
+SECRET_NAME = "teacher.secret"
+FORMAT = "armgame-class"
+FORMAT_VERSION = 1
+CODE_ALPHABET = "ACDEFGHJKMNPQRTUVWXY"
+CODE_LENGTH = 4
+#: Names one class holds: a lecture hall of students, each with a program or two, with room.
+MAX_PLAYERS = 2000
+MAX_ROSTER_BYTES = 2 * 1024 * 1024
+_HEX64 = re.compile(r"[0-9a-f]{64}")
+_SECRET = re.compile(r"[A-Za-z0-9_-]{20,100}")
+
+
+def new_code() -> str:
+    return "".join(secrets.choice(CODE_ALPHABET) for _ in range(CODE_LENGTH))
+
+
+def normal_code(text: str) -> str:
+    """A typed join code as the class compares it: case and surrounding spaces do not matter."""
+    return text.strip().upper()
+
+
+def token_digest(token: str) -> str:
+    return hashlib.sha256(token.encode("utf-8", "surrogatepass")).hexdigest()
+
+
+@dataclass
+class Player:
+    name: str
+    token_sha256: str
+    joined: str
+
+
+@dataclass
+class Roster:
+    """The class's record, in memory; ``save`` writes it back (the clerk thread is its one writer)."""
+
+    folder: Path
+    code: str
+    seed: int
+    secret: str
+    closed: bool = False
+    players: dict[str, Player] = field(default_factory=dict)
+    hidden: set[str] = field(default_factory=set)
+    created: str = field(default_factory=now_iso)
+
+    @property
+    def path(self) -> Path:
+        return self.folder / ROSTER_NAME
+
+    # ------------------------------------------------------------------ files
+    @classmethod
+    def open(cls, folder: Path, seed: int | None) -> tuple[Roster, bool]:
+        """The class in ``folder`` (going on with it), or a new one there; and whether it is new.
+
+        ``seed``: the seed asked for (None: the class's own, or the default for a new class). A class
+        ranks one seed for its whole life: asking another for an existing class is refused.
+        """
+        path = folder / ROSTER_NAME
+        if os.path.lexists(path):
+            roster = cls._read(folder)
+            if seed is not None and seed != roster.seed:
+                raise DataFileError(f"the class in {folder} ranks seed {roster.seed}, not {seed}: go on with it "
+                                    f"without --seed, or start a new class in another --folder")
+            return roster, False
+        roster = cls(folder, new_code(), DEFAULT_SEED if seed is None else seed, _new_secret(folder))
+        roster.save()
+        return roster, True
+
+    @classmethod
+    def _read(cls, folder: Path) -> Roster:
+        path = folder / ROSTER_NAME
+        data = read_limited(path, MAX_ROSTER_BYTES, "class record", follow=False)
+        try:
+            d = parse_json(data)
+            if not isinstance(d, dict) or d.get("format") != FORMAT:
+                raise ValueError(f"not an armgame class record (no \"format\": \"{FORMAT}\")")
+            d = check_keys("class record", d, {"format", "format_version", "code", "seed", "closed", "players",
+                                               "hidden", "created"})
+            if check_int("format_version", d["format_version"], 1, 10**6) != FORMAT_VERSION:
+                raise ValueError(f"class record format {d['format_version']} is not one this armgame reads")
+            code = check_str("code", d["code"], CODE_LENGTH)
+            if len(code) != CODE_LENGTH or any(c not in CODE_ALPHABET for c in code):
+                raise ValueError(f"code must be {CODE_LENGTH} letters of {CODE_ALPHABET}, got {code!r}")
+            seed = check_int("seed", d["seed"], 0, 2**63 - 1)
+            if not isinstance(d["closed"], bool):
+                raise ValueError("closed must be true or false")
+            if not isinstance(d["players"], dict) or len(d["players"]) > MAX_PLAYERS:
+                raise ValueError(f"players must be an object of at most {MAX_PLAYERS} names")
+            players = {}
+            for key, item in d["players"].items():
+                p = check_keys(f"player {key!r}", item, {"name", "token_sha256", "joined"})
+                name = check_name(p["name"])
+                if player_key(name) != key:
+                    raise ValueError(f"player {key!r} is filed under another name's key")
+                digest = check_str("token_sha256", p["token_sha256"], 64)
+                if not _HEX64.fullmatch(digest):
+                    raise ValueError(f"player {name!r}: token_sha256 is not a SHA-256")
+                players[key] = Player(name, digest, check_date("joined", p["joined"]))
+            if not isinstance(d["hidden"], list) or not all(isinstance(k, str) for k in d["hidden"]):
+                raise ValueError("hidden must be a list of names")
+            created = check_date("created", d["created"])
+        except ValueError as exc:
+            raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
+        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, set(d["hidden"]), created)
+
+    def save(self) -> None:
+        data = dump_json({
+            "format": FORMAT, "format_version": FORMAT_VERSION, "code": self.code, "seed": self.seed,
+            "closed": self.closed, "created": self.created, "hidden": sorted(self.hidden),
+            "players": {k: {"name": p.name, "token_sha256": p.token_sha256, "joined": p.joined}
+                        for k, p in self.players.items()},
+        })
+        atomic_write_bytes(self.path, data, "class record")
+
+    # ------------------------------------------------------------------ questions
+    def code_matches(self, typed: str) -> bool:
+        return hmac.compare_digest(normal_code(typed).encode(), self.code.encode())
+
+    def secret_matches(self, typed: str) -> bool:
+        return hmac.compare_digest(typed.encode("utf-8", "surrogatepass"), self.secret.encode())
+
+    def player_of(self, token: str) -> Player | None:
+        digest = token_digest(token)
+        return next((p for p in self.players.values() if hmac.compare_digest(p.token_sha256, digest)), None)
+
+    def is_hidden(self, name: str) -> bool:
+        return player_key(name) in self.hidden
+
+
+def _new_secret(folder: Path) -> str:
+    """The teacher's secret, in a file only its owner may read; kept if one is already there."""
+    path = folder / SECRET_NAME
+    if os.path.lexists(path):
+        return _read_secret(folder)
+    secret = secrets.token_urlsafe(18)
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags, 0o600)
+    except OSError as exc:
+        raise DataFileError(f"{path}: cannot write the teacher's secret: {exc.strerror or exc}") from None
+    with os.fdopen(fd, "w", encoding="ascii") as f:
+        f.write(secret + "\n")
+        f.flush()
+        os.fsync(f.fileno())
+    return secret
+
+
+def _read_secret(folder: Path) -> str:
+    path = folder / SECRET_NAME
+    with contextlib.suppress(FileNotFoundError):
+        if stat.S_ISLNK(os.lstat(path).st_mode):
+            raise DataFileError(f"{path}: is a symbolic link; the teacher's secret must be a regular file")
+    secret = read_limited(path, 200, "teacher's secret", follow=False).decode("ascii", "replace").strip()
+    if not _SECRET.fullmatch(secret):
+        raise DataFileError(f"{path}: not a teacher's secret armgame wrote")
+    return secret

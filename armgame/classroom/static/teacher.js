@@ -1,0 +1,80 @@
+// The teacher's controls: every call carries the secret typed here (kept for this tab only).
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+let secret = sessionStorage.getItem("armgame-secret") || "";
+
+function say(text) { $("status").textContent = text; }
+
+async function call(path, body) {
+  const options = {headers: {Authorization: "Bearer " + secret}};
+  if (body !== undefined) {
+    options.method = "POST";
+    options.headers["Content-Type"] = "application/json";
+    options.body = JSON.stringify(body);
+  }
+  const r = await fetch(path, options);
+  if (!r.ok) {
+    let message = r.status + "";
+    try { message = (await r.json()).error; } catch (e) { /* not JSON */ }
+    throw new Error(message);
+  }
+  return r;
+}
+
+function row(table, r, kind) {
+  const tr = document.createElement("tr");
+  for (const text of [kind, r.name, String(r.score), r.games + " games", r.hidden ? "hidden" : "shown"]) {
+    const td = document.createElement("td");
+    td.textContent = text;
+    tr.appendChild(td);
+  }
+  const td = document.createElement("td");
+  const button = document.createElement("button");
+  button.textContent = r.hidden ? "Show" : "Hide";
+  button.addEventListener("click", async () => {
+    try { say((await (await call("/api/teacher/hide", {name: r.name, hidden: !r.hidden})).json()).message); }
+    catch (e) { say(e.message); }
+    refresh();
+  });
+  td.appendChild(button);
+  tr.appendChild(td);
+  table.appendChild(tr);
+}
+
+async function refresh() {
+  try {
+    const s = await (await call("/api/teacher/standings")).json();
+    $("controls").hidden = false;
+    const table = $("everyone");
+    table.replaceChildren();
+    for (const r of s.students) row(table, r, "student");
+    for (const r of s.programs) row(table, r, "program");
+    say(s.closed ? "The class is closed to new games." : "The class takes games.");
+  } catch (e) {
+    $("controls").hidden = true;
+    say(e.message);
+  }
+}
+
+async function download(path, filename) {
+  try {
+    const blob = await (await call(path)).blob();
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(blob);
+    a.download = filename;
+    a.click();
+    URL.revokeObjectURL(a.href);
+  } catch (e) { say(e.message); }
+}
+
+$("unlock").addEventListener("click", () => {
+  secret = $("secret").value.trim();
+  sessionStorage.setItem("armgame-secret", secret);
+  refresh();
+});
+$("close").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: true}); } catch (e) { say(e.message); } refresh(); });
+$("open").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: false}); } catch (e) { say(e.message); } refresh(); });
+$("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
+$("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
+if (secret) refresh();

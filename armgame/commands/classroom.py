@@ -1,0 +1,151 @@
+"""armgame class: a live class served from the teacher's machine (serve), games handed in by hand
+(submit), and the standings in a window for a room without a browser (show)."""
+
+from __future__ import annotations
+
+import argparse
+
+DEFAULT_PORT = 8765
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"must be from 0 to 65535, got {text!r}")
+    return value
+
+
+def add_join_options(p: argparse.ArgumentParser) -> None:
+    """``--join HOST:PORT --code CODE``: shared by play, lab and class submit."""
+    p.add_argument("--join", metavar="HOST:PORT", help="hand every finished game in to the live class at HOST:PORT "
+                   "(the projector shows it; needs --code)")
+    p.add_argument("--code", metavar="CODE", help="with --join: the class's code, as the projector shows it")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    from .play import _seed
+
+    p = subparsers.add_parser(
+        "class",
+        help="a live class: serve it from the teacher's machine, hand games in, show the standings",
+        description="A live class. The teacher runs 'armgame class serve'; it prints what students type "
+        "(armgame play --join HOST:PORT --code CODE --name NAME), the projector's page and a secret for the "
+        "teacher's page. Every game a student finishes is handed in by itself, verified by replaying it, and "
+        "ranked on the projector, one row per student.",
+    )
+    sub = p.add_subparsers(dest="action", metavar="ACTION")
+    serve = sub.add_parser("serve", help="serve the class from this machine (Ctrl-C stops it)",
+                           description="Serve a class: the table lives in --folder (default: a new folder per class "
+                           "under the per-user data folder); the same --folder again goes on with the same class, "
+                           "code and secret. It listens only on --host (default: this machine's address on the "
+                           "network with the default route).")
+    serve.add_argument("--folder", metavar="DIR", help="the class's folder (default: a new one per class)")
+    serve.add_argument("--host", metavar="HOST", help="the address to listen on (default: this machine's LAN "
+                       "address; 127.0.0.1 for a trial on one machine)")
+    serve.add_argument("--port", type=_port, default=DEFAULT_PORT, help=f"the port (default: {DEFAULT_PORT})")
+    serve.add_argument("--seed", type=_seed, default=None, help="the seed the class ranks (a new class: default 10)")
+    serve.set_defaults(run=run_serve)
+    submit = sub.add_parser("submit", help="hand replay files in to a class (games or lab runs)",
+                            description="Hand replays in by hand: games kept while the class could not be reached, "
+                            "games recorded with --record, lab runs. This machine joins under --name (or the name "
+                            "it joined under before).")
+    submit.add_argument("address", metavar="HOST:PORT")
+    submit.add_argument("files", metavar="FILE", nargs="+")
+    submit.add_argument("--code", required=True, help="the class's code")
+    submit.add_argument("--name", help="the name to hand in under (default: the one this machine joined with)")
+    submit.set_defaults(run=run_submit)
+    show = sub.add_parser("show", help="the class's standings in a window (for a room without a browser)")
+    show.add_argument("address", metavar="HOST:PORT")
+    from ..ui.options import add_window_options
+
+    add_window_options(show)
+    show.set_defaults(run=run_show)
+    p.set_defaults(run=lambda args: (p.print_help(), 0)[1])
+
+
+def run_serve(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..classroom.serve import default_folder, lan_address, serve
+    from ..records.storage import user_path
+
+    folder = user_path(args.folder, "--folder") if args.folder else default_folder()
+    if folder.exists() and not folder.is_dir():
+        from ..errors import UserError
+
+        raise UserError(f"--folder {folder}: not a folder")
+    host = args.host or lan_address()
+    return serve(Path(folder), host, args.port, args.seed, say=lambda line: print(line, flush=True))
+
+
+def run_submit(args: argparse.Namespace) -> int:
+    from ..classroom import client
+    from ..errors import UserError
+    from ..limits import MAX_REPLAY_BYTES
+    from ..records.storage import read_limited, user_path
+    from . import read_lab_replays
+
+    read_lab_replays()
+    address = client.ClassAddress.parse(args.address, "HOST:PORT")
+    membership = client.join(address, args.code, args.name)
+    for line in client.send_outbox(membership):
+        print(line)
+    failed = 0
+    for text in args.files:
+        path = user_path(text, "FILE")
+        try:
+            data = read_limited(path, MAX_REPLAY_BYTES, "replay file")
+        except UserError as exc:
+            print(f"{path}: {exc}")
+            failed += 1
+            continue
+        result = client.hand_in(membership, data, keep=False)
+        failed += result.refused
+        print(f"{path}: {result.message}")
+    return 1 if failed else 0
+
+
+def run_show(args: argparse.Namespace) -> int:
+    from ..classroom.client import ClassAddress
+    from ..ui.class_window import show_class
+    from ..ui.options import window_settings
+
+    address = ClassAddress.parse(args.address, "HOST:PORT")
+    settings, _ = window_settings(args)
+    return show_class(address, settings, fullscreen=args.fullscreen)
+
+
+def join_class(args: argparse.Namespace):
+    """The class ``--join``/``--code`` name, joined (the outbox handed in first); None without --join.
+
+    Sets ``args.name`` to the name joined under. A class that cannot be reached is played offline when
+    this machine joined it before: its games wait in the outbox for the next join."""
+    import sys
+
+    from ..classroom import client
+    from ..errors import UserError
+
+    if args.code is not None and args.join is None:
+        raise UserError("--code goes with --join HOST:PORT")
+    if args.join is None:
+        return None
+    if args.code is None:
+        raise UserError("--join needs --code CODE: the class's code, as the projector shows it")
+    address = client.ClassAddress.parse(args.join)
+    try:
+        membership = client.join(address, args.code, args.name)
+    except client.UnreachableError as exc:
+        membership = client.offline(address, args.code, args.name)
+        if membership is None:
+            raise
+        print(f"armgame: {exc}; playing on: your games are kept and handed in the next time you join",
+              file=sys.stderr)
+    else:
+        print(f"joined the class at {address.label} as {membership.name} (seed {membership.seed})", file=sys.stderr)
+        for line in client.send_outbox(membership):
+            print(line, file=sys.stderr)
+    args.name = membership.name
+    return membership

@@ -1,0 +1,50 @@
+"""A live class on loopback for the tests: served on a thread of the test's process, stopped after."""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+from armgame.classroom.serve import ClassServer, open_class
+from armgame.game.bots import Autopilot, make_bot
+from armgame.game.rules import GameConfig
+from armgame.game.session import UP, GameSession, InputEvent
+from armgame.records.replay import Replay
+
+
+@contextlib.contextmanager
+def running_class(folder: Path, seed: int | None = None, lines: list[str] | None = None) -> Iterator[ClassServer]:
+    """The class in ``folder`` served on 127.0.0.1 (a free port) until the block ends."""
+    ready = threading.Event()
+    said = lines if lines is not None else []
+    opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set())
+    thread = threading.Thread(target=opened.run, daemon=True)
+    thread.start()
+    try:
+        assert ready.wait(20), "the class did not start"
+        yield opened
+    finally:
+        opened.stop()
+        thread.join(20)
+        assert not thread.is_alive(), "the class did not stop"
+
+
+@functools.cache
+def _bot_timeline(seed: int) -> tuple[InputEvent, ...]:
+    session = GameSession(GameConfig(seed=seed))
+    Autopilot(session, make_bot("model")).play()
+    return tuple(session.timeline)
+
+
+def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, driven: str = "keyboard") -> Replay:
+    """A whole standard game whose keys were the model bot's for its first ``seconds`` and then none: the
+    longer, the higher the score, and each length another game. Cheap: the bot plays once per seed."""
+    session = GameSession(GameConfig(seed=seed))
+    last = round(seconds / session.config.dt)
+    events = [e for e in _bot_timeline(seed) if e.step < last]
+    events += [InputEvent(last, m.key, UP) for m in session.config.muscles]  # whatever was held, let go
+    session.play(events)
+    return Replay.from_session(session, driven, None if driven == "keyboard" else "test", player)

@@ -1,0 +1,130 @@
+"""The live class on loopback: serve, join, hand in, standings per student, and the class kept on disk."""
+
+from __future__ import annotations
+
+import json
+import urllib.request
+
+import pytest
+from class_server import keyboard_game, running_class
+
+from armgame.classroom import client
+from armgame.cli import main
+from armgame.records.scores import ScoreTable
+
+
+@pytest.fixture
+def students(tmp_path, monkeypatch):
+    """A client folder per student machine: ``machine(name)`` makes its environment current."""
+    def machine(name: str) -> None:
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machines" / name))
+    return machine
+
+
+def standings(opened) -> dict:
+    with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}/api/standings", timeout=10) as r:
+        return json.loads(r.read())
+
+
+def test_a_class_from_join_to_standings_one_row_per_student(tmp_path, students, capsys):
+    folder = tmp_path / "class"
+    with running_class(folder) as opened:
+        code = opened.clerk.roster.code
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        results = {}
+        for name, presses in (("Ann", [30, 4, 50]), ("Bo", [40]), ("Cy", [10, 20])):
+            students(name)
+            m = client.join(address, code.lower(), name)  # the code is read whatever its case
+            results[name] = [client.hand_in(m, keyboard_game(n, player=name).to_bytes()) for n in presses]
+        assert all(r.answer is not None for rs in results.values() for r in rs)
+        assert results["Ann"][-1].message.startswith("handed in: ")
+        students("Dee")
+        assert main(["play", "--headless", "--bot", "model", "--join", f"127.0.0.1:{opened.port}", "--code", code,
+                     "--name", "Dee's bot"]) == 0
+        assert "among the programs" in capsys.readouterr().out
+        s = standings(opened)
+    people = [(r["name"], r["games"]) for r in s["students"]]
+    assert sorted(people) == [("Ann", 3), ("Bo", 1), ("Cy", 2)]  # one row each, with their games played
+    assert [r["name"] for r in s["programs"]] == ["Dee's bot"] and s["programs"][0]["driver"] == "bot (model)"
+    assert s["joined"] == 4 and s["games"] == 7
+    # The folder holds an ordinary table: armgame scores and verify read it afterwards.
+    assert len(ScoreTable(folder).all_entries()) == 7
+    assert main(["verify", str(folder)]) == 0
+
+
+def test_the_end_line_names_the_rank_among_students_and_the_best(tmp_path, students):
+    with running_class(tmp_path / "class") as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        students("a")
+        a = client.join(address, code, "Ann")
+        students("b")
+        b = client.join(address, code, "Bo")
+        first = client.hand_in(a, keyboard_game(20, player="Ann").to_bytes()).answer
+        second = client.hand_in(b, keyboard_game(40, player="Bo").to_bytes()).answer
+        worse = client.hand_in(a, keyboard_game(5, player="Ann").to_bytes())
+    assert first["rank"] == 1 and first["of"] == 1 and first["note"] == "first game"
+    assert second["score"] > first["score"] > worse.answer["score"]  # longer play, more hits
+    assert second["rank"] == 1 and second["of"] == 2 and second["note"] == "first game"
+    assert worse.answer["rank"] == 2 and worse.answer["best"] == first["score"]
+    assert worse.message == (f"handed in: score {worse.answer['score']}; your best, {first['score']}, is 2nd of 2 "
+                             f"in the class")
+
+
+def test_a_name_is_the_first_machines_and_a_game_counts_once(tmp_path, students):
+    with running_class(tmp_path / "class") as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        students("honest")
+        honest = client.join(address, code, "Ann")
+        students("other")
+        with pytest.raises(client.RefusalError, match="taken"):
+            client.join(address, code, "ann ")  # another machine, the same name in another case
+        other = client.join(address, code, "Bo")
+        game = keyboard_game(12, player="Ann").to_bytes()
+        assert client.hand_in(honest, game).answer["already"] is False
+        again = client.hand_in(honest, game)  # the same machine again (an answer lost on the way): one game
+        assert again.answer["already"] is True and again.message.startswith("already handed in")
+        copied = client.hand_in(other, game)  # the same game from another machine, under another name
+        assert copied.refused and "already handed in by Ann" in copied.message
+        forged = client.Membership(address, code, "Ann", "not-the-token", 10)
+        assert client.hand_in(forged, keyboard_game(2).to_bytes()).refused
+        students("honest")
+        assert client.join(address, code, "Ann").token == honest.token  # the machine that took it rejoins
+        assert standings(opened)["games"] == 1
+
+
+def test_a_game_kept_while_the_class_is_away_is_handed_in_at_the_next_join(tmp_path, students):
+    folder = tmp_path / "class"
+    students("ann")
+    with running_class(folder) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code, port = opened.clerk.roster.code, opened.port
+        m = client.join(address, code, "Ann")
+    kept = client.hand_in(m, keyboard_game(15, player="Ann").to_bytes())  # the server is gone
+    assert kept.kept is not None and kept.kept.is_file() and "kept" in kept.message
+    with running_class(folder) as opened:  # the same folder: the same class, code and secret
+        assert opened.clerk.roster.code == code and not opened.new
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        lines = client.send_outbox(client.join(address, code, None))  # the name this machine joined under
+        assert len(lines) == 1 and "handed in" in lines[0]
+        assert not kept.kept.exists()
+        assert standings(opened)["games"] == 1
+    assert port  # (the port may differ between runs: the join line always shows the current one)
+
+
+def test_play_join_refuses_what_would_not_be_the_class_game(tmp_path, students, capsys):
+    students("x")
+    assert main(["play", "--headless", "--bot", "model", "--code", "ABCD"]) == 2
+    assert "--code goes with --join" in capsys.readouterr().err
+    assert main(["play", "--headless", "--bot", "model", "--join", "127.0.0.1:1", "--name", "x"]) == 2
+    assert "--join needs --code" in capsys.readouterr().err
+    assert main(["play", "--headless", "--bot", "model", "--join", "127.0.0.1:99999", "--code", "ACDE"]) == 2
+    assert "port must be" in capsys.readouterr().err
+    assert main(["play", "--headless", "--bot", "model", "--duration", "5", "--join", "127.0.0.1:1",
+                 "--code", "ACDE", "--name", "x"]) == 2
+    assert "standard 60 s game" in capsys.readouterr().err
+    assert main(["play", "--headless", "--bot", "model", "--join", "127.0.0.1:1", "--code", "ACDE",
+                 "--name", "x"]) == 2
+    err = capsys.readouterr().err
+    assert "cannot reach the class at 127.0.0.1:1" in err and "school Wi-Fi" in err and len(err.splitlines()) == 1
