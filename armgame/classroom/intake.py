@@ -236,7 +236,12 @@ class Clerk:
             self.lab_runs.append(LabRun(player.name, replay.driven != "keyboard", protocol, trial_rows(session),
                                         path))
             self.version += 1
-        counted = "in the class curve" if first else "kept (your first run of this protocol is the one in the curve)"
+        if replay.driven != "keyboard":
+            counted = "a program's run: kept apart, not in the class curve"
+        elif first:
+            counted = "in the class curve"
+        else:
+            counted = "kept (your first run of this protocol is the one in the curve)"
         return {"ok": True, "already": False, "message": f"lab run handed in: {counted}"}
 
     def load_lab(self) -> list[str]:

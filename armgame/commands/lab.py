@@ -55,6 +55,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-figures", action="store_true", help="with --out, or in a window: trials.csv only (no figures)")
     p.add_argument("--record", metavar="FILE", help="save the run's replay to FILE (JSON)")
     p.add_argument("--name", help="the player's name, kept in the replay (never in the high-score table)")
+    from .classroom import add_join_options
+
+    add_join_options(p)
     p.add_argument("--catch", type=_count, default=None, metavar="N",
                    help="N catch trials (the perturbation off, unannounced) in each perturbed block")
     p.add_argument("--keys", default="dfjk",
@@ -103,6 +106,9 @@ def run(args: argparse.Namespace) -> int:
     if args.no_figures and not args.out and args.headless:
         raise UserError("--no-figures applies with --out only (or to the run a window keeps)")
     _check_outputs(args)
+    from .classroom import join_class
+
+    args.membership = join_class(args)  # before the run: a wrong code is said now, not after ten minutes
     config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys)),
                               str(args.protocol))
     session = LabSession(config, protocol)
@@ -118,6 +124,8 @@ def run(args: argparse.Namespace) -> int:
         Autopilot(session, bot).play()  # type: ignore[arg-type]
         _report(session, args)
         _keep(session, args)
+        if args.membership is not None:
+            print(_hand_in(session, args))
         return 0
     if not 1 <= args.fps <= 1000:
         raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
@@ -192,10 +200,14 @@ class RunKeeper:
             self.lines = [f"not kept: {exc}"]
             return self.lines
         self.lines = [f"replay saved to {path}" if path == record else f"wrote {path}" for path in written]
+        if args.membership is not None:
+            self.lines.append(_hand_in(session, args))
         shown = [f"Kept in {_home(folder)}:" if folder is not None else "Kept:"] + \
             [f"   {path.name if path.parent == folder else _home(path)}" for path in written]
         if folder is not None and not figures and not args.no_figures:
             shown.append("   (figures need matplotlib: pip install 'armgame[plot]')")
+        if args.membership is not None:
+            shown.append(self.lines[-1][:1].upper() + self.lines[-1][1:])
         return shown
 
 
@@ -259,15 +271,10 @@ def _keep(session, args: argparse.Namespace) -> None:
 def _save(session, args: argparse.Namespace, record: Path | None, out: Path | None, figures: bool) -> list[Path]:
     """The replay to ``record`` and trials.csv (and the figures) to ``out``, each when given; what was written."""
     from ..lab.analysis import write_run_outputs
-    from ..lab.record import LabTask
-    from ..records.replay import Replay, now_iso
 
     written: list[Path] = []
     if record:
-        driven = "bot" if args.bot else "keyboard"
-        replay = Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name,
-                        now_iso(), task=LabTask.of(session))
-        replay.save(record)
+        _replay(session, args).save(record)
         written.append(record)
     if out:
         if not session.outcomes:
@@ -278,6 +285,24 @@ def _save(session, args: argparse.Namespace, record: Path | None, out: Path | No
             raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
         written += write_run_outputs(session, out, figures=figures)
     return written
+
+
+def _hand_in(session, args: argparse.Namespace) -> str:
+    """Hand a finished run in to the class; the line saying what became of it."""
+    from ..classroom.client import hand_in
+
+    if not session.finished:
+        return "the run stopped before its last trial: not handed in to the class"
+    return hand_in(args.membership, _replay(session, args).to_bytes()).message
+
+
+def _replay(session, args: argparse.Namespace):
+    from ..lab.record import LabTask
+    from ..records.replay import Replay, now_iso
+
+    driven = "bot" if args.bot else "keyboard"
+    return Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name, now_iso(),
+                  task=LabTask.of(session))
 
 
 def _cm(value: object) -> str:

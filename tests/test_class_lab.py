@@ -1,0 +1,82 @@
+"""Volunteers' lab runs in a live class: verified, one run per student in the class curve, kept on disk."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import json
+import urllib.request
+
+import pytest
+from class_server import running_class
+
+from armgame.classroom import client
+from armgame.cli import main
+from armgame.records.replay import Replay
+
+#: A two-block protocol with a field and a washout: short to run, and it has an after-effect to mark.
+PROTOCOL = ('name = "short"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
+            'perturbation = "curl"\nb = 10.0\n[[blocks]]\nname = "washout"\ntrials = 2\n')
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Three bot runs of the protocol, recorded once: relabelled as people's runs where a test needs that."""
+    folder = tmp_path_factory.mktemp("runs")
+    (folder / "short.toml").write_text(PROTOCOL)
+    for seed in (1, 2, 3):
+        assert main(["lab", str(folder / "short.toml"), "--bot", "adaptive", "--headless", "--seed", str(seed),
+                     "--record", str(folder / f"run{seed}.json")]) == 0
+    return folder
+
+
+def as_person(path, name: str) -> bytes:
+    replay = Replay.load(path)
+    return dataclasses.replace(replay, driven="keyboard", driver=None, player=name).to_bytes()
+
+
+def get(opened, path: str, secret: str | None = None) -> bytes:
+    headers = {"Authorization": f"Bearer {secret}"} if secret else {}
+    req = urllib.request.Request(f"http://127.0.0.1:{opened.port}{path}", headers=headers)
+    with urllib.request.urlopen(req, timeout=10) as r:
+        return r.read()
+
+
+def test_volunteers_runs_fill_the_class_curve_one_run_each(tmp_path, runs, monkeypatch, capsys):
+    folder = tmp_path / "class"
+    with running_class(folder) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        members = {}
+        for i, name in enumerate(("Ann", "Bo"), 1):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            members[name] = client.join(address, code, name)
+            assert "in the class curve" in client.hand_in(members[name], as_person(runs / f"run{i}.json", name)).message
+        again = client.hand_in(members["Ann"], as_person(runs / "run3.json", "Ann"))  # a second run: kept apart
+        assert "your first run" in again.message
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "bot"))
+        assert main(["lab", str(runs / "short.toml"), "--bot", "adaptive", "--headless", "--join",
+                     f"127.0.0.1:{opened.port}", "--code", code, "--name", "Bot"]) == 0
+        assert "a program's run" in capsys.readouterr().out
+        lab = json.loads(get(opened, "/api/lab"))
+        rows = list(csv.DictReader(io.StringIO(get(opened, "/api/teacher/lab.csv", opened.clerk.roster.secret)
+                                               .decode())))
+    assert lab["protocol"] == "short" and lab["students"] == 2 and lab["programs"] == 1
+    assert lab["metric"] == "max_perpendicular_error_m" and lab["unit"] == "mm"
+    assert [t["trial"] for t in lab["trials"]] == [1, 2, 3, 4] and all(t["n"] == 2 for t in lab["trials"])
+    assert [t["perturbation"] for t in lab["trials"]][1:3] != ["none", "none"]
+    assert {r["player"] for r in rows} == {"Ann", "Bo", "Bot"} and len(rows) == 12
+    assert len(list((folder / "lab").glob("*.json"))) == 3 and len(list((folder / "lab-more").glob("*.json"))) == 1
+    # The folder is a class folder analyze reads: the same two students' curve.
+    assert main(["analyze", "--class", str(folder / "lab"), "--out", str(tmp_path / "curve"), "--no-figures"]) in (0, 1)
+    # Started again on the same folder, the runs are verified again and the curve is the same.
+    with running_class(folder) as opened:
+        for _ in range(100):
+            again = json.loads(get(opened, "/api/lab"))
+            if again["students"] == 2:
+                break
+            import time
+
+            time.sleep(0.05)
+    assert again == lab
