@@ -11,7 +11,7 @@ from pathlib import Path
 from armgame.classroom.serve import ClassServer, open_class
 from armgame.game.bots import Autopilot, make_bot
 from armgame.game.rules import GameConfig
-from armgame.game.session import UP, GameSession, InputEvent
+from armgame.game.session import DOWN, UP, GameSession, InputEvent
 from armgame.records.replay import Replay
 
 
@@ -48,3 +48,11 @@ def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, dri
     events += [InputEvent(last, m.key, UP) for m in session.config.muscles]  # whatever was held, let go
     session.play(events)
     return Replay.from_session(session, driven, None if driven == "keyboard" else "test", player)
+
+
+def tapped_game(n: int, seed: int = 10, player: str | None = None) -> Replay:
+    """The ``n``-th of many different whole games, each cheap: the shoulder flexor tapped from step n + 1
+    for 50 steps (a different start, a different path: another game)."""
+    session = GameSession(GameConfig(seed=seed))
+    session.play([InputEvent(n + 1, "d", DOWN), InputEvent(n + 51, "d", UP)])
+    return Replay.from_session(session, "keyboard", None, player)

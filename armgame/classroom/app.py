@@ -24,10 +24,13 @@ from __future__ import annotations
 
 import asyncio
 import json
+import queue
+import sys
+import threading
 import time
 from collections import OrderedDict, deque
 from collections.abc import AsyncIterator, Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +46,8 @@ from . import page
 from .intake import MAX_HANDIN_BYTES, Clerk, RefusedError
 
 QUEUE_LIMIT = 64
+#: Hand-ins entered with one table write at the most.
+BATCH = 32
 UPLOADS = 8
 BODY_SECONDS = 30.0
 MAX_JSON_BYTES = 4096
@@ -85,13 +90,95 @@ class Failures:
         self._recent(address).append(self.clock())
 
 
+class ClerkThread:
+    """The clerk's one thread. Jobs run in the order they came; hand-ins waiting together are checked
+    one by one and entered together (``Clerk.enter``: one table write for a burst, each answer sent
+    only after that write). ``after`` runs on the thread after every job (the pages' data rebuilt)."""
+
+    def __init__(self, clerk: Clerk, after: Callable[[], None]) -> None:
+        self.clerk, self.after = clerk, after
+        self.jobs: queue.SimpleQueue[tuple[str, Any, Future | None]] = queue.SimpleQueue()
+        self.thread = threading.Thread(target=self._serve, name="armgame-clerk", daemon=True)
+        self.thread.start()
+
+    def submit(self, kind: str, work: Any) -> Future:
+        """``kind`` "job": ``work()`` is run; "hand-in": ``work`` is (token, body) to check and enter."""
+        future: Future = Future()
+        self.jobs.put((kind, work, future))
+        return future
+
+    def stop(self) -> None:
+        """The jobs already queued are finished (a hand-in being written is never cut), then the thread ends."""
+        self.jobs.put(_STOP)
+        self.thread.join()
+
+    def _serve(self) -> None:
+        held = None
+        while True:
+            job = held if held is not None else self.jobs.get()
+            held = None
+            if job is _STOP:
+                return
+            if job[0] == "job":
+                _settle(job[2], job[1])
+            else:
+                batch = [job]
+                while len(batch) < BATCH:  # what arrived meanwhile goes in the same write
+                    try:
+                        more = self.jobs.get_nowait()
+                    except queue.Empty:
+                        break
+                    if more[0] != "hand-in":
+                        held = more
+                        break
+                    batch.append(more)
+                self._hand_in(batch)
+            try:
+                self.after()
+            except Exception as exc:
+                print(f"armgame class: the pages' data could not be rebuilt: {exc}", file=sys.stderr)
+
+    def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> None:
+        checked = []
+        for _, (token, body), future in batch:
+            try:
+                found = self.clerk.check(token, body)
+            except BaseException as exc:
+                future.set_exception(exc)
+                continue
+            if isinstance(found, dict):
+                future.set_result(found)
+            else:
+                checked.append((found, future))
+        if checked:
+            try:
+                answers = self.clerk.enter([c for c, _ in checked])
+            except BaseException as exc:
+                answers = [exc] * len(checked)
+            for (_, future), answer in zip(checked, answers, strict=True):
+                if isinstance(answer, BaseException):
+                    future.set_exception(answer)
+                else:
+                    future.set_result(answer)
+
+
+_STOP: tuple[str, Any, Future | None] = ("stop", None, None)
+
+
+def _settle(future: Future, work: Callable[[], Any]) -> None:
+    try:
+        future.set_result(work())
+    except BaseException as exc:
+        future.set_exception(exc)
+
+
 @dataclass
 class ClassState:
     """What the routes share: the clerk and its thread, and what the pages read (built on that thread)."""
 
     clerk: Clerk
     join_line: str
-    executor: ThreadPoolExecutor = field(default_factory=lambda: ThreadPoolExecutor(1, "armgame-clerk"))
+    worker: ClerkThread | None = None
     waiting: int = 0
     failures: Failures = field(default_factory=Failures)
     uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(UPLOADS))
@@ -111,18 +198,15 @@ class ClassState:
             self.snapshot = json.dumps(standings, ensure_ascii=True).encode()
             self.lab = json.dumps(self.clerk.lab_curve(), ensure_ascii=True, allow_nan=False).encode()
 
-    async def run(self, job: Callable[[], Any]) -> Any:
-        """``job`` on the clerk's thread, if the queue has room; the pages are told of any change."""
+    async def run(self, job: Callable[[], Any], kind: str = "job") -> Any:
+        """``job`` on the clerk's thread (or, for "hand-in", ``job`` is (token, body)), if the queue has
+        room; the pages are told of any change."""
         if self.waiting >= QUEUE_LIMIT:
             raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
+        assert self.worker is not None, "the class is not serving"
         self.waiting += 1
         try:
-            def work() -> Any:
-                try:
-                    return job()
-                finally:
-                    self.publish()
-            return await asyncio.get_running_loop().run_in_executor(self.executor, work)
+            return await asyncio.wrap_future(self.worker.submit(kind, job))
         finally:
             self.waiting -= 1
             self.changed.set()
@@ -223,6 +307,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
 
     @asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
+        state.worker = ClerkThread(clerk, state.publish)
         await state.run(lambda: None)  # the first snapshot
         if on_ready is not None:
             on_ready()
@@ -234,7 +319,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
             state.stopping.set()
             state.changed.set()
             loading.cancel()
-            state.executor.shutdown(wait=True)  # a hand-in being written is finished, never cut
+            state.worker.stop()  # a hand-in being written is finished, never cut
 
     async def home(request: Request) -> Response:
         return page.response("standings.html", SECURITY_HEADERS)
@@ -297,7 +382,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
             raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
         async with state.uploads:
             data = await _body(request, MAX_HANDIN_BYTES)
-        return _json(await state.run(lambda: clerk.hand_in(token, data)))
+        return _json(await state.run((token, data), "hand-in"))
 
     async def teacher_hide(request: Request) -> Response:
         _check_secret(state, request)

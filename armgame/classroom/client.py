@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import http.client
 import ipaddress
 import json
 import os
@@ -109,6 +110,11 @@ class UnreachableError(UserError):
     """The class could not be reached; the message names the address and the likely cause."""
 
 
+class BadAnswerError(UnreachableError):
+    """An answer that is not the class's (cut off as the server stopped, or another program at that address):
+    what became of a hand-in is not known, so it is kept to be handed in again (a game counts once)."""
+
+
 class RefusalError(UserError):
     """The class answered no; the message is its one line."""
 
@@ -135,8 +141,8 @@ def _request(address: ClassAddress, path: str, body: bytes, headers: dict[str, s
                 waited += pause
                 continue
             raise RefusalError(exc.code, message) from None
-        except (urllib.error.URLError, OSError) as exc:
-            reason = getattr(exc, "reason", exc)
+        except (urllib.error.URLError, OSError, http.client.HTTPException) as exc:
+            reason = getattr(exc, "reason", exc) or type(exc).__name__
             raise UnreachableError(
                 f"cannot reach the class at {address.label} ({getattr(reason, 'strerror', None) or reason}): is the "
                 f"class started, and is this machine on the teacher's network? (school Wi-Fi often keeps laptops "
@@ -158,7 +164,8 @@ def _answer(data: bytes, quiet: bool = False) -> dict:
     if not isinstance(value, dict):
         if quiet:
             return {}
-        raise RefusalError(502, "the class's answer is not armgame's (is that address an armgame class?)")
+        raise BadAnswerError("the class's answer was cut off or is not armgame's (is that address an armgame "
+                             "class?)")
     return value
 
 
@@ -238,7 +245,7 @@ def join(address: ClassAddress, code: str, name: str | None) -> Membership:
     try:
         membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]))
     except (KeyError, TypeError, ValueError):
-        raise RefusalError(502, "the class's answer is not armgame's (is that address an armgame class?)") from None
+        raise BadAnswerError("the class's answer is not armgame's (is that address an armgame class?)") from None
     _remember(membership)
     return membership
 

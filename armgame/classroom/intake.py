@@ -18,11 +18,14 @@ The class's folder::
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import io
 import math
+import os
 import re
+import stat
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -69,6 +72,15 @@ class Arrival:
     program: bool
 
 
+@dataclass(frozen=True)
+class Checked:
+    """A game checked and verified, not yet entered: its player, its replay under their name, its identity."""
+
+    player: Player
+    replay: Replay
+    digest: str
+
+
 @dataclass
 class LabRun:
     player: str
@@ -95,12 +107,23 @@ class Clerk:
         elif self.table.seed != roster.seed:
             raise DataFileError(f"{self.table.path} ranks seed {self.table.seed}, the class seed {roster.seed}: "
                                 f"this folder's table is not the class's (nothing was changed)")
+        self._sweep()
         self.entries: list[ScoreEntry] = self.table.all_entries()
         self.games: dict[str, ScoreEntry] = {e.game_sha256: e for e in self.entries if e.game_sha256}
         self.lab_runs: list[LabRun] = []
         self.lab_digests: set[str] = set()
         self.arrival: Arrival | None = None
         self.version = 0  # bumped at every change the projector should see
+
+    def _sweep(self) -> None:
+        """Temporary files a server killed mid-write left (never renamed: nothing refers to them). Only
+        this class's server writes its folders, and it is not writing yet."""
+        for folder in (self.table.replays, self.folder / LAB_DIR, self.folder / LAB_MORE_DIR):
+            if folder.is_dir() and not folder.is_symlink():
+                for stale in folder.glob(".*.tmp"):
+                    with contextlib.suppress(OSError):
+                        if stat.S_ISREG(os.lstat(stale).st_mode):
+                            stale.unlink()
 
     # ------------------------------------------------------------------ joining
     def join(self, name: object, token: str | None) -> tuple[Player, str | None]:
@@ -144,6 +167,18 @@ class Clerk:
     # ------------------------------------------------------------------ handing in
     def hand_in(self, token: str | None, data: bytes) -> dict[str, object]:
         """Check, verify and enter one replay; the answer the student's machine shows. Raises RefusedError."""
+        found = self.check(token, data)
+        if isinstance(found, dict):
+            return found
+        answer = self.enter([found])[0]
+        if isinstance(answer, RefusedError):
+            raise answer
+        return answer
+
+    def check(self, token: str | None, data: bytes) -> dict[str, object] | Checked:
+        """A hand-in checked and verified, ready to ``enter``; or the answer already (a game handed in
+        before by the same player; a lab run, which is kept here at once). Raises RefusedError; writes
+        nothing but a lab run."""
         player = self.player(token)
         if self.roster.closed:
             raise RefusedError(403, "the class is closed: no more games are taken (your replay stays on your machine)")
@@ -159,7 +194,7 @@ class Clerk:
             return self._lab_run(player, replay)
         return self._game(player, replay)
 
-    def _game(self, player: Player, replay: Replay) -> dict[str, object]:
+    def _game(self, player: Player, replay: Replay) -> dict[str, object] | Checked:
         r = replay.result
         if not replay.complete:
             raise RefusedError(400, "the game stopped before its clock ran out: only a whole game is handed in")
@@ -178,17 +213,38 @@ class Clerk:
         if not ok:
             raise RefusedError(422, f"the replay does not reproduce its score (recorded {r.score}, it replays to "
                                f"{recomputed.score}): not entered")
+        return Checked(player, replay.with_player(player.name), digest)
+
+    def enter(self, checked: Sequence[Checked]) -> list[dict[str, object] | RefusedError]:
+        """Enter checked games together (one table write for all: a burst of a class costs one write, not
+        thirty); each game's answer, or why it was not entered. Durable on disk before this returns."""
         try:
-            entry = self.table.add(replay.with_player(player.name))
-        except ValueError as exc:  # TableError included: nothing was entered
-            raise RefusedError(503, f"the class's table could not take the game: {exc}") from None
-        self.entries.append(entry)
+            results = self.table.add_many([c.replay for c in checked])
+        except (ValueError, UserError) as exc:  # the table could not be written: none was entered
+            refusal = RefusedError(503, f"the class's table could not take the game: {exc}")
+            return [refusal for _ in checked]
+        answers: list[dict[str, object] | RefusedError] = []
+        fresh = [r for r in results if isinstance(r, ScoreEntry)]
+        self.entries.extend(fresh)
         self.entries.sort(key=sort_key)
-        self.games[digest] = entry
-        answer = self._answer(entry)
-        self.version += 1
-        self.arrival = Arrival(self.version, entry.name, entry.score, str(answer["note"]), entry.program)
-        return answer
+        for c, result in zip(checked, results, strict=True):
+            if isinstance(result, ScoreEntry):
+                self.games[c.digest] = result
+        for c, result in zip(checked, results, strict=True):
+            twin = self.games.get(c.digest)
+            if isinstance(result, ScoreEntry):
+                answer = self._answer(result)
+                self.version += 1
+                self.arrival = Arrival(self.version, result.name, result.score, str(answer["note"]), result.program)
+                answers.append(answer)
+            elif twin is not None and player_key(twin.name) == player_key(c.player.name):
+                answers.append(self._answer(twin, already=True))  # the same game twice in one burst
+            elif twin is not None:
+                answers.append(RefusedError(409, f"this game was already handed in by {twin.name}: a game counts "
+                                                 f"once, whoever hands it in"))
+            else:
+                answers.append(RefusedError(400, f"not entered: {result}"))
+        return answers
 
     def _answer(self, entry: ScoreEntry, already: bool = False) -> dict[str, object]:
         """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""

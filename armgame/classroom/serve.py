@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import signal
 import socket
 import sys
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import date
@@ -71,11 +73,21 @@ class ClassServer:
         return int(self.sock.getsockname()[1])
 
     def run(self) -> None:
-        """Serve until Ctrl-C, SIGTERM or ``stop``; the socket is closed after."""
+        """Serve until Ctrl-C, SIGTERM or ``stop``; the socket is closed after.
+
+        uvicorn stops gracefully on SIGINT and SIGTERM, then raises the signal again for the handler
+        that was there before it. For a class that is the normal end, not an interruption: SIGTERM's
+        handler is made to raise KeyboardInterrupt as SIGINT's does, and both end the run quietly."""
+        main = threading.current_thread() is threading.main_thread()
+        before = signal.signal(signal.SIGTERM, _interrupt) if main else None
         try:
             self.server.run(sockets=[self.sock])
+        except KeyboardInterrupt:
+            pass
         finally:
             self.sock.close()
+            if main:
+                signal.signal(signal.SIGTERM, before)
 
     def stop(self) -> None:
         self.server.should_exit = True
@@ -134,6 +146,10 @@ def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[s
     opened.run()
     say(f"armgame class stopped: {len(opened.clerk.entries)} games kept in {folder}")
     return 0
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def _label(host: str) -> str:

@@ -72,6 +72,7 @@ from .storage import (
     STRICT_DECODER,
     DataFileError,
     atomic_write_bytes,
+    atomic_write_many,
     check_float,
     check_int,
     check_keys,
@@ -465,11 +466,7 @@ class ScoreTable:
         """Save the replay in replays/ (before the table is touched); returns its path."""
         self._safe_folder()
         data = replay.to_bytes()
-        digest = hashlib.sha256(data).hexdigest()
-        stamp = replay.date or now_iso()
-        slug = re.sub(r"[^A-Za-z0-9]+", "-", replay.player or "").strip("-")[:24] or "player"
-        name = f"{datetime.fromisoformat(stamp).strftime('%Y%m%dT%H%M%S')}-{slug}-{digest[:8]}.json"
-        path = self.replays / name
+        path = self.replays / self._replay_name(replay, data)
         try:
             if read_limited(path, MAX_REPLAY_BYTES, "replay file", follow=False) == data:
                 return path  # already there, byte for byte
@@ -478,47 +475,71 @@ class ScoreTable:
         atomic_write_bytes(path, data, "replay")
         return path
 
+    @staticmethod
+    def _replay_name(replay: Replay, data: bytes) -> str:
+        """A replay's file name in replays/: its date, its player and its bytes' digest (never a name a
+        file or a client gave)."""
+        stamp = replay.date or now_iso()
+        slug = re.sub(r"[^A-Za-z0-9]+", "-", replay.player or "").strip("-")[:24] or "player"
+        when = datetime.fromisoformat(stamp).strftime("%Y%m%dT%H%M%S")
+        return f"{when}-{slug}-{hashlib.sha256(data).hexdigest()[:8]}.json"
+
     def add(self, replay: Replay, replay_path: Path | None = None) -> ScoreEntry:
         """Save ``replay`` beside the table and enter its game; returns the new entry.
 
         Raises ``TableBusyError`` (the replay is saved; ``armgame scores --add`` enters it later) or
         ``TableError``/``ValueError`` with nothing changed.
         """
-        if replay.player is None:
-            raise ValueError("a game enters the table under a player's name")
-        if replay.task is not None:
-            raise ValueError("a lab run is not a game: it never enters the high-score table")
-        if not replay.complete:
-            raise ValueError("only a game played to the end enters the table")
+        _enterable(replay)
         # The replay first: a crash in between leaves a spare replay, never an entry without one.
         self._safe_folder()
         path = replay_path or self.save_replay(replay)
         data = read_limited(path, MAX_REPLAY_BYTES, "replay file", follow=False)
-        claims = replay_claims(replay)
-        r = replay.result
-        entry = ScoreEntry.from_dict(dict(
-            id=uuid.uuid4().hex, name=replay.player, driven=replay.driven, driver=replay.driver, score=r.score,
-            hits=r.hits, resets=r.resets, seed=r.seed, scene=r.scene, duration=r.duration,
-            date=replay.date or now_iso(), version=replay.version, replay=path.name,
-            replay_sha256=hashlib.sha256(data).hexdigest(), ruleset=claims["ruleset"],
-            config_sha256=claims["config_sha256"], game_sha256=claims["game_sha256"], complete=True,
-        ))
+        entry = _new_entry(replay, path.name, data)
         try:
             with self._locked():
-                return self._enter(entry)
+                result = self._enter_many([entry])[0]
+            if isinstance(result, Exception):
+                raise result
+            return result
         except TableBusyError as exc:
             later = shlex.join(["armgame", "scores", "--scores", str(self.folder), "--add", str(path)])
             raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with {later}") from None
+
+    def add_many(self, replays: Sequence[Replay]) -> list[ScoreEntry | ValueError]:
+        """``add`` for many games at once, for a server taking a class's games: their replays written with
+        one folder fsync, the table read and written once under the lock. Returns, for each game, its
+        entry or the ValueError (a ``TableError`` for a game already in) that kept it out; raises
+        ``TableError`` (busy, over a limit, not a safe place) with none entered."""
+        results: list[ScoreEntry | ValueError] = []
+        files: dict[str, bytes] = {}
+        for replay in replays:
+            try:
+                _enterable(replay)
+                data = replay.to_bytes()
+                name = self._replay_name(replay, data)
+                results.append(_new_entry(replay, name, data))
+                files[name] = data
+            except ValueError as exc:
+                results.append(exc)
+        self._safe_folder()
+        atomic_write_many([(self.replays / name, data) for name, data in files.items()], "replay")
+        entries = [r for r in results if isinstance(r, ScoreEntry)]
+        with self._locked():
+            entered = iter(self._enter_many(entries))
+        return [next(entered) if isinstance(r, ScoreEntry) else r for r in results]
 
     def new(self, seed: int) -> None:
         """Start the table (empty) ranking ``seed``; refused if it already holds entries."""
         self._safe_folder()
         with self._locked():
-            self._enter(None, seed)
+            self._enter_many([], seed)
 
-    def _enter(self, entry: ScoreEntry | None, seed: int | None = None) -> ScoreEntry | None:
-        """Under the lock: write the table with ``entry`` added (its place in the order of entry and
-        the time given here), or, with ``seed``, an empty table ranking that seed. Returns the entry."""
+    def _enter_many(self, new_entries: Sequence[ScoreEntry], seed: int | None = None
+                    ) -> list[ScoreEntry | TableError]:
+        """Under the lock: write the table with ``new_entries`` added in order (each its place in the order
+        of entry and the time given here; a game already in is refused, as its TableError), or, with
+        ``seed``, an empty table ranking that seed. Returns each entry as entered, or why not."""
         # Under the lock nobody else is writing the table: any temporary file of it was left by a
         # writer that died mid-write. Replays are written outside the lock, so theirs are left alone.
         for stale in self.folder.glob(f".{TABLE_NAME}.*.tmp"):
@@ -539,9 +560,15 @@ class ScoreTable:
                 head = _Head(seed=seed, next_entry=head.next_entry)
             entries, head = _numbered(entries, head)
             self._seed = head.seed
-            if entry is not None:
-                entry = self._admit(entry, entries, head)
+            results: list[ScoreEntry | TableError] = []
+            for entry in new_entries:
+                try:
+                    entry = self._admit(entry, entries, head)
+                except TableError as exc:
+                    results.append(exc)
+                    continue
                 entries.append(entry)
+                results.append(entry)
                 head = _Head(head.seed, entry.entered + 1)  # type: ignore[operator]
             if len(entries) > MAX_TABLE_ENTRIES:
                 raise TableError(f"the table holds {len(entries) - 1} entries, its limit: not entered (nothing was "
@@ -562,7 +589,7 @@ class ScoreTable:
             if damage is not None:
                 where = f"; the damaged file is kept as {kept.name}" if kept else ""
                 self.warn(f"{damage.describe(self.path)}{where}")
-            return entry
+            return results
         finally:
             if fd is not None:
                 os.close(fd)
@@ -728,6 +755,29 @@ class ScoreTable:
             return Check(False, "NOT A WHOLE GAME", "the game stopped before its clock ran out", claims["ruleset"],
                          claims["game_sha256"])
         return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"], claims["game_sha256"])
+
+
+def _enterable(replay: Replay) -> None:
+    """Refuse a game that can never enter a table: no player's name, a lab run, a game stopped early."""
+    if replay.player is None:
+        raise ValueError("a game enters the table under a player's name")
+    if replay.task is not None:
+        raise ValueError("a lab run is not a game: it never enters the high-score table")
+    if not replay.complete:
+        raise ValueError("only a game played to the end enters the table")
+
+
+def _new_entry(replay: Replay, replay_name: str, data: bytes) -> ScoreEntry:
+    """The entry of ``replay``, whose file ``replay_name`` in replays/ holds ``data`` (not yet entered)."""
+    claims = replay_claims(replay)
+    r = replay.result
+    return ScoreEntry.from_dict(dict(
+        id=uuid.uuid4().hex, name=replay.player, driven=replay.driven, driver=replay.driver, score=r.score,
+        hits=r.hits, resets=r.resets, seed=r.seed, scene=r.scene, duration=r.duration,
+        date=replay.date or now_iso(), version=replay.version, replay=replay_name,
+        replay_sha256=hashlib.sha256(data).hexdigest(), ruleset=claims["ruleset"],
+        config_sha256=claims["config_sha256"], game_sha256=claims["game_sha256"], complete=True,
+    ))
 
 
 #: What recomputing one hit costs, in physics steps: drawing the next target tries up to 1,000 postures,

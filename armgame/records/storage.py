@@ -170,6 +170,41 @@ def atomic_write_bytes(path: Path, data: bytes, what: str = "file") -> None:
         f.write(data)
 
 
+def atomic_write_many(items: list[tuple[Path, bytes]], what: str = "file") -> None:
+    """``atomic_write_bytes`` for many files of one folder, as durable, at a fraction of the cost.
+
+    Each file is written to its temporary file and fsynced, then renamed; the folder is fsynced once,
+    after the last rename (one folder fsync for a batch of replays rather than one a file). On an error
+    the files not yet renamed are removed and the error is raised: the ones renamed are whole."""
+    pending: list[tuple[Path, Path]] = []
+    try:
+        for path, data in items:
+            path = check_output_path(Path(path), what)
+            try:
+                fd, tmp = _temporary(path.parent, path.name)
+            except OSError as exc:
+                raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
+            pending.append((tmp, path))
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+        while pending:
+            tmp, path = pending[0]
+            check_output_path(path, what)
+            os.replace(tmp, path)
+            pending.pop(0)
+    except BaseException as exc:
+        for tmp, _ in pending:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise DataFileError(f"cannot write the {what}: {exc.strerror or exc}") from None
+        raise
+    for folder in {Path(path).parent for path, _ in items}:
+        fsync_folder(folder)
+
+
 def save_figure(fig: object, path: Path, **options: object) -> Path:
     """A matplotlib figure saved through ``atomic_writer`` (the format from the file's suffix)."""
     path = Path(path)
