@@ -17,6 +17,9 @@ SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else s
 #: game of more (a long clock, a "hit storm" claiming thousands of hits, a replay of 100,000 events) is
 #: listed NOT CHECKED: ``armgame verify`` checks it, whatever it costs.
 MAX_CHECK_WORK = 300_000
+#: The fewest entries ``listing`` checks together (batches recompute many games at once): a list still
+#: wanting rows checks at least this many of the entries below, not one game at a time.
+MIN_BATCH = 256
 
 
 def add_scores_option(p: argparse.ArgumentParser) -> None:
@@ -167,7 +170,7 @@ def listing(table, entries, limit: int | None, check: bool, per_player: bool = T
         return len(players[name]) < limit
 
     pending = sorted(entries, key=sort_key)
-    size = max(2 * limit, 256) if limit else max(1, len(pending))
+    size = max(2 * limit, MIN_BATCH) if limit else max(1, len(pending))
 
     def check_batch(batch: list) -> None:
         results = check_entries(table, batch, MAX_CHECK_WORK) if check else ((e, None) for e in batch)
