@@ -20,6 +20,7 @@ from armgame.records.cache import VerificationCache
 from armgame.records.identity import game_digest
 from armgame.records.replay import Replay
 from armgame.records.scores import ScoreTable, replay_claims
+from armgame.records.standings import player_key
 
 _GAMES: list[Replay] = []
 
@@ -110,3 +111,14 @@ def test_drawn_tables_hold(tmp_path_factory, kinds, cache):
     trusted_plant = cache == "private ok for forgeries"  # the user's own cache: trusted by design
     if not trusted_plant:
         assert all(e.score == true_scores[e.id] for e in rows)  # no forged score listed as checked
+    # One row a player: each player once, at the first of their games in the every-game list, with all of
+    # that list's games of theirs (every entry is checked here, so every game counted checked out).
+    players, _ = listing(table, table.all_entries(), None, check=True)
+    for name, games_listed in lists.items():
+        mine = players[name]
+        assert len({player_key(row.name) for row in mine}) == len(mine)
+        firsts = {}
+        for row in games_listed:
+            firsts.setdefault(player_key(row.name), row.best[0].id)
+        assert [row.best[0].id for row in mine] == list(firsts.values())
+        assert sum(row.games for row in mine) == len(games_listed)
