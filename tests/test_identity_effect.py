@@ -285,3 +285,24 @@ def test_a_forged_entry_naming_an_honest_replay_file_never_pushes_it_out(tmp_pat
     assert main(["verify", str(table.folder)]) == 1
     out = capsys.readouterr().out
     assert "Honest: score 0" in out and "DUPLICATE" not in out and "1 flagged" in out
+
+
+def test_a_live_class_knows_a_game_entered_before_the_bump(tmp_path):
+    """The class's clerk looks a hand-in up by every identity version's digest, as the table's door does."""
+    from armgame.classroom.intake import Clerk, RefusedError
+    from armgame.classroom.roster import Roster
+
+    folder = tmp_path / "class"
+    folder.mkdir()
+    roster, _ = Roster.open(folder, 10)
+    clerk = Clerk(folder, roster)
+    old, token = clerk.join("Old", None)
+    other, other_token = clerk.join("Bo", None)
+    data = old_game().to_bytes()
+    assert clerk.hand_in(token, data)["already"] is False
+    _stored_digest(clerk.table, V1_DIGEST)  # the class's table as an armgame before the bump wrote it
+    clerk = Clerk(folder, roster)  # the class goes on after a restart
+    assert clerk.hand_in(token, data)["already"] is True
+    with pytest.raises(RefusedError, match="already handed in by Old"):
+        clerk.hand_in(other_token, data)
+    assert old.name == "Old" and other.name == "Bo"

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
-from ..records.identity import game_digest
+from ..records.identity import game_digest, game_digests
 from ..records.replay import Replay, check_name, now_iso
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
@@ -167,8 +167,9 @@ class Clerk:
         if rules not in RULESETS or r.seed != self.roster.seed:
             raise RefusedError(400, f"this class plays the standard game of seed {self.roster.seed}; this game is "
                                f"{rules} rules, seed {r.seed} (play it with --join to get the class's game)")
-        digest = game_digest(replay)
-        twin = self.games.get(digest)
+        # An entry keeps the digest of the identity version that entered it: the game is looked up by each.
+        digests = game_digests(replay)
+        twin = next((self.games[d] for d in digests if d in self.games), None)
         if twin is not None:
             if player_key(twin.name) == player_key(player.name):
                 return self._answer(twin, already=True)
@@ -184,7 +185,7 @@ class Clerk:
             raise RefusedError(503, f"the class's table could not take the game: {exc}") from None
         self.entries.append(entry)
         self.entries.sort(key=sort_key)
-        self.games[digest] = entry
+        self.games[digests[0]] = entry
         answer = self._answer(entry)
         self.version += 1
         self.arrival = Arrival(self.version, entry.name, entry.score, str(answer["note"]), entry.program)
