@@ -133,7 +133,8 @@ def listing(table, entries, limit: int | None, check: bool, per_player: bool = T
     (``records.batch_verify``), only while a list still wants rows: at most ``limit`` rows (players) of
     each list of standard games (each costs exactly its ruleset's steps, once per user: verdicts,
     failures too, are cached), and at most ``limit`` custom games, flagged ones included (their cost
-    is their own). Once a player has a row, their entries below it are not replayed. So a row's
+    is their own). Once a player has a row, their entries below it are not replayed (but for those in
+    the batch that found it, checked together). So a row's
     ``games`` is the player's entries in its list less those found flagged (a check failed, or a copy of
     an earlier game): with a limit, their games below the best count as entered; with none (``--all``:
     every entry is checked), only games that check out count. Which of two entries of one game counts,
