@@ -278,9 +278,10 @@ def test_cli_headless_play_enters_the_table_only_with_a_name(tmp_path, capsys):
     out = capsys.readouterr().out.splitlines()
     # Headless games are a program's, and 0.2 s games not the standard game: listed apart, never ranked.
     assert out[2].strip() == "no ranked games yet" and out[3].startswith("Programs")
-    assert out[4].split()[:2] == ["#", "name"]
-    assert [row.split()[1] for row in out[5:]] == ["Zoe", "Yan"]  # equal scores: the earlier entry first
-    assert all(row.rstrip().endswith("ok") and " script " in row for row in out[5:])
+    assert out[4].split()[:4] == ["#", "name", "score", "games"]
+    assert [row.split()[1] for row in out[5:7]] == ["Zoe", "Yan"]  # equal scores: the earlier entry first
+    assert all(row.rstrip().endswith("ok") and " script " in row for row in out[5:7])
+    assert out[7].startswith("One row a player") and len(out) == 8
 
 
 @pytest.mark.parametrize("name", ["x" * 10_000, "a\x07b", "   "])

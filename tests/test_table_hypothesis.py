@@ -20,6 +20,7 @@ from armgame.records.cache import VerificationCache
 from armgame.records.identity import game_digest
 from armgame.records.replay import Replay
 from armgame.records.scores import ScoreTable, replay_claims
+from armgame.records.standings import player_key
 
 _GAMES: list[Replay] = []
 
@@ -101,8 +102,8 @@ def test_drawn_tables_hold(tmp_path_factory, kinds, cache):
     assert {p: p.read_bytes() for p in folder.rglob("*") if p.is_file() and p.parent != folder / "cache"} == \
         {p: b for p, b in before.items() if p.parent != folder / "cache"}
     table = ScoreTable(folder, warn=lambda m: None, cache=VerificationCache(cache_dir, warn=lambda m: None))
-    lists, _ = listing(table, table.all_entries(), None, check=True)
-    rows = [e for rows in lists.values() for e, _ in rows]
+    lists, _ = listing(table, table.all_entries(), None, check=True, per_player=False)  # every game: each its row
+    rows = [row.best[0] for rows in lists.values() for row in rows]
     digests = [game_digest(Replay.load(folder / "replays" / e.replay)) for e in rows]
     assert len(digests) == len(set(digests))  # each game listed once
     honest = {game_digest(games()[which]) for kind, which in kinds if kind in ("honest", "copy", "old format")}
@@ -110,3 +111,14 @@ def test_drawn_tables_hold(tmp_path_factory, kinds, cache):
     trusted_plant = cache == "private ok for forgeries"  # the user's own cache: trusted by design
     if not trusted_plant:
         assert all(e.score == true_scores[e.id] for e in rows)  # no forged score listed as checked
+    # One row a player: each player once, at the first of their games in the every-game list, with all of
+    # that list's games of theirs (every entry is checked here, so every game counted checked out).
+    players, _ = listing(table, table.all_entries(), None, check=True)
+    for name, games_listed in lists.items():
+        mine = players[name]
+        assert len({player_key(row.name) for row in mine}) == len(mine)
+        firsts = {}
+        for row in games_listed:
+            firsts.setdefault(player_key(row.name), row.best[0].id)
+        assert [row.best[0].id for row in mine] == list(firsts.values())
+        assert sum(row.games for row in mine) == len(games_listed)

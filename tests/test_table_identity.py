@@ -20,7 +20,7 @@ from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
 from armgame.records.identity import game_digest
 from armgame.records.replay import Replay
-from armgame.records.scores import PRACTICE, PROGRAMS, RANKED, ScoreTable, TableError
+from armgame.records.scores import PRACTICE, PROGRAMS, RANKED, ScoreTable, TableError, replay_claims
 from armgame.records.storage import atomic_write_bytes
 
 
@@ -189,9 +189,8 @@ def _forge_99(table: ScoreTable, entry) -> dict:
     data = json.loads(table.path.read_text())
     data["entries"][0].update(score=99, hits=99, replay_sha256=digest)
     table.path.write_text(json.dumps(data))
-    claims = {k: data["entries"][0][k] for k in ("name", "driven", "driver", "score", "hits", "resets", "seed",
-                                                  "scene", "duration", "date", "config_sha256", "ruleset",
-                                                  "game_sha256", "complete")}
+    claims = replay_claims(Replay.load(table.replay_path(entry)))  # what the forged replay says: score 99
+    assert claims["score"] == data["entries"][0]["score"] == 99
     return {digest: {"ok": True, "label": "ok", "detail": "", "claims": claims}}
 
 

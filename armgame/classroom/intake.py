@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
-from ..records.identity import game_digest
+from ..records.identity import game_digest, game_digests
 from ..records.replay import Replay, check_name, now_iso
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
@@ -74,11 +74,12 @@ class Arrival:
 
 @dataclass(frozen=True)
 class Checked:
-    """A game checked and verified, not yet entered: its player, its replay under their name, its identity."""
+    """A game checked and verified, not yet entered: its player, its replay under their name, its identity
+    (``identity.game_digests``: the current version's first)."""
 
     player: Player
     replay: Replay
-    digest: str
+    digests: tuple[str, ...]
 
 
 @dataclass
@@ -202,8 +203,9 @@ class Clerk:
         if rules not in RULESETS or r.seed != self.roster.seed:
             raise RefusedError(400, f"this class plays the standard game of seed {self.roster.seed}; this game is "
                                f"{rules} rules, seed {r.seed} (play it with --join to get the class's game)")
-        digest = game_digest(replay)
-        twin = self.games.get(digest)
+        # An entry keeps the digest of the identity version that entered it: the game is looked up by each.
+        digests = game_digests(replay)
+        twin = next((self.games[d] for d in digests if d in self.games), None)
         if twin is not None:
             if player_key(twin.name) == player_key(player.name):
                 return self._answer(twin, already=True)
@@ -213,7 +215,7 @@ class Clerk:
         if not ok:
             raise RefusedError(422, f"the replay does not reproduce its score (recorded {r.score}, it replays to "
                                f"{recomputed.score}): not entered")
-        return Checked(player, replay.with_player(player.name), digest)
+        return Checked(player, replay.with_player(player.name), digests)
 
     def enter(self, checked: Sequence[Checked]) -> list[dict[str, object] | RefusedError]:
         """Enter checked games together (one table write for all: a burst of a class costs one write, not
@@ -229,9 +231,9 @@ class Clerk:
         self.entries.sort(key=sort_key)
         for c, result in zip(checked, results, strict=True):
             if isinstance(result, ScoreEntry):
-                self.games[c.digest] = result
+                self.games[c.digests[0]] = result
         for c, result in zip(checked, results, strict=True):
-            twin = self.games.get(c.digest)
+            twin = next((self.games[d] for d in c.digests if d in self.games), None)
             if isinstance(result, ScoreEntry):
                 answer = self._answer(result)
                 self.version += 1

@@ -109,8 +109,9 @@ def class_members(runs: list, wanted: str | None) -> tuple[list, object, list[tu
     ``(path, why)`` of each run left out.
 
     The protocol is the one most runs share (ties: the one whose first file sorts first), or the one
-    named ``wanted``: one planted file sorting first cannot set it. A game is counted once, by its
-    digest (``records.identity``), so five copies of one replay are one student.
+    named ``wanted``: one planted file sorting first cannot set it. ``runs`` are ``(path, rows, session,
+    digest)``, each game once: ``_class`` leaves copies out (``records.identity.FirstEntries``), so five
+    copies of one replay are one student.
     """
     groups: list[tuple[object, list]] = []  # (protocol, its runs), protocols compared whole
     for run in runs:
@@ -138,14 +139,7 @@ def class_members(runs: list, wanted: str | None) -> tuple[list, object, list[tu
         why = (f"its protocol is also named {other.name!r} but differs from the class's ({shared})"
                if other.name == protocol.name else f"its protocol {other.name!r} differs from the class's ({shared})")
         left_out += [(r[0], why) for r in members]
-    seen: dict[str, Path] = {}
-    students = []
-    for path, rows, _, digest in chosen:
-        if digest in seen:
-            left_out.append((path, f"the same game as {seen[digest].name} (a copy counts once)"))
-            continue
-        seen[digest] = path
-        students.append((path, rows))
+    students = [(path, rows) for path, rows, _, _ in chosen]
     return students, protocol, sorted(left_out, key=lambda item: str(item[0]))
 
 
@@ -241,23 +235,24 @@ def _class(args: argparse.Namespace) -> int:
         raise UserError(f"{folder}: no replays (*.json) there")
     if len(files) > MAX_CLASS_FILES:
         raise UserError(f"{folder}: {len(files)} replays, more than a class curve reads ({MAX_CLASS_FILES})")
-    from ..records.identity import game_digest
+    from ..records.identity import FirstEntries, game_digest
 
     runs, skipped, copies = [], 0, []
-    seen: dict[str, Path] = {}
+    first: FirstEntries[Path] = FirstEntries()  # in file order: the first verified run of a game counts
     for path in files:
         try:
             replay = lab_replay(path)
             digest = game_digest(replay)
-            if digest in seen:  # a copy of a game already verified: counted once, never replayed again
-                copies.append((path, f"the same game as {seen[digest].name} (a copy counts once)"))
+            twin = first.counted(digest)
+            if twin is not None:  # a copy of a game already verified: counted once, never replayed again
+                copies.append((path, f"the same game as {twin.name} (a copy counts once)"))
                 continue
             rows, session = verified_run(path, replay)
         except UserError as exc:
             print(f"armgame analyze: {exc}", file=sys.stderr)
             skipped += 1
             continue
-        seen[digest] = path
+        first.copy_of(path, None, digest, ok=True)  # verified: it counts from now on
         runs.append((path, rows, session, digest))
     students, protocol, left_out = class_members(runs, args.protocol)
     left_out = sorted(left_out + copies, key=lambda item: str(item[0]))

@@ -323,20 +323,22 @@ def list_name(kind: str) -> str:
 
 
 def _table_of_list(session, args: argparse.Namespace, entry=None):
-    """The table, the entries of the list the game goes to (or would go to), best first, and that list."""
+    """The table, the rows of the list the game goes to (or would go to), one a player at their best game
+    (``records.standings``), best first, and that list."""
     import sys
 
     from ..records.scores import ScoreTable
+    from ..records.standings import one_row_per_player
     from .scores import scores_dir
 
     table = ScoreTable(scores_dir(args), warn=lambda m: print(f"armgame play: {m}", file=sys.stderr))
     everything = table.all_entries()  # read once: it also gives the table's seed, which the lists need
     kind = table.list_of(entry) if entry is not None else _list_it_would_join(session, args, table)
-    return table, table.of_list(kind, everything), kind
+    return table, one_row_per_player(table.of_list(kind, everything)), kind
 
 
 def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[int, str, int], ...]:
-    """The top 10 as (rank, name, score), and the game's own row after them if it ranks lower."""
+    """The top 10 as (rank, name, score), and the player's own row after them if it ranks lower."""
     rows = [(i, name, score) for i, (name, score) in enumerate(ranked[:10], 1)]
     if own is not None and own > 10:
         rows.append((own, *ranked[own - 1]))
@@ -347,6 +349,7 @@ def _standing(session, args: argparse.Namespace):
     """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
     import sys
 
+    from ..records.standings import rank_of
     from ..ui.render import Standing
 
     membership = getattr(args, "membership", None)
@@ -358,12 +361,13 @@ def _standing(session, args: argparse.Namespace):
         try:
             entry = _keep(session, args)
             args.kept = True
-            _, entries, kind = _table_of_list(session, args, entry)
+            _, rows, kind = _table_of_list(session, args, entry)
         except UserError as exc:
             print(f"armgame play: error: {exc}", file=sys.stderr)
             return None
-        rank = next((i for i, e in enumerate(entries, 1) if entry is not None and e.id == entry.id), None)
-        return Standing(rank, len(entries), _rows([(e.name, e.score) for e in entries], rank), list_name(kind))
+        # The player's place, at their best game (maybe an earlier one): "#3" is the third player.
+        rank = None if entry is None else rank_of(rows, entry.name)
+        return Standing(rank, len(rows), _rows([(r.name, r.best.score) for r in rows], rank), list_name(kind))
 
     return standing
 
@@ -427,22 +431,23 @@ def _list_it_would_join(session, args: argparse.Namespace, table) -> str:
 
 
 def _preview(session, args: argparse.Namespace):
-    """The end screen's first look: where the score would rank, before any name is typed (nothing
-    is entered: an equal score already in the table stays ahead, as the earlier game)."""
+    """The end screen's first look: where the score would rank, before any name is typed, as a new
+    player's (nothing is entered: an equal score already in the table stays ahead, as the earlier game)."""
     import sys
 
+    from ..records.standings import place_of_new
     from ..records.storage import DataFileError
     from ..ui.render import Standing
 
     def preview() -> Standing | None:
         try:
-            _, entries, kind = _table_of_list(session, args)
+            _, rows, kind = _table_of_list(session, args)
         except (UserError, DataFileError, OSError) as exc:
             print(f"armgame play: {exc}", file=sys.stderr)
             return None
         score = session.rules.board.score
-        rank = 1 + sum(1 for e in entries if e.score >= score)
-        ranked = [(e.name, e.score) for e in entries]
+        rank = place_of_new(rows, score)
+        ranked = [(r.name, r.best.score) for r in rows]
         ranked.insert(rank - 1, ("", score))
         return Standing(rank, len(ranked), _rows(ranked, rank), list_name(kind), pending=True)
 

@@ -17,6 +17,9 @@ SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else s
 #: game of more (a long clock, a "hit storm" claiming thousands of hits, a replay of 100,000 events) is
 #: listed NOT CHECKED: ``armgame verify`` checks it, whatever it costs.
 MAX_CHECK_WORK = 300_000
+#: The fewest entries ``listing`` checks together (batches recompute many games at once): a list still
+#: wanting rows checks at least this many of the entries below, not one game at a time.
+MIN_BATCH = 256
 
 
 def add_scores_option(p: argparse.ArgumentParser) -> None:
@@ -33,8 +36,9 @@ def scores_dir(args: argparse.Namespace):
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "scores",
-        help="the high-score table, best first",
-        description="Print the high-score table, best first (equal scores: the earlier entry first). The ranked "
+        help="the high-score table, best first, one row a player",
+        description="Print the high-score table, best first (equal scores: the earlier entry first), one row a "
+        "player: their best game and how many games they played (--all-games: every game). The ranked "
         "table holds keyboard games of the standard rules (the default 60 s game) and the table's seed "
         f"({DEFAULT_SEED} unless the table was started with --new --seed N); games of another seed are listed "
         "apart as practice, games a program played (bots, scripts) apart as programs, games of other rules apart "
@@ -44,8 +48,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "reproduce its score is flagged and not ranked.",
     )
     add_scores_option(p)
-    p.add_argument("--top", type=int, default=10, metavar="N", help="how many entries of each list (default: 10)")
-    p.add_argument("--all", action="store_true", help="every entry")
+    p.add_argument("--top", type=int, default=10, metavar="N",
+                   help="how many rows of each list: players, or games with --all-games (default: 10)")
+    p.add_argument("--all", action="store_true", help="every row, every entry checked")
+    p.add_argument("--all-games", action="store_true",
+                   help="a row for every game, not one a player (a player's games each ranked)")
     p.add_argument("--no-check", action="store_true", help="do not replay the games (faster, nothing flagged)")
     p.add_argument("--add", metavar="REPLAY", help="enter the game of a replay file (a game the table was too busy "
                    "to take, or one recorded with play --record); it is verified first")
@@ -106,67 +113,82 @@ def run(args: argparse.Namespace) -> int:
     if not entries:
         print(f"no scores yet in {table.path}")
         return 0
-    lists, flagged = listing(table, entries, None if args.all else args.top, check=not args.no_check)
+    limit = None if args.all else args.top
+    per_player = not args.all_games
+    lists, flagged = listing(table, entries, limit, check=not args.no_check, per_player=per_player)
     if cache is not None:
         cache.save()
-    _print_listing(table, len(entries), lists, flagged, args.no_check)
+    _print_listing(table, len(entries), lists, flagged, args.no_check, _games_note(per_player, limit, args.no_check))
     return 0
 
 
-def listing(table, entries, limit: int | None, check: bool):
-    """Each list's rows ``(entry, check)`` best first, at most ``limit`` each, and the flagged entries.
+def listing(table, entries, limit: int | None, check: bool, per_player: bool = True):
+    """Each list's rows best first, at most ``limit`` each, and the flagged entries ``(entry, check)``.
+
+    A row is a ``standings.PlayerRow`` whose ``best`` is ``(entry, check)``: with ``per_player``, one a
+    player (``standings.one_row_per_player``), their best game that checks out and how many games they
+    played in that list; else one a game (``games`` 1), as ``--all-games`` lists them.
 
     Cost: no replay is read without ``check``. With it, entries are checked best first, in batches
-    (``records.batch_verify``), only while a list still wants rows: at most ``limit`` passing entries
-    of each list of standard games (each costs exactly its ruleset's steps, once per user: verdicts,
+    (``records.batch_verify``), only while a list still wants rows: at most ``limit`` rows (players) of
+    each list of standard games (each costs exactly its ruleset's steps, once per user: verdicts,
     failures too, are cached), and at most ``limit`` custom games, flagged ones included (their cost
-    is their own). A game entered twice is flagged at its later entry.
+    is their own). Once a player has a row, their entries below it are not replayed (but for those in
+    the batch that found it, checked together). So a row's
+    ``games`` is the player's entries in its list less those found flagged (a check failed, or a copy of
+    an earlier game): with a limit, their games below the best count as entered; with none (``--all``:
+    every entry is checked), only games that check out count. Which of two entries of one game counts,
+    and which is the copy, is ``records.identity.FirstEntries``'s to say; the entries flagged are those
+    met on the way.
     """
     from ..records.batch_verify import check_entries
-    from ..records.scores import CUSTOM_GAMES, LIST_TITLES, entry_order
+    from ..records.identity import FirstEntries
+    from ..records.scores import CUSTOM_GAMES, LIST_TITLES, sort_key
+    from ..records.standings import PlayerRow, one_row_per_player, player_key
 
-    first: dict[str, object] = {}
-    duplicate: dict[str, object] = {}
-    # One replay file entered twice: the later entry is flagged unread (the same bytes check out or fail
-    # alike). Games are compared after their checks, among those that check out: a forged entry planted
-    # earlier with an honest game's digest never pushes the honest entry out.
-    for e in sorted(entries, key=entry_order):
-        if e.replay_sha256 in first:
-            duplicate[e.id] = first[e.replay_sha256]
-        first.setdefault(e.replay_sha256, e)
-    lists: dict[str, list] = {name: [] for name in LIST_TITLES}
+    first: FirstEntries = FirstEntries()
+    counted: dict[str, list] = {name: [] for name in LIST_TITLES}  # (entry, check) of each list's games
+    players: dict[str, set[str]] = {name: set() for name in LIST_TITLES}  # who has a row, by list
     flagged: list = []
     custom_checked = 0
 
+    def who(e) -> str:
+        return player_key(e.name) if per_player else e.id
+
     def wants(e, custom_in_batch: int) -> bool:
+        twin = first.counted_file(e.replay_sha256)
+        if twin is not None:  # a replay file already counted: the copy is flagged unread
+            flagged.append((e, _duplicate(twin)))
+            return False
         name = table.list_of(e)
         if limit is None:
             return True
+        if who(e) in players[name]:  # their row is found: a game below it is counted, not replayed
+            counted[name].append((e, None))
+            return False
         if name == CUSTOM_GAMES:  # each may cost up to MAX_GAME_STEPS: never more than --top of them
             return custom_checked + custom_in_batch < limit
-        return len(lists[name]) < limit
+        return len(players[name]) < limit
 
-    pending = [e for e in entries if e.id not in duplicate]
-    for e in entries:
-        if e.id in duplicate:
-            flagged.append((e, _duplicate(duplicate[e.id])))
-    games: dict[str, object] = {}
-    size = max(2 * limit, 256) if limit else max(1, len(pending))
+    pending = sorted(entries, key=sort_key)
+    size = max(2 * limit, MIN_BATCH) if limit else max(1, len(pending))
 
     def check_batch(batch: list) -> None:
         results = check_entries(table, batch, MAX_CHECK_WORK) if check else ((e, None) for e in batch)
         for e, c in results:
             name = table.list_of(e, c)
-            if limit is not None and name != CUSTOM_GAMES and len(lists[name]) >= limit:
+            if limit is not None and name != CUSTOM_GAMES and len(players[name]) >= limit \
+                    and who(e) not in players[name]:
                 continue
+            # Unchecked (--no-check), an entry is taken at its word: the earlier of two counts.
+            twin = first.copy_of(e, e.replay_sha256, None if c is None else c.game, c is None or c.ok)
             if c is not None and not c.ok:
                 flagged.append((e, c))
-            elif c is not None and c.game is not None and games.setdefault(c.game, e) is not e:
-                # Only games that check out count: a forged copy of a game never pushes out its honest entry.
-                # Two that check out have one score, so the earlier entry comes first (sort_key).
-                flagged.append((e, _duplicate(games[c.game])))
+            elif twin is not None:
+                flagged.append((e, _duplicate(twin)))
             else:
-                lists[name].append((e, c))
+                players[name].add(who(e))
+                counted[name].append((e, c))
 
     # One pass, best first: an entry its list no longer wants now is never wanted later (lists only fill).
     batch: list = []
@@ -182,15 +204,12 @@ def listing(table, entries, limit: int | None, check: bool):
             batch, custom_in_batch = [], 0
     if batch:
         check_batch(batch)
-    for rows in lists.values():
-        rows.sort(key=lambda row: _order(row[0]))
+    lists = {}
+    for name, games in counted.items():
+        games.sort(key=lambda game: sort_key(game[0]))
+        lists[name] = (one_row_per_player(games, lambda game: game[0].name) if per_player
+                       else [PlayerRow(e.name, (e, c), 1) for e, c in games])
     return lists, flagged
-
-
-def _order(e):
-    from ..records.scores import sort_key
-
-    return sort_key(e)
 
 
 def _duplicate(twin):
@@ -198,19 +217,33 @@ def _duplicate(twin):
     return _check("DUPLICATE", f"the same game as {twin.name}'s entry of {when}, which counts")
 
 
-def _print_listing(table, count: int, lists, flagged, no_check: bool) -> None:
+def _games_note(per_player: bool, limit: int | None, no_check: bool) -> str | None:
+    """What the "games" column counts (``listing``'s docstring), or None without one."""
+    if not per_player:
+        return None
+    if no_check:
+        return "One row a player, at their best game; games: their entries in the list (no replay checked)"
+    if limit is None:
+        return "One row a player, at their best game; games: their games in the list that check out"
+    return ("One row a player, at their best game (its replay checked); games: their entries in the list, "
+            "flagged ones not counted (--all checks every game)")
+
+
+def _print_listing(table, count: int, lists, flagged, no_check: bool, note: str | None = None) -> None:
     from ..records.scores import LIST_TITLES, RANKED
 
     checked = "" if no_check else ", replays checked"
     print(f"High scores in {table.path} ({plural(count, 'entry')}{checked})")
     print(f"Ranked: keyboard games of the standard rules, seed {table.seed}")
-    _print_rows(lists[RANKED], no_check)
+    _print_rows(lists[RANKED], note is not None)
     if not lists[RANKED]:
         print("  no ranked games yet")
     for name, title in LIST_TITLES.items():
         if name != RANKED and lists[name]:
             print(title[0].upper() + title[1:])
-            _print_rows(lists[name], no_check)
+            _print_rows(lists[name], note is not None)
+    if note is not None and any(lists.values()):
+        print(note)
     if flagged:
         print(f"{len(flagged)} flagged: the replay does not back the score (not ranked)")
         for e, c in flagged:
@@ -223,16 +256,19 @@ def _check(label: str, detail: str):
     return Check(False, label, detail)
 
 
-def _print_rows(rows_in, no_check: bool) -> None:
-    rows = [("#", "name", "score", "hits", "resets", "driven", "seed", "length", "date", "version", "replay")]
-    for rank, (e, c) in enumerate(rows_in, 1):
+def _print_rows(rows_in, games: bool) -> None:
+    """The rows of one list (``listing``'s), ranked; ``games``: with the column of each player's games."""
+    rows = [("#", "name", "score", *(("games",) if games else ()), "hits", "resets", "driven", "seed", "length",
+             "date", "version", "replay")]
+    for rank, row in enumerate(rows_in, 1):
+        e, c = row.best
         when = e.when.astimezone().strftime("%Y-%m-%d %H:%M")
-        rows.append((str(rank), e.name, str(e.score), str(e.hits), str(e.resets), e.how, str(e.seed),
-                     f"{e.duration:g} s" if e.complete is not False else "stopped", when, e.version,
-                     "-" if c is None else c.label))
+        rows.append((str(rank), e.name, str(e.score), *((str(row.games),) if games else ()), str(e.hits),
+                     str(e.resets), e.how, str(e.seed), f"{e.duration:g} s" if e.complete is not False else "stopped",
+                     when, e.version, "-" if c is None else c.label))
     if len(rows) == 1:
         return
-    right = {0, 2, 3, 4, 6, 7}
+    right = {0, 2, 3, 4, 6, 7} if not games else {0, 2, 3, 4, 5, 7, 8}
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     for r in rows:
         cells = [c.rjust(w) if i in right else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths, strict=True))]
@@ -272,7 +308,8 @@ def _add(table, args: argparse.Namespace) -> int:
 
 
 def where_it_went(table, entry) -> str:
-    """One line: the entry's place and the list it went to (``armgame scores`` and ``play`` say it)."""
+    """One line: the place of the entry's player (one row a player: ``ScoreTable.rank``) and the list it
+    went to (``armgame scores`` and ``play`` say it)."""
     from ..records.scores import LIST_TITLES
 
     return f"#{table.rank(entry)} in {LIST_TITLES[table.list_of(entry)]} ({table.path})"

@@ -108,6 +108,7 @@ def _verify_table(folder) -> int:
 
     from ..errors import UserError
     from ..records.batch_verify import check_entries
+    from ..records.identity import FirstEntries
     from ..records.scores import ScoreTable, VerificationCache, entry_order
 
     cache = VerificationCache()
@@ -118,15 +119,13 @@ def _verify_table(folder) -> int:
     if damage:
         print(f"armgame verify: {damage.describe(table.path)}", file=sys.stderr)
     flagged = 0
-    seen: set[str] = set()
-    games: dict[str, object] = {}
+    first: FirstEntries = FirstEntries()
     for e, c in check_entries(table, sorted(entries, key=entry_order)):  # the table's order, never a claimed date
-        if c.ok and e.replay_sha256 in seen:
-            c = type(c)(False, "DUPLICATE", "the same replay is entered more than once", c.ruleset)
-        elif c.ok and c.game is not None and games.setdefault(c.game, e) is not e:
-            first = games[c.game]
-            c = type(c)(False, "DUPLICATE", f"the same game as {first.name}'s earlier entry", c.ruleset)  # type: ignore[attr-defined]
-        seen.add(e.replay_sha256)
+        twin = first.copy_of(e, e.replay_sha256, c.game, c.ok)
+        if twin is not None and twin.replay_sha256 == e.replay_sha256:
+            c = type(c)(False, "DUPLICATE", f"the same replay as {twin.name}'s earlier entry", c.ruleset)
+        elif twin is not None:
+            c = type(c)(False, "DUPLICATE", f"the same game as {twin.name}'s earlier entry", c.ruleset)
         flagged += not c.ok
         rules = f", {c.ruleset} rules" if c.ruleset else ""
         line = f"{e.name}: score {e.score} ({e.how}{rules}, {e.date[:16].replace('T', ' ')}): {c.label}"

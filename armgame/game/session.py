@@ -154,7 +154,8 @@ class GameSession:
         """Apply a key event before the next physics step. Returns whether it changed anything.
 
         Unknown keys, repeats of a held key and events after the end are ignored, and
-        only events that did something enter the timeline.
+        only events that did something enter the timeline. A game's identity (``records.identity``,
+        ``applied_input``) is read from what this applies: what acts here, and when, is what it counts.
         """
         if self.over:
             return False

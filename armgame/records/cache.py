@@ -2,8 +2,10 @@
 
 A verdict is keyed by the replay file's SHA-256 and the armgame version, and holds what the
 replay claims (so a cached entry is judged without reading its replay again) and whether it
-reproduced. Failures are cached as well as passes: a planted failing replay costs its work
-once per user, not at every ``armgame scores``.
+reproduced. Its claims carry the game's identity version (``records.identity``): a verdict of
+another version is recomputed, never compared, so a stale digest cannot pass or flag a game.
+Failures are cached as well as passes: a planted failing replay costs its work once per user,
+not at every ``armgame scores``.
 
 Trust: a cache is a list of verdicts, so whoever can write it can plant an ``ok`` for a forged
 game. It is read (and written) only when its folder and its file belong to the user running
@@ -29,12 +31,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 from .. import __version__
+from .identity import current_claims
 from .storage import DataFileError, atomic_write_bytes, parse_json, read_limited, user_path
 
 CACHE_ENV = "ARMGAME_CACHE"
 _HEX64 = re.compile(r"[0-9a-f]{64}")
 CLAIM_KEYS = frozenset({"name", "driven", "driver", "score", "hits", "resets", "seed", "scene", "duration", "date",
-                        "config_sha256", "ruleset", "game_sha256", "complete"})
+                        "config_sha256", "ruleset", "complete", "identity", "game_sha256", "earlier_game_sha256"})
 
 
 def default_cache_dir() -> Path | None:
@@ -184,4 +187,7 @@ def _valid(v: object) -> bool:
     if v["label"] == "NOT CHECKED" and type(v.get("work")) is not int:
         return False
     claims = v.get("claims")
-    return claims is None or (isinstance(claims, dict) and set(claims) == CLAIM_KEYS)
+    # Claims of another identity version hold digests this armgame does not compare (the cache file is
+    # kept per armgame version, which a development checkout does not bump): such a verdict is recomputed.
+    return claims is None or (isinstance(claims, dict) and set(claims) == CLAIM_KEYS and current_claims(claims)
+                              and isinstance(claims["earlier_game_sha256"], list))

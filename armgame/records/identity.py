@@ -1,57 +1,195 @@
 """A game's identity: what it is, not the file it came in, so that one game enters a table once.
 
-Two replays are the same game when they play the same rules with the same seed and the same
-input, whatever else differs: the JSON's layout, the date, the player's name, the armgame
-version, the muscles' key bindings (``--keys`` only renames them), and events that change
-nothing. ``game_digest`` is the SHA-256 of the canonical form:
+Two replays are one game when the physics and the score cannot tell them apart. ``game_digest``
+is the SHA-256 of the canonical form of what the game's session did:
 
 * the ruleset's digest (``rulesets.config_digest``: the whole configuration but the seed and
   the key bindings), the seed and the number of steps played;
-* the input timeline as the session applies it (``GameSession.key_event``): a muscle key named
-  by its muscle's index, and only events that change something. A key-down of a key already
-  held, a key-up of a key that is up, the release of space or tab (only their press acts) and
-  anything at or after the last step are dropped, exactly as the session ignores them.
+* what each physics step applied (``applied_input``): the set of muscles held, by muscle index,
+  as runs over the steps (the step each run starts at and its set), and the resets, as the
+  number at each step that has any.
 
-A classmate who copies a replay under another name, moves its date by a microsecond, or adds
-a repeated key-down gets the same digest, and the table refuses the copy.
+That form is what ``GameSession`` reads, not the events that produced it, so whatever changes
+nothing drops out by construction: the muscles' goals are set by ``key_event`` alone and read
+only by the next physics step, so a repeated key-down, a key-up of a key that is up, the order
+of a step's events and a key pressed and released within one step leave the same set held
+after the step's events; tab flips only whether the window draws the arm (``GameRules.toggle_arm``:
+neither the physics nor the score reads it); events the session ignores (the end of the clock)
+apply nothing. Each space press at a step resets the arm and counts a reset, so two at one step
+are two resets: the count is in the form. The key bindings (``--keys``), the JSON's layout, the
+date, the player's name and the armgame version are not.
+
+One caveat, on the safe side: a reset pressed at the very step a lab run's last trial ends is
+kept in the form though the lab ignores it (the run is over; a replay does not say so without
+replaying). Identity is never coarser than the session, only there finer.
+
+This module is the one owner of "is this the same game as an earlier one, and which counts":
+``FirstEntries`` answers it for ``armgame scores``, ``armgame verify DIR`` and ``armgame analyze
+--class`` alike. A classmate who copies a replay under another name, moves its date by a
+microsecond, or adds a tab press or a tap within one step gets the same digest, and the copy
+does not count twice.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Generic, TypeVar
 
 from ..game.session import DOWN, RESET_KEY, TOGGLE_ARM_KEY
 from .replay import Replay
 from .rulesets import config_digest
 
-#: Bumped if the canonical form ever changes (a new digest for every game).
-IDENTITY_VERSION = 1
+#: Bumped whenever the canonical form changes (a new digest for every game). 2: what each step applies,
+#: not the events (1). Tables keep the digests older versions wrote: ``names_its_game`` still knows them.
+IDENTITY_VERSION = 2
+
+T = TypeVar("T")
 
 
-def canonical_timeline(replay: Replay) -> list[tuple[int, str, str]]:
-    """The events that change the game, muscle keys named by index (``m0``..``m3``)."""
+@dataclass(frozen=True)
+class AppliedInput:
+    """What a game's input did, step by step (see the module docstring).
+
+    ``held``: ``(step, mask)`` at each step from which the muscles held change (bit ``i``: muscle ``i``
+    held), starting from none held; only steps the game ran. ``resets``: ``(step, count)`` at each step
+    with resets.
+    """
+
+    held: tuple[tuple[int, int], ...]
+    resets: tuple[tuple[int, int], ...]
+
+
+def applied_input(replay: Replay) -> AppliedInput:
+    """What each step of the replay's game applies, as its session applies it (``TimelineInput`` feeding
+    ``GameSession.key_event``): the events of a step, then the step."""
+    index = {m.key: i for i, m in enumerate(replay.config.muscles)}
+    steps = replay.result.steps
+    # The session takes input until its clock ends (``over``); a game stopped early took it up to its stop,
+    # where a reset still counts but a muscle held runs no step.
+    end = replay.config.total_steps
+    held = mask = 0
+    runs: list[tuple[int, int]] = []
+    resets: dict[int, int] = {}
+    timeline = replay.timeline
+    for n, e in enumerate(timeline):
+        if e.step >= end or e.step > steps:  # the session is over, or the game stopped before it
+            break
+        m = index.get(e.key)
+        if m is not None:
+            held = held | 1 << m if e.action == DOWN else held & ~(1 << m)
+        elif e.key == RESET_KEY and e.action == DOWN:
+            resets[e.step] = resets.get(e.step, 0) + 1
+        if (n + 1 == len(timeline) or timeline[n + 1].step != e.step) and held != mask and e.step < steps:
+            runs.append((e.step, held))  # the step's last event: the set its physics step reads
+            mask = held
+    return AppliedInput(tuple(runs), tuple(sorted(resets.items())))
+
+
+def _form(replay: Replay) -> dict[str, object]:
+    applied = applied_input(replay)
+    return {"identity": IDENTITY_VERSION, "rules": config_digest(replay.config), "seed": replay.config.seed,
+            "steps": replay.result.steps, "held": applied.held, "resets": applied.resets}
+
+
+def _form_v1(replay: Replay) -> dict[str, object]:
+    """Version 1's form (events, those that change nothing dropped), kept only to recognise the digests
+    tables took before version 2: exactly as it was computed then."""
     index = {m.key: f"m{i}" for i, m in enumerate(replay.config.muscles)}
     held: set[str] = set()
     last = replay.result.steps
     events = []
     for e in replay.timeline:
-        if e.step >= last:  # the session ignores input once the game is over
+        if e.step >= last:
             break
         down = e.action == DOWN
         if e.key in index:
             name = index[e.key]
             if (name in held) == down:
-                continue  # a key-down of a held key, or a key-up of a key that is up
+                continue
             (held.add if down else held.discard)(name)
             events.append((e.step, name, e.action))
         elif e.key in (RESET_KEY, TOGGLE_ARM_KEY) and down:
             events.append((e.step, e.key, e.action))
-    return events
+    return {"identity": 1, "rules": config_digest(replay.config), "seed": replay.config.seed,
+            "steps": replay.result.steps, "timeline": events}
+
+
+def _digest(form: dict[str, object]) -> str:
+    return hashlib.sha256(json.dumps(form, separators=(",", ":")).encode()).hexdigest()
 
 
 def game_digest(replay: Replay) -> str:
     """SHA-256 (hex) of the game's canonical form: equal digests, the same game."""
-    form = {"identity": IDENTITY_VERSION, "rules": config_digest(replay.config), "seed": replay.config.seed,
-            "steps": replay.result.steps, "timeline": canonical_timeline(replay)}
-    return hashlib.sha256(json.dumps(form, separators=(",", ":")).encode()).hexdigest()
+    return _digest(_form(replay))
+
+
+def game_digests(replay: Replay) -> tuple[str, ...]:
+    """The game's digest by every identity version this armgame knows, the current one first: a table
+    entered before a bump holds the older one."""
+    return game_digest(replay), _digest(_form_v1(replay))
+
+
+def identity_claims(replay: Replay) -> dict[str, object]:
+    """What a replay says about its game's identity, for an entry's claims (``scores.replay_claims``)
+    and the verification cache: the version, the current digest and the older versions' digests."""
+    current, *earlier = game_digests(replay)
+    return {"identity": IDENTITY_VERSION, "game_sha256": current, "earlier_game_sha256": earlier}
+
+
+def current_claims(claims: Mapping[str, object]) -> bool:
+    """Whether ``identity_claims`` were made by this identity version (a cache may hold older ones)."""
+    return claims.get("identity") == IDENTITY_VERSION
+
+
+def names_its_game(stored: str, claims: Mapping[str, object]) -> bool:
+    """Whether a digest an entry stored is its replay's game: the current digest, or the one the version
+    that entered it computed (``identity_claims``). A digest of another game is neither."""
+    return stored == claims["game_sha256"] or stored in claims["earlier_game_sha256"]  # type: ignore[operator]
+
+
+class FirstEntries(Generic[T]):
+    """Which of several entries of one game counts, and which are its copies.
+
+    Fed items in the order that decides (the table's order of entry; two entries of one game that check
+    out score alike, so best first is that order among them), each with its replay file's SHA-256, its
+    game's digest (``game_digest``) and whether it checks out, it names of each item the earlier item it
+    copies. The rules, the same for ``armgame scores``, ``verify DIR`` and ``analyze --class``:
+
+    * the first item of a game that checks out counts; a later item of that game is its copy;
+    * one replay file is one game (the same bytes play the same game), so a later item of a file already
+      counted is a copy before any check: ``counted_file`` lets a caller flag it unread;
+    * an item that does not check out takes no place (its check says what is wrong with it), so a forged
+      entry planted earlier, naming an honest replay file or carrying an honest game's digest, never
+      pushes the honest entry out.
+    """
+
+    def __init__(self) -> None:
+        self._files: dict[str, T] = {}
+        self._games: dict[str, T] = {}
+
+    def counted_file(self, file_sha256: str) -> T | None:
+        """The item that counts for this replay file so far, if any: a later item of it is a copy."""
+        return self._files.get(file_sha256)
+
+    def counted(self, game: str) -> T | None:
+        """The item that counts for ``game`` so far, if any (to skip checking a copy at all)."""
+        return self._games.get(game)
+
+    def copy_of(self, item: T, file_sha256: str | None, game: str | None, ok: bool) -> T | None:
+        """The earlier item ``item`` copies (same replay file or same game), or None. An ``item`` that
+        checks out (``ok``) and copies none counts from now on, for its file and its game."""
+        if not ok:
+            return None
+        first = self._files.get(file_sha256) if file_sha256 is not None else None
+        if first is None and game is not None:
+            first = self._games.get(game)
+        if first is not None and first is not item:
+            return first
+        if file_sha256 is not None:
+            self._files[file_sha256] = item
+        if game is not None:
+            self._games[game] = item
+        return None

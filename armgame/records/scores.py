@@ -39,7 +39,9 @@ Which list an entry goes to (``ScoreTable.list_of``), the first that applies:
 * ``ranked``: the rest, keyboard games of the standard rules and the table's seed.
 
 One game enters once: each entry holds its game's digest (``armgame.records.identity``), and a
-second entry of the same game is refused, whoever's name and whatever date it carries. Ties
+second entry of the same game is refused, whoever's name and whatever date it carries. A digest
+stays the one the armgame that entered it computed: an entry is judged against its replay's digest
+by that identity version (``identity.names_its_game``), so a new version flags no old entry. Ties
 are broken by the order of entry, a counter the table keeps under its lock (``entered``),
 never by the date a player's file claims.
 """
@@ -64,10 +66,11 @@ from ..game.session import GameResult
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from ..words import plural
 from .cache import VerificationCache, default_cache_dir, file_signature  # noqa: F401 (the cache's old home)
-from .identity import game_digest
+from .identity import game_digests, identity_claims, names_its_game
 from .locking import LockBusyError, LockError, file_lock
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
 from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_by_digest, ruleset_name
+from .standings import one_row_per_player, rank_of
 from .storage import (
     STRICT_DECODER,
     DataFileError,
@@ -329,12 +332,13 @@ class Damage:
 
 
 def replay_claims(replay: Replay) -> dict[str, object]:
-    """What an entry must say about its replay's game, field for field."""
+    """What an entry must say about its replay's game, field for field; and the game's identity
+    (``identity.identity_claims``: the digest an entry may hold, by each identity version)."""
     r = replay.result
     return {"name": replay.player, "driven": replay.driven, "driver": replay.driver, "score": r.score,
             "hits": r.hits, "resets": r.resets, "seed": r.seed, "scene": r.scene, "duration": r.duration,
             "date": replay.date, "config_sha256": config_digest(replay.config),
-            "ruleset": ruleset_name(replay.config), "game_sha256": game_digest(replay), "complete": replay.complete}
+            "ruleset": ruleset_name(replay.config), "complete": replay.complete, **identity_claims(replay)}
 
 
 class ScoreTable:
@@ -498,7 +502,7 @@ class ScoreTable:
         entry = _new_entry(replay, path.name, data)
         try:
             with self._locked():
-                result = self._enter_many([entry])[0]
+                result = self._enter_many([(entry, frozenset(game_digests(replay)))])[0]
             if isinstance(result, Exception):
                 raise result
             return result
@@ -511,23 +515,23 @@ class ScoreTable:
         one folder fsync, the table read and written once under the lock. Returns, for each game, its
         entry or the ValueError (a ``TableError`` for a game already in) that kept it out; raises
         ``TableError`` (busy, over a limit, not a safe place) with none entered."""
-        results: list[ScoreEntry | ValueError] = []
+        results: list[tuple[ScoreEntry, frozenset[str]] | ValueError] = []
         files: dict[str, bytes] = {}
         for replay in replays:
             try:
                 _enterable(replay)
                 data = replay.to_bytes()
                 name = self._replay_name(replay, data)
-                results.append(_new_entry(replay, name, data))
+                results.append((_new_entry(replay, name, data), frozenset(game_digests(replay))))
                 files[name] = data
             except ValueError as exc:
                 results.append(exc)
         self._safe_folder()
         atomic_write_many([(self.replays / name, data) for name, data in files.items()], "replay")
-        entries = [r for r in results if isinstance(r, ScoreEntry)]
+        entries = [r for r in results if not isinstance(r, ValueError)]
         with self._locked():
             entered = iter(self._enter_many(entries))
-        return [next(entered) if isinstance(r, ScoreEntry) else r for r in results]
+        return [r if isinstance(r, ValueError) else next(entered) for r in results]
 
     def new(self, seed: int) -> None:
         """Start the table (empty) ranking ``seed``; refused if it already holds entries."""
@@ -535,11 +539,12 @@ class ScoreTable:
         with self._locked():
             self._enter_many([], seed)
 
-    def _enter_many(self, new_entries: Sequence[ScoreEntry], seed: int | None = None
+    def _enter_many(self, new_entries: Sequence[tuple[ScoreEntry, frozenset[str]]], seed: int | None = None
                     ) -> list[ScoreEntry | TableError]:
         """Under the lock: write the table with ``new_entries`` added in order (each its place in the order
         of entry and the time given here; a game already in is refused, as its TableError), or, with
-        ``seed``, an empty table ranking that seed. Returns each entry as entered, or why not."""
+        ``seed``, an empty table ranking that seed. Returns each entry as entered, or why not. Each entry
+        comes with its game's digests by every identity version (``identity.game_digests``)."""
         # Under the lock nobody else is writing the table: any temporary file of it was left by a
         # writer that died mid-write. Replays are written outside the lock, so theirs are left alone.
         for stale in self.folder.glob(f".{TABLE_NAME}.*.tmp"):
@@ -561,9 +566,9 @@ class ScoreTable:
             entries, head = _numbered(entries, head)
             self._seed = head.seed
             results: list[ScoreEntry | TableError] = []
-            for entry in new_entries:
+            for entry, digests in new_entries:
                 try:
-                    entry = self._admit(entry, entries, head)
+                    entry = self._admit(entry, entries, head, digests)
                 except TableError as exc:
                     results.append(exc)
                     continue
@@ -595,10 +600,12 @@ class ScoreTable:
                 os.close(fd)
 
     @staticmethod
-    def _admit(entry: ScoreEntry, entries: list[ScoreEntry], head: _Head) -> ScoreEntry:
-        """``entry`` with its place in the order of entry; refused if its game or replay is already in."""
+    def _admit(entry: ScoreEntry, entries: list[ScoreEntry], head: _Head, digests: frozenset[str]
+               ) -> ScoreEntry:
+        """``entry`` with its place in the order of entry; refused if its game or replay is already in
+        (its game by any identity version's digest: an entry taken before a bump holds the older one)."""
         twin = next((e for e in entries if e.replay_sha256 == entry.replay_sha256
-                     or (e.game_sha256 is not None and e.game_sha256 == entry.game_sha256)), None)
+                     or (e.game_sha256 is not None and e.game_sha256 in digests)), None)
         if twin is not None:
             when = (twin.entered_at or twin.date)[:16].replace("T", " ")
             raise TableError(f"this game is already in the table: entered by {twin.name} on {when} UTC "
@@ -626,9 +633,10 @@ class ScoreTable:
         return [e for e in (self.all_entries() if entries is None else entries) if self.list_of(e) == name]
 
     def rank(self, entry: ScoreEntry) -> int:
-        """The entry's place in its own list."""
-        ordered = self.of_list(self.list_of(entry))
-        return next((i for i, e in enumerate(ordered, 1) if e.id == entry.id), len(ordered))
+        """The place of the entry's player in its list, one row a player (``standings``): #3 is the third
+        player, ranked by their best game, whichever of theirs this entry is. Unchecked, like ``of_list``."""
+        rows = one_row_per_player(self.of_list(self.list_of(entry)))
+        return rank_of(rows, entry.name) or len(rows)
 
     # ------------------------------------------------------------------ trust
     def replay_path(self, entry: ScoreEntry) -> Path:
@@ -740,17 +748,20 @@ class ScoreTable:
         claims = cached["claims"]
         if claims is None:
             return Check(False, cached["label"], cached["detail"])
-        wanted = dict(claims)
+        wanted = {key: value for key, value in claims.items() if key in _ENTRY_CLAIMS}
         if entry.config_sha256 is None:  # a format 1 entry makes no claim about its rules
             wanted.pop("config_sha256")
             wanted.pop("ruleset")
-        for key in ("game_sha256", "complete"):  # entries from older tables make no such claims
-            if getattr(entry, key) is None:
-                wanted.pop(key)
+        if entry.complete is None:  # entries from older tables make no such claim
+            wanted.pop("complete")
         for key, value in wanted.items():
             if getattr(entry, key) != value:
                 return Check(False, "NOT ITS REPLAY", f"the entry says {key} {getattr(entry, key)!r}, its replay "
                              f"{value!r}", claims["ruleset"], claims["game_sha256"])
+        # The digest by the identity version that entered it (older tables: none stored).
+        if entry.game_sha256 is not None and not names_its_game(entry.game_sha256, claims):
+            return Check(False, "NOT ITS REPLAY", f"the entry says game_sha256 {entry.game_sha256!r}, its replay "
+                         f"{claims['game_sha256']!r}", claims["ruleset"], claims["game_sha256"])
         if not claims["complete"]:
             return Check(False, "NOT A WHOLE GAME", "the game stopped before its clock ran out", claims["ruleset"],
                          claims["game_sha256"])
@@ -778,6 +789,11 @@ def _new_entry(replay: Replay, replay_name: str, data: bytes) -> ScoreEntry:
         replay_sha256=hashlib.sha256(data).hexdigest(), ruleset=claims["ruleset"],
         config_sha256=claims["config_sha256"], game_sha256=claims["game_sha256"], complete=True,
     ))
+
+
+#: The claims an entry's own fields must equal (the game's digest is compared by ``names_its_game``).
+_ENTRY_CLAIMS = frozenset({"name", "driven", "driver", "score", "hits", "resets", "seed", "scene", "duration", "date",
+                           "config_sha256", "ruleset", "complete"})
 
 
 #: What recomputing one hit costs, in physics steps: drawing the next target tries up to 1,000 postures,

@@ -2,8 +2,10 @@
 
 A table holds games; a class ranks people. ``one_row_per_player`` folds a best-first list of games
 into one row a player, in the order of each player's best game, so one keen student cannot fill the
-top of the table. ``armgame scores``, the play window's end screen and the live class's standings
-all ask it, so "your rank" means the same thing everywhere.
+top of the table. ``armgame scores`` (each of its lists, unless ``--all-games``), ``play`` and
+``scores --add`` ("#3 in the ranked table": the third player, ``ScoreTable.rank``) and the play
+window's end screen (``rank_of``; before a name is typed, ``place_of_new``) all ask it, so "your
+rank" means the same thing everywhere.
 
 Players are told apart by ``player_key``: the name as typed, compatibility-normalised (NFKC: a
 full-width "Ａlice" is "Alice") and case-folded, so "alice" and "Alice " are one player.
@@ -52,3 +54,10 @@ def rank_of(rows: list[PlayerRow[T]], name: str) -> int | None:
     """A player's place (1-based) in the rows, or None if they have none."""
     key = player_key(name)
     return next((i for i, row in enumerate(rows, 1) if player_key(row.name) == key), None)
+
+
+def place_of_new(rows: list[PlayerRow[T]], score: int, score_of: Callable[[T], int] = lambda e: e.score  # type: ignore[attr-defined]
+                 ) -> int:
+    """The place (1-based) a new player whose game scores ``score`` would take: after every row whose
+    best scores as much (an equal score already in is the earlier game)."""
+    return 1 + sum(1 for row in rows if score_of(row.best) >= score)
