@@ -120,7 +120,7 @@ class ClerkThread:
             if job is _STOP:
                 return
             if job[0] == "job":
-                _settle(job[2], job[1])
+                outcomes = [(job[2], _outcome(job[1]))]
             else:
                 batch = [job]
                 while len(batch) < BATCH:  # what arrived meanwhile goes in the same write
@@ -132,44 +132,44 @@ class ClerkThread:
                         held = more
                         break
                     batch.append(more)
-                self._hand_in(batch)
+                outcomes = self._hand_in(batch)
             try:
-                self.after()
+                self.after()  # before any answer goes out: a client that asks next sees its own game
             except Exception as exc:
                 print(f"armgame class: the pages' data could not be rebuilt: {exc}", file=sys.stderr)
+            for future, outcome in outcomes:
+                if isinstance(outcome, BaseException):
+                    future.set_exception(outcome)
+                else:
+                    future.set_result(outcome)
 
-    def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> None:
+    def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
+        """Each hand-in's answer (or the exception to raise in its request), in the batch's order."""
+        outcomes: list[tuple[Future, Any]] = []
         checked = []
         for _, (token, body), future in batch:
-            try:
-                found = self.clerk.check(token, body)
-            except BaseException as exc:
-                future.set_exception(exc)
-                continue
-            if isinstance(found, dict):
-                future.set_result(found)
+            found = _outcome(lambda token=token, body=body: self.clerk.check(token, body))
+            if isinstance(found, BaseException | dict):
+                outcomes.append((future, found))
             else:
                 checked.append((found, future))
         if checked:
-            try:
-                answers = self.clerk.enter([c for c, _ in checked])
-            except BaseException as exc:
-                answers = [exc] * len(checked)
-            for (_, future), answer in zip(checked, answers, strict=True):
-                if isinstance(answer, BaseException):
-                    future.set_exception(answer)
-                else:
-                    future.set_result(answer)
+            answers = _outcome(lambda: self.clerk.enter([c for c, _ in checked]))
+            if isinstance(answers, BaseException):
+                answers = [answers] * len(checked)
+            outcomes += [(future, answer) for (_, future), answer in zip(checked, answers, strict=True)]
+        return outcomes
 
 
 _STOP: tuple[str, Any, Future | None] = ("stop", None, None)
 
 
-def _settle(future: Future, work: Callable[[], Any]) -> None:
+def _outcome(work: Callable[[], Any]) -> Any:
+    """What ``work()`` returns, or the exception it raised (for the request that asked for it)."""
     try:
-        future.set_result(work())
+        return work()
     except BaseException as exc:
-        future.set_exception(exc)
+        return exc
 
 
 @dataclass
