@@ -29,7 +29,7 @@ function draw(lab) {
   const box = svg.getBoundingClientRect();
   const W = Math.max(box.width, 300), H = Math.max(box.height, 200);
   svg.setAttribute("viewBox", "0 0 " + W + " " + H);
-  const left = W * 0.08, right = W * 0.98, top = H * 0.1, bottom = H * 0.86;
+  const left = W * 0.08, right = W * 0.98, top = H * 0.12, bottom = H * 0.84;
   const t = lab.trials;
   const values = [];
   for (const p of t) if (p.mean !== null) values.push(p.mean + (p.sem || 0), p.mean - (p.sem || 0));
@@ -68,11 +68,15 @@ function draw(lab) {
   }
   svg.appendChild(el("polygon", {class: "band", points: upper.concat(lower).join(" ")}));
   svg.appendChild(el("path", {class: "mean", d: path}));
+  if (lo < 0 && hi > 0) svg.appendChild(el("line", {class: "zero", x1: left, x2: right, y1: y(0), y2: y(0)}));
   svg.appendChild(el("line", {class: "axis", x1: left, x2: right, y1: bottom, y2: bottom}));
+  svg.appendChild(el("text", {x: x(first), y: bottom + 24, "text-anchor": "middle"}, String(first)));
+  svg.appendChild(el("text", {x: x(last), y: bottom + 24, "text-anchor": "middle"}, String(last)));
   svg.appendChild(el("line", {class: "axis", x1: left, x2: left, y1: top, y2: bottom}));
   svg.appendChild(el("text", {x: (left + right) / 2, y: H - 8, "text-anchor": "middle"}, "trial"));
   svg.appendChild(el("text", {x: left - 8, y: y(hi), "text-anchor": "end"}, hi.toFixed(hi < 10 ? 1 : 0)));
   svg.appendChild(el("text", {x: left - 8, y: y(lo), "text-anchor": "end"}, lo.toFixed(lo > -10 ? 1 : 0)));
+  if (lo < 0 && hi > 0) svg.appendChild(el("text", {x: left - 8, y: y(0), "text-anchor": "end"}, "0"));
   svg.appendChild(el("text", {x: left, y: top - 8 - H * 0.03}, lab.unit));
   document.body.dataset.students = String(lab.students);
 }

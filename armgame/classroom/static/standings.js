@@ -29,7 +29,12 @@ function fill(container, rows, programs, fresh) {
     if (fresh !== null && r.name === fresh) tr.className = "fresh";
     cell(tr, String(r.rank), "rank");
     cell(tr, r.name, "name");
-    if (programs) cell(tr, r.driver || "", "driver");
+    if (programs) {  // which program, under its name
+      const driver = document.createElement("span");
+      driver.className = "driver";
+      driver.textContent = r.driver || "";
+      tr.lastChild.appendChild(driver);
+    }
     cell(tr, String(r.score), "score");
     if (!programs) cell(tr, gamesText(r.games), "games");
     table.appendChild(tr);
@@ -61,6 +66,20 @@ function showJoin(line) {
   code.className = "code";
   code.textContent = line.slice(at + 7);
   join.appendChild(code);
+  join.append(" --name ");
+  const you = document.createElement("span");
+  you.className = "you";
+  you.textContent = "NAME";
+  join.appendChild(you);
+  // The whole line on one line, as large as fits: students type it from the back row.
+  join.style.fontSize = "";
+  join.style.whiteSpace = "nowrap";
+  let size = parseFloat(getComputedStyle(join).fontSize);
+  while (join.scrollWidth > join.clientWidth && size > 19) {
+    size -= 1;
+    join.style.fontSize = size + "px";
+  }
+  if (join.scrollWidth > join.clientWidth) join.style.whiteSpace = "normal";
 }
 
 function announce(a) {

@@ -1,0 +1,87 @@
+"""Draw the live class's pages as a projector shows them: docs/img/class_page.png and class_lab.png.
+
+    python docs/make_class_screenshots.py             # writes docs/img/class_*.png
+    python docs/make_class_screenshots.py --out DIR   # somewhere else, at 1024x768 and 1920x1080 both
+
+A real class on loopback (a thread of this process) takes a class's games, a few programs' and four
+volunteers' lab runs, and Debian's chromium (driven by Playwright, as in the tests) draws the pages.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "tests"))
+
+from browser import FLAGS, chromium_path  # noqa: E402
+from class_server import keyboard_game, running_class  # noqa: E402
+
+from armgame.classroom import client  # noqa: E402
+from armgame.cli import main  # noqa: E402
+from armgame.records.replay import Replay  # noqa: E402
+
+STUDENTS = [("Amira", 42), ("Ben", 30), ("Chloé", 55), ("Dmitri", 18), ("Eun-ji", 48), ("Farah", 25),
+            ("Gabriel", 36), ("Hana", 12), ("Ife", 58), ("Jonas", 22), ("Kai", 40), ("Lucía", 33), ("Mateo", 8),
+            ("Nour", 45), ("Oskar", 28)]
+LAB = ('name = "curl lesson"\ntargets = 4\ntimeout = 1.5\n[[blocks]]\nname = "baseline"\ntrials = 8\n'
+       '[[blocks]]\nname = "curl field"\ntrials = 24\nperturbation = "curl"\nb = -2.0\n'
+       '[[blocks]]\nname = "washout"\ntrials = 12\n')
+
+
+def fill(opened, work: Path) -> None:
+    address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+    code = opened.clerk.roster.code
+    for i, (name, seconds) in enumerate(STUDENTS):
+        os.environ[client.CLIENT_ENV] = str(work / f"m{i}")
+        member = client.join(address, code, name)
+        client.hand_in(member, keyboard_game(seconds * 0.7, player=name).to_bytes())
+        if i % 3 == 0:
+            client.hand_in(member, keyboard_game(seconds * 0.5 + 1, player=name).to_bytes())
+    (work / "lesson.toml").write_text(LAB)
+    for i, name in enumerate(("Amira", "Ben", "Chloé", "Dmitri")):
+        os.environ[client.CLIENT_ENV] = str(work / f"m{i}")
+        record = work / f"lab{i}.json"
+        main(["lab", str(work / "lesson.toml"), "--bot", "adaptive", "--headless", "--seed", str(i + 1),
+              "--record", str(record)])
+        replay = dataclasses.replace(Replay.load(record), driven="keyboard", driver=None, player=name)
+        client.hand_in(client.join(address, code, name), replay.to_bytes())
+    for name, bot in (("Ife's robot", "model"), ("Kai", "naive")):
+        os.environ[client.CLIENT_ENV] = str(work / f"bot-{bot}")
+        main(["play", "--headless", "--bot", bot, "--join", f"127.0.0.1:{opened.port}", "--code", code,
+              "--name", name])
+
+
+def main_(argv: list[str] | None = None) -> int:
+    from playwright.sync_api import sync_playwright
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=None)
+    args = parser.parse_args(argv)
+    sizes = [(1024, 768)] if args.out is None else [(1024, 768), (1920, 1080)]
+    out = args.out or HERE / "img"
+    with tempfile.TemporaryDirectory() as tmp, running_class(Path(tmp) / "class") as opened:
+        fill(opened, Path(tmp))
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=chromium_path(), args=FLAGS)
+            for width, height in sizes:
+                page = browser.new_page(viewport={"width": width, "height": height})
+                suffix = "" if args.out is None else f"-{width}x{height}"
+                page.goto(f"http://127.0.0.1:{opened.port}/")
+                page.wait_for_selector("#students tr:nth-child(6)")
+                page.screenshot(path=str(out / f"class_page{suffix}.png"))
+                page.goto(f"http://127.0.0.1:{opened.port}/lab")
+                page.wait_for_selector("body[data-students='4']", state="attached")
+                page.screenshot(path=str(out / f"class_lab{suffix}.png"))
+                print(f"wrote {out / f'class_page{suffix}.png'} and class_lab{suffix}.png")
+            browser.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main_())

@@ -1,0 +1,39 @@
+"""The projector's page in a real browser: a game handed in appears without a reload, every hostile name is
+shown as text, and the text reads from the back row at 1024x768."""
+
+from __future__ import annotations
+
+from browser import browser_page
+from class_server import running_class, tapped_game
+
+from armgame.classroom import client
+
+HOSTILE = ['<img src=x onerror="alert(1)">', '"><script>alert(2)</script>', "\u05e9\u05dc\u05d5\u05dd <b>bold</b>"]
+
+
+def test_the_page_shows_games_as_they_arrive_and_names_as_text(tmp_path, monkeypatch):
+    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))
+    with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        page.goto(f"http://127.0.0.1:{opened.port}/")
+        # (Selectors, not script: the page's content security policy allows no evaluated string.)
+        page.wait_for_selector("body[data-version]", state="attached")
+        assert code in page.inner_text("#join") and "no games yet" in page.inner_text("#students")
+        for i, name in enumerate(HOSTILE):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / f"machine{i}"))
+            member = client.join(address, code, name)
+            assert client.hand_in(member, tapped_game(i, player=name).to_bytes()).answer is not None
+        page.wait_for_selector("#students tr:nth-child(3)", timeout=10_000)
+        shown = page.eval_on_selector_all("#students td.name", "cells => cells.map(c => c.textContent)")
+        assert sorted(shown) == sorted(HOSTILE)  # the names as typed, as text
+        assert page.dialogs == [] and page.query_selector("#students img, #students script, #students b") is None
+        news = page.inner_text("#news")
+        assert HOSTILE[-1] in news and "first game" in news
+        # The back row: every row's text at least 19 px at 1024x768, none of it cut off the page.
+        sizes = page.eval_on_selector_all("#students td, #join, .facts", "els => els.map("
+                                          "e => parseFloat(getComputedStyle(e).fontSize))")
+        assert min(sizes) >= 19
+        assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
+        page.screenshot(path=str(tmp_path / "class-1024x768.png"))
+    assert (tmp_path / "class-1024x768.png").stat().st_size > 10_000
