@@ -2,6 +2,7 @@
 
     python docs/make_class_screenshots.py             # writes docs/img/class_*.png
     python docs/make_class_screenshots.py --out DIR   # somewhere else, at 1024x768 and 1920x1080 both
+    python docs/make_class_screenshots.py --out DIR --quick   # a smaller class (the tests: it cannot rot)
 
 A real class on loopback (a thread of this process) takes a class's games, a few programs' and four
 volunteers' lab runs, and Debian's chromium (driven by Playwright, as in the tests) draws the pages.
@@ -34,24 +35,30 @@ LAB = ('name = "curl lesson"\ntargets = 4\ntimeout = 1.5\n[[blocks]]\nname = "ba
        '[[blocks]]\nname = "washout"\ntrials = 12\n')
 
 
-def fill(opened, work: Path) -> None:
+QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
+             'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 2\n')
+#: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
+PICTURES = ("class_page.png", "class_lab.png")
+
+
+def fill(opened, work: Path, quick: bool = False) -> None:
     address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
     code = opened.clerk.roster.code
-    for i, (name, seconds) in enumerate(STUDENTS):
+    for i, (name, seconds) in enumerate(STUDENTS[:4] if quick else STUDENTS):
         os.environ[client.CLIENT_ENV] = str(work / f"m{i}")
         member = client.join(address, code, name)
         client.hand_in(member, keyboard_game(seconds * 0.7, player=name).to_bytes())
         if i % 3 == 0:
             client.hand_in(member, keyboard_game(seconds * 0.5 + 1, player=name).to_bytes())
-    (work / "lesson.toml").write_text(LAB)
-    for i, name in enumerate(("Amira", "Ben", "Chloé", "Dmitri")):
+    (work / "lesson.toml").write_text(QUICK_LAB if quick else LAB)
+    for i, name in enumerate(("Amira", "Ben") if quick else ("Amira", "Ben", "Chloé", "Dmitri")):
         os.environ[client.CLIENT_ENV] = str(work / f"m{i}")
         record = work / f"lab{i}.json"
         main(["lab", str(work / "lesson.toml"), "--bot", "adaptive", "--headless", "--seed", str(i + 1),
               "--record", str(record)])
         replay = dataclasses.replace(Replay.load(record), driven="keyboard", driver=None, player=name)
         client.hand_in(client.join(address, code, name), replay.to_bytes())
-    for name, bot in (("Ife's robot", "model"), ("Kai", "naive")):
+    for name, bot in (("Ife's robot", "model"),) if quick else (("Ife's robot", "model"), ("Robo", "naive")):
         os.environ[client.CLIENT_ENV] = str(work / f"bot-{bot}")
         main(["play", "--headless", "--bot", bot, "--join", f"127.0.0.1:{opened.port}", "--code", code,
               "--name", name])
@@ -62,21 +69,22 @@ def main_(argv: list[str] | None = None) -> int:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--quick", action="store_true", help="a smaller class, one size")
     args = parser.parse_args(argv)
-    sizes = [(1024, 768)] if args.out is None else [(1024, 768), (1920, 1080)]
+    sizes = [(1024, 768)] if args.out is None or args.quick else [(1024, 768), (1920, 1080)]
     out = args.out or HERE / "img"
     with tempfile.TemporaryDirectory() as tmp, running_class(Path(tmp) / "class") as opened:
-        fill(opened, Path(tmp))
+        fill(opened, Path(tmp), args.quick)
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=chromium_path(), args=FLAGS)
             for width, height in sizes:
                 page = browser.new_page(viewport={"width": width, "height": height})
-                suffix = "" if args.out is None else f"-{width}x{height}"
+                suffix = "" if args.out is None or args.quick else f"-{width}x{height}"
                 page.goto(f"http://127.0.0.1:{opened.port}/")
-                page.wait_for_selector("#students tr:nth-child(6)")
+                page.wait_for_selector("#students tr:nth-child(4)")
                 page.screenshot(path=str(out / f"class_page{suffix}.png"))
                 page.goto(f"http://127.0.0.1:{opened.port}/lab")
-                page.wait_for_selector("body[data-students='4']", state="attached")
+                page.wait_for_selector(f"body[data-students='{2 if args.quick else 4}']", state="attached")
                 page.screenshot(path=str(out / f"class_lab{suffix}.png"))
                 print(f"wrote {out / f'class_page{suffix}.png'} and class_lab{suffix}.png")
             browser.close()

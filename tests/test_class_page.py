@@ -37,3 +37,19 @@ def test_the_page_shows_games_as_they_arrive_and_names_as_text(tmp_path, monkeyp
         assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
         page.screenshot(path=str(tmp_path / "class-1024x768.png"))
     assert (tmp_path / "class-1024x768.png").stat().st_size > 10_000
+
+
+def test_the_class_screenshot_script_draws_every_class_picture(tmp_path, monkeypatch):
+    """docs/make_class_screenshots.py cannot rot: it runs here, on a smaller class, into a temporary folder."""
+    import importlib.util
+    from pathlib import Path
+
+    docs = Path(__file__).resolve().parent.parent / "docs"
+    spec = importlib.util.spec_from_file_location("make_class_screenshots", docs / "make_class_screenshots.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))
+    assert script.main_(["--out", str(tmp_path / "img"), "--quick"]) == 0
+    drawn = sorted(p.name for p in (tmp_path / "img").iterdir())
+    assert drawn == sorted(script.PICTURES) == sorted(p.name for p in (docs / "img").glob("class_*.png"))
+    assert all((tmp_path / "img" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for name in drawn)

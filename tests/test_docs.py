@@ -296,7 +296,8 @@ def test_the_screenshot_script_draws_every_picture(tmp_path):
                           env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     pictures = sorted(p.name for p in tmp_path.iterdir())
-    assert pictures == sorted(p.name for p in (ROOT / "docs" / "img").glob("*.png"))
+    # The live class's pages are drawn by a browser (docs/make_class_screenshots.py, run by test_class_page).
+    assert pictures == sorted(p.name for p in (ROOT / "docs" / "img").glob("*.png") if not p.name.startswith("class_"))
     for name in pictures:
         data = (tmp_path / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) < 200_000
