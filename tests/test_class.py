@@ -128,3 +128,64 @@ def test_play_join_refuses_what_would_not_be_the_class_game(tmp_path, students, 
                  "--name", "x"]) == 2
     err = capsys.readouterr().err
     assert "cannot reach the class at 127.0.0.1:1" in err and "school Wi-Fi" in err and len(err.splitlines()) == 1
+
+
+def test_class_submit_hands_replay_files_in_and_names_each(tmp_path, students, capsys):
+    students("ann")
+    game = tmp_path / "game.json"
+    game.write_bytes(keyboard_game(20, player="Ann").to_bytes())
+    (tmp_path / "bad.json").write_text("{")
+    with running_class(tmp_path / "class") as opened:
+        code = opened.clerk.roster.code
+        where = f"127.0.0.1:{opened.port}"
+        assert main(["class", "submit", where, "--code", code, "--name", "Ann", str(game)]) == 0
+        assert f"{game}: handed in: 1st of 1 in the class" in capsys.readouterr().out
+        assert main(["class", "submit", where, "--code", code, str(game), str(tmp_path / "bad.json")]) == 1
+        out = capsys.readouterr().out.splitlines()
+        assert out[0].startswith(f"{game}: already handed in") and out[1].startswith(f"{tmp_path / 'bad.json'}: not")
+        assert main(["class", "submit", where, "--code", "QQQQ", "--name", "Ann", str(game)]) == 2
+        assert "wrong class code" in capsys.readouterr().err
+
+
+def test_a_machine_that_joined_before_plays_on_while_the_class_is_away(tmp_path, students, capsys):
+    """The join fails, the game is played with the class's seed all the same, kept, and handed in later."""
+    students("ann")
+    folder = tmp_path / "class"
+    with running_class(folder) as opened:
+        code, where = opened.clerk.roster.code, f"127.0.0.1:{opened.port}"
+        client.join(client.ClassAddress.parse(where), code, "Ann")
+    assert main(["play", "--headless", "--bot", "naive", "--join", where, "--code", code]) == 0
+    captured = capsys.readouterr()
+    assert "cannot reach the class" in captured.err and "playing on" in captured.err
+    assert "kept and is handed in the next time you join" in captured.out
+    with running_class(folder) as opened:
+        assert main(["play", "--headless", "--bot", "naive", "--join", f"127.0.0.1:{opened.port}", "--code",
+                     code]) == 0
+        captured = capsys.readouterr()
+        assert "a game kept from before: handed in" in captured.err
+        assert "already handed in" in captured.out  # the same bot, the same game: one game
+        assert standings(opened)["games"] == 1
+
+
+def test_the_end_screen_hands_in_on_a_thread_and_shows_what_became_of_the_game(tmp_path, students):
+    import argparse
+    import time
+
+    from armgame.commands.play import _class_standing
+    from armgame.game.rules import GameConfig
+    from armgame.game.session import GameSession
+
+    students("ann")
+    with running_class(tmp_path / "class") as opened:
+        member = client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Ann")
+        session = GameSession(GameConfig(seed=member.seed))
+        session.play([])
+        standing = _class_standing(session, argparse.Namespace(bot=None), member)(None)
+        assert standing.note == "Handing your game in..." and standing.later is not None
+        for _ in range(200):
+            final = standing.later()
+            if final is not None:
+                break
+            time.sleep(0.02)
+    assert final.note == "Handed in:\n1st of 1 in the class (your best so far)"
+    assert final.rank == 1 and final.entries == 1 and final.top == ((1, "Ann", 0),)

@@ -233,7 +233,7 @@ def join(address: ClassAddress, code: str, name: str | None) -> Membership:
     known = remembered().get(code)
     if name is None:
         if known is None:
-            raise UserError("--join needs --name the first time this machine joins a class")
+            raise UserError(f"--name is needed: this machine has not joined the class with code {code} before")
         name = known["name"]
     try:
         name = check_name(name, "--name")
