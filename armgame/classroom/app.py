@@ -292,6 +292,11 @@ def _refusals(handler: Callable[[Request], Any]) -> Callable[[Request], Any]:
             return _refusal(exc)
         except UserError as exc:  # a file the clerk could not write: one line, nothing entered
             return _refusal(RefusedError(503, str(exc)))
+        except Exception as exc:  # a bug: the request gets one line, the teacher's terminal one line, the class goes on
+            print(f"armgame class: {request.method} {request.url.path}: {type(exc).__name__}: {exc}"[:300],
+                  file=sys.stderr)
+            return _refusal(RefusedError(500, "the class could not take this request (the teacher's terminal says "
+                                              "why); nothing was entered"))
     return wrapped
 
 
