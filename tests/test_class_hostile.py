@@ -200,3 +200,16 @@ def test_a_flood_is_queued_and_refused_politely_and_nothing_is_lost(tmp_path, mo
         assert len(served.clerk.entries) == 50
     assert all(r is not None and r.answer is not None for r in results)
     assert busy  # some were told the class was busy, and came back
+
+
+def test_a_failure_inside_the_class_is_one_line_and_the_class_goes_on(opened, monkeypatch, capsys):
+    def broken(teacher: bool = False):
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(opened.clerk, "standings", broken)
+    status, answer = call(opened, "GET", "/api/teacher/standings",
+                          headers={"Authorization": f"Bearer {opened.clerk.roster.secret}"})
+    assert status == 500 and "nothing was entered" in answer["error"]
+    assert capsys.readouterr().err.strip() == "armgame class: GET /api/teacher/standings: RuntimeError: a bug"
+    monkeypatch.undo()
+    assert join(opened, "Ann")[0] == 200
