@@ -21,6 +21,7 @@ import http.client
 import json
 import threading
 import time
+import unicodedata
 import urllib.error
 import urllib.request
 from collections.abc import Callable, Sequence
@@ -100,7 +101,7 @@ def _text(value: object, what: str, limit: int) -> str:
     cut to ``limit`` characters."""
     if not isinstance(value, str):
         raise ValueError(f"{what} is not text")
-    kept = "".join(c if c.isprintable() else " " for c in value[: 4 * limit]).strip()
+    kept = "".join(c if c.isprintable() else " " for c in unicodedata.normalize("NFC", value[: 4 * limit])).strip()
     return kept if len(kept) <= limit else kept[: limit - 1] + "…"
 
 
@@ -302,8 +303,11 @@ class ClassWindow:
         news_h = big + 2 * gap
         foot = pygame.Rect(pad, h - pad - news_h - 2 * gap, width, news_h + 2 * gap)
         if self.news is not None:
-            text = r.fit_text(self.news.news, news_h - 2 * gap, width - 4 * gap)
-            lab = r.label(text, news_h - 2 * gap, p.ink, "news", center=foot.center)
+            size = big  # smaller, down to the lists' size, before a long name is cut
+            while size > normal and r.text_size(self.news.news, size)[0] > width - 4 * gap:
+                size -= 1
+            text = r.fit_text(self.news.news, size, width - 4 * gap)
+            lab = r.label(text, size, p.ink, "news", center=foot.center)
             lay.panels.append(("news", lab.rect.inflate(4 * gap, 2 * gap).clamp(foot)))
             lay.labels.append(lab)
         else:
@@ -325,10 +329,13 @@ class ClassWindow:
                 fixed + r.text_size(row.name, small)[0] + r.text_size(row.driver or "", small)[0]
                 for row in s.programs[:MAX_SHOWN]])
             wide = round(min(max(natural, 0.28 * body.width), 0.38 * body.width))
+            fit = self._fit(body.height, normal, gap)
+            want = self._column_need(normal, False, gap, max((r.text_size(row.name, normal)[0]
+                                                              for row in s.students[:fit]), default=0))
             two = 2 * self._column_need(normal, False, gap) + 4 * gap
-            if len(s.students) > self._fit(body.height, normal, gap) and body.width - wide - 2 * gap < two \
-                    <= body.width - round(0.28 * body.width) - 2 * gap:
-                wide = body.width - 2 * gap - two
+            if len(s.students) > fit and two <= body.width - round(0.28 * body.width) - 2 * gap:
+                want = two
+            wide = max(round(0.28 * body.width), min(wide, body.width - 2 * gap - want))
             split = body.width - wide
             students = pygame.Rect(body.left, body.top, split - 2 * gap, body.height)
             programs = pygame.Rect(body.left + split + 2 * gap, body.top, body.width - split - 2 * gap, body.height)
@@ -416,14 +423,20 @@ class ClassWindow:
     def _fit(self, height: int, text: int, gap: int) -> int:
         """How many rows of ``text`` px fit under a list's heading in an area ``height`` px tall."""
         r = self.renderer
-        line_h = r.font(text).get_height()
+        line_h = self._line(text)
         pitch = line_h + max(2, gap // 2)
         return max(0, (height - r.text_size(STUDENTS, text)[1] - gap + pitch - line_h) // pitch)
 
-    def _column_need(self, height: int, programs: bool, gap: int) -> int:
-        """The narrowest column of a list: room for a name of ten letters beside the rank, score and the rest."""
+    def _line(self, text: int) -> int:
+        """A row's height: the font's line, or more where a descender reaches below it (as SDL measures)."""
+        return max(self.renderer.font(text).get_height(), self.renderer.text_size("Agjpqy", text)[1])
+
+    def _column_need(self, height: int, programs: bool, gap: int, name: int | None = None) -> int:
+        """The width of a list's column with room for a name ``name`` px wide (default: ten letters) beside
+        the rank, the score and the games played or the driver."""
         r = self.renderer
-        return (r.text_size("999.", height)[0] + r.text_size("n" * 10, height)[0] + r.text_size("9999", height)[0]
+        name = r.text_size("n" * 10, height)[0] if name is None else name
+        return (r.text_size("999.", height)[0] + name + r.text_size("9999", height)[0]
                 + r.text_size("bot (model)" if programs else "99 games", height)[0] + 5 * gap)
 
     def _section(self, lay: ClassLayout, key: str, area: pygame.Rect, heading: str, rows: Sequence[Row],
@@ -437,7 +450,7 @@ class ClassWindow:
         lay.labels.append(head)
         lay.rules.append(((area.left, head.rect.bottom + gap // 2), (area.right, head.rect.bottom + gap // 2)))
         top = head.rect.bottom + gap
-        line_h = r.font(height).get_height()
+        line_h = self._line(height)
         pitch = line_h + max(2, gap // 2)
         fit = self._fit(area.bottom - area.top, height, gap)
         lay.shown[key], lay.more[key] = 0, 0
@@ -526,7 +539,7 @@ class ClassWindow:
         for start, end in lay.rules:
             pygame.draw.line(screen, p.faint, start, end, max(2, round(2 * u)))
         for lab in lay.labels:
-            screen.blit(self.renderer.text(lab.text, lab.height, lab.colour), lab.rect)
+            self.renderer.draw_label(screen, lab)
         return lay
 
     def frame(self) -> ClassLayout:

@@ -19,12 +19,11 @@ otherwise, and the line's direction is its first letter's.
 from __future__ import annotations
 
 import unicodedata
-from collections.abc import Sequence
 from functools import cache
 
 import pygame
 
-from .render import RGB, GameRenderer, Palette
+from .render import RGB, GameRenderer, Label, Palette
 
 #: Fonts tried, in order, for what the default font lacks (pygame's names for installed fonts: lower
 #: case, no spaces). The common ones on Linux, Windows and macOS with Hebrew, Arabic and more.
@@ -37,6 +36,8 @@ SCRIPTS = {"ARABIC": "Arab", "HEBREW": "Hebr", "SYRIAC": "Syrc", "THAANA": "Thaa
            "TELUGU": "Telu", "KANNADA": "Knda", "MALAYALAM": "Mlym", "THAI": "Thai", "KHMER": "Khmr"}
 _RTL = ("R", "AL")
 _NUMBER = ("EN", "AN")
+#: How far accents may rise above a line of text, as a fraction of its height (into the gap above it).
+HEADROOM = 0.2
 #: Caches kept bounded: a window that runs for a lesson sees new names all the time.
 MAX_CACHED = 2048
 
@@ -176,7 +177,13 @@ class _Coverage:
 
 
 class TextRenderer(GameRenderer):
-    """The game's renderer, drawing any printable Unicode (``text`` and ``text_size``; see the module)."""
+    """The game's renderer, drawing any printable Unicode (see the module).
+
+    An ASCII string is measured and drawn as the game's renderer does. Any other is measured as one
+    line of the default font (``text_size``: the same height whatever its letters, so a row of names
+    stays a row), and drawn by ``draw_label`` on that line's baseline: accents above a capital may
+    rise into the gap above the line by up to HEADROOM of its height, and nothing reaches further (a
+    name stacked with combining marks stays in its row)."""
 
     def __init__(self, key_labels: tuple[str, ...] = (), muscle_names: tuple[str, ...] = (),
                  palette: str | Palette = "okabe-ito", text_scale: float = 1.0) -> None:
@@ -184,9 +191,10 @@ class TextRenderer(GameRenderer):
         self._coverage = _Coverage()
         self._plain: dict[str, bool] = {}
         self._run_fonts: dict[tuple[str | None, int, bool, str | None], pygame.font.Font] = {}
+        self._lifted: dict[tuple[str, int, RGB], tuple[pygame.Surface, int]] = {}
 
     def is_plain(self, text: str) -> bool:
-        """Whether the default font draws ``text`` as it is (left to right, every glyph its own)."""
+        """Whether the default font draws ``text`` as it is: left to right, a glyph for every letter."""
         if text.isascii():
             return True
         plain = self._plain.get(text)
@@ -222,6 +230,8 @@ class TextRenderer(GameRenderer):
         return font
 
     def _pieces(self, text: str, height: int) -> list[tuple[str, pygame.font.Font]]:
+        if self.is_plain(text):
+            return [(text, self.font(height))]
         pieces = []
         for run, rtl in visual_runs(text):
             font = self._run_font(self._path_for(run), height, rtl, script_of(run))
@@ -233,31 +243,54 @@ class TextRenderer(GameRenderer):
         return pieces
 
     def text_size(self, text: str, height: int) -> tuple[int, int]:
-        if self.is_plain(text):
+        if text.isascii():
             return super().text_size(text, height)
         key = (text, height)
         size = self._sizes.get(key)
         if size is None:
-            # As tall as the default font's line: a layout's rows stay where they were.
-            size = (sum(font.size(run)[0] for run, font in self._pieces(text, height)), self.font(height).get_height())
+            width = sum(font.size(run)[0] for run, font in self._pieces(text, height))
+            size = (width, self.font(height).get_height())
             if len(self._sizes) > 2048:
                 self._sizes.clear()
             self._sizes[key] = size
         return size
 
-    def text(self, string: str, height: int, colour: RGB | None = None) -> pygame.Surface:
-        if self.is_plain(string):
-            return super().text(string, height, colour)
+    def rendered(self, text: str, height: int, colour: RGB | None = None) -> tuple[pygame.Surface, int]:
+        """``text`` drawn, and how many pixels above its label's rectangle the surface goes."""
         colour = self.palette.ink if colour is None else colour
-        key = (string, height, colour)
-        surface = self._text.get(key)
-        if surface is None:
-            surface = _compose([(font.render(run, True, colour), font) for run, font in self._pieces(string, height)],
-                               self.font(height))
-            if len(self._text) > 512:
-                self._text.clear()
-            self._text[key] = surface
-        return surface
+        if text.isascii():
+            return super().text(text, height, colour), 0
+        key = (text, height, colour)
+        done = self._lifted.get(key)
+        if done is None:
+            line = self.font(height)
+            room = round(HEADROOM * line.get_height())
+            pieces = [(font.render(run, True, colour), font, run) for run, font in self._pieces(text, height)]
+            out = pygame.Surface((max(1, sum(s.get_width() for s, _, _ in pieces)), line.get_height() + room),
+                                 pygame.SRCALPHA)
+            x = 0
+            for surface, font, run in pieces:
+                out.blit(surface, (x, room + line.get_ascent() - _baseline(font, run)))
+                x += surface.get_width()
+            if len(self._lifted) > 512:
+                self._lifted.clear()
+            done = self._lifted[key] = (out, room)
+        return done
+
+    def text(self, string: str, height: int, colour: RGB | None = None) -> pygame.Surface:
+        """The surface ``draw_label`` draws (taller than the label's rectangle for any non-ASCII string)."""
+        return self.rendered(string, height, colour)[0]
+
+    def draw_label(self, screen: pygame.Surface, label: Label) -> pygame.Rect:
+        surface, lift = self.rendered(label.text, label.height, label.colour)
+        return screen.blit(surface, (label.rect.x, label.rect.y - lift))
+
+
+def _baseline(font: pygame.font.Font, run: str) -> int:
+    """Where SDL_ttf puts the baseline in a surface it renders: at the font's ascent, lower when a glyph
+    (an accented capital) rises above it."""
+    tops = [m[3] for m in font.metrics(run) if m]
+    return max([font.get_ascent(), *tops])
 
 
 def _cap_height(font: pygame.font.Font) -> int:
@@ -285,15 +318,3 @@ def _has_harfbuzz() -> bool:
     except (AttributeError, pygame.error):
         return False
     return True
-
-
-def _compose(pieces: Sequence[tuple[pygame.Surface, pygame.font.Font]], line: pygame.font.Font) -> pygame.Surface:
-    """The runs side by side on one transparent surface of the default font's line height, each on its
-    baseline (a taller font's empty top and its deepest descenders fall outside)."""
-    height, baseline = line.get_height(), line.get_ascent()
-    out = pygame.Surface((max(1, sum(s.get_width() for s, _ in pieces)), height), pygame.SRCALPHA)
-    x = 0
-    for surface, font in pieces:
-        out.blit(surface, (x, baseline - font.get_ascent()))
-        x += surface.get_width()
-    return out
