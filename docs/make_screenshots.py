@@ -4,7 +4,8 @@
     python docs/make_screenshots.py --out DIR  # somewhere else (the tests do, into a temporary folder)
 
 Each picture is a real frame of a real run: the game's model bot playing seed 10, the lab's adapting
-bot in the curl field (mid-reach, and the window's last screen with its learning curve), drawn by the
+bot in the curl field (mid-reach, and the window's last screen with its learning curve), a live class's
+standings as ``armgame class show`` draws them (from standings made up here: no class is served), drawn by the
 windows' own renderers onto an off-screen surface (SDL's dummy
 video driver: no display needed), then scaled down to a small PNG for the README.
 """
@@ -34,6 +35,8 @@ from armgame.ui.render import GameRenderer, Hud
 HERE = Path(__file__).resolve().parent
 #: Drawn at a projector's size, saved at half of it: small files, text still legible on GitHub.
 DRAW_SIZE, SAVE_SIZE = (1280, 720), (800, 450)
+#: The class's standings are drawn and saved at a projector's size: they are read from the back row.
+CLASS_SIZE = (1024, 768)
 
 
 def _save(surface: pygame.Surface, path: Path) -> Path:
@@ -96,6 +99,34 @@ def lab_end_frame(out: Path) -> Path:
     return _save(surface, out / "lab_end.png")
 
 
+def class_frame(out: Path) -> Path:
+    """`armgame class show`: a class of 24 halfway through a lesson, a new personal best just in (the
+    standings as the class's /api/standings answers them; saved at a projector's 1024 x 768)."""
+    import json
+
+    from armgame.ui.class_window import ClassWindow, parse_standings
+
+    names = ["Priya", "Yusuf", "Zoë", "Tom", "Ольга", "Kai", "Lena", "محمد", "Noah", "Uma", "Ann", "Bo", "שירה",
+             "Mateo", "Aiko", "Jonas", "Fatima", "Leo", "Sara", "Ravi", "Emma", "Finn", "Nia", "Omar"]
+    students = [{"rank": i + 1, "name": name, "score": 52 - 2 * i + (i % 3), "hits": 52 - 2 * i + (i % 3),
+                 "games": 1 + (7 * i) % 5, "driver": None} for i, name in enumerate(names)]
+    programs = [{"rank": i + 1, "name": name, "score": score, "hits": score, "games": 1, "driver": driver}
+                for i, (name, score, driver) in enumerate((("Dee's bot", 61, "bot (model)"),
+                                                          ("naive", 38, "bot (naive)"),
+                                                          ("Kai's script", 31, "script")))]
+    answer = {"version": 40, "seed": 10, "closed": False, "joined": 27, "games": 61, "students": students,
+              "programs": programs, "join": "armgame play --join 192.168.1.20:8765 --code HAPF",
+              "arrival": {"seq": 61, "name": "Yusuf", "score": 51, "note": "new personal best", "program": False}}
+    window = ClassWindow("192.168.1.20:8765", None)
+    window.update(parse_standings(json.dumps({**answer, "arrival": {**answer["arrival"], "seq": 60}}).encode()), None)
+    window.update(parse_standings(json.dumps(answer).encode()), None)  # arrived after the window opened: news
+    surface = pygame.Surface(CLASS_SIZE)
+    window.draw(surface)
+    path = out / "class_show.png"
+    pygame.image.save(surface, str(path))
+    return path
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=HERE / "img", help="folder for the PNGs (default docs/img)")
@@ -104,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     pygame.display.init()
     pygame.font.init()
     try:
-        for draw in (game_frame, lab_frame, lab_end_frame):
+        for draw in (game_frame, lab_frame, lab_end_frame, class_frame):
             print(f"wrote {draw(args.out)}")
     finally:
         pygame.quit()

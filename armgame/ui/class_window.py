@@ -320,36 +320,58 @@ class ClassWindow:
                                       midtop=(w // 2, body.top)))
             return lay
         fresh = self.news if self.news is not None else None
-        # Side by side on a landscape window, the programs below the students on a narrow one.
-        if w >= 1.15 * h:
-            # The programs as wide as their rows need, from 28% to 38% of the width, the rest the students';
-            # narrower, down to 28%, where that lets the students' list take a second column.
-            fixed = r.text_size("999.", small)[0] + r.text_size("9999", small)[0] + 7 * gap
-            natural = max([r.text_size(PROGRAMS, small)[0]] + [
-                fixed + r.text_size(row.name, small)[0] + r.text_size(row.driver or "", small)[0]
-                for row in s.programs[:MAX_SHOWN]])
-            wide = round(min(max(natural, 0.28 * body.width), 0.38 * body.width))
-            fit = self._fit(body.height, normal, gap)
-            want = self._column_need(normal, False, gap, max((r.text_size(row.name, normal)[0]
-                                                              for row in s.students[:fit]), default=0))
-            two = 2 * self._column_need(normal, False, gap) + 4 * gap
-            if len(s.students) > fit and two <= body.width - round(0.28 * body.width) - 2 * gap:
-                want = two
-            wide = max(round(0.28 * body.width), min(wide, body.width - 2 * gap - want))
-            split = body.width - wide
-            students = pygame.Rect(body.left, body.top, split - 2 * gap, body.height)
-            programs = pygame.Rect(body.left + split + 2 * gap, body.top, body.width - split - 2 * gap, body.height)
-        else:
-            pitch = r.font(small).get_height() + gap // 2
-            wanted = 2 * r.font(small).get_height() + 3 * gap + max(1, len(s.programs)) * pitch
-            below = min(wanted, body.height // 3)
-            students = pygame.Rect(body.left, body.top, body.width, body.height - below - 2 * gap)
-            programs = pygame.Rect(body.left, students.bottom + 2 * gap, body.width, below)
+        students, programs = self._arrange(body, s, normal, small, gap, landscape=w >= 1.15 * h)
         self._section(lay, "students", students, STUDENTS, s.students, normal, gap,
                       fresh if fresh is not None and not fresh.program else None)
         self._section(lay, "programs", programs, PROGRAMS, s.programs, small, gap,
                       fresh if fresh is not None and fresh.program else None)
         return lay
+
+    def _arrange(self, body: pygame.Rect, s: Standings, normal: int, small: int, gap: int,
+                 landscape: bool) -> tuple[pygame.Rect, pygame.Rect]:
+        """Where the students' list and the programs' go: side by side on a landscape window, the programs
+        below on a narrow one, or on a landscape one where that shows more students (two columns of them)."""
+        r = self.renderer
+        fixed = r.text_size("999.", small)[0] + r.text_size("9999", small)[0] + 7 * gap
+        natural = max([r.text_size(PROGRAMS, small)[0]] + [
+            fixed + r.text_size(row.name, small)[0] + r.text_size(row.driver or "", small)[0]
+            for row in s.programs[:MAX_SHOWN]])
+        pitch = self._line(small) + max(2, gap // 2)
+        band = r.text_size(PROGRAMS, small)[1] + gap + max(1, len(s.programs)) * pitch
+        below = min(band, body.height // 3)
+        # Below, as wide as their rows need on a landscape window (a score far from its name reads badly).
+        across = body.width if not landscape else min(body.width, max(natural, body.width // 2))
+        stacked = (pygame.Rect(body.left, body.top, body.width, body.height - below - 2 * gap),
+                   pygame.Rect(body.left, body.bottom - below, across, below))
+        if not landscape:
+            return stacked
+        # Beside: the programs as wide as their rows need, from 28% to 38% of the width, the rest the
+        # students'; narrower, down to 28%, where that makes the students' names whole or gives them a
+        # second column.
+        wide = round(min(max(natural, 0.28 * body.width), 0.38 * body.width))
+        fit = self._fit(body.height, normal, gap)
+        want = self._column_need(normal, False, gap, max((r.text_size(row.name, normal)[0]
+                                                          for row in s.students[:fit]), default=0))
+        two = 2 * self._column_need(normal, False, gap) + 4 * gap
+        if len(s.students) > fit and two <= body.width - round(0.28 * body.width) - 2 * gap:
+            want = two
+        if body.width - 2 * gap - want >= round(0.28 * body.width):  # only where it makes them whole
+            wide = min(wide, body.width - 2 * gap - want)
+        split = body.width - wide
+        side = (pygame.Rect(body.left, body.top, split - 2 * gap, body.height),
+                pygame.Rect(body.left + split + 2 * gap, body.top, wide - 2 * gap, body.height))
+        n = len(s.students)
+        if self._columns(stacked[0], normal, False, gap, n)[2] > self._columns(side[0], normal, False, gap, n)[2]:
+            return stacked
+        return side
+
+    def _columns(self, area: pygame.Rect, height: int, programs: bool, gap: int, rows: int) -> tuple[int, int, int]:
+        """How a list of ``rows`` goes in ``area``: rows per column, columns (two where one would leave
+        rows out and each is still wide enough), and the rows shown (the last line says "and N more")."""
+        fit = self._fit(area.height, height, gap)
+        columns = 2 if rows > fit and area.width >= 2 * self._column_need(height, programs, gap) + 4 * gap else 1
+        room = fit * columns
+        return fit, columns, rows if rows <= room else max(0, room - 1)
 
     def _join_line(self, lay: ClassLayout, join: str, largest: int, smallest: int, pad: int, gap: int) -> int:
         """The line students type, as large as fits the width, the code in a box; two lines (before
@@ -452,7 +474,7 @@ class ClassWindow:
         top = head.rect.bottom + gap
         line_h = self._line(height)
         pitch = line_h + max(2, gap // 2)
-        fit = self._fit(area.bottom - area.top, height, gap)
+        fit, columns, shown = self._columns(area, height, key == "programs", gap, len(rows))
         lay.shown[key], lay.more[key] = 0, 0
         if fit == 0:
             return
@@ -465,10 +487,7 @@ class ClassWindow:
         rank_w = r.text_size("999.", height)[0]
         score_w = r.text_size("9999", height)[0]
         between = 4 * gap
-        columns = 2 if len(rows) > fit and area.width >= 2 * self._column_need(height, programs, gap) + between else 1
         col_w = (area.width - (columns - 1) * between) // columns
-        room = fit * columns
-        shown = len(rows) if len(rows) <= room else max(0, room - 1)
         if columns == 2:
             x = area.left + col_w + between // 2
             lay.rules.append(((x, top), (x, top + min(fit, max(shown + 1, 1)) * pitch - pitch + line_h)))
