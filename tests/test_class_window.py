@@ -102,7 +102,7 @@ def test_a_full_class_with_hostile_names_fits_every_projector(size):
     assert any(lab.text.startswith("<script>") for lab in lay.labels if lab.role == "name")  # as the characters
     assert any("Connection refused" in t for t in texts) and "CLOSED: no more games" in " ".join(texts)
     news = next(lab.text for lab in lay.labels if lab.role == "news")
-    assert news == f"{HOSTILE[0]}: 90, new personal best" or size[0] < size[1] and news.startswith(HOSTILE[0])
+    assert news == f"{HOSTILE[0]}: 90, new personal best" or (size[0] < size[1] and news.startswith(HOSTILE[0]))
     # A whole 40-letter name in a class of one column on a wide projector.
     small = check_fits(window(answer(students=10)), size)
     assert size[0] < 1280 or LONG in [lab.text for lab in small.labels]

@@ -6,6 +6,7 @@ import os
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 os.environ["SDL_AUDIODRIVER"] = "dummy"
 
+import json
 import subprocess
 import sys
 
@@ -58,9 +59,9 @@ def test_each_entry_starts_its_window_and_the_menu_comes_back(monkeypatch):
 
     seen = scripted(monkeypatch, [
         ["return"],  # Play
-        ["down", "return"], ["2"],  # Lab, then its second preset
-        ["escape"], ["3"], ["6"],  # back; Demos, the sixth
-        ["escape"], ["4"], ["escape"], ["5"], ["escape"], ["6"],  # Replays and scores, Settings, Quit
+        ["down", "down", "return"], ["2"],  # Lab, then its second preset
+        ["escape"], ["4"], ["6"],  # back; Demos, the sixth
+        ["escape"], ["5"], ["escape"], ["6"], ["escape"], ["7"],  # Replays and scores, Settings, Quit
     ])
     menu = run_menu(lambda: menu_command.main_page(launch), fps=0, max_frames=40)
     assert launched == [["play"], ["lab", "curl"], ["demo", "autopilot"]]
@@ -83,10 +84,10 @@ def test_the_mouse_chooses_and_clicks():
     pygame.display.init()
     menu.screen = pygame.display.set_mode((1024, 768))
     rows = dict(menu.layout((1024, 768)).rows)
-    assert sorted(rows) == list(range(6))
-    menu.handle(pygame.event.Event(pygame.MOUSEMOTION, pos=rows[2].center, rel=(0, 0), buttons=(0, 0, 0)))
-    assert menu.page.selected == 2
-    menu.handle(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=rows[2].center, button=1))
+    assert sorted(rows) == list(range(7))
+    menu.handle(pygame.event.Event(pygame.MOUSEMOTION, pos=rows[3].center, rel=(0, 0), buttons=(0, 0, 0)))
+    assert menu.page.selected == 3
+    menu.handle(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=rows[3].center, button=1))
     assert menu.page.title == "Demos"
     menu.handle(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=(5, 5), button=3))  # right click: back
     assert menu.page.title == "armgame"
@@ -149,6 +150,97 @@ def test_settings_toggle_sound_and_colours_in_the_file(tmp_path):
     assert load()[0].palette == menu_command.settings_page().items[1].label.split(": ")[1] != "okabe-ito"
 
 
+def text(value):
+    return pygame.event.Event(pygame.TEXTINPUT, text=value)
+
+
+@pytest.fixture
+def client_folder(tmp_path, monkeypatch):
+    from armgame.classroom import client
+
+    folder = tmp_path / "client"
+    monkeypatch.setenv(client.CLIENT_ENV, str(folder))
+    return folder
+
+
+def test_join_a_class_asks_checks_and_starts_play_join(monkeypatch, client_folder):
+    """Typed once on the menu, each value checked as the command line checks it (its one line on the
+    menu), then `armgame play --join` and `armgame class show` started with them."""
+    launched = []
+    real = MenuWindow.frame
+    statuses = []
+
+    def frame(self):
+        for step in script.pop(0) if script else ["escape"]:  # a key's name, or ("text", what is typed)
+            pygame.event.post(key(step) if isinstance(step, str) else text(step[1]))
+        real(self)
+        statuses.append((self.page.title, self.status, self.typing))
+
+    script = [
+        ["2"],  # Join a class
+        ["4"],  # Join and play, with nothing typed yet: not started, says what is missing
+        ["1", ("text", "192.168.1.20:99999"), "return"],  # the address, refused
+        ["backspace"] * 5 + [("text", "8765"), "return"],  # mended, kept
+        ["down", "return", "h", ("text", "h"), ("text", "apf"), "return"],  # the code, in the case typed
+        ["down", "return", ("text", "x"), "escape"],  # Esc: the name stays as it was (empty)
+        ["return", ("text", "<script>alert(1)</script>"), "return"],
+        ["4"],  # Join and play
+        ["5"],  # Show the class's standings
+    ]
+    monkeypatch.setattr(MenuWindow, "frame", frame)
+    menu = run_menu(lambda: menu_command.main_page(lambda argv: launched.append(argv) or 0), fps=0, max_frames=30)
+    assert statuses[1][1].startswith("type the class's address first")
+    assert statuses[2][1] == "the class's address '192.168.1.20:99999': the port must be a number from 1 to 65535 " \
+        "(HOST:PORT, as the projector shows)" and statuses[2][2] == "192.168.1.20:99999"  # still typing
+    assert statuses[3][1:] == ("", None)
+    assert statuses[5][2] is None
+    join = ["play", "--join", "192.168.1.20:8765", "--code", "HAPF", "--name", "<script>alert(1)</script>"]
+    assert launched == [join, ["class", "show", "192.168.1.20:8765"]]
+    assert statuses[-1][0] == "armgame" and not menu.running
+    assert not client_folder.exists()  # the menu keeps nothing: the join itself remembers the class
+
+
+def test_join_a_class_offers_the_class_this_machine_joined_last(client_folder):
+    client_folder.mkdir()
+    (client_folder / "memberships.json").write_text(json.dumps({
+        "ACDE": {"name": "Bo", "token": "t1", "seed": "10", "address": "10.0.0.4:8765", "at": "1.0"},
+        "HAPF": {"name": "Ann", "token": "t2", "seed": "10", "address": "10.0.0.5:8765", "at": "2.0"}}))
+    launched = []
+    menu = MenuWindow(lambda: menu_command.class_page(lambda argv: launched.append(argv) or 0))
+    assert [item.shown() for item in menu.page.items[:3]] == \
+        ["Class address: 10.0.0.5:8765", "Code: HAPF", "Your name: Ann"]
+    assert menu.page.items[3].detail == "armgame play --join 10.0.0.5:8765 --code HAPF --name Ann"
+    menu.choose(3)
+    menu.pending.start()
+    assert launched == [["play", "--join", "10.0.0.5:8765", "--code", "HAPF", "--name", "Ann"]]
+    # A stale value from the file is checked before it is used.
+    (client_folder / "memberships.json").write_text(json.dumps({
+        "HAPF": {"name": "Ann", "token": "t2", "seed": "10", "address": "not an address!", "at": "2.0"}}))
+    menu = MenuWindow(lambda: menu_command.class_page(lambda argv: 0))
+    menu.choose(4)
+    assert menu.pending is None and "'not an address!' is not an address" in menu.status
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_typing_a_long_or_right_to_left_value_fits_every_window(size, client_folder):
+    pygame.display.init()
+    pygame.font.init()
+    window = pygame.Rect((0, 0), size)
+    for typed in ("W" * 260, "محمد علي " * 4, "שלום"):
+        menu = MenuWindow(lambda: menu_command.class_page(lambda argv: 0))
+        menu.choose(2)
+        menu.typing = typed
+        menu.status = "your name must be at most 40 characters, got 41"
+        lay = menu.layout(size)
+        item = next(lab for lab in lay.labels if lab.role == "item" and lab.text.startswith("3  Your name: "))
+        assert item.text.endswith("|")  # the end of what is typed, where the caret is, in view
+        boxes = lay.boxes()
+        for i, (name, rect) in enumerate(boxes):
+            assert window.contains(rect) and rect.height >= MIN_TEXT_AT_720 * min(size) // 720, (size, name, rect)
+            for other, r in boxes[i + 1:]:
+                assert not rect.colliderect(r), (size, name, other)
+
+
 @pytest.mark.parametrize("size", SIZES)
 def test_every_page_fits_every_window(size):
     pygame.display.init()
@@ -156,7 +248,8 @@ def test_every_page_fits_every_window(size):
     min_height = int(MIN_TEXT_AT_720 * min(size) / 720)
     window = pygame.Rect((0, 0), size)
     pages = [lambda: menu_command.main_page(lambda argv: 0), lambda: menu_command.demos_page(lambda argv: 0),
-             lambda: menu_command.lab_page(lambda argv: 0), menu_command.settings_page]
+             lambda: menu_command.lab_page(lambda argv: 0), menu_command.settings_page,
+             lambda: menu_command.class_page(lambda argv: 0)]
     for build in pages:
         menu = MenuWindow(build)
         menu.status = "armgame play stopped (status 2): the terminal says why"

@@ -81,8 +81,12 @@ def _start(launch: Callable[[Sequence[str]], int], *argv: str) -> Callable[[], s
 def main_page(launch: Callable[[Sequence[str]], int]):
     from ..ui.menu import Item, Page
 
+    typed: dict[str, str] = {}  # the class page's values, while the menu is open (kept nowhere else)
+
     return Page("armgame", [
         Item("Play", "the game: hit the targets with d f j k, one minute", start=_start(launch, "play")),
+        Item("Join a class", "play in the live class the projector shows: its games go to the class",
+             page=lambda: class_page(launch, typed)),
         Item("Lab", "reach in a force field or a changed display, and adapt",
              page=lambda: lab_page(launch)),
         Item("Demos", "the arm's dynamics, one idea at a time", page=lambda: demos_page(launch)),
@@ -90,6 +94,57 @@ def main_page(launch: Callable[[Sequence[str]], int]):
         Item("Settings", "sound, colours, where the settings file is", page=settings_page),
         Item("Quit", "close armgame", quit=True),
     ])
+
+
+def class_page(launch: Callable[[Sequence[str]], int], typed: dict[str, str] | None = None):
+    """Join a live class: its address, code and the student's name, typed once and checked as the
+    command line checks them; the first time, the class this machine joined last (the client's own
+    memberships file, the one place they are kept). ``typed`` holds them while the page is open."""
+    import shlex
+
+    from ..classroom import client
+    from ..errors import UserError
+    from ..records.replay import MAX_NAME, check_name
+    from ..ui.menu import Field, Item, Page
+
+    typed = {} if typed is None else typed
+    if not typed:
+        last = client.last_class()
+        typed.update(zip(("address", "code", "name"), last or ("", "", ""), strict=True))
+    checks: dict[str, Callable[[str], str]] = {
+        "address": lambda text: client.ClassAddress.parse(text, "the class's address").label,
+        "code": lambda text: client.check_code(text, "the code"),
+        "name": lambda text: check_name(text, "your name"),
+    }
+
+    def field(key: str, limit: int) -> Field:
+        return Field(typed[key], checks[key], lambda value: typed.__setitem__(key, value), limit)
+
+    def missing(*keys: str) -> str | None:
+        """The first value not set or not taken by its check (a remembered one may be stale), in its words."""
+        for key in keys:
+            if not typed[key]:
+                return {"address": "type the class's address first (HOST:PORT, as the projector shows it)",
+                        "code": "type the class's code first (its four letters, as the projector shows them)",
+                        "name": "type your name first"}[key]
+            try:
+                checks[key](typed[key])
+            except (ValueError, UserError) as exc:
+                return str(exc)
+        return None
+
+    join = ["play", "--join", typed["address"], "--code", typed["code"], "--name", typed["name"]]
+    ready = all(typed.values())
+    return Page("Join a class", [
+        Item("Class address", "HOST:PORT, as the projector shows it", field=field("address", 260)),
+        Item("Code", "the class's four letters, as the projector shows them", field=field("code", 16)),
+        Item("Your name", f"as the class's table shows it: 1 to {MAX_NAME} characters", field=field("name", MAX_NAME)),
+        Item("Join and play", "armgame " + shlex.join(join) if ready else "the three above first",
+             start=lambda: _start(launch, *join)(), ready=lambda: missing("address", "code", "name")),
+        Item("Show the class's standings", "the projector's table, here: armgame class show "
+             + (typed["address"] or "HOST:PORT"), start=lambda: _start(launch, "class", "show", typed["address"])(),
+             ready=lambda: missing("address")),
+    ], lines=("Every game you finish is handed in to the class by itself.",))
 
 
 def lab_page(launch: Callable[[Sequence[str]], int]):

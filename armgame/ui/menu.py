@@ -3,10 +3,13 @@
 The menu knows nothing of commands, score files or settings files: the command line hands it pages
 (``Page``) whose items either open another page or start something (``Item.start``, called with the
 menu's window closed, since every armgame window opens and closes the display itself). When that
-window closes, the menu opens again where it was. Keys: up/down (or the item's number) choose,
-Enter starts, Esc goes back (and quits at the first page), F11 fills the screen; the mouse hovers
-and clicks. Like the game's renderer, every frame is laid out before it is drawn (``MenuWindow.layout``),
-so the tests check at every window size that no text is cut, overlaps another or is too small.
+window closes, the menu opens again where it was. An item may hold a ``Field``, a value typed on the
+page (a class's address, a name): Enter begins typing, Enter again keeps it if its check takes it (else
+the check's one line shows and typing goes on), Esc leaves it as it was. Keys: up/down (or the item's
+number) choose, Enter starts, Esc goes back (and quits at the first page), F11 fills the screen; the
+mouse hovers and clicks. Like the game's renderer, every frame is laid out before it is drawn
+(``MenuWindow.layout``), so the tests check at every window size that no text is cut, overlaps another
+or is too small.
 """
 
 from __future__ import annotations
@@ -16,11 +19,28 @@ from dataclasses import dataclass, field
 
 import pygame
 
+from ..errors import UserError
 from .display import open_window, toggle_fullscreen
-from .render import PALETTES, GameRenderer, Label, min_text
+from .names import TextRenderer
+from .render import PALETTES, Label, min_text
 
 CAPTION = "armgame"
 DEFAULT_SIZE = (1024, 720)
+
+
+@dataclass
+class Field:
+    """A value typed on a page. ``check`` turns what was typed into the value kept, or raises ValueError
+    (or UserError) with the one line the menu shows; ``keep`` is told the value kept, and the page is
+    built again (what depends on the value shows it). Nothing is kept anywhere else."""
+
+    value: str = ""
+    check: Callable[[str], str] | None = None
+    keep: Callable[[str], None] | None = None
+    #: The most characters typed.
+    limit: int = 80
+    #: Shown for an empty value.
+    empty: str = "(not set: Enter to type it)"
 
 
 @dataclass
@@ -28,7 +48,9 @@ class Item:
     """One line of a page: ``label`` and a short ``detail``. Enter opens ``page()`` (a page built when
     it is opened, so it shows the table and files as they are now), or calls ``start()`` with the
     menu's window closed (a window of its own), or ``act()`` with it open (a setting changed: the
-    page is built again to show it). ``start`` and ``act`` return a line for the menu to show, or None."""
+    page is built again to show it), or types its ``field``. ``start`` and ``act`` return a line for
+    the menu to show, or None; ``ready``, asked before ``start``, returns the line that says why it
+    cannot start yet (a value still missing), or None."""
 
     label: str
     detail: str = ""
@@ -36,6 +58,14 @@ class Item:
     start: Callable[[], str | None] | None = None
     act: Callable[[], str | None] | None = None
     quit: bool = False
+    field: Field | None = None
+    ready: Callable[[], str | None] | None = None
+
+    def shown(self) -> str:
+        """The item's line: its label, and its field's value."""
+        if self.field is None:
+            return self.label
+        return f"{self.label}: {self.field.value or self.field.empty}"
 
 
 @dataclass
@@ -65,13 +95,16 @@ class MenuWindow:
         #: The pages open, first to current, each with what builds it again.
         self.stack: list[tuple[Callable[[], Page], Page]] = [(root, root())]
         self.palette = PALETTES.get(palette, PALETTES["okabe-ito"])
-        self.renderer = GameRenderer((), (), self.palette)
+        # Names typed here are drawn in any script (a student's name, before the class shows it).
+        self.renderer = TextRenderer((), (), self.palette)
         self.fullscreen = fullscreen
         self.windowed_size = size
         self.running = True
         self.status = ""
         #: An item to start once the menu's window is closed (set by Enter or a click).
         self.pending: Item | None = None
+        #: What is being typed into the chosen item's field (None: not typing).
+        self.typing: str | None = None
         self.screen: pygame.Surface | None = None
 
     @property
@@ -88,8 +121,14 @@ class MenuWindow:
         if item.page is not None:
             self.stack.append((item.page, item.page()))
             self.status = ""
+        elif item.field is not None:
+            self.begin_typing(item.field)
         elif item.start is not None:
-            self.pending = item
+            why = item.ready() if item.ready is not None else None
+            if why:
+                self.status = why
+            else:
+                self.pending = item
         elif item.act is not None:
             self.status = item.act() or ""
             self.refresh()
@@ -103,6 +142,53 @@ class MenuWindow:
         page.selected = min(old.selected, max(len(page.items) - 1, 0))
         self.stack[-1] = (build, page)
 
+    # ----------------------------------------------------------------- typing
+    def begin_typing(self, field: Field) -> None:
+        self.typing = field.value
+        self.status = ""
+        pygame.key.start_text_input()
+        pygame.key.set_repeat(400, 40)  # a held Backspace deletes on
+
+    def stop_typing(self) -> None:
+        self.typing = None
+        pygame.key.stop_text_input()
+        pygame.key.set_repeat()
+
+    def keep_typed(self) -> None:
+        """Enter: the field takes what was typed if its check does; else its line shows, and typing goes on."""
+        field = self.page.items[self.page.selected].field
+        assert field is not None and self.typing is not None
+        try:
+            value = field.check(self.typing) if field.check is not None else self.typing
+        except (ValueError, UserError) as exc:
+            self.status = str(exc)
+            return
+        field.value = value
+        self.stop_typing()
+        self.status = ""
+        if field.keep is not None:
+            field.keep(value)
+            self.refresh()
+
+    def type_key(self, event: pygame.event.Event) -> None:
+        field = self.page.items[self.page.selected].field
+        assert field is not None and self.typing is not None
+        if event.type == pygame.TEXTINPUT:
+            typed = "".join(c for c in event.text if c.isprintable())
+            self.typing = (self.typing + typed)[:field.limit]
+            return
+        name = pygame.key.name(event.key).lower()
+        if name == "escape":
+            self.stop_typing()
+            self.status = ""
+        elif name in ("return", "enter"):
+            self.keep_typed()
+        elif name == "backspace":
+            self.typing = self.typing[:-1]
+        elif name == "f11":
+            self.screen = toggle_fullscreen(self.windowed_size or self.screen.get_size())
+            self.fullscreen = bool(self.screen.get_flags() & pygame.FULLSCREEN)
+
     def back(self) -> None:
         if len(self.stack) > 1:
             self.stack.pop()
@@ -112,6 +198,13 @@ class MenuWindow:
 
     def handle(self, event: pygame.event.Event) -> None:
         page = self.page
+        if self.typing is not None and event.type in (pygame.TEXTINPUT, pygame.KEYDOWN):
+            self.type_key(event)
+            return
+        if self.typing is not None and event.type in (pygame.MOUSEMOTION, pygame.MOUSEBUTTONDOWN):
+            if event.type == pygame.MOUSEMOTION:
+                return  # the row being typed stays chosen
+            self.stop_typing()  # a click elsewhere leaves the value as it was
         if event.type == pygame.QUIT:
             self.running = False
         elif event.type == pygame.VIDEORESIZE and not self.fullscreen:
@@ -148,6 +241,8 @@ class MenuWindow:
         return next((i for i, r in rows if r.collidepoint(pos)), None)
 
     def help_items(self) -> tuple[str, ...]:
+        if self.typing is not None:
+            return ("type", "Backspace deletes", "Enter keeps it", "Esc leaves it as it was")
         back = "Esc back" if len(self.stack) > 1 else "Esc quit"
         count = min(len(self.page.items), 9)
         number = (f"1-{count} start that one",) if count > 1 else ()
@@ -182,7 +277,9 @@ class MenuWindow:
         y += gap
         column = min(width, max(round(800 * u), 280))
         left = (w - column) // 2
-        row_h = r.font(normal).get_height() + r.font(small).get_height() + 2 * gap
+        content = r.font(normal).get_height() + r.font(small).get_height()
+        # Its lines in the middle of the row (seven rows, the main page's, fit a 640 x 480 window).
+        row_h = content + gap + gap // 2
         items = self.page.items
         fit = max(1, (bottom - y) // (row_h + gap // 2))
         first = min(max(0, self.page.selected - fit + 1), max(0, len(items) - fit))  # the chosen one in view
@@ -192,8 +289,14 @@ class MenuWindow:
             lay.rows.append((i, rect))
             colour = p.ink
             number = f"{i + 1}  " if i < 9 else "    "
-            lay.labels.append(r.label(r.fit_text(number + item.label, normal, column - 2 * gap), normal, colour,
-                                      "item", topleft=(left + gap, y + gap // 2)))
+            if self.typing is not None and i == self.page.selected:
+                # What is typed keeps its end, where the caret is, in view: its start gives way first.
+                prefix = r.fit_text(f"{number}{item.label}: ", normal, (column - 2 * gap) // 2)
+                room = column - 2 * gap - r.text_size(prefix, normal)[0]
+                text = prefix + r.fit_tail(self.typing + "|", normal, room)
+            else:
+                text = r.fit_text(number + item.shown(), normal, column - 2 * gap)
+            lay.labels.append(r.label(text, normal, colour, "item", topleft=(left + gap, y + (row_h - content) // 2)))
             if item.detail:
                 lay.labels.append(r.label(r.fit_text(item.detail, small, column - 2 * gap), small, p.faint,
                                           "detail", topleft=(left + gap, lay.labels[-1].rect.bottom)))
@@ -215,12 +318,14 @@ class MenuWindow:
         radius = max(4, round(10 * min(screen.get_size()) / 720))
         for i, rect in lay.rows:
             selected = i == self.page.selected
-            pygame.draw.rect(screen, p.bar_back if selected else p.panel, rect, border_radius=radius)
+            # The row being typed in is a text box: the page's lightest fill.
+            fill = p.scene if selected and self.typing is not None else p.bar_back if selected else p.panel
+            pygame.draw.rect(screen, fill, rect, border_radius=radius)
             pygame.draw.rect(screen, p.ink if selected else p.edge, rect,
                              max(2, round(3 * min(screen.get_size()) / 720)) if selected else 1,
                              border_radius=radius)
         for lab in lay.labels:
-            screen.blit(self.renderer.text(lab.text, lab.height, lab.colour), lab.rect)
+            self.renderer.draw_label(screen, lab)
         return lay
 
     def frame(self) -> None:

@@ -281,6 +281,14 @@ class TextRenderer(GameRenderer):
         """The surface ``draw_label`` draws (taller than the label's rectangle for any non-ASCII string)."""
         return self.rendered(string, height, colour)[0]
 
+    def fit_tail(self, text: str, height: int, width: int) -> str:
+        """``text`` cut at its start with an ellipsis to ``width`` px (what is typed: its end stays in view)."""
+        if self.text_size(text, height)[0] <= width:
+            return text
+        while text and self.text_size("..." + text, height)[0] > width:
+            text = text[1:]
+        return "..." + text
+
     def draw_label(self, screen: pygame.Surface, label: Label) -> pygame.Rect:
         surface, lift = self.rendered(label.text, label.height, label.colour)
         return screen.blit(surface, (label.rect.x, label.rect.y - lift))
