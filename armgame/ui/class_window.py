@@ -265,6 +265,8 @@ class ClassWindow:
     def update(self, standings: Standings | None, problem: str | None) -> None:
         """Take what the poller has: a new arrival is said for NEWS_SECONDS, and its row picked out."""
         self.problem = problem
+        if self.news is not None and self.clock() >= self.news_until:
+            self.news = None
         if standings is None:
             return
         self.standings = standings
@@ -275,8 +277,6 @@ class ClassWindow:
         elif arrival is not None and seq > self.last_seq:
             self.last_seq = seq
             self.news, self.news_until = arrival, self.clock() + NEWS_SECONDS
-        if self.news is not None and self.clock() >= self.news_until:
-            self.news = None
 
     # ------------------------------------------------------------------ layout
     def layout(self, size: tuple[int, int]) -> ClassLayout:
@@ -303,11 +303,10 @@ class ClassWindow:
         news_h = big + 2 * gap
         foot = pygame.Rect(pad, h - pad - news_h - 2 * gap, width, news_h + 2 * gap)
         if self.news is not None:
-            size = big  # smaller, down to the lists' size, before a long name is cut
-            while size > normal and r.text_size(self.news.news, size)[0] > width - 4 * gap:
-                size -= 1
-            text = r.fit_text(self.news.news, size, width - 4 * gap)
-            lab = r.label(text, size, p.ink, "news", center=foot.center)
+            said = big  # smaller, down to the lists' size, before a long name is cut
+            while said > normal and r.text_size(self.news.news, said)[0] > width - 4 * gap:
+                said -= 1
+            lab = r.label(r.fit_text(self.news.news, said, width - 4 * gap), said, p.ink, "news", center=foot.center)
             lay.panels.append(("news", lab.rect.inflate(4 * gap, 2 * gap).clamp(foot)))
             lay.labels.append(lab)
         else:
@@ -319,7 +318,7 @@ class ClassWindow:
             lay.labels.append(r.label(r.fit_text(wait, normal, width), normal, p.faint, "empty",
                                       midtop=(w // 2, body.top)))
             return lay
-        fresh = self.news if self.news is not None else None
+        fresh = self.news
         students, programs = self._arrange(body, s, normal, small, gap, landscape=w >= 1.15 * h)
         self._section(lay, "students", students, STUDENTS, s.students, normal, gap,
                       fresh if fresh is not None and not fresh.program else None)
@@ -564,10 +563,7 @@ class ClassWindow:
     def frame(self) -> ClassLayout:
         for event in pygame.event.get():
             self.handle(event)
-        if self.poller is not None:
-            self.update(*self.poller.latest())
-        elif self.news is not None and self.clock() >= self.news_until:
-            self.news = None
+        self.update(*self.poller.latest()) if self.poller is not None else self.update(None, self.problem)
         screen = self.screen = pygame.display.get_surface() or self.screen
         assert screen is not None
         lay = self.draw(screen)

@@ -5,9 +5,10 @@ Hebrew, Arabic, Chinese or Hindi would come out as empty boxes, and a right-to-l
 letters in the wrong order. ``TextRenderer`` is the game's renderer with one change: a string that
 the default font cannot draw whole, or that holds right-to-left letters, is split into runs of one
 direction, each drawn with the first font on this machine that has all of its glyphs (right-to-left
-runs shaped right to left by SDL_ttf's HarfBuzz), and the runs are placed in visual order. A string
-the default font draws left to right (every ASCII one) is measured and drawn exactly as before, so
-the windows' layouts do not change.
+runs shaped right to left by SDL_ttf's HarfBuzz), and the runs are placed in visual order. An ASCII
+string is measured and drawn exactly as the game's renderer does; any other is measured as one line
+of the default font whatever its letters (an accented capital or a stack of combining marks never
+makes a row taller), so a layout's rows stay where they were.
 
 The runs follow a simplified Unicode bidirectional algorithm (UAX #9) for one line with no explicit
 embeddings (the names that reach a window are checked printable, which leaves out the invisible
