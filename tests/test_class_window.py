@@ -36,7 +36,8 @@ from armgame.ui.settings import Settings
 
 SIZES = [(1024, 768), (1280, 800), (1920, 1080), (800, 1280)]
 LONG = "Maria-Fernanda Gonzalez de la Cruz Lopez"  # 40 characters, the most a name has
-HOSTILE = ["<script>alert(1)</script>", LONG, "שלום עליכם", "محمد علي", "Zoë 李小龙", "' OR 1=1 --", "%s%n{0}"]
+HOSTILE = ["<script>alert(1)</script>", LONG, "שלום עליכם", "محمد علي", "Zoë 李小龙", "' OR 1=1 --", "%s%n{0}",
+           "Ǻsa Ångström", "Z\u0301\u0301\u0301\u0301\u0301a\u0327\u0327\u0327lgo"]  # accents, a stack of marks
 
 
 @pytest.fixture(autouse=True)
@@ -93,6 +94,7 @@ def check_fits(w: ClassWindow, size: tuple[int, int]) -> class_window.ClassLayou
 def test_a_full_class_with_hostile_names_fits_every_projector(size):
     w = window(answer(), problem="cannot reach the class at 192.168.100.200:8765 (Connection refused); retrying")
     lay = check_fits(w, size)
+    assert w.draw(pygame.Surface(size)).boxes() == lay.boxes()  # every script drawn (fallback fonts, right to left)
     texts = [lab.text for lab in lay.labels]
     # The rows that do not fit are summed up, never lost: shown and "and N more" add up to the class.
     assert lay.shown["students"] + lay.more["students"] == 40 and lay.shown["programs"] == 3
