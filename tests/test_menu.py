@@ -171,15 +171,21 @@ def test_join_a_class_asks_checks_and_starts_play_join(monkeypatch, client_folde
     statuses = []
 
     def frame(self):
-        for step in script.pop(0) if script else ["escape"]:  # a key's name, or ("text", what is typed)
-            pygame.event.post(key(step) if isinstance(step, str) else text(step[1]))
+        for step in script.pop(0) if script else ["escape"]:  # a key's name, ("text", typed) or ("number", n)
+            if isinstance(step, str):
+                pygame.event.post(key(step))
+            elif step[0] == "number":
+                pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.key.key_code(step[1]), unicode=step[1]))
+            else:
+                pygame.event.post(text(step[1]))
         real(self)
         statuses.append((self.page.title, self.status, self.typing))
 
     script = [
         ["2"],  # Join a class
         ["4"],  # Join and play, with nothing typed yet: not started, says what is missing
-        ["1", ("text", "192.168.1.20:99999"), "return"],  # the address, refused
+        # The address, refused. As SDL sends a key that types: its key (that chooses the item), then its text.
+        [("number", "1"), ("text", "1"), ("text", "192.168.1.20:99999"), "return"],
         ["backspace"] * 5 + [("text", "8765"), "return"],  # mended, kept
         ["down", "return", "h", ("text", "h"), ("text", "apf"), "return"],  # the code, in the case typed
         ["down", "return", ("text", "x"), "escape"],  # Esc: the name stays as it was (empty)

@@ -105,6 +105,8 @@ class MenuWindow:
         self.pending: Item | None = None
         #: What is being typed into the chosen item's field (None: not typing).
         self.typing: str | None = None
+        #: The text of the key that began typing (its number): SDL sends it again as text just after.
+        self._swallow = ""
         self.screen: pygame.Surface | None = None
 
     @property
@@ -174,9 +176,13 @@ class MenuWindow:
         field = self.page.items[self.page.selected].field
         assert field is not None and self.typing is not None
         if event.type == pygame.TEXTINPUT:
+            if self._swallow and event.text == self._swallow:
+                self._swallow = ""
+                return
             typed = "".join(c for c in event.text if c.isprintable())
             self.typing = (self.typing + typed)[:field.limit]
             return
+        self._swallow = ""
         name = pygame.key.name(event.key).lower()
         if name == "escape":
             self.stop_typing()
@@ -225,6 +231,8 @@ class MenuWindow:
                     self.back()
             elif name.isdigit() and name != "0":
                 self.choose(int(name) - 1)
+                if self.typing is not None:
+                    self._swallow = getattr(event, "unicode", "")
         elif event.type == pygame.MOUSEMOTION and self.screen is not None:
             hit = self._row_at(event.pos)
             if hit is not None:
