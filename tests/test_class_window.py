@@ -194,7 +194,7 @@ def test_a_class_that_does_not_answer_never_stalls_the_window():
         silent.listen(4)
         port = silent.getsockname()[1]
         poller = StandingsPoller(f"http://127.0.0.1:{port}/api/standings", f"127.0.0.1:{port}", interval=0.05,
-                                 timeout=0.4).start()
+                                 timeout=0.25).start()
         screen = pygame.display.set_mode((1024, 768))
         w = ClassWindow(f"127.0.0.1:{port}", screen, poller)
         started = time.monotonic()
