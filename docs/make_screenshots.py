@@ -122,7 +122,8 @@ def class_frame(out: Path) -> Path:
     window.update(parse_standings(json.dumps(answer).encode()), None)  # arrived after the window opened: news
     surface = pygame.Surface(CLASS_SIZE)
     window.draw(surface)
-    path = out / "class_show.png"
+    # Not class_*.png: those are the class's web pages, drawn by a browser (docs/make_class_screenshots.py).
+    path = out / "show_class.png"
     pygame.image.save(surface, str(path))
     return path
 
