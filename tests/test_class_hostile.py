@@ -17,7 +17,6 @@ from class_server import keyboard_game, running_class, tapped_game
 
 from armgame.classroom import app as class_app
 from armgame.classroom import client
-from armgame.classroom.intake import MAX_HANDIN_BYTES
 
 
 @pytest.fixture
@@ -79,9 +78,10 @@ def test_bad_bodies_are_refused_in_one_line_and_nothing_is_entered(opened):
 def test_a_body_over_the_limit_is_cut_off_as_it_arrives_and_a_slow_one_in_time(opened, monkeypatch):
     _status, answer = join(opened, "Ann")
     headers = {"Authorization": f"Bearer {answer['token']}", "X-Armgame-Code": opened.clerk.roster.code}
+    monkeypatch.setattr(class_app, "MAX_HANDIN_BYTES", 200_000)  # the same cut, sooner
     conn = http.client.HTTPConnection("127.0.0.1", opened.port, timeout=20)
     chunk = b"x" * 65536
-    conn.request("POST", "/api/handin", body=iter([chunk] * (MAX_HANDIN_BYTES // len(chunk) + 2)),
+    conn.request("POST", "/api/handin", body=iter([chunk] * (200_000 // len(chunk) + 2)),
                  headers=headers, encode_chunked=True)
     response = conn.getresponse()
     assert response.status == 413 and "larger than a class takes" in json.loads(response.read())["error"]

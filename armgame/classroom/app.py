@@ -220,6 +220,8 @@ def _json(data: object, status: int = 200, headers: dict[str, str] | None = None
 
 def _refusal(exc: RefusedError) -> Response:
     headers = {"Retry-After": "2"} if exc.status in (429, 503) else {}
+    if exc.status in (400, 408, 413):  # a body may be left unread: the connection is not used again
+        headers["Connection"] = "close"
     return _json({"ok": False, "error": exc.message}, exc.status, headers)
 
 
