@@ -12,7 +12,7 @@ from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 from armgame.records import storage
 from armgame.records.replay import Replay
-from armgame.records.scores import ScoreTable, replay_work
+from armgame.records.scores import EVENT_WORK, HIT_WORK, ScoreTable, replay_work
 
 
 @pytest.fixture(autouse=True)
@@ -66,7 +66,7 @@ def _storm(player: str = "storm") -> Replay:
 
 def test_a_costly_replay_is_counted_before_it_runs_and_not_run_by_scores(tmp_path, monkeypatch, capsys):
     storm = _storm()
-    assert replay_work(storm) == storm.result.steps + 1000 * 5000 + 20 * len(storm.timeline)
+    assert replay_work(storm) == storm.result.steps + HIT_WORK * 5000 + EVENT_WORK * len(storm.timeline)
     table = ScoreTable(tmp_path / "t")
     entry = table.add(short_game("honest", 3))
     data = json.loads(table.path.read_text())

@@ -12,11 +12,17 @@ SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else s
                "else ~/.local/share/armgame/scores)")
 
 
-#: The most work ``scores`` spends recomputing one game, in physics steps (``records.scores.replay_work``:
-#: steps, 1,000 a claimed hit, 20 an input event). A standard game is 15,000 and its hits and events; a
-#: game of more (a long clock, a "hit storm" claiming thousands of hits, a replay of 100,000 events) is
-#: listed NOT CHECKED: ``armgame verify`` checks it, whatever it costs.
-MAX_CHECK_WORK = 300_000
+#: The most work ``scores`` spends recomputing one game, in physics steps of the compiled loop
+#: (``records.scores.replay_work``: steps, 100 a claimed hit under a ranked ruleset and 6,000 under others,
+#: 20 an input event): about 0.13 s. Three times the largest honest game measured: the model bot's standard
+#: game of seed 18, 333,900 (15,000 steps, 50 hits, 15,695 events); the naive bot's largest is 64,720 and
+#: a keyboard player pressing each of the four keys 20 times a second 214,960 (``python
+#: benchmarks/honest_work.py``: both bots on seeds 0 to 41). A game of more (a long clock, a "hit storm"
+#: claiming thousands of hits, a replay of 100,000 events) is listed apart, not checked yet and not ranked:
+#: ``armgame verify`` checks it, whatever it costs, and the next listing has its verdict.
+MAX_CHECK_WORK = 1_000_000
+#: The rows of ``listing`` left unchecked for their cost (one a game): listed apart, neither flagged nor ranked.
+COSTLY = "costly"
 #: The fewest entries ``listing`` checks together (batches recompute many games at once): a list still
 #: wanting rows checks at least this many of the entries below, not one game at a time.
 MIN_BATCH = 256
@@ -85,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..errors import UserError
     from ..records.scores import ScoreTable
+    from ..records.storage import user_path
 
     if args.top < 1:
         raise UserError(f"--top must be 1 or more, got {args.top}")
@@ -100,7 +107,8 @@ def run(args: argparse.Namespace) -> int:
 
     cache = None if args.no_check or args.new else verification_cache(args, warn)
     read_lab_replays()
-    table = ScoreTable(scores_dir(args), warn=warn, cache=cache)
+    records = user_path(args.cache, "--cache") if args.cache is not None else None  # the teacher's record's folder
+    table = ScoreTable(scores_dir(args), warn=warn, cache=cache, records=records)
     if args.new:
 
         seed = DEFAULT_SEED if args.seed is None else args.seed
@@ -139,17 +147,19 @@ def listing(table, entries, limit: int | None, check: bool, per_player: bool = T
     an earlier game): with a limit, their games below the best count as entered; with none (``--all``:
     every entry is checked), only games that check out count. Which of two entries of one game counts,
     and which is the copy, is ``records.identity.FirstEntries``'s to say; the entries flagged are those
-    met on the way.
+    met on the way. A game whose replay costs more than ``MAX_CHECK_WORK`` is a row of ``lists[COSTLY]``
+    (one a game): not checked yet, so neither flagged nor ranked.
     """
     from ..records.batch_verify import check_entries
     from ..records.identity import FirstEntries
-    from ..records.scores import CUSTOM_GAMES, LIST_TITLES, sort_key
+    from ..records.scores import CUSTOM_GAMES, LIST_TITLES, NOT_CHECKED, sort_key
     from ..records.standings import PlayerRow, one_row_per_player, player_key
 
     first: FirstEntries = FirstEntries()
     counted: dict[str, list] = {name: [] for name in LIST_TITLES}  # (entry, check) of each list's games
     players: dict[str, set[str]] = {name: set() for name in LIST_TITLES}  # who has a row, by list
     flagged: list = []
+    costly: list = []
     custom_checked = 0
 
     def who(e) -> str:
@@ -182,7 +192,9 @@ def listing(table, entries, limit: int | None, check: bool, per_player: bool = T
                 continue
             # Unchecked (--no-check), an entry is taken at its word: the earlier of two counts.
             twin = first.copy_of(e, e.replay_sha256, None if c is None else c.game, c is None or c.ok)
-            if c is not None and not c.ok:
+            if c is not None and c.label == NOT_CHECKED:
+                costly.append(PlayerRow(e.name, (e, c), 1))  # honest or not, nobody knows yet: verify checks it
+            elif c is not None and not c.ok:
                 flagged.append((e, c))
             elif twin is not None:
                 flagged.append((e, _duplicate(twin)))
@@ -209,6 +221,7 @@ def listing(table, entries, limit: int | None, check: bool, per_player: bool = T
         games.sort(key=lambda game: sort_key(game[0]))
         lists[name] = (one_row_per_player(games, lambda game: game[0].name) if per_player
                        else [PlayerRow(e.name, (e, c), 1) for e, c in games])
+    lists[COSTLY] = costly
     return lists, flagged
 
 
@@ -242,8 +255,13 @@ def _print_listing(table, count: int, lists, flagged, no_check: bool, note: str 
         if name != RANKED and lists[name]:
             print(title[0].upper() + title[1:])
             _print_rows(lists[name], note is not None)
-    if note is not None and any(lists.values()):
+    if note is not None and any(lists[name] for name in LIST_TITLES):
         print(note)
+    if lists.get(COSTLY):
+        print(f"{len(lists[COSTLY])} not checked yet (costly replay: armgame verify checks it; not ranked until then)")
+        for row in lists[COSTLY]:
+            e, c = row.best
+            print(f"  {e.name} ({e.score}, {e.date[:16].replace('T', ' ')}): {c.label}: {c.detail}")
     if flagged:
         print(f"{len(flagged)} flagged: the replay does not back the score (not ranked)")
         for e, c in flagged:

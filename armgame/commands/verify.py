@@ -16,10 +16,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "one, and name the ruleset it plays (standard, or custom). FILE is a replay, a score table "
         "(scores.json, or its folder: every entry is checked against its replay) or a folder of replays "
         "(every *.json file in it; symbolic links are not followed). Many games are recomputed together "
-        "in batches. Exit status: 0 if everything matches, 1 if not, 2 on a bad file.",
+        "in batches. Exit status: 0 if everything matches, 1 if something does not, 2 on a bad file or a damaged "
+        "table, 3 if nothing differs but some games were left unchecked (--max-work).",
     )
     p.add_argument("file", metavar="FILE", help="a replay file, a scores.json, a scores folder or a folder of replays")
+    p.add_argument("--max-work", type=_work_arg, metavar="N", help="check no game whose replay counts more than N "
+                   "physics steps of work (its steps, 100 a claimed hit under the standard rules and 6,000 under "
+                   "others, 20 an input event: counted before it runs; a standard game is 15,000 and its hits and "
+                   "events): such games are reported NOT CHECKED. For a folder from a stranger: bounds the run "
+                   "(default: every game is checked, whatever it costs)")
     p.set_defaults(run=run)
+
+
+def _work_arg(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= 10**12:
+        raise argparse.ArgumentTypeError(f"must be a whole number of steps from 1 to 10^12, got {text!r}")
+    return value
 
 
 def run(args: argparse.Namespace) -> int:
@@ -28,13 +44,14 @@ def run(args: argparse.Namespace) -> int:
 
     read_lab_replays()
     path = user_path(args.file, "FILE")
+    limit = getattr(args, "max_work", None)
     if path.is_dir() and not (path / TABLE_NAME).exists() and not (path / TABLE_NAME).is_symlink():
-        return _verify_folder(path)
+        return _verify_folder(path, limit)
     if path.is_dir():
-        return _verify_table(path)
+        return _verify_table(path, limit)
     if path.name == TABLE_NAME or _looks_like_table(path):
-        return _verify_table(path.parent)
-    return _verify_replay(path)
+        return _verify_table(path.parent, limit)
+    return _verify_replay(path, limit)
 
 
 def _looks_like_table(path) -> bool:
@@ -54,14 +71,29 @@ def _looks_like_table(path) -> bool:
         os.close(fd)
 
 
-def _verify_replay(path) -> int:
+def _verify_replay(path, limit: int | None = None) -> int:
     from ..records.replay import Replay
 
     replay = Replay.load(path)
+    if _over(replay, limit):
+        _not_checked(path, replay)
+        return 3
     return _report(path, replay, *replay.verify())
 
 
-def _verify_folder(folder) -> int:
+def _over(replay, limit: int | None) -> bool:
+    from ..records.scores import replay_work
+
+    return limit is not None and replay_work(replay) > limit
+
+
+def _not_checked(path, replay) -> None:
+    from ..records.scores import NOT_CHECKED, not_checked_detail, replay_work
+
+    print(f"{path}: {NOT_CHECKED}: {not_checked_detail(replay, replay_work(replay))}")
+
+
+def _verify_folder(folder, limit: int | None = None) -> int:
     from ..errors import UserError
     from ..records.batch_verify import replay_files, verify_files
     from ..records.scores import TABLE_NAME
@@ -69,15 +101,19 @@ def _verify_folder(folder) -> int:
     paths = replay_files(folder)
     if not paths:
         raise UserError(f"{folder}: no score table ({TABLE_NAME}) and no replays (*.json) there")
-    differ = bad = 0
-    for path, replay, got, ok in verify_files(paths):
-        if got is None:
+    differ = bad = unchecked = 0
+    for path, replay, got, ok in verify_files(paths, (lambda r: _over(r, limit)) if limit is not None else None):
+        if got is None and not isinstance(replay, Exception):
+            unchecked += 1
+            _not_checked(path, replay)
+        elif got is None:
             bad += 1
             print(f"{path}: BAD REPLAY: {str(replay).removeprefix(f'{path}: ')}")
         else:
             differ += _report(path, replay, ok, got)
-    print(f"{folder}: {plural(len(paths), 'replay')}, {differ} differ, {bad} unreadable")
-    return 2 if bad else 1 if differ else 0
+    left = f", {unchecked} not checked (over --max-work)" if unchecked else ""
+    print(f"{folder}: {plural(len(paths), 'replay')}, {differ} differ, {bad} unreadable{left}")
+    return 2 if bad else 1 if differ else 3 if unchecked else 0
 
 
 def _report(path, replay, ok: bool, got) -> int:
@@ -103,33 +139,40 @@ def _report(path, replay, ok: bool, got) -> int:
     return 1
 
 
-def _verify_table(folder) -> int:
+def _verify_table(folder, limit: int | None = None) -> int:
     import sys
 
     from ..errors import UserError
     from ..records.batch_verify import check_entries
     from ..records.identity import FirstEntries
-    from ..records.scores import ScoreTable, VerificationCache, entry_order
+    from ..records.scores import NOT_CHECKED, ScoreTable, VerificationCache, entry_order
 
-    cache = VerificationCache()
-    table = ScoreTable(folder, cache=cache)
+    def warn(message: str) -> None:
+        print(f"armgame verify: {message}", file=sys.stderr)
+
+    cache = VerificationCache(warn=warn)
+    table = ScoreTable(folder, warn=warn, cache=cache)
     if not table.path.is_file() or table.path.is_symlink():
         raise UserError(f"{table.path}: no score table there")
     entries, damage = table.read()
     if damage:
-        print(f"armgame verify: {damage.describe(table.path)}", file=sys.stderr)
-    flagged = 0
+        warn(damage.describe(table.path))
+    for note in table.notes:  # where this account's record of the table disagrees with it
+        warn(note)
+    flagged = unchecked = 0
     first: FirstEntries = FirstEntries()
-    for e, c in check_entries(table, sorted(entries, key=entry_order)):  # the table's order, never a claimed date
+    for e, c in check_entries(table, sorted(entries, key=entry_order), limit):  # the table's order, never a date
         twin = first.copy_of(e, e.replay_sha256, c.game, c.ok)
         if twin is not None and twin.replay_sha256 == e.replay_sha256:
             c = type(c)(False, "DUPLICATE", f"the same replay as {twin.name}'s earlier entry", c.ruleset)
         elif twin is not None:
             c = type(c)(False, "DUPLICATE", f"the same game as {twin.name}'s earlier entry", c.ruleset)
-        flagged += not c.ok
+        unchecked += c.label == NOT_CHECKED
+        flagged += not c.ok and c.label != NOT_CHECKED
         rules = f", {c.ruleset} rules" if c.ruleset else ""
         line = f"{e.name}: score {e.score} ({e.how}{rules}, {e.date[:16].replace('T', ' ')}): {c.label}"
         print(line + (f": {c.detail}" if c.detail else ""))
     cache.save()
-    print(f"{table.path}: {plural(len(entries), 'entry')}, {flagged} flagged")
-    return 2 if damage else 1 if flagged else 0
+    left = f", {unchecked} not checked (over --max-work)" if unchecked else ""
+    print(f"{table.path}: {plural(len(entries), 'entry')}, {flagged} flagged{left}")
+    return 2 if damage else 1 if flagged else 3 if unchecked else 0

@@ -9,7 +9,7 @@ and recomputed ``CHUNK`` at a time, so memory stays bounded however many there a
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from itertools import islice
 from pathlib import Path
 
@@ -67,10 +67,12 @@ def replay_files(folder: Path) -> list[Path]:
     return files_in(folder, ".json", MAX_FOLDER_REPLAYS, "replay files")
 
 
-def verify_files(paths: Iterable[Path]) -> Iterator[tuple[Path, Replay | DataFileError, GameResult | None, bool]]:
+def verify_files(paths: Iterable[Path], skip: Callable[[Replay], bool] | None = None
+                 ) -> Iterator[tuple[Path, Replay | DataFileError, GameResult | None, bool]]:
     """For each file, in order: (path, its replay, the recomputed result, whether it matches).
 
-    A file that is not a valid replay gives (path, the error, None, False) and the others go on.
+    A file that is not a valid replay gives (path, the error, None, False) and the others go on; a
+    replay that ``skip`` says not to recompute (its cost) gives (path, the replay, None, False).
     """
     for chunk in _chunks(paths, CHUNK):
         loaded: list[Replay | DataFileError] = []
@@ -79,9 +81,10 @@ def verify_files(paths: Iterable[Path]) -> Iterator[tuple[Path, Replay | DataFil
                 loaded.append(Replay.load(path))
             except DataFileError as exc:
                 loaded.append(exc)
-        verdicts = iter(verify_replays([r for r in loaded if isinstance(r, Replay)]))
-        for path, r in zip(chunk, loaded, strict=True):
-            if isinstance(r, Replay):
+        wanted = [isinstance(r, Replay) and not (skip is not None and skip(r)) for r in loaded]
+        verdicts = iter(verify_replays([r for r, w in zip(loaded, wanted, strict=True) if w]))  # type: ignore[misc]
+        for path, r, w in zip(chunk, loaded, wanted, strict=True):
+            if w:
                 ok, got = next(verdicts)
                 yield path, r, got, ok
             else:

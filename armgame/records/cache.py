@@ -27,7 +27,7 @@ import os
 import re
 import stat
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .. import __version__
@@ -81,6 +81,25 @@ def untrusted_reason(path: Path, kind: str) -> str | None:
     return None
 
 
+def private_place_reason(folder: Path, path: Path, tables: Sequence[Path]) -> str | None:
+    """Why ``folder`` and its file ``path`` are not this user's alone (see the module docstring), or None.
+
+    Shared with ``records.teacher``: the teacher's record of a table is trusted by the same rules."""
+    try:
+        resolved = folder.resolve()
+        for table in tables:
+            table = table.resolve()
+            if resolved == table or table in resolved.parents or resolved == table.parent:
+                return f"folder {folder} is in or beside the table's folder"
+    except (OSError, RuntimeError):
+        return f"folder {folder} cannot be resolved"
+    for place, kind in ((folder, "folder"), (path, "file")):
+        reason = untrusted_reason(place, kind)
+        if reason is not None:
+            return f"{kind} {place} {reason}"
+    return None
+
+
 class VerificationCache:
     """Verdicts of replays already recomputed (see the module docstring)."""
 
@@ -118,19 +137,7 @@ class VerificationCache:
 
     def _distrust(self) -> str | None:
         assert self.folder is not None and self.path is not None
-        try:
-            folder = self.folder.resolve()
-            for table in self.tables:
-                table = table.resolve()
-                if folder == table or table in folder.parents or folder == table.parent:
-                    return f"folder {self.folder} is in or beside the table's folder"
-        except (OSError, RuntimeError):
-            return f"folder {self.folder} cannot be resolved"
-        for path, kind in ((self.folder, "folder"), (self.path, "file")):
-            reason = untrusted_reason(path, kind)
-            if reason is not None:
-                return f"{kind} {path} {reason}"
-        return None
+        return private_place_reason(self.folder, self.path, self.tables)
 
     def _load(self) -> dict[str, dict]:
         if self._items is None:

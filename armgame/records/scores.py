@@ -58,7 +58,7 @@ import stat
 import sys
 import uuid
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -69,7 +69,7 @@ from .cache import VerificationCache, default_cache_dir, file_signature  # noqa:
 from .identity import game_digests, identity_claims, names_its_game
 from .locking import LockBusyError, LockError, file_lock
 from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
-from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_by_digest, ruleset_name
+from .rulesets import CUSTOM, RULESETS, config_digest, ruleset_by_digest, ruleset_name, ruleset_of
 from .standings import one_row_per_player, rank_of
 from .storage import (
     STRICT_DECODER,
@@ -86,6 +86,7 @@ from .storage import (
     read_limited,
     user_path,
 )
+from .teacher import TeacherRecord, disagreements, in_recorded_order
 
 SCORES_ENV = "ARMGAME_SCORES"
 TABLE_NAME = "scores.json"
@@ -104,6 +105,8 @@ LIST_TITLES = {
     PROGRAMS: "programs (bots and scripts: listed apart, never ranked)",
     CUSTOM_GAMES: "custom games (their own rules: not ranked)",
 }
+#: The label of a game whose replay costs more than its checker would spend (``check_many``'s ``max_work``).
+NOT_CHECKED = "NOT CHECKED"
 #: Seconds a writer waits for the table's lock before saying the table is busy.
 LOCK_WAIT = 5.0
 _COUNT_MAX = 10**9
@@ -342,10 +345,14 @@ def replay_claims(replay: Replay) -> dict[str, object]:
 
 
 class ScoreTable:
-    """The table in ``folder``; ``warn`` receives one-line notices (a damaged table, say)."""
+    """The table in ``folder``; ``warn`` receives one-line notices (a damaged table, say).
+
+    ``records``: the folder of this account's records of tables (``records.teacher``; None: the
+    verification cache's folder). Where this account started the table, its record decides the seed
+    and the order of entry, whatever the file says (``read``)."""
 
     def __init__(self, folder: Path, warn: Callable[[str], None] | None = None,
-                 cache: VerificationCache | None = None) -> None:
+                 cache: VerificationCache | None = None, records: Path | None = None) -> None:
         self.folder = Path(folder)
         self.path = self.folder / TABLE_NAME
         self.lock_path = self.folder / LOCK_NAME
@@ -354,7 +361,13 @@ class ScoreTable:
         self.cache = cache
         if cache is not None:
             cache.guard(self.folder)
+        if records is None and cache is not None:
+            records = cache.folder
+        self.record = TeacherRecord(self.folder, records, self.warn)
         self._seed: int | None = None
+        #: One line for each way the table disagrees with this account's record, or of a seed that is not valid.
+        self.notes: list[str] = []
+        self._said: set[str] = set()
 
     # ------------------------------------------------------------------ reading
     def _open_table(self) -> int | None:
@@ -386,12 +399,39 @@ class ScoreTable:
         with os.fdopen(fd, "rb") as f:
             data = f.read(MAX_TABLE_BYTES + 1)
         entries, damage, head = _parse(data)
-        self._seed = head.seed
+        entries, self._seed, self.notes = self._as_recorded(entries, head)
         return entries, damage
+
+    def _as_recorded(self, entries: list[ScoreEntry], head: _Head) -> tuple[list[ScoreEntry], int, list[str]]:
+        """The entries as this account's record of the table has them (``records.teacher``), the seed
+        that ranks and the notes: without a record, the table as it says. With one, the entries are
+        numbered 1, 2, ... in the record's order of entry (those it knows first; the others after, in the
+        table's order), so that every tie and duplicate goes by the record."""
+        record = self.record.load()
+        if record is None:
+            if head.seed is not None:
+                return entries, head.seed, []
+            return entries, DEFAULT_SEED, [f"the table's seed {head.seed_problem}: games are ranked as the default "
+                                           f"seed {DEFAULT_SEED} until \"seed\" is set in {self.path}"]
+        notes = []
+        if head.seed is None:
+            notes.append(f"the table's seed {head.seed_problem}; ranking seed {record.seed} (this account's record "
+                         f"of the table)")
+        elif head.seed != record.seed:
+            notes.append(f"the table's seed was changed from {record.seed} to {head.seed}; ranking seed "
+                         f"{record.seed} (this account's record of the table)")
+        notes += disagreements(entries, record, entry_order)
+        ordered = in_recorded_order(entries, record, entry_order)
+        renumbered = []
+        for i, e in enumerate(ordered, 1):
+            known = record.knows(e)
+            renumbered.append(replace(e, entered=i, entered_at=known.at if known is not None else e.entered_at))
+        return renumbered, record.seed, notes
 
     @property
     def seed(self) -> int:
-        """The seed this table ranks (its head's; the default game's for a table without one)."""
+        """The seed this table ranks: this account's record's, else its head's (the default game's for a
+        table without one, or whose seed is not valid: ``notes`` says so)."""
         if self._seed is None:
             with contextlib.suppress(DataFileError):
                 self.read()
@@ -399,11 +439,19 @@ class ScoreTable:
         return self._seed
 
     def all_entries(self) -> list[ScoreEntry]:
-        """Every valid entry, in any list, best first; a damaged file is reported through ``warn``."""
+        """Every valid entry, in any list, best first; a damaged file and the ``notes`` are reported
+        through ``warn`` (a note once)."""
         entries, damage = self.read()
         if damage:
             self.warn(damage.describe(self.path) + "; the file will be kept aside at the next save")
+        for note in self.notes:
+            self._say(note)
         return sorted(entries, key=sort_key)
+
+    def _say(self, note: str) -> None:
+        if note not in self._said:
+            self._said.add(note)
+            self.warn(note)
 
     def entries(self) -> list[ScoreEntry]:
         """The ranked entries (keyboard games of a ranked ruleset and the table's seed), best first."""
@@ -558,29 +606,46 @@ class ScoreTable:
             else:
                 data = _read_all(fd)
                 entries, damage, head = _parse(data)
+            record = self.record.load(fresh=True)  # under the lock: what this account's last write left
             if seed is not None:
                 if entries:
                     raise TableError(f"{self.path} already holds {plural(len(entries), 'entry')}: a new table "
                                      f"needs its own folder (--scores DIR); nothing was changed")
                 head = _Head(seed=seed, next_entry=head.next_entry)
-            entries, head = _numbered(entries, head)
-            self._seed = head.seed
+                record = None  # the new table's record is started below
+            notes = []
+            ranked, kept_seed = head.seed, head.kept_seed
+            if record is not None and head.seed != record.seed:
+                was = f"was changed from {record.seed} to {head.seed}" if head.seed is not None \
+                    else head.seed_problem
+                notes.append(f"the table's seed {was}: this account's record of the table puts seed {record.seed} "
+                             f"back")
+                ranked = record.seed
+            elif ranked is None:
+                notes.append(f"the table's seed {head.seed_problem}: kept as it is (nothing here chooses a seed for "
+                             f"the table); games are ranked as the default seed {DEFAULT_SEED} until \"seed\" is "
+                             f"set in {self.path}")
+            entries, next_entry, counter_note = _numbered(entries, head, len(new_entries))
+            if counter_note is not None:
+                notes.append(counter_note)
+            self._seed = DEFAULT_SEED if ranked is None else ranked
             results: list[ScoreEntry | TableError] = []
             for entry, digests in new_entries:
                 try:
-                    entry = self._admit(entry, entries, head, digests)
+                    entry = self._admit(entry, entries, next_entry, digests)
                 except TableError as exc:
                     results.append(exc)
                     continue
                 entries.append(entry)
                 results.append(entry)
-                head = _Head(head.seed, entry.entered + 1)  # type: ignore[operator]
+                next_entry += 1
             if len(entries) > MAX_TABLE_ENTRIES:
                 raise TableError(f"the table holds {len(entries) - 1} entries, its limit: not entered (nothing was "
                                  f"dropped; start a new table with --scores)")
-            new = table_bytes(entries, head.seed, head.next_entry)
+            new = table_bytes(entries, ranked, next_entry, kept_seed)
             if len(new) > MAX_TABLE_BYTES:
                 raise TableError("the table would grow past its size limit: not entered (nothing was dropped)")
+            _reads_back(new, entries, ranked, next_entry)
             kept = None
             if damage is not None and fd is not None:
                 kept = self._copy_aside(fd)  # the damaged bytes, copied before anything else changes
@@ -591,17 +656,22 @@ class ScoreTable:
                     with contextlib.suppress(OSError):
                         kept.unlink()
                 raise
+            if seed is not None:
+                self.record.start(seed)
+            elif record is not None:
+                self.record.entered([e for e in results if isinstance(e, ScoreEntry)])
             if damage is not None:
                 where = f"; the damaged file is kept as {kept.name}" if kept else ""
                 self.warn(f"{damage.describe(self.path)}{where}")
+            for note in notes:
+                self.warn(note)
             return results
         finally:
             if fd is not None:
                 os.close(fd)
 
     @staticmethod
-    def _admit(entry: ScoreEntry, entries: list[ScoreEntry], head: _Head, digests: frozenset[str]
-               ) -> ScoreEntry:
+    def _admit(entry: ScoreEntry, entries: list[ScoreEntry], place: int, digests: frozenset[str]) -> ScoreEntry:
         """``entry`` with its place in the order of entry; refused if its game or replay is already in
         (its game by any identity version's digest: an entry taken before a bump holds the older one)."""
         twin = next((e for e in entries if e.replay_sha256 == entry.replay_sha256
@@ -610,7 +680,7 @@ class ScoreTable:
             when = (twin.entered_at or twin.date)[:16].replace("T", " ")
             raise TableError(f"this game is already in the table: entered by {twin.name} on {when} UTC "
                              f"(entry #{twin.entered}); a game enters once, whoever's name it carries")
-        return ScoreEntry(**{**entry.as_dict(), "entered": head.next_entry,
+        return ScoreEntry(**{**entry.as_dict(), "entered": place,
                              "entered_at": datetime.now(UTC).isoformat(timespec="seconds")})
 
     def _copy_aside(self, fd: int) -> Path:
@@ -660,7 +730,8 @@ class ScoreTable:
         ``recompute`` maps replays to ``replay.verify()`` of each (``records.batch_verify`` passes
         the batched one); if it fails, the games are recomputed one at a time, so one entry's
         failure still marks only that entry. ``max_work``: a replay whose ``replay_work`` is more
-        is not recomputed (``NOT CHECKED``, not cached: ``armgame verify`` checks it whatever it costs).
+        is not recomputed (``NOT CHECKED``; remembered, so that it is not read again, until a check with a
+        larger ``max_work`` or none, as ``armgame verify``'s, recomputes it).
         """
         found: list[Check | tuple[str, dict | Replay, list[int]]] = []
         for entry in entries:
@@ -673,11 +744,8 @@ class ScoreTable:
             if not isinstance(f, Check) and isinstance(f[1], Replay):
                 work = replay_work(f[1])
                 if max_work is not None and work > max_work:
-                    r = f[1].result
-                    skipped = {"claims": replay_claims(f[1]), "ok": False, "label": "NOT CHECKED", "file": f[2],
-                               "work": work, "detail": f"its replay claims {plural(r.steps, 'step')}, "
-                               f"{plural(r.hits, 'hit')} and {plural(len(f[1].timeline), 'event')}, more work "
-                               f"({work:,}) than scores spends on one game ({max_work:,}): armgame verify checks it"}
+                    skipped = {"claims": replay_claims(f[1]), "ok": False, "label": NOT_CHECKED, "file": f[2],
+                               "work": work, "detail": not_checked_detail(f[1], work)}
                     if self.cache is not None:  # remembered, so the next listing does not even read it
                         self.cache.put(f[0], skipped)
                     found[i] = (f[0], skipped, f[2])
@@ -796,22 +864,38 @@ _ENTRY_CLAIMS = frozenset({"name", "driven", "driver", "score", "hits", "resets"
                            "config_sha256", "ruleset", "complete"})
 
 
-#: What recomputing one hit costs, in physics steps: drawing the next target tries up to 1,000 postures,
-#: each about a step's arithmetic (``GameRules._draw_target``).
-HIT_WORK = 1_000
-#: What one input event costs, in physics steps: reading it, and applying it between steps.
+# Work is counted in physics steps of the game's compiled loop (0.12 us each on the 2-core build machine),
+# the loop every install with a C compiler runs; measured with ``python benchmarks/honest_work.py``. In the
+# Python loop a step costs 20 times more and an event or a try no more, so these overcount there.
+#: What recomputing one hit can cost under any rules: drawing the next target tries up to 1,000 postures
+#: (``GameRules._draw_target``), each measured at 5.9 steps (0.73 us): 5,900, rounded up.
+HIT_WORK = 6_000
+#: What one hit costs under a ranked ruleset, whose target ranges keep a drawn target clear of the hand:
+#: 1.36 tries on average and at most 9 in 20,000 draws from random hands, a draw measured at 14 steps.
+RANKED_HIT_WORK = 100
+#: What one input event costs: reading it, ``key_event`` and a call of the loop between steps (20.5 steps).
 EVENT_WORK = 20
 
 
 def replay_work(replay: Replay) -> int:
     """The most work recomputing ``replay`` can take, in physics steps, known before running it: its
-    steps, its claimed hits (verification stops as soon as the game passes its claim) and its events."""
-    return replay.result.steps + HIT_WORK * replay.result.hits + EVENT_WORK * len(replay.timeline)
+    steps, its claimed hits (verification stops as soon as the game passes its claim), each a target draw
+    (``RANKED_HIT_WORK`` under a ranked ruleset, else ``HIT_WORK``), and its events."""
+    hit = RANKED_HIT_WORK if ruleset_of(replay.config) is not None else HIT_WORK
+    return replay.result.steps + hit * replay.result.hits + EVENT_WORK * len(replay.timeline)
+
+
+def not_checked_detail(replay: Replay, work: int) -> str:
+    """Why a replay was left unchecked: what it claims, and the work that makes (``replay_work``)."""
+    r = replay.result
+    return (f"its replay claims {plural(r.steps, 'step')}, {plural(r.hits, 'hit')} and "
+            f"{plural(len(replay.timeline), 'event')}: {work:,} steps of work, more than this check spends on one "
+            f"game (armgame verify checks it)")
 
 
 def _usable(cached: dict | None, max_work: int | None) -> dict | None:
     """A cached verdict, unless it is a game left unchecked for its cost that this caller would check."""
-    if cached is not None and cached["label"] == "NOT CHECKED" and (max_work is None or cached["work"] <= max_work):
+    if cached is not None and cached["label"] == NOT_CHECKED and (max_work is None or cached["work"] <= max_work):
         return None
     return cached
 
@@ -833,6 +917,23 @@ def _recompute(replays: list[Replay],
 
 class TableBusyError(TableError):
     """The lock was not free within ``LOCK_WAIT`` seconds."""
+
+
+def _reads_back(new: bytes, entries: list[ScoreEntry], seed: int | None, next_entry: int) -> None:
+    """Refuse to write a table that would not read back as written: every entry, its seed, its counter.
+
+    Whatever a planted value did to the counters, a table that the next read would call damaged (and set
+    aside, with entries dropped) is never written."""
+    back, damage, head = _parse(new)
+    problem = (damage.reason if damage is not None
+               else f"{len(back)} of {len(entries)} entries" if len(back) != len(entries)
+               else f"next_entry {head.next_entry}, not {next_entry}" if head.next_entry != next_entry
+               or head.counter_problem is not None
+               else f"seed {head.seed}, not {seed}" if head.seed != seed
+               else None)
+    if problem is not None:
+        raise TableError(f"the table as it would be written does not read back ({problem}): not entered, "
+                         f"nothing was changed")
 
 
 def _read_all(fd: int) -> bytes:
@@ -867,25 +968,53 @@ def _judged(replay: Replay, ok: bool, recomputed: GameResult) -> dict[str, objec
 
 @dataclass(frozen=True)
 class _Head:
-    """The table's own fields: the seed it ranks and the next place in its order of entry."""
+    """The table's own fields: the seed it ranks and the next place in its order of entry.
 
-    seed: int = DEFAULT_SEED
-    next_entry: int = 1
-
-
-def _numbered(entries: list[ScoreEntry], head: _Head) -> tuple[list[ScoreEntry], _Head]:
-    """Entries carried over from an older table get their places, in the order of their dates, once.
-
-    The counter never goes back, even past a hand-edited ``next_entry``: places are never reused.
+    ``seed`` is None when the table's seed is not valid (``seed_problem`` says how): nothing chooses one for
+    it, the file keeps what it holds (``kept_seed``, the seed's JSON as found; None: the table has none).
+    A ``next_entry`` that is not valid is read as 1 (``counter_problem``): the next write sets it after the
+    last entry, and says so.
     """
-    start = max([head.next_entry, *((e.entered or 0) + 1 for e in entries)])
+
+    seed: int | None = DEFAULT_SEED
+    next_entry: int = 1
+    seed_problem: str | None = None
+    kept_seed: str | None = None
+    counter_problem: str | None = None
+
+
+def _numbered(entries: list[ScoreEntry], head: _Head, adding: int = 1) -> tuple[list[ScoreEntry], int, str | None]:
+    """The entries with every place in the order of entry set, the next place, and a one-line note if a
+    counter had to be repaired.
+
+    Entries carried over from an older table get their places, in the order of their dates, once. The
+    counter never goes back past a place in use (places are never reused), but it never passes
+    ``_COUNT_MAX`` either, where a place or ``next_entry`` would no longer read back: a planted
+    ``next_entry`` that high is set after the last entry, and a planted ``entered`` that high renumbers
+    the entries 1, 2, ... in their order. The ``adding`` entries of this write and the ``next_entry``
+    after them must fit.
+    """
+    last = max([0, *(e.entered or 0 for e in entries)])
+    start = max(head.next_entry, last + 1)
     old = sorted((e for e in entries if e.entered is None), key=entry_order)
+    note = None
+    if head.counter_problem is not None:
+        note = f"the table's next_entry counter is not valid ({head.counter_problem}): set after its last entry"
+    if start + len(old) + adding > _COUNT_MAX:
+        if last + 1 + len(old) + adding <= _COUNT_MAX:
+            note = (f"the table's next_entry counter was {head.next_entry:,}, at its limit ({_COUNT_MAX:,}): set "
+                    f"after its last entry")
+            start = last + 1
+        else:
+            ordered = sorted(entries, key=lambda e: (e.entered is None, *entry_order(e)))
+            note = (f"the table's order of entry had reached {last:,}, its limit ({_COUNT_MAX:,}): its "
+                    f"{plural(len(ordered), 'entry')} are renumbered 1 to {len(ordered)} in their order")
+            return [replace(e, entered=i) for i, e in enumerate(ordered, 1)], len(ordered) + 1, note
     if not old:
-        return entries, _Head(head.seed, start)
+        return entries, start, note
     places = {e.id: start + i for i, e in enumerate(old)}
-    numbered = [e if e.entered is not None else ScoreEntry(**{**e.as_dict(), "entered": places[e.id]})
-                for e in entries]
-    return numbered, _Head(head.seed, start + len(old))
+    numbered = [e if e.entered is not None else replace(e, entered=places[e.id]) for e in entries]
+    return numbered, start + len(old), note
 
 
 def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
@@ -899,19 +1028,22 @@ def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
 
 
 def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
-    """``parse_table`` and the table's head (a damaged table's head is the default one)."""
+    """``parse_table`` and the table's head (``_Head``: a seed or counter that is not valid is said there,
+    not damage; a damaged table's head is what can be found of it)."""
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         text = data.decode("utf-8", errors="replace")
-        return (*_salvage(text, "not UTF-8 text"), _Head())
+        return (*_salvage(text, "not UTF-8 text"), _salvaged_head(text))
     try:
         table = parse_json(text)
     except ValueError as exc:
-        return (*_salvage(text, str(exc)), _Head())
+        return (*_salvage(text, str(exc)), _salvaged_head(text))
+    head = _Head()
     try:
         if not isinstance(table, dict) or table.get("format") != FORMAT:
             raise ValueError(f"not an armgame score table (no \"format\": \"{FORMAT}\")")
+        head = _head_of(table)
         check_keys("table", table, {"format", "format_version", "entries"}, frozenset({"seed", "next_entry"}))
         version = check_int("format_version", table["format_version"], 1, 10**6)
         if version not in READS_FORMATS:
@@ -919,10 +1051,8 @@ def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
                              f"({', '.join(map(str, READS_FORMATS))})")
         if not isinstance(table["entries"], list):
             raise ValueError("entries must be a list")
-        head = _Head(check_int("seed", table.get("seed", DEFAULT_SEED), 0, 2**63 - 1),
-                     check_int("next_entry", table.get("next_entry", 1), 1, _COUNT_MAX))
     except ValueError as exc:
-        return (*_salvage(text, str(exc)), _Head())
+        return (*_salvage(text, str(exc)), head)
     entries: list[ScoreEntry] = []
     seen: set[str] = set()
     problem = None
@@ -938,6 +1068,53 @@ def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
         entries.append(entry)
     n = len(table["entries"])
     return entries, (Damage(problem, len(entries), n) if problem else None), head
+
+
+def _head_of(table: dict) -> _Head:
+    """The head of a table read as JSON. A seed that is not valid is kept as found, never replaced by the
+    default: tables of formats 1 and 2 had no seed and rank the default one, a format 3 table without one
+    has none (a table of a format this armgame does not read is damage, its seed the default). A
+    ``next_entry`` that is not valid is read as 1 (the next write sets it after the last entry)."""
+    counter, counter_problem = table.get("next_entry", 1), None
+    try:
+        counter = check_int("next_entry", counter, 1, _COUNT_MAX)
+    except ValueError as exc:
+        counter, counter_problem = 1, str(exc)
+    if "seed" not in table:
+        if table.get("format_version") == FORMAT_VERSION:  # armgame writes one in every such table
+            return _Head(None, counter, "is missing", None, counter_problem)
+        return _Head(DEFAULT_SEED, counter, counter_problem=counter_problem)
+    raw = table["seed"]
+    try:
+        return _Head(check_int("seed", raw, 0, _SEED_MAX), counter, counter_problem=counter_problem)
+    except ValueError as exc:
+        problem = str(exc)
+    try:
+        kept = json.dumps(raw, ensure_ascii=False, allow_nan=False)
+    except (ValueError, RecursionError):
+        kept = None
+    return _Head(None, counter, f"is not valid ({problem[:200]})", kept, counter_problem)
+
+
+#: Where a damaged table's head shows its seed: before its entries, as armgame writes it.
+_HEAD_SEED = re.compile(r'"seed"\s*:\s*(\d{1,19})\s*[,}]')
+_HEAD_VERSION = re.compile(r'"format_version"\s*:\s*(\d{1,7})\s*[,}]')
+
+
+def _salvaged_head(text: str) -> _Head:
+    """What can be found of a damaged table's head. A file that does not even say it is a score table has
+    no seed to lose (a new table's head); one that does, but whose seed is past saving, has none."""
+    end = text.find('"entries"')
+    head = text[: 65536 if end < 0 else min(end, 65536)]
+    if f'"{FORMAT}"' not in head:
+        return _Head()
+    seed = _HEAD_SEED.search(head)
+    if seed is not None and int(seed.group(1)) <= _SEED_MAX:
+        return _Head(int(seed.group(1)))
+    version = _HEAD_VERSION.search(head)
+    if '"seed"' not in head and (version is None or int(version.group(1)) != FORMAT_VERSION):
+        return _Head()
+    return _Head(None, 1, "cannot be read (the file is damaged)", None)
 
 
 #: A flat JSON object (an entry has no nested values), strings honoured. Possessive quantifiers
@@ -959,15 +1136,22 @@ def _salvage(text: str, reason: str) -> tuple[list[ScoreEntry], Damage]:
     return entries, Damage(reason, len(entries), len(entries))
 
 
-def table_bytes(entries: list[ScoreEntry], seed: int = DEFAULT_SEED, next_entry: int | None = None) -> bytes:
+def table_bytes(entries: list[ScoreEntry], seed: int | None = DEFAULT_SEED, next_entry: int | None = None,
+                kept_seed: str | None = None) -> bytes:
     """The table file: one entry a line, best first, so it reads (and diffs) as a list.
 
-    Fields an entry lacks (it came from an older table) are left out rather than written as null."""
+    Fields an entry lacks (it came from an older table) are left out rather than written as null. A
+    ``seed`` of None writes ``kept_seed`` (the JSON of a seed that is not valid, kept as found), or no
+    seed at all."""
     lines = [json.dumps({k: v for k, v in e.as_dict().items() if v is not None or k not in _OPTIONAL},
                         sort_keys=True, ensure_ascii=False, allow_nan=False)
              for e in sorted(entries, key=sort_key)]
     if next_entry is None:
         next_entry = max([0, *(e.entered or 0 for e in entries)]) + 1
-    head = json.dumps({"format": FORMAT, "format_version": FORMAT_VERSION, "seed": seed,
-                       "next_entry": next_entry})[:-1]
+    head = json.dumps({"format": FORMAT, "format_version": FORMAT_VERSION})[:-1]
+    if seed is not None:
+        head += f', "seed": {seed}'
+    elif kept_seed is not None:
+        head += f', "seed": {kept_seed}'
+    head += f', "next_entry": {next_entry}'
     return (head + ', "entries": [\n' + ",\n".join(lines) + "\n]}\n").encode("utf-8")
