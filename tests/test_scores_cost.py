@@ -86,3 +86,84 @@ def test_a_costly_replay_is_counted_before_it_runs_and_not_run_by_scores(tmp_pat
         assert "storm (5000" in out and "NOT CHECKED: its replay claims" in out and "honest" in out
     assert len([s for s in parsed if path.name in s]) == 1  # the second listing knew it without reading it
     assert entry.name == "honest"
+    assert "flagged" not in out and "1 not checked yet (costly replay" in out  # a cost, not a verdict
+
+
+# ------------------------------------------------------------------ honest games are never flagged (issue 26, 5)
+
+def test_the_largest_honest_games_are_well_within_the_budget():
+    """The largest honest games ``benchmarks/honest_work.py`` found, with the margin MAX_CHECK_WORK states."""
+    from armgame.commands.scores import MAX_CHECK_WORK
+    from armgame.game.bots import play_bot
+
+    model = Replay.from_session(play_bot(GameConfig(seed=18), "model"), "bot", "model")  # the model bot's worst seed
+    session = GameSession(GameConfig(seed=10))
+    for step in range(0, session.total_steps, 12):  # each of the four keys pressed 20 times a second
+        for i, key in enumerate("dfjk"):
+            session.advance(step + 3 * i - session.steps)
+            session.key_event(key, "down")
+            session.advance(step + 3 * i + 6 - session.steps)
+            session.key_event(key, "up")
+    session.advance(session.total_steps)
+    masher = Replay.from_session(session, "keyboard", None, "fast")
+    assert replay_work(model) == 333_900 and 200_000 < replay_work(masher) < 220_000
+    assert 2.5 * max(replay_work(model), replay_work(masher)) < MAX_CHECK_WORK
+
+
+def standard_game(player: str, presses: int) -> Replay:
+    """A standard 60 s game of seed 10 with ``presses`` key presses."""
+    session = GameSession(GameConfig(seed=10))
+    for i in range(presses):
+        session.advance(100 + 50 * i - session.steps)
+        session.key_event("d", "down")
+        session.advance(20)
+        session.key_event("d", "up")
+    session.advance(session.total_steps)
+    return Replay.from_session(session, "keyboard", None, player)
+
+
+def test_a_costly_game_is_listed_apart_unflagged_and_ranked_once_verify_checks_it(tmp_path, monkeypatch, capsys):
+    import armgame.commands.scores as scores_command
+
+    table = ScoreTable(tmp_path / "t")
+    table.add(standard_game("cheap", 1))  # 15,000 steps and 2 events: 15,040
+    table.add(standard_game("busy", 10))  # 20 events: 15,400
+    monkeypatch.setattr(scores_command, "MAX_CHECK_WORK", 15_100)
+    assert main(["scores", "--scores", str(table.folder)]) == 0
+    out = capsys.readouterr().out
+    ranked, apart = out.split("not checked yet")
+    assert "cheap" in ranked and "busy" not in ranked and "flagged" not in out
+    assert "1 not checked yet (costly replay: armgame verify checks it; not ranked until then)" in out
+    assert "busy (0, " in apart and "15,400 steps of work" in apart
+    assert main(["verify", str(table.folder)]) == 0  # checks everything, whatever it costs
+    capsys.readouterr()
+    assert main(["scores", "--scores", str(table.folder)]) == 0
+    out = capsys.readouterr().out
+    assert "not checked" not in out and "busy" in out.split("Ranked")[1] and "flagged" not in out
+
+
+def test_verify_max_work_bounds_a_run_and_says_what_it_left(tmp_path, monkeypatch, capsys):
+    import armgame.records.batch_verify as batch_verify
+
+    table = ScoreTable(tmp_path / "t")
+    cheap, busy = table.add(standard_game("cheap", 1)), table.add(standard_game("busy", 10))
+    recomputed = []
+    real = batch_verify.verify_replays
+    monkeypatch.setattr(batch_verify, "verify_replays",
+                        lambda replays, kernel=None: recomputed.extend(r.player for r in replays) or real(replays))
+    assert main(["verify", str(table.folder), "--max-work", "15100"]) == 3
+    out = capsys.readouterr().out
+    assert "busy: score 0" in out and "NOT CHECKED: its replay claims" in out and "15,400 steps of work" in out
+    assert out.splitlines()[-1].endswith("2 entries, 0 flagged, 1 not checked (over --max-work)")
+    assert main(["verify", str(table.replay_path(busy)), "--max-work", "15100"]) == 3
+    assert main(["verify", str(table.replay_path(cheap)), "--max-work", "15100"]) == 0
+    assert main(["verify", str(table.replays), "--max-work", "15100"]) == 3
+    assert "2 replays, 0 differ, 0 unreadable, 1 not checked (over --max-work)" in capsys.readouterr().out
+    assert "busy" not in recomputed  # never run, on the table or the folder
+    forged = json.loads(table.replay_path(cheap).read_text())
+    forged["result"].update(resets=2)  # no more work claimed: it is recomputed, and differs
+    table.replay_path(cheap).write_text(json.dumps(forged))
+    assert main(["verify", str(table.replays), "--max-work", "15100"]) == 1  # a difference outranks a game left
+    with pytest.raises(SystemExit) as exit_:
+        main(["verify", str(table.folder), "--max-work", "0"])
+    assert exit_.value.code == 2 and capsys.readouterr().err.count("\n") == 1
