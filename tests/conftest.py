@@ -12,7 +12,9 @@ instead of 89 s on two cores (and a second run 86 s). Moving the bytecode to a p
 does not help: Python then compiles numpy, scipy and the standard library there too."""
 
 import os
+import shutil
 import sys
+import tempfile
 
 if os.environ.get("ARMGAME_TEST_NO_POSIX") == "1":
     sys.modules["fcntl"] = None  # type: ignore[assignment]  # "import fcntl" now raises ImportError
@@ -22,6 +24,12 @@ if os.environ.get("ARMGAME_TEST_NO_POSIX") == "1":
 
 
 def pytest_configure(config) -> None:
+    # No test writes into the user's own cache folder (verdicts, the teacher's records of tables): each
+    # process of the run gets a private one, and tests that need their own set it themselves.
+    folder = tempfile.mkdtemp(prefix="armgame-test-cache-")
+    os.chmod(folder, 0o700)
+    os.environ["ARMGAME_CACHE"] = folder
+    config.add_cleanup(lambda: shutil.rmtree(folder, ignore_errors=True))
     if sys.dont_write_bytecode:
         sys.dont_write_bytecode = False
         os.environ.pop("PYTHONDONTWRITEBYTECODE", None)  # the armgame subprocesses the tests start too
