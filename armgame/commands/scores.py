@@ -51,7 +51,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "as custom games. A game "
         "enters once, whatever name or date its copy carries. Each entry's replay is played again (once: "
         "verdicts, failures too, are cached per user): an entry whose replay is missing, changed or does not "
-        "reproduce its score is flagged and not ranked.",
+        "reproduce its score is flagged and not ranked; one that would cost more than a listing spends is listed "
+        "apart, not ranked until armgame verify checks it.",
     )
     add_scores_option(p)
     p.add_argument("--top", type=int, default=10, metavar="N",
@@ -64,7 +65,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "to take, or one recorded with play --record); it is verified first")
     p.add_argument("--name", help="with --add: the player's name, if the replay has none")
     p.add_argument("--new", action="store_true", help="start an empty table in the --scores folder (with --seed: "
-                   "the seed it ranks)")
+                   "the seed it ranks); this account then keeps its own record of the table's seed and of the order "
+                   "of the games it enters, which its listings follow wherever the shared file says otherwise")
     p.add_argument("--seed", type=_seed_arg, metavar="N", help="with --new: the seed the table ranks "
                    f"(default: {DEFAULT_SEED}, the default game's)")
     p.add_argument("--cache", metavar="DIR", help="folder of the verification cache (default: $ARMGAME_CACHE, "
