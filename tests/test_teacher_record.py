@@ -325,3 +325,13 @@ def test_every_game_added_after_planted_head_and_counters_is_listed(tmp_path_fac
         assert after["seed"] == 3 and table.seed == 3
     elif seed != "absent" and not (type(seed) is int and 0 <= seed < 2**63) and version == 3:
         assert after["seed"] == seed  # a seed that is not valid is kept as found
+
+
+def test_a_burst_of_games_entered_at_once_is_recorded_in_its_order(tmp_path):
+    """The live class's clerk enters many hand-ins with one write (``add_many``): the record knows each."""
+    table = class_table(tmp_path)
+    games = [played(f"s{i}", press=10 + i, time_limit=0.2) for i in range(3)]
+    entered = table.add_many([*games, games[0].with_player("copier")])
+    assert isinstance(entered[3], TableError)  # the same game again: refused, and never recorded
+    record = TeacherRecord(table.folder, tmp_path / "teacher" / "cache").load()
+    assert [record.entries[e.id].order for e in entered[:3]] == [1, 2, 3] and len(record.entries) == 3
