@@ -86,7 +86,7 @@ def test_a_costly_replay_is_counted_before_it_runs_and_not_run_by_scores(tmp_pat
         assert "storm (5000" in out and "NOT CHECKED: its replay claims" in out and "honest" in out
     assert len([s for s in parsed if path.name in s]) == 1  # the second listing knew it without reading it
     assert entry.name == "honest"
-    assert "flagged" not in out and "1 not checked yet (costly replay" in out  # a cost, not a verdict
+    assert "flagged:" not in out and "1 not checked yet (costly replay" in out  # a cost, not a verdict
 
 
 # ------------------------------------------------------------------ honest games are never flagged (issue 26, 5)
@@ -132,14 +132,14 @@ def test_a_costly_game_is_listed_apart_unflagged_and_ranked_once_verify_checks_i
     assert main(["scores", "--scores", str(table.folder)]) == 0
     out = capsys.readouterr().out
     ranked, apart = out.split("not checked yet")
-    assert "cheap" in ranked and "busy" not in ranked and "flagged" not in out
+    assert "cheap" in ranked and "busy" not in ranked and "flagged:" not in out
     assert "1 not checked yet (costly replay: armgame verify checks it; not ranked until then)" in out
     assert "busy (0, " in apart and "15,400 steps of work" in apart
     assert main(["verify", str(table.folder)]) == 0  # checks everything, whatever it costs
     capsys.readouterr()
     assert main(["scores", "--scores", str(table.folder)]) == 0
     out = capsys.readouterr().out
-    assert "not checked" not in out and "busy" in out.split("Ranked")[1] and "flagged" not in out
+    assert "not checked" not in out and "busy" in out.split("Ranked")[1] and "flagged:" not in out
 
 
 def test_verify_max_work_bounds_a_run_and_says_what_it_left(tmp_path, monkeypatch, capsys):

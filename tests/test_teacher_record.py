@@ -316,8 +316,8 @@ def test_every_game_added_after_planted_head_and_counters_is_listed(tmp_path_fac
     folder.mkdir(parents=True, exist_ok=True)
     table.path.write_text(json.dumps(data))
     added = [table.add(played(f"new {i}", time_limit=0.12, press=10 + i)) for i in range(games)]
-    lists, flagged = listing(table, table.all_entries(), None, check=False)
-    listed = {e.id for rows in lists.values() for e, _ in rows}
+    lists, flagged = listing(table, table.all_entries(), None, check=False, per_player=False)
+    listed = {row.best[0].id for rows in lists.values() for row in rows}
     assert {e.id for e in added + planted} <= listed and not flagged
     assert not list(folder.glob("scores.json.corrupt-*"))  # the planted values were repaired, nothing set aside
     after = json.loads(table.path.read_text())
