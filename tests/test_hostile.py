@@ -19,7 +19,7 @@ import pytest
 
 import armgame.records.batch_verify as batch_verify
 import armgame.records.replay as replay_module
-import armgame.records.scores as scores_module
+import armgame.records.tablefile as tablefile_module
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, NonFiniteStateError
@@ -479,12 +479,12 @@ def test_a_replay_planted_as_a_symlink_is_not_followed(tmp_path):
 
 
 def test_a_busy_table_keeps_the_game_and_says_how_to_enter_it(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(scores_module, "LOCK_WAIT", 0.3)
+    monkeypatch.setattr(tablefile_module, "LOCK_WAIT", 0.3)
     folder = tmp_path / "t"
     ScoreTable(folder).add(game("first"))
     holder = file_lock(folder / "scores.lock", 1.0)
     waits = []  # counted, not timed: play asks for the lock once, for LOCK_WAIT, and gives up
-    monkeypatch.setattr(scores_module, "file_lock", lambda path, wait: waits.append(wait) or file_lock(path, wait))
+    monkeypatch.setattr(tablefile_module, "file_lock", lambda path, wait: waits.append(wait) or file_lock(path, wait))
     holder.__enter__()  # someone else holds the table
     try:
         code = main(["play", "--headless", "--duration", "0.5", "--name", "Late", "--scores", str(folder)])
@@ -531,7 +531,7 @@ def test_a_damaged_table_on_a_full_disk_loses_nothing(tmp_path, monkeypatch):
             raise DataFileError(f"{path}: cannot write the {what}: No space left on device")
         return atomic_write_bytes(path, data, what)
 
-    monkeypatch.setattr(scores_module, "atomic_write_bytes", full)
+    monkeypatch.setattr(tablefile_module, "atomic_write_bytes", full)
     with pytest.raises(DataFileError, match="No space"):
         table.add(game("bob", time_limit=1.0))
     assert table.path.read_bytes() == damaged  # everything as it was
@@ -558,13 +558,13 @@ def test_a_table_over_the_limit_is_refused_whole_never_set_aside(tmp_path, monke
     table = ScoreTable(tmp_path)
     table.add(game("p0", time_limit=0.1))
     before = table.path.read_bytes()
-    monkeypatch.setattr(scores_module, "MAX_TABLE_BYTES", len(before) - 1)
+    monkeypatch.setattr(tablefile_module, "MAX_TABLE_BYTES", len(before) - 1)
     with pytest.raises(DataFileError, match="nothing was changed"):
         table.add(game("p1", time_limit=0.1))
     assert main(["scores", "--scores", str(tmp_path)]) == 2
     assert table.path.read_bytes() == before and not list(tmp_path.glob("scores.json.corrupt-*"))
-    monkeypatch.setattr(scores_module, "MAX_TABLE_BYTES", 10**9)
-    monkeypatch.setattr(scores_module, "MAX_TABLE_ENTRIES", 1)
+    monkeypatch.setattr(tablefile_module, "MAX_TABLE_BYTES", 10**9)
+    monkeypatch.setattr(tablefile_module, "MAX_TABLE_ENTRIES", 1)
     with pytest.raises(DataFileError, match="nothing was dropped"):
         table.add(game("p2", time_limit=0.1))
     assert table.path.read_bytes() == before
@@ -591,7 +591,7 @@ def test_a_table_of_100000_entries_is_read(tmp_path):
 
     assert table_of(3) == table_bytes([dataclasses.replace(one, id=f"{i:032x}") for i in range(3)])
     data = table_of(100_000)
-    assert len(data) <= scores_module.MAX_TABLE_BYTES
+    assert len(data) <= tablefile_module.MAX_TABLE_BYTES
     (tmp_path / "scores.json").write_bytes(data)
     read, damage = ScoreTable(tmp_path).read()
     assert damage is None and len(read) == 100_000

@@ -16,6 +16,7 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 import pytest
 
 import armgame.records.scores as scores_module
+import armgame.records.tablefile as entry_module
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
@@ -387,12 +388,12 @@ def _entry_by_the_generic_checks(data: object) -> ScoreEntry:
     from armgame.records.replay import DRIVEN, check_date, check_name, check_word
     from armgame.records.storage import check_float, check_int, check_keys, check_str
 
-    m, big = scores_module._match, 10**9
-    d = check_keys("entry", data, scores_module._REQUIRED, scores_module._OPTIONAL)
+    m, big = entry_module._match, 10**9
+    d = check_keys("entry", data, entry_module._REQUIRED, entry_module._OPTIONAL)
     driven = check_str("driven", d["driven"], 20)
     if driven not in DRIVEN:
         raise ValueError(f"driven must be one of {', '.join(DRIVEN)}, got {driven!r}")
-    h32, h64 = scores_module._HEX32, scores_module._HEX64
+    h32, h64 = entry_module._HEX32, entry_module._HEX64
     ruleset, digest, game, entered, entered_at, complete = (
         d.get(k) for k in ("ruleset", "config_sha256", "game_sha256", "entered", "entered_at", "complete"))
     entry = ScoreEntry(
@@ -403,14 +404,14 @@ def _entry_by_the_generic_checks(data: object) -> ScoreEntry:
         scene=check_word("scene", d["scene"]),
         duration=check_float("duration", d["duration"], 0.0, 86400.0, low_open=True),
         date=check_date("date", d["date"]), version=check_word("version", d["version"]),
-        replay=m("replay", d["replay"], scores_module._REPLAY_FILE),
+        replay=m("replay", d["replay"], entry_module._REPLAY_FILE),
         replay_sha256=m("replay_sha256", d["replay_sha256"], h64),
         ruleset=None if ruleset is None else check_word("ruleset", ruleset),
         config_sha256=None if digest is None else m("config_sha256", digest, h64),
         game_sha256=None if game is None else m("game_sha256", game, h64),
         entered=None if entered is None else check_int("entered", entered, 1, big),
         entered_at=None if entered_at is None else check_date("entered_at", entered_at),
-        complete=None if complete is None else scores_module._bool("complete", complete),
+        complete=None if complete is None else entry_module._bool("complete", complete),
     )
     if (entry.ruleset is None) != (entry.config_sha256 is None):
         raise ValueError("ruleset and config_sha256 come together")

@@ -14,13 +14,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import armgame.records.scores as scores_module
+import armgame.records.tablefile as tablefile_module
 from armgame.cli import main
 from armgame.commands.scores import listing
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 from armgame.records.replay import Replay
-from armgame.records.scores import ScoreTable, TableError
+from armgame.records.scores import ScoreTable, TableError, entry_order
 from armgame.records.teacher import TeacherRecord
 
 
@@ -203,7 +203,7 @@ def test_the_record_orders_what_it_knows_and_says_what_the_table_lost(tmp_path, 
 
     edit(table, swap_and_drop)
     reader = ScoreTable(table.folder, warn=(notes := []).append)
-    assert [e.id for e in sorted(reader.all_entries(), key=scores_module.entry_order)] == [first.id, second.id]
+    assert [e.id for e in sorted(reader.all_entries(), key=entry_order)] == [first.id, second.id]
     assert len(notes) == 2 and "was changed for 2 of the 2 entries" in notes[0]
     assert "1 of the 3 games this account entered in the table is no longer in it" in notes[1]
 
@@ -268,15 +268,15 @@ def test_a_hostile_counter_is_repaired_once_and_every_game_kept(tmp_path, plant)
     assert {e.id for e in added} <= {e.id for e in entries} and len(entries) == 6
     assert not list(table.folder.glob("scores.json.corrupt-*"))
     assert len(notes) == 1 and ("renumbered" in notes[0] or "set after its last entry" in notes[0])
-    assert [e.name for e in sorted(entries, key=scores_module.entry_order)] == ["first", *(f"p{i}" for i in range(5))]
+    assert [e.name for e in sorted(entries, key=entry_order)] == ["first", *(f"p{i}" for i in range(5))]
 
 
 def test_a_table_that_would_not_read_back_is_never_written(tmp_path, monkeypatch):
     table = ScoreTable(tmp_path / "own", warn=lambda m: None)
     table.add(played("ann", time_limit=0.2))
     before = table.path.read_bytes()
-    real = scores_module.table_bytes
-    monkeypatch.setattr(scores_module, "table_bytes",
+    real = tablefile_module.table_bytes
+    monkeypatch.setattr(tablefile_module, "table_bytes",
                         lambda *a, **k: real(*a, **k).replace(b'"name": "', b'"name": " ', 1))
     with pytest.raises(TableError, match="does not read back"):
         table.add(played("bob", time_limit=0.2, press=9))

@@ -1,0 +1,925 @@
+"""The table's file and what it holds: entries (each field checked), read, parsed (or salvaged), written
+whole under a lock, with its head and counters, and each entry checked against its replay.
+
+Storage, in one folder (see ``scores.default_scores_dir``)::
+
+    scores.json           the table: JSON, one entry a line
+    scores.lock           locked by whoever writes the table (``records.locking``)
+    replays/*.json        one replay per entry, named by the entry
+
+Why one file under a lock rather than an append-only log with a merge: the table stays
+one small, readable JSON file a teacher can open, and every change is all or nothing. A
+change is read-modify-write under an exclusive lock on ``scores.lock`` (``flock`` on Linux and
+macOS, ``LockFileEx`` on Windows: ``armgame.records.locking``), so two games finishing at the
+same moment queue for a few milliseconds and both entries land; the kernel drops the lock
+when its holder exits, even by SIGKILL, so there is no stale lock to clean up. A writer waits
+at most ``LOCK_WAIT`` seconds for the lock, then says the table is busy; the game's replay
+is already saved and ``armgame scores --add`` enters it later. The new table is written to a
+temporary file in the same folder, fsynced and renamed over the old one
+(``armgame.records.storage``): readers need no lock, since they always see a whole table,
+old or new.
+
+Trust: the table is parsed as data with a schema check of every field. A damaged table
+(truncated, not JSON, an entry failing its checks) is never overwritten silently: the next
+write first copies its bytes to ``scores.json.corrupt-<UTC time>``, then writes the new
+table with every valid entry it could find, and only that rename retires the damaged file;
+if anything fails, the table stays as it was. A valid table is never set aside: one over
+the size limit is refused whole (no entry added) rather than dropped.
+
+The head holds the seed the table ranks and ``next_entry``, the next place in the order of entry.
+A seed that is not valid is kept as found, never replaced by the default; counters are bounded and
+a planted one is repaired at the next write (``_numbered``); and a table that would not read back
+as written is never written (``_reads_back``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import re
+import stat
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, fields, replace
+from datetime import UTC, datetime
+from pathlib import Path
+
+from ..game.session import GameResult
+from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
+from ..words import plural
+from .cache import VerificationCache, file_signature
+from .identity import identity_claims, names_its_game
+from .locking import LockBusyError, LockError, file_lock
+from .replay import DRIVEN, Replay, check_date, check_name, check_word, now_iso
+from .rulesets import config_digest, ruleset_name, ruleset_of
+from .storage import (
+    STRICT_DECODER,
+    DataFileError,
+    atomic_write_bytes,
+    check_float,
+    check_int,
+    check_keys,
+    check_str,
+    copy_aside,
+    open_regular,
+    parse_json,
+    read_limited,
+)
+from .teacher import TeacherRecord
+
+_COUNT_MAX = 10**9
+_REPLAY_FILE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,150}\.json")
+_HEX64 = re.compile(r"[0-9a-f]{64}")
+_HEX32 = re.compile(r"[0-9a-f]{32}")
+
+
+@dataclass(frozen=True)
+class ScoreEntry:
+    id: str
+    name: str
+    driven: str
+    driver: str | None
+    score: int
+    hits: int
+    resets: int
+    seed: int
+    scene: str
+    duration: float
+    date: str
+    version: str
+    replay: str
+    replay_sha256: str
+    #: The ruleset the game claims (``standard``, or ``custom``) and its config digest; None in
+    #: entries carried over from a format 1 table (their replay decides, see ``ScoreTable.ruleset``).
+    ruleset: str | None = None
+    config_sha256: str | None = None
+    #: The game's identity (``identity.game_digest``), its place in the order of entry (1, 2, ...), when the
+    #: table took it, and whether it ran its whole clock; None in entries carried over from older tables.
+    game_sha256: str | None = None
+    entered: int | None = None
+    entered_at: str | None = None
+    complete: bool | None = None
+
+    def as_dict(self) -> dict[str, object]:
+        return {name: getattr(self, name) for name in _ENTRY_FIELDS}  # dataclasses.asdict deep-copies: 10x slower
+
+    @property
+    def when(self) -> datetime:
+        return datetime.fromisoformat(self.date)
+
+    @property
+    def how(self) -> str:
+        return f"{self.driven} ({self.driver})" if self.driver else self.driven
+
+    @property
+    def program(self) -> bool:
+        """Whether the game says a program played it: anything but the keyboard with no driver named."""
+        return self.driven != "keyboard" or self.driver is not None
+
+    @classmethod
+    def from_dict(cls, data: object) -> ScoreEntry:
+        """Check every field; raises ValueError naming the first bad one.
+
+        Why it is written out field by field: a 100,000-entry table is read on every ``armgame scores``,
+        and generic checks plus the frozen dataclass's ``__init__`` took most of that time. Each field
+        first takes a test that only passes values the field's check would pass unchanged (exact
+        types, precompiled patterns that bound the length and allow no control character); anything
+        else goes through the check itself, in the same order, so the same first error is named.
+        """
+        if type(data) is dict and _REQUIRED <= data.keys() <= _ALL_FIELDS:  # what check_keys passes
+            d = data
+        else:
+            d = check_keys("entry", data, _REQUIRED, _OPTIONAL)
+        get = d.get
+        v = d["driven"]
+        if v not in DRIVEN:  # DRIVEN holds short printable words, so only its words pass check_str and this
+            raise ValueError(f"driven must be one of {', '.join(DRIVEN)}, got {check_str('driven', v, 20)!r}")
+        driven = v
+        ruleset, digest = get("ruleset"), get("config_sha256")
+        v = d["id"]
+        id_ = v if type(v) is str and _HEX32.fullmatch(v) else _match("id", v, _HEX32)
+        v = raw_name = d["name"]
+        name = v if type(v) is str and _NAME.fullmatch(v) else check_name(v)
+        v = d["driver"]
+        if v is not None and not (type(v) is str and len(v) <= 200 and v.isprintable()):
+            v = check_str("driver", v, 200)
+        driver = v
+        v = d["score"]
+        score = v if type(v) is int and 0 <= v <= _COUNT_MAX else check_int("score", v, 0, _COUNT_MAX)
+        v = d["hits"]
+        hits = v if type(v) is int and 0 <= v <= _COUNT_MAX else check_int("hits", v, 0, _COUNT_MAX)
+        v = d["resets"]
+        resets = v if type(v) is int and 0 <= v <= _COUNT_MAX else check_int("resets", v, 0, _COUNT_MAX)
+        v = d["seed"]
+        seed = v if type(v) is int and 0 <= v <= _SEED_MAX else check_int("seed", v, 0, _SEED_MAX)
+        v = d["scene"]
+        scene = v if type(v) is str and _WORD40.fullmatch(v) else check_word("scene", v)
+        v = d["duration"]
+        duration = (v if type(v) is float and 0.0 < v <= 86400.0
+                    else check_float("duration", v, 0.0, 86400.0, low_open=True))
+        date = check_date("date", d["date"])
+        v = d["version"]
+        version = v if type(v) is str and _WORD40.fullmatch(v) else check_word("version", v)
+        v = d["replay"]
+        replay = v if type(v) is str and _REPLAY_FILE.fullmatch(v) else _match("replay", v, _REPLAY_FILE)
+        v = d["replay_sha256"]
+        replay_sha256 = v if type(v) is str and _HEX64.fullmatch(v) else _match("replay_sha256", v, _HEX64)
+        if ruleset is not None and not (type(ruleset) is str and _WORD40.fullmatch(ruleset)):
+            ruleset = check_word("ruleset", ruleset)
+        if digest is not None and not (type(digest) is str and _HEX64.fullmatch(digest)):
+            digest = _match("config_sha256", digest, _HEX64)
+        v = get("game_sha256")
+        if v is not None and not (type(v) is str and _HEX64.fullmatch(v)):
+            v = _match("game_sha256", v, _HEX64)
+        game = v
+        v = get("entered")
+        if v is not None and not (type(v) is int and 1 <= v <= _COUNT_MAX):
+            v = check_int("entered", v, 1, _COUNT_MAX)
+        entered = v
+        v = get("entered_at")
+        entered_at = None if v is None else check_date("entered_at", v)
+        v = get("complete")
+        complete = None if v is None else _bool("complete", v)
+        if (ruleset is None) != (digest is None):
+            raise ValueError("ruleset and config_sha256 come together")
+        if score > hits:
+            raise ValueError(f"score {score} is more than the hits {hits}")
+        if name != raw_name:
+            raise ValueError(f"name {raw_name!r} has surrounding spaces")
+        # The fields are checked: set them as the frozen dataclass's __init__ would, in one step.
+        entry = _new_object(cls)
+        entry.__dict__.update(
+            id=id_, name=name, driven=driven, driver=driver, score=score, hits=hits, resets=resets, seed=seed,
+            scene=scene, duration=duration, date=date, version=version, replay=replay,
+            replay_sha256=replay_sha256, ruleset=ruleset, config_sha256=digest, game_sha256=game,
+            entered=entered, entered_at=entered_at, complete=complete,
+        )
+        return entry
+
+
+_ENTRY_FIELDS = tuple(f.name for f in fields(ScoreEntry))
+_OPTIONAL = frozenset({"ruleset", "config_sha256", "game_sha256", "entered", "entered_at", "complete"})
+_REQUIRED = set(_ENTRY_FIELDS) - _OPTIONAL
+_ALL_FIELDS = frozenset(_ENTRY_FIELDS)
+_SEED_MAX = 2**63 - 1
+_new_object = object.__new__
+#: The values check_word passes unchanged at its default length: a word of 1 to 40 characters.
+_WORD40 = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]{0,39}")
+#: The names check_name passes unchanged: 1 to 40 printable characters, none of them surrounding spaces.
+#: (Only a guard for the fast path: it lets through fewer names than check_name, never more.)
+_NAME = re.compile(r"[!-~](?:[ -~]{0,38}[!-~])?")
+
+
+def _match(name: str, value: object, pattern: re.Pattern[str]) -> str:
+    value = check_str(name, value, 200)
+    if not pattern.fullmatch(value):
+        raise ValueError(f"{name} is not a valid {name.replace('_', ' ')}: {value!r}")
+    return value
+
+
+def _bool(name: str, value: object) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"{name} must be true or false, got {value!r}")
+    return value
+
+
+def sort_key(entry: ScoreEntry) -> tuple[int, int, datetime, str]:
+    """Best first; equal scores by the table's order of entry, the earlier entry first.
+
+    Entries carried over from a table older than format 3 have no place yet (they get one, in
+    the order of their dates, at the table's next write): among them the earlier date first.
+    """
+    return (-entry.score, entry.entered or 0, entry.when, entry.id)
+
+
+def entry_order(entry: ScoreEntry) -> tuple[int, datetime, str]:
+    """The order the table took its entries in: the first of two entries of one game is the one that counts."""
+    return (entry.entered or 0, entry.when, entry.id)
+
+
+def replay_claims(replay: Replay) -> dict[str, object]:
+    """What an entry must say about its replay's game, field for field; and the game's identity
+    (``identity.identity_claims``: the digest an entry may hold, by each identity version)."""
+    r = replay.result
+    return {"name": replay.player, "driven": replay.driven, "driver": replay.driver, "score": r.score,
+            "hits": r.hits, "resets": r.resets, "seed": r.seed, "scene": r.scene, "duration": r.duration,
+            "date": replay.date, "config_sha256": config_digest(replay.config),
+            "ruleset": ruleset_name(replay.config), "complete": replay.complete, **identity_claims(replay)}
+
+
+#: The label of a game whose replay costs more than its checker would spend (``check_many``'s ``max_work``).
+NOT_CHECKED = "NOT CHECKED"
+
+
+@dataclass(frozen=True)
+class Check:
+    """What recomputing an entry's game says: ``ok``, or a short label and why not.
+
+    ``ruleset`` is the ruleset the replay plays (``custom`` if none), when the replay could be read.
+    """
+
+    ok: bool
+    label: str
+    detail: str = ""
+    ruleset: str | None = None
+    #: The game's digest (``identity.game_digest``), when the replay could be read.
+    game: str | None = None
+
+
+class TableChecks:
+    """``check`` and ``check_many`` of a table's entries; ``ScoreTable`` is one (its ``replays`` folder and
+    its ``cache``)."""
+
+    replays: Path
+    cache: VerificationCache | None
+
+    def replay_path(self, entry: ScoreEntry) -> Path:
+        return self.replays / entry.replay
+
+    def _replay_file(self, entry: ScoreEntry) -> Path:
+        mode = os.lstat(self.replays).st_mode if self.replays.exists() or self.replays.is_symlink() else None
+        if mode is not None and not stat.S_ISDIR(mode):
+            raise DataFileError(f"{self.replays}: is not a folder (a symbolic link is not followed)")
+        return self.replay_path(entry)
+
+    def check(self, entry: ScoreEntry) -> Check:
+        """Whether the entry's replay is the one it names and reproduces its game. Never raises."""
+        return self.check_many([entry])[0]
+
+    def check_many(self, entries: Sequence[ScoreEntry],
+                   recompute: Callable[[Sequence[Replay]], list[tuple[bool, GameResult]]] | None = None,
+                   max_work: int | None = None) -> list[Check]:
+        """``check`` for each entry; the games not in the cache are recomputed together.
+
+        ``recompute`` maps replays to ``replay.verify()`` of each (``records.batch_verify`` passes
+        the batched one); if it fails, the games are recomputed one at a time, so one entry's
+        failure still marks only that entry. ``max_work``: a replay whose ``replay_work`` is more
+        is not recomputed (``NOT CHECKED``; remembered, so that it is not read again, until a check with a
+        larger ``max_work`` or none, as ``armgame verify``'s, recomputes it).
+        """
+        found: list[Check | tuple[str, dict | Replay, list[int]]] = []
+        for entry in entries:
+            try:
+                found.append(self._claim(entry, max_work))
+            except Exception as exc:  # one entry's failure never takes the table down
+                found.append(_bad(exc))
+        pending: dict[str, tuple[Replay, list[int]]] = {}
+        for i, f in enumerate(found):
+            if not isinstance(f, Check) and isinstance(f[1], Replay):
+                work = replay_work(f[1])
+                if max_work is not None and work > max_work:
+                    skipped = {"claims": replay_claims(f[1]), "ok": False, "label": NOT_CHECKED, "file": f[2],
+                               "work": work, "detail": not_checked_detail(f[1], work)}
+                    if self.cache is not None:  # remembered, so the next listing does not even read it
+                        self.cache.put(f[0], skipped)
+                    found[i] = (f[0], skipped, f[2])
+                else:
+                    pending[f[0]] = (f[1], f[2])
+        verdicts = _recompute([replay for replay, _ in pending.values()], recompute)
+        judged: dict[str, dict] = {}
+        for (digest, (replay, signature)), verdict in zip(pending.items(), verdicts, strict=True):
+            judged[digest] = {"claims": replay_claims(replay), **verdict, "file": signature}
+            if self.cache is not None:
+                self.cache.put(digest, judged[digest])
+        checks = []
+        for entry, f in zip(entries, found, strict=True):
+            if isinstance(f, Check):
+                checks.append(f)
+                continue
+            digest, item, _ = f
+            try:
+                checks.append(self._judge(entry, judged[digest] if isinstance(item, Replay) else item))
+            except Exception as exc:
+                checks.append(_bad(exc))
+        return checks
+
+    def _claim(self, entry: ScoreEntry, max_work: int | None = None) -> Check | tuple[str, dict | Replay, list[int]]:
+        """A failed ``Check``; or the replay's digest with its cached verdict, or the replay still to
+        recompute, and the replay file's signature. A replay file whose signature a cached verdict
+        recorded is not read at all (``cache.file_signature``)."""
+        try:
+            path = self._replay_file(entry)
+            fd = open_regular(path, "replay file", follow=False)
+        except DataFileError as exc:
+            missing = not self.replay_path(entry).exists() and not self.replay_path(entry).is_symlink()
+            return Check(False, "REPLAY MISSING" if missing else "REPLAY UNREADABLE", str(exc))
+        with os.fdopen(fd, "rb") as f:
+            signature = file_signature(os.fstat(f.fileno()))
+            if self.cache is not None and self.cache.digest_of(signature) == entry.replay_sha256:
+                cached = _usable(self.cache.get(entry.replay_sha256), max_work)
+                if cached is not None:
+                    return entry.replay_sha256, cached, signature
+            try:
+                data = f.read(MAX_REPLAY_BYTES + 1)
+            except OSError as exc:
+                return Check(False, "REPLAY UNREADABLE", f"{path}: cannot read: {exc.strerror or exc}")
+        if len(data) > MAX_REPLAY_BYTES:
+            return Check(False, "REPLAY UNREADABLE", f"{path}: larger than a replay may be")
+        digest = hashlib.sha256(data).hexdigest()
+        if digest != entry.replay_sha256:
+            return Check(False, "REPLAY CHANGED", f"{path.name} is not the replay this entry was saved with")
+        cached = _usable(self.cache.get(digest), max_work) if self.cache else None
+        if cached is not None:
+            if self.cache is not None and cached.get("file") != signature:
+                self.cache.put(digest, {**cached, "file": signature})  # known unchanged without reading, next time
+            return digest, cached, signature
+        try:
+            replay = Replay.from_bytes(data, str(path))
+        except DataFileError as exc:
+            cached = {"claims": None, "ok": False, "label": "BAD REPLAY", "detail": str(exc), "file": signature}
+            if self.cache:
+                self.cache.put(digest, cached)
+            return digest, cached, signature
+        if replay.task is not None:
+            return Check(False, "NOT A GAME", f"{path.name} is a lab run, which is never ranked")
+        return digest, replay, signature
+
+    @staticmethod
+    def _judge(entry: ScoreEntry, cached: dict) -> Check:
+        """The verdict on an entry whose replay's claims and recomputed verdict are ``cached``."""
+        claims = cached["claims"]
+        if claims is None:
+            return Check(False, cached["label"], cached["detail"])
+        wanted = {key: value for key, value in claims.items() if key in _ENTRY_CLAIMS}
+        if entry.config_sha256 is None:  # a format 1 entry makes no claim about its rules
+            wanted.pop("config_sha256")
+            wanted.pop("ruleset")
+        if entry.complete is None:  # entries from older tables make no such claim
+            wanted.pop("complete")
+        for key, value in wanted.items():
+            if getattr(entry, key) != value:
+                return Check(False, "NOT ITS REPLAY", f"the entry says {key} {getattr(entry, key)!r}, its replay "
+                             f"{value!r}", claims["ruleset"], claims["game_sha256"])
+        # The digest by the identity version that entered it (older tables: none stored).
+        if entry.game_sha256 is not None and not names_its_game(entry.game_sha256, claims):
+            return Check(False, "NOT ITS REPLAY", f"the entry says game_sha256 {entry.game_sha256!r}, its replay "
+                         f"{claims['game_sha256']!r}", claims["ruleset"], claims["game_sha256"])
+        if not claims["complete"]:
+            return Check(False, "NOT A WHOLE GAME", "the game stopped before its clock ran out", claims["ruleset"],
+                         claims["game_sha256"])
+        return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"], claims["game_sha256"])
+
+
+#: The claims an entry's own fields must equal (the game's digest is compared by ``names_its_game``).
+_ENTRY_CLAIMS = frozenset({"name", "driven", "driver", "score", "hits", "resets", "seed", "scene", "duration", "date",
+                           "config_sha256", "ruleset", "complete"})
+
+
+# Work is counted in physics steps of the game's compiled loop (0.12 us each on the 2-core build machine),
+# the loop every install with a C compiler runs; measured with ``python benchmarks/honest_work.py``. In the
+# Python loop a step costs 20 times more and an event or a try no more, so these overcount there.
+#: What recomputing one hit can cost under any rules: drawing the next target tries up to 1,000 postures
+#: (``GameRules._draw_target``), each measured at 5.9 steps (0.73 us): 5,900, rounded up.
+HIT_WORK = 6_000
+#: What one hit costs under a ranked ruleset, whose target ranges keep a drawn target clear of the hand:
+#: 1.36 tries on average and at most 9 in 20,000 draws from random hands, a draw measured at 14 steps.
+RANKED_HIT_WORK = 100
+#: What one input event costs: reading it, ``key_event`` and a call of the loop between steps (20.5 steps).
+EVENT_WORK = 20
+
+
+def replay_work(replay: Replay) -> int:
+    """The most work recomputing ``replay`` can take, in physics steps, known before running it: its
+    steps, its claimed hits (verification stops as soon as the game passes its claim), each a target draw
+    (``RANKED_HIT_WORK`` under a ranked ruleset, else ``HIT_WORK``), and its events."""
+    hit = RANKED_HIT_WORK if ruleset_of(replay.config) is not None else HIT_WORK
+    return replay.result.steps + hit * replay.result.hits + EVENT_WORK * len(replay.timeline)
+
+
+def not_checked_detail(replay: Replay, work: int) -> str:
+    """Why a replay was left unchecked: what it claims, and the work that makes (``replay_work``)."""
+    r = replay.result
+    return (f"its replay claims {plural(r.steps, 'step')}, {plural(r.hits, 'hit')} and "
+            f"{plural(len(replay.timeline), 'event')}: {work:,} steps of work, more than this check spends on one "
+            f"game (armgame verify checks it)")
+
+
+def _usable(cached: dict | None, max_work: int | None) -> dict | None:
+    """A cached verdict, unless it is a game left unchecked for its cost that this caller would check."""
+    if cached is not None and cached["label"] == NOT_CHECKED and (max_work is None or cached["work"] <= max_work):
+        return None
+    return cached
+
+
+def _bad(exc: Exception) -> Check:
+    reason = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+    return Check(False, "BAD REPLAY", reason)
+
+
+def _recompute(replays: list[Replay],
+               recompute: Callable[[Sequence[Replay]], list[tuple[bool, GameResult]]] | None) -> list[dict]:
+    if replays and recompute is not None:
+        try:
+            return [_judged(replay, *outcome) for replay, outcome in zip(replays, recompute(replays), strict=True)]
+        except Exception:  # e.g. one game's blow-up stopped the batch: find it one game at a time
+            pass
+    return [_verdict(replay) for replay in replays]
+
+
+def _verdict(replay: Replay) -> dict[str, object]:
+    try:
+        ok, recomputed = replay.verify()
+    except Exception as exc:  # a blow-up (NonFiniteState) or anything else the game raises
+        return {"ok": False, "label": "BAD REPLAY", "detail": str(exc) or type(exc).__name__}
+    return _judged(replay, ok, recomputed)
+
+
+def _judged(replay: Replay, ok: bool, recomputed: GameResult) -> dict[str, object]:
+    if ok:
+        return {"ok": True, "label": "ok", "detail": ""}
+    r = replay.result
+    return {"ok": False, "label": "NOT REPRODUCED",
+            "detail": f"recorded score {r.score}, the replay gives {recomputed.score} "
+                      f"({plural(recomputed.hits, 'hit')}, {plural(recomputed.resets, 'reset')})"}
+
+
+TABLE_NAME = "scores.json"
+LOCK_NAME = "scores.lock"
+REPLAYS_DIR = "replays"
+FORMAT = "armgame-scores"
+#: 2 adds each entry's ruleset and config digest; 3 the table's ranked seed and order-of-entry counter, and
+#: each entry's game digest, order of entry and whole-clock flag. Older tables are read (and rewritten as 3).
+FORMAT_VERSION = 3
+READS_FORMATS = (1, 2, 3)
+#: Seconds a writer waits for the table's lock before saying the table is busy.
+LOCK_WAIT = 5.0
+
+
+class TableError(DataFileError):
+    """The table cannot be changed (busy, over its limits, not a safe place): nothing was changed."""
+
+
+class TableBusyError(TableError):
+    """The lock was not free within ``LOCK_WAIT`` seconds."""
+
+
+@dataclass(frozen=True)
+class Damage:
+    reason: str
+    recovered: int
+    found: int
+
+    def describe(self, path: Path) -> str:
+        return f"{path} is damaged ({self.reason}); {plural(self.recovered, 'valid entry')} recovered"
+
+
+class TableFile:
+    """The table's file in ``folder``, and the one way it is written (``_enter``, under its lock).
+
+    ``warn`` receives one-line notices; ``records``: the folder of this account's records of tables
+    (``records.teacher``; None: the verification cache's), told of each entry this account enters."""
+
+    def __init__(self, folder: Path, warn: Callable[[str], None], records: Path | None = None) -> None:
+        self.folder = Path(folder)
+        self.path = self.folder / TABLE_NAME
+        self.lock_path = self.folder / LOCK_NAME
+        self.replays = self.folder / REPLAYS_DIR
+        self.warn = warn
+        self.record = TeacherRecord(self.folder, records, warn)
+        self._seed: int | None = None
+
+    def _open_table(self) -> int | None:
+        """A descriptor of the table file, or None if there is none. Never follows a symlink."""
+        try:
+            st = os.lstat(self.path)
+        except FileNotFoundError:
+            return None
+        except OSError as exc:
+            raise TableError(f"{self.path}: cannot read: {exc.strerror or exc}") from None
+        if stat.S_ISLNK(st.st_mode):
+            raise TableError(f"{self.path}: is a symbolic link; the table must be a regular file in its folder")
+        fd = open_regular(self.path, "score table", follow=False)
+        if os.fstat(fd).st_size > MAX_TABLE_BYTES:
+            os.close(fd)
+            raise TableError(f"{self.path}: larger than {MAX_TABLE_BYTES // (1024 * 1024)} MiB, more than armgame "
+                             f"reads; nothing was changed (move some entries to another table)")
+        return fd
+
+    def _file_bytes(self) -> bytes | None:
+        """The table file's bytes, or None if there is none (``_open_table``'s refusals raise)."""
+        fd = self._open_table()
+        if fd is None:
+            return None
+        with os.fdopen(fd, "rb") as f:
+            return f.read(MAX_TABLE_BYTES + 1)
+
+    def _safe_folder(self) -> None:
+        """Create the folder and replays/; refuse a replays/ or scores.lock planted as a symlink."""
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            for path, folder in ((self.replays, True), (self.lock_path, False)):
+                with contextlib.suppress(FileNotFoundError):
+                    mode = os.lstat(path).st_mode
+                    if stat.S_ISLNK(mode):
+                        raise TableError(f"{path}: is a symbolic link; armgame writes only inside {self.folder}")
+                    if folder and not stat.S_ISDIR(mode):
+                        raise TableError(f"{path}: is not a folder")
+                    if not folder and not stat.S_ISREG(mode):
+                        raise TableError(f"{path}: is not a regular file")
+            self.replays.mkdir(exist_ok=True)
+        except OSError as exc:
+            raise TableError(f"cannot write the table in {self.folder}: {exc.strerror or exc}") from None
+
+    @contextlib.contextmanager
+    def _locked(self, wait: float | None = None) -> Iterator[None]:
+        wait = LOCK_WAIT if wait is None else wait
+        try:
+            with file_lock(self.lock_path, wait):
+                yield
+        except LockBusyError:
+            raise TableBusyError(f"the table in {self.folder} is busy (another program has held its "
+                                 f"lock for {wait:g} s)") from None
+        except LockError as exc:
+            raise TableError(f"{self.lock_path}: cannot take the lock: {exc}") from None
+
+    def save_replay(self, replay: Replay) -> Path:
+        """Save the replay in replays/ (before the table is touched); returns its path."""
+        self._safe_folder()
+        data = replay.to_bytes()
+        path = self.replays / self._replay_name(replay, data)
+        try:
+            if read_limited(path, MAX_REPLAY_BYTES, "replay file", follow=False) == data:
+                return path  # already there, byte for byte
+        except DataFileError:
+            pass
+        atomic_write_bytes(path, data, "replay")
+        return path
+
+    @staticmethod
+    def _replay_name(replay: Replay, data: bytes) -> str:
+        """A replay's file name in replays/: its date, its player and its bytes' digest (never a name a
+        file or a client gave)."""
+        stamp = replay.date or now_iso()
+        slug = re.sub(r"[^A-Za-z0-9]+", "-", replay.player or "").strip("-")[:24] or "player"
+        when = datetime.fromisoformat(stamp).strftime("%Y%m%dT%H%M%S")
+        return f"{when}-{slug}-{hashlib.sha256(data).hexdigest()[:8]}.json"
+
+    def _enter_many(self, new_entries: Sequence[tuple[ScoreEntry, frozenset[str]]], seed: int | None = None
+                    ) -> list[ScoreEntry | TableError]:
+        """Under the lock: write the table with ``new_entries`` added in order (each its place in the order
+        of entry and the time given here; a game already in is refused, as its TableError), or, with
+        ``seed``, an empty table ranking that seed. Returns each entry as entered, or why not. Each entry
+        comes with its game's digests by every identity version (``identity.game_digests``)."""
+        # Under the lock nobody else is writing the table: any temporary file of it was left by a
+        # writer that died mid-write. Replays are written outside the lock, so theirs are left alone.
+        for stale in self.folder.glob(f".{TABLE_NAME}.*.tmp"):
+            with contextlib.suppress(OSError):
+                if stat.S_ISREG(os.lstat(stale).st_mode):
+                    stale.unlink()
+        fd = self._open_table()
+        try:
+            if fd is None:
+                entries, damage, head = [], None, _Head()
+            else:
+                data = _read_all(fd)
+                entries, damage, head = _parse(data)
+            record = self.record.load(fresh=True)  # under the lock: what this account's last write left
+            if seed is not None:
+                if entries:
+                    raise TableError(f"{self.path} already holds {plural(len(entries), 'entry')}: a new table "
+                                     f"needs its own folder (--scores DIR); nothing was changed")
+                head = _Head(seed=seed, next_entry=head.next_entry)
+                record = None  # the new table's record is started below
+            notes = []
+            ranked, kept_seed = head.seed, head.kept_seed
+            if record is not None and head.seed != record.seed:
+                was = f"was changed from {record.seed} to {head.seed}" if head.seed is not None \
+                    else head.seed_problem
+                notes.append(f"the table's seed {was}: this account's record of the table puts seed {record.seed} "
+                             f"back")
+                ranked = record.seed
+            elif ranked is None:
+                notes.append(f"the table's seed {head.seed_problem}: kept as it is (nothing here chooses a seed for "
+                             f"the table); games are ranked as the default seed {DEFAULT_SEED} until \"seed\" is "
+                             f"set in {self.path}")
+            entries, next_entry, counter_note = _numbered(entries, head, len(new_entries))
+            if counter_note is not None:
+                notes.append(counter_note)
+            self._seed = DEFAULT_SEED if ranked is None else ranked
+            results: list[ScoreEntry | TableError] = []
+            for entry, digests in new_entries:
+                try:
+                    entry = self._admit(entry, entries, next_entry, digests)
+                except TableError as exc:
+                    results.append(exc)
+                    continue
+                entries.append(entry)
+                results.append(entry)
+                next_entry += 1
+            if len(entries) > MAX_TABLE_ENTRIES:
+                raise TableError(f"the table holds {len(entries) - 1} entries, its limit: not entered (nothing was "
+                                 f"dropped; start a new table with --scores)")
+            new = table_bytes(entries, ranked, next_entry, kept_seed)
+            if len(new) > MAX_TABLE_BYTES:
+                raise TableError("the table would grow past its size limit: not entered (nothing was dropped)")
+            _reads_back(new, entries, ranked, next_entry)
+            kept = None
+            if damage is not None and fd is not None:
+                kept = self._copy_aside(fd)  # the damaged bytes, copied before anything else changes
+            try:
+                atomic_write_bytes(self.path, new, "score table")  # the rename retires the damaged file
+            except BaseException:
+                if kept is not None:
+                    with contextlib.suppress(OSError):
+                        kept.unlink()
+                raise
+            if seed is not None:
+                self.record.start(seed)
+            elif record is not None:
+                self.record.entered([e for e in results if isinstance(e, ScoreEntry)])
+            if damage is not None:
+                where = f"; the damaged file is kept as {kept.name}" if kept else ""
+                self.warn(f"{damage.describe(self.path)}{where}")
+            for note in notes:
+                self.warn(note)
+            return results
+        finally:
+            if fd is not None:
+                os.close(fd)
+
+    @staticmethod
+    def _admit(entry: ScoreEntry, entries: list[ScoreEntry], place: int, digests: frozenset[str]) -> ScoreEntry:
+        """``entry`` with its place in the order of entry; refused if its game or replay is already in
+        (its game by any identity version's digest: an entry taken before a bump holds the older one)."""
+        twin = next((e for e in entries if e.replay_sha256 == entry.replay_sha256
+                     or (e.game_sha256 is not None and e.game_sha256 in digests)), None)
+        if twin is not None:
+            when = (twin.entered_at or twin.date)[:16].replace("T", " ")
+            raise TableError(f"this game is already in the table: entered by {twin.name} on {when} UTC "
+                             f"(entry #{twin.entered}); a game enters once, whoever's name it carries")
+        return ScoreEntry(**{**entry.as_dict(), "entered": place,
+                             "entered_at": datetime.now(UTC).isoformat(timespec="seconds")})
+
+    def _copy_aside(self, fd: int) -> Path:
+        stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+        for n in range(1000):
+            kept = self.folder / f"{TABLE_NAME}.corrupt-{stamp}{f'-{n}' if n else ''}"
+            try:
+                copy_aside(fd, kept)
+                return kept
+            except FileExistsError:
+                continue
+            except OSError as exc:
+                raise TableError(f"cannot keep a copy of the damaged table: {exc.strerror or exc}; nothing was "
+                                 f"changed") from None
+        raise TableError("cannot name a copy of the damaged table; nothing was changed")
+
+
+def _reads_back(new: bytes, entries: list[ScoreEntry], seed: int | None, next_entry: int) -> None:
+    """Refuse to write a table that would not read back as written: every entry, its seed, its counter.
+
+    Whatever a planted value did to the counters, a table that the next read would call damaged (and set
+    aside, with entries dropped) is never written."""
+    back, damage, head = _parse(new)
+    problem = (damage.reason if damage is not None
+               else f"{len(back)} of {len(entries)} entries" if len(back) != len(entries)
+               else f"next_entry {head.next_entry}, not {next_entry}" if head.next_entry != next_entry
+               or head.counter_problem is not None
+               else f"seed {head.seed}, not {seed}" if head.seed != seed
+               else None)
+    if problem is not None:
+        raise TableError(f"the table as it would be written does not read back ({problem}): not entered, "
+                         f"nothing was changed")
+
+
+def _read_all(fd: int) -> bytes:
+    chunks = []
+    size = 0
+    while chunk := os.read(fd, 1 << 20):
+        chunks.append(chunk)
+        size += len(chunk)
+        if size > MAX_TABLE_BYTES:
+            raise TableError("the table grew past its size limit while being read; nothing was changed")
+    return b"".join(chunks)
+
+
+@dataclass(frozen=True)
+class _Head:
+    """The table's own fields: the seed it ranks and the next place in its order of entry.
+
+    ``seed`` is None when the table's seed is not valid (``seed_problem`` says how): nothing chooses one for
+    it, the file keeps what it holds (``kept_seed``, the seed's JSON as found; None: the table has none).
+    A ``next_entry`` that is not valid is read as 1 (``counter_problem``): the next write sets it after the
+    last entry, and says so.
+    """
+
+    seed: int | None = DEFAULT_SEED
+    next_entry: int = 1
+    seed_problem: str | None = None
+    kept_seed: str | None = None
+    counter_problem: str | None = None
+
+
+def _numbered(entries: list[ScoreEntry], head: _Head, adding: int = 1) -> tuple[list[ScoreEntry], int, str | None]:
+    """The entries with every place in the order of entry set, the next place, and a one-line note if a
+    counter had to be repaired.
+
+    Entries carried over from an older table get their places, in the order of their dates, once. The
+    counter never goes back past a place in use (places are never reused), but it never passes
+    ``_COUNT_MAX`` either, where a place or ``next_entry`` would no longer read back: a planted
+    ``next_entry`` that high is set after the last entry, and a planted ``entered`` that high renumbers
+    the entries 1, 2, ... in their order. The ``adding`` entries of this write and the ``next_entry``
+    after them must fit.
+    """
+    last = max([0, *(e.entered or 0 for e in entries)])
+    start = max(head.next_entry, last + 1)
+    old = sorted((e for e in entries if e.entered is None), key=entry_order)
+    note = None
+    if head.counter_problem is not None:
+        note = f"the table's next_entry counter is not valid ({head.counter_problem}): set after its last entry"
+    if start + len(old) + adding > _COUNT_MAX:
+        if last + 1 + len(old) + adding <= _COUNT_MAX:
+            note = (f"the table's next_entry counter was {head.next_entry:,}, at its limit ({_COUNT_MAX:,}): set "
+                    f"after its last entry")
+            start = last + 1
+        else:
+            ordered = sorted(entries, key=lambda e: (e.entered is None, *entry_order(e)))
+            note = (f"the table's order of entry had reached {last:,}, its limit ({_COUNT_MAX:,}): its "
+                    f"{plural(len(ordered), 'entry')} are renumbered 1 to {len(ordered)} in their order")
+            return [replace(e, entered=i) for i, e in enumerate(ordered, 1)], len(ordered) + 1, note
+    if not old:
+        return entries, start, note
+    places = {e.id: start + i for i, e in enumerate(old)}
+    numbered = [e if e.entered is not None else replace(e, entered=places[e.id]) for e in entries]
+    return numbered, start + len(old), note
+
+
+def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
+    """Entries of a table file, and the damage if it is not a clean table.
+
+    A clean table yields all its entries. Otherwise every object in the text that passes
+    the entry schema is recovered, wherever it sits (truncated tails, broken brackets).
+    """
+    entries, damage, _ = _parse(data)
+    return entries, damage
+
+
+def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
+    """``parse_table`` and the table's head (``_Head``: a seed or counter that is not valid is said there,
+    not damage; a damaged table's head is what can be found of it)."""
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        text = data.decode("utf-8", errors="replace")
+        return (*_salvage(text, "not UTF-8 text"), _salvaged_head(text))
+    try:
+        table = parse_json(text)
+    except ValueError as exc:
+        return (*_salvage(text, str(exc)), _salvaged_head(text))
+    head = _Head()
+    try:
+        if not isinstance(table, dict) or table.get("format") != FORMAT:
+            raise ValueError(f"not an armgame score table (no \"format\": \"{FORMAT}\")")
+        head = _head_of(table)
+        check_keys("table", table, {"format", "format_version", "entries"}, frozenset({"seed", "next_entry"}))
+        version = check_int("format_version", table["format_version"], 1, 10**6)
+        if version not in READS_FORMATS:
+            raise ValueError(f"table format {version} is not one this armgame reads "
+                             f"({', '.join(map(str, READS_FORMATS))})")
+        if not isinstance(table["entries"], list):
+            raise ValueError("entries must be a list")
+    except ValueError as exc:
+        return (*_salvage(text, str(exc)), head)
+    entries: list[ScoreEntry] = []
+    seen: set[str] = set()
+    problem = None
+    for i, item in enumerate(table["entries"]):
+        try:
+            entry = ScoreEntry.from_dict(item)
+            if entry.id in seen:
+                raise ValueError(f"id {entry.id} appears twice")
+        except ValueError as exc:
+            problem = problem or f"entry {i + 1}: {exc}"
+            continue
+        seen.add(entry.id)
+        entries.append(entry)
+    n = len(table["entries"])
+    return entries, (Damage(problem, len(entries), n) if problem else None), head
+
+
+def _head_of(table: dict) -> _Head:
+    """The head of a table read as JSON. A seed that is not valid is kept as found, never replaced by the
+    default: tables of formats 1 and 2 had no seed and rank the default one, a format 3 table without one
+    has none (a table of a format this armgame does not read is damage, its seed the default). A
+    ``next_entry`` that is not valid is read as 1 (the next write sets it after the last entry)."""
+    counter, counter_problem = table.get("next_entry", 1), None
+    try:
+        counter = check_int("next_entry", counter, 1, _COUNT_MAX)
+    except ValueError as exc:
+        counter, counter_problem = 1, str(exc)
+    if "seed" not in table:
+        if table.get("format_version") == FORMAT_VERSION:  # armgame writes one in every such table
+            return _Head(None, counter, "is missing", None, counter_problem)
+        return _Head(DEFAULT_SEED, counter, counter_problem=counter_problem)
+    raw = table["seed"]
+    try:
+        return _Head(check_int("seed", raw, 0, _SEED_MAX), counter, counter_problem=counter_problem)
+    except ValueError as exc:
+        problem = str(exc)
+    try:
+        kept = json.dumps(raw, ensure_ascii=False, allow_nan=False)
+    except (ValueError, RecursionError):
+        kept = None
+    return _Head(None, counter, f"is not valid ({problem[:200]})", kept, counter_problem)
+
+
+#: Where a damaged table's head shows its seed: before its entries, as armgame writes it.
+_HEAD_SEED = re.compile(r'"seed"\s*:\s*(\d{1,19})\s*[,}]')
+_HEAD_VERSION = re.compile(r'"format_version"\s*:\s*(\d{1,7})\s*[,}]')
+
+
+def _salvaged_head(text: str) -> _Head:
+    """What can be found of a damaged table's head. A file that does not even say it is a score table has
+    no seed to lose (a new table's head); one that does, but whose seed is past saving, has none."""
+    end = text.find('"entries"')
+    head = text[: 65536 if end < 0 else min(end, 65536)]
+    if f'"{FORMAT}"' not in head:
+        return _Head()
+    seed = _HEAD_SEED.search(head)
+    if seed is not None and int(seed.group(1)) <= _SEED_MAX:
+        return _Head(int(seed.group(1)))
+    version = _HEAD_VERSION.search(head)
+    if '"seed"' not in head and (version is None or int(version.group(1)) != FORMAT_VERSION):
+        return _Head()
+    return _Head(None, 1, "cannot be read (the file is damaged)", None)
+
+
+#: A flat JSON object (an entry has no nested values), strings honoured. Possessive quantifiers
+#: never backtrack, so the scan is linear in the file's size whatever it holds.
+_FLAT_OBJECT = re.compile(r'\{(?:[^{}"\[\]]++|"(?:[^"\\]++|\\.)*+")*+\}')
+
+
+def _salvage(text: str, reason: str) -> tuple[list[ScoreEntry], Damage]:
+    entries: list[ScoreEntry] = []
+    seen: set[str] = set()
+    for match in _FLAT_OBJECT.finditer(text):
+        try:
+            entry = ScoreEntry.from_dict(STRICT_DECODER.decode(match.group()))
+        except (ValueError, RecursionError):
+            continue
+        if entry.id not in seen:
+            seen.add(entry.id)
+            entries.append(entry)
+    return entries, Damage(reason, len(entries), len(entries))
+
+
+def table_bytes(entries: list[ScoreEntry], seed: int | None = DEFAULT_SEED, next_entry: int | None = None,
+                kept_seed: str | None = None) -> bytes:
+    """The table file: one entry a line, best first, so it reads (and diffs) as a list.
+
+    Fields an entry lacks (it came from an older table) are left out rather than written as null. A
+    ``seed`` of None writes ``kept_seed`` (the JSON of a seed that is not valid, kept as found), or no
+    seed at all."""
+    lines = [json.dumps({k: v for k, v in e.as_dict().items() if v is not None or k not in _OPTIONAL},
+                        sort_keys=True, ensure_ascii=False, allow_nan=False)
+             for e in sorted(entries, key=sort_key)]
+    if next_entry is None:
+        next_entry = max([0, *(e.entered or 0 for e in entries)]) + 1
+    head = json.dumps({"format": FORMAT, "format_version": FORMAT_VERSION})[:-1]
+    if seed is not None:
+        head += f', "seed": {seed}'
+    elif kept_seed is not None:
+        head += f', "seed": {kept_seed}'
+    head += f', "next_entry": {next_entry}'
+    return (head + ', "entries": [\n' + ",\n".join(lines) + "\n]}\n").encode("utf-8")
