@@ -1,6 +1,6 @@
 """The work ``armgame scores`` counts for honest games, and what that work really costs: the measurements
 behind ``MAX_CHECK_WORK`` (``armgame.commands.scores``) and ``HIT_WORK``/``EVENT_WORK``
-(``armgame.records.scores``).
+(``armgame.records.checking``).
 
     python benchmarks/honest_work.py              # every bot on seeds 0 to 41, fast keyboard players
     python benchmarks/honest_work.py --seeds 10

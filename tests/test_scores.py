@@ -15,8 +15,8 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 
 import pytest
 
+import armgame.records.entry as entry_module
 import armgame.records.scores as scores_module
-import armgame.records.tablefile as entry_module
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession

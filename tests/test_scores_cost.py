@@ -42,11 +42,12 @@ def test_listing_and_ranking_old_entries_read_no_replay(tmp_path, monkeypatch, c
     for i in range(3):  # standard games: their length and scene alone cannot say they are custom
         table.add(short_game(f"old{i}", i, 60.0))
     _as_old_format(table)
+    import armgame.records.checking as checking_module
     import armgame.records.replay as replay_module
     import armgame.records.tablefile as tablefile_module
 
     reads = []
-    for module in (storage, tablefile_module, replay_module):
+    for module in (storage, checking_module, tablefile_module, replay_module):
         for name in ("open_regular", "read_limited"):
             if not hasattr(module, name):
                 continue

@@ -13,7 +13,7 @@ SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else s
 
 
 #: The most work ``scores`` spends recomputing one game, in physics steps of the compiled loop
-#: (``records.scores.replay_work``: steps, 100 a claimed hit under a ranked ruleset and 6,000 under others,
+#: (``records.checking.replay_work``: steps, 100 a claimed hit under a ranked ruleset and 6,000 under others,
 #: 20 an input event): about 0.13 s. Three times the largest honest game measured: the model bot's standard
 #: game of seed 18, 333,900 (15,000 steps, 50 hits, 15,695 events); the naive bot's largest is 64,720 and
 #: a keyboard player pressing each of the four keys 20 times a second 214,960 (``python

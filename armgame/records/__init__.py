@@ -3,7 +3,11 @@
 ``storage`` is the one way armgame reads and writes files (regular files only, never blocking,
 atomic, no symlink followed out of a folder, JSON strictly as data); ``replay`` turns a game's
 configuration and input timeline into a file that recomputes its result; ``rulesets`` names the
-games that rank, by the digest of their configuration; ``scores`` keeps the high-score table,
-each entry backed by its replay, with a per-user cache of verdicts. The limits every reader and
-writer shares are in ``armgame.limits``.
+games that rank, by the digest of their configuration; ``scores`` keeps the high-score table
+(``ScoreTable``: its lists and ranks), each entry backed by its replay. The table is three concepts,
+each a module: ``entry`` (``ScoreEntry``, each field checked, its orders), ``tablefile`` (the file:
+read, parsed or salvaged, written whole under its lock, its head and counters) and ``checking`` (each
+entry against its replay, within a cost counted beforehand), with ``cache`` (the per-user verdicts)
+and ``teacher`` (the account that started a table keeps its seed and order of entry where no
+classmate writes). The limits every reader and writer shares are in ``armgame.limits``.
 """

@@ -41,38 +41,37 @@ from pathlib import Path
 
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES
 from .cache import VerificationCache, default_cache_dir, file_signature  # noqa: F401 (the cache's old home)
+from .checking import (  # noqa: F401 (imported from here by the commands and tests)
+    EVENT_WORK,
+    HIT_WORK,
+    NOT_CHECKED,
+    RANKED_HIT_WORK,
+    Check,
+    TableChecks,
+    not_checked_detail,
+    replay_work,
+)
+from .entry import ScoreEntry, entry_order, replay_claims, sort_key
 from .identity import game_digests
 from .replay import Replay, now_iso
 from .rulesets import CUSTOM, RULESETS, ruleset_by_digest
 from .standings import one_row_per_player, rank_of
 from .storage import DataFileError, atomic_write_many, read_limited, user_path
 from .tablefile import (  # noqa: F401 (imported from here by the commands and tests)
-    EVENT_WORK,
     FORMAT,
     FORMAT_VERSION,
-    HIT_WORK,
     LOCK_NAME,
     LOCK_WAIT,
-    NOT_CHECKED,
-    RANKED_HIT_WORK,
     READS_FORMATS,
     REPLAYS_DIR,
     TABLE_NAME,
-    Check,
     Damage,
-    ScoreEntry,
     TableBusyError,
-    TableChecks,
     TableError,
     TableFile,
     _Head,
     _parse,
-    entry_order,
-    not_checked_detail,
     parse_table,
-    replay_claims,
-    replay_work,
-    sort_key,
     table_bytes,
 )
 from .teacher import disagreements, in_recorded_order
