@@ -27,6 +27,8 @@ SELECTION = [
     "tests/test_hostile.py::test_a_busy_table_keeps_the_game_and_says_how_to_enter_it",
     "tests/test_hostile.py::test_slow_lock_holder_does_not_lose_entries",
     "tests/test_table_identity.py::test_the_same_game_enters_once_however_it_is_copied",
+    "tests/test_teacher_record.py::test_a_planted_copy_never_pushes_out_a_game_the_teacher_entered",
+    "tests/test_teacher_record.py::test_a_hostile_counter_is_repaired_once_and_every_game_kept",
 ]
 
 
