@@ -189,7 +189,7 @@ _ENTRY_CLAIMS = frozenset({"name", "driven", "driver", "score", "hits", "resets"
 # the loop every install with a C compiler runs; measured with ``python benchmarks/honest_work.py``. In the
 # Python loop a step costs 20 times more and an event or a try no more, so these overcount there.
 #: What recomputing one hit can cost under any rules: drawing the next target tries up to 1,000 postures
-#: (``GameRules._draw_target``), each measured at 5.9 steps (0.73 us): 5,900, rounded up.
+#: (``GameRules._draw_target``), each measured at 5.8 to 6.1 steps (0.72 to 0.75 us) over runs: 6,000.
 HIT_WORK = 6_000
 #: What one hit costs under a ranked ruleset, whose target ranges keep a drawn target clear of the hand:
 #: 1.36 tries on average and at most 9 in 20,000 draws from random hands, a draw measured at 14 steps.
