@@ -31,10 +31,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
     )
     p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
-    p.add_argument("--out", metavar="PATH", required=True,
+    p.add_argument("--out", metavar="PATH",
                    help="a .csv file (all reaches in one table, each row led by its player and replay), or a folder "
                    "(one REPLAY.trials.csv each); "
-                   "with --class, the folder for class_curve.csv and class_curve.png")
+                   "with --class, the folder for class_curve.csv and class_curve.png; with --fit it may be left out: "
+                   "the fit is printed and nothing written")
     p.add_argument("--class", dest="class_dir", metavar="DIR", help="a folder of students' lab replays")
     p.add_argument("--metric", default=None,
                    help="the class curve's measure (default: max_perpendicular_error_m for force fields, "
@@ -44,7 +45,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--fit", choices=("two-rate",),
                    help="fit the two-rate model's retention and learning rates (A_f, A_s, B_f, B_s) to each replay's "
                    "per-trial errors: the values with 95%% confidence intervals and the residual, and NAME.fit.png "
-                   "(the fit over the data) next to --out")
+                   "(the fit over the data) next to --out, if given")
     p.add_argument("--fit-on", choices=("error", "index"), default="error",
                    help="with --fit: the errors of the reaches that are not channel trials (default; the measure "
                    "the learning figure plots), or the adaptation index of the channel trials")
@@ -59,16 +60,21 @@ def run(args: argparse.Namespace) -> int:
     if args.class_dir is not None:
         if args.replays:
             raise UserError("give replays or --class DIR, not both")
+        if args.out is None:
+            raise UserError("--class needs --out DIR: the folder for class_curve.csv and class_curve.png")
         return _class(args)
     if not args.replays:
         raise UserError("no replay given: armgame analyze REPLAY... --out trials.csv (or --class DIR)")
+    if args.out is None and not args.fit:  # a fit alone is printed; the table has nowhere else to go
+        raise UserError("--out is needed: a .csv file or a folder for the reaches' table (only --fit prints "
+                        "without it)")
     if args.metric:
         raise UserError("--metric applies with --class only")
     if args.no_figures and not args.fit:
         raise UserError("--no-figures applies with --class or --fit only")
     if args.fit_on != "error" and not args.fit:
         raise UserError("--fit-on applies with --fit only")
-    if args.fit and not args.no_figures:
+    if args.fit and not args.no_figures and args.out is not None:  # without --out no figure is drawn
         from ..lab.figures import require_matplotlib
 
         try:
@@ -146,11 +152,12 @@ def class_members(runs: list, wanted: str | None) -> tuple[list, object, list[tu
 def _replays(args: argparse.Namespace) -> int:
     from ..lab.metrics import LABEL_COLUMNS, write_trials_csv
 
-    out = user_path(args.out, "--out")
-    one_table = out.suffix.lower() == ".csv"
+    # No --out (a fit only): the fit is printed, nothing written.
+    out = None if args.out is None else user_path(args.out, "--out")
+    one_table = out is not None and out.suffix.lower() == ".csv"
     if one_table and not out.resolve().parent.is_dir():
         raise UserError(f"--out {args.out}: its folder does not exist")
-    if not one_table and out.exists() and not out.is_dir():
+    if out is not None and not one_table and out.exists() and not out.is_dir():
         raise UserError(f"--out {args.out}: not a folder (give a .csv file for one table)")
     table: list[dict[str, object]] = []
     skipped = 0
@@ -166,7 +173,8 @@ def _replays(args: argparse.Namespace) -> int:
             continue
         print(f"{path}: verified: {session.protocol.name}, seed {session.config.seed}, {len(rows)} reaches")
         if args.fit:
-            figure = None if args.no_figures else (out.parent if one_table else out) / f"{path.stem}.fit.png"
+            figure = None if args.no_figures or out is None else \
+                (out.parent if one_table else out) / f"{path.stem}.fit.png"
             try:
                 written += _fit(session, rows, args.fit_on, figure)
             except UserError as exc:
@@ -176,7 +184,7 @@ def _replays(args: argparse.Namespace) -> int:
         if one_table:  # whose each row is: several runs' trials restart at 1
             who = {"player": replay.player or "", "replay": str(path)}  # the file verified, not read again
             table += [{**who, **row} for row in rows]
-        else:
+        elif out is not None:
             out.mkdir(parents=True, exist_ok=True)
             target = out / f"{path.stem}.trials.csv"
             write_trials_csv(target, rows)

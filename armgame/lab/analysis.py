@@ -142,13 +142,18 @@ def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndar
     """Each finished trial's disturbance, in units of the run's first perturbation (the reference: +1 that
     perturbation, -1 its opposite, 0 none and catch trials), and whether it was an error-clamp (channel)
     trial: the schedule ``fit.fit_two_rate`` fits the learner to. Raises ValueError for a run with no
-    perturbation, or one whose perturbations are not multiples of each other (a curl and a rotation)."""
-    reference = next((b.perturbation for b in protocol.blocks if b.perturbation.kind != "none"), None)
+    perturbation or only zero ones (curl ``b = 0``, ``angle = 0``: the unit a disturbance is counted in
+    would be zero), or one whose perturbations are not multiples of each other (a curl and a rotation)."""
+    perturbed = [b.perturbation for b in protocol.blocks if b.perturbation.kind != "none"]
+    reference = next((p for p in perturbed if not p.is_null), None)
     if reference is None:
+        if perturbed:
+            raise ValueError(f"its perturbation is zero ({perturbed[0].label()}): nothing to learn; a fit needs "
+                             "a field (or a changed display) to fit")
         raise ValueError("the protocol has no perturbation: nothing to learn, nothing to fit")
 
     def scale(p) -> float:
-        if p.kind == "none":
+        if p.is_null:  # none, or a zero field: no disturbance (and no division by a zero reference)
             return 0.0
         if p.kind in ("curl", "viscous") and reference.kind in ("curl", "viscous"):
             b, r = np.asarray(p.matrix), np.asarray(reference.matrix)

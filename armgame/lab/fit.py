@@ -29,6 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..words import plural
+
 PARAMETER_NAMES = ("retention_fast", "retention_slow", "rate_fast", "rate_slow")
 SYMBOLS = {"retention_fast": "A_f", "retention_slow": "A_s", "rate_fast": "B_f", "rate_slow": "B_s", "gain": "k"}
 OBSERVED = ("error", "index")
@@ -101,7 +103,7 @@ def fit_two_rate(disturbance: Sequence[float] | np.ndarray, clamped: Sequence[bo
     if observed_kind == "error":
         seen &= ~clamp
     if seen.sum() < 8:
-        raise ValueError(f"{int(seen.sum())} trials with a value: a two-rate fit needs at least 8")
+        raise ValueError(f"{plural(int(seen.sum()), 'trial')} with a value: a two-rate fit needs at least 8")
     if not np.any(f[~clamp] != 0.0):
         raise ValueError("no trial had a disturbance to learn from: nothing to fit")
     with_gain = observed_kind == "error"

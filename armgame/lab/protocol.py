@@ -128,6 +128,15 @@ class Perturbation:
     def is_visual(self) -> bool:
         return self.kind in VISUAL_KINDS
 
+    @property
+    def is_null(self) -> bool:
+        """Whether it changes nothing: ``none``, or a field or rotation of size zero (curl ``b = 0``, a zero
+        matrix, no force, no stiffness, ``angle = 0``). A mirror or a joint-space display always changes
+        the display."""
+        if self.kind in ("mirror", "jointspace"):
+            return False
+        return all(value == 0.0 for _name, value in self.params)
+
     def label(self) -> str:
         """e.g. ``curl b=2 N s/m``; ``none`` for none."""
         if self.kind == "viscous":

@@ -1,0 +1,80 @@
+"""Inputs that gave a traceback or ran on (issue 26, item 6): each is now one line naming what is wrong
+and a non-zero exit, or ends quietly, within bounded work."""
+
+import math
+
+import pytest
+
+from armgame.cli import main
+
+
+def error_lines(capsys, argv, code=2) -> list[str]:
+    """stderr's lines of ``armgame argv`` run in this process, which must exit with ``code``."""
+    assert main([str(a) for a in argv]) == code
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.strip(), err
+    return err.strip().splitlines()
+
+
+# ------------------------------------------------------------------ analyze --fit on nothing to fit
+
+TINY = """name = "tiny"
+timeout = 0.5
+delay_min = 0.1
+delay_max = 0.1
+[[blocks]]
+name = "exposure"
+trials = {trials}
+{perturbation}
+"""
+
+
+@pytest.mark.parametrize(("perturbation", "trials", "said"), [
+    ('perturbation = "curl"\nb = 0.0', 2, "its perturbation is zero (curl b=0 N s/m)"),
+    ('perturbation = "curl"', 2, "its perturbation is zero (curl b=0 N s/m)"),  # b left at its default, 0
+    ('perturbation = "rotation"\nangle = 0', 2, "its perturbation is zero (rotation angle=0 deg)"),
+    ('perturbation = "viscous"\nmatrix = [[0, 0], [0.0, 0]]', 2, "its perturbation is zero (viscous B=[[0, 0]"),
+    ('perturbation = "curl"\nb = 2.0', 1, "1 trial with a value: a two-rate fit needs at least 8"),
+])
+def test_a_fit_to_nothing_to_fit_is_one_line(tmp_path, capsys, perturbation, trials, said):
+    protocol = tmp_path / "p.toml"
+    protocol.write_text(TINY.format(trials=trials, perturbation=perturbation))
+    run = tmp_path / "run.json"
+    assert main(["lab", str(protocol), "--bot", "model", "--headless", "--record", str(run)]) == 0
+    capsys.readouterr()
+    lines = error_lines(capsys, ["analyze", run, "--fit", "two-rate", "--no-figures"])
+    assert len(lines) == 2 and lines[1] == "armgame analyze: error: no replay could be analysed"
+    assert lines[0].startswith(f"armgame analyze: {run}: cannot fit the two-rate model to its ") and said in lines[0]
+
+
+def test_the_zero_field_is_no_reference_for_a_later_one():
+    """A zero field before a real one counts as no disturbance; the real one is the unit."""
+    from armgame.lab.analysis import disturbance_schedule
+    from armgame.lab.protocol import Block, Perturbation, Protocol
+
+    zero, field = Perturbation.make("curl", b=0.0), Perturbation.make("curl", b=2.0)
+    protocol = Protocol("p", (Block("a", 1, zero), Block("b", 1, field),
+                              Block("c", 1, Perturbation.make("curl", b=-1.0))))
+    plans = [type("Plan", (), {"channel": False, "active": p})() for p in (zero, field, protocol.blocks[2].perturbation)]
+    disturbance, clamped = disturbance_schedule(protocol, plans)
+    assert disturbance.tolist() == [0.0, 1.0, -0.5] and not clamped.any()
+    assert Perturbation().is_null and zero.is_null and not field.is_null
+    assert not Perturbation.make("mirror", axis=0.0).is_null and Perturbation.make("rotation", angle=0).is_null
+    assert math.isfinite(disturbance.sum())
+
+
+def test_analyze_fit_prints_without_out(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    protocol = tmp_path / "p.toml"
+    protocol.write_text(TINY.format(trials=10, perturbation='perturbation = "curl"\nb = 2.0'))
+    assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--record", "run.json"]) == 0
+    capsys.readouterr()
+    assert main(["analyze", "run.json", "--fit", "two-rate"]) == 0  # no --out: no figure, nothing written
+    out = capsys.readouterr().out
+    assert "two-rate fit to max_perpendicular_error_m (10 trials)" in out and "wrote" not in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["p.toml", "run.json"]
+    assert error_lines(capsys, ["analyze", "run.json"]) == [
+        "armgame analyze: error: --out is needed: a .csv file or a folder for the reaches' table (only --fit "
+        "prints without it)"]
+    assert error_lines(capsys, ["analyze", "--class", tmp_path]) == [
+        "armgame analyze: error: --class needs --out DIR: the folder for class_curve.csv and class_curve.png"]
