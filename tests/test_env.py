@@ -165,7 +165,7 @@ def test_no_action_drives_the_arm_past_the_speed_bound():
 
 
 def test_bad_arguments_and_actions_are_refused_in_one_line():
-    for kwargs, word in [({"decision_steps": 0}, "decision_steps"), ({"time_limit": -1.0}, "duration"),
+    for kwargs, word in [({"decision_steps": 0}, "decision_steps"), ({"time_limit": -1.0}, "time_limit must be a"),
                          ({"time_limit": "60"}, "time_limit"), ({"render_mode": "ascii"}, "render_mode"),
                          ({"render_size": (0, 10)}, "render_size"), ({"config": {}}, "config"),
                          ({"reset_key": "yes"}, "reset_key")]:

@@ -55,7 +55,7 @@ def test_the_zero_field_is_no_reference_for_a_later_one():
     zero, field = Perturbation.make("curl", b=0.0), Perturbation.make("curl", b=2.0)
     protocol = Protocol("p", (Block("a", 1, zero), Block("b", 1, field),
                               Block("c", 1, Perturbation.make("curl", b=-1.0))))
-    plans = [type("Plan", (), {"channel": False, "active": p})() for p in (zero, field, protocol.blocks[2].perturbation)]
+    plans = [type("Plan", (), {"channel": False, "active": b.perturbation})() for b in protocol.blocks]
     disturbance, clamped = disturbance_schedule(protocol, plans)
     assert disturbance.tolist() == [0.0, 1.0, -0.5] and not clamped.any()
     assert Perturbation().is_null and zero.is_null and not field.is_null
@@ -78,3 +78,31 @@ def test_analyze_fit_prints_without_out(tmp_path, capsys, monkeypatch):
         "prints without it)"]
     assert error_lines(capsys, ["analyze", "--class", tmp_path]) == [
         "armgame analyze: error: --class needs --out DIR: the folder for class_curve.csv and class_curve.png"]
+
+
+# ------------------------------------------------------------------ env arguments
+
+@pytest.mark.parametrize("env_id", ["armgame/Reach-v1", "armgame/ReachContinuous-v0"])
+@pytest.mark.parametrize("time_limit", [1e-9, 0.0, -1.0, math.nan, math.inf, 1e300])
+def test_an_env_with_no_game_to_play_is_refused_naming_the_argument(env_id, time_limit):
+    gym = pytest.importorskip("gymnasium")
+    import armgame.env  # noqa: F401  (registers the ids)
+
+    with pytest.raises(ValueError, match=r"^time_limit must be a number of seconds from 0\.004 \(one physics step\) "
+                                         r"to 86400, got "):
+        gym.make(env_id, time_limit=time_limit)
+
+
+def test_a_vector_env_or_a_config_with_no_game_to_play_is_refused():
+    pytest.importorskip("gymnasium")
+    from armgame.env.reach_v1 import ReachV1Env
+    from armgame.env.vector import ReachV1VectorEnv
+    from armgame.game.rules import GameConfig
+
+    with pytest.raises(ValueError, match="time_limit must be a number of seconds from"):
+        ReachV1VectorEnv(2, time_limit=1e-9)
+    with pytest.raises(ValueError, match=r"config\.time_limit must be at least one physics step \(0\.004 s\)"):
+        ReachV1Env(config=GameConfig(time_limit=1e-9))
+    env = ReachV1Env(time_limit=0.004)  # the shortest game: one physics step, one env step
+    env.reset(seed=1)
+    assert env.step(env.action_space.sample())[3] is True

@@ -26,6 +26,8 @@ from .features import check_dtype, check_reward, reach_bounds_v1
 #: Decision step of the standard envs in physics steps: 5 x 4 ms = 20 ms, a 50 Hz controller.
 DEFAULT_DECISION_STEPS = 5
 MAX_DECISION_STEPS = 1000
+#: The longest game an env plays, in seconds: the game's own limit (``GameConfig``).
+MAX_TIME_LIMIT = 24 * 3600.0
 #: The game's seeds (``GameConfig.seed``) are whole numbers below this.
 SEED_LIMIT = 2**63
 OBSERVATION_NAMES = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "target_x", "target_y", "time_left")
@@ -55,12 +57,20 @@ class ReachSettings:
         elif not isinstance(config, GameConfig):
             raise EnvArgumentError(f"config must be an armgame GameConfig, got {type(config).__name__}")
         if time_limit is not None:
-            if isinstance(time_limit, bool) or not isinstance(time_limit, int | float):
-                raise EnvArgumentError(f"time_limit must be a number of seconds, got {time_limit!r}")
+            # At least one physics step: a game of none is over at its reset, and v1's observation divides
+            # the time left by the game's length.
+            low, high = config.dt, MAX_TIME_LIMIT
+            if isinstance(time_limit, bool) or not isinstance(time_limit, int | float) \
+                    or not (math.isfinite(time_limit) and low <= time_limit <= high):
+                raise EnvArgumentError(f"time_limit must be a number of seconds from {low:g} (one physics step) "
+                                       f"to {high:g}, got {time_limit!r}")
             try:
                 config = dataclasses.replace(config, time_limit=float(time_limit))
             except UserError as exc:  # the game's own check, in its words
                 raise EnvArgumentError(str(exc)) from None
+        if config.total_steps < 1:
+            raise EnvArgumentError(f"config.time_limit must be at least one physics step ({config.dt:g} s), got "
+                                   f"{config.time_limit!r}")
         if isinstance(decision_steps, bool) or not isinstance(decision_steps, int | np.integer) \
                 or not 1 <= decision_steps <= MAX_DECISION_STEPS:
             raise EnvArgumentError(f"decision_steps must be a whole number of physics steps from 1 to "
