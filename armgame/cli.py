@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import itertools
+import os
 import re
+import signal
 import sys
 from collections.abc import Sequence
 from typing import NoReturn
@@ -67,7 +70,30 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: The exit status when the reader of the output left early (``armgame scores | head``): a shell's for a
+#: process ended by SIGPIPE, 128 + 13; 1 where there is no such signal (Windows).
+EXIT_BROKEN_PIPE = 128 + getattr(signal, "SIGPIPE", -127)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command ``argv`` (the command line's arguments if None); returns the exit status."""
+    try:
+        try:
+            return _main(argv)
+        finally:
+            # Flushed here, so a reader that left early is found inside this try, not at the interpreter's
+            # exit (which would print "Exception ignored ... BrokenPipeError").
+            sys.stdout.flush()
+    except BrokenPipeError:
+        # The recipe of Python's signal docs: what is still buffered goes to devnull, not to the closed pipe
+        # at exit; nothing is said (the reader is gone, and stderr may be the same pipe).
+        with contextlib.suppress(OSError, ValueError):
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
     if extra:  # left over by the command's parser: its error, under its name

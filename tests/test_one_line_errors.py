@@ -2,6 +2,9 @@
 and a non-zero exit, or ends quietly, within bounded work."""
 
 import math
+import os
+import subprocess
+import sys
 
 import pytest
 
@@ -106,3 +109,40 @@ def test_a_vector_env_or_a_config_with_no_game_to_play_is_refused():
     env = ReachV1Env(time_limit=0.004)  # the shortest game: one physics step, one env step
     env.reset(seed=1)
     assert env.step(env.action_space.sample())[3] is True
+
+
+# ------------------------------------------------------------------ output into a closed pipe
+
+@pytest.mark.skipif(sys.platform == "win32", reason="a closed pipe is EINVAL there, and no SIGPIPE")
+def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
+    """``armgame scores --all | head -1``: the listing stops when its reader has gone, with no traceback."""
+    import dataclasses
+
+    from armgame.cli import EXIT_BROKEN_PIPE
+    from armgame.records.rulesets import RULESETS
+    from armgame.records.scores import ScoreEntry, table_bytes
+
+    one = ScoreEntry.from_dict(dict(id="0" * 32, name="a", driven="keyboard", driver=None, score=9, hits=9, resets=0,
+                                    seed=10, scene="game", duration=60.0, date="2025-03-01T10:00:00+00:00",
+                                    version="0.1.0", replay="r.json", replay_sha256="0" * 64, ruleset="standard",
+                                    config_sha256=RULESETS["standard"].digest))
+    entries = [dataclasses.replace(one, id=f"{i:032x}", name=f"p{i}") for i in range(3000)]  # ~200 KB listed
+    (tmp_path / "scores.json").write_bytes(table_bytes(entries))
+    env = {**os.environ, "ARMGAME_CACHE": str(tmp_path / "cache")}
+    argv = [sys.executable, "-m", "armgame", "scores", "--all", "--no-check", "--scores", str(tmp_path)]
+    child = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    assert child.stdout.readline().startswith(b"High scores in ")
+    child.stdout.close()  # the reader leaves, as head does
+    err = child.stderr.read()
+    assert child.wait(timeout=60) == EXIT_BROKEN_PIPE == 141 and err == b""
+
+
+def test_a_broken_pipe_inside_any_command_is_its_exit_status(monkeypatch, capsys):
+    from armgame import cli
+
+    def gone(_args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr("armgame.commands.settings.run", gone)  # register() reads it on every main()
+    assert cli.main(["settings"]) == cli.EXIT_BROKEN_PIPE
+    assert capsys.readouterr().err == ""
