@@ -146,3 +146,77 @@ def test_a_broken_pipe_inside_any_command_is_its_exit_status(monkeypatch, capsys
     monkeypatch.setattr("armgame.commands.settings.run", gone)  # register() reads it on every main()
     assert cli.main(["settings"]) == cli.EXIT_BROKEN_PIPE
     assert capsys.readouterr().err == ""
+
+
+# ------------------------------------------------------------------ paths too long for the file system
+
+def _too_long(tmp_path, kind: str) -> str:
+    """A path the file system cannot name: one name past its longest name, or a whole past its longest path."""
+    from armgame.files import path_limits
+
+    name_max, path_max = path_limits(tmp_path)
+    if kind == "name":
+        return str(tmp_path / ("x" * (name_max + 45)))
+    return str(tmp_path.joinpath(*["y" * 200] * (path_max // 201 + 2)))
+
+
+@pytest.mark.parametrize("kind", ["name", "path"])
+@pytest.mark.parametrize("argv", [
+    ["scores", "--scores", "{p}"], ["scores", "--scores", "{p}", "--all"], ["scores", "--new", "--scores", "{p}"],
+    ["scores", "--add", "{p}"], ["scores", "--cache", "{p}"],
+    ["play", "--headless", "--duration", "0.1", "--name", "Ann", "--scores", "{p}"],
+    ["play", "--headless", "--duration", "0.1", "--record", "{p}"], ["play", "--headless", "--script", "{p}"],
+    ["verify", "{p}"], ["replay", "{p}", "--headless"], ["settings", "--settings", "{p}"],
+    ["lab", "{p}", "--headless", "--bot", "model"], ["lab", "null", "--headless", "--bot", "model", "--record", "{p}"],
+    ["lab", "null", "--headless", "--bot", "model", "--out", "{p}"],
+    ["analyze", "--class", "{p}", "--out", "{tmp}"], ["analyze", "{tmp}/r.json", "--out", "{p}"],
+    ["simulate", "--scene", "pendulum", "--out", "{p}"], ["demo", "chaos", "--headless", "--out", "{p}"],
+])
+def test_a_path_too_long_for_the_file_system_is_one_line(tmp_path, capsys, monkeypatch, argv, kind):
+    monkeypatch.setenv("ARMGAME_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("ARMGAME_SCORES", str(tmp_path / "scores"))
+    p = _too_long(tmp_path, kind)
+    (line,) = error_lines(capsys, [a.format(p=p, tmp=tmp_path) for a in argv])
+    assert line.startswith(f"armgame {argv[0]}: error: ") and "more than the file system allows" in line
+    assert len(line) < 400 and not any(tmp_path.iterdir())  # refused before anything was made
+
+
+@pytest.mark.parametrize("argv", [["scores"], ["play", "--headless", "--duration", "0.1", "--name", "Ann"]])
+def test_an_armgame_scores_too_long_is_one_line(tmp_path, capsys, monkeypatch, argv):
+    monkeypatch.setenv("ARMGAME_SCORES", _too_long(tmp_path, "name"))
+    (line,) = error_lines(capsys, argv)
+    assert f"error: $ARMGAME_SCORES {tmp_path}" in line and "more than the file system allows" in line
+
+
+def test_analyze_names_a_replay_too_long_and_goes_on(tmp_path, capsys):
+    lines = error_lines(capsys, ["analyze", _too_long(tmp_path, "name"), "--out", tmp_path / "t.csv"])
+    assert lines[0].startswith(f"armgame analyze: REPLAY {tmp_path}") and "more than the file system" in lines[0]
+    assert lines[1:] == ["armgame analyze: error: no replay could be analysed"]
+
+
+def test_a_table_too_deep_for_its_own_files_is_refused_before_writing(tmp_path):
+    from armgame.files import path_limits
+    from armgame.game.rules import GameConfig
+    from armgame.game.session import GameSession
+    from armgame.records.replay import Replay
+    from armgame.records.scores import ScoreTable, TableError
+    from armgame.records.storage import DataFileError, check_output_path, check_writable_folder
+
+    _, path_max = path_limits(tmp_path)
+    left = path_max - 1 - 60 - len(str(tmp_path))  # a folder 60 bytes short of the longest path
+    full, rest = divmod(left, 201)  # names of 200 bytes and their separators, and one name of what is left
+    if rest < 2:
+        full, rest = full - 1, rest + 201
+    folder = tmp_path.joinpath(*["z" * 200] * full, "w" * (rest - 1))
+    assert len(str(folder)) == path_max - 61
+    session = GameSession(GameConfig(time_limit=0.1))
+    session.advance(session.total_steps)
+    with pytest.raises(TableError, match=r"^the table's folder .*more than the file system allows \(with room"):
+        ScoreTable(folder).add(Replay.from_session(session, "keyboard", None, "Ann"))
+    assert not any(tmp_path.iterdir())
+    deep = _too_long(tmp_path, "path")
+    with pytest.raises(DataFileError, match="cannot write the replay: File name too long"):
+        check_output_path(tmp_path / deep / "r.json", "replay")  # pathlib's is_dir() raised here
+    with pytest.raises(Exception, match="more than the file system allows") as caught:
+        check_writable_folder(tmp_path / deep, "--scores")
+    assert "Traceback" not in str(caught.value)

@@ -43,11 +43,12 @@ def test_records_tests_pass_without_posix_locks_or_flags():
 
 @pytest.mark.skipif(not SIMULATED, reason="only where POSIX is simulated away")
 def test_the_simulated_platform_really_lacks_them():
+    import armgame.files as files
     import armgame.records.storage as storage
 
     with pytest.raises(ImportError):
         import fcntl  # noqa: F401
-    assert storage._NOFOLLOW == storage._NONBLOCK == storage._NOCTTY == 0
+    assert files._NOFOLLOW == files._NONBLOCK == files._NOCTTY == storage._NOFOLLOW == 0
     assert not hasattr(os, "O_NOFOLLOW") and not hasattr(os, "O_NONBLOCK")
 
 

@@ -165,6 +165,7 @@ def _replays(args: argparse.Namespace) -> int:
     for name in args.replays:
         path = Path(name)
         try:
+            path = user_path(name, "REPLAY")
             replay = lab_replay(path)
             rows, session = verified_run(path, replay)
         except UserError as exc:
@@ -228,7 +229,7 @@ def _class(args: argparse.Namespace) -> int:
     from ..lab.figures import class_curve
     from ..lab.metrics import write_class_csv
 
-    folder = Path(args.class_dir)
+    folder = user_path(args.class_dir, "--class")
     if not folder.is_dir():
         raise UserError(f"--class {args.class_dir}: not a folder")
     out = user_path(args.out, "--out")

@@ -78,8 +78,11 @@ def load_protocol_argument(text: str):
 
     if text in PRESETS:
         return preset(text)
-    if text.endswith(".toml") or Path(text).exists():
-        return load_protocol(Path(text))
+    from ..records.storage import user_path
+
+    path = user_path(text, "PROTOCOL")  # a path the file system cannot name is one line, not OSError
+    if text.endswith(".toml") or path.exists():
+        return load_protocol(path)
     raise UserError(unknown_name("lab protocol", text, PRESETS, "or give a .toml file"))
 
 

@@ -102,12 +102,11 @@ def check_recordable(config, what: str):
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from ..game.script import load_script
     from ..game.session import GameSession
+    from ..records.storage import user_path
 
-    if args.script and (len(args.script) > 1 or Path(args.script[0]).is_dir()):
+    if args.script and (len(args.script) > 1 or user_path(args.script[0], "--script").is_dir()):
         return _play_class(args)
     args.membership = _join(args)
     if args.script:

@@ -16,8 +16,8 @@ import math
 from pathlib import Path
 
 from ..errors import UserError
+from ..files import read_limited
 from ..limits import MAX_EVENTS, MAX_GAME_SECONDS, MAX_SCRIPT_BYTES
-from ..records.storage import read_limited
 from .session import DOWN, UP, InputEvent
 
 

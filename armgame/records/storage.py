@@ -14,13 +14,17 @@ What it guarantees, whatever is planted at the path:
   folder (a rename is only atomic within one file system), is flushed and fsynced, renamed
   over the target, and then the folder is fsynced so that the rename survives a power cut.
   A reader therefore sees the old file or the new one, never a mixture.
-* Paths given by the user: ``~user`` that names nobody is one line, not a traceback.
+* Paths given by the user: ``~user`` that names nobody, or a path too long for the file system, is
+  one line, not a traceback.
+
+The reading half (``open_regular``, ``read_limited``, ``user_path``, ``DataFileError``) lives in
+``armgame.files``, below every layer, so the game reads its scripts without reaching up to records;
+it is re-exported here, where every other reader and writer finds it.
 """
 
 from __future__ import annotations
 
 import contextlib
-import errno
 import json
 import math
 import os
@@ -30,11 +34,22 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from ..errors import UserError
+from ..files import (
+    _CLOEXEC,
+    _NOFOLLOW,
+    DataFileError,
+    check_path_length,
+    open_regular,
+    read_limited,
+    show_path,
+    user_path,
+)
+from ..files import kind_of as _kind
 
-
-class DataFileError(UserError):
-    """A file that is not what it claims to be: unreadable, not JSON, or failing its schema."""
+__all__ = ["STRICT_DECODER", "DataFileError", "atomic_write_bytes", "atomic_writer", "check_float", "check_int",
+           "check_keys", "check_output_path", "check_path_length", "check_str", "check_writable_folder",
+           "copy_aside", "dump_json", "fsync_folder", "open_regular", "parse_json", "read_limited", "save_figure",
+           "show_path", "user_path"]
 
 
 def _read_umask() -> int:
@@ -44,45 +59,18 @@ def _read_umask() -> int:
 
 
 _UMASK = _read_umask()
-# POSIX flags, each optional: where the platform lacks one (Windows has none of these) the same
-# promise is kept another way, or is moot there (a FIFO or a terminal cannot sit at a file path).
-_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
-_NOCTTY = getattr(os, "O_NOCTTY", 0)
-_NONBLOCK = getattr(os, "O_NONBLOCK", 0)
-_BINARY = getattr(os, "O_BINARY", 0)  # Windows: bytes as they are, no newline translation
-_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
 
 
-def show_path(path: object) -> str:
-    """A path for a one-line message: control characters escaped, at most 200 characters."""
-    text = str(path)
-    if not text.isprintable():
-        text = repr(text)[1:-1]
-    return text if len(text) <= 200 else text[:197] + "..."
-
-
-def user_path(text: str | os.PathLike[str], what: str = "path") -> Path:
-    """A path the user typed, ``~`` expanded; a ``~user`` that names nobody is a ``UserError``."""
-    if isinstance(text, str) and not text:
-        raise UserError(f"{what} is empty")
+def _folder_mode(folder: Path, about: str) -> int | None:
+    """The mode of ``folder`` (following links), None if there is nothing there; any other failure to
+    look (a path too long for the file system, no permission to search) is one ``DataFileError``
+    beginning ``about``. pathlib's ``exists()`` and ``is_dir()`` raise for those instead."""
     try:
-        return Path(text).expanduser()
-    except RuntimeError:  # Path("~nosuchuser/x").expanduser(): "Could not determine home directory"
-        raise UserError(f"{what} {str(text)[:80]!r}: no such user's home folder") from None
-
-
-def _kind(mode: int) -> str:
-    if stat.S_ISDIR(mode):
-        return "a folder"
-    if stat.S_ISFIFO(mode):
-        return "a FIFO"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        return "a device"
-    if stat.S_ISLNK(mode):
-        return "a symbolic link"
-    return "not a regular file"
+        return os.stat(folder).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError as exc:
+        raise DataFileError(f"{about}: {exc.strerror or exc}") from None
 
 
 def check_output_path(path: Path, what: str = "file") -> Path:
@@ -103,7 +91,8 @@ def check_output_path(path: Path, what: str = "file") -> Path:
     if st is not None and not (stat.S_ISREG(st.st_mode) or stat.S_ISLNK(st.st_mode)):
         raise DataFileError(f"{show_path(path)}: is {_kind(st.st_mode)}; the {what} is written only to a regular file")
     folder = path.parent
-    if not folder.is_dir():
+    mode = _folder_mode(folder, f"{show_path(path)}: cannot write the {what}")
+    if mode is None or not stat.S_ISDIR(mode):
         raise DataFileError(f"{show_path(path)}: cannot write the {what}: folder {show_path(folder)} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK):  # known before a game or a run, not after it
         raise DataFileError(f"{show_path(path)}: cannot write the {what}: folder {show_path(folder)} is not "
@@ -111,15 +100,18 @@ def check_output_path(path: Path, what: str = "file") -> Path:
     return path
 
 
-def check_writable_folder(folder: Path, what: str = "folder") -> None:
-    """Find out before a game that its results could not be saved there (not after it)."""
+def check_writable_folder(folder: Path, what: str = "folder", room: int = 0) -> None:
+    """Find out before a game that its results could not be saved there (not after it): ``room`` is the
+    longest path, in bytes, of what will be made inside (``files.check_path_length``)."""
     folder = Path(folder)
+    check_path_length(folder, what, room)
     probe = folder
-    while not probe.exists():  # the nearest existing ancestor decides whether mkdir will work
+    about = f"{what} {show_path(folder)}: cannot use it"
+    while (mode := _folder_mode(probe, about)) is None:  # the nearest existing ancestor decides whether mkdir works
         if probe.parent == probe:
             break
         probe = probe.parent
-    if not probe.is_dir():
+    if mode is None or not stat.S_ISDIR(mode):
         raise DataFileError(f"{what} {show_path(folder)}: {show_path(probe)} is not a folder")
     if not os.access(probe, os.W_OK | os.X_OK):
         raise DataFileError(f"{what} {show_path(folder)}: {show_path(probe)} cannot be written by you")
@@ -271,70 +263,6 @@ def parse_json(text: str | bytes) -> object:
         raise ValueError(f"not valid JSON: {exc}") from None
     except RecursionError:
         raise ValueError("not valid JSON: nested too deeply") from None
-
-
-def open_regular(path: Path, what: str, follow: bool = True) -> int:
-    """Open ``path`` for reading without blocking and return the descriptor of a regular file.
-
-    ``O_NONBLOCK`` makes opening a FIFO return at once (no writer needed); ``fstat`` on the
-    open descriptor then refuses it, so there is no window between the check and the read. A
-    platform without ``O_NONBLOCK`` (Windows, where no FIFO sits at a file path) checks the path
-    before opening it.
-    ``follow=False`` refuses a symlink (files inside a folder armgame owns): by ``O_NOFOLLOW``, or
-    where the platform has none, by ``lstat`` before the open and the same file (device and inode)
-    after it, so a symlink swapped in between is refused too.
-    """
-    path = Path(path)
-    flags = os.O_RDONLY | _NONBLOCK | _NOCTTY | _CLOEXEC | _BINARY | (0 if follow else _NOFOLLOW)
-    seen = None
-    try:
-        if (not follow and not _NOFOLLOW) or not _NONBLOCK:
-            seen = os.stat(path, follow_symlinks=follow)
-            if stat.S_ISLNK(seen.st_mode):
-                raise OSError(errno.ELOOP, "is a symbolic link")
-            if not stat.S_ISREG(seen.st_mode) and not stat.S_ISDIR(seen.st_mode):
-                # No O_NONBLOCK: a FIFO would block the open itself, so it is refused before.
-                raise DataFileError(f"{show_path(path)}: is {_kind(seen.st_mode)}, not a {what}")
-        fd = os.open(path, flags)
-    except FileNotFoundError:
-        raise DataFileError(f"{show_path(path)}: no such {what}") from None
-    except IsADirectoryError:
-        raise DataFileError(f"{show_path(path)}: is a folder, not a {what}") from None
-    except OSError as exc:
-        if exc.errno == errno.ELOOP and not follow:
-            raise DataFileError(f"{show_path(path)}: is a symbolic link; a {what} here must be a regular file") \
-                from None
-        raise DataFileError(f"{show_path(path)}: cannot read: {exc.strerror or exc}") from None
-    try:
-        st = os.fstat(fd)
-        if seen is not None and (st.st_dev, st.st_ino) != (seen.st_dev, seen.st_ino):
-            raise DataFileError(f"{show_path(path)}: changed while it was opened (a symbolic link swapped in?)")
-        if not stat.S_ISREG(st.st_mode):
-            raise DataFileError(f"{show_path(path)}: is {_kind(st.st_mode)}, not a {what}")
-        if _NONBLOCK and os.get_blocking(fd) is False:
-            os.set_blocking(fd, True)  # a regular file never blocks; plain reads from here on
-    except BaseException:
-        os.close(fd)
-        raise
-    return fd
-
-
-def read_limited(path: Path, limit: int, what: str, follow: bool = True) -> bytes:
-    """At most ``limit`` bytes of the regular file ``path``; anything else is one ``DataFileError``."""
-    path = Path(path)
-    fd = open_regular(path, what, follow)
-    try:
-        with os.fdopen(fd, "rb") as f:
-            data = f.read(limit + 1)
-    except OSError as exc:
-        raise DataFileError(f"{show_path(path)}: cannot read: {exc.strerror or exc}") from None
-    if len(data) > limit:
-        raise DataFileError(f"{show_path(path)}: larger than {_size(limit)}, too large for a {what}")
-    return data
-
-
-def _size(n: int) -> str:
-    return f"{n // (1024 * 1024)} MiB" if n >= 1024 * 1024 else f"{n} bytes"
 
 
 def dump_json(value: object) -> bytes:

@@ -44,6 +44,7 @@ from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
 
+from ..errors import UserError
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from ..words import plural
 from .entry import _COUNT_MAX, _OPTIONAL, _SEED_MAX, ScoreEntry, entry_order, sort_key
@@ -55,6 +56,7 @@ from .storage import (
     atomic_write_bytes,
     check_int,
     check_keys,
+    check_path_length,
     copy_aside,
     open_regular,
     parse_json,
@@ -72,6 +74,9 @@ FORMAT_VERSION = 3
 READS_FORMATS = (1, 2, 3)
 #: Seconds a writer waits for the table's lock before saying the table is busy.
 LOCK_WAIT = 5.0
+#: The longest path the table makes inside its folder, in bytes, with room: a replay's temporary file,
+#: ``/replays/.YYYYmmddTHHMMSS-<24>-<8>.json.<12>.tmp`` (81).
+_FOLDER_ROOM = 96
 
 
 class TableError(DataFileError):
@@ -133,7 +138,12 @@ class TableFile:
             return f.read(MAX_TABLE_BYTES + 1)
 
     def _safe_folder(self) -> None:
-        """Create the folder and replays/; refuse a replays/ or scores.lock planted as a symlink."""
+        """Create the folder and replays/; refuse a replays/ or scores.lock planted as a symlink, or a folder
+        too deep for the file system to name the files made in it."""
+        try:
+            check_path_length(self.folder, "the table's folder", _FOLDER_ROOM)
+        except UserError as exc:
+            raise TableError(str(exc)) from None
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             for path, folder in ((self.replays, True), (self.lock_path, False)):

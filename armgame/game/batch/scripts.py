@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ...errors import UserError
+from ...files import user_path
 from ..rules import GameConfig
 from ..session import RESET_KEY, TOGGLE_ARM_KEY, GameResult
 from .session import replay_many
@@ -46,7 +47,7 @@ def script_paths(names: Sequence[str | Path]) -> list[Path]:
     """Script files from the command line: files as given, folders as their ``*.txt`` files in sorted order."""
     paths: list[Path] = []
     for name in names:
-        path = Path(name)
+        path = user_path(name, "--script")  # a name the file system cannot take is one line, not an OSError
         if path.is_dir():
             inside = files_in(path, ".txt", MAX_SCRIPTS, "scripts")
             if not inside:
