@@ -22,6 +22,13 @@ MAX_GAME_SECONDS = 3600.0
 MAX_EVENTS = 200_000
 #: Hits one replay may claim; verification stops as soon as the replay passes its claim.
 MAX_HITS = 100_000
+#: The most work one verification of a game spends, in ``records.checking.replay_work``'s units (physics
+#: steps of the compiled loop: 6 a target posture tried, 20 an input event), counted as it runs: the
+#: longest game with the most events, hitting 5 targets a second, is under 6,000,000, so no game whose
+#: targets land clear of the hand comes near it. A "hit storm" (targets drawn on the hand, so that every
+#: step hits and each hit tries 1,000 postures) stops here, after about 7 s, rather than after the
+#: minutes 100,000 claimed hits take.
+MAX_VERIFY_WORK = 60_000_000
 #: Size of one replay file: MAX_EVENTS events at about 40 bytes each, and the rest.
 MAX_REPLAY_BYTES = 16 * 1024 * 1024
 #: Size of a score table: at least 100,000 entries of about 330 bytes each, with room.

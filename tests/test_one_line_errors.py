@@ -220,3 +220,102 @@ def test_a_table_too_deep_for_its_own_files_is_refused_before_writing(tmp_path):
     with pytest.raises(Exception, match="more than the file system allows") as caught:
         check_writable_folder(tmp_path / deep, "--scores")
     assert "Traceback" not in str(caught.value)
+
+
+# ------------------------------------------------------------------ a hit storm's verification
+
+def _storm(hits: int, steps: int | None = None):
+    """A custom game whose targets are all drawn on the hand's start (both ranges one angle): every step hits,
+    and every hit tries 1,000 postures for its next target. Its replay claims ``hits`` in ``steps``."""
+    import json
+
+    from armgame.game.rules import GameConfig
+    from armgame.game.session import GameSession
+    from armgame.records.replay import Replay
+
+    steps = hits if steps is None else steps
+    config = GameConfig(seed=10, time_limit=steps * 0.004, target_shoulder_range=(45.0, 45.0),
+                        target_elbow_range=(90.0, 90.0))
+    data = Replay.from_session(GameSession(config), "keyboard", None, "storm").as_dict()
+    data["result"].update(score=hits, hits=hits, steps=steps)
+    return Replay.from_dict(json.loads(json.dumps(data)))
+
+
+#: A verification's budget in these tests: the default's 60,000,000 is about 7 s of a hit storm, this 0.15 s.
+BUDGET = 1_200_000
+
+
+@pytest.fixture
+def small_budget(monkeypatch):
+    """Every verification's budget ``BUDGET``: the commands' (``limits.MAX_VERIFY_WORK``, read when they run)
+    and ``Replay.verify``'s default."""
+    from armgame.records.replay import Replay
+
+    monkeypatch.setattr("armgame.limits.MAX_VERIFY_WORK", BUDGET)
+    real = Replay.verify
+    monkeypatch.setattr(Replay, "verify", lambda self, max_work=BUDGET: real(self, max_work))
+
+
+def test_a_hit_storm_is_stopped_at_its_budget_and_an_honest_game_never_is():
+    import time
+
+    from armgame.game.rules import MAX_TRIES
+    from armgame.limits import MAX_EVENTS, MAX_GAME_SECONDS, MAX_GAME_STEPS, MAX_VERIFY_WORK
+    from armgame.records import checking
+    from armgame.records.replay import EVENT_WORK, TRY_WORK, VerifyCostError
+
+    assert checking.HIT_WORK == MAX_TRIES * TRY_WORK and checking.EVENT_WORK == EVENT_WORK  # one set of units
+    storm = _storm(5000)
+    start = time.perf_counter()
+    with pytest.raises(VerifyCostError, match=r"^by step ([\d,]+) of 5,000 its game had tried ([\d,]+) target "
+                                              r"postures for [\d,]+ hits \(5,000 claimed\): more work than one "
+                                              r"verification spends \(1,200,000 steps\), its targets keep landing "
+                                              r"on the hand$") as caught:
+        storm.verify(max_work=BUDGET)
+    assert time.perf_counter() - start < 2.0
+    words = caught.value.args[0].split(" ")
+    step, tries = int(words[2].replace(",", "")), int(words[9].replace(",", ""))
+    one_hit = TRY_WORK * MAX_TRIES  # the budget is passed by one hit's drawing at most
+    assert BUDGET - one_hit <= step + TRY_WORK * tries <= BUDGET + one_hit
+    small = _storm(150)  # the same storm claiming what the budget covers is checked, and matches
+    assert checking.replay_work(small) <= BUDGET and small.verify(max_work=BUDGET)[0]
+    assert small.verify(max_work=None)[0]  # None: whatever it costs
+    # No game whose targets land clear of the hand comes near the default: the longest, with the most events,
+    # hitting 5 targets a second, each drawn in 10 tries (the standard game's draws take 1.35 on average, 9 at most).
+    assert MAX_GAME_STEPS + EVENT_WORK * MAX_EVENTS + TRY_WORK * 10 * 5 * MAX_GAME_SECONDS < MAX_VERIFY_WORK / 5
+    with pytest.raises(VerifyCostError, match=r"^its 5,000 steps and 0 input events are more work \(5,000 steps\)"):
+        storm.verify(max_work=4_999)  # refused before anything runs
+
+
+def test_verify_of_a_hit_storm_is_one_line_in_bounded_time(tmp_path, capsys, small_budget):
+    path = tmp_path / "storm.json"
+    _storm(5000).save(path)
+    assert main(["verify", str(path)]) == 3  # verify's "some games were left unchecked"
+    said = capsys.readouterr()
+    assert said.err == "" and said.out.startswith(f"{path}: NOT CHECKED: by step ") and said.out.count("\n") == 1
+    assert said.out.rstrip().endswith("its targets keep landing on the hand (--max-work N spends up to N)")
+    (line,) = error_lines(capsys, ["scores", "--scores", tmp_path / "t", "--add", path])
+    assert line.startswith(f"armgame scores: error: {path}: by step ") and line.endswith(": not entered")
+    _storm(300).save(path)  # 1,800,300 steps of work: past the budget, within a --max-work that asks for more
+    assert main(["verify", str(path)]) == 3
+    assert main(["verify", str(path), "--max-work", "2000000"]) == 0
+    assert "matches" in capsys.readouterr().out.splitlines()[-1]
+
+
+def test_verify_of_a_folder_or_a_table_goes_on_past_a_hit_storm(tmp_path, capsys, small_budget):
+    from armgame.records.scores import ScoreTable
+
+    folder = tmp_path / "runs"
+    folder.mkdir()
+    _storm(5000).save(folder / "a-storm.json")
+    _storm(100).save(folder / "b-small.json")
+    assert main(["verify", str(folder)]) == 3
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith(f"{folder / 'a-storm.json'}: NOT CHECKED: by step ")
+    assert out[1].startswith(f"{folder / 'b-small.json'}: matches: ")
+    assert out[2] == f"{folder}: 2 replays, 0 differ, 0 unreadable, 1 not checked (over their work budget)"
+    table = ScoreTable(tmp_path / "t")
+    table.add(_storm(5000))
+    assert main(["verify", str(tmp_path / "t")]) == 3
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("storm: score 5000 (keyboard, custom rules, ") and ": NOT CHECKED: by step " in out[0]

@@ -314,7 +314,12 @@ def _add(table, args: argparse.Namespace) -> int:
         raise UserError(f"{path}: the replay has no player's name: give --name")
     if not replay.complete:
         raise UserError(f"{path}: the game was stopped before its end: only a whole game enters the table")
-    ok, got = replay.verify()
+    from ..records.replay import VerifyCostError
+
+    try:
+        ok, got = replay.verify()
+    except VerifyCostError as exc:  # a hit storm: one line naming the file, after a bounded try
+        raise UserError(f"{path}: {exc}: not entered") from None
     if not ok:
         raise UserError(f"{path}: the replay does not reproduce its score (recorded {replay.result.score}, "
                         f"replayed {got.score}): not entered")

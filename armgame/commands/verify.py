@@ -72,13 +72,27 @@ def _looks_like_table(path) -> bool:
 
 
 def _verify_replay(path, limit: int | None = None) -> int:
-    from ..records.replay import Replay
+    from ..records.replay import Replay, VerifyCostError
+    from ..records.scores import NOT_CHECKED
 
     replay = Replay.load(path)
     if _over(replay, limit):
         _not_checked(path, replay)
         return 3
-    return _report(path, replay, *replay.verify())
+    try:
+        verdict = replay.verify(_budget(limit))
+    except VerifyCostError as exc:  # a hit storm, stopped at its budget: seconds and one line, not minutes
+        print(f"{path}: {NOT_CHECKED}: {exc} (--max-work N spends up to N)")
+        return 3
+    return _report(path, replay, *verdict)
+
+
+def _budget(limit: int | None) -> int:
+    """What one game's verification may spend as it runs (``Replay.verify``): ``MAX_VERIFY_WORK``, or more if
+    --max-work asks for more (a game it let through up front never stops on the way)."""
+    from ..limits import MAX_VERIFY_WORK
+
+    return MAX_VERIFY_WORK if limit is None else max(limit, MAX_VERIFY_WORK)
 
 
 def _over(replay, limit: int | None) -> bool:
@@ -96,14 +110,19 @@ def _not_checked(path, replay) -> None:
 def _verify_folder(folder, limit: int | None = None) -> int:
     from ..errors import UserError
     from ..records.batch_verify import replay_files, verify_files
-    from ..records.scores import TABLE_NAME
+    from ..records.replay import VerifyCostError
+    from ..records.scores import NOT_CHECKED, TABLE_NAME
 
     paths = replay_files(folder)
     if not paths:
         raise UserError(f"{folder}: no score table ({TABLE_NAME}) and no replays (*.json) there")
     differ = bad = unchecked = 0
-    for path, replay, got, ok in verify_files(paths, (lambda r: _over(r, limit)) if limit is not None else None):
-        if got is None and not isinstance(replay, Exception):
+    skip = (lambda r: _over(r, limit)) if limit is not None else None
+    for path, replay, got, ok in verify_files(paths, skip, _budget(limit)):
+        if got is None and isinstance(replay, VerifyCostError):  # a hit storm, stopped at its budget
+            unchecked += 1
+            print(f"{path}: {NOT_CHECKED}: {replay}")
+        elif got is None and not isinstance(replay, Exception):
             unchecked += 1
             _not_checked(path, replay)
         elif got is None:
@@ -111,7 +130,8 @@ def _verify_folder(folder, limit: int | None = None) -> int:
             print(f"{path}: BAD REPLAY: {str(replay).removeprefix(f'{path}: ')}")
         else:
             differ += _report(path, replay, ok, got)
-    left = f", {unchecked} not checked (over --max-work)" if unchecked else ""
+    over = "--max-work" if limit is not None else "their work budget"  # without it: hit storms stopped on the way
+    left = f", {unchecked} not checked (over {over})" if unchecked else ""
     print(f"{folder}: {plural(len(paths), 'replay')}, {differ} differ, {bad} unreadable{left}")
     return 2 if bad else 1 if differ else 3 if unchecked else 0
 

@@ -78,6 +78,10 @@ class Scoreboard:
     hit_times: list[float] = field(default_factory=list)
 
 
+#: Postures one target drawing tries at most (``GameRules._draw_target``).
+MAX_TRIES = 1000
+
+
 class GameRules:
     """Targets, scoring and the clock; told where the hand is after every physics step."""
 
@@ -86,6 +90,9 @@ class GameRules:
         self._rng = random.Random(config.seed)
         self.board = Scoreboard()
         self.arm_visible = True
+        #: Postures tried by every target drawn so far: the cost of the targets, which a hit whose next
+        #: target keeps landing on the hand makes 1,000 a hit (``records.replay.Replay.verify`` bounds it).
+        self.tries = 0
         q1, q2 = config.start_posture
         self.target = self._draw_target(self._hand(q1, q2))
 
@@ -102,7 +109,7 @@ class GameRules:
         xmin, xmax, ymin, ymax = c.view
         r = c.target_radius
         best, best_distance = None, -1.0
-        for _ in range(1000):
+        for tries in range(1, MAX_TRIES + 1):
             q1 = math.radians(self._rng.uniform(*c.target_shoulder_range))
             q2 = math.radians(self._rng.uniform(*c.target_elbow_range))
             x, y = self._hand(q1, q2)
@@ -110,9 +117,11 @@ class GameRules:
                 continue
             distance = math.dist((x, y), hand)
             if distance > 3.0 * r:
+                self.tries += tries
                 return Target(x, y, r)
             if distance > best_distance:
                 best, best_distance = Target(x, y, r), distance
+        self.tries += MAX_TRIES
         if best is None:
             raise UserError("no target fits on screen with these settings (target radius or ranges too large)")
         return best  # the ranges are too narrow to keep clear of the hand: the farthest one found

@@ -13,9 +13,11 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from itertools import islice
 from pathlib import Path
 
+from ..errors import UserError
 from ..game.batch import files_in, replay_many
 from ..game.session import GameResult
-from .replay import Replay, same_outcome
+from ..limits import MAX_VERIFY_WORK
+from .replay import Replay, VerifyCostError, same_outcome
 from .rulesets import ruleset_of
 from .scores import Check, ScoreEntry, ScoreTable
 from .storage import DataFileError
@@ -42,7 +44,7 @@ def verify_replays(replays: Sequence[Replay], kernel: str | None = None) -> list
     more than it claims (a rigged configuration could hit a target at every step), so both keep
     their own ``verify``. ``kernel`` is ``BatchGameSession``'s (None: compiled where built).
     """
-    batched = [i for i, r in enumerate(replays) if r.task is None and ruleset_of(r.config) is not None]
+    batched = [i for i, r in enumerate(replays) if batchable(r)]
     # exact: the results are the single session's (numpy's fast kernel replays a game alone where a hit
     # was decided within round-off of a target's edge), so the batch's verdict is final both ways: a
     # planted pile of forgeries costs its batched steps, not one single-session game each.
@@ -52,6 +54,11 @@ def verify_replays(replays: Sequence[Replay], kernel: str | None = None) -> list
     for i, got in zip(batched, results, strict=True):
         verdicts[i] = (same_outcome(got, replays[i].result), got)
     return [v if v is not None else r.verify() for r, v in zip(replays, verdicts, strict=True)]
+
+
+def batchable(replay: Replay) -> bool:
+    """Whether ``verify_replays`` recomputes ``replay`` in a batch: a game of a ranked ruleset."""
+    return replay.task is None and ruleset_of(replay.config) is not None
 
 
 def check_entries(table: ScoreTable, entries: Iterable[ScoreEntry],
@@ -67,12 +74,14 @@ def replay_files(folder: Path) -> list[Path]:
     return files_in(folder, ".json", MAX_FOLDER_REPLAYS, "replay files")
 
 
-def verify_files(paths: Iterable[Path], skip: Callable[[Replay], bool] | None = None
-                 ) -> Iterator[tuple[Path, Replay | DataFileError, GameResult | None, bool]]:
+def verify_files(paths: Iterable[Path], skip: Callable[[Replay], bool] | None = None,
+                 max_work: int | None = MAX_VERIFY_WORK
+                 ) -> Iterator[tuple[Path, Replay | UserError, GameResult | None, bool]]:
     """For each file, in order: (path, its replay, the recomputed result, whether it matches).
 
-    A file that is not a valid replay gives (path, the error, None, False) and the others go on; a
-    replay that ``skip`` says not to recompute (its cost) gives (path, the replay, None, False).
+    A file that is not a valid replay, or a game stopped at its verification's budget ``max_work`` (a hit
+    storm: ``Replay.verify``'s ``VerifyCostError``), gives (path, the error, None, False) and the others go
+    on; a replay that ``skip`` says not to recompute (its cost) gives (path, the replay, None, False).
     """
     for chunk in _chunks(paths, CHUNK):
         loaded: list[Replay | DataFileError] = []
@@ -82,10 +91,25 @@ def verify_files(paths: Iterable[Path], skip: Callable[[Replay], bool] | None = 
             except DataFileError as exc:
                 loaded.append(exc)
         wanted = [isinstance(r, Replay) and not (skip is not None and skip(r)) for r in loaded]
-        verdicts = iter(verify_replays([r for r, w in zip(loaded, wanted, strict=True) if w]))  # type: ignore[misc]
+        # The ranked games in batches; the others each on its own, a hit storm stopped at its budget.
+        batched = iter(verify_replays([r for r, w in zip(loaded, wanted, strict=True)  # type: ignore[misc]
+                                       if w and batchable(r)]))  # type: ignore[arg-type]
         for path, r, w in zip(chunk, loaded, wanted, strict=True):
-            if w:
-                ok, got = next(verdicts)
-                yield path, r, got, ok
-            else:
+            if not w:
                 yield path, r, None, False
+                continue
+            verdict = next(batched) if batchable(r) else _own_verdict(r, max_work)  # type: ignore[arg-type]
+            if isinstance(verdict, VerifyCostError):
+                yield path, verdict, None, False
+            else:
+                ok, got = verdict
+                yield path, r, got, ok
+
+
+def _own_verdict(replay: Replay, max_work: int | None) -> tuple[bool, GameResult] | VerifyCostError:
+    """``replay.verify(max_work)``, or why it was not checked (a hit storm stopped at its budget), so the
+    other files of a folder are still checked."""
+    try:
+        return replay.verify(max_work)
+    except VerifyCostError as exc:
+        return exc

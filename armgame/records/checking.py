@@ -23,7 +23,7 @@ from ..words import plural
 from .cache import VerificationCache, file_signature
 from .entry import ScoreEntry, replay_claims
 from .identity import names_its_game
-from .replay import Replay
+from .replay import Replay, VerifyCostError
 from .rulesets import ruleset_of
 from .storage import DataFileError, open_regular
 
@@ -239,6 +239,8 @@ def _recompute(replays: list[Replay],
 def _verdict(replay: Replay) -> dict[str, object]:
     try:
         ok, recomputed = replay.verify()
+    except VerifyCostError as exc:  # a hit storm, stopped at its verification's budget: unchecked, not bad
+        return {"ok": False, "label": NOT_CHECKED, "detail": str(exc), "work": replay_work(replay)}
     except Exception as exc:  # a blow-up (NonFiniteState) or anything else the game raises
         return {"ok": False, "label": "BAD REPLAY", "detail": str(exc) or type(exc).__name__}
     return _judged(replay, ok, recomputed)

@@ -29,9 +29,9 @@ from typing import Any, Protocol
 from .. import __version__
 from ..errors import UserError
 from ..game.muscles import MuscleSet, MuscleSpec
-from ..game.rules import GameConfig
+from ..game.rules import MAX_TRIES, GameConfig
 from ..game.session import DOWN, UP, GameResult, GameSession, InputEvent, TimelineInput
-from ..limits import MAX_EVENTS, MAX_GAME_SECONDS, MAX_GAME_STEPS, MAX_HITS, MAX_REPLAY_BYTES
+from ..limits import MAX_EVENTS, MAX_GAME_SECONDS, MAX_GAME_STEPS, MAX_HITS, MAX_REPLAY_BYTES, MAX_VERIFY_WORK
 from ..physics.integrators import SCHEMES
 from ..physics.params import TwoJointParams
 from .storage import (
@@ -217,6 +217,17 @@ _RESULT_FIELDS = frozenset(f.name for f in fields(GameResult))
 _VERIFY_CHUNK = 2_500  # steps between checks of the running score during verification
 _COUNT_MAX = 10**9
 
+#: The work ``Replay.verify`` counts as a game runs, in ``checking.replay_work``'s units (physics steps of the
+#: compiled loop): a target posture tried (its ``HIT_WORK`` is ``MAX_TRIES`` of them) and an input event.
+#: Here, below checking, which imports this module; tests/test_one_line_errors.py holds the two equal.
+TRY_WORK = 6
+EVENT_WORK = 20
+
+
+class VerifyCostError(UserError):
+    """A game whose verification would cost more than its caller spends (``Replay.verify``'s ``max_work``):
+    not checked, rather than run for minutes."""
+
 
 def result_from_dict(data: object) -> GameResult:
     d = check_keys("result", data, set(_RESULT_FIELDS))
@@ -334,21 +345,43 @@ class Replay:
             return self.task.session(self.config, self.timeline, self.result.steps).result()
         return GameSession(self.config).play(self.timeline, self.result.steps)
 
-    def verify(self) -> tuple[bool, GameResult]:
+    def verify(self, max_work: int | None = MAX_VERIFY_WORK) -> tuple[bool, GameResult]:
         """Replay and compare. Bounded: the game is at most ``MAX_GAME_STEPS`` long (checked at load),
         and the replay stops as soon as it scores more hits or resets than recorded, so a replay
         that claims little cannot make its verifier draw a target at every step for hours. A lab
-        run is compared trial by trial as well (its length was checked at load like a game's)."""
+        run is compared trial by trial as well (its length was checked at load like a game's).
+
+        A replay that claims much (a "hit storm": its targets drawn on the hand, so every step hits and
+        each hit tries 1,000 postures) is bounded by ``max_work``, in ``checking.replay_work``'s units
+        counted as the game runs (its steps, ``TRY_WORK`` a posture tried, ``EVENT_WORK`` an event): past
+        it, ``VerifyCostError`` (not checked). A game whose ``replay_work`` is at most ``max_work`` stays
+        under it (but for its first target's drawing); None spends whatever it takes."""
         if self.task is not None:
             ok, recomputed, _ = self.task.verify(self.config, self.timeline, self.result)
             return ok, recomputed
-        session = GameSession(self.config)
-        feed = TimelineInput(self.timeline, self.result.steps)
         claimed = self.result
-        board = session.rules.board
+        fixed = EVENT_WORK * len(self.timeline)
+        if max_work is not None and claimed.steps + fixed > max_work:
+            raise VerifyCostError(f"its {claimed.steps:,} steps and {len(self.timeline):,} input events are more "
+                                  f"work ({claimed.steps + fixed:,} steps) than one verification spends "
+                                  f"({max_work:,})")
+        session = GameSession(self.config)
+        rules = session.rules
+        feed = TimelineInput(self.timeline, claimed.steps)
+        board = rules.board
         step = 0
         while step < claimed.steps:
-            step = min(step + _VERIFY_CHUNK, claimed.steps)
+            chunk = _VERIFY_CHUNK
+            if max_work is not None:
+                left = max_work - fixed - step - TRY_WORK * rules.tries
+                if left < 0:
+                    raise VerifyCostError(
+                        f"by step {step:,} of {claimed.steps:,} its game had tried {rules.tries:,} target postures "
+                        f"for {board.hits:,} hits ({claimed.hits:,} claimed): more work than one verification "
+                        f"spends ({max_work:,} steps), its targets keep landing on the hand")
+                # A step costs itself and at most one hit's drawing: the budget is never passed by more than one.
+                chunk = min(chunk, max(1, left // (1 + TRY_WORK * MAX_TRIES)))
+            step = min(step + chunk, claimed.steps)
             feed.run_to(session, step)
             if board.hits > claimed.hits or board.resets > claimed.resets:
                 break
