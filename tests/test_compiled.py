@@ -5,8 +5,10 @@ kernels). The single session's own compiled loop (``_ckernel.game_steps``) is he
 Python loop, ``GameSession(compiled=False)``, with ``==``.
 """
 
+import math
 import os
 import random
+import struct
 import types
 from dataclasses import replace
 
@@ -68,6 +70,16 @@ def test_a_valid_call_steps_the_games_to_their_halt_and_applies_their_events():
     ({"n": 2**61}, "at most"),
     ({"n": 2**62}, "at most"),
     ({"n": 2**63 - 1}, "at most"),
+    # Counts a game cannot have (it is at most 24 h long: 21,600,000 steps of 4 ms) ran for as long as anyone
+    # waited; NaN or infinite params stepped every game to NaN.
+    ({"halt": np.full(3, 2**62, dtype=np.int64)}, r"game 0: steps 0, halt 4611686018427387904: expected 0 to "
+                                                  r"21600001 \(86400 s at dt 0\.004\)"),
+    ({"halt": np.array([50, 50, -1], dtype=np.int64)}, "game 2: steps 0, halt -1"),
+    ({"steps": np.array([0, -2**62, 0], dtype=np.int64)}, "game 1: steps -4611686018427387904"),
+    ({"params": np.where(np.arange(26) == 0, np.nan, 1.0)}, "params dt is not finite"),
+    ({"params": np.where(np.arange(26) == 3, np.inf, 1.0)}, "params b is not finite"),
+    ({"params": np.where(np.arange(26) == 0, -0.004, 1.0)}, "params dt must be positive"),
+    ({"ev_goal": np.array([1.0, np.nan])}, "event 1: its goal or rate is not finite"),
 ])
 def test_bad_arguments_are_refused_before_any_step(change, message):
     args = arrays()
@@ -145,6 +157,8 @@ needs_loop = pytest.mark.skipif(not (session_module._c_game_steps or os.environ.
                                 reason="the compiled loop is not built here")
 
 GAME = GameConfig()
+#: The params bytes of a game with dt 4 ms and nothing else: enough for a call's checks.
+DT_ONLY = struct.pack("=26d", 0.004, *[0.0] * 25)
 #: One arm per accel the loop must copy (TwoJointArm._build_components): damped (the game's), neither
 #: damped nor under gravity, and under gravity with damping (a weak one: the game's muscles cannot
 #: lift the arm against 9.81 m/s^2 to any target).
@@ -267,8 +281,18 @@ def test_the_compiled_loop_runs_rk4_and_steps_it_is_given_run_in_python():
     ((b"short", 1, 5, *[0.0] * 19), "params"),
     (("not bytes", 1, 5, *[0.0] * 19), "params"),
     ((bytes(26 * 8), 3, 5, *[0.0] * 19), "mode 3"),
-    ((bytes(26 * 8), 1, -1, *[0.0] * 19), "steps >= 0"),
+    ((DT_ONLY, 1, -1, *[0.0] * 19), "steps >= 0"),
     ((bytes(26 * 8), 1, 5, "q1", *[0.0] * 18), "must be real number"),
+    # A count past the longest game at this dt (24 h: 21,600,001 steps of 4 ms) ran for as long as anyone
+    # waited; a NaN anywhere gave NaN back.
+    ((DT_ONLY, 1, 2**62, *[0.0] * 19), r"game_steps: 4611686018427387904 steps: expected steps >= 0 and at most "
+                                       r"21600001 \(86400 s at dt 0\.004\)"),
+    ((DT_ONLY, 1, 21_600_002, *[0.0] * 19), "at most 21600001"),
+    ((bytes(26 * 8), 1, 5, *[0.0] * 19), "params dt must be positive"),
+    ((DT_ONLY[:8] + struct.pack("=d", math.nan) + DT_ONLY[16:], 1, 5, *[0.0] * 19), "params h is not finite"),
+    ((DT_ONLY, 1, 5, math.nan, *[0.0] * 18), "game_steps: q1 is not finite"),
+    ((DT_ONLY, 1, 5, *[0.0] * 16, 1.0, math.inf, 0.0), "game_steps: ty is not finite"),
+    ((DT_ONLY, 1, 5, *[0.0] * 18, -math.inf), "game_steps: rr is not finite"),
 ])
 def test_game_steps_refuses_bad_arguments_before_any_step(args, message):
     with pytest.raises((TypeError, ValueError), match=message):
@@ -318,6 +342,9 @@ def test_a_lab_run_with_the_compiled_step_is_the_python_loops_bit_for_bit():
     ((b"short", 1, *[0.0] * 7), "params"),
     ((bytes(26 * 8), -1, *[0.0] * 7), "mode -1"),
     ((bytes(26 * 8), 1, "q1", *[0.0] * 6), "must be real number"),
+    ((bytes(26 * 8), 1, math.nan, *[0.0] * 6), "rk4_step: q1 is not finite"),
+    ((bytes(26 * 8), 1, *[0.0] * 6, math.inf), "rk4_step: dt is not finite"),
+    ((struct.pack("=26d", math.nan, *[0.0] * 25), 1, *[0.0] * 6, 0.004), "rk4_step: params dt is not finite"),
 ])
 def test_rk4_step_refuses_bad_arguments(args, message):
     with pytest.raises((TypeError, ValueError), match=message):

@@ -16,11 +16,18 @@
  * The kernel knows nothing of targets' rules: it stops a game whose hand may be on its target
  * (within a relative 1e-6 of the disc) and lets Python decide, with the single session's own
  * test and its ``GameRules``. See ``armgame/game/batch/compiled.py`` for the calling side.
+ *
+ * Every entry point refuses, before its loop, what no game of armgame's passes: params or values
+ * that are not finite, and counts of steps outside a game's (0 to 24 h at its dt), so a bad call is
+ * one ValueError, never NaN results or a loop that runs for as long as anyone waits. The checks cost
+ * a call of one step about 10 ns (a bot calls once a step; params already found finite are not
+ * checked again), a game nothing measurable (benchmarks/game_speed.py).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Layout of the ``params`` buffer (doubles), as compiled.py's ``CompiledKernel`` writes it. */
@@ -30,6 +37,41 @@ enum {
     P_S0, P_S1, P_S2, P_S3, P_E0, P_E1, P_E2, P_E3,
     P_COUNT
 };
+
+/* The P_* names, for a message naming a parameter that is not finite. */
+static const char *const PARAM_NAMES[P_COUNT] = {
+    "dt", "h", "k", "b", "d", "det0", "amd", "g1", "g2", "k1", "k2",
+    "l1", "l2", "radius", "near", "reach1", "reach2", "limit2",
+    "s0", "s1", "s2", "s3", "e0", "e1", "e2", "e3",
+};
+
+/* The longest game GameConfig allows (time_limit <= 24 h), in seconds: no count of steps past it at the
+ * params' dt is a game's, and refusing it bounds the work of a call before its loop (a halt of 2**62 ran
+ * for as long as anyone waited). */
+#define MAX_GAME_SECONDS 86400.0
+
+/* Refuse, before any loop, params that are not finite (a NaN arm or dt made every result NaN), and a dt
+ * that is not positive where ``counted`` (the loops of steps: their counts are bounded by it). */
+static int check_params(const char *name, const double *p, int counted)
+{
+    for (int i = 0; i < P_COUNT; i++) {
+        if (!isfinite(p[i])) {
+            PyErr_Format(PyExc_ValueError, "%s: params %s is not finite", name, PARAM_NAMES[i]);
+            return -1;
+        }
+    }
+    if (counted && !(p[P_DT] > 0.0)) {
+        PyErr_Format(PyExc_ValueError, "%s: params dt must be positive", name);
+        return -1;
+    }
+    return 0;
+}
+
+/* The most steps a game may have at step dt (MAX_GAME_SECONDS of them, with one for rounding). */
+static double max_steps(double dt)
+{
+    return MAX_GAME_SECONDS / dt + 1.0;
+}
 
 /* Which accel the single session uses (TwoJointArm._build_components). */
 enum { MODE_UNFORCED = 0, MODE_DAMPING = 1, MODE_GRAVITY = 2 };
@@ -134,7 +176,8 @@ PyDoc_STRVAR(run_doc,
 "cursor[i]:ev_end[i] of ev_step (int64), ev_muscle (int64, 0-3), ev_goal, ev_rate (float64),\n"
 "sorted by step; an event at step s applies before the step from s; flags (n,) uint8.\n"
 "With fast true, RK4's elbow trig comes by angle addition (the numpy fast kernel's method):\n"
-"round-off, not bit for bit.");
+"round-off, not bit for bit. Refused before any step (ValueError): params not finite or dt not positive,\n"
+"steps or halt outside 0 to the steps of a 24 h game at dt, a command's goal or rate not finite.");
 
 static PyObject *run(PyObject *self, PyObject *args)
 {
@@ -177,6 +220,8 @@ static PyObject *run(PyObject *self, PyObject *args)
         goto done;
 
     const double *p = b[0].view.buf;
+    if (check_params("run", p, 1) < 0)
+        goto done;
     double *x = b[1].view.buf, *act = b[2].view.buf, *goal = b[3].view.buf, *rate = b[4].view.buf;
     double *slack = b[5].view.buf;
     const double *tx = b[6].view.buf, *ty = b[7].view.buf;
@@ -186,17 +231,31 @@ static PyObject *run(PyObject *self, PyObject *args)
     const double *ev_goal = b[14].view.buf, *ev_rate = b[15].view.buf;
     uint8_t *flags = b[16].view.buf;
 
-    /* The work is bounded before it starts: cursors within the events, muscles 0-3. */
+    /* The work is bounded before it starts: cursors within the events, muscles 0-3, finite commands, and
+     * every game's steps and halt from 0 to a game's most steps at this dt. */
+    const double most = max_steps(p[P_DT]);
     for (Py_ssize_t i = 0; i < n; i++) {
         if (cursor[i] < 0 || cursor[i] > ev_end[i] || ev_end[i] > events) {
             PyErr_Format(PyExc_ValueError, "game %zd: events %lld:%lld of %zd", i, (long long)cursor[i],
                          (long long)ev_end[i], events);
             goto done;
         }
+        if (steps[i] < 0 || halt[i] < 0 || (double)steps[i] > most || (double)halt[i] > most) {
+            char message[200];  /* PyErr_Format has no %g */
+            snprintf(message, sizeof message,
+                     "run: game %zd: steps %lld, halt %lld: expected 0 to %.15g (%g s at dt %g)", i,
+                     (long long)steps[i], (long long)halt[i], most, MAX_GAME_SECONDS, p[P_DT]);
+            PyErr_SetString(PyExc_ValueError, message);
+            goto done;
+        }
     }
     for (Py_ssize_t e = 0; e < events; e++) {
         if (ev_muscle[e] < 0 || ev_muscle[e] > 3) {
             PyErr_Format(PyExc_ValueError, "event %zd: muscle %lld", e, (long long)ev_muscle[e]);
+            goto done;
+        }
+        if (!isfinite(ev_goal[e]) || !isfinite(ev_rate[e])) {
+            PyErr_Format(PyExc_ValueError, "event %zd: its goal or rate is not finite", e);
             goto done;
         }
     }
@@ -342,6 +401,21 @@ static inline void rk4_exact(const Arm *arm, double t1, double t2, double dt, do
     x[3] = w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
 }
 
+/* Nonzero if ``x`` is NaN or infinite: its exponent bits all ones. No branch, so checking a call's
+ * arguments as they are read costs next to nothing. */
+static inline uint64_t not_finite(double x)
+{
+    const uint64_t exponent = UINT64_C(0x7ff0000000000000);
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    return (bits & exponent) == exponent;
+}
+
+/* The params bytes object last found finite, held so that it cannot be freed and its address reused:
+ * a session passes the same object on every call (a bot's, once a step), which is then not checked
+ * again (bytes do not change). */
+static PyObject *finite_params = NULL;
+
 static int arg_double(PyObject *obj, double *out)
 {
     if (PyFloat_CheckExact(obj)) {
@@ -353,9 +427,12 @@ static int arg_double(PyObject *obj, double *out)
 }
 
 /* The calls of one game (game_steps, rk4_step): ``expected`` arguments, the first two the params bytes
- * (P_* doubles, into p) and the mode, then ``count`` doubles from ``first`` on (into v). */
+ * (P_* doubles, into p) and the mode, then ``count`` doubles from ``first`` on (into v), named ``names``
+ * (space-separated) in a message: every one must be finite (a NaN in gave NaN out, or a loop that never
+ * found its target). ``counted``: a loop of steps follows, whose dt must be positive. */
 static int one_game_args(const char *name, PyObject *const *args, Py_ssize_t nargs, Py_ssize_t expected,
-                         double *p, Arm *arm, Py_ssize_t first, int count, double *v)
+                         double *p, Arm *arm, Py_ssize_t first, int count, double *v, const char *names,
+                         int counted)
 {
     if (nargs != expected) {
         PyErr_Format(PyExc_TypeError, "%s takes %zd arguments, got %zd", name, expected, nargs);
@@ -373,9 +450,39 @@ static int one_game_args(const char *name, PyObject *const *args, Py_ssize_t nar
         PyErr_Format(PyExc_ValueError, "mode %ld: expected mode 0, 1 or 2", mode);
         return -1;
     }
-    for (int i = 0; i < count; i++)
+    uint64_t bad = 0;
+    for (int i = 0; i < count; i++) {
         if (arg_double(args[first + i], &v[i]) < 0)
             return -1;
+        bad |= not_finite(v[i]);
+    }
+    if (args[0] != finite_params) {
+        if (check_params(name, p, 0) < 0)
+            return -1;
+        Py_INCREF(args[0]);
+        Py_XSETREF(finite_params, args[0]);
+    }
+    if (counted && !(p[P_DT] > 0.0)) {
+        PyErr_Format(PyExc_ValueError, "%s: params dt must be positive", name);
+        return -1;
+    }
+    for (int i = 0; bad && i < count; i++) {
+        if (!isfinite(v[i])) {
+            /* The i-th of the space-separated names. */
+            const char *at = names;
+            for (int j = 0; j < i && at != NULL; j++) {
+                at = strchr(at, ' ');
+                if (at != NULL)
+                    at++;
+            }
+            const char *end = at == NULL ? NULL : strchr(at, ' ');
+            const int width = at == NULL ? 1 : (end == NULL ? (int)strlen(at) : (int)(end - at));
+            char message[120];  /* PyErr_Format has no %.*s before Python 3.12 */
+            snprintf(message, sizeof message, "%s: %.*s is not finite", name, width, at == NULL ? "?" : at);
+            PyErr_SetString(PyExc_ValueError, message);
+            return -1;
+        }
+    }
     const Arm value = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], (int)mode};
     *arm = value;
     return 0;
@@ -392,20 +499,27 @@ PyDoc_STRVAR(game_steps_doc,
 "rates r) and RK4 from state (q1, q2, w1, w2), stopping early after a step that leaves the hand\n"
 "(hx, hy) within a relative 1e-9 of the target disc (tx, ty, radius squared rr): near is then true,\n"
 "and the caller decides the hit with the session's own test. p1-p4 is the state before the last\n"
-"step run. params is a bytes object of the P_* doubles (only the arm's, dt's and moments' are read).");
+"step run. params is a bytes object of the P_* doubles (only the arm's, dt's and moments' are read).\n"
+"Refused before any step (ValueError): a value or param not finite, dt not positive, n past the steps\n"
+"of a 24 h game at dt.");
 
 static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
     double p[P_COUNT], v[19];
     Arm arm;
-    if (one_game_args("game_steps", args, nargs, 22, p, &arm, 3, 19, v) < 0)
+    if (one_game_args("game_steps", args, nargs, 22, p, &arm, 3, 19, v,
+                      "q1 q2 w1 w2 a0 a1 a2 a3 g0 g1 g2 g3 r0 r1 r2 r3 tx ty rr", 1) < 0)
         return NULL;
     const Py_ssize_t n = PyLong_AsSsize_t(args[2]);
     if (n == -1 && PyErr_Occurred())
         return NULL;
-    if (n < 0) {
-        PyErr_Format(PyExc_ValueError, "%zd steps: expected steps >= 0", n);
+    if (n < 0 || ((double)n - 1.0) * p[P_DT] > MAX_GAME_SECONDS) {  /* n <= max_steps(dt), without a division */
+        char message[160];  /* PyErr_Format has no %g */
+        snprintf(message, sizeof message,
+                 "game_steps: %zd steps: expected steps >= 0 and at most %.15g (%g s at dt %g)", n,
+                 max_steps(p[P_DT]), MAX_GAME_SECONDS, p[P_DT]);
+        PyErr_SetString(PyExc_ValueError, message);
         return NULL;
     }
     double x[4] = {v[0], v[1], v[2], v[3]};
@@ -465,14 +579,15 @@ fail:
 PyDoc_STRVAR(rk4_step_doc,
 "rk4_step(params, mode, q1, q2, w1, w2, t1, t2, dt) -> (q1, q2, w1, w2)\n\n"
 "One step of integrators._rk4 on TwoJointArm's accel (mode 0, 1 or 2, as game_steps), torques t1, t2\n"
-"held over dt: the Python step's operations in order. params as game_steps' (only the arm's read).");
+"held over dt: the Python step's operations in order. params as game_steps' (only the arm's read).\n"
+"A value or param not finite is refused (ValueError).");
 
 static PyObject *rk4_step(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
     double p[P_COUNT], v[7];
     Arm arm;
-    if (one_game_args("rk4_step", args, nargs, 9, p, &arm, 2, 7, v) < 0)
+    if (one_game_args("rk4_step", args, nargs, 9, p, &arm, 2, 7, v, "q1 q2 w1 w2 t1 t2 dt", 0) < 0)
         return NULL;
     double x[4] = {v[0], v[1], v[2], v[3]};
     rk4_exact(&arm, v[4], v[5], v[6], x);
