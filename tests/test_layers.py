@@ -1,9 +1,14 @@
-"""The layers never reach upward: physics <- game, lab rules <- records <- ui <- commands.
+"""The layers never reach upward: physics <- game <- records <- lab <- ui <- commands.
 
 Each layer's modules are imported in a fresh interpreter, and nothing above the layer may
 have been imported with them. Records in particular knows no lab: a lab replay's task
 section is read by the reader the lab registers, and every command that reads replays
-registers it first, whatever was imported before.
+registers it first, whatever was imported before. The game knows no records: what both read
+files with (``armgame.files``) sits below every layer, with ``errors``, ``limits`` and ``words``.
+
+Within a package, no modules import each other in a circle: a piece two modules share lives
+below both (``env.errors``, ``ui.palette``, ``commands.seed_argument``); an import for a type
+annotation only goes under ``if TYPE_CHECKING:``, which never runs.
 """
 
 import ast
@@ -32,13 +37,15 @@ ABOVE_LAB = ("armgame.ui", "armgame.commands", "armgame.cli", "armgame.demos", "
 #: What each layer must never import, anywhere in its files (inside functions too: a lazy import is a dependency).
 LAYERS = {
     "armgame.physics": ("armgame.game", "armgame.lab", "armgame.records", *ABOVE_LAB),
-    "armgame.game": ("armgame.lab", *ABOVE_LAB),
+    "armgame.game": ("armgame.records", "armgame.lab", *ABOVE_LAB),
     "armgame.records": ("armgame.lab", *ABOVE_LAB),
     "armgame.lab": ABOVE_LAB,
     # The live class: above records, lab and game, below the commands; pygame only through ui (class show).
     "armgame.classroom": tuple(name for name in ABOVE_LAB if name != "armgame.classroom"),
 }
 ROOT = Path(armgame.__file__).parent
+#: The modules below every layer: each may import only the others.
+BASE = ("armgame.errors", "armgame.files", "armgame.limits", "armgame.words")
 
 
 def imported_names(path: Path, module: str) -> Iterator[tuple[int, str]]:
@@ -68,6 +75,105 @@ def test_no_file_of_a_layer_imports_from_above_it(layer):
         found += [f"{path.relative_to(ROOT)}:{line} imports {name}" for line, name in imported_names(path, module)
                   if reaches(name, LAYERS[layer])]
     assert found == []
+
+
+def test_the_modules_below_every_layer_import_only_each_other():
+    found = []
+    for module in BASE:
+        path = ROOT / f"{module.split('.')[1]}.py"
+        found += [f"{path.name}:{line} imports {name}" for line, name in imported_names(path, module)
+                  if name.startswith("armgame") and not reaches(name, BASE)]
+    assert found == []
+
+
+# ----------------------------------------------------------------- no import circles within a package
+
+def _type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or \
+        (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def runtime_imports(path: Path, module: str, lazy: bool) -> Iterator[tuple[int, str, tuple[str, ...]]]:
+    """(line, the module named after ``from`` or ``import``, the names imported from it) of every import
+    that runs: not under ``if TYPE_CHECKING:``, and with ``lazy`` only those inside functions too."""
+    package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
+
+    def walk(node: ast.AST) -> Iterator[tuple[int, str, tuple[str, ...]]]:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and _type_checking(child.test):
+                yield from (x for branch in child.orelse for x in walk(ast.Module([branch], [])))
+                continue
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)) and not lazy:
+                continue
+            if isinstance(child, ast.Import):
+                yield from ((child.lineno, alias.name, ()) for alias in child.names)
+            elif isinstance(child, ast.ImportFrom):
+                base = ".".join(package[:len(package) - child.level + 1]) if child.level else ""
+                yield child.lineno, ".".join(p for p in (base, child.module or "") if p), \
+                    tuple(alias.name for alias in child.names)
+            else:
+                yield from walk(child)
+
+    yield from walk(ast.parse(path.read_text(), str(path)))
+
+
+def import_circles(folder: Path, package: str, lazy: bool) -> list[list[str]]:
+    """The circles among the modules of one package (its ``__init__`` one of them): each as the import
+    statements that make it. ``from P import x`` imports P itself and, where x is a module of P, x."""
+    modules = {(package if f.name == "__init__.py" else f"{package}.{f.stem}"): f for f in folder.glob("*.py")}
+    edges: dict[str, dict[str, int]] = {m: {} for m in modules}
+    for module, path in modules.items():
+        for line, name, names in runtime_imports(path, module, lazy):
+            for target in (name, *(f"{name}.{n}" for n in names)):
+                if target in modules and target != module:
+                    edges[module].setdefault(target, line)
+    circles, done = [], set()
+    for start in sorted(modules):  # depth first from each module: a path back to one on it is a circle
+        stack = [(start, iter(sorted(edges[start])))]
+        on_path = [start]
+        while stack:
+            module, following = stack[-1]
+            target = next(following, None)
+            if target is None:
+                stack.pop()
+                on_path.pop()
+                done.add(module)
+            elif target in on_path:
+                ring = on_path[on_path.index(target):]
+                following_ring = ring[1:] + ring[:1]
+                circles.append([f"{a} (line {edges[a][b]}) -> {b}" for a, b in zip(ring, following_ring, strict=True)])
+            elif target not in done:
+                stack.append((target, iter(sorted(edges[target]))))
+                on_path.append(target)
+    return circles
+
+
+PACKAGES = sorted(".".join(("armgame", *p.parent.relative_to(ROOT).parts)) for p in ROOT.rglob("__init__.py"))
+
+
+@pytest.mark.parametrize("lazy", [False, True], ids=["module-level", "with-lazy-imports"])
+def test_no_modules_of_a_package_import_each_other_in_a_circle(lazy):
+    found = {package: import_circles(ROOT.joinpath(*package.split(".")[1:]), package, lazy) for package in PACKAGES}
+    assert "armgame.game.batch" in found and "armgame.commands" in found
+    assert {package: circles for package, circles in found.items() if circles} == {}
+
+
+def test_the_circle_check_sees_circles_and_passes_typing_only_imports(tmp_path):
+    """The check above can fail: an import under ``if TYPE_CHECKING:`` makes no circle, a lazy one does
+    (lazy imports counted), and so does ``from . import b`` back into a package whose ``__init__`` imports
+    the module (the old ``game.batch.session``'s ``from . import compiled``)."""
+    (tmp_path / "__init__.py").write_text("")
+    (tmp_path / "a.py").write_text("from typing import TYPE_CHECKING\nfrom .b import f\nx = 1\n"
+                                   "if TYPE_CHECKING:\n    from . import c\n")
+    (tmp_path / "b.py").write_text("def f():\n    from .c import y\n")
+    (tmp_path / "c.py").write_text("from .a import x\ny = 2\n")
+    assert import_circles(tmp_path, "p", lazy=False) == []
+    assert import_circles(tmp_path, "p", lazy=True) == [["p.a (line 2) -> p.b", "p.b (line 2) -> p.c",
+                                                         "p.c (line 1) -> p.a"]]
+    (tmp_path / "__init__.py").write_text("from .a import x\n")
+    (tmp_path / "b.py").write_text("from . import c\n")
+    assert ["p (line 1) -> p.a", "p.a (line 2) -> p.b", "p.b (line 1) -> p"] in \
+        import_circles(tmp_path, "p", lazy=False)
 
 
 def test_the_static_check_sees_relative_and_lazy_imports(tmp_path):

@@ -8,6 +8,7 @@ that does the same without one, which the CLI prints when no display can be open
 
 from __future__ import annotations
 
+import argparse
 import shlex
 from collections.abc import Sequence
 
@@ -15,6 +16,18 @@ from collections.abc import Sequence
 def command_line(typed: Sequence[str], *added: str) -> str:
     """``armgame`` with the arguments the user typed and ``added``, quoted to paste into a shell."""
     return shlex.join(["armgame", *typed, *added])
+
+
+def seed_argument(text: str) -> int:
+    """``--seed``'s type: a game's seed, a whole number from 0 to 2^63 - 1. Here, below the commands that
+    take one (play, lab, scores --new, class), so that none imports another for it."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"must be from 0 to 2^63 - 1, got {text!r}")
+    return value
 
 
 def read_lab_replays() -> None:

@@ -26,7 +26,7 @@ def add_join_options(p: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from .play import _seed
+    from . import seed_argument as _seed
 
     p = subparsers.add_parser(
         "class",

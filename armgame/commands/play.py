@@ -9,16 +9,7 @@ from ..errors import UserError
 from ..limits import DEFAULT_SEED
 from ..words import plural
 from . import read_lab_replays
-
-
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 0 <= value < 2**63:
-        raise argparse.ArgumentTypeError(f"must be from 0 to 2^63 - 1, got {text!r}")
-    return value
+from . import seed_argument as _seed
 
 
 def add_game_options(p: argparse.ArgumentParser) -> None:

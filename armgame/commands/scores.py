@@ -75,7 +75,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _seed_arg(text: str) -> int:
-    from .play import _seed
+    from . import seed_argument as _seed
 
     return _seed(text)
 

@@ -12,14 +12,11 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from ..errors import UserError
 from ..game.session import DOWN, RESET_KEY, UP, GameSession
+from .errors import EnvArgumentError
 from .features import muscle_levels
 
-
-class EnvArgumentError(UserError, ValueError):
-    """A bad argument to an env: one line naming it (a ``ValueError`` too, as Gymnasium users expect)."""
-
+__all__ = ["EnvArgumentError", "SessionEnv"]  # EnvArgumentError's old home: env.errors holds it
 
 class SessionEnv(gym.Env):
     """A Gymnasium env over one armgame session (``self.session``, None before ``reset``).

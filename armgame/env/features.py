@@ -35,6 +35,7 @@ import numpy as np
 
 from ..game.rules import GameConfig
 from ..physics.params import TwoJointParams
+from .errors import EnvArgumentError
 
 #: Reward per metre of progress toward the current target's edge (1 per 10 cm).
 DEFAULT_PROGRESS_WEIGHT = 10.0
@@ -87,8 +88,6 @@ OBSERVATION_DTYPES = ("float32", "float64")
 
 def check_dtype(value: object) -> str:
     """``observation_dtype``: float32 (the default: what networks take) or float64 (the game's state exactly)."""
-    from .base import EnvArgumentError
-
     name = np.dtype(value).name if isinstance(value, type) and issubclass(value, np.floating) else value
     if name not in OBSERVATION_DTYPES:
         raise EnvArgumentError(f"observation_dtype must be 'float32' or 'float64', got {value!r}")
@@ -97,8 +96,6 @@ def check_dtype(value: object) -> str:
 
 def check_reward(reward: object, progress_weight: object, hit_bonus: object) -> tuple[str, float, float]:
     """The reward arguments of a v1 env, checked: one line naming a bad one."""
-    from .base import EnvArgumentError
-
     if reward not in REWARDS:
         raise EnvArgumentError(f"reward must be 'dense' or 'sparse', got {reward!r}")
     for name, value in (("progress_weight", progress_weight), ("hit_bonus", hit_bonus)):

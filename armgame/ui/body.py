@@ -20,14 +20,10 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import pygame
 
-if TYPE_CHECKING:
-    from .render import Palette
-
-RGB = tuple[int, int, int]
+from .palette import RGB, Palette
 
 Point = tuple[float, float]
 

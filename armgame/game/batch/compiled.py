@@ -39,10 +39,16 @@ from .schedule import MuscleEvents
 if TYPE_CHECKING:
     from .session import BatchGameSession
 
-__all__ = ["AVAILABLE", "KERNEL_VERSION", "CompiledKernel", "speaks_our_convention"]
+__all__ = ["AVAILABLE", "KERNEL_VERSION", "CompiledKernel", "available", "speaks_our_convention"]
 
 #: Whether the compiled kernel is here to use.
 AVAILABLE = _ckernel is not None
+
+
+def available() -> bool:
+    """``AVAILABLE``, read when asked (tests switch it off): how ``session`` asks, importing this module's
+    names rather than the package, whose ``__init__`` imports ``session`` (an import circle)."""
+    return AVAILABLE
 
 
 class CompiledKernel:

@@ -52,8 +52,8 @@ from ...physics.twojoint import TwoJointArm
 from ..muscles import MuscleLevelError, MuscleSet
 from ..rules import GameConfig, GameRules
 from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
-from . import compiled
 from .compiled import CompiledKernel
+from .compiled import available as compiled_available
 from .numpy_kernel import NumpyKernel
 from .schedule import MuscleEvents, schedule
 
@@ -124,7 +124,7 @@ class BatchGameSession:
             raise UserError(problem)
         if kernel not in KERNELS:
             raise ValueError(f"kernel {kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
-        if kernel == "compiled" and not compiled.AVAILABLE:
+        if kernel == "compiled" and not compiled_available():
             raise ValueError("kernel 'compiled': the compiled kernel is not built here (no C compiler at install?)")
         self.configs = configs
         #: True: the single session's arithmetic, bit for bit; False: the kernels may use their fast RK4
@@ -165,7 +165,7 @@ class BatchGameSession:
         #: Games whose hand came within ``KNIFE_EDGE`` of a target's edge in the fast kernel: their hits
         #: could differ from the single session's (``replay_many`` plays them again alone).
         self.knife_edge = np.zeros(n, dtype=bool)
-        use_compiled = kernel != "numpy" and compiled.AVAILABLE and c.integrator == "rk4"
+        use_compiled = kernel != "numpy" and compiled_available() and c.integrator == "rk4"
         # Whether the kernel may round differently from the single session: the fast stages, which
         # compiled pay at any batch size, in numpy only from ``_series_from`` games (call overhead).
         self._series_from = SERIES_MIN_GAMES
