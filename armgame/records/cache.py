@@ -31,6 +31,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .. import __version__
+from ..errors import UserError
 from .identity import current_claims
 from .storage import DataFileError, atomic_write_bytes, parse_json, read_limited, user_path
 
@@ -108,9 +109,15 @@ class VerificationCache:
     MAX_ITEMS = 200_000
 
     def __init__(self, folder: Path | None = None, warn: Callable[[str], None] | None = None) -> None:
-        self.folder = Path(folder) if folder is not None else default_cache_dir()
-        self.path = self.folder / f"verified-{__version__}.json" if self.folder is not None else None
         self.warn = warn or (lambda message: print(f"armgame: {message}", file=sys.stderr))
+        if folder is None:
+            try:
+                folder = default_cache_dir()
+            except UserError as exc:  # $ARMGAME_CACHE names no usable folder (too long, no such user): a note,
+                # as for an untrusted one; the command goes on (a game just played still enters its table)
+                self.warn(f"note: the verification cache {exc}: ignored (every replay is checked afresh)")
+        self.folder = Path(folder) if folder is not None else None
+        self.path = self.folder / f"verified-{__version__}.json" if self.folder is not None else None
         self.tables: list[Path] = []
         #: Without a (trusted) folder the cache lives only as long as the command.
         self._items: dict[str, dict] | None = None if self.path is not None else {}
