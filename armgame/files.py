@@ -85,20 +85,32 @@ def path_limits(path: Path) -> tuple[int, int]:
 
 def check_path_length(path: Path, what: str = "path", room: int = 0) -> None:
     """Refuse a path the file system cannot name, in one line naming ``what``: a name in it longer than
-    the file system's longest name, or the whole (made absolute, with ``room`` bytes more for the files
-    armgame will make under it) longer than its longest path (both in bytes: the system's units)."""
+    the file system's longest name, or the whole (made absolute, with ``room`` more for the files armgame
+    will make in or beside it) longer than its longest path, in the system's units (bytes; UTF-16 units
+    on Windows)."""
     name_max, path_max = path_limits(path)
-    longest = max(Path(path).parts, key=lambda part: len(os.fsencode(part)), default="")
-    size = len(os.fsencode(longest))
+    longest = max(Path(path).parts, key=_size_of, default="")
+    size = _size_of(longest)
     if size > name_max:
-        raise UserError(f"{what} {show_path(path)}: a name in it is {size:,} bytes long, more than the file "
+        raise UserError(f"{what} {show_path(path)}: a name in it is {size:,} {_UNITS} long, more than the file "
                         f"system allows ({name_max})")
-    size = len(os.fsencode(os.path.abspath(path)))
+    size = _size_of(os.path.abspath(path))
     most = path_max - 1 - room  # PATH_MAX counts the terminating NUL
     if size > most:
         extra = " (with room for the names armgame makes in it or beside it)" if room else ""
-        raise UserError(f"{what} {show_path(path)}: the path is {size:,} bytes long, more than the file system "
+        raise UserError(f"{what} {show_path(path)}: the path is {size:,} {_UNITS} long, more than the file system "
                         f"allows{extra}: {most:,}")
+
+
+#: What the file system counts a name's length in: Windows' (NTFS) in UTF-16 units, POSIX ones in bytes.
+_UNITS = "characters" if os.name == "nt" else "bytes"
+
+
+def _size_of(text: str) -> int:
+    """The length of a name or path as the file system counts it (``_UNITS``)."""
+    if os.name == "nt":
+        return len(text.encode("utf-16-le", "surrogatepass")) // 2
+    return len(os.fsencode(text))
 
 
 def kind_of(mode: int) -> str:
