@@ -54,6 +54,18 @@ def default_cache_dir() -> Path | None:
         return None
 
 
+def usable_cache_dir(warn: Callable[[str], None], what: str) -> Path | None:
+    """``default_cache_dir()``, or None where ``$ARMGAME_CACHE`` names no usable folder (too long for the file
+    system, no such user's home), said to ``warn`` as a note that ``what`` is ignored: the cache and the
+    teacher's record only save work or add trust, so a command goes on without them (a game just played
+    still enters its table)."""
+    try:
+        return default_cache_dir()
+    except UserError as exc:
+        warn(f"note: {what} {exc}: ignored")
+        return None
+
+
 def file_signature(st: os.stat_result) -> list[int]:
     """What changes whenever a file's bytes can have changed (ctime cannot be set back by its owner)."""
     return [st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns]
@@ -110,12 +122,8 @@ class VerificationCache:
 
     def __init__(self, folder: Path | None = None, warn: Callable[[str], None] | None = None) -> None:
         self.warn = warn or (lambda message: print(f"armgame: {message}", file=sys.stderr))
-        if folder is None:
-            try:
-                folder = default_cache_dir()
-            except UserError as exc:  # $ARMGAME_CACHE names no usable folder (too long, no such user): a note,
-                # as for an untrusted one; the command goes on (a game just played still enters its table)
-                self.warn(f"note: the verification cache {exc}: ignored (every replay is checked afresh)")
+        if folder is None:  # as an untrusted one, an unusable $ARMGAME_CACHE is a note: every replay checked afresh
+            folder = usable_cache_dir(self.warn, "the verification cache")
         self.folder = Path(folder) if folder is not None else None
         self.path = self.folder / f"verified-{__version__}.json" if self.folder is not None else None
         self.tables: list[Path] = []

@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
 from ..limits import MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
-from .cache import default_cache_dir, private_place_reason
+from .cache import private_place_reason, usable_cache_dir
 from .replay import check_date
 from .storage import DataFileError, atomic_write_bytes, check_int, check_keys, parse_json, read_limited
 
@@ -137,8 +137,8 @@ class TeacherRecord:
     def __init__(self, table_folder: Path, folder: Path | None = None,
                  warn: Callable[[str], None] | None = None) -> None:
         self.table_folder = Path(table_folder)
-        self.folder = Path(folder) if folder is not None else default_cache_dir()
         self.warn = warn or (lambda message: None)
+        self.folder = Path(folder) if folder is not None else usable_cache_dir(self.warn, "the teacher's record")
         self._loaded = False
         self._data: RecordData | None = None
         self._said: set[str] = set()
