@@ -12,6 +12,7 @@ annotation only goes under ``if TYPE_CHECKING:``, which never runs.
 """
 
 import ast
+import functools
 import json
 import subprocess
 import sys
@@ -114,7 +115,13 @@ def runtime_imports(path: Path, module: str, lazy: bool) -> Iterator[tuple[int, 
             else:
                 yield from walk(child)
 
-    yield from walk(ast.parse(path.read_text(), str(path)))
+    yield from walk(_parsed(path.read_text(), str(path)))
+
+
+@functools.cache
+def _parsed(text: str, name: str) -> ast.Module:
+    """A file's syntax tree, parsed once for both of the circle tests (keyed by its text: files change)."""
+    return ast.parse(text, name)
 
 
 def import_circles(folder: Path, package: str, lazy: bool) -> list[list[str]]:
