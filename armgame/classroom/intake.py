@@ -25,6 +25,7 @@ import io
 import math
 import os
 import re
+import secrets
 import stat
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -145,8 +146,6 @@ class Clerk:
             raise RefusedError(403, "the class is closed to new players")
         if len(self.roster.players) >= MAX_PLAYERS:
             raise RefusedError(403, f"the class has {MAX_PLAYERS} players, as many as it takes")
-        import secrets
-
         new_token = secrets.token_urlsafe(24)
         player = Player(name, token_digest(new_token), now_iso())
         self.roster.players[key] = player
