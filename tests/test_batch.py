@@ -425,8 +425,9 @@ def test_a_folder_of_scripts_plays_its_txt_files_in_sorted_order_and_follows_no_
 
 
 @pytest.mark.parametrize(("extra", "message"), [
-    (["--name", "Ann"], "--name and --record are for one game"),
-    (["--record", "x.json"], "--name and --record are for one game"),
+    (["--name", "Ann"], "--name, --record and --join are for one game"),
+    (["--record", "x.json"], "--name, --record and --join are for one game"),
+    (["--join", "127.0.0.1:8765", "--code", "ACDE"], "--name, --record and --join are for one game"),
     (["--bot", "model"], "--bot and --script"),
 ])
 def test_options_for_one_game_are_refused_for_many_in_one_line(tmp_path, capsys, extra, message):

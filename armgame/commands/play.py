@@ -180,8 +180,8 @@ def _play_class(args: argparse.Namespace) -> int:
         raise UserError("--script drives a headless game: add --headless")
     if args.bot:
         raise UserError("--bot and --script both drive the game: give one of them")
-    if args.name is not None or args.record:
-        raise UserError("--name and --record are for one game: give one script, not several")
+    if args.name is not None or args.record or args.join is not None:
+        raise UserError("--name, --record and --join are for one game: give one script, not several")
     paths = script_paths(args.script)
     for path, result in zip(paths, play_scripts(game_config(args), paths), strict=True):
         if args.json:
