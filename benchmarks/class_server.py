@@ -1,0 +1,758 @@
+"""The live class's server as a teacher's laptop runs it, under a class's load, on loopback only.
+
+    python benchmarks/class_server.py                           # classes of 30, 100 and 1,000; 3 repeats
+    python benchmarks/class_server.py --sizes 30,100 --repeats 5 --json
+    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60   # a quick look, about 30 s
+
+The whole default run takes about 8 minutes on the 2-core machine of docs/performance.md (making
+the games about 40 s; a class of 1,000 about 80 s a repeat).
+
+The server is ``python -m armgame class serve --folder TMP --host 127.0.0.1 --port P`` in its own
+process, a new class in a new temporary folder for every class and repeat. The students are
+threads of ``--clients`` other processes (this script again, ``--client``), each student talking
+HTTP through the students' own client code (``armgame.classroom.client._request``, whose policy
+on a busy class is the one a student's machine has: wait what Retry-After says, at most a minute
+in all, then keep the game for later). A class goes through:
+
+1. **joining**: every student joins once, all at the same moment (the lesson starts);
+2. **a round's end**: every student hands in one game at the same moment. "The whole class
+   handed in within X s" is the time from that moment until the last student has their answer;
+3. **sustained**: every student hands in ``ceil(--sustained / class)`` more games (2 at least)
+   one after another, as fast as the server takes them; hand-ins per second is the games
+   acknowledged over the time until the last answer.
+
+Each hand-in's latency is measured by its client, from the request to the answer, the waits
+after a 503 (busy) included; the 503s are counted. Meanwhile a projector keeps the class's
+event stream open, as the page does, and asks ``GET /api/standings`` every 0.2 s; its latency
+is reported. The server's peak memory is its VmHWM (Linux), else its ``ru_maxrss`` once it has
+stopped (other POSIX), else n/a; its CPU time per hand-in is read from /proc where there is one.
+At the end of every class the server is stopped with Ctrl-C's signal and its folder is read as
+``ScoreTable``: every acknowledged game must be there under its student's name, with its replay
+(the benchmark fails otherwise).
+
+The games are the standard game (seed 10, 60 s), distinct, made before anything is timed and
+the same on every run: keyboard games whose keys switch every 0.1-0.5 s as in
+``class_speed.py`` (about 9 KB each), and one hand-in in twenty (``--bot-share``) the model
+bot's game (about 0.53 MB), each let go of at another step near the end so that each is its
+own game. The projector's figures and the clients share the machine with the server: on a
+2-core machine the clients take a share of it (printed: the clients' CPU seconds).
+
+Figures are medians over ``--repeats`` with [min-max]; the machine and its load average are printed
+beside them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import http.client
+import json
+import math
+import os
+import platform
+import queue
+import random
+import re
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.request
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+CLASS_SEED = 10
+#: A replay's date, fixed so that the bytes sent are the same on every run.
+GAME_DATE = "2026-01-05T09:00:00.000000+00:00"
+STANDINGS_EVERY = 0.2
+#: From the word go (every client's students ready) to the moment they start: the word's way down the pipes.
+GO_LEAD = 0.1
+START_SECONDS = 60.0
+STOP_SECONDS = 30.0
+
+
+# ------------------------------------------------------------------ the games
+
+def student_keys(rng: random.Random, dt: float, seconds: float) -> list[Any]:
+    """A student's keys as ``class_speed.py`` makes them: one of the four switching every 0.1-0.5 s,
+    a reset after one switch in a hundred."""
+    from armgame.game.session import InputEvent
+
+    events, held, t = [], set(), 0.0
+    while True:
+        t += rng.uniform(0.1, 0.5)
+        if t >= seconds:
+            return events
+        step = round(t / dt)
+        key = rng.choice("dfjk")
+        events.append(InputEvent(step, key, "up" if key in held else "down"))
+        held ^= {key}
+        if rng.random() < 0.01:
+            events.append(InputEvent(step, "space", "down"))
+
+
+def is_bot(index: int, share: float) -> bool:
+    """Whether game ``index`` is a bot's: evenly spread, ``share`` of them."""
+    return math.floor((index + 1) * share) > math.floor(index * share)
+
+
+def make_games(folder: Path, count: int, bot_share: float, seed: int) -> list[dict[str, Any]]:
+    """``count`` distinct standard games written to ``folder`` (``NNNNN.json``); each one's path, identity,
+    size and kind. Deterministic: the same bytes for the same arguments."""
+    from armgame.game.bots import Autopilot, make_bot
+    from armgame.game.rules import GameConfig
+    from armgame.game.session import UP, GameSession, InputEvent
+    from armgame.records.identity import game_digest
+    from armgame.records.replay import Replay
+
+    config = GameConfig(seed=CLASS_SEED)
+    bot_timeline: list[Any] = []
+    if any(is_bot(i, bot_share) for i in range(count)):
+        session = GameSession(config)
+        Autopilot(session, make_bot("model")).play()
+        bot_timeline = list(session.timeline)
+    folder.mkdir(parents=True, exist_ok=True)
+    games: list[dict[str, Any]] = []
+    seen: set[str] = set()
+    tries = {"bot": 0, "keyboard": 0}
+    while len(games) < count:
+        index = len(games)
+        kind = "bot" if is_bot(index, bot_share) else "keyboard"
+        tries[kind] += 1
+        if tries[kind] > 2 * count + 100 or tries["bot"] * 10 >= config.total_steps:
+            raise SystemExit("class_server: cannot make enough distinct games (a bug)")
+        session = GameSession(config)
+        if kind == "bot":
+            # The bot's game, its keys let go 10 steps (40 ms) earlier than the bot game before it's: its own game.
+            last = config.total_steps - 10 * tries["bot"]
+            events = [e for e in bot_timeline if e.step < last]
+            events += [InputEvent(last, m.key, UP) for m in config.muscles]
+            session.play(events)
+            replay = Replay.from_session(session, "bot", "model")
+        else:
+            session.play(student_keys(random.Random(f"{seed}-{tries[kind]}"), config.dt, config.time_limit))
+            replay = Replay.from_session(session, "keyboard")
+        replay = dataclasses.replace(replay, date=GAME_DATE)
+        digest = game_digest(replay)
+        if digest in seen:  # the same game by effect: it would count once, so it is not a new game
+            continue
+        seen.add(digest)
+        data = replay.to_bytes()
+        path = folder / f"{index:05d}.json"
+        path.write_bytes(data)
+        games.append({"path": str(path), "digest": digest, "bytes": len(data), "bot": replay.driven == "bot",
+                      "score": replay.result.score})
+    return games
+
+
+# ------------------------------------------------------------------ the server
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+class Server:
+    """``armgame class serve`` in its own process; its output drained on a thread (never blocks it)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.lines: queue.Queue[str | None] = queue.Queue()
+        self.said: list[str] = []
+        self.banner = 0
+        self.port = free_port()
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "armgame", "class", "serve", "--folder", str(folder), "--host", "127.0.0.1",
+             "--port", str(self.port)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            text=True, errors="replace")
+        self.rusage_maxrss: int | None = None
+        threading.Thread(target=self._drain, daemon=True).start()
+        self.code = self._wait_ready()
+
+    def _drain(self) -> None:
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            self.lines.put(line.rstrip("\n"))
+        self.lines.put(None)
+
+    def _wait_ready(self) -> str:
+        code = None
+        deadline = time.monotonic() + START_SECONDS
+        while time.monotonic() < deadline:
+            try:
+                line = self.lines.get(timeout=max(0.01, deadline - time.monotonic()))
+            except queue.Empty:
+                break
+            if line is None:
+                break
+            self.said.append(line)
+            found = re.search(r"code ([A-Z]{4})", line)
+            if found and code is None:
+                code = found.group(1)
+            if "Ctrl-C stops the class" in line and code is not None:  # the banner's last line
+                self.banner = len(self.said)
+                return code
+        raise RuntimeError("the class's server did not start:\n" + "\n".join(self.said))
+
+    def notices(self) -> dict[str, int]:
+        """What the server printed after its banner (uvicorn's warnings too), each line with its count; its last
+        line ("armgame class stopped: ...") left out."""
+        while True:
+            try:
+                line = self.lines.get_nowait()
+            except queue.Empty:
+                break
+            if line is not None:
+                self.said.append(line)
+        counts: dict[str, int] = {}
+        for line in self.said[self.banner:]:
+            if not line.startswith("armgame class stopped:"):
+                counts[line] = counts.get(line, 0) + 1
+        return counts
+
+    def cpu_seconds(self) -> float | None:
+        """The server's CPU time so far (user and system), where /proc tells it."""
+        try:
+            fields = Path(f"/proc/{self.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            return None
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+    def peak_rss(self) -> int | None:
+        """The server's peak resident memory in bytes so far (VmHWM), where /proc tells it."""
+        try:
+            status = Path(f"/proc/{self.proc.pid}/status").read_text()
+        except OSError:
+            return self.rusage_maxrss
+        found = re.search(r"^VmHWM:\s+(\d+)\s+kB", status, re.MULTILINE)
+        return int(found.group(1)) * 1024 if found else self.rusage_maxrss
+
+    def stop(self) -> int | None:
+        """Ctrl-C's signal, then a kill if it has not stopped within ``STOP_SECONDS``; its exit status."""
+        if self.proc.poll() is not None:
+            return self.proc.returncode
+        if sys.platform == "win32":
+            self.proc.terminate()
+        else:
+            self.proc.send_signal(signal.SIGINT)
+        if hasattr(os, "wait4") and not Path("/proc/self/status").exists():
+            # Without /proc the peak memory is known only from the rusage of the reaped process.
+            deadline = time.monotonic() + STOP_SECONDS
+            while time.monotonic() < deadline:
+                pid, status, usage = os.wait4(self.proc.pid, os.WNOHANG)
+                if pid:
+                    scale = 1 if sys.platform == "darwin" else 1024  # macOS counts bytes, the others KiB
+                    self.rusage_maxrss = usage.ru_maxrss * scale
+                    self.proc.returncode = os.waitstatus_to_exitcode(status)
+                    return self.proc.returncode
+                time.sleep(0.05)
+        try:
+            return self.proc.wait(STOP_SECONDS)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait(STOP_SECONDS)
+            return None
+
+
+# ------------------------------------------------------------------ the students (in --client processes)
+
+def student_thread(address: Any, code: str, student: dict[str, Any], phase: str, go: threading.Event,
+                   start: list[float], games: dict[int, bytes], out: list[dict[str, Any]]) -> None:
+    """One student's share of ``phase``, once ``go`` is set, from the moment ``start[0]`` (``time.time``); a record
+    per request in ``out``."""
+    from armgame.classroom import client
+
+    busy = [0]
+
+    def counted_sleep(seconds: float) -> None:  # the client sleeps once for every 503 it is answered
+        busy[0] += 1
+        time.sleep(seconds)
+
+    def request(path: str, body: bytes, headers: dict[str, str]) -> dict[str, Any]:
+        busy[0] = 0
+        began = time.perf_counter()
+        record: dict[str, Any] = {}
+        try:
+            answer = client._request(address, path, body, headers, sleep=counted_sleep)
+            record.update(outcome="ok", answer=answer)
+        except client.RefusalError as exc:
+            record.update(outcome=f"refused {exc.status}", error=str(exc)[:200])
+        except client.UnreachableError as exc:
+            record.update(outcome="unreachable", error=str(exc)[:200])
+        except Exception as exc:  # reported, never hidden: the benchmark's figures would be wrong without it
+            record.update(outcome=f"error {type(exc).__name__}", error=str(exc)[:200])
+        record.update(latency=time.perf_counter() - began, end=time.time(), busy=busy[0])
+        return record
+
+    if not go.wait(START_SECONDS):
+        return
+    time.sleep(max(0.0, start[0] - time.time()))
+    if phase == "join":
+        record = request("/api/join", json.dumps({"code": code, "name": student["name"]}).encode(),
+                         {"Content-Type": "application/json"})
+        answer = record.pop("answer", None)
+        if answer is not None:
+            student["token"] = str(answer.get("token"))
+        out.append(record)
+        return
+    indices = student["games"][:1] if phase == "burst" else student["games"][1:]
+    for index in indices:
+        if "token" not in student:
+            return
+        headers = {"Content-Type": "application/json", "Authorization": f"Bearer {student['token']}",
+                   "X-Armgame-Code": code}
+        record = request("/api/handin", games[index], headers)
+        answer = record.pop("answer", None)
+        if answer is not None and not (answer.get("ok") and answer.get("name") == student["name"]):
+            record["outcome"] = "wrong answer"
+            record["error"] = json.dumps(answer)[:200]
+        record.update(game=index, name=student["name"], already=bool(answer and answer.get("already")))
+        out.append(record)
+
+
+def client_main() -> int:
+    """A ``--client`` process: its students from stdin's first line, then for each phase its name (the students
+    are made ready: a line back) and its moment (they go: their records back on a line)."""
+    from armgame.classroom import client
+
+    threading.stack_size(512 * 1024)  # hundreds of threads that only wait on sockets
+    spec = json.loads(sys.stdin.readline())
+    address = client.ClassAddress.parse(spec["address"])
+    students: list[dict[str, Any]] = spec["students"]
+    games = {int(i): Path(path).read_bytes() for i, path in spec["games"]}
+    print(json.dumps({"ready": True}), flush=True)
+    for line in sys.stdin:
+        command = json.loads(line)
+        if command["phase"] == "quit":
+            return 0
+        out: list[dict[str, Any]] = []
+        go, start = threading.Event(), [0.0]
+        threads = [threading.Thread(target=student_thread, daemon=True,
+                                    args=(address, spec["code"], s, command["phase"], go, start, games, out))
+                   for s in students]
+        for t in threads:
+            t.start()
+        print(json.dumps({"armed": True}), flush=True)
+        start[0] = json.loads(sys.stdin.readline())["start_at"]
+        late = time.time() - start[0]  # above 0: this process's students started after the moment
+        before = time.process_time()  # the whole process's, every thread's
+        go.set()
+        deadline = time.monotonic() + command["timeout"]
+        for t in threads:
+            t.join(max(0.0, deadline - time.monotonic()))
+        cpu = time.process_time() - before
+        print(json.dumps({"records": list(out), "unfinished": sum(t.is_alive() for t in threads), "cpu": cpu,
+                          "late": late}), flush=True)
+    return 0
+
+
+class Clients:
+    """The ``--client`` processes, each with its share of the class."""
+
+    def __init__(self, n: int, address: str, code: str, students: list[dict[str, Any]], games: list[str]) -> None:
+        self.procs: list[subprocess.Popen] = []
+        self.answers: list[queue.Queue[str | None]] = []
+        for k in range(n):
+            mine = students[k::n]
+            if not mine:
+                continue
+            proc = subprocess.Popen([sys.executable, __file__, "--client"], stdin=subprocess.PIPE,
+                                    stdout=subprocess.PIPE, text=True)
+            answers: queue.Queue[str | None] = queue.Queue()
+            threading.Thread(target=self._drain, args=(proc, answers), daemon=True).start()
+            self.procs.append(proc)
+            self.answers.append(answers)
+            self._send(proc, {"address": address, "code": code, "students": mine,
+                              "games": [[i, games[i]] for s in mine for i in s["games"]]})
+        self._collect(START_SECONDS)
+
+    @staticmethod
+    def _drain(proc: subprocess.Popen, answers: queue.Queue[str | None]) -> None:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            answers.put(line)
+        answers.put(None)
+
+    @staticmethod
+    def _send(proc: subprocess.Popen, message: dict[str, Any]) -> None:
+        assert proc.stdin is not None
+        proc.stdin.write(json.dumps(message) + "\n")
+        proc.stdin.flush()
+
+    def _collect(self, timeout: float) -> list[dict[str, Any]]:
+        deadline = time.monotonic() + timeout
+        replies = []
+        for answers in self.answers:
+            try:
+                line = answers.get(timeout=max(0.01, deadline - time.monotonic()))
+            except queue.Empty:
+                line = None
+            if line is None:
+                raise RuntimeError("a client process did not answer in time (or ended)")
+            replies.append(json.loads(line))
+        return replies
+
+    def phase(self, name: str, timeout: float) -> tuple[list[dict[str, Any]], float, dict[str, float]]:
+        """Every student's requests of phase ``name``, all started at one moment once every client process has its
+        threads ready; (the records, that moment, {the clients' CPU seconds, how late the last process started})."""
+        for proc in self.procs:
+            self._send(proc, {"phase": name, "timeout": timeout})
+        self._collect(START_SECONDS)
+        start_at = time.time() + GO_LEAD
+        for proc in self.procs:
+            self._send(proc, {"start_at": start_at})
+        replies = self._collect(GO_LEAD + timeout + 10)
+        if any(r["unfinished"] for r in replies):
+            raise RuntimeError(f"{sum(r['unfinished'] for r in replies)} students did not finish the {name} within "
+                               f"{timeout:g} s")
+        return ([rec for r in replies for rec in r["records"]], start_at,
+                {"clients_cpu_s": sum(r["cpu"] for r in replies), "start_late_s": max(r["late"] for r in replies)})
+
+    def close(self) -> None:
+        for proc in self.procs:
+            with contextlib.suppress(OSError, ValueError):
+                self._send(proc, {"phase": "quit"})
+        for proc in self.procs:
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(10)
+
+
+# ------------------------------------------------------------------ the projector
+
+class Projector:
+    """The projector's page, from this process: the event stream held open, and ``GET /api/standings``
+    every ``STANDINGS_EVERY`` s, each timed."""
+
+    def __init__(self, port: int) -> None:
+        self.port = port
+        self.latencies: list[float] = []
+        self.failures: list[str] = []
+        self.events = 0
+        self.done = threading.Event()
+        self.connection: http.client.HTTPConnection | None = None
+        self.threads = [threading.Thread(target=self._poll, daemon=True),
+                        threading.Thread(target=self._stream, daemon=True)]
+        for t in self.threads:
+            t.start()
+
+    def _poll(self) -> None:
+        url = f"http://127.0.0.1:{self.port}/api/standings"
+        while not self.done.wait(STANDINGS_EVERY):
+            began = time.perf_counter()
+            try:
+                with urllib.request.urlopen(url, timeout=15) as response:
+                    json.loads(response.read())
+                self.latencies.append(time.perf_counter() - began)
+            except (OSError, ValueError, http.client.HTTPException) as exc:
+                self.failures.append(f"{type(exc).__name__}: {exc}"[:200])
+
+    def _stream(self) -> None:
+        connection = self.connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=20)  # beats: 15 s
+        try:
+            connection.request("GET", "/events")
+            response = connection.getresponse()
+            while not self.done.is_set():
+                line = response.readline()
+                if not line:
+                    break
+                if line.startswith(b"event: standings"):
+                    self.events += 1
+        except (OSError, http.client.HTTPException) as exc:
+            if not self.done.is_set():
+                self.failures.append(f"events: {type(exc).__name__}: {exc}"[:200])
+        finally:
+            connection.close()
+
+    def stop(self) -> None:
+        """Both stopped; the stream closed from here (else the server would wait its grace for it to end)."""
+        self.done.set()
+        if self.connection is not None and self.connection.sock is not None:
+            with contextlib.suppress(OSError):
+                self.connection.sock.shutdown(socket.SHUT_RDWR)
+        for t in self.threads:
+            t.join(20)
+
+
+# ------------------------------------------------------------------ one class
+
+def percentile(values: list[float], q: float) -> float | None:
+    """The ``q``-th percentile (linear between the closest ranks), None of nothing."""
+    if not values:
+        return None
+    ordered = sorted(values)
+    at = (len(ordered) - 1) * q / 100
+    low = math.floor(at)
+    high = min(low + 1, len(ordered) - 1)
+    return ordered[low] + (ordered[high] - ordered[low]) * (at - low)
+
+
+def tally(records: list[dict[str, Any]], start_at: float) -> dict[str, Any]:
+    """A phase's figures from its requests' records."""
+    ok = [r for r in records if r["outcome"] == "ok"]
+    latencies = [r["latency"] for r in ok]
+    last = max((r["end"] for r in records), default=start_at)
+    failed: dict[str, int] = {}
+    for r in records:
+        if r["outcome"] != "ok":
+            failed[r["outcome"]] = failed.get(r["outcome"], 0) + 1
+    return {"requests": len(records), "acknowledged": len(ok), "seconds": last - start_at,
+            "per_second": len(ok) / (last - start_at) if last > start_at else None,
+            "p50_s": percentile(latencies, 50), "p99_s": percentile(latencies, 99),
+            "max_s": max(latencies, default=None), "busy_503": sum(r["busy"] for r in records),
+            "not_acknowledged": failed, "already": sum(bool(r.get("already")) for r in ok),
+            "errors": sorted({r["error"] for r in records if "error" in r})[:3]}
+
+
+def check_folder(folder: Path, acked: dict[int, str], games: list[dict[str, Any]]) -> dict[str, Any]:
+    """The class's folder read as a score table: every acknowledged game in it under its student's name, with
+    its replay. Raises SystemExit if one is missing."""
+    from armgame.records.scores import ScoreTable
+
+    entries, damage = ScoreTable(folder).read()
+    if damage is not None:
+        raise SystemExit(f"class_server: the class's table is damaged: {damage}")
+    kept = {e.game_sha256: e for e in entries}
+    missing = [i for i, name in acked.items()
+               if games[i]["digest"] not in kept or kept[games[i]["digest"]].name != name
+               or not (folder / "replays" / kept[games[i]["digest"]].replay).is_file()]
+    if missing:
+        raise SystemExit(f"class_server: {len(missing)} acknowledged games are not in {folder} as handed in "
+                         f"(games {missing[:10]}): a bug")
+    return {"entries": len(entries), "acknowledged_kept": len(acked), "not_acknowledged_but_kept":
+            len(entries) - len(acked)}
+
+
+def one_class(size: int, games: list[dict[str, Any]], args: argparse.Namespace,
+              say: Callable[[str], None]) -> dict[str, Any]:
+    """One class of ``size`` students from join to the end of the sustained phase; its figures."""
+    per_student = max(2, math.ceil(args.sustained / size))
+    students = [{"name": f"student {s + 1:04d}", "games": [s] + [size + s * per_student + k
+                                                                 for k in range(per_student)]}
+                for s in range(size)]
+    with tempfile.TemporaryDirectory(prefix="armgame-class-server-") as tmp:
+        folder = Path(tmp) / "class"
+        server = Server(folder)
+        clients = projector = None
+        try:
+            clients = Clients(min(args.clients, size), f"127.0.0.1:{server.port}", server.code, students,
+                              [g["path"] for g in games])
+            joined, start, joins_how = clients.phase("join", args.timeout)
+            joins = tally(joined, start) | joins_how
+            if joins["acknowledged"] != size:
+                raise RuntimeError(f"{size - joins['acknowledged']} students could not join: {joins['errors']}")
+            projector = Projector(server.port)
+            cpu0 = server.cpu_seconds()
+            burst_records, start, burst_how = clients.phase("burst", args.timeout)
+            burst = tally(burst_records, start) | burst_how
+            cpu1 = server.cpu_seconds()
+            sustained_records, start, sustained_how = clients.phase("sustained", args.timeout)
+            sustained = tally(sustained_records, start) | sustained_how
+            cpu2 = server.cpu_seconds()
+            projector.stop()
+            peak = server.peak_rss()
+        finally:
+            if projector is not None:
+                projector.stop()
+            if clients is not None:
+                clients.close()
+            status = server.stop()
+        peak = peak if peak is not None else server.rusage_maxrss
+        notices = server.notices()
+        acked = {r["game"]: r["name"] for r in burst_records + sustained_records if r["outcome"] == "ok"}
+        folder_check = check_folder(folder, acked, games)
+    handins = burst["acknowledged"] + sustained["acknowledged"]
+    server_cpu = None if None in (cpu0, cpu1, cpu2) else {
+        "burst_s": cpu1 - cpu0, "sustained_s": cpu2 - cpu1, "ms_per_handin": 1000 * (cpu2 - cpu0) / max(1, handins)}
+    result = {"students": size, "games_per_student_sustained": per_student, "joins": joins, "burst": burst,
+              "sustained": sustained,
+              "standings": {"samples": len(projector.latencies), "p50_ms": _ms(percentile(projector.latencies, 50)),
+                            "p99_ms": _ms(percentile(projector.latencies, 99)),
+                            "max_ms": _ms(max(projector.latencies, default=None)),
+                            "failures": projector.failures[:3], "events_received": projector.events},
+              "server_peak_rss_mb": None if peak is None else peak / 2**20, "server_cpu": server_cpu,
+              "server_exit": status, "server_notices": dict(sorted(notices.items(), key=lambda kv: -kv[1])[:5]),
+              "folder": folder_check, "load_average_1min": _load()}
+    say(f"  class of {size}: whole class in {burst['seconds']:.2f} s, sustained "
+        f"{sustained['per_second'] or 0:.1f} hand-ins/s, {burst['busy_503'] + sustained['busy_503']} x 503, "
+        f"server peak {result['server_peak_rss_mb'] or float('nan'):.0f} MB, load {_load()}")
+    return result
+
+
+def _ms(seconds: float | None) -> float | None:
+    return None if seconds is None else 1000 * seconds
+
+
+def _load() -> float | None:
+    return round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None
+
+
+def machine() -> dict[str, Any]:
+    model = platform.processor() or platform.machine()
+    with contextlib.suppress(OSError), open("/proc/cpuinfo") as f:
+        model = next((line.split(":", 1)[1].strip() for line in f if line.startswith("model name")), model)
+    import starlette
+    import uvicorn
+
+    return {"cpu": model, "cores": os.cpu_count(), "os": platform.platform(), "python": platform.python_version(),
+            "uvicorn": uvicorn.__version__, "starlette": starlette.__version__, "load_average_1min": _load()}
+
+
+# ------------------------------------------------------------------ the whole run
+
+#: The figures summarised over repeats: (label, path into a class's result).
+FIGURES = (
+    ("joined_s", ("joins", "seconds")),
+    ("whole_class_s", ("burst", "seconds")),
+    ("burst_p50_s", ("burst", "p50_s")),
+    ("burst_p99_s", ("burst", "p99_s")),
+    ("burst_503", ("burst", "busy_503")),
+    ("sustained_per_s", ("sustained", "per_second")),
+    ("sustained_p50_s", ("sustained", "p50_s")),
+    ("sustained_p99_s", ("sustained", "p99_s")),
+    ("sustained_503", ("sustained", "busy_503")),
+    ("standings_p50_ms", ("standings", "p50_ms")),
+    ("standings_p99_ms", ("standings", "p99_ms")),
+    ("server_peak_rss_mb", ("server_peak_rss_mb",)),
+    ("server_cpu_ms_per_handin", ("server_cpu", "ms_per_handin")),
+)
+
+
+def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for label, path in FIGURES:
+        values = []
+        for run in runs:
+            value: Any = run
+            for key in path:
+                value = None if value is None else value.get(key)
+            if value is not None:
+                values.append(float(value))
+        out[label] = {"median": statistics.median(values), "min": min(values), "max": max(values)} if values \
+            else None
+    out["not_acknowledged"] = sum(sum(r[p]["not_acknowledged"].values()) for r in runs for p in ("burst", "sustained"))
+    return out
+
+
+def measure(sizes: list[int], repeats: int = 3, sustained: int = 600, clients: int = 4, bot_share: float = 0.05,
+            seed: int = 0, timeout: float = 300.0, say: Callable[[str], None] = lambda line: None) -> dict[str, Any]:
+    """The figures for each class size (see the module docstring); ``say`` gets progress lines."""
+    args = argparse.Namespace(sustained=sustained, clients=clients, timeout=timeout)
+    needed = max(size + size * max(2, math.ceil(sustained / size)) for size in sizes)
+    report: dict[str, Any] = {"machine": machine(), "repeats": repeats, "sustained": sustained, "clients": clients,
+                              "bot_share": bot_share, "seed": seed, "classes": {}}
+    with tempfile.TemporaryDirectory(prefix="armgame-class-games-") as tmp:
+        began = time.perf_counter()
+        games = make_games(Path(tmp), needed, bot_share, seed)
+        keyboard = [g["bytes"] for g in games if not g["bot"]]
+        bots = [g["bytes"] for g in games if g["bot"]]
+        report["games"] = {"made": len(games), "seconds_to_make": time.perf_counter() - began, "bots": len(bots),
+                           "keyboard_bytes_mean": statistics.fmean(keyboard) if keyboard else None,
+                           "bot_bytes_mean": statistics.fmean(bots) if bots else None,
+                           "keyboard_score_mean": statistics.fmean(g["score"] for g in games if not g["bot"])
+                           if keyboard else None}
+        say(f"made {len(games)} games ({len(bots)} bots') in {report['games']['seconds_to_make']:.0f} s")
+        for size in sizes:
+            runs = []
+            for repeat in range(repeats):
+                say(f"class of {size}, repeat {repeat + 1} of {repeats}")
+                runs.append(one_class(size, games, args, say))
+            report["classes"][str(size)] = {**summary(runs), "runs": runs}
+    report["machine"]["load_average_1min_end"] = _load()
+    return report
+
+
+def _fmt(figure: dict[str, float] | None, scale: float = 1.0, digits: int = 2) -> str:
+    if figure is None:
+        return "n/a"
+    return (f"{figure['median'] * scale:.{digits}f} [{figure['min'] * scale:.{digits}f}-"
+            f"{figure['max'] * scale:.{digits}f}]")
+
+
+def print_report(report: dict[str, Any]) -> None:
+    m, g = report["machine"], report["games"]
+    print(f"{m['cpu']}, {m['cores']} cores, {m['os']}, Python {m['python']}, uvicorn {m['uvicorn']}, starlette "
+          f"{m['starlette']}; load average {m['load_average_1min']} at the start, {m['load_average_1min_end']} at "
+          f"the end")
+    print(f"games: keyboard {g['keyboard_bytes_mean'] or 0:,.0f} bytes on average, {g['bots']} of {g['made']} "
+          f"the bot's ({g['bot_bytes_mean'] or 0:,.0f} bytes); {report['clients']} client processes; median "
+          f"[min-max] of {report['repeats']}")
+    rows = [
+        ("the class joined (all at once), s", "joined_s", 1, 2),
+        ("round's end: the whole class handed in within, s", "whole_class_s", 1, 2),
+        ("  a hand-in's latency p50, s", "burst_p50_s", 1, 2),
+        ("  a hand-in's latency p99, s", "burst_p99_s", 1, 2),
+        ("  503s (busy) seen", "burst_503", 1, 0),
+        ("sustained: hand-ins per second", "sustained_per_s", 1, 1),
+        ("  a hand-in's latency p50, s", "sustained_p50_s", 1, 2),
+        ("  a hand-in's latency p99, s", "sustained_p99_s", 1, 2),
+        ("  503s (busy) seen", "sustained_503", 1, 0),
+        ("GET /api/standings under that load, p50 ms", "standings_p50_ms", 1, 1),
+        ("GET /api/standings under that load, p99 ms", "standings_p99_ms", 1, 1),
+        ("server's peak memory (VmHWM), MB", "server_peak_rss_mb", 1, 0),
+        ("server's CPU per hand-in, ms", "server_cpu_ms_per_handin", 1, 1),
+    ]
+    sizes = list(report["classes"])
+    width = max(len(r[0]) for r in rows)
+    print(f"{'students':<{width}}  " + "  ".join(f"{s:>24}" for s in sizes))
+    for label, key, scale, digits in rows:
+        print(f"{label:<{width}}  " + "  ".join(f"{_fmt(report['classes'][s][key], scale, digits):>24}"
+                                                for s in sizes))
+    for s in sizes:
+        c = report["classes"][s]
+        run = c["runs"][0]
+        print(f"class of {s}: {run['burst']['acknowledged']} + {run['sustained']['acknowledged']} hand-ins a repeat "
+              f"({run['games_per_student_sustained']} a student sustained), not acknowledged in all: "
+              f"{c['not_acknowledged']}; every acknowledged game found in the folder; clients' CPU "
+              f"{run['burst']['clients_cpu_s'] + run['sustained']['clients_cpu_s']:.1f} s in the first repeat")
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv == ["--client"]:
+        return client_main()
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default="30,100,1000", help="class sizes, comma-separated (default: 30,100,1000)")
+    parser.add_argument("--repeats", type=int, default=3, help="repeats of each class, for the spread (default: 3)")
+    parser.add_argument("--sustained", type=int, default=600,
+                        help="hand-ins of the sustained phase, shared out (2 a student at least; default: 600)")
+    parser.add_argument("--clients", type=int, default=4, help="client processes the students run in (default: 4)")
+    parser.add_argument("--bot-share", type=float, default=0.05, help="share of bot games (default: 0.05)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the students' keys (default: 0)")
+    parser.add_argument("--timeout", type=float, default=300.0, help="the most a phase may take, s (default: 300)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+    try:
+        sizes = [int(s) for s in args.sizes.split(",")]
+    except ValueError:
+        parser.error("--sizes: whole numbers separated by commas")
+    if not (sizes and all(1 <= s <= 2000 for s in sizes) and 1 <= args.repeats <= 20 and 1 <= args.clients <= 64
+            and 0 <= args.sustained <= 100_000 and 0 <= args.bot_share <= 1 and 1 <= args.timeout <= 3600):
+        parser.error("need class sizes 1 to 2000 (a class's most), 1 <= --repeats <= 20, 1 <= --clients <= 64, "
+                     "0 <= --sustained <= 100000, 0 <= --bot-share <= 1, 1 <= --timeout <= 3600")
+    # SIGTERM ends the run as Ctrl-C does, so every server and client process is stopped on the way out.
+    signal.signal(signal.SIGTERM, _interrupt)
+    report = measure(sizes, args.repeats, args.sustained, args.clients, args.bot_share, args.seed, args.timeout,
+                     say=lambda line: print(line, file=sys.stderr, flush=True))
+    if args.json:
+        print(json.dumps(report, indent=1))
+    else:
+        print_report(report)
+    return 0
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+if __name__ == "__main__":
+    sys.exit(main())
