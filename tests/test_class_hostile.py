@@ -7,6 +7,7 @@ import csv
 import http.client
 import io
 import json
+import logging
 import socket
 import threading
 import time
@@ -213,3 +214,15 @@ def test_a_failure_inside_the_class_is_one_line_and_the_class_goes_on(opened, mo
     assert capsys.readouterr().err.strip() == "armgame class: GET /api/teacher/standings: RuntimeError: a bug"
     monkeypatch.undo()
     assert join(opened, "Ann")[0] == 200
+
+
+def test_a_full_class_does_not_flood_the_teachers_terminal(opened):
+    """uvicorn's "Exceeded concurrency limit.", a line for every connection past its limit (thousands when a lecture
+    hall hands in at once), is not printed; its other warnings are."""
+    logger = logging.getLogger("uvicorn.error")
+
+    def warning(message: str) -> logging.LogRecord:
+        return logging.LogRecord("uvicorn.error", logging.WARNING, __file__, 1, message, None, None)
+
+    assert not logger.filter(warning("Exceeded concurrency limit."))
+    assert logger.filter(warning("Invalid HTTP request received."))

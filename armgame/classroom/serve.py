@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import logging
 import signal
 import socket
 import sys
@@ -136,8 +137,20 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="on",
                             timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5, limit_concurrency=400,
                             h11_max_incomplete_event_size=16 * 1024)
+    errors = logging.getLogger("uvicorn.error")  # configured by uvicorn.Config, just above
+    if not any(isinstance(f, _QuietWhenFull) for f in errors.filters):
+        errors.addFilter(_QuietWhenFull())
     opened = ClassServer(clerk, sock, uvicorn.Server(config), join_line, new)
     return opened
+
+
+class _QuietWhenFull(logging.Filter):
+    """uvicorn warns once for every connection past its limit: thousands of lines when a lecture hall hands in at
+    once (benchmarks/class_server.py), scrolling the code and the secret out of the teacher's terminal. Each of
+    those machines is answered 503 and comes back by itself: nothing for the teacher to act on."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.getMessage() != "Exceeded concurrency limit."
 
 
 def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[str], None] = print) -> int:
