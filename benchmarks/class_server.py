@@ -578,7 +578,8 @@ def one_class(size: int, games: list[dict[str, Any]], args: argparse.Namespace,
               "standings": {"samples": len(projector.latencies), "p50_ms": _ms(percentile(projector.latencies, 50)),
                             "p99_ms": _ms(percentile(projector.latencies, 99)),
                             "max_ms": _ms(max(projector.latencies, default=None)),
-                            "failures": projector.failures[:3], "events_received": projector.events},
+                            "refused": len(projector.failures), "failures": projector.failures[:3],
+                            "events_received": projector.events},
               "server_peak_rss_mb": None if peak is None else peak / 2**20, "server_cpu": server_cpu,
               "server_exit": status, "server_notices": dict(sorted(notices.items(), key=lambda kv: -kv[1])[:5]),
               "folder": folder_check, "load_average_1min": _load()}
@@ -622,6 +623,7 @@ FIGURES = (
     ("sustained_503", ("sustained", "busy_503")),
     ("standings_p50_ms", ("standings", "p50_ms")),
     ("standings_p99_ms", ("standings", "p99_ms")),
+    ("standings_refused", ("standings", "refused")),
     ("server_peak_rss_mb", ("server_peak_rss_mb",)),
     ("server_cpu_ms_per_handin", ("server_cpu", "ms_per_handin")),
 )
@@ -639,6 +641,7 @@ def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
                 values.append(float(value))
         out[label] = {"median": statistics.median(values), "min": min(values), "max": max(values)} if values \
             else None
+    out["real_load_per_s"] = {key: runs[0]["students"] / 60 for key in ("median", "min", "max")}
     out["not_acknowledged"] = sum(sum(r[p]["not_acknowledged"].values()) for r in runs for p in ("burst", "sustained"))
     return out
 
@@ -674,6 +677,8 @@ def measure(sizes: list[int], repeats: int = 3, sustained: int = 600, clients: i
 def _fmt(figure: dict[str, float] | None, scale: float = 1.0, digits: int = 2) -> str:
     if figure is None:
         return "n/a"
+    if figure["min"] == figure["max"]:
+        return f"{figure['median'] * scale:.{digits}f}"
     return (f"{figure['median'] * scale:.{digits}f} [{figure['min'] * scale:.{digits}f}-"
             f"{figure['max'] * scale:.{digits}f}]")
 
@@ -684,8 +689,8 @@ def print_report(report: dict[str, Any]) -> None:
           f"{m['starlette']}; load average {m['load_average_1min']} at the start, {m['load_average_1min_end']} at "
           f"the end")
     print(f"games: keyboard {g['keyboard_bytes_mean'] or 0:,.0f} bytes on average, {g['bots']} of {g['made']} "
-          f"the bot's ({g['bot_bytes_mean'] or 0:,.0f} bytes); {report['clients']} client processes; median "
-          f"[min-max] of {report['repeats']}")
+          f"the bot's ({g['bot_bytes_mean'] or 0:,.0f} bytes); the students in {report['clients']} client processes "
+          f"(fewer for fewer students); median [min-max] of {report['repeats']}")
     rows = [
         ("the class joined (all at once), s", "joined_s", 1, 2),
         ("round's end: the whole class handed in within, s", "whole_class_s", 1, 2),
@@ -693,11 +698,13 @@ def print_report(report: dict[str, Any]) -> None:
         ("  a hand-in's latency p99, s", "burst_p99_s", 1, 2),
         ("  503s (busy) seen", "burst_503", 1, 0),
         ("sustained: hand-ins per second", "sustained_per_s", 1, 1),
+        ("  (one game a student a minute would be)", "real_load_per_s", 1, 1),
         ("  a hand-in's latency p50, s", "sustained_p50_s", 1, 2),
         ("  a hand-in's latency p99, s", "sustained_p99_s", 1, 2),
         ("  503s (busy) seen", "sustained_503", 1, 0),
         ("GET /api/standings under that load, p50 ms", "standings_p50_ms", 1, 1),
         ("GET /api/standings under that load, p99 ms", "standings_p99_ms", 1, 1),
+        ("  of them refused or failed", "standings_refused", 1, 0),
         ("server's peak memory (VmHWM), MB", "server_peak_rss_mb", 1, 0),
         ("server's CPU per hand-in, ms", "server_cpu_ms_per_handin", 1, 1),
     ]
