@@ -2,10 +2,11 @@
 
     python benchmarks/class_server.py                           # classes of 30, 100 and 1,000; 3 repeats
     python benchmarks/class_server.py --sizes 30,100 --repeats 5 --json
-    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60   # a quick look, about 30 s
+    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60   # a quick look, about 4 s
 
-The whole default run takes about 8 minutes on the 2-core machine of docs/performance.md (making
-the games about 40 s; a class of 1,000 about 80 s a repeat).
+The default run takes about 7 minutes on the 2-core machine of docs/performance.md (8 under other
+jobs' load): making the 3,000 games about 25 s, a class of 30 or 100 about 15 s a repeat, a class
+of 1,000 about 100 s.
 
 The server is ``python -m armgame class serve --folder TMP --host 127.0.0.1 --port P`` in its own
 process, a new class in a new temporary folder for every class and repeat. The students are
