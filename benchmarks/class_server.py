@@ -34,7 +34,7 @@ At the end of every class the server is stopped with Ctrl-C's signal and its fol
 The games are the standard game (seed 10, 60 s), distinct, made before anything is timed and
 the same on every run: keyboard games whose keys switch every 0.1-0.5 s as in
 ``class_speed.py`` (about 9 KB each), and one hand-in in twenty (``--bot-share``) the model
-bot's game (about 0.53 MB), each let go of at another step near the end so that each is its
+bot's game (about 0.5 MB), each let go of at another step near the end so that each is its
 own game. The projector's figures and the clients share the machine with the server: on a
 2-core machine the clients take a share of it (printed: the clients' CPU seconds).
 
@@ -74,6 +74,8 @@ GAME_DATE = "2026-01-05T09:00:00.000000+00:00"
 STANDINGS_EVERY = 0.2
 #: From the word go (every client's students ready) to the moment they start: the word's way down the pipes.
 GO_LEAD = 0.1
+#: Steps between the ends of two bot games' keys (4 ms each): 1,500 bot games at most.
+BOT_SHIFT = 10
 START_SECONDS = 60.0
 STOP_SECONDS = 30.0
 
@@ -126,12 +128,13 @@ def make_games(folder: Path, count: int, bot_share: float, seed: int) -> list[di
         index = len(games)
         kind = "bot" if is_bot(index, bot_share) else "keyboard"
         tries[kind] += 1
-        if tries[kind] > 2 * count + 100 or tries["bot"] * 10 >= config.total_steps:
-            raise SystemExit("class_server: cannot make enough distinct games (a bug)")
+        if tries[kind] > 2 * count + 100 or tries["bot"] * BOT_SHIFT >= config.total_steps:
+            raise SystemExit(f"class_server: cannot make {count} distinct games of which {bot_share:.0%} bots': "
+                             f"ask for fewer")
         session = GameSession(config)
         if kind == "bot":
-            # The bot's game, its keys let go 10 steps (40 ms) earlier than the bot game before it's: its own game.
-            last = config.total_steps - 10 * tries["bot"]
+            # The k-th bot game: the model bot's keys, all let go BOT_SHIFT * k steps before the end (its own game).
+            last = config.total_steps - BOT_SHIFT * tries["bot"]
             events = [e for e in bot_timeline if e.step < last]
             events += [InputEvent(last, m.key, UP) for m in config.muscles]
             session.play(events)
@@ -165,17 +168,24 @@ class Server:
 
     def __init__(self, folder: Path) -> None:
         self.folder = folder
-        self.lines: queue.Queue[str | None] = queue.Queue()
-        self.said: list[str] = []
-        self.banner = 0
-        self.port = free_port()
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "armgame", "class", "serve", "--folder", str(folder), "--host", "127.0.0.1",
-             "--port", str(self.port)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-            text=True, errors="replace")
         self.rusage_maxrss: int | None = None
-        threading.Thread(target=self._drain, daemon=True).start()
-        self.code = self._wait_ready()
+        for attempt in range(3):  # the free port found may be taken before the server binds it: another then
+            self.lines: queue.Queue[str | None] = queue.Queue()
+            self.said: list[str] = []
+            self.banner = 0
+            self.port = free_port()
+            self.proc = subprocess.Popen(
+                [sys.executable, "-m", "armgame", "class", "serve", "--folder", str(folder), "--host", "127.0.0.1",
+                 "--port", str(self.port)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT, text=True, errors="replace")
+            threading.Thread(target=self._drain, daemon=True).start()
+            try:
+                self.code = self._wait_ready()
+                return
+            except RuntimeError:
+                self.stop()  # never left running, whatever it was doing
+                if attempt == 2 or not any("is in use" in line for line in self.said):
+                    raise
 
     def _drain(self) -> None:
         assert self.proc.stdout is not None
@@ -372,7 +382,11 @@ class Clients:
             self.answers.append(answers)
             self._send(proc, {"address": address, "code": code, "students": mine,
                               "games": [[i, games[i]] for s in mine for i in s["games"]]})
-        self._collect(START_SECONDS)
+        try:
+            self._collect(START_SECONDS)
+        except BaseException:
+            self.close()  # none left running
+            raise
 
     @staticmethod
     def _drain(proc: subprocess.Popen, answers: queue.Queue[str | None]) -> None:
