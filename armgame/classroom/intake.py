@@ -220,7 +220,7 @@ class Clerk:
         """Enter checked games together (one table write for all: a burst of a class costs one write, not
         thirty); each game's answer, or why it was not entered. Durable on disk before this returns."""
         try:
-            results = self.table.add_many([c.replay for c in checked])
+            results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked])
         except (ValueError, UserError) as exc:  # the table could not be written: none was entered
             refusal = RefusedError(503, f"the class's table could not take the game: {exc}")
             return [refusal for _ in checked]

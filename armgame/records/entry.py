@@ -10,6 +10,7 @@ file with that file's SHA-256; ``replay_claims`` is what its replay says about t
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, fields
 from datetime import datetime
 
@@ -188,11 +189,12 @@ def entry_order(entry: ScoreEntry) -> tuple[int, datetime, str]:
     return (entry.entered or 0, entry.when, entry.id)
 
 
-def replay_claims(replay: Replay) -> dict[str, object]:
+def replay_claims(replay: Replay, digests: Sequence[str] | None = None) -> dict[str, object]:
     """What an entry must say about its replay's game, field for field; and the game's identity
     (``identity.identity_claims``: the digest an entry may hold, by each identity version)."""
     r = replay.result
     return {"name": replay.player, "driven": replay.driven, "driver": replay.driver, "score": r.score,
             "hits": r.hits, "resets": r.resets, "seed": r.seed, "scene": r.scene, "duration": r.duration,
             "date": replay.date, "config_sha256": config_digest(replay.config),
-            "ruleset": ruleset_name(replay.config), "complete": replay.complete, **identity_claims(replay)}
+            "ruleset": ruleset_name(replay.config), "complete": replay.complete,
+            **identity_claims(replay, digests)}

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Generic, TypeVar
 
@@ -132,10 +132,11 @@ def game_digests(replay: Replay) -> tuple[str, ...]:
     return game_digest(replay), _digest(_form_v1(replay))
 
 
-def identity_claims(replay: Replay) -> dict[str, object]:
+def identity_claims(replay: Replay, digests: Sequence[str] | None = None) -> dict[str, object]:
     """What a replay says about its game's identity, for an entry's claims (``scores.replay_claims``)
-    and the verification cache: the version, the current digest and the older versions' digests."""
-    current, *earlier = game_digests(replay)
+    and the verification cache: the version, the current digest and the older versions' digests.
+    ``digests``: ``game_digests(replay)`` if the caller has them already (a class's server does)."""
+    current, *earlier = game_digests(replay) if digests is None else digests
     return {"identity": IDENTITY_VERSION, "game_sha256": current, "earlier_game_sha256": earlier}
 
 

@@ -250,19 +250,23 @@ class ScoreTable(TableFile, TableChecks):
             later = shlex.join(["armgame", "scores", "--scores", str(self.folder), "--add", str(path)])
             raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with {later}") from None
 
-    def add_many(self, replays: Sequence[Replay]) -> list[ScoreEntry | ValueError]:
+    def add_many(self, replays: Sequence[Replay], digests: Sequence[Sequence[str]] | None = None
+                 ) -> list[ScoreEntry | ValueError]:
         """``add`` for many games at once, for a server taking a class's games: their replays written with
         one folder fsync, the table read and written once under the lock. Returns, for each game, its
         entry or the ValueError (a ``TableError`` for a game already in) that kept it out; raises
-        ``TableError`` (busy, over a limit, not a safe place) with none entered."""
+        ``TableError`` (busy, over a limit, not a safe place) with none entered. ``digests``: each game's
+        ``identity.game_digests``, where the caller computed them already (a quarter of a class server's
+        work was computing them again)."""
         results: list[tuple[ScoreEntry, frozenset[str]] | ValueError] = []
         files: dict[str, bytes] = {}
-        for replay in replays:
+        for i, replay in enumerate(replays):
             try:
                 _enterable(replay)
                 data = replay.to_bytes()
                 name = self._replay_name(replay, data)
-                results.append((_new_entry(replay, name, data), frozenset(game_digests(replay))))
+                known = game_digests(replay) if digests is None else tuple(digests[i])
+                results.append((_new_entry(replay, name, data, known), frozenset(known)))
                 files[name] = data
             except ValueError as exc:
                 results.append(exc)
@@ -301,9 +305,9 @@ def _enterable(replay: Replay) -> None:
         raise ValueError("only a game played to the end enters the table")
 
 
-def _new_entry(replay: Replay, replay_name: str, data: bytes) -> ScoreEntry:
+def _new_entry(replay: Replay, replay_name: str, data: bytes, digests: Sequence[str] | None = None) -> ScoreEntry:
     """The entry of ``replay``, whose file ``replay_name`` in replays/ holds ``data`` (not yet entered)."""
-    claims = replay_claims(replay)
+    claims = replay_claims(replay, digests)
     r = replay.result
     return ScoreEntry.from_dict(dict(
         id=uuid.uuid4().hex, name=replay.player, driven=replay.driven, driver=replay.driver, score=r.score,
