@@ -189,3 +189,27 @@ def test_the_end_screen_hands_in_on_a_thread_and_shows_what_became_of_the_game(t
             time.sleep(0.02)
     assert final.note == "Handed in:\n1st of 1 in the class (your best so far)"
     assert final.rank == 1 and final.entries == 1 and final.top == ((1, "Ann", 0),)
+
+
+def test_the_end_screen_says_in_one_line_that_a_game_is_kept_when_the_class_is_away(tmp_path, students, capsys):
+    import argparse
+    import time
+
+    from armgame.commands.play import _class_standing
+    from armgame.game.rules import GameConfig
+    from armgame.game.session import GameSession
+
+    students("ann")
+    gone = client.Membership(client.ClassAddress.parse("127.0.0.1:1"), "ACDE", "Ann", "token", 10)
+    session = GameSession(GameConfig(seed=10))
+    session.play([])
+    standing = _class_standing(session, argparse.Namespace(bot=None), gone)(None)
+    for _ in range(500):
+        final = standing.later()
+        if final is not None:
+            break
+        time.sleep(0.02)
+    assert final.note == ("Not handed in: the class cannot be reached.\nYour game is kept: it goes in the next "
+                          "time you join")
+    assert "cannot reach the class at 127.0.0.1:1" in capsys.readouterr().err
+    assert len(list(client.outbox(gone).glob("*.json"))) == 1

@@ -365,6 +365,7 @@ def _standing(session, args: argparse.Namespace):
 def _class_standing(session, args: argparse.Namespace, membership):
     """The end screen in a live class: the game is handed in on a thread (the window never waits for
     the network), and the screen shows what became of it, and the class's top, when the answer comes."""
+    import sys
     import threading
 
     from ..records.replay import Replay
@@ -384,6 +385,10 @@ def _class_standing(session, args: argparse.Namespace, membership):
                 return None
             result = done[0]
             answer = result.answer
+            if result.kept is not None:  # the whole reason goes to the terminal; the screen says what matters
+                print(f"armgame play: {result.message}", file=sys.stderr)
+                return Standing(None, 0, (), "the class", note="Not handed in: the class cannot be reached.\n"
+                                "Your game is kept: it goes in the next time you join")
             if answer is None:
                 return Standing(None, 0, (), "the class", note=_screen_line(result.message))
             top = tuple((int(r), str(n), int(v)) for r, n, v in answer.get("top", ()))
