@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import threading
 from collections.abc import Iterator
@@ -52,7 +53,20 @@ def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, dri
 
 def tapped_game(n: int, seed: int = 10, player: str | None = None) -> Replay:
     """The ``n``-th of many different whole games, each cheap: the shoulder flexor tapped from step n + 1
-    for 50 steps (a different start, a different path: another game)."""
+    for 50 steps (a different start, a different path: another game). None of the first thousand hits a
+    target, so their result is the untouched game's (``tapped_games`` makes many at once from that)."""
     session = GameSession(GameConfig(seed=seed))
-    session.play([InputEvent(n + 1, "d", DOWN), InputEvent(n + 51, "d", UP)])
+    session.play(_taps(n))
     return Replay.from_session(session, "keyboard", None, player)
+
+
+def tapped_games(count: int, players: list[str], seed: int = 10) -> list[bytes]:
+    """The replays of ``tapped_game(0..count-1)`` (player ``players[i % len(players)]``), played once: each
+    claims the first game's result, none hit (whoever takes them replays each: a wrong claim is refused)."""
+    first = tapped_game(0, seed)
+    return [dataclasses.replace(first, timeline=tuple(_taps(i)), player=players[i % len(players)]).to_bytes()
+            for i in range(count)]
+
+
+def _taps(n: int) -> list[InputEvent]:
+    return [InputEvent(n + 1, "d", DOWN), InputEvent(n + 51, "d", UP)]

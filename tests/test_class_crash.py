@@ -13,7 +13,7 @@ import threading
 import time
 
 import pytest
-from class_server import tapped_game
+from class_server import tapped_games
 
 from armgame.classroom import client
 from armgame.records.scores import ScoreTable
@@ -44,7 +44,7 @@ def start(folder, port: int) -> tuple[subprocess.Popen, str]:
 def test_every_acknowledged_game_survives_a_kill_in_a_burst(tmp_path, monkeypatch):
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machines"))
     folder, port = tmp_path / "class", free_port()
-    games = [tapped_game(i, player=f"s{i % CLIENTS}").to_bytes() for i in range(GAMES)]
+    games = tapped_games(GAMES, [f"s{c}" for c in range(CLIENTS)])
     proc, code = start(folder, port)
     address = client.ClassAddress.parse(f"127.0.0.1:{port}")
     members = [client.join(address, code, f"s{c}") for c in range(CLIENTS)]

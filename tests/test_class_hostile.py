@@ -15,7 +15,7 @@ import time
 import urllib.request
 
 import pytest
-from class_server import keyboard_game, running_class, tapped_game
+from class_server import keyboard_game, running_class, tapped_game, tapped_games
 
 from armgame.classroom import app as class_app
 from armgame.classroom import client
@@ -195,7 +195,7 @@ def test_a_flood_is_queued_and_refused_politely_and_nothing_is_lost(tmp_path, mo
     with running_class(tmp_path / "class") as served:
         address = client.ClassAddress.parse(f"127.0.0.1:{served.port}")
         members = [client.join(address, served.clerk.roster.code, f"m{i}") for i in range(50)]
-        games = [tapped_game(i, player=f"m{i}").to_bytes() for i in range(50)]
+        games = tapped_games(50, [f"m{i}" for i in range(50)])
         results: list = [None] * 50
         original_sleep = time.sleep
 
