@@ -33,7 +33,6 @@ from collections.abc import AsyncIterator, Callable
 from concurrent.futures import Future
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from starlette.applications import Starlette
@@ -435,7 +434,3 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
     app = Starlette(routes=routes, lifespan=lifespan)
     app.state.armgame = state
     return app
-
-
-def folder_of(app: Starlette) -> Path:
-    return app.state.armgame.clerk.folder

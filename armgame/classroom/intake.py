@@ -24,7 +24,6 @@ import hashlib
 import io
 import math
 import os
-import re
 import secrets
 import stat
 from collections.abc import Sequence
@@ -39,6 +38,7 @@ from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
 from ..records.standings import one_row_per_player, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
+from ..records.tablefile import name_slug
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
 
 #: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
@@ -273,19 +273,17 @@ class Clerk:
     def _lab_run(self, player: Player, replay: Replay) -> dict[str, object]:
         from ..lab.analysis import trial_rows
 
+        game = _lab_identity(replay)
+        if game in self.lab_digests:  # known before its replay (the costly part) is run again
+            return {"ok": True, "already": True, "message": "already handed in: this lab run is in the class"}
         replay = replay.with_player(player.name)
-        digest = hashlib.sha256(repr((player_key(player.name), _lab_identity(replay))).encode()).hexdigest()
         ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)  # type: ignore[union-attr]
         if not ok:
             raise RefusedError(422, "the lab run does not reproduce its trials: not taken")
         protocol = replay.task.protocol  # type: ignore[union-attr]
-        game = _lab_identity(replay)
-        if game in self.lab_digests:
-            return {"ok": True, "already": True, "message": "already handed in: this lab run is in the class"}
         first = not any(run.protocol == protocol and player_key(run.player) == player_key(player.name)
                         for run in self.lab_runs)
-        slug = re.sub(r"[^A-Za-z0-9]+", "-", player.name).strip("-")[:24] or "player"
-        path = self.folder / (LAB_DIR if first else LAB_MORE_DIR) / f"{slug}-{digest[:12]}.json"
+        path = self.folder / (LAB_DIR if first else LAB_MORE_DIR) / f"{name_slug(player.name)}-{game[:12]}.json"
         path.parent.mkdir(exist_ok=True)
         atomic_write_bytes(path, replay.to_bytes(), "lab run")
         self.lab_digests.add(game)
@@ -306,12 +304,9 @@ class Clerk:
         from ..lab.analysis import trial_rows
 
         problems = []
-        folder = self.folder / LAB_DIR
-        paths = sorted(p for p in folder.glob("*.json") if p.is_file() and not p.is_symlink()) \
-            if folder.is_dir() else []
-        for path in paths:
+        for path in _runs_in(self.folder / LAB_DIR):
             try:
-                replay = Replay.from_bytes(read_limited(path, MAX_HANDIN_BYTES, "lab run", follow=False), str(path))
+                replay = _read_run(path)
                 if replay.task is None or replay.player is None:
                     raise UserError(f"{path}: not a lab run with a player's name")
                 ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)
@@ -323,13 +318,9 @@ class Clerk:
             self.lab_digests.add(_lab_identity(replay))
             self.lab_runs.append(LabRun(replay.player, replay.driven != "keyboard", replay.task.protocol,
                                         trial_rows(session), path))
-        for path in sorted((self.folder / LAB_MORE_DIR).glob("*.json")) if (self.folder / LAB_MORE_DIR).is_dir() \
-                else []:
-            try:
-                replay = Replay.from_bytes(read_limited(path, MAX_HANDIN_BYTES, "lab run", follow=False), str(path))
-                self.lab_digests.add(_lab_identity(replay))
-            except UserError:
-                continue
+        for path in _runs_in(self.folder / LAB_MORE_DIR):
+            with contextlib.suppress(UserError):
+                self.lab_digests.add(_lab_identity(_read_run(path)))
         if self.lab_runs:
             self.version += 1
         return problems
@@ -418,6 +409,17 @@ class Clerk:
         columns = ("player", "program", "protocol", "replay", *TRIAL_COLUMNS)
         return _csv(columns, ([run.player, run.program, run.protocol.name, run.path.name,
                                *(row[c] for c in TRIAL_COLUMNS)] for run in self.lab_runs for row in run.rows))
+
+
+def _runs_in(folder: Path) -> list[Path]:
+    """The lab runs kept in ``folder`` (regular files only: a planted link is not followed)."""
+    if not folder.is_dir() or folder.is_symlink():
+        return []
+    return sorted(p for p in folder.glob("*.json") if p.is_file() and not p.is_symlink())
+
+
+def _read_run(path: Path) -> Replay:
+    return Replay.from_bytes(read_limited(path, MAX_HANDIN_BYTES, "lab run", follow=False), str(path))
 
 
 def _lab_identity(replay: Replay) -> str:

@@ -46,7 +46,7 @@ def other_addresses(main: str) -> list[str]:
     return sorted(a for a in found if a != main and not a.startswith("127."))
 
 
-def default_folder(code_hint: str = "") -> Path:
+def default_folder() -> Path:
     """A new folder for a new class, under the per-user data folder: ``classes/2026-11-25``, ``-2``..."""
     from ..records.scores import user_data_dir
 

@@ -67,8 +67,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_serve(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from ..classroom.serve import default_folder, lan_address, serve
     from ..records.storage import user_path
 
@@ -78,7 +76,7 @@ def run_serve(args: argparse.Namespace) -> int:
 
         raise UserError(f"--folder {folder}: not a folder")
     host = args.host or lan_address()
-    return serve(Path(folder), host, args.port, args.seed, say=lambda line: print(line, flush=True))
+    return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True))
 
 
 def run_submit(args: argparse.Namespace) -> int:

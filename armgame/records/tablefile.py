@@ -189,7 +189,7 @@ class TableFile:
         """A replay's file name in replays/: its date, its player and its bytes' digest (never a name a
         file or a client gave)."""
         stamp = replay.date or now_iso()
-        slug = re.sub(r"[^A-Za-z0-9]+", "-", replay.player or "").strip("-")[:24] or "player"
+        slug = name_slug(replay.player or "")
         when = datetime.fromisoformat(stamp).strftime("%Y%m%dT%H%M%S")
         return f"{when}-{slug}-{hashlib.sha256(data).hexdigest()[:8]}.json"
 
@@ -521,3 +521,9 @@ def table_bytes(entries: list[ScoreEntry], seed: int | None = DEFAULT_SEED, next
         head += f', "seed": {kept_seed}'
     head += f', "next_entry": {next_entry}'
     return (head + ', "entries": [\n' + ",\n".join(lines) + "\n]}\n").encode("utf-8")
+
+
+def name_slug(name: str) -> str:
+    """A player's name as part of a file name armgame makes: ASCII letters and digits joined by dashes,
+    at most 24 characters ("player" if nothing is left). A name never becomes a path."""
+    return re.sub(r"[^A-Za-z0-9]+", "-", name).strip("-")[:24] or "player"
