@@ -185,6 +185,7 @@ class ClassState:
     snapshot: bytes = b"{}"
     lab: bytes = b"{}"
     seen_version: int = -1
+    seen_lab_version: int = -1
     changed: asyncio.Event = field(default_factory=asyncio.Event)
     stopping: asyncio.Event = field(default_factory=asyncio.Event)
 
@@ -195,6 +196,8 @@ class ClassState:
             standings = self.clerk.standings()
             standings["join"] = self.join_line
             self.snapshot = json.dumps(standings, ensure_ascii=True).encode()
+        if self.clerk.lab_version != self.seen_lab_version:  # a game handed in leaves the curve as it was
+            self.seen_lab_version = self.clerk.lab_version
             self.lab = json.dumps(self.clerk.lab_curve(), ensure_ascii=True, allow_nan=False).encode()
 
     async def run(self, job: Callable[[], Any], kind: str = "job") -> Any:

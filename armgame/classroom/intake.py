@@ -116,6 +116,7 @@ class Clerk:
         self.lab_digests: set[str] = set()
         self.arrival: Arrival | None = None
         self.version = 0  # bumped at every change the projector should see
+        self.lab_version = 0  # and at every change of the class curve (a lab run, a name hidden)
 
     def _sweep(self) -> None:
         """Temporary files a server killed mid-write left (never renamed: nothing refers to them). Only
@@ -291,6 +292,7 @@ class Clerk:
             self.lab_runs.append(LabRun(player.name, replay.driven != "keyboard", protocol, trial_rows(session),
                                         path))
             self.version += 1
+            self.lab_version += 1
         if replay.driven != "keyboard":
             counted = "a program's run: kept apart, not in the class curve"
         elif first:
@@ -323,6 +325,7 @@ class Clerk:
                 self.lab_digests.add(_lab_identity(_read_run(path)))
         if self.lab_runs:
             self.version += 1
+            self.lab_version += 1
         return problems
 
     def lab_curve(self) -> dict[str, object]:
@@ -360,6 +363,7 @@ class Clerk:
         (self.roster.hidden.add if hidden else self.roster.hidden.discard)(key)
         self.roster.save()
         self.version += 1
+        self.lab_version += 1
         return f"{name} is {'hidden from' if hidden else 'shown on'} the projector"
 
     def close(self, closed: bool) -> str:
