@@ -24,7 +24,8 @@ async function call(path, body) {
 
 function row(table, r, kind) {
   const tr = document.createElement("tr");
-  for (const text of [kind, r.name, String(r.score), r.games + " games", r.hidden ? "hidden" : "shown"]) {
+  const games = r.games === 1 ? "1 game" : r.games + " games";
+  for (const text of [kind, r.name, String(r.score), games, r.hidden ? "hidden on the projector" : "shown"]) {
     const td = document.createElement("td");
     td.textContent = text;
     tr.appendChild(td);
