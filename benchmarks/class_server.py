@@ -178,7 +178,8 @@ class Server:
                 [sys.executable, "-m", "armgame", "class", "serve", "--folder", str(folder), "--host", "127.0.0.1",
                  "--port", str(self.port)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                 stderr=subprocess.STDOUT, text=True, errors="replace")
-            threading.Thread(target=self._drain, daemon=True).start()
+            self.drainer = threading.Thread(target=self._drain, daemon=True)
+            self.drainer.start()
             try:
                 self.code = self._wait_ready()
                 return
@@ -247,6 +248,14 @@ class Server:
 
     def stop(self) -> int | None:
         """Ctrl-C's signal, then a kill if it has not stopped within ``STOP_SECONDS``; its exit status."""
+        try:
+            return self._stop()
+        finally:
+            self.drainer.join(STOP_SECONDS)  # the output read to its end before its pipe is closed
+            assert self.proc.stdout is not None
+            self.proc.stdout.close()
+
+    def _stop(self) -> int | None:
         if self.proc.poll() is not None:
             return self.proc.returncode
         if sys.platform == "win32":
@@ -369,6 +378,7 @@ class Clients:
 
     def __init__(self, n: int, address: str, code: str, students: list[dict[str, Any]], games: list[str]) -> None:
         self.procs: list[subprocess.Popen] = []
+        self.drainers: list[threading.Thread] = []
         self.answers: list[queue.Queue[str | None]] = []
         for k in range(n):
             mine = students[k::n]
@@ -377,7 +387,9 @@ class Clients:
             proc = subprocess.Popen([sys.executable, __file__, "--client"], stdin=subprocess.PIPE,
                                     stdout=subprocess.PIPE, text=True)
             answers: queue.Queue[str | None] = queue.Queue()
-            threading.Thread(target=self._drain, args=(proc, answers), daemon=True).start()
+            drainer = threading.Thread(target=self._drain, args=(proc, answers), daemon=True)
+            drainer.start()
+            self.drainers.append(drainer)
             self.procs.append(proc)
             self.answers.append(answers)
             self._send(proc, {"address": address, "code": code, "students": mine,
@@ -440,6 +452,11 @@ class Clients:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait(10)
+        for proc, drainer in zip(self.procs, self.drainers, strict=True):
+            drainer.join(10)
+            for pipe in (proc.stdin, proc.stdout):
+                with contextlib.suppress(OSError):
+                    pipe.close()
 
 
 # ------------------------------------------------------------------ the projector

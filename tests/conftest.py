@@ -1,9 +1,10 @@
 """Suite-wide test setup.
 
 ``ARMGAME_TEST_NO_POSIX=1`` runs the tests as on a platform without POSIX's file locking and open
-flags (Windows): ``fcntl`` cannot be imported and ``os`` lacks ``O_NOFOLLOW``, ``O_NONBLOCK`` and
-``O_NOCTTY``. Done here, before any armgame module is imported, so that every module sees the
-platform as it would be (``tests/test_portable.py`` runs the records tests so).
+flags (Windows), as armgame's own modules see it: their ``import fcntl`` fails and their ``os`` lacks
+``O_NOFOLLOW``, ``O_NONBLOCK`` and ``O_NOCTTY`` (``tests/no_posix.py``; the standard library and pytest
+keep theirs, as on Windows). Done here, before any armgame module is imported
+(``tests/test_portable.py`` runs the records tests so).
 
 Where ``PYTHONDONTWRITEBYTECODE`` is set, the suite still writes bytecode as Python does by default
 (``__pycache__`` folders, which git ignores): otherwise every xdist worker and every ``armgame``
@@ -16,11 +17,9 @@ import shutil
 import sys
 import tempfile
 
-if os.environ.get("ARMGAME_TEST_NO_POSIX") == "1":
-    sys.modules["fcntl"] = None  # type: ignore[assignment]  # "import fcntl" now raises ImportError
-    for flag in ("O_NOFOLLOW", "O_NONBLOCK", "O_NOCTTY"):
-        if hasattr(os, flag):
-            delattr(os, flag)
+import no_posix
+
+no_posix.install_if_asked()
 
 
 def pytest_configure(config) -> None:

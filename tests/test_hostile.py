@@ -5,6 +5,7 @@ Classes: (1) only the standard game ranks, (2) one bad entry never takes the tab
 never a traceback or a hang. Everything is written under tmp_path.
 """
 
+import copy
 import json
 import os
 import subprocess
@@ -734,7 +735,9 @@ def hostile_replays(draw):
     data = _base_replay()
     paths = list(_paths(data))
     for _ in range(draw(st.integers(0, 3))):
-        data = _mutate(data, draw(st.sampled_from(paths)), draw(HOSTILE_VALUES))
+        # A copy: a later mutation inside a drawn {} or [] must not change HOSTILE_VALUES' own, which
+        # would make the strategy draw differently the next time (hypothesis: FlakyStrategyDefinition).
+        data = _mutate(data, draw(st.sampled_from(paths)), copy.deepcopy(draw(HOSTILE_VALUES)))
         if not isinstance(data, dict):
             break
         paths = list(_paths(data))

@@ -139,7 +139,8 @@ def test_one_table_of_several_runs_says_whose_each_row_is(short_class, tmp_path)
     (folder / "student2.json").write_text(json.dumps(data))
     out = tmp_path / "all.csv"
     assert main(["analyze", str(folder / "student1.json"), str(folder / "student2.json"), "--out", str(out)]) == 0
-    rows = list(csv.DictReader(out.open()))
+    with out.open() as f:
+        rows = list(csv.DictReader(f))
     assert len(rows) == 32
     assert {(r["player"], r["replay"]) for r in rows[:16]} == {("Student 1", str(folder / "student1.json"))}
     assert {(r["player"], r["replay"]) for r in rows[16:]} == {("'=HYPERLINK(1)", str(folder / "student2.json"))}

@@ -133,7 +133,8 @@ def test_output_into_a_pipe_closed_early_ends_quietly(tmp_path):
     child = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
     assert child.stdout.readline().startswith(b"High scores in ")
     child.stdout.close()  # the reader leaves, as head does
-    err = child.stderr.read()
+    with child.stderr:
+        err = child.stderr.read()
     assert child.wait(timeout=60) == EXIT_BROKEN_PIPE == 141 and err == b""
 
 

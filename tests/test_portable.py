@@ -1,8 +1,9 @@
 """Saving works where POSIX's locking and open flags do not exist (Windows): the records tests run
-again in a subprocess with ``fcntl`` unimportable and ``O_NOFOLLOW``, ``O_NONBLOCK``, ``O_NOCTTY``
-absent (``tests/conftest.py``), and must pass there too."""
+again in a subprocess where armgame's own modules cannot import ``fcntl`` and find no ``O_NOFOLLOW``,
+``O_NONBLOCK``, ``O_NOCTTY`` in ``os`` (``tests/no_posix.py``), and must pass there too."""
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -44,12 +45,39 @@ def test_records_tests_pass_without_posix_locks_or_flags():
 @pytest.mark.skipif(not SIMULATED, reason="only where POSIX is simulated away")
 def test_the_simulated_platform_really_lacks_them():
     import armgame.files as files
+    import armgame.records.locking as locking
     import armgame.records.storage as storage
 
-    with pytest.raises(ImportError):
-        import fcntl  # noqa: F401
     assert files._NOFOLLOW == files._NONBLOCK == files._NOCTTY == storage._NOFOLLOW == 0
-    assert not hasattr(os, "O_NOFOLLOW") and not hasattr(os, "O_NONBLOCK")
+    assert not hasattr(locking.os, "O_NOFOLLOW") and not hasattr(files.os, "O_NONBLOCK")
+    # Only armgame is fooled: the standard library and pytest keep the platform's own (Python 3.13's
+    # shutil.rmtree opens folders with os.O_NONBLOCK).
+    assert hasattr(os, "O_NONBLOCK") == hasattr(shutil.os, "O_NONBLOCK") == (sys.platform != "win32")
+
+
+#: What armgame's records once did, POSIX-only: each line must fail under the simulation as on Windows.
+OLD_POSIX_ONLY_CODE = [
+    "import fcntl",
+    "import os\nflags = os.O_RDONLY | os.O_NOFOLLOW",
+    "from os import O_NONBLOCK",
+    "import os.path\nos.O_NOCTTY",
+]
+
+
+@pytest.mark.parametrize("code", OLD_POSIX_ONLY_CODE)
+def test_posix_only_code_in_armgame_fails_under_the_simulation(code):
+    """Run in a fresh interpreter, as a module of armgame: fails with the simulation, works without it."""
+    probe = ("import sys; sys.path.insert(0, 'tests'); import no_posix; no_posix.install_if_asked()\n"
+             f"exec({code!r}, {{'__name__': 'armgame.records.old'}})\n"
+             "import os, shutil, tempfile; shutil.rmtree(tempfile.mkdtemp())  # the rest of the process is untouched")
+    for simulated in (True, False):
+        env = {**os.environ, "ARMGAME_TEST_NO_POSIX": "1" if simulated else "0"}
+        proc = subprocess.run([sys.executable, "-c", probe], cwd=REPO, env=env, capture_output=True, text=True,
+                              timeout=60)
+        if simulated:
+            assert proc.returncode == 1 and ("ImportError" in proc.stderr or "AttributeError" in proc.stderr)
+        elif sys.platform != "win32":
+            assert proc.returncode == 0, proc.stderr
 
 
 @pytest.mark.skipif(not SIMULATED, reason="only where POSIX is simulated away")
@@ -99,3 +127,22 @@ def test_a_lock_file_another_user_made_read_only_is_still_locked(tmp_path, monke
             pass
     finally:
         os.close(fd)
+
+
+def test_the_supported_pythons_are_said_alike_everywhere():
+    """requires-python, the classifiers, CI's oldest and the README agree on the oldest supported Python,
+    and the classifiers name every minor version from it to the newest CI tests, none missing."""
+    import re
+    import tomllib
+
+    project = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]
+    oldest = re.fullmatch(r">=3\.(\d+)", project["requires-python"]).group(1)
+    minors = sorted(int(c.rsplit(".", 1)[1]) for c in project["classifiers"]
+                    if re.fullmatch(r"Programming Language :: Python :: 3\.\d+", c))
+    assert minors == list(range(int(oldest), minors[-1] + 1)) and minors[0] == int(oldest)
+    ci = (REPO / ".ci" / "run").read_text()
+    assert re.search(r"^OLDEST=3\.(\d+)\b", ci, re.M).group(1) == oldest
+    readme = (REPO / "README.md").read_text()
+    tested = re.search(r"Python 3\.(\d+) or newer \([^)]*CI tests 3\.(\d+) and 3\.(\d+)\)", readme.replace("\n", " "))
+    assert tested.group(1) == tested.group(2) == oldest and int(tested.group(3)) == minors[-1]
+    assert sys.version_info[:2] >= (3, int(oldest))

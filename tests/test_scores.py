@@ -14,6 +14,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 
 import pytest
+import table_writer
 
 import armgame.records.entry as entry_module
 import armgame.records.scores as scores_module
@@ -91,19 +92,12 @@ def test_unnamed_or_unfinished_games_do_not_enter(tmp_path):
         table.add(Replay.from_session(session, "keyboard", player="ann"))
 
 
-def _writer(folder: str, who: int, count: int, barrier) -> None:
-    replays = [quick_replay(f"writer {who}", seed=who * count + k) for k in range(count)]  # a game enters once
-    barrier.wait()
-    table = ScoreTable(Path(folder))
-    for replay in replays:
-        table.add(replay)
-
-
 def test_concurrent_writers_all_keep_their_entries(tmp_path):
-    ctx = multiprocessing.get_context("fork")
+    # spawn, as on Windows and macOS: fork from pytest's threads is deprecated from Python 3.12 on.
+    ctx = multiprocessing.get_context("spawn")
     writers, each = 6, 5
     barrier = ctx.Barrier(writers)
-    procs = [ctx.Process(target=_writer, args=(str(tmp_path), w, each, barrier)) for w in range(writers)]
+    procs = [ctx.Process(target=table_writer.write, args=(str(tmp_path), w, each, barrier)) for w in range(writers)]
     for p in procs:
         p.start()
     for p in procs:
