@@ -59,6 +59,6 @@ def test_protocol_names_the_class_and_an_unknown_name_is_one_line(tmp_path, reco
     assert "class curve of 1 students (1 left out), 1 trials" in captured.out
     assert "student1.json: its protocol 'short' differs from the class's ('tiny', shared by 1 replays)" \
         in captured.err
-    assert main(["analyze", "--class", str(folder), "--protocol", "nope", *out]) == 2
+    assert main(["analyze", "--class", str(folder), "--protocol", "nope", *out, "--force"]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "'short', 'tiny'" in err

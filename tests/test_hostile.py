@@ -427,6 +427,8 @@ def test_outputs_are_only_regular_files(tmp_path, capsys):
     for target in ("/dev/null", fifo, tmp_path / "dir"):
         for cmd in (["simulate", "--scene", "passive", "--duration", "0.1", "--out", target],
                     ["play", "--headless", "--duration", "0.1", "--record", target]):
+            if cmd[0] == "play" and target == tmp_path / "dir":
+                continue  # play --record FOLDER: a numbered file inside it (test_new_files)
             line = one_line_error(armgame(*cmd, timeout=10)) if target == fifo else in_process_error(capsys, *cmd)
             assert "is a " in line and "regular file" in line
     assert os.path.exists("/dev/null") and fifo.is_fifo()
@@ -438,8 +440,10 @@ def test_a_planted_temporary_symlink_is_never_written_through(tmp_path):  # in-p
     out = tmp_path / "out.csv"
     for name in ("out.csv.part", ".out.csv.tmp", "out.csv.tmp"):
         (tmp_path / name).symlink_to(victim)
-    out.symlink_to(victim)  # even the target itself: the link is replaced, not written through
-    assert main(["simulate", "--scene", "passive", "--duration", "0.1", "--out", str(out)]) in (0, None)
+    out.symlink_to(victim)  # even the target itself: refused, and with --force replaced, never written through
+    assert main(["simulate", "--scene", "passive", "--duration", "0.1", "--out", str(out)]) == 2
+    assert victim.read_text() == "precious" and out.is_symlink()
+    assert main(["simulate", "--scene", "passive", "--duration", "0.1", "--out", str(out), "--force"]) in (0, None)
     assert victim.read_text() == "precious" and out.is_file() and not out.is_symlink()
 
 

@@ -251,7 +251,7 @@ def test_channel_trials_end_to_end(tmp_path, capsys):
     assert (tmp_path / "fit" / "run.fit.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # 5 channel trials cannot pin four rates: one line saying so, the replay left out.
     assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "fit"), "--fit", "two-rate",
-                 "--fit-on", "index", "--no-figures"]) == 2
+                 "--fit-on", "index", "--no-figures", "--force"]) == 2
     err = capsys.readouterr().err
     assert "cannot fit the two-rate model to its adaptation_index: 5 trials with a value" in err
 

@@ -52,10 +52,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--protocol", metavar="NAME", default=None,
                    help="with --class: the protocol (its name) whose replays make the curve (default: the one most "
                    "replays share)")
+    from .outputs import add_force_option
+
+    add_force_option(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    with _fresh_outputs(args):  # what --out would replace is refused before anything is replayed
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     read_lab_replays()
     if args.class_dir is not None:
         if args.replays:
@@ -291,3 +299,30 @@ def _class(args: argparse.Namespace) -> int:
     for path in written:
         print(f"wrote {path}")
     return 1 if skipped else 0
+
+
+def _fresh_outputs(args: argparse.Namespace):
+    """``outputs.fresh_outputs`` for every file --out would get: the class curve's, one table, or each
+    replay's table and fit figure (two replays of one name would write one file: refused)."""
+    from .outputs import fresh_outputs
+
+    if args.out is None:
+        return fresh_outputs([], args.force)
+    out = user_path(args.out, "--out")
+    figures = not args.no_figures
+    if args.class_dir is not None:
+        return fresh_outputs([out / "class_curve.csv", *([out / "class_curve.png"] if figures else [])],
+                             args.force, folder=out)
+    one_table = out.suffix.lower() == ".csv"
+    folder = out.parent if one_table else out
+    files = [out] if one_table else []
+    stems: dict[str, str] = {}
+    for name in args.replays:
+        stem = Path(name).stem
+        if stem in stems and (args.fit or not one_table):
+            raise UserError(f"{stems[stem]} and {name} would both write {stem}.* in {folder}: give --out a .csv "
+                            "file for one table, or rename one")
+        stems[stem] = name
+        files += [] if one_table else [out / f"{stem}.trials.csv"]
+        files += [folder / f"{stem}.fit.png"] if args.fit and figures else []
+    return fresh_outputs(files, args.force, folder=folder)

@@ -44,13 +44,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print the rows, ratios and defaults as JSON instead")
     p.add_argument("--out", metavar="DIR", default=None,
                    help="also write bench.csv, work_precision.png and convergence.png into DIR (needs matplotlib)")
+    from .outputs import add_force_option
+
+    add_force_option(p, "those files in --out")
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-
     from ..bench import report
     from ..bench.run import Options, run_bench
+    from .outputs import fresh_outputs
 
     out = None
     if args.out is not None:
@@ -62,20 +65,22 @@ def run(args: argparse.Namespace) -> int:
         from ..bench import figures
 
         figures.require()  # fail now, in one line, not after minutes of measuring
-    options = Options(quick=args.quick, cases=args.cases, integrators=args.integrators, peers=not args.no_peers,
-                      bars=not args.no_bars)
-    progress = (lambda m: None) if args.json else (lambda m: print(f"... {m}", file=sys.stderr, flush=True))
-    result = run_bench(options, progress)
-    if out is not None:
-        from ..bench import figures
+    files = [] if out is None else [out / "bench.csv", out / "work_precision.png", out / "convergence.png"]
+    with fresh_outputs(files, args.force, folder=out):  # an existing one is refused now, not after minutes
+        options = Options(quick=args.quick, cases=args.cases, integrators=args.integrators, peers=not args.no_peers,
+                          bars=not args.no_bars)
+        progress = (lambda m: None) if args.json else (lambda m: print(f"... {m}", file=sys.stderr, flush=True))
+        result = run_bench(options, progress)
+        if out is not None:
+            from ..bench import figures
 
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise UserError(f"cannot create --out folder {out}: {exc.strerror or exc}") from None
-        report.write_csv(result.rows, out / "bench.csv")
-        figures.work_precision(result.rows, out / "work_precision.png")
-        figures.convergence(result.rows, out / "convergence.png")
-        result.notes.append(f"wrote {out / 'bench.csv'}, {out / 'work_precision.png'}, {out / 'convergence.png'}")
+            try:
+                out.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise UserError(f"cannot create --out folder {out}: {exc.strerror or exc}") from None
+            report.write_csv(result.rows, out / "bench.csv")
+            figures.work_precision(result.rows, out / "work_precision.png")
+            figures.convergence(result.rows, out / "convergence.png")
+            result.notes.append(f"wrote {out / 'bench.csv'}, {out / 'work_precision.png'}, {out / 'convergence.png'}")
     print(report.json_report(result) if args.json else report.text_report(result))
     return 0

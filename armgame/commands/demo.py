@@ -41,6 +41,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--gravity", action="store_true",
                    help="interaction only: the reach in a vertical plane, so gravity adds its torques")
     p.add_argument("--speed", type=float, default=1.0, help="window: initial playback rate (default: 1 = real time)")
+    from .outputs import add_force_option
+
+    add_force_option(p, "NAME.csv and NAME.png in --out")
     add_window_options(p, sound=False)
     p.set_defaults(run=run, without_window=without_window)
 
@@ -55,8 +58,9 @@ def run(args: argparse.Namespace) -> int:
         from ..records.storage import user_path
 
         if args.headless:
-            print(autopilot.run_headless(None if args.out is None else user_path(args.out, "--out"), args.duration,
-                                         figures=not args.no_figures))
+            out = None if args.out is None else user_path(args.out, "--out")
+            with _fresh(out, "autopilot", args):
+                print(autopilot.run_headless(out, args.duration, figures=not args.no_figures))
         else:
             from ..ui.autopilot_window import run_window as autopilot_window
             from ..ui.options import window_settings
@@ -71,8 +75,10 @@ def run(args: argparse.Namespace) -> int:
         from ..demos.catalog import run_headless
         from ..records.storage import user_path
 
-        result = run_headless(args.name, user_path(args.out, "--out"), args.duration, args.integrator, args.dt,
-                              args.gravity, figures=not args.no_figures)
+        out = user_path(args.out, "--out")
+        with _fresh(out, args.name, args):
+            result = run_headless(args.name, out, args.duration, args.integrator, args.dt, args.gravity,
+                                  figures=not args.no_figures)
         print(f"{args.name}: {result.summary}")
         for path in result.files:
             print(f"wrote {path}")
@@ -86,6 +92,16 @@ def run(args: argparse.Namespace) -> int:
 
     run_window(args.name, run_, speed=args.speed, size=_window_size(args), fullscreen=args.fullscreen)
     return 0
+
+
+def _fresh(out, name: str, args: argparse.Namespace):
+    """NAME.csv and NAME.png in ``out`` are new files, or refused before the demo runs (unless --force)."""
+    from .outputs import fresh_outputs
+
+    if out is None:
+        return fresh_outputs([], args.force)
+    return fresh_outputs([out / f"{name}.csv", *([] if args.no_figures else [out / f"{name}.png"])], args.force,
+                         folder=out)
 
 
 def _window_size(args: argparse.Namespace) -> tuple[int, int] | None:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..errors import UserError
 from ..words import unknown_name
+from .outputs import RecordTarget, fresh_outputs
 from .play import DEFAULT_SEED, _seed, check_recordable
 
 
@@ -53,7 +54,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--headless", action="store_true", help="no window (needs --bot): run as fast as possible")
     p.add_argument("--out", metavar="DIR", help="write trials.csv, learning.png and paths.png to DIR")
     p.add_argument("--no-figures", action="store_true", help="with --out, or in a window: trials.csv only (no figures)")
-    p.add_argument("--record", metavar="FILE", help="save the run's replay to FILE (JSON)")
+    p.add_argument("--record", metavar="FILE|FOLDER",
+                   help="save the run's replay to FILE (JSON), or into FOLDER as NAME-labN.json (the player's name "
+                   "and the next number there)")
+    from .outputs import add_force_option
+
+    add_force_option(p, "an existing --record FILE and --out's files")
     p.add_argument("--name", help="the player's name, kept in the replay (never in the high-score table)")
     from .classroom import add_join_options
 
@@ -135,8 +141,11 @@ def run(args: argparse.Namespace) -> int:
     keeper = RunKeeper(args)
     _play_in_window(session, bot, args, keeper)
     _report(session, args)
-    if not keeper.kept and (session.outcomes or args.record or args.out):
+    played = session.steps > 0 and (bot is not None or bool(session.timeline))
+    if not keeper.kept and played and (session.outcomes or args.record or args.out):
         keeper(session)  # quit before the end: what was done is kept all the same
+    elif not keeper.kept and not played:  # Esc at the first card: no empty run to mistake for a volunteer's
+        print("nothing was played: nothing kept")
     for line in keeper.lines:
         print(line)
     if keeper.error is not None:
@@ -189,7 +198,7 @@ class RunKeeper:
                     folder.mkdir(parents=True)
                 except OSError as exc:
                     raise UserError(f"cannot create {folder}: {exc.strerror or exc}") from None
-            record = args.record or folder / "replay.json"
+            record = args.record or RecordTarget(folder / "replay.json", folder=False)
             out = args.out or folder
             figures = not args.no_figures
             if figures and not args.out:
@@ -202,7 +211,7 @@ class RunKeeper:
             self.error = exc
             self.lines = [f"not kept: {exc}"]
             return self.lines
-        self.lines = [f"replay saved to {path}" if path == record else f"wrote {path}" for path in written]
+        self.lines = [f"replay saved to {path}" if path.suffix == ".json" else f"wrote {path}" for path in written]
         if args.membership is not None:
             self.lines.append(_hand_in(session, args))
         shown = [f"Kept in {_home(folder)}:" if folder is not None else "Kept:"] + \
@@ -214,6 +223,10 @@ class RunKeeper:
         return shown
 
 
+#: What a run writes in --out (adaptation.png only with channel trials): refused before the run if there.
+OUT_FILES = ("trials.csv", "learning.png", "paths.png", "adaptation.png")
+
+
 def _check_outputs(args: argparse.Namespace) -> None:
     """Refuse a bad --record, --name or missing matplotlib before the run, not after it."""
     if args.name is not None:
@@ -223,13 +236,15 @@ def _check_outputs(args: argparse.Namespace) -> None:
             args.name = check_name(args.name, "--name")
         except ValueError as exc:
             raise UserError(str(exc)) from None
-    from ..records.storage import check_output_path, user_path
+    from ..records.storage import user_path
+    from .outputs import refuse_existing
 
     if args.record:
         record = user_path(args.record, "--record")
         if not record.resolve().parent.is_dir():
             raise UserError(f"--record {args.record}: its folder does not exist")
-        args.record = check_output_path(record, "replay")  # a device, FIFO or folder: refused before the run
+        # A device, FIFO, or a file there already (without --force): refused before the run.
+        args.record = RecordTarget.parse(args.record, args.force, "lab")
     if args.out and not args.no_figures:
         from ..lab.figures import require_matplotlib
 
@@ -238,6 +253,7 @@ def _check_outputs(args: argparse.Namespace) -> None:
         args.out = user_path(args.out, "--out")
         if args.out.exists() and not args.out.is_dir():
             raise UserError(f"--out {args.out}: not a folder")
+        refuse_existing([args.out / name for name in OUT_FILES], args.force)
 
 
 def _report(session, args: argparse.Namespace) -> None:
@@ -268,17 +284,17 @@ def _home(path: Path) -> str:
 def _keep(session, args: argparse.Namespace) -> None:
     """A headless run keeps what --record and --out ask for, and says where."""
     for path in _save(session, args, args.record, args.out, not args.no_figures):
-        print(f"replay saved to {path}" if path == args.record else f"wrote {path}")
+        print(f"replay saved to {path}" if path.suffix == ".json" else f"wrote {path}")
 
 
-def _save(session, args: argparse.Namespace, record: Path | None, out: Path | None, figures: bool) -> list[Path]:
+def _save(session, args: argparse.Namespace, record: RecordTarget | None, out: Path | None,
+          figures: bool) -> list[Path]:
     """The replay to ``record`` and trials.csv (and the figures) to ``out``, each when given; what was written."""
     from ..lab.analysis import write_run_outputs
 
     written: list[Path] = []
     if record:
-        _replay(session, args).save(record)
-        written.append(record)
+        written.append(record.save(_replay(session, args)))
     if out:
         if not session.outcomes:
             raise UserError("no trial was finished: nothing to write to --out")
@@ -286,7 +302,8 @@ def _save(session, args: argparse.Namespace, record: Path | None, out: Path | No
             out.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
-        written += write_run_outputs(session, out, figures=figures)
+        with fresh_outputs([], args.force, folder=out):  # a file that appeared during the run stays
+            written += write_run_outputs(session, out, figures=figures)
     return written
 
 

@@ -49,11 +49,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _add_score_options(p: argparse.ArgumentParser) -> None:
+    from .outputs import add_force_option
     from .scores import add_scores_option
 
     p.add_argument("--name", help="the player's name for the high-score table (the window asks at the end "
                    "otherwise; a headless game enters the table only with --name)")
-    p.add_argument("--record", metavar="FILE", help="save the game's replay to FILE (JSON)")
+    p.add_argument("--record", metavar="FILE|FOLDER", nargs="?", const=".",
+                   help="save each game's replay: to FILE (JSON; a window's later games beside it, FILE-2.json and "
+                   "on), or into FOLDER (alone: the current folder) as NAME-gameN.json, the player's name and the "
+                   "next number there (ann-b-game3.json). A file that exists is never replaced: refused before "
+                   "the game unless --force")
+    add_force_option(p, "the --record FILE")
     add_scores_option(p)
     from .classroom import add_join_options
 
@@ -196,7 +202,8 @@ def _check_score_options(args: argparse.Namespace) -> None:
     import sys
 
     from ..records.replay import check_name
-    from ..records.storage import check_output_path, check_writable_folder, user_path
+    from ..records.storage import check_writable_folder, user_path
+    from .outputs import RecordTarget
     from .scores import scores_dir
 
     if args.name is not None:
@@ -205,8 +212,8 @@ def _check_score_options(args: argparse.Namespace) -> None:
         except ValueError as exc:
             raise UserError(str(exc)) from None
     args.script_path = user_path(args.script, "--script") if args.script is not None else None
-    if args.record is not None:
-        check_output_path(user_path(args.record, "--record"), "replay")
+    if args.record is not None:  # an existing file is refused now, not after a minute of play
+        args.record_target = RecordTarget.parse(args.record, args.force, "game")
     if args.name is not None:  # a game that will enter the table
         check_writable_folder(scores_dir(args), "--scores")
     elif not args.headless:  # the window may ask for a name: say now if it could not be saved
@@ -225,7 +232,6 @@ def _keep(session, args: argparse.Namespace):
 
     from ..records.replay import Replay
     from ..records.scores import ScoreTable, VerificationCache
-    from ..records.storage import check_output_path, user_path
     from .scores import scores_dir, where_it_went
 
     read_lab_replays()  # the table's other entries are read too
@@ -234,9 +240,14 @@ def _keep(session, args: argparse.Namespace):
     driven = "bot" if bot else "script" if args.headless else "keyboard"
     driver = bot or (driver_name(Path(args.script).name) if args.script else None)
     replay = Replay.from_session(session, driven, driver, args.name)
-    if args.record:
-        replay.save(check_output_path(user_path(args.record, "--record"), "replay"))
-        print(f"replay saved to {args.record}", file=out)
+    args.saved_to = None
+    if session.steps == 0:  # Esc at the countdown: nothing to keep, no empty file to hand in by mistake
+        print("the game was quit before it started: nothing kept", file=out)
+        return None
+    if _played(session, args):
+        args.saved_to = _record(replay, args, out)
+    elif getattr(args, "record_target", None) is not None:  # nobody at the keys: not a game to hand in
+        print("no key was pressed in this game: nothing saved for --record", file=out)
     membership = getattr(args, "membership", None)
     if membership is not None and replay.complete:
         _hand_in(replay, membership, out)
@@ -244,7 +255,7 @@ def _keep(session, args: argparse.Namespace):
     if args.name is None or not replay.complete or membership is not None:
         if membership is not None:
             print("the game was stopped before the end: not handed in to the class", file=out)
-        if not args.headless and session.steps > 0:  # a window's game: nothing is lost (Esc on the end screen)
+        if not args.headless:  # a window's game: nothing is lost (Esc on the end screen)
             _keep_replay(replay, args, out)
         elif args.name is not None:
             print("the game was stopped before the end: not entered in the high-score table", file=out)
@@ -262,18 +273,35 @@ def _keep(session, args: argparse.Namespace):
     return entry
 
 
+def _played(session, args: argparse.Namespace) -> bool:
+    """Whether a game is worth a --record file: it began, and in a window a key of the game (or a bot) played
+    it. A headless game is what its script asked for, even an empty one."""
+    if session.steps == 0:
+        return False
+    return bool(getattr(args, "headless", False) or getattr(args, "bot", None) or session.timeline)
+
+
+def _record(replay, args: argparse.Namespace, out):
+    """The replay where --record asks (``outputs.RecordTarget``), and a line naming the file; its path."""
+    target = getattr(args, "record_target", None)
+    if target is None:
+        return None
+    path = target.save(replay)
+    print(f"replay saved to {path}", file=out)
+    return path
+
+
 def _keep_replay(replay, args: argparse.Namespace, out) -> None:
     """A window's game not entered in the table: its replay is kept (beside the table's, or where
     --record put it) and the line printed says how to enter it later, or to watch it."""
     import shlex
-    from pathlib import Path
 
     from ..records.scores import ScoreTable
     from ..records.storage import DataFileError
     from .scores import scores_dir
 
-    if args.record:
-        path = Path(args.record)
+    if args.saved_to is not None:
+        path = args.saved_to
     else:
         try:
             path = ScoreTable(scores_dir(args)).save_replay(replay)
@@ -357,9 +385,16 @@ def _standing(session, args: argparse.Namespace):
             return None
         # The player's place, at their best game (maybe an earlier one): "#3" is the third player.
         rank = None if entry is None else rank_of(rows, entry.name)
-        return Standing(rank, len(rows), _rows([(r.name, r.best.score) for r in rows], rank), list_name(kind))
+        return Standing(rank, len(rows), _rows([(r.name, r.best.score) for r in rows], rank), list_name(kind),
+                        saved=_saved_line(args))
 
     return standing
+
+
+def _saved_line(args: argparse.Namespace) -> str | None:
+    """The end screen's line naming the --record file just written (the terminal has its whole path)."""
+    path = getattr(args, "saved_to", None)
+    return None if path is None else f"Saved as {path.name}"
 
 
 def _class_standing(session, args: argparse.Namespace, membership):
@@ -376,6 +411,13 @@ def _class_standing(session, args: argparse.Namespace, membership):
         if not session.over:
             return Standing(None, 0, (), "the class", note="Stopped before the end: not handed in")
         replay = Replay.from_session(session, "bot" if args.bot else "keyboard", args.bot, membership.name)
+        args.saved_to = None
+        if _played(session, args):
+            try:
+                args.saved_to = _record(replay, args, sys.stdout)
+            except UserError as exc:
+                print(f"armgame play: error: {exc}", file=sys.stderr)
+        saved = _saved_line(args)
         done: list = []
         thread = threading.Thread(target=lambda: done.append(_quiet_hand_in(replay, membership)), daemon=True)
         thread.start()
@@ -388,15 +430,15 @@ def _class_standing(session, args: argparse.Namespace, membership):
             if result.kept is not None:  # the whole reason goes to the terminal; the screen says what matters
                 print(f"armgame play: {result.message}", file=sys.stderr)
                 return Standing(None, 0, (), "the class", note="Not handed in: the class cannot be reached.\n"
-                                "Your game is kept: it goes in the next time you join")
+                                "Your game is kept: it goes in the next time you join", saved=saved)
             if answer is None:
-                return Standing(None, 0, (), "the class", note=_screen_line(result.message))
+                return Standing(None, 0, (), "the class", note=_screen_line(result.message), saved=saved)
             top = tuple((int(r), str(n), int(v)) for r, n, v in answer.get("top", ()))
             where = "the class" if answer.get("list") == "students" else "the programs"
             return Standing(int(answer["rank"]), int(answer["of"]), top, where,
-                            note=_screen_line(result.message))
+                            note=_screen_line(result.message), saved=saved)
 
-        return Standing(None, 0, (), "the class", note="Handing your game in...", later=later)
+        return Standing(None, 0, (), "the class", note="Handing your game in...", later=later, saved=saved)
 
     return standing
 
@@ -450,8 +492,6 @@ def _preview(session, args: argparse.Namespace):
 
 
 def _play_in_window(session, args: argparse.Namespace, window):
-    from pathlib import Path
-
     from ..game.session import GameSession
 
     try:
@@ -460,18 +500,12 @@ def _play_in_window(session, args: argparse.Namespace, window):
         raise UserError(f"the window needs pygame-ce: {exc}") from None
     settings, path = window
     named = args.name  # --name: every game of the window goes under it; else each is asked its own
-    record = args.record
-    games = [1]
 
     def next_game(finished):
         """Enter on the end screen: this game is kept and reported, the next has the same options."""
         args.name = args.name or finished.player_name
         _report(finished.session, finished.session.result(), args)
-        games[0] += 1
-        args.name, args.kept = named, False
-        if record:  # --record FILE: the next games beside it, FILE-2.json and on, none overwritten
-            path = Path(record)
-            args.record = str(path.with_name(f"{path.stem}-{games[0]}{path.suffix}"))
+        args.name, args.kept = named, False  # --record's target numbers the next games' files itself
         new = GameSession(game_config(args))
         return NextGame(new, _bot_driver(new, args), _standing(new, args),
                         None if getattr(args, "membership", None) else _preview(new, args))

@@ -48,7 +48,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="initial joint angles in degrees and velocities in deg/s, in armgame's convention "
                    "(q1 from +x, q2 relative to the upper arm); default: the scene's")
     p.add_argument("--sample-rate", type=float, default=200.0, help="rows per simulated second (default: 200)")
-    p.add_argument("--out", required=True, help="CSV file to write")
+    p.add_argument("--out", required=True, help="CSV file to write (a file there already: refused unless --force)")
+    from .outputs import add_force_option
+
+    add_force_option(p, "the --out file")
     p.set_defaults(run=run)
 
 
@@ -64,7 +67,10 @@ def run(args: argparse.Namespace) -> int:
     scene = get_scene(args.scene)
     if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
         raise UserError(f"--duration must be a positive, finite number of seconds, got {args.duration!r}")
-    run_ = simulate_to_csv(scene, args.integrator, args.dt, out, args.duration, args.initial, args.sample_rate)
+    from .outputs import fresh_outputs
+
+    with fresh_outputs([out], args.force, "CSV"):
+        run_ = simulate_to_csv(scene, args.integrator, args.dt, out, args.duration, args.initial, args.sample_rate)
     summary = f"{scene.name}: {plural(run_.rows, 'row')} to {args.out} ({args.integrator}, dt={args.dt:g} s, " \
         f"{run_.t_end:g} s)"
     if run_.energy_start is not None and run_.rows > 1 and run_.energy_start != 0.0:

@@ -14,6 +14,10 @@ What it guarantees, whatever is planted at the path:
   folder (a rename is only atomic within one file system), is flushed and fsynced, renamed
   over the target, and then the folder is fsynced so that the rename survives a power cut.
   A reader therefore sees the old file or the new one, never a mixture.
+* A file made for a person (a replay ``--record`` names, the CSVs and figures of ``--out``) is never
+  replaced unless asked: the temporary file is *linked* to its name (``link_new``), which fails if
+  anything is there, instead of renamed over it. ``fresh_files`` says which targets those are, so the
+  writers below the commands (the lab's CSVs, the figures) keep the promise without knowing of it.
 * Paths given by the user: ``~user`` that names nobody, or a path too long for the file system, is
   one line, not a traceback.
 
@@ -25,12 +29,13 @@ it is re-exported here, where every other reader and writer finds it.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import json
 import math
 import os
 import secrets
 import stat
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
@@ -48,8 +53,8 @@ from ..files import kind_of as _kind
 
 __all__ = ["STRICT_DECODER", "DataFileError", "atomic_write_bytes", "atomic_writer", "check_float", "check_int",
            "check_keys", "check_output_path", "check_path_length", "check_str", "check_writable_folder",
-           "copy_aside", "dump_json", "fsync_folder", "open_regular", "parse_json", "read_limited", "save_figure",
-           "show_path", "user_path"]
+           "copy_aside", "dump_json", "fresh_files", "fsync_folder", "is_taken", "link_new", "open_regular",
+           "parse_json", "read_limited", "save_figure", "show_path", "user_path", "write_new"]
 
 
 def _read_umask() -> int:
@@ -128,14 +133,81 @@ def _temporary(folder: Path, name: str) -> tuple[int, Path]:
     raise DataFileError(f"{folder}: cannot create a temporary file")
 
 
+#: The targets that must not be replaced (``fresh_files``), as ``_key`` spells them: a context variable, so
+#: that two commands run in one process (the tests, a thread) never see each other's.
+_FRESH: contextvars.ContextVar[frozenset[str]] = contextvars.ContextVar("armgame_fresh_files", default=frozenset())
+
+
+def _key(path: Path) -> str:
+    return os.path.normcase(os.path.abspath(path))
+
+
+def is_taken(path: Path) -> bool:
+    """Something, anything (a dangling symlink too), is at ``path``: a new file may not be made there."""
+    try:
+        os.lstat(path)
+    except FileNotFoundError:
+        return False
+    except OSError:  # cannot tell (a name too long, no permission): the writer's own check says why
+        return False
+    return True
+
+
 @contextlib.contextmanager
-def atomic_writer(path: Path, what: str = "file") -> Iterator[BinaryIO]:
+def fresh_files(paths: Iterable[Path] = (), folders: Iterable[Path] = ()) -> Iterator[None]:
+    """While the block runs, every atomic write to one of ``paths``, or to any file directly in one of
+    ``folders`` (a figure added to a command's output later is covered too), makes a new file or fails
+    (a ``DataFileError``), whichever function below the command writes it."""
+    keys = {_key(Path(p)) for p in paths} | {_key(Path(f)) + os.sep for f in folders}
+    token = _FRESH.set(_FRESH.get() | keys)
+    try:
+        yield
+    finally:
+        _FRESH.reset(token)
+
+
+def _is_fresh(path: Path) -> bool:
+    fresh = _FRESH.get()
+    key = _key(path)
+    return key in fresh or (os.path.dirname(key) + os.sep) in fresh
+
+
+def link_new(tmp: Path, path: Path) -> None:
+    """Give the whole file ``tmp`` the name ``path`` only if nothing is there (``FileExistsError`` if
+    something is), never replacing it, even if it appeared a moment ago: two writers racing for one name
+    cannot both have it. ``tmp`` is gone afterwards.
+
+    A hard link is atomic and refuses an existing name (a symlink too: nothing is written through it).
+    Where the file system has no hard links (FAT, some network shares): on Windows a plain rename, which
+    never replaces there; elsewhere the name is claimed by an exclusive create and the file renamed onto
+    the claim (a crash between leaves an empty file, never a lost one)."""
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        raise
+    except (AttributeError, NotImplementedError, OSError):  # no hard links here: the ways below say why not
+        if os.name == "nt":
+            os.rename(tmp, path)
+            return
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666 & ~_UMASK)
+        os.close(fd)
+        os.replace(tmp, path)
+        return
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
+
+
+@contextlib.contextmanager
+def atomic_writer(path: Path, what: str = "file", replace: bool | None = None) -> Iterator[BinaryIO]:
     """Yield a binary file whose content replaces ``path`` atomically when the block ends cleanly.
 
     Rows can be streamed into it (``simulate`` writes as it integrates); on any error the
-    temporary file is removed and the target stays as it was.
+    temporary file is removed and the target stays as it was. ``replace=False`` makes a new file or
+    fails if ``path`` is taken (``link_new``); None: False for the targets of ``fresh_files``, else True.
     """
     path = check_output_path(Path(path), what)
+    if replace is None:
+        replace = not _is_fresh(path)
     folder = path.parent
     try:
         fd, tmp = _temporary(folder, path.name)
@@ -147,19 +219,63 @@ def atomic_writer(path: Path, what: str = "file") -> Iterator[BinaryIO]:
             f.flush()
             os.fsync(f.fileno())
         check_output_path(path, what)  # the target may have been swapped for a FIFO while we wrote
-        os.replace(tmp, path)
+        if replace:
+            os.replace(tmp, path)
+        else:
+            link_new(tmp, path)
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, FileExistsError):
+            raise DataFileError(f"{show_path(path)}: already exists (it appeared while the {what} was made): "
+                                f"it was not replaced") from None
         if isinstance(exc, OSError):
             raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
         raise
     fsync_folder(folder)
 
 
-def atomic_write_bytes(path: Path, data: bytes, what: str = "file") -> None:
-    with atomic_writer(path, what) as f:
+def atomic_write_bytes(path: Path, data: bytes, what: str = "file", replace: bool | None = None) -> None:
+    with atomic_writer(path, what, replace) as f:
         f.write(data)
+
+
+#: The most numbered names ``write_new`` tries before it gives up: far more than any class makes.
+MAX_NUMBERED = 10_000
+
+
+def write_new(name_of: Callable[[int], Path], first: int, data: bytes, what: str = "file") -> Path:
+    """Write ``data`` to a new file ``name_of(n)``, the first ``n`` from ``first`` whose name is free, and
+    return it. Each name is claimed atomically (``link_new``): two writers at once get two numbers, and
+    no file already there is ever replaced. All the names lie in one folder."""
+    first_path = check_output_path(Path(name_of(first)), what)
+    folder = first_path.parent
+    try:
+        fd, tmp = _temporary(folder, first_path.name)
+    except OSError as exc:
+        raise DataFileError(f"{show_path(first_path)}: cannot write the {what}: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        for n in range(first, first + MAX_NUMBERED):
+            path = Path(name_of(n))
+            if n != first:
+                check_output_path(path, what)
+            try:
+                link_new(tmp, path)
+            except FileExistsError:
+                continue
+            fsync_folder(folder)
+            return path
+        raise DataFileError(f"{show_path(first_path)}: {MAX_NUMBERED:,} numbered names after it are all taken")
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise DataFileError(f"{show_path(first_path)}: cannot write the {what}: {exc.strerror or exc}") from None
+        raise
 
 
 def atomic_write_many(items: list[tuple[Path, bytes]], what: str = "file") -> None:

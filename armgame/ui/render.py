@@ -119,6 +119,8 @@ class Standing:
     #: Asked every frame while the standing is still on its way (a hand-in over the network): returns
     #: the standing to show once it has arrived, None until then. The window never waits for it.
     later: Callable[[], Standing | None] | None = None
+    #: The line naming the file the game was saved to ("Saved as ann-b-game3.json"): the one to hand in.
+    saved: str | None = None
 
 
 @dataclass
@@ -421,6 +423,8 @@ class GameRenderer:
                 lines.append((f"{would} {standing.rank} of {standing.entries}", normal, p.ink))
             else:
                 lines.append(("Not entered in the table", normal, p.ink))
+            if standing.saved is not None:
+                lines.append((standing.saved, normal, p.ink))
             rows = list(standing.top)
         margin = max(8, round(24 * lay.unit))
         panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
