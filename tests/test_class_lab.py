@@ -63,7 +63,7 @@ def test_volunteers_runs_fill_the_class_curve_one_run_each(tmp_path, runs, monke
         rows = list(csv.DictReader(io.StringIO(get(opened, "/api/teacher/lab.csv", opened.clerk.roster.secret)
                                                .decode())))
     assert lab["protocol"] == "short" and lab["students"] == 2 and lab["programs"] == 1
-    assert lab["metric"] == "max_perpendicular_error_m" and lab["unit"] == "mm"
+    assert lab["metric"] == "max_perpendicular_error_m" and lab["unit"] == "cm"
     assert [t["trial"] for t in lab["trials"]] == [1, 2, 3, 4] and all(t["n"] == 2 for t in lab["trials"])
     assert [t["perturbation"] for t in lab["trials"]][1:3] != ["none", "none"]
     assert {r["player"] for r in rows} == {"Ann", "Bo", "Bot"} and len(rows) == 12

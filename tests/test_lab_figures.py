@@ -12,7 +12,7 @@ from lab_synthetic import HOME, protocol, student, targets
 from armgame.errors import UserError
 from armgame.lab import figures
 from armgame.lab.figures import blocks_of, class_curve, class_figure, learning_figure, paths_figure
-from armgame.lab.metrics import CLASS_COLUMNS, write_class_csv
+from armgame.lab.metrics import class_columns, write_class_csv
 
 
 @pytest.fixture(scope="module")
@@ -95,12 +95,16 @@ def test_class_figure_and_csv(tmp_path):
     class_figure(curve, tmp_path / "class.png")
     assert png_size(tmp_path / "class.png") == (1920, 1080)
     class_figure(class_curve(students[:2]), tmp_path / "even.png", metric="initial_direction_error_deg")
-    write_class_csv(tmp_path / "class.csv", curve)
+    write_class_csv(tmp_path / "class.csv", curve, "initial_direction_error_deg")
     with open(tmp_path / "class.csv", newline="") as f:
         table = list(csv.DictReader(f))
-    assert list(table[0]) == list(CLASS_COLUMNS) and len(table) == len(curve)
-    assert float(table[20]["mean"]) == curve[20]["mean"] and int(table[-1]["n"]) == 4
-    assert table[0]["sem"] != "" and float(table[0]["sem"]) == curve[0]["sem"]
+    # The mean and s.e.m. name their measure and its unit.
+    assert list(table[0]) == list(class_columns("initial_direction_error_deg")) == \
+        ["trial", "block", "perturbation", "mean_initial_direction_error_deg", "sem_initial_direction_error_deg", "n"]
+    assert len(table) == len(curve)
+    assert float(table[20]["mean_initial_direction_error_deg"]) == curve[20]["mean"] and int(table[-1]["n"]) == 4
+    assert table[0]["sem_initial_direction_error_deg"] != ""
+    assert float(table[0]["sem_initial_direction_error_deg"]) == curve[0]["sem"]
 
 
 def test_bad_requests_are_one_line_user_errors(tmp_path, experiment):

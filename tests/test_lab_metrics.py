@@ -62,9 +62,9 @@ def straight(deg, distance=D):
 
 def test_straight_minimum_jerk_reach():
     m = reach_metrics(make_reach(straight(30.0)))
-    assert m.peak_speed == pytest.approx(1.875 * D / T, rel=2e-5)  # central differences: -dt^2/6 |x'''|
-    assert m.reaction_time == pytest.approx(START - GO + S5 * T, abs=SAMPLED)
-    assert m.movement_time == pytest.approx((1.0 - 2.0 * S5) * T, abs=SAMPLED)
+    assert m.peak_speed_m_per_s == pytest.approx(1.875 * D / T, rel=2e-5)  # central differences: -dt^2/6 |x'''|
+    assert m.reaction_time_s == pytest.approx(START - GO + S5 * T, abs=SAMPLED)
+    assert m.movement_time_s == pytest.approx((1.0 - 2.0 * S5) * T, abs=SAMPLED)
     assert m.initial_direction_error_deg == pytest.approx(0.0, abs=1e-9)
     assert m.max_perpendicular_error_m == pytest.approx(0.0, abs=1e-15)
     assert m.path_length_ratio == pytest.approx(1.0, abs=1e-12)
@@ -73,8 +73,8 @@ def test_straight_minimum_jerk_reach():
 def test_thresholds_move_onset_and_end_as_the_speed_profile_says():
     m = reach_metrics(make_reach(straight(0.0)), threshold=0.2)
     s = (1.0 - math.sqrt(1.0 - 4.0 * math.sqrt(0.2 * 1.875 / 30.0))) / 2.0
-    assert m.reaction_time == pytest.approx(START - GO + s * T, abs=SAMPLED)
-    assert m.movement_time == pytest.approx((1.0 - 2.0 * s) * T, abs=SAMPLED)
+    assert m.reaction_time_s == pytest.approx(START - GO + s * T, abs=SAMPLED)
+    assert m.movement_time_s == pytest.approx((1.0 - 2.0 * s) * T, abs=SAMPLED)
 
 
 @pytest.mark.parametrize("angle", [25.0, -25.0, 90.0, -150.0])
@@ -87,7 +87,7 @@ def test_rotated_path_gives_the_rotation_with_its_sign(angle, direction_at):
     p_end = float(progress(1.0 - S5))
     assert m.max_perpendicular_error_m == pytest.approx(D * p_end * math.sin(math.radians(angle)), abs=1e-7)
     assert m.path_length_ratio == pytest.approx(1.0, abs=1e-12)
-    assert m.peak_speed == pytest.approx(1.875 * D / T, rel=2e-5)  # central differences: -dt^2/6 |x'''|
+    assert m.peak_speed_m_per_s == pytest.approx(1.875 * D / T, rel=2e-5)  # central differences: -dt^2/6 |x'''|
 
 
 def test_a_reach_the_wrong_way_reads_180_degrees():
@@ -122,7 +122,7 @@ def test_sine_bump_path_has_its_known_deviation_length_and_initial_direction(bum
     chord = float(np.hypot(*(curved(np.array([p_end])) - curved(np.array([p_on])))[0]))
     assert m.path_length_ratio == pytest.approx(arc / chord, rel=1e-5)
     assert m.path_length_ratio > 1.0
-    assert m.peak_speed == pytest.approx(speed.max() / T, rel=2e-5)
+    assert m.peak_speed_m_per_s == pytest.approx(speed.max() / T, rel=2e-5)
 
     # The hand 100 ms after onset, from where it was at onset, against the target direction.
     s_on = s[above[0]]
@@ -136,14 +136,14 @@ def test_sine_bump_path_has_its_known_deviation_length_and_initial_direction(bum
 def test_delayed_onset_shifts_only_the_reaction_time():
     early = reach_metrics(make_reach(straight(45.0), 45.0, start_at=0.30))
     late = reach_metrics(make_reach(straight(45.0), 45.0, start_at=0.55))
-    assert late.reaction_time - early.reaction_time == pytest.approx(0.25, abs=1e-9)
-    for name in ("movement_time", "peak_speed", "initial_direction_error_deg", "path_length_ratio"):
+    assert late.reaction_time_s - early.reaction_time_s == pytest.approx(0.25, abs=1e-9)
+    for name in ("movement_time_s", "peak_speed_m_per_s", "initial_direction_error_deg", "path_length_ratio"):
         assert getattr(late, name) == pytest.approx(getattr(early, name), abs=1e-9)
 
 
 def test_movement_before_the_go_cue_is_a_negative_reaction_time():
     m = reach_metrics(make_reach(straight(0.0), 0.0, start_at=GO - 0.1))
-    assert m.reaction_time == pytest.approx(-0.1 + S5 * T, abs=SAMPLED)
+    assert m.reaction_time_s == pytest.approx(-0.1 + S5 * T, abs=SAMPLED)
 
 
 def test_resting_offset_does_not_bias_the_direction():
@@ -158,14 +158,14 @@ def test_a_corrective_submovement_after_the_primary_one_is_left_out():
     t = np.arange(0.0, 1.6 + DT / 2, DT)
     hand = primary(progress((t - START) / T)) + np.outer(progress((t - 1.0) / 0.3), 0.2 * D * left_of(0.0))
     m = reach_metrics(Reach(t, hand, tuple(HOME), tuple(HOME + D * unit(0.0)), GO, True))
-    assert m.movement_time == pytest.approx((1.0 - 2.0 * S5) * T, abs=SAMPLED)
+    assert m.movement_time_s == pytest.approx((1.0 - 2.0 * S5) * T, abs=SAMPLED)
     assert m.max_perpendicular_error_m == pytest.approx(0.0, abs=1e-12)
     assert m.path_length_ratio == pytest.approx(1.0, abs=1e-12)
 
 
 def test_a_reach_cut_off_mid_movement_ends_at_the_last_sample():
     m = reach_metrics(make_reach(straight(0.0), 0.0, duration=START + 0.7 * T))
-    assert m.movement_time == pytest.approx(0.7 * T - S5 * T, abs=SAMPLED)
+    assert m.movement_time_s == pytest.approx(0.7 * T - S5 * T, abs=SAMPLED)
     assert math.isfinite(m.path_length_ratio)
 
 
@@ -177,7 +177,7 @@ def test_no_movement_is_nan_except_the_peak_speed():
     t = np.arange(0.0, 1.0, DT)
     still = Reach(t, np.tile(HOME, (t.size, 1)), tuple(HOME), tuple(HOME + D * unit(0.0)), GO, False)
     m = reach_metrics(still)
-    assert m.peak_speed == 0.0
+    assert m.peak_speed_m_per_s == 0.0
     assert nan_or_value(m) == [0.0]
     jitter = Reach(t, HOME + 1e-6 * np.sin(50 * t)[:, None], tuple(HOME), tuple(HOME + D * unit(0.0)), GO, False)
     assert nan_or_value(reach_metrics(jitter)) == [pytest.approx(50e-6 * math.sqrt(2), rel=1e-2)]
@@ -224,15 +224,15 @@ def test_any_finite_path_gives_metrics_and_never_raises(coords, go):
     assert all(math.isnan(v) or math.isfinite(v) for v in m.as_dict().values())
     if math.isfinite(m.path_length_ratio):
         assert m.path_length_ratio >= 1.0 - 1e-9
-    if math.isfinite(m.movement_time):
-        assert m.movement_time >= 0.0
+    if math.isfinite(m.movement_time_s):
+        assert m.movement_time_s >= 0.0
 
 
 # ----------------------------------------------------------------------------------- trials table
 
 def row(number, **changes):
     base = {"block": "exposure", "trial": number, "target_deg": 45.0, "perturbation": "curl",
-            "reaction_time": 0.3141592653589793, "movement_time": 0.45, "peak_speed": 0.375,
+            "reaction_time_s": 0.3141592653589793, "movement_time_s": 0.45, "peak_speed_m_per_s": 0.375,
             "initial_direction_error_deg": -12.5, "max_perpendicular_error_m": 0.0123,
             "path_length_ratio": 1.1, "hit": True, "channel_force_peak_n": float("nan"),
             "channel_force_at_peak_speed_n": float("nan"), "adaptation_index": float("nan")}
@@ -243,7 +243,7 @@ def row(number, **changes):
 def test_trials_round_trip_exactly_with_nan_as_empty(tmp_path):
     rows = [row(1, perturbation="channel", channel_force_peak_n=1.5, channel_force_at_peak_speed_n=-0.25,
                 adaptation_index=0.75),
-            row(2, hit=False, reaction_time=float("nan"), path_length_ratio=np.float64(1 / 3)),
+            row(2, hit=False, reaction_time_s=float("nan"), path_length_ratio=np.float64(1 / 3)),
             row(3, block="washout", perturbation="none", trial=np.int64(3), hit=np.bool_(True))]
     path = tmp_path / "trials.csv"
     write_trials_csv(path, rows)
@@ -252,15 +252,16 @@ def test_trials_round_trip_exactly_with_nan_as_empty(tmp_path):
     assert ",," in text.splitlines()[2]
     back = read_trials_csv(path)
     assert [list(r) for r in back] == [list(TRIAL_COLUMNS)] * 3
-    assert back[1]["path_length_ratio"] == 1 / 3 and math.isnan(back[1]["reaction_time"])
+    assert back[1]["path_length_ratio"] == 1 / 3 and math.isnan(back[1]["reaction_time_s"])
     assert back[0] == rows[0] and back[2]["trial"] == 3 and back[2]["hit"] is True and back[1]["hit"] is False
 
 
 def test_write_refuses_bad_rows_and_non_regular_targets(tmp_path):
     path = tmp_path / "trials.csv"
     for bad in ({**row(1), "extra": 1}, {k: v for k, v in row(1).items() if k != "hit"}, row(1, trial=1.5),
-                row(1, hit=1), row(1, block=""), row(1, peak_speed=float("inf")), row(1, target_deg=float("nan")),
-                row(1, movement_time="0.4")):
+                row(1, hit=1), row(1, block=""), row(1, peak_speed_m_per_s=float("inf")),
+                row(1, target_deg=float("nan")),
+                row(1, movement_time_s="0.4")):
         with pytest.raises(ValueError):
             write_trials_csv(path, [bad])
     assert not path.exists()
@@ -294,7 +295,7 @@ GOOD = "exposure,1,45,curl,0.3,0.45,0.375,-12.5,0.0123,1.1,1"
     (HEADER.replace("hit", "block") + "\n", "named twice"),
     (HEADER + "\n" + GOOD + ",9\n", "line 2: 12 fields"),
     (HEADER + "\n" + GOOD.replace(",1.1,", ",nan,") + "\n", "line 2, column path_length_ratio"),
-    (HEADER + "\n" + GOOD + "\n" + GOOD.replace(",0.375,", ",1e999,") + "\n", "line 3, column peak_speed"),
+    (HEADER + "\n" + GOOD + "\n" + GOOD.replace(",0.375,", ",1e999,") + "\n", "line 3, column peak_speed_m_per_s"),
     (HEADER + "\n" + GOOD.replace(",0.375,", ",-0.1,") + "\n", "must not be negative"),
     (HEADER + "\n" + GOOD.replace(",45,", ",,") + "\n", "column target_deg"),
     (HEADER + "\n" + GOOD.replace("exposure,1,", "exposure,-1,") + "\n", "column trial"),
@@ -312,11 +313,28 @@ def test_hostile_tables_get_one_line_naming_line_and_column(tmp_path, text, mess
 
 def test_reader_accepts_a_spreadsheets_table(tmp_path):
     columns = list(reversed(BASE_COLUMNS))
-    values = dict(zip(BASE_COLUMNS, GOOD.split(","), strict=True)) | {"hit": "TRUE", "reaction_time": ""}
+    values = dict(zip(BASE_COLUMNS, GOOD.split(","), strict=True)) | {"hit": "TRUE", "reaction_time_s": ""}
     text = "\ufeff" + ",".join(columns) + "\r\n" + ",".join(values[c] for c in columns) + "\r\n\r\n"
     (rows,) = read_trials_csv(write_text(tmp_path, text))
-    assert rows["hit"] is True and math.isnan(rows["reaction_time"]) and rows["trial"] == 1
+    assert rows["hit"] is True and math.isnan(rows["reaction_time_s"]) and rows["trial"] == 1
     assert list(rows) == list(TRIAL_COLUMNS) and math.isnan(rows["adaptation_index"])  # absent: read as NaN
+
+
+def test_a_table_from_before_each_column_named_its_unit_still_reads(tmp_path):
+    old = HEADER.replace("reaction_time_s", "reaction_time").replace("movement_time_s", "movement_time") \
+        .replace("peak_speed_m_per_s", "peak_speed")
+    assert old != HEADER
+    (rows,) = read_trials_csv(write_text(tmp_path, old + "\n" + GOOD + "\n"))
+    assert (rows["reaction_time_s"], rows["movement_time_s"], rows["peak_speed_m_per_s"]) == (0.3, 0.45, 0.375)
+    with pytest.raises(TrialsFileError, match="named twice"):  # an old name beside its new one is the same column
+        read_trials_csv(write_text(tmp_path, HEADER + ",peak_speed\n"))
+
+
+def test_every_measure_names_its_unit():
+    """SI in every table: a measure's column ends in its unit, or is a ratio or an index."""
+    for name in TRIAL_COLUMNS:
+        if name not in ("block", "trial", "perturbation", "hit", "path_length_ratio", "adaptation_index"):
+            assert name.endswith(("_s", "_m", "_m_per_s", "_deg", "_n")), name
 
 
 def test_reader_refuses_non_regular_big_and_binary_files(tmp_path, monkeypatch):
@@ -370,8 +388,9 @@ text = st.text(st.characters(codec="utf-8", categories=("L", "N", "P", "S", "Zs"
 @settings(max_examples=30, deadline=None)
 @given(st.lists(st.fixed_dictionaries({
     "block": text, "trial": st.integers(0, 1_000_000), "target_deg": st.floats(-1e6, 1e6),
-    "perturbation": text, "reaction_time": measure, "movement_time": measure.map(abs),
-    "peak_speed": measure.map(abs), "initial_direction_error_deg": measure, "max_perpendicular_error_m": measure,
+    "perturbation": text, "reaction_time_s": measure, "movement_time_s": measure.map(abs),
+    "peak_speed_m_per_s": measure.map(abs), "initial_direction_error_deg": measure,
+    "max_perpendicular_error_m": measure,
     "path_length_ratio": measure.map(abs), "hit": st.booleans(), "channel_force_peak_n": measure,
     "channel_force_at_peak_speed_n": measure, "adaptation_index": measure}), max_size=5))
 def test_any_table_round_trips_exactly(tmp_path_factory, rows):

@@ -330,7 +330,7 @@ class Clerk:
 
     def lab_curve(self) -> dict[str, object]:
         """The class curve of the protocol most students ran (people's runs; programs' counted apart)."""
-        from ..lab.analysis import figure_metric
+        from ..lab.analysis import display_unit, figure_metric
         from ..lab.figures import class_curve
 
         people = [run for run in self.lab_runs if not run.program and not self.roster.is_hidden(run.player)]
@@ -347,7 +347,7 @@ class Clerk:
         protocol, runs = max(groups, key=lambda g: len(g[1]))
         metric = figure_metric(protocol)
         curve = class_curve([run.rows for run in runs], metric)
-        scale, unit = (1000.0, "mm") if metric.endswith("_m") else (1.0, "deg")
+        scale, unit = display_unit(metric)
         trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
                    "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
                   for row in curve]

@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="per-reach measures of lab replays (verified first), or a class's mean learning curve",
         description="Re-simulate each lab replay from its input timeline, check that it reproduces its recorded "
         "trials, and measure every reach: one row per reach (block, trial, target_deg, perturbation, "
-        "reaction_time, movement_time, peak_speed, initial_direction_error_deg, max_perpendicular_error_m, "
+        "reaction_time_s, movement_time_s, peak_speed_m_per_s, initial_direction_error_deg, max_perpendicular_error_m, "
         "path_length_ratio, hit, and on error-clamp trials channel_force_peak_n, channel_force_at_peak_speed_n, "
         "adaptation_index). --fit two-rate fits the two-rate learner's rates to each run. A replay that does "
         "not verify is reported and left out. With --class DIR: "
@@ -182,10 +182,9 @@ def _replays(args: argparse.Namespace) -> int:
             continue
         print(f"{path}: verified: {session.protocol.name}, seed {session.config.seed}, {len(rows)} reaches")
         if args.fit:
-            figure = None if args.no_figures or out is None else \
-                (out.parent if one_table else out) / f"{path.stem}.fit.png"
+            beside = None if out is None else (out.parent if one_table else out)  # the fit's files: by the table
             try:
-                written += _fit(session, rows, args.fit_on, figure)
+                written += _fit(session, rows, args.fit_on, beside, path, replay.player, not args.no_figures)
             except UserError as exc:
                 print(f"armgame analyze: {path}: {exc}", file=sys.stderr)
                 skipped += 1
@@ -208,8 +207,9 @@ def _replays(args: argparse.Namespace) -> int:
     return 1 if skipped else 0
 
 
-def _fit(session, rows, on: str, figure: Path | None) -> list[Path]:
-    """Fit the two-rate model to one verified run and print it; draw the fit to ``figure`` if given."""
+def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | None, figures: bool) -> list[Path]:
+    """Fit the two-rate model to one verified run and print it; with ``beside`` (a folder), keep the fit
+    there as ``NAME.fit.json`` (and draw ``NAME.fit.png``)."""
     from ..lab.analysis import figure_metric, fit_schedule
     from ..lab.fit import fit_two_rate
 
@@ -220,16 +220,38 @@ def _fit(session, rows, on: str, figure: Path | None) -> list[Path]:
         fit = fit_two_rate(disturbance, clamped, observed, on)
     except ValueError as exc:
         raise UserError(f"cannot fit the two-rate model to its {metric}: {exc}") from None
+    unit = metric.rsplit("_", 1)[1] if metric != "adaptation_index" else ""
+    shown, scale = ("cm", 100.0) if unit == "m" else (unit, 1.0)  # a student reads cm; the file keeps metres
     print(f"  two-rate fit to {metric} ({fit.n} trials):")
-    for line in fit.lines():
+    for line in fit.lines(shown, scale):
         print(line)
-    if figure is None:
+    if beside is None:
         return []
-    from ..lab.figures import fit_figure
+    import json
 
-    figure.parent.mkdir(parents=True, exist_ok=True)
-    fit_figure(rows, fit, figure, metric)
-    return [figure]
+    from ..lab.metrics import check_regular_target
+    from ..records.storage import atomic_write_bytes
+
+    try:
+        beside.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the output folder {beside}: {exc.strerror or exc}") from None
+    kept = beside / f"{path.stem}.fit.json"
+    check_regular_target(kept)
+    record = {"replay": str(path), "player": player or "", "protocol": session.protocol.name,
+              "seed": session.config.seed, "measure": metric, **fit.as_dict(unit)}
+    try:
+        atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
+    except (OSError, ValueError) as exc:
+        raise UserError(f"cannot write {kept}: {exc}") from None
+    written = [kept]
+    if figures:
+        from ..lab.figures import fit_figure
+
+        figure = beside / f"{path.stem}.fit.png"
+        fit_figure(rows, fit, figure, metric)
+        written.append(figure)
+    return written
 
 
 def _class(args: argparse.Namespace) -> int:
@@ -288,7 +310,7 @@ def _class(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
     csv_path = out / "class_curve.csv"
-    write_class_csv(csv_path, curve)
+    write_class_csv(csv_path, curve, metric)
     written = [csv_path]
     if not args.no_figures:
         from ..lab.figures import class_figure

@@ -66,9 +66,9 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
         "trial": o.plan.index + 1,
         "target_deg": o.plan.target_deg,
         "perturbation": perturbation_label(o),
-        "reaction_time": m.reaction_time,
-        "movement_time": m.movement_time,
-        "peak_speed": m.peak_speed,
+        "reaction_time_s": m.reaction_time_s,
+        "movement_time_s": m.movement_time_s,
+        "peak_speed_m_per_s": m.peak_speed_m_per_s,
         "initial_direction_error_deg": m.initial_direction_error_deg,
         "max_perpendicular_error_m": m.max_perpendicular_error_m,
         "path_length_ratio": m.path_length_ratio,
@@ -243,12 +243,22 @@ class LearningCurve:
     after_effect: tuple[int, float] | None  # the first measured washout trial after a perturbed block
 
 
+def display_unit(metric: str) -> tuple[float, str]:
+    """The factor from a measure's SI unit (its column's) to the unit every screen and figure shows, and
+    that unit: one unit for distances a student reads, cm, wherever they read it."""
+    for suffix, shown in (("_m_per_s", (1.0, "m/s")), ("_m", (100.0, "cm")), ("_s", (1000.0, "ms")),
+                          ("_deg", (1.0, "deg"))):
+        if metric.endswith(suffix):
+            return shown
+    return 1.0, ""  # a ratio or an index
+
+
 def learning_curve(rows: Sequence[Mapping[str, object]], metric: str) -> LearningCurve:
     """The learning curve of a run's trial rows (``trial_rows``), in cm or degrees."""
     from .figures import blocks_of
 
-    scale, label, unit = (100.0, "perpendicular error", "cm") if metric == "max_perpendicular_error_m" \
-        else (1.0, "initial direction error", "deg")
+    scale, unit = display_unit(metric)
+    label = "perpendicular error" if metric == "max_perpendicular_error_m" else "initial direction error"
     spans = blocks_of(rows) if rows else []
     points, blocks = [], []
     unperturbed = spans[0]["perturbation"] if spans else "none"

@@ -35,11 +35,11 @@ FONT = {"font.size": 15, "axes.titlesize": 18, "axes.labelsize": 16, "xtick.labe
 #: How each measure is labelled, and the factor from its stored unit to the unit shown.
 MEASURES: dict[str, tuple[str, float]] = {
     "initial_direction_error_deg": ("initial direction error (deg, + = counter-clockwise)", 1.0),
-    "max_perpendicular_error_m": ("maximum perpendicular error (mm, + = left)", 1000.0),
+    "max_perpendicular_error_m": ("maximum perpendicular error (cm, + = left)", 100.0),
     "path_length_ratio": ("path length / straight distance", 1.0),
-    "peak_speed": ("peak speed (m/s)", 1.0),
-    "reaction_time": ("reaction time (ms)", 1000.0),
-    "movement_time": ("movement time (ms)", 1000.0),
+    "peak_speed_m_per_s": ("peak speed (m/s)", 1.0),
+    "reaction_time_s": ("reaction time (ms)", 1000.0),
+    "movement_time_s": ("movement time (ms)", 1000.0),
 }
 assert set(MEASURES) == set(METRIC_COLUMNS)
 

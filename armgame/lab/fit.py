@@ -55,14 +55,40 @@ class TwoRateFit:
     predicted: np.ndarray
     estimate: np.ndarray
 
-    def lines(self) -> list[str]:
-        """The fit as printed: one line per parameter, then the residual."""
+    def lines(self, unit: str = "", scale: float = 1.0) -> list[str]:
+        """The fit as printed: one line per parameter, then the residual; the gain and the residual in
+        ``unit``, ``scale`` times the data's own (a student reads cm, the data is in m)."""
         out = []
-        for name in (*PARAMETER_NAMES, *(("gain",) if "gain" in self.values else ())):
+        for name in PARAMETER_NAMES:
             low, high = self.intervals[name]
             out.append(f"  {SYMBOLS[name]} = {self.values[name]:.4g}  (95% CI {low:.4g} to {high:.4g})")
-        out.append(f"  residual: rms {self.rms:.4g} over {self.n} trials, R^2 = {self.r_squared:.3f}")
+        per = f" {unit}" if unit else ""
+        if "gain" in self.values:
+            low, high = (scale * v for v in self.intervals["gain"])
+            out.append(f"  k = {scale * self.values['gain']:.4g}{per} per unit of field  (95% CI {low:.4g} to "
+                       f"{high:.4g})")
+        out.append(f"  residual: rms {scale * self.rms:.4g}{per} over {self.n} trials, R^2 = {self.r_squared:.3f}")
         return out
+
+    def as_dict(self, unit: str) -> dict[str, object]:
+        """The fit as a file keeps it: each parameter's value and 95% interval, the residual and R^2, in the
+        data's own ``unit`` (SI: m, deg, or "" for the adaptation index)."""
+        names = (*PARAMETER_NAMES, *(("gain",) if "gain" in self.values else ()))
+
+        def number(v: float) -> float | None:  # JSON has no NaN: an undefined value is null
+            return float(v) if math.isfinite(v) else None
+
+        return {
+            "fitted_to": self.observed_kind,
+            "trials": self.n,
+            "parameters": {SYMBOLS[name]: {"value": number(self.values[name]),
+                                           "ci95_low": number(self.intervals[name][0]),
+                                           "ci95_high": number(self.intervals[name][1])} for name in names},
+            **({"gain_unit": f"{unit} per unit of field"} if "gain" in self.values else {}),
+            "residual_rms": number(self.rms),
+            "residual_unit": unit,
+            "r_squared": number(self.r_squared),
+        }
 
 
 def _parameters(theta: np.ndarray) -> tuple[float, float, float, float]:

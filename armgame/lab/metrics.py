@@ -91,9 +91,9 @@ class Reach:
 class ReachMetrics:
     """The measures of one reach (definitions in the module docstring); NaN where undefined."""
 
-    reaction_time: float
-    movement_time: float
-    peak_speed: float
+    reaction_time_s: float
+    movement_time_s: float
+    peak_speed_m_per_s: float
     initial_direction_error_deg: float
     max_perpendicular_error_m: float
     path_length_ratio: float
@@ -167,7 +167,7 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
     >>> s = np.clip((t - 0.3) / T, 0.0, 1.0)
     >>> x = D * (10 * s**3 - 15 * s**4 + 6 * s**5)
     >>> m = reach_metrics(Reach(t, np.stack([x, 0 * x], axis=1), (0.0, 0.0), (D, 0.0), 0.2, True))
-    >>> round(m.peak_speed / (D / T), 4), round(m.path_length_ratio, 6), m.max_perpendicular_error_m
+    >>> round(m.peak_speed_m_per_s / (D / T), 4), round(m.path_length_ratio, 6), m.max_perpendicular_error_m
     (1.875, 1.0, 0.0)
     """
     if not 0.0 < threshold < 1.0:
@@ -199,10 +199,10 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
     step = (t[-1] - t[0]) / (t.size - 1)  # the step is uniform: one spacing keeps a still hand at exactly 0
     speed = np.hypot(*np.gradient(hand, step, axis=0).T)
     peak = int(after_go[np.argmax(speed[after_go])])
-    peak_speed = float(speed[peak])
-    if not peak_speed >= min_peak_speed or peak_speed == 0.0:
-        return ReachMetrics(NAN, NAN, peak_speed, NAN, NAN, NAN)
-    level = threshold * peak_speed
+    peak_speed_m_per_s = float(speed[peak])
+    if not peak_speed_m_per_s >= min_peak_speed or peak_speed_m_per_s == 0.0:
+        return ReachMetrics(NAN, NAN, peak_speed_m_per_s, NAN, NAN, NAN)
+    level = threshold * peak_speed_m_per_s
 
     below = np.flatnonzero(speed[:peak] < level)
     if below.size:  # the speed rises through the level between samples i and i + 1
@@ -253,9 +253,9 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
         deviation = direction = NAN
 
     return ReachMetrics(
-        reaction_time=float(t_on - go),
-        movement_time=float(t_end - t_on),
-        peak_speed=peak_speed,
+        reaction_time_s=float(t_on - go),
+        movement_time_s=float(t_end - t_on),
+        peak_speed_m_per_s=peak_speed_m_per_s,
         initial_direction_error_deg=float(direction),
         max_perpendicular_error_m=deviation,
         path_length_ratio=ratio,
@@ -267,14 +267,17 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
 #: The error-clamp columns, empty on other trials; a table without them (written before they existed)
 #: still reads, with them empty.
 CHANNEL_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ChannelMeasures))
-TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time",
-                                  "movement_time", "peak_speed", "initial_direction_error_deg",
+TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time_s",
+                                  "movement_time_s", "peak_speed_m_per_s", "initial_direction_error_deg",
                                   "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS)
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
 _TEXT_COLUMNS = ("block", "perturbation")
 #: Whose run a row is, in a table of several runs (``armgame analyze A.json B.json --out all.csv``).
 LABEL_COLUMNS: tuple[str, ...] = ("player", "replay")
-_NONNEGATIVE = ("movement_time", "peak_speed", "path_length_ratio")
+_NONNEGATIVE = ("movement_time_s", "peak_speed_m_per_s", "path_length_ratio")
+#: Columns named before every column named its unit: a table written then reads under the new names.
+RENAMED_COLUMNS = {"reaction_time": "reaction_time_s", "movement_time": "movement_time_s",
+                   "peak_speed": "peak_speed_m_per_s"}
 MAX_TRIALS_BYTES = 16 * 1024 * 1024
 MAX_TEXT = 64
 MAX_TRIAL = 1_000_000
@@ -317,7 +320,8 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
     with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``CHANNEL_COLUMNS``
     may be absent, as in tables written before error-clamp trials existed, and read as NaN;
-    ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned). Each row is
+    ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned; the old names of
+    ``RENAMED_COLUMNS``, before each column named its unit, read as the new ones). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a
     whole number from 0 to 1,000,000, ``target_deg`` a finite number, each measure a finite number
     or empty (read as NaN; times may be negative, speed, movement time and ratio may not), ``hit``
@@ -337,7 +341,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
         header = next(reader, None)
         if header is None:
             raise TrialsFileError(f"{path}: empty, expected a header naming {', '.join(TRIAL_COLUMNS)}")
-        header = [name.strip() for name in header]
+        header = [RENAMED_COLUMNS.get(name.strip(), name.strip()) for name in header]
         if len(set(header)) != len(header):
             raise TrialsFileError(f"{path}: line 1: a column is named twice")
         missing = [name for name in TRIAL_COLUMNS if name not in header and name not in CHANNEL_COLUMNS]
@@ -364,22 +368,29 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
     return rows
 
 
-CLASS_COLUMNS: tuple[str, ...] = ("trial", "block", "perturbation", "mean", "sem", "n")
+def class_columns(metric: str) -> tuple[str, ...]:
+    """A class curve's columns: the mean and s.e.m. name the measure and its unit (``mean_<metric>``, in the
+    measure's SI unit, as in ``trials.csv``), so the file says what it holds."""
+    return ("trial", "block", "perturbation", f"mean_{metric}", f"sem_{metric}", "n")
 
 
-def write_class_csv(path: Path, curve: Iterable[Mapping[str, object]]) -> None:
-    """Write a class curve (``figures.class_curve``): one row per trial, ``CLASS_COLUMNS``, atomically.
+def write_class_csv(path: Path, curve: Iterable[Mapping[str, object]], metric: str) -> None:
+    """Write a class curve (``figures.class_curve`` of ``metric``): one row per trial, ``class_columns(metric)``,
+    atomically.
 
-    ``mean`` and ``sem`` are in the measure's own unit; NaN (no data, or fewer than two students)
-    is an empty field. Same file rules as ``write_trials_csv``.
+    The mean and s.e.m. are in the measure's own (SI) unit, as ``trials.csv`` has it; NaN (no data, or
+    fewer than two students) is an empty field. Same file rules as ``write_trials_csv``.
     """
+    if metric not in METRIC_COLUMNS:
+        raise ValueError(f"no such measure {metric!r}")
     path = Path(path)
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(CLASS_COLUMNS)
+    writer.writerow(class_columns(metric))
+    fields_ = {"trial", "block", "perturbation", "mean", "sem", "n"}
     for n, row in enumerate(curve, start=1):
-        if set(row) != set(CLASS_COLUMNS):
-            raise ValueError(f"class curve row {n} must have exactly the fields {', '.join(CLASS_COLUMNS)}")
+        if set(row) != fields_:
+            raise ValueError(f"class curve row {n} must have exactly the fields {', '.join(sorted(fields_))}")
         writer.writerow([_format("trial", row["trial"], n), _format("block", row["block"], n),
                          _format("perturbation", row["perturbation"], n), _format("mean", row["mean"], n),
                          _format("sem", row["sem"], n), _format("trial", row["n"], n)])
