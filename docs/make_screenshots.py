@@ -79,23 +79,23 @@ def lab_frame(out: Path) -> Path:
 
 
 def lab_end_frame(out: Path) -> Path:
-    """The lab window's last screen: the learning curve of a shortened curl run by the adapting bot."""
-    from dataclasses import replace
-
+    """The lab window's last screen: the lesson's learning curve, by the adapting bot (a volunteer's run,
+    kept with --record volunteers/v1.json, looks the same)."""
+    from armgame.commands.lab import kept_lines
     from armgame.lab.analysis import figure_metric, learning_curve, trial_rows
     from armgame.ui.lab_panels import draw_end
 
-    curl = preset("curl")
-    protocol = replace(curl, blocks=tuple(replace(b, trials=n) for b, n in zip(curl.blocks, (8, 32, 16), strict=True)))
+    protocol = preset("lesson")
     session = LabSession(lab_config(protocol, 10), protocol)
     Autopilot(session, make_lab_bot("adaptive")).play()
     renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
     surface = pygame.Surface(DRAW_SIZE)
     curve = learning_curve(trial_rows(session), figure_metric(protocol))
-    kept = ("Kept in ~/.local/share/armgame/lab/2026-11-23_101500_curl:", "   replay.json   trials.csv   "
-            "learning.png   paths.png")
-    draw_end(renderer, surface, f"curl (shortened): {len(session.outcomes)} trials, {session.result().hits} hits",
-             curve, kept, ("Esc quit",))
+    folder = Path.home() / ".local/share/armgame/lab/2026-11-25_104500_lesson"  # shown as ~/ on any machine
+    kept = kept_lines([Path.home() / "class/volunteers/v1.json", folder / "trials.csv",
+                       folder / "learning.png", folder / "paths.png"])
+    draw_end(renderer, surface, f"lesson: {len(session.outcomes)} trials, {session.result().hits} hits", curve,
+             kept, ("r run again", "Esc quit"))
     return _save(surface, out / "lab_end.png")
 
 

@@ -63,7 +63,7 @@ def test_presets_round_trip_through_plain_data(name):
         assert p.blocks[1].perturbation == Perturbation.make("curl", b=CURL_B)
         return
     assert [b.name for b in p.blocks] == ["baseline", "exposure", "washout"]
-    assert p.blocks[1].perturbation.kind == ("none" if name == "null" else name)
+    assert p.blocks[1].perturbation.kind == {"null": "none", "lesson": "curl"}.get(name, name)
 
 
 def test_toml_protocol_file(tmp_path):

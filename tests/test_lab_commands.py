@@ -162,7 +162,7 @@ def test_class_curve_merges_verified_students(short_class, tmp_path, capsys):
     assert code == 1, captured.err
     assert "cheat.json: DIFFERS" in captured.err and "game.json: a game, not a lab run" in captured.err
     lines = (tmp_path / "curve" / "class_curve.csv").read_text().splitlines()
-    assert lines[0] == "trial,block,perturbation,mean,sem,n"
+    assert lines[0] == "trial,block,perturbation,mean_max_perpendicular_error_m,sem_max_perpendicular_error_m,n"
     assert "class curve of 3 students (2 left out), 16 trials, max_perpendicular_error_m" in captured.out
     assert len(lines) == 17 and all(line.endswith(",3") for line in lines[1:])
     # The mean is the mean over the three students' own tables.
@@ -189,6 +189,8 @@ def test_class_curve_merges_verified_students(short_class, tmp_path, capsys):
     (["lab", "curl", "--headless", "--bot", "model", "--record", "~nosuchuser/r.json"], "no such user"),
     (["lab", "curl", "--headless", "--bot", "model", "--out", "~nosuchuser/run"], "no such user"),
     (["analyze", "--out", "x.csv"], "no replay given"),
+    (["lab", "lesson", "--speed", "2"], "--speed sets a bot's run in the window"),
+    (["lab", "lesson", "--bot", "adaptive", "--headless", "--speed", "4"], "--headless runs as fast as it can"),
 ])
 def test_command_errors_are_one_line(argv, message, capsys, monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
@@ -248,7 +250,19 @@ def test_channel_trials_end_to_end(tmp_path, capsys):
     assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "fit"), "--fit", "two-rate"]) == 0
     out = capsys.readouterr().out
     assert "two-rate fit to max_perpendicular_error_m (14 trials)" in out and "A_s = " in out and "R^2" in out
+    assert " cm over 14 trials" in out and " cm per unit of field" in out  # a student reads cm
     assert (tmp_path / "fit" / "run.fit.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # Beside the figure, the fit as a file: each rate with its interval, the residual in the data's unit, R^2.
+    kept = json.loads((tmp_path / "fit" / "run.fit.json").read_text())
+    assert kept["measure"] == "max_perpendicular_error_m" and kept["trials"] == 14 and kept["residual_unit"] == "m"
+    assert set(kept["parameters"]) == {"A_f", "A_s", "B_f", "B_s", "k"} and kept["gain_unit"] == "m per unit of field"
+    a_s = kept["parameters"]["A_s"]
+    assert f"A_s = {a_s['value']:.4g}  (95% CI {a_s['ci95_low']:.4g} to {a_s['ci95_high']:.4g})" in out
+    assert f"rms {100 * kept['residual_rms']:.4g} cm" in out and f"R^2 = {kept['r_squared']:.3f}" in out
+    # Without --out the fit is printed, and nothing is written.
+    before = sorted(tmp_path.rglob("*"))
+    assert main(["analyze", str(tmp_path / "run.json"), "--fit", "two-rate"]) == 0
+    assert f"A_s = {a_s['value']:.4g}" in capsys.readouterr().out and sorted(tmp_path.rglob("*")) == before
     # 5 channel trials cannot pin four rates: one line saying so, the replay left out.
     assert main(["analyze", str(tmp_path / "run.json"), "--out", str(tmp_path / "fit"), "--fit", "two-rate",
                  "--fit-on", "index", "--no-figures", "--force"]) == 2

@@ -3,6 +3,7 @@ session says, and a bot in the window plays the same trials as headless."""
 
 import json
 import os
+from pathlib import Path
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 os.environ["SDL_AUDIODRIVER"] = "dummy"
@@ -197,7 +198,7 @@ def test_cards_and_paths_stop_the_window_clock_but_never_change_the_trials(scree
             key(pygame.K_SPACE)
         win.frame(0.05)
         frames += 1
-    assert session.finished and block_card == "Block 2 of 2: exposure"
+    assert session.finished and block_card == "Block 2 of 2: keep reaching"
     headless = LabSession(lab_config(PROTOCOL, 3), PROTOCOL)
     headless.play(session.timeline, session.steps)
     assert headless.trial_records() == session.trial_records() and headless.state == session.state
@@ -268,3 +269,161 @@ def test_lab_replay_keys_move_by_trials_and_change_speed(screen):
         key(pygame.K_RIGHT)
         win.frame(0.0)
     assert win.session.trial_records() == recorded.trial_records() and win.curve is not None
+
+
+def bot_window(screen, protocol, seed=4, **options):
+    session = LabSession(lab_config(protocol, seed), protocol)
+    driver = RealTimeDriver(Autopilot(session, make_lab_bot("model")))
+    return LabWindow(session, screen, clock=FakeClock(), fps=0, driver=driver, mode="AUTOPILOT: model", **options)
+
+
+def test_the_last_screen_closes_only_on_esc_or_runs_again_on_r(screen):
+    """Volunteers press space all run long to pass the cards: one press too many must not close the curve."""
+    win = bot_window(screen, THREE)
+    for _ in range(400):
+        if win.ended:
+            break
+        win.frame(0.1)
+    assert win.ended and win.curve is not None
+    assert win.help_items() == ("r run again", "Esc quit")
+    for k in (pygame.K_SPACE, pygame.K_RETURN, pygame.K_KP_ENTER):
+        key(k)
+        win.frame(2.0)
+    assert win.running and not win.play_again
+    from armgame.ui.lab_panels import draw_end
+
+    texts = [t for t, _ in draw_end(win.renderer, win.screen, win.summary, win.curve, win.saved, win.help_items())]
+    assert "r run again    Esc quit" in texts
+    key(pygame.K_r)
+    win.frame(0.1)
+    assert win.play_again and not win.running
+
+
+def spoken(win):
+    """Every text the renderer draws in the next frame."""
+    said = []
+    text = win.renderer.text
+
+    def spy(words, *args, **kwargs):
+        said.append(words)
+        return text(words, *args, **kwargs)
+
+    win.renderer.text = spy
+    win.frame(0.0)
+    win.renderer.text = text
+    return said
+
+
+def test_the_header_names_the_block_of_the_reach_on_screen(screen):
+    """The last exposure reach's path is shown as the washout's first trial waits: the header still says
+    exposure, the trial shown."""
+    win = bot_window(screen, THREE)
+    for _ in range(400):
+        if win.feedback is not None and win.feedback.outcome.plan.index == 3:
+            break
+        win.frame(0.05)
+    assert win.session.block.name == "washout" and win.feedback.outcome.plan.block_name == "exposure"
+    said = spoken(win)
+    assert "Trial 4 of 6  -  exposure" in said and not any(t.startswith("Trial") and "washout" in t for t in said)
+    assert "Keep reaching." in said  # the instruction of the block shown, not the next one's
+
+
+def test_the_cards_say_what_to_do_never_what_will_happen(screen):
+    from armgame.lab.protocol import DEFAULT_INSTRUCTIONS, preset
+
+    lesson = preset("lesson")
+    assert [b.trials for b in lesson.blocks] == [4, 16, 4] and lesson.targets == 4
+    short = Protocol("lesson", tuple(Block(b.name, 1, b.perturbation, 0, DEFAULT_INSTRUCTIONS[b.name])
+                                     for b in lesson.blocks), targets=4)
+    win = bot_window(screen, short)
+    cards = []
+    for _ in range(400):
+        if win.card is not None and (not cards or cards[-1] is not win.card):
+            cards.append(win.card)
+        if win.ended:
+            break
+        win.frame(0.1)
+    assert [c.title for c in cards] == ["The reaching lab", "Block 2 of 3: keep reaching",
+                                        "Block 3 of 3: keep reaching"]
+    words = " ".join(" ".join((c.title, *c.lines)) for c in cards).lower()
+    for telling in ("normal", "chang", "field", "force", "washout", "exposure", "back"):
+        assert telling not in words, telling
+
+
+def test_a_bots_run_has_a_speed_key_and_plays_the_same_trials(screen):
+    headless = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    Autopilot(headless, make_lab_bot("model")).play()
+    frames = {}
+    for speed_ups in (0, 3):
+        win = bot_window(screen, PROTOCOL, seed=2)
+        assert "-/+ speed" in win.help_items()
+        for _ in range(speed_ups):
+            key(pygame.K_PLUS)
+        win.frame(0.0)
+        assert win.speed == 2.0 ** speed_ups
+        assert f"{win.speed:g}x" in spoken(win)
+        n = 0
+        while not win.ended and n < 3000:
+            win.frame(1 / 30)
+            n += 1
+        frames[speed_ups] = n
+        assert win.session.trial_records() == headless.trial_records()  # the same steps, only sooner
+    # 8x: the reaching, the paths and the cards all go 8 times as fast.
+    assert frames[3] < frames[0] / 6
+    person = LabWindow(LabSession(lab_config(PROTOCOL, 2), PROTOCOL), screen, clock=FakeClock(), fps=0)
+    key(pygame.K_PLUS)
+    person.frame(0.0)
+    assert person.speed == 1.0 and "-/+ speed" not in person.help_items()  # a person plays at real speed
+
+
+TINY_TOML = """
+name = "tiny"
+targets = 4
+[[blocks]]
+name = "baseline"
+trials = 1
+[[blocks]]
+name = "exposure"
+trials = 1
+perturbation = "curl"
+b = 2.0
+"""
+
+
+def test_r_runs_again_in_the_same_window_and_each_file_is_listed_where_it_is(tmp_path, monkeypatch, capsys):
+    """armgame lab --record volunteers/v1.json: the last screen lists the replay under its own folder, the
+    run's folder with what is in it; r runs again into v1_2.json and a folder of its own; Esc then quits."""
+    from armgame.cli import main
+    from armgame.commands.lab import kept_lines
+
+    screens = []
+
+    def play_to_the_end(self, max_frames=None):
+        for _ in range(500):
+            if self.ended:
+                break
+            self.frame(0.1)
+        screens.append((self.saved, self.screen))
+        key(pygame.K_r if len(screens) == 1 else pygame.K_ESCAPE)
+        self.frame(0.1)
+        assert not self.running
+        return self.session
+
+    monkeypatch.setattr(LabWindow, "run", play_to_the_end)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "volunteers").mkdir()
+    (tmp_path / "tiny.toml").write_text(TINY_TOML)
+    assert main(["lab", "tiny.toml", "--bot", "model", "--record", "volunteers/v1.json", "--size", "640x480",
+                 "--no-figures", "--speed", "8"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("lab tiny: 2 of 2 trials") == 2
+    runs = sorted((tmp_path / "data" / "armgame" / "lab").glob("*_tiny*"))
+    assert len(runs) == 2 and screens[0][1] is screens[1][1]  # the window stayed open for the second run
+    for (saved, _), replay, folder in zip(screens, ("v1.json", "v1_2.json"), runs, strict=True):
+        assert (tmp_path / "volunteers" / replay).is_file() and (folder / "trials.csv").is_file()
+        assert list(saved) == [f"Kept in {tmp_path / 'volunteers'}:", f"   {replay}", f"Kept in {folder}:",
+                               "   trials.csv"]
+    assert main(["verify", "volunteers/v1_2.json"]) == 0
+    home = Path.home()
+    assert kept_lines([home / "a" / "r.json", home / "a" / "t.csv"]) == ["Kept in ~/a:", "   r.json   t.csv"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from pathlib import Path
 
 from ..errors import UserError
@@ -76,7 +77,28 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     add_window_options(p, sound=False)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
+    p.add_argument("--speed", type=_speed, default=1.0, metavar="X",
+                   help=f"a bot's run in the window starts at this speed ({_speeds()}; - and + change it as it "
+                   "runs; default 1)")
     p.set_defaults(run=run, without_window=without_window)
+
+
+def _speeds() -> str:
+    from ..ui.playback import REPLAY_SPEEDS
+
+    return ", ".join(f"{s:g}" for s in REPLAY_SPEEDS)
+
+
+def _speed(text: str) -> float:
+    from ..ui.playback import REPLAY_SPEEDS
+
+    try:
+        value = float(text.rstrip("xX"))
+    except ValueError:
+        value = math.nan
+    if value not in REPLAY_SPEEDS:
+        raise argparse.ArgumentTypeError(f"must be one of {_speeds()}, got {text!r}")
+    return value
 
 
 def load_protocol_argument(text: str):
@@ -114,6 +136,9 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--retention and --learning set the adaptive bot's learner: add --bot adaptive")
     if args.no_figures and not args.out and args.headless:
         raise UserError("--no-figures applies with --out only (or to the run a window keeps)")
+    if args.speed != 1.0 and not (args.bot and not args.headless):
+        raise UserError("--speed sets a bot's run in the window (--bot, no --headless): a person plays at real "
+                        "speed, and --headless runs as fast as it can")
     _check_outputs(args)
     from .classroom import join_class
 
@@ -121,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys)),
                               str(args.protocol))
     session = LabSession(config, protocol)
-    bot = None
+    bot, rates = None, None
     if args.bot:
         defaults = LearningRates()
         rates = LearningRates(*(args.retention or (defaults.retention_fast, defaults.retention_slow)),
@@ -138,18 +163,28 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if not 1 <= args.fps <= 1000:
         raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
-    keeper = RunKeeper(args)
-    _play_in_window(session, bot, args, keeper)
-    _report(session, args)
-    played = session.steps > 0 and (bot is not None or bool(session.timeline))
-    if not keeper.kept and played and (session.outcomes or args.record or args.out):
-        keeper(session)  # quit before the end: what was done is kept all the same
-    elif not keeper.kept and not played:  # Esc at the first card: no empty run to mistake for a volunteer's
-        print("nothing was played: nothing kept")
-    for line in keeper.lines:
-        print(line)
-    if keeper.error is not None:
-        raise keeper.error
+
+    def new_run(number: int):
+        """Run ``number`` of this window (r on the last screen starts the next): the same protocol, seed,
+        player and bot, kept apart from the one before."""
+        fresh = session if number == 1 else LabSession(config, protocol)
+        player = bot if number == 1 else make_lab_bot(args.bot, rates if args.bot == "adaptive" else None) \
+            if args.bot else None
+        return fresh, player, RunKeeper(args, number)
+
+    def end_run(done, keeper: RunKeeper) -> None:
+        _report(done, args)
+        played = done.steps > 0 and (args.bot is not None or bool(done.timeline))
+        if not keeper.kept and played and (done.outcomes or args.record or args.out):
+            keeper(done)  # quit before the end: what was done is kept all the same
+        elif not keeper.kept and not played:  # Esc at the first card: no empty run to mistake for a volunteer's
+            print("nothing was played: nothing kept")
+        for line in keeper.lines:
+            print(line)
+        if keeper.error is not None:
+            raise keeper.error
+
+    _play_in_window(args, new_run, end_run)
     return 0
 
 
@@ -181,8 +216,11 @@ class RunKeeper:
     """Keeps a window run (the replay, trials.csv and, with matplotlib, the figures), once; the window calls
     it at the end to name where on its last screen, the command after the window when quit early."""
 
-    def __init__(self, args: argparse.Namespace) -> None:
+    def __init__(self, args: argparse.Namespace, run: int = 1) -> None:
         self.args = args
+        #: The window's run again (r) makes run 2, 3, ...: its --record and --out get that number, so no run
+        #: overwrites the one before.
+        self.run = run
         self.kept = False
         self.lines: list[str] = []
         self.error: UserError | None = None
@@ -198,8 +236,9 @@ class RunKeeper:
                     folder.mkdir(parents=True)
                 except OSError as exc:
                     raise UserError(f"cannot create {folder}: {exc.strerror or exc}") from None
+            # A second run (r) goes beside the first: --record numbers its replays itself, --out is numbered here.
             record = args.record or RecordTarget(folder / "replay.json", folder=False)
-            out = args.out or folder
+            out = _numbered(args.out, self.run) or folder
             figures = not args.no_figures
             if figures and not args.out:
                 try:
@@ -214,8 +253,7 @@ class RunKeeper:
         self.lines = [f"replay saved to {path}" if path.suffix == ".json" else f"wrote {path}" for path in written]
         if args.membership is not None:
             self.lines.append(_hand_in(session, args))
-        shown = [f"Kept in {_home(folder)}:" if folder is not None else "Kept:"] + \
-            [f"   {path.name if path.parent == folder else _home(path)}" for path in written]
+        shown = kept_lines(written)
         if folder is not None and not figures and not args.no_figures:
             shown.append("   (figures need matplotlib: pip install 'armgame[plot]')")
         if args.membership is not None:
@@ -225,6 +263,32 @@ class RunKeeper:
 
 #: What a run writes in --out (adaptation.png only with channel trials): refused before the run if there.
 OUT_FILES = ("trials.csv", "learning.png", "paths.png", "adaptation.png")
+
+
+def _numbered(path: Path | None, run: int) -> Path | None:
+    """``path`` for the window's run number ``run``: itself for the first, ``DIR-2`` (the first such name not
+    yet taken, as --record numbers a window's replays) for the next."""
+    if path is None or run == 1:
+        return path
+    n = run
+    while True:
+        numbered = path.with_name(f"{path.name}-{n}")
+        if not numbered.exists():
+            return numbered
+        n += 1
+
+
+def kept_lines(written: list[Path]) -> list[str]:
+    """Where a run was kept, as its last screen says it: each folder once (absolute, home as ~), then the
+    files kept in it on one line, so a replay --record put elsewhere is never listed in the run's folder."""
+    folders: dict[Path, list[str]] = {}
+    for path in written:
+        path = Path(os.path.abspath(path))
+        folders.setdefault(path.parent, []).append(path.name)
+    lines: list[str] = []
+    for folder, names in folders.items():
+        lines += [f"Kept in {_home(folder)}:", "   " + "   ".join(names)]
+    return lines
 
 
 def _check_outputs(args: argparse.Namespace) -> None:
@@ -330,7 +394,10 @@ def _cm(value: object) -> str:
     return "n/a" if not math.isfinite(v) else f"{100.0 * v:+.2f} cm"
 
 
-def _play_in_window(session, bot, args: argparse.Namespace, keeper: RunKeeper) -> None:
+def _play_in_window(args: argparse.Namespace, new_run, end_run) -> None:
+    """Runs in one window until its last screen is closed with Esc: ``new_run(n)`` gives run n's session, bot
+    and keeper; ``end_run`` reports and keeps each, between runs, the window staying open (a projector's
+    full screen is not lost to r)."""
     from ..errors import NoDisplayError
 
     try:
@@ -340,12 +407,6 @@ def _play_in_window(session, bot, args: argparse.Namespace, keeper: RunKeeper) -
         from ..ui.lab_window import LabWindow
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
-    driver = None
-    if bot is not None:
-        from ..game.bots import Autopilot
-        from ..game.session import RealTimeDriver
-
-        driver = RealTimeDriver(Autopilot(session, bot))  # type: ignore[arg-type]
     try:
         from ..ui.options import window_settings
 
@@ -354,9 +415,25 @@ def _play_in_window(session, bot, args: argparse.Namespace, keeper: RunKeeper) -
     except pygame.error as exc:
         raise NoDisplayError(f"cannot open a window ({exc})") from None
     try:
-        LabWindow(session, screen, fps=args.fps, driver=driver,
-                  mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}", on_finish=keeper,
-                  palette=settings.palette, text_scale=settings.text_scale).run()
+        number = 1
+        while True:
+            session, bot, keeper = new_run(number)
+            driver = None
+            if bot is not None:
+                from ..game.bots import Autopilot
+                from ..game.session import RealTimeDriver
+
+                driver = RealTimeDriver(Autopilot(session, bot))  # type: ignore[arg-type]
+            window = LabWindow(session, screen, fps=args.fps, driver=driver,
+                               mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}", on_finish=keeper,
+                               palette=settings.palette, text_scale=settings.text_scale)
+            window.speed = args.speed
+            window.run()
+            end_run(window.session, keeper)
+            if not window.play_again:
+                return
+            screen = pygame.display.get_surface() or window.screen
+            number += 1
     finally:
         pygame.display.quit()
 

@@ -24,6 +24,7 @@ LAB_PRESETS = {
     "rotation": "the cursor turned 30 degrees from the hand",
     "mirror": "the cursor mirrored left to right",
     "jointspace": "the cursor driven by the joint angles, not the hand",
+    "lesson": "the class's two minutes: the curl field, 24 reaches",
 }
 
 

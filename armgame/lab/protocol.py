@@ -180,10 +180,12 @@ class Block:
         return self.channel_trials == self.trials
 
 
+#: What a block's card asks, by block name. What to do, never what will happen ("something has changed",
+#: "back to normal"): a volunteer told the field is gone stops expecting it, and the after-effect shrinks.
 DEFAULT_INSTRUCTIONS = {
     "baseline": "Reach straight to each target as soon as it appears, and hold it.",
-    "exposure": "Something has changed: keep reaching straight to each target, and hold it.",
-    "washout": "Back to normal: keep reaching straight to each target, and hold it.",
+    "exposure": "Keep reaching straight to each target, and hold it.",
+    "washout": "Keep reaching straight to each target, and hold it.",
     "clamp": "Keep reaching straight to each target, and hold it.",
 }
 
@@ -273,8 +275,25 @@ def _blocks(exposure: Perturbation, baseline: int = 16, exposure_trials: int = 8
     )
 
 
+#: The lesson's preset: blocks of 4, 16 and 4 reaches to 4 targets in the curl field. About two minutes at
+#: the keys (each reach is 0.5 to 1 s at home, the reach, 0.2 s on the target and 1.2 s of its path shown:
+#: 3.5 to 5 s for a person, at most 5 s when every reach times out), so two volunteers and the bot fit
+#: the lesson's 12 minutes; 16 exposure reaches leave the adapting bot a clear after-effect (+1.0 to +1.4 cm
+#: on the first washout reach against +0.1 cm in baseline, seeds 10, 1 and 2).
+LESSON_BLOCKS = (4, 16, 4)
+
+
+def lesson() -> Protocol:
+    """The 50-minute lesson's lab (docs/teaching.md): a short curl-field experiment for volunteers."""
+    baseline, exposure, washout = LESSON_BLOCKS
+    return Protocol("lesson", _blocks(Perturbation.make("curl", b=CURL_B), baseline, exposure, washout), targets=4)
+
+
 def preset(name: str) -> Protocol:
-    """A named protocol: ``null``, ``curl``, ``rotation``, ``mirror`` or ``jointspace``."""
+    """A named protocol: ``lesson``, ``null``, ``curl``, ``rotation``, ``mirror``, ``jointspace``, ``viscous``,
+    ``savings`` or ``spontaneous``."""
+    if name == "lesson":
+        return lesson()
     if name == "null":
         return Protocol("null", _blocks(NONE))
     if name == "curl":
@@ -295,7 +314,7 @@ def preset(name: str) -> Protocol:
     raise UserError(unknown_name("lab preset", name, PRESETS, "or give a .toml file"))
 
 
-PRESETS = ("null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous")
+PRESETS = ("lesson", "null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous")
 
 
 def savings(counter: int = SAVINGS_COUNTER) -> Protocol:

@@ -45,6 +45,8 @@ FEEDBACK_SECONDS = 1.2
 #: A bot's cards go on by themselves after this long (a person's wait for space).
 BOT_CARD_SECONDS = 2.5
 START_KEYS = ("space", "return", "enter")
+#: On the last screen: another run (a replay: watched again). Esc alone quits.
+RUN_AGAIN = "r"
 
 
 @dataclass
@@ -155,9 +157,10 @@ class LabRenderer(GameRenderer):
         total = len(session.plans)
         feedback = hud.feedback if isinstance(hud, LabHud) else None
         number = total if plan is None else plan.index + 1
-        if feedback is not None:  # still the trial just made
-            number = feedback.outcome.plan.index + 1
         block = session.block
+        if feedback is not None:  # still the trial just made, and its block (the next may be another)
+            number = feedback.outcome.plan.index + 1
+            block = session.protocol.blocks[feedback.outcome.plan.block]
         y = margin
         title = self.text(self.fit_text(f"Trial {number} of {total}  -  {block.name}", big,
                                         screen.get_width() - 2 * margin), big)
@@ -176,10 +179,10 @@ class LabRenderer(GameRenderer):
             seconds = (last.end_step - last.go_step) * session.config.dt
             line, colour = (f"last trial: hit, {seconds:.2f} s", HIT) if last.hit else ("last trial: time out", p.warn)
             screen.blit(self.text(line, small, colour), (margin, y))
-        if hud.progress is not None:
-            shown, _ = hud.progress
-            speed = f"   {hud.speed:g}x" if hud.speed is not None else ""
-            status = self.text(f"{shown:.0f} s{speed}", small)
+        if hud.progress is not None or hud.speed is not None:
+            shown = f"{hud.progress[0]:.0f} s   " if hud.progress is not None else ""
+            speed = f"{hud.speed:g}x" if hud.speed is not None else ""
+            status = self.text(f"{shown}{speed}".strip(), small)
             screen.blit(status, status.get_rect(topright=(screen.get_width() - margin, margin)))
         keys = self.key_labels
         help_text = self.text(self.fit_text(self.help_line(hud), small, screen.get_width() - 2 * margin), small,
@@ -263,6 +266,8 @@ class LabWindow(GameWindow):
         self.watching = isinstance(self.driver, TimelineDriver)
         if not self.watching:
             self.driver.session = TrialGate(self.driver.session, session)  # type: ignore[assignment]
+            # At 8x a frame carries 8 frames' steps: the driver's clamp on a stalled frame must allow them.
+            self.driver.max_frame_time = MAX_FRAME * max(REPLAY_SPEEDS)
         self.on_finish = on_finish
         self.saved: tuple[str, ...] = ()
         self.curve: LearningCurve | None = None
@@ -282,13 +287,14 @@ class LabWindow(GameWindow):
         keys = s.muscles.keys
         blocks = s.protocol.blocks
         first = blocks[0]
+        # What to do, never what will happen: a volunteer told that something changes, or goes back to
+        # normal, reaches differently, and the after-effect the lesson shows shrinks.
         lines = (
             "Hold the cursor (the black dot) in the blue home circle.",
             "Wait for the target; then reach it and hold it there.",
             f"{keys[0]}/{keys[1]} turn the shoulder, {keys[2]}/{keys[3]} the elbow; space brings the hand home.",
-            f"{plural(s.protocol.trials, 'trial')} in {plural(len(blocks), 'block')}: "
-            + ", ".join(b.name for b in blocks) + ".",
-            f"Block 1 of {len(blocks)}: {first.name}. {first.instruction}".strip(),
+            f"{plural(s.protocol.trials, 'trial')} in {plural(len(blocks), 'block')}, a card before each.",
+            f"Block 1 of {len(blocks)}: {first.instruction or 'reach each target and hold it.'}",
         )
         if not self.keyboard:
             who = self.mode.split(":", 1)[-1].strip() or "a bot"
@@ -302,7 +308,7 @@ class LabWindow(GameWindow):
             return None
         block = s.protocol.blocks[plan.block]
         lines = (block.instruction,) if block.instruction else ()
-        return Card(f"Block {plan.block + 1} of {len(s.protocol.blocks)}: {block.name}",
+        return Card(f"Block {plan.block + 1} of {len(s.protocol.blocks)}: keep reaching",
                     (*lines, f"{plural(block.trials, 'trial')}."), self._prompt())
 
     @property
@@ -314,7 +320,7 @@ class LabWindow(GameWindow):
     def help_items(self) -> tuple[str, ...]:
         keys = self.session.muscles.keys
         if self.ended:
-            return ("Esc quit",)
+            return ("r watch again" if self.lab_replay is not None else "r run again", "Esc quit")
         items: list[str] = []
         if self.keyboard:
             items += [f"{keys[0]}/{keys[1]} shoulder", f"{keys[2]}/{keys[3]} elbow", "space home"]
@@ -325,6 +331,8 @@ class LabWindow(GameWindow):
         items.append("p pause")
         if self.lab_replay is not None:
             items += ["-/+ speed", "left/right trial"]
+        elif not self.keyboard:  # a bot's run: as fast as the class needs it
+            items.append("-/+ speed")
         items += ["F11 fullscreen", "Esc quit"]
         return tuple(items)
 
@@ -334,16 +342,38 @@ class LabWindow(GameWindow):
             if self.card is not None and name in START_KEYS:
                 self.card = None
                 return
-            if self.ended and name in START_KEYS:
-                self.running = False
-                return
+            if self.ended:
+                # Only Esc (in GameWindow) closes the last screen: a volunteer presses space all run long
+                # to pass the cards, and one press too many would close the curve the class came to see.
+                if name == RUN_AGAIN:
+                    self._run_again()
+                    return
+                if name in START_KEYS:
+                    return
             if self.lab_replay is not None and self._lab_replay_key(name):
+                return
+            if not self.keyboard and self.lab_replay is None and (speed := speed_after(name, self.speed)) is not None:
+                self.speed = speed  # a bot's run: its steps are the same at any speed, only sooner
                 return
             if self.stopped and name not in ("escape", "f11", "p"):
                 return  # a card or a path on screen: keys are not game input
         elif event.type == pygame.KEYUP and self.stopped:
             return  # the keys were released when the clock stopped
         super().handle(event)
+
+    def _run_again(self) -> None:
+        """r on the last screen: a replay is watched again from its start; a run ends, asking the command
+        for another (``play_again``), which keeps this one first."""
+        if self.lab_replay is None:
+            self.play_again = True
+            self.running = False
+            return
+        self.session, self.driver = self.lab_replay.start(0)  # type: ignore[assignment]
+        self.ended = False
+        self.curve = None
+        self.seen = 0
+        self.feedback = None
+        self.hits.clear()
 
     def _lab_replay_key(self, name: str) -> bool:
         if (speed := speed_after(name, self.speed)) is not None:
@@ -394,7 +424,9 @@ class LabWindow(GameWindow):
             self._stop_the_clock()
 
     def _tick(self, elapsed: float) -> None:
-        """Cards and paths age (in real time; a replay's paths in its own time)."""
+        """Cards and paths age (in real time, sped up with a bot's run; a replay's paths in its own time)."""
+        if not self.keyboard:
+            elapsed *= self.speed
         if self.card is not None:
             self.card.shown_for += elapsed
             if not self.keyboard and self.card.shown_for >= BOT_CARD_SECONDS:
@@ -427,6 +459,8 @@ class LabWindow(GameWindow):
 
     def _lab_hud(self, saving: bool = False) -> LabHud:
         hud = self.hud()
+        if not self.keyboard and hud.speed is None:  # a bot's run or a replay: the speed the keys set
+            hud.speed = self.speed
         saved = ("saving the run ...",) if saving else self.saved
         return LabHud(**{f: getattr(hud, f) for f in Hud.__dataclass_fields__}, card=self.card,
                       feedback=self.feedback, curve=self.curve, summary=self.summary, saved=saved)
