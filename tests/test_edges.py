@@ -132,7 +132,7 @@ def test_a_mistyped_name_gets_the_closest_in_one_line(argv, meant, capsys, tmp_p
 def test_a_name_close_to_nothing_lists_the_choices_only(capsys):
     assert main(["lab", "spiral"]) == 2
     err = capsys.readouterr().err
-    assert "did you mean" not in err and "choose one of null, curl" in err and err.count("\n") == 1
+    assert "did you mean" not in err and "choose one of lesson, null, curl" in err and err.count("\n") == 1
     with pytest.raises(SystemExit):
         main(["xyzzy"])
     err = capsys.readouterr().err
