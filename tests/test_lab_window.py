@@ -392,7 +392,7 @@ b = 2.0
 
 def test_r_runs_again_in_the_same_window_and_each_file_is_listed_where_it_is(tmp_path, monkeypatch, capsys):
     """armgame lab --record volunteers/v1.json: the last screen lists the replay under its own folder, the
-    run's folder with what is in it; r runs again into v1_2.json and a folder of its own; Esc then quits."""
+    run's folder with what is in it; r runs again into v1-2.json and a folder of its own; Esc then quits."""
     from armgame.cli import main
     from armgame.commands.lab import kept_lines
 
@@ -420,10 +420,14 @@ def test_r_runs_again_in_the_same_window_and_each_file_is_listed_where_it_is(tmp
     assert out.count("lab tiny: 2 of 2 trials") == 2
     runs = sorted((tmp_path / "data" / "armgame" / "lab").glob("*_tiny*"))
     assert len(runs) == 2 and screens[0][1] is screens[1][1]  # the window stayed open for the second run
-    for (saved, _), replay, folder in zip(screens, ("v1.json", "v1_2.json"), runs, strict=True):
+    for (saved, _), replay, folder in zip(screens, ("v1.json", "v1-2.json"), runs, strict=True):
         assert (tmp_path / "volunteers" / replay).is_file() and (folder / "trials.csv").is_file()
         assert list(saved) == [f"Kept in {tmp_path / 'volunteers'}:", f"   {replay}", f"Kept in {folder}:",
                                "   trials.csv"]
-    assert main(["verify", "volunteers/v1_2.json"]) == 0
+    assert main(["verify", "volunteers/v1-2.json"]) == 0
+    from armgame.commands.lab import _numbered
+
+    (tmp_path / "run-2").mkdir()
+    assert _numbered(tmp_path / "run", 1) == tmp_path / "run" and _numbered(tmp_path / "run", 2) == tmp_path / "run-3"
     home = Path.home()
     assert kept_lines([home / "a" / "r.json", home / "a" / "t.csv"]) == ["Kept in ~/a:", "   r.json   t.csv"]

@@ -325,7 +325,7 @@ def _class(args: argparse.Namespace) -> int:
 
 def _fresh_outputs(args: argparse.Namespace):
     """``outputs.fresh_outputs`` for every file --out would get: the class curve's, one table, or each
-    replay's table and fit figure (two replays of one name would write one file: refused)."""
+    replay's table and fit (two replays of one name would write one file: refused)."""
     from .outputs import fresh_outputs
 
     if args.out is None:
@@ -346,5 +346,6 @@ def _fresh_outputs(args: argparse.Namespace):
                             "file for one table, or rename one")
         stems[stem] = name
         files += [] if one_table else [out / f"{stem}.trials.csv"]
+        files += [folder / f"{stem}.fit.json"] if args.fit else []
         files += [folder / f"{stem}.fit.png"] if args.fit and figures else []
     return fresh_outputs(files, args.force, folder=folder)
