@@ -15,7 +15,7 @@ import pytest
 
 from armgame.commands import menu as menu_command
 from armgame.ui.menu import MenuWindow, run_menu
-from armgame.ui.render import MIN_TEXT_AT_720
+from armgame.ui.render import MIN_TEXT_AT_720, PALETTES
 
 SIZES = [(640, 480), (1024, 768), (1280, 720), (1920, 1080), (720, 1280)]
 
@@ -141,13 +141,88 @@ def test_settings_toggle_sound_and_colours_in_the_file(tmp_path):
     from armgame.ui.settings import load
 
     page = menu_command.settings_page()
-    assert page.items[0].label == "Sound: on" and page.items[0].detail == "Enter: mute"
-    assert page.items[0].act().startswith("saved to")
+    assert page.items[2].label == "Sound: on" and page.items[2].detail == "Enter: mute"
+    assert page.items[2].act().startswith("saved to")
     assert load()[0].mute
     page = menu_command.settings_page()
-    assert page.items[0].label == "Sound: off" and page.items[0].detail == "Enter: unmute"
+    assert page.items[2].label == "Sound: off" and page.items[2].detail == "Enter: unmute"
     page.items[1].act()
     assert load()[0].palette == menu_command.settings_page().items[1].label.split(": ")[1] != "okabe-ito"
+    assert load()[0].mute  # one change leaves the others as they were
+
+
+def test_the_text_size_goes_up_a_step_at_a_time_and_round_to_the_smallest():
+    from armgame.ui.settings import load
+
+    seen = []
+    for _ in range(len(menu_command.TEXT_SCALES)):
+        page = menu_command.settings_page()
+        assert page.items[0].label == f"Text size: {load()[0].text_scale:g}x"
+        page.items[0].act()
+        seen.append(load()[0].text_scale)
+    assert seen == [1.25, 1.5, 2.0, 2.5, 0.75, 1.0]
+    assert menu_command.next_text_scale(1.3) == 1.5  # a value typed into the file goes to the next step
+
+
+def item_height(menu, size=(1024, 768)):
+    return next(lab.rect.height for lab in menu.layout(size).labels if lab.role == "item")
+
+
+def test_the_settings_page_shows_a_new_text_size_and_palette_at_once():
+    """Enter on Text size and on Colours: saved to the file, and the menu itself is drawn with them at once."""
+    from armgame.ui.settings import load
+
+    pygame.display.init()
+    pygame.font.init()
+    menu = MenuWindow(menu_command.settings_page, looks=lambda: menu_command.looks("okabe-ito", 1.0))
+    before = item_height(menu)
+    menu.choose(0)  # 1.0 -> 1.25
+    menu.choose(0)  # -> 1.5
+    assert load()[0].text_scale == 1.5 and menu.text_scale == 1.5
+    assert item_height(menu) >= 1.45 * before
+    menu.choose(1)  # okabe-ito -> classic
+    menu.choose(1)  # -> high-contrast
+    assert load()[0].palette == "high-contrast" and menu.palette is PALETTES["high-contrast"]
+    menu.screen = pygame.display.set_mode((1024, 768))
+    menu.draw()
+    assert menu.screen.get_at((3, 3))[:3] == PALETTES["high-contrast"].window != PALETTES["okabe-ito"].window
+    assert menu.status.startswith("saved to")
+
+
+def test_the_menu_opens_with_the_settings_files_palette_and_text_size(tmp_path, monkeypatch):
+    seen = {}
+    monkeypatch.setattr("armgame.ui.menu.run_menu", lambda root, **kwargs: seen.update(kwargs))
+    folder = tmp_path / "config" / "armgame"
+    folder.mkdir(parents=True)
+    (folder / "settings.toml").write_text('palette = "high-contrast"\ntext_scale = 1.5\n', encoding="utf-8")
+    assert menu_command.run(None, lambda argv: 0) == 0
+    assert seen["palette"] == "high-contrast" and seen["text_scale"] == 1.5
+    assert seen["looks"]() == ("high-contrast", 1.5)
+    (folder / "settings.toml").write_text('palette = "nope"\n', encoding="utf-8")
+    assert seen["looks"]() == ("high-contrast", 1.5)  # a file gone bad meanwhile: the looks as they were
+
+
+@pytest.mark.parametrize("scale", [1.5, 2.5])
+def test_large_text_grows_one_and_a_half_times_and_every_page_still_fits(scale):
+    pygame.display.init()
+    pygame.font.init()
+    plain = MenuWindow(lambda: menu_command.main_page(lambda argv: 0))
+    large = MenuWindow(lambda: menu_command.main_page(lambda argv: 0), text_scale=scale)
+    assert item_height(large) >= (scale - 0.05) * item_height(plain)
+    for size in SIZES:
+        window = pygame.Rect((0, 0), size)
+        for build in (lambda: menu_command.main_page(lambda argv: 0), menu_command.settings_page,
+                      lambda: menu_command.demos_page(lambda argv: 0)):
+            menu = MenuWindow(build, text_scale=scale)
+            menu.status = "saved to /home/teacher/.config/armgame/settings.toml"
+            lay = menu.layout(size)
+            if build is not menu_command.demos_page and size[1] >= 720 and scale == 1.5:
+                assert len(lay.rows) == len(menu.page.items), (size, menu.page.title)  # nothing scrolled away
+            boxes = lay.boxes()
+            for i, (name, rect) in enumerate(boxes):
+                assert window.contains(rect), (size, name, rect)
+                for other, r in boxes[i + 1:]:
+                    assert not rect.colliderect(r), (size, name, other)
 
 
 def text(value):

@@ -67,8 +67,21 @@ def run(parser: argparse.ArgumentParser, launch: Callable[[Sequence[str]], int])
     from ..ui.options import window_settings
 
     settings, _ = window_settings(argparse.Namespace())
-    run_menu(lambda: main_page(launch), palette=settings.palette, size=settings.size)
+    run_menu(lambda: main_page(launch), palette=settings.palette, size=settings.size,
+             text_scale=settings.text_scale, looks=lambda: looks(settings.palette, settings.text_scale))
     return 0
+
+
+def looks(palette: str, text_scale: float) -> tuple[str, float]:
+    """The settings file's palette and text scale, read again after a change on a page (the Settings
+    page's, or a window's); ``palette`` and ``text_scale`` while the file cannot be used (the page says why)."""
+    from ..ui.settings import SettingsError, load
+
+    try:
+        settings, _ = load()
+    except SettingsError:
+        return palette, text_scale
+    return settings.palette, settings.text_scale
 
 
 def _start(launch: Callable[[Sequence[str]], int], *argv: str) -> Callable[[], str | None]:
@@ -92,7 +105,7 @@ def main_page(launch: Callable[[Sequence[str]], int]):
              page=lambda: lab_page(launch)),
         Item("Demos", "the arm's dynamics, one idea at a time", page=lambda: demos_page(launch)),
         Item("Replays and scores", "the high-score table and the games recorded", page=lambda: replays_page(launch)),
-        Item("Settings", "sound, colours, where the settings file is", page=settings_page),
+        Item("Settings", "text size, colours, sound, where the settings file is", page=settings_page),
         Item("Quit", "close armgame", quit=True),
     ])
 
@@ -219,7 +232,21 @@ def replays_page(launch: Callable[[Sequence[str]], int]):
     return Page("Replays and scores", items, lines=lines)
 
 
+#: The Settings page's text sizes, smallest first: Enter takes the next larger, after the largest the smallest.
+TEXT_SCALES = (0.75, 1.0, 1.25, 1.5, 2.0, 2.5)
+#: What each palette is for, as the Settings page says it.
+PALETTE_USES = {"okabe-ito": "colour-blind safe (the default)", "classic": "the 2012 game's colours",
+                "high-contrast": "black on white, for a bright room"}
+
+
+def next_text_scale(scale: float) -> float:
+    """The next larger of TEXT_SCALES (a value typed into the file between two goes to the larger)."""
+    return next((s for s in TEXT_SCALES if s > scale + 1e-9), TEXT_SCALES[0])
+
+
 def settings_page():
+    """Text size, colours and sound, each changed by Enter, saved to the settings file at once; the
+    menu redraws itself with the new text size and colours (``looks``), so the choice is seen as made."""
     from ..ui.menu import Item, Page
     from ..ui.settings import PALETTES, SettingsError, load, save
 
@@ -241,8 +268,15 @@ def settings_page():
 
     following = PALETTES[(PALETTES.index(settings.palette) + 1) % len(PALETTES)] \
         if settings.palette in PALETTES else PALETTES[0]
+    larger = next_text_scale(settings.text_scale)
     return Page("Settings", [
+        Item(f"Text size: {settings.text_scale:g}x",
+             f"Enter: {larger:g}x" + (" (1.5x reads from the back of a classroom)" if larger == 1.5 else
+                                      " (the smallest)" if larger < settings.text_scale else ""),
+             act=change(text_scale=larger)),
+        Item(f"Colours: {settings.palette}", f"Enter: {following}, {PALETTE_USES.get(following, '')}",
+             act=change(palette=following)),
         Item(f"Sound: {'off' if settings.mute else 'on'}", "Enter: unmute" if settings.mute else "Enter: mute",
              act=change(mute=not settings.mute)),
-        Item(f"Colours: {settings.palette}", f"Enter: {following}", act=change(palette=following)),
-    ], lines=(f"{path}", *settings.describe()))
+    ], lines=("Every armgame window uses these, kept in", str(path),
+              *(line for line in settings.describe() if line.startswith("keys"))))

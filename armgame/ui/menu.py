@@ -9,7 +9,9 @@ the check's one line shows and typing goes on), Esc leaves it as it was. Keys: u
 number) choose, Enter starts, Esc goes back (and quits at the first page), F11 fills the screen; the
 mouse hovers and clicks. Like the game's renderer, every frame is laid out before it is drawn
 (``MenuWindow.layout``), so the tests check at every window size that no text is cut, overlaps another
-or is too small.
+or is too small. The palette and ``text_scale`` are the settings' (a bright room's high-contrast, a
+large room's 1.5); ``looks``, asked again after every change made on a page, lets the Settings page
+show a new text size or palette at once.
 """
 
 from __future__ import annotations
@@ -91,12 +93,13 @@ class MenuWindow:
     """The menu in ``screen``; ``frame()`` handles events and draws, ``run()`` loops until quit."""
 
     def __init__(self, root: Callable[[], Page], palette: str = "okabe-ito", fullscreen: bool = False,
-                 size: tuple[int, int] | None = None) -> None:
+                 size: tuple[int, int] | None = None, text_scale: float = 1.0,
+                 looks: Callable[[], tuple[str, float]] | None = None) -> None:
         #: The pages open, first to current, each with what builds it again.
         self.stack: list[tuple[Callable[[], Page], Page]] = [(root, root())]
-        self.palette = PALETTES.get(palette, PALETTES["okabe-ito"])
-        # Names typed here are drawn in any script (a student's name, before the class shows it).
-        self.renderer = TextRenderer((), (), self.palette)
+        #: The palette's name and the text scale in force, asked again after a page's change (None: fixed).
+        self.looks = looks
+        self.restyle(palette, text_scale)
         self.fullscreen = fullscreen
         self.windowed_size = size
         self.running = True
@@ -108,6 +111,13 @@ class MenuWindow:
         #: The text of the key that began typing (its number): SDL sends it again as text just after.
         self._swallow = ""
         self.screen: pygame.Surface | None = None
+
+    def restyle(self, palette: str, text_scale: float) -> None:
+        """Draw from now on with ``palette`` and every text ``text_scale`` times its size."""
+        self.palette = PALETTES.get(palette, PALETTES["okabe-ito"])
+        self.text_scale = text_scale
+        # Names typed here are drawn in any script (a student's name, before the class shows it).
+        self.renderer = TextRenderer((), (), self.palette, text_scale)
 
     @property
     def page(self) -> Page:
@@ -143,6 +153,10 @@ class MenuWindow:
         page = build()
         page.selected = min(old.selected, max(len(page.items) - 1, 0))
         self.stack[-1] = (build, page)
+        if self.looks is not None:
+            palette, scale = self.looks()
+            if (palette, scale) != (self.palette.name, self.text_scale):
+                self.restyle(palette, scale)
 
     # ----------------------------------------------------------------- typing
     def begin_typing(self, field: Field) -> None:
@@ -262,9 +276,10 @@ class MenuWindow:
         w, h = size
         u = min(w, h) / 720.0
         r, p = self.renderer, self.palette
-        small = max(min_text(size), round(20 * u))
-        normal = max(small + 2, round(30 * u))
-        big = max(normal + 4, round(56 * u))
+        k = self.text_scale
+        small = round(max(min_text(size), round(20 * u)) * k)
+        normal = max(small + 2, round(30 * u * k))
+        big = max(normal + 4, round(56 * u))  # already large: the room it would take goes to the rows
         pad, gap = max(8, round(28 * u)), max(4, round(10 * u))
         lay = MenuLayout()
         width = w - 2 * pad
@@ -277,18 +292,27 @@ class MenuWindow:
         bottom = h - pad - len(help_lines) * (line_h + gap // 2)
         if self.status:
             bottom -= line_h + gap
+        column = min(width, max(round(800 * u * max(k, 1.0)), 280))
+        left = (w - column) // 2
+        items = self.page.items
+        content = r.font(normal).get_height() + r.font(small).get_height()
+        lines_h = len(self.page.lines) * (line_h + gap // 2) + gap
+        # A page too long for its rows with their details (large text, a short window) shows them one
+        # line each, the chosen row's detail once above the keys: every item stays on the page.
+        compact = lines_h + len(items) * (content + 2 * gap) > bottom - y and any(item.detail for item in items)
+        if compact:
+            content = r.font(normal).get_height()
+            bottom -= line_h + gap
+        # Its lines in the middle of the row (seven rows, the main page's, fit a 640 x 480 window).
+        row_h = content + (gap if compact else gap + gap // 2)
+        # The page's lines give way to its rows: up to three rows (all, if fewer) stay in view.
+        rows_room = min(len(items), 3) * (row_h + gap // 2)
         for line in self.page.lines:
-            if y + line_h > bottom:
+            if y + line_h + gap > bottom - rows_room:
                 break
             lay.labels.append(r.label(r.fit_text(line, small, width), small, p.faint, "line", midtop=(w // 2, y)))
             y = lay.labels[-1].rect.bottom + gap // 2
         y += gap
-        column = min(width, max(round(800 * u), 280))
-        left = (w - column) // 2
-        content = r.font(normal).get_height() + r.font(small).get_height()
-        # Its lines in the middle of the row (seven rows, the main page's, fit a 640 x 480 window).
-        row_h = content + gap + gap // 2
-        items = self.page.items
         fit = max(1, (bottom - y) // (row_h + gap // 2))
         first = min(max(0, self.page.selected - fit + 1), max(0, len(items) - fit))  # the chosen one in view
         for i in range(first, min(len(items), first + fit)):
@@ -305,10 +329,14 @@ class MenuWindow:
             else:
                 text = r.fit_text(number + item.shown(), normal, column - 2 * gap)
             lay.labels.append(r.label(text, normal, colour, "item", topleft=(left + gap, y + (row_h - content) // 2)))
-            if item.detail:
+            if item.detail and not compact:
                 lay.labels.append(r.label(r.fit_text(item.detail, small, column - 2 * gap), small, p.faint,
                                           "detail", topleft=(left + gap, lay.labels[-1].rect.bottom)))
             y = rect.bottom + gap // 2
+        chosen = items[self.page.selected] if 0 <= self.page.selected < len(items) else None
+        if compact and chosen is not None and chosen.detail:
+            lay.labels.append(r.label(r.fit_text(chosen.detail, small, width), small, p.faint, "detail",
+                                      midtop=(w // 2, bottom + gap // 2)))
         y = h - pad
         for line in reversed(help_lines):
             lay.labels.append(r.label(line, small, p.faint, "help", midbottom=(w // 2, y)))
@@ -346,10 +374,11 @@ class MenuWindow:
 
 
 def run_menu(root: Callable[[], Page], *, palette: str = "okabe-ito", size: tuple[int, int] | None = None,
-             fullscreen: bool = False, fps: int = 30, max_frames: int | None = None) -> MenuWindow:
+             fullscreen: bool = False, fps: int = 30, max_frames: int | None = None, text_scale: float = 1.0,
+             looks: Callable[[], tuple[str, float]] | None = None) -> MenuWindow:
     """Show the menu until it is quit; each started item runs with the menu's window closed, then the
     menu opens again on the same page, saying what the item returned."""
-    menu = MenuWindow(root, palette, fullscreen, size)
+    menu = MenuWindow(root, palette, fullscreen, size, text_scale, looks)
     limiter = pygame.time.Clock()
     frames = 0
     while menu.running and (max_frames is None or frames < max_frames):
