@@ -89,8 +89,11 @@ def run(args: argparse.Namespace) -> int:
 
     run_ = make_run(args.name, args.integrator, args.dt, args.gravity)
     from ..ui.demo_window import run_window
+    from ..ui.options import window_settings
 
-    run_window(args.name, run_, speed=args.speed, size=_window_size(args), fullscreen=args.fullscreen)
+    settings = window_settings(args)[0]
+    run_window(args.name, run_, speed=args.speed, size=settings.size, fullscreen=args.fullscreen,
+               palette=settings.palette, text_scale=settings.text_scale)
     return 0
 
 
@@ -102,12 +105,6 @@ def _fresh(out, name: str, args: argparse.Namespace):
         return fresh_outputs([], args.force)
     return fresh_outputs([out / f"{name}.csv", *([] if args.no_figures else [out / f"{name}.png"])], args.force,
                          folder=out)
-
-
-def _window_size(args: argparse.Namespace) -> tuple[int, int] | None:
-    from ..ui.options import window_settings
-
-    return window_settings(args)[0].size
 
 
 def without_window(args: argparse.Namespace, typed: list[str]) -> str:

@@ -21,11 +21,10 @@ from ..game.rules import GameConfig
 from ..game.session import GameSession, RealTimeDriver
 from .display import open_window, toggle_fullscreen
 from .playback import MAX_FRAME, PLAYBACK_HELP, REPLAY_SPEEDS, SKIP_SECONDS, skip_sign, speed_after
-from .render import PALETTES, GameRenderer, Hud, Label
+from .render import PALETTES, GameRenderer, Hud, Label, text_heights
 
 CAPTION = ("Same targets, same planner. {0}: the bot knows the interaction torques. "
            "{1}: it drives each joint as if the other did not move.")
-DEFAULT_SIZE = (1280, 720)
 #: The keys, as the help line says them: the same set as the demos' and the replays'.
 HELP = ("p pause", "r restart", *PLAYBACK_HELP, "F11 fullscreen", "Esc quit")
 WHO = {"model": "AUTOPILOT: model", "naive": "AUTOPILOT: naive"}
@@ -54,6 +53,12 @@ class AutopilotWindow:
         self.running = True
         self.speed = 1.0
         self.games: list[Game] = []
+        #: What never moves, drawn once per window size and pause state (``static_builds`` counts them).
+        self._static: pygame.Surface | None = None
+        self._static_areas: list[pygame.Rect] = []
+        self._static_key: tuple | None = None
+        self._shown: object = None
+        self.static_builds = 0
         self.restart()
 
     def restart(self) -> None:
@@ -68,13 +73,17 @@ class AutopilotWindow:
 
     # ---------------------------------------------------------------- layout
     def layout(self, size: tuple[int, int]) -> tuple[list[Label], list[pygame.Rect], list[Label]]:
-        """The caption and help labels, and each game's area, for a window of ``size``."""
+        """The caption and help labels, and each game's area, for a window of ``size``.
+
+        Every text, the games' too, is sized for the whole window (``GameRenderer.text_basis``): each game
+        gets half of it, but the back row reads them at the window's scale (19 px or more at 768 lines)."""
         w, h = size
         u = min(w, h) / 720.0
         pad, gap = max(6, round(12 * u)), max(4, round(6 * u))
         renderer = self.games[0].renderer
-        k = self.text_scale
-        caption_h, help_h = round(max(14, round(22 * u)) * k), round(max(12, round(18 * u)) * k)
+        for game in self.games:
+            game.renderer.text_basis = size
+        _, caption_h, help_h = text_heights(size, self.text_scale)
         # Side by side on a wide screen, one above the other on a tall one (where neither would fit beside).
         caption = CAPTION.format(*(("Top", "Bottom") if h > w else ("Left", "Right")))
         lines = renderer.wrap_items(re.split(r"(?<=\.) ", caption), caption_h, w - 2 * pad, gap)
@@ -96,6 +105,21 @@ class AutopilotWindow:
             half = w // 2
             areas = [pygame.Rect(i * half, top, half, max(bottom - top, 10)) for i in range(2)]
         return labels, areas, footer
+
+    def _static_layer(self, size: tuple[int, int]) -> tuple[pygame.Surface, list[pygame.Rect]]:
+        """The window's background, caption and help line, drawn once per size and pause state (the
+        help line says "p resume" while paused), and the games' areas."""
+        key = (size, self.paused)
+        if self._static_key != key:
+            labels, areas, footer = self.layout(size)
+            layer = pygame.Surface(size)
+            layer.fill(self.palette.window)
+            renderer = self.games[0].renderer
+            for lab in labels + footer:
+                layer.blit(renderer.text(lab.text, lab.height, lab.colour), lab.rect)
+            self._static, self._static_areas, self._static_key = layer, areas, key
+            self.static_builds += 1
+        return self._static, self._static_areas
 
     def all_boxes(self, size: tuple[int, int]) -> list[tuple[str, pygame.Rect]]:
         """Every text and bar rectangle in window coordinates (for the tests)."""
@@ -150,15 +174,17 @@ class AutopilotWindow:
         for event in pygame.event.get():
             self.handle(event)
         screen = self.screen = pygame.display.get_surface() or self.screen
-        screen.fill(self.palette.window)
-        labels, areas, footer = self.layout(screen.get_size())
+        layer, areas = self._static_layer(screen.get_size())
+        # A new layer, or a window cleared by a change of mode (F11; its corner is the layer's no more):
+        # all of it once. The games cover their areas every frame, and nothing else on the window moves.
+        shown = (id(layer), id(screen), screen.get_size())
+        if self._shown != shown or screen.get_at((0, 0)) != layer.get_at((0, 0)):
+            screen.blit(layer, (0, 0))
+            self._shown = shown
         for game, area in zip(self.games, areas, strict=True):
             alpha = game.driver.advance(0.0 if self.paused else min(max(elapsed, 0.0), MAX_FRAME) * self.speed) \
                 if not game.session.over else 1.0
             game.renderer.draw(screen.subsurface(area), game.session, alpha, self.hud(game))
-        renderer = self.games[0].renderer
-        for lab in labels + footer:
-            screen.blit(renderer.text(lab.text, lab.height, lab.colour), lab.rect)
         end = areas[1].bottomleft if areas[1].left > areas[0].left else areas[1].topright
         pygame.draw.line(screen, self.palette.edge, areas[1].topleft, end,
                          max(1, round(2 * min(screen.get_size()) / 720)))
@@ -172,7 +198,8 @@ def run_window(seed: int, duration: float = 60.0, size: tuple[int, int] | None =
                max_frames: int | None = None, screenshot: Path | None = None, palette: str = "okabe-ito",
                text_scale: float = 1.0) -> dict[str, int]:
     """Two bot games side by side at real time until Esc or close; returns the hits of each bot."""
-    screen = open_window(size, fullscreen, "armgame demo: autopilot, model against naive", DEFAULT_SIZE)
+    # No size asked: the desktop's own shape (a 4:3 projector gets a 4:3 window, not a 16:9 strip in it).
+    screen = open_window(size, fullscreen, "armgame demo: autopilot, model against naive", None)
     window = AutopilotWindow(seed, duration, screen, palette=palette, text_scale=text_scale)
     limiter = pygame.time.Clock()
     last = window.clock()

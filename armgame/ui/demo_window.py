@@ -2,12 +2,14 @@
 
 The only demo module that imports pygame. Physics advances in fixed steps from an accumulator of real
 time (``time.perf_counter``, injectable so tests never sleep), scaled by the playback speed; the drawing
-interpolates joint angles between the last two steps. The scene is drawn on a surface 800 px high and
-as wide as the window's shape (``scene_shape``), then scaled to the (resizable) window, so a projector's
-resolution changes nothing but sharpness and no band of the window is left empty; the arm's reach is
-framed in the room the texts leave (``frame_content``). The window opens as large as the desktop
-allows, and F11 fills the screen. The arm is the game's (``armgame.ui.body``). Every text drawn is recorded
-(``text_boxes``), so the tests check that none is cut or overlaps another at any window size.
+interpolates joint angles between the last two steps. The scene is drawn at the (resizable) window's
+own size and pixels (``scene_shape``), its sizes in proportion to its shorter side (``px``: the pixels of
+an 800 px one) and its text to its height (the smallest 2.5% of it, times the settings' ``text_scale``),
+in the settings' palette; the arm's reach is framed in the room the texts leave (``frame_content``).
+What never moves is drawn once per size (``_static_layer``). With no size asked, the window opens in the
+desktop's shape, as large as it allows (a 4:3 projector, a 4:3 window), and F11 fills the screen. The
+arm is the game's (``armgame.ui.body``). Every text drawn is recorded (``text_boxes``), so the tests
+check that none is cut or overlaps another at any window size.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from ..demos.runs import VISIBLY_APART
 from .body import draw_arm, draw_torso
 from .display import open_window, toggle_fullscreen
 from .playback import MAX_FRAME, PLAYBACK_HELP, SKIP_SECONDS, skip_sign, speed_after
-from .render import PALETTES
+from .render import MIN_LINE, MIN_TEXT_FRACTION, PALETTES
 
 SCENE_SIZE = (800, 800)
 #: The scene's shorter side, in pixels: the longer one follows the window's shape.
@@ -41,18 +43,23 @@ SPEEDS = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
 #: The keys every demo window offers, as its help line says them (one set with the replays').
 HELP = ("p pause", "r restart", *PLAYBACK_HELP, "F11 fullscreen", "Esc quit")
 
-BACKGROUND = (255, 255, 255)
-INK = (20, 20, 28)
-FAINT = (85, 85, 95)  # help text: 7:1 on white, still 4.5:1 once smoothscaled
-LINK = (45, 50, 62)
+# The scene's colours are the settings' palette (``armgame.ui.palette``); these mark the second arm and
+# its path, which the captions call orange whatever the palette.
 # Lines a class must see: 3:1 or more on white (WCAG's rule for graphics), 4 px in the scene.
 ARM_B = (213, 94, 0)
-TRAIL = (30, 136, 200)
 TRAIL_B = (213, 94, 0)
-PATH = (120, 126, 138)
 LINE = 4
 SPEED_PLOT_SIZE = (220, 170)
-BODY_PALETTE = PALETTES["okabe-ito"]
+#: The planning demo's legend: each path's colour (None: the palette's arm colour, dark) and what it shows.
+LEGEND = ((None, "minimum jerk: straight, bell-shaped speed"),
+          (ARM_B, "minimum torque change: the arm's dynamics curve it"))
+#: The rows' labels in short words, for a narrow window (the caption names the interaction torques).
+NARROW_LABELS = {
+    "own_inertial": "own",
+    "interaction_inertial": "inter. inertial",
+    "coriolis_centrifugal": "inter. Coriolis",
+    "gravity": "gravity",
+}
 SHORT_LABELS = {
     "own_inertial": "own inertia",
     "interaction_inertial": "interaction, inertial",
@@ -73,10 +80,15 @@ def _tick_step(scale: float) -> float:
 
 
 class DemoWindow:
-    """One demo on screen. ``frame()`` handles events, advances the physics and draws once."""
+    """One demo on screen. ``frame()`` handles events, advances the physics and draws once.
+
+    What never moves (the background, the planned paths, the speed plot, the bars' axes, the caption
+    and the help line) is drawn once per scene size into a layer of its own (``static_builds`` counts
+    them); a frame copies it and draws only what moves over it."""
 
     def __init__(self, name: str, run: Any, speed: float = 1.0, clock: Callable[[], float] = time.perf_counter,
-                 size: tuple[int, int] | None = None, fullscreen: bool = False) -> None:
+                 size: tuple[int, int] | None = None, fullscreen: bool = False, palette: str = "okabe-ito",
+                 text_scale: float = 1.0) -> None:
         self.info = get_info(name)
         self.name = name
         self.run = run
@@ -84,6 +96,9 @@ class DemoWindow:
         self.clock = clock
         self.size = size
         self.fullscreen = fullscreen
+        #: The settings' palette and text scale (a bright room's high-contrast, a large room's 1.5).
+        self.palette = PALETTES.get(palette, PALETTES["okabe-ito"])
+        self.text_scale = text_scale
         self.windowed_size = self.size or SCENE_SIZE
         #: Every text of the last frame: (text, rectangle in scene pixels).
         self.placed: list[tuple[str, Any]] = []
@@ -91,7 +106,6 @@ class DemoWindow:
         self.accumulator = 0.0
         self.last_time: float | None = None
         self.scene_size = SCENE_SIZE
-        self.help_extra = 0
         self.shoulder, self.pixels_per_metre = (400.0, 450.0), 400.0
         self.speed_plot = pygame.Rect((560, 290), SPEED_PLOT_SIZE)
         self.reach = self.content_box()
@@ -99,23 +113,38 @@ class DemoWindow:
         self.parted_at: float | None = None
         self.screen: Any = None
         self._snapshots: dict[int, tuple[Any, Any]] = {}
+        self._fonts: dict[int, Any] = {}
+        self._sized: tuple = (None, (40, 34, 30))
+        self._rendered: dict[tuple[str, int, tuple[int, int, int]], Any] = {}
+        self._static: Any = None
+        self._static_key: tuple | None = None
+        self._static_placed: list[tuple[str, Any]] = []
+        #: How many times the static layer was drawn (once per scene size and pause state).
+        self.static_builds = 0
+        self._laid_out: tuple | None = None
 
     # ------------------------------------------------------------------ lifecycle
     def open(self) -> None:
-        self.screen = open_window(self.size, self.fullscreen, self.info.title, (1200, 800))
+        # A 4:3 projector gets a 4:3 window: the desktop's own shape, as large as it allows.
+        self.screen = open_window(self.size, self.fullscreen, self.info.title, None)
         self.size = self.windowed_size = self.screen.get_size()
-        # Sized so that the smallest text is 2.5% of the window's height or more (20 px of the scene's 800).
-        self.caption_font = pygame.font.Font(None, 40)
-        self.status_font = pygame.font.Font(None, 34)
-        self.small_font = pygame.font.Font(None, 30)
         self.frame_content()
         self.restart()
 
     @staticmethod
     def scene_shape(size: tuple[int, int]) -> tuple[int, int]:
-        """The scene's size for a window of ``size``: 800 px on its shorter side, the window's shape."""
-        w, h = max(size[0], 1), max(size[1], 1)
-        return (round(SCENE_SIDE * w / h), SCENE_SIDE) if w >= h else (SCENE_SIDE, round(SCENE_SIDE * h / w))
+        """The scene's size for a window of ``size``: the window's own, drawn at its pixels (never scaled:
+        text scaled up to a 1920 x 1080 projector came out blurred, and the scaling cost a frame 1.4 ms)."""
+        return max(size[0], 1), max(size[1], 1)
+
+    def px(self, pixels: float) -> int:
+        """``pixels`` of a scene 800 px on its shorter side, in this scene's pixels."""
+        return max(1, round(pixels * min(self.scene_size) / SCENE_SIDE))
+
+    @property
+    def line(self) -> int:
+        """Paths and trails: 4 px at 800 lines, never under MIN_LINE."""
+        return max(MIN_LINE, self.px(LINE))
 
     def content_box(self) -> tuple[float, float, float, float]:
         """What the arm can cover, in metres (xmin, xmax, ymin, ymax) about the shoulder: the whole reach
@@ -134,29 +163,154 @@ class DemoWindow:
         pad = 0.06
         return min(xs) - pad, max(xs) + pad, min(min(ys), -0.12) - pad, max(ys) + pad
 
+    # -------------------------------------------------------------------- text
+    def font(self, size: int) -> Any:
+        """pygame's default font at ``size`` (its nominal size; lines are about 0.7 of it high)."""
+        font = self._fonts.get(size)
+        if font is None:
+            font = self._fonts[size] = pygame.font.Font(None, size)
+        return font
+
+    def _nominal(self, height: int) -> int:
+        """The smallest nominal size whose lines are ``height`` px or more."""
+        size = max(1, round(height / 0.7))
+        while size > 1 and self.font(size - 1).get_height() >= height:
+            size -= 1
+        while self.font(size).get_height() < height:
+            size += 1
+        return size
+
+    def _sizes(self) -> tuple[int, int, int]:
+        """Font sizes (caption, status, small): the smallest text 2.5% of the window's height (20 px of
+        800, 19 of 768; a tall window's text with its height), the others 1.13 and 1.33 times it, all
+        times ``text_scale``."""
+        key = (self.scene_size[1], self.text_scale)
+        if self._sized[0] != key:
+            small = math.ceil(MIN_TEXT_FRACTION * self.scene_size[1] * self.text_scale - 1e-9)
+            self._sized = (key, (self._nominal(round(small * 4 / 3)), self._nominal(round(small * 34 / 30)),
+                                 self._nominal(small)))
+        return self._sized[1]
+
+    def _wrap_words(self, text: str, size: int, width: int) -> list[str]:
+        return self._wrap(text, self.font(size), width)
+
+    def _wrap_parts(self, parts: list[str], size: int, width: int) -> list[str]:
+        """Parts (never split) on as few lines as ``width`` holds, three spaces apart."""
+        lines: list[str] = []
+        for part in parts:
+            if lines and self.font(size).size(lines[-1] + "   " + part)[0] <= width:
+                lines[-1] += "   " + part
+            else:
+                lines.append(part)
+        return lines
+
+    def _fit(self, text: str, size: int, width: int) -> str:
+        font = self.font(size)
+        if font.size(text)[0] <= width:
+            return text
+        while text and font.size(text + "...")[0] > width:
+            text = text[:-1]
+        return text + "..."
+
+    def _status_lines(self, width: int) -> list[str]:
+        """The clock and speed on a line, then what the demo measures (each wrapped between its parts)."""
+        speed = f"{self.speed:g}x" + ("   PAUSED" if self.paused else "")
+        size = self._sizes()[1]
+        return self._wrap_parts([f"t = {self.run.t:5.2f} s", f"speed {speed}"], size, width) + \
+            self._wrap_parts(self._status().split("   "), size, width)
+
+    # ------------------------------------------------------------------ layout
     def frame_content(self) -> None:
-        """Lay the scene out for the window's shape: the texts at the edges, and the arm's reach scaled
-        into the room they leave, centred."""
+        """Lay the scene out for the window's shape and the text size: the texts at the edges, and the
+        arm's reach scaled into the room they leave, centred."""
         self.scene_size = self.scene_shape(self.size or SCENE_SIZE)
         w, h = self.scene_size
+        caption, status, small = self._sizes()
+        small_h = self.font(small).get_linesize() + 2
+        gap = max(4, round(6 * small / 30))
+        self.margin = margin = self.px(20)
         self.scene = pygame.Surface(self.scene_size)
-        self.caption_lines = self._wrap(self.info.caption, self.caption_font, w - 40)
-        top = 12 + 31 * len(self.caption_lines) + 76
-        self.help_extra = 26 * (len(self.help_lines()) - 1)  # a help line that wraps pushes the rest up
-        bottom = h - 44 - self.help_extra
-        right = w - 20
+        self.caption_lines = self._wrap_words(self.info.caption, caption, w - 2 * margin)
+        self.edge = self.px(12)  # the caption's top, the help line's bottom
+        # Two pixels between lines: scaled down to a small window, rounding never makes them touch.
+        self.caption_pitch = self.font(caption).get_linesize() + 2
+        self.status_top = self.edge + self.caption_pitch * len(self.caption_lines) + gap
+        self.status_pitch = self.font(status).get_linesize() + 2
+        # Room for the status as it reads now, and for chaos's longer line once the arms have parted.
+        longest = self._status_lines(w - 2 * margin)
+        if self.name == "chaos":
+            longest = self._wrap_parts([*longest, "parted at t = 00.0 s"], status, w - 2 * margin)
+        self.status_rows = len(longest)
+        top = self.status_top + self.status_pitch * self.status_rows + 2 * gap
+        self.help_pitch = small_h
+        bottom = h - self.edge - small_h * len(self.help_lines()) - gap
+        right = w - margin
+        self.bar_geometry = None
         if isinstance(self.run, ReachRun):
-            bottom -= (len(self._bar_rows(self.run)) + 1) * self._row_height(self.run) + 54
+            bottom = self._lay_out_bars(bottom, gap)
         if self.name == "planning":
-            bottom = h - 104 - self.help_extra
-            right = w - SPEED_PLOT_SIZE[0] - 60
-            self.speed_plot = pygame.Rect((w - SPEED_PLOT_SIZE[0] - 20, top + 40), SPEED_PLOT_SIZE)
+            bottom, right = self._lay_out_planning(top, bottom, gap)
         xmin, xmax, ymin, ymax = self.reach
-        room = pygame.Rect(20, top, right - 20, max(bottom - top, 40))
+        room = pygame.Rect(margin, top, right - margin, max(bottom - top, 40))
         k = min(room.width / (xmax - xmin), room.height / (ymax - ymin))
         self.pixels_per_metre = k
         self.shoulder = (room.centerx - (xmin + xmax) / 2 * k, room.centery + (ymin + ymax) / 2 * k)
         self.room = room
+        self._static_key = None
+
+    def _lay_out_bars(self, bottom: int, gap: int) -> int:
+        """The torque bars' block above the help line: a column of row labels as wide as the widest,
+        then both joints side by side; returns the room's new bottom."""
+        run = self.run
+        small = self._sizes()[2]
+        font = self.font(small)
+        line = font.get_linesize()
+        value_w = font.size("+88.8")[0] + gap
+        needed = max(font.size("shoulder (N m)")[0] + 2 * gap, 3 * value_w)  # one joint's header and bars
+        # Each row's label beside its bars where both joints still have room (in short words if it must),
+        # else on a line above them (a tall, narrow window with large text).
+        for names in (SHORT_LABELS, NARROW_LABELS, SHORT_LABELS):
+            rows = [names.get(k, k) for k in self._bar_rows(run)]
+            label_w = max(font.size(r)[0] for r in rows) + 2 * gap
+            stacked = (self.scene_size[0] - 2 * self.margin - label_w) // 2 < needed
+            if not stacked:
+                break
+        self.bar_labels = rows
+        left = self.margin + (0 if stacked else label_w)
+        row_h = 2 * line + 3 if stacked else line + gap
+        span = (self.scene_size[0] - self.margin - left) // 2
+        centres = (left + span // 2, left + span + span // 2)
+        half = max(20, span // 2 - value_w // 2 - gap)
+        block_h = (len(rows) + 1) * row_h + line + gap
+        top = bottom - block_h
+        # (top, row pitch, the joints' centres, half a bar's span, the bars' offset in their row)
+        self.bar_geometry = (top, row_h, centres, half, line + 1 if stacked else 0)
+        return top - gap
+
+    def _lay_out_planning(self, top: int, bottom: int, gap: int) -> tuple[int, int]:
+        """The speed plot (beside the arm on a wide scene, under it on a tall one) and the legend; returns
+        the room's new bottom and right edge."""
+        small = self._sizes()[2]
+        font = self.font(small)
+        line = font.get_linesize() + 2
+        w, h = self.scene_size
+        t = small / 30
+        # The legend's two entries, each wrapped beside its line's sample (a narrow scene: two lines each).
+        width = w - 2 * self.margin - round(36 * t)
+        self.legend = [(colour, self._wrap_words(text, small, width)) for colour, text in LEGEND]
+        bottom -= sum(len(lines) for _, lines in self.legend) * line + 2 * gap
+        self.legend_top = bottom
+        axis_w = font.size("0.0")[0] + 2 * gap
+        plot_w, plot_h = round(SPEED_PLOT_SIZE[0] * t), round(SPEED_PLOT_SIZE[1] * t)
+        if w >= 1.2 * h:
+            # Its "out" and "back" below it stay above the legend.
+            plot_h = min(plot_h, bottom - 2 * gap - line - (top + line + gap))
+            self.speed_plot = pygame.Rect(w - self.margin - plot_w, top + line + gap, plot_w, plot_h)
+            return bottom - gap, self.speed_plot.left - axis_w - 2 * self.margin
+        plot_w, plot_h = min(w - 2 * self.margin - axis_w, round(plot_w * 1.5)), min(plot_h, round(0.15 * h))
+        self.speed_plot = pygame.Rect(w - self.margin - plot_w, bottom - gap - line - plot_h, plot_w, plot_h)
+        return self.speed_plot.top - line - 3 * gap, w - self.margin
+
 
     def close(self) -> None:
         pygame.display.quit()
@@ -289,12 +443,21 @@ class DemoWindow:
                 line = trial
         return [*lines, line]
 
-    def _text(self, text: str, font: Any, colour: tuple[int, int, int], pos: tuple[int, int],
-              anchor: str = "topleft") -> None:
-        surface = font.render(text, True, colour)
+    def _render(self, text: str, size: int, colour: tuple[int, int, int]) -> Any:
+        key = (text, size, colour)
+        surface = self._rendered.get(key)
+        if surface is None:
+            if len(self._rendered) > 512:  # the clock and the speeds make new strings every frame
+                self._rendered.clear()
+            surface = self._rendered[key] = self.font(size).render(text, True, colour)
+        return surface
+
+    def _text(self, text: str, size: int, colour: tuple[int, int, int], pos: tuple[int, int],
+              anchor: str = "topleft", target: Any = None, placed: list | None = None) -> None:
+        surface = self._render(text, size, colour)
         rect = surface.get_rect(**{anchor: pos})
-        self.scene.blit(surface, rect)
-        self.placed.append((text, rect))
+        (self.scene if target is None else target).blit(surface, rect)
+        (self.placed if placed is None else placed).append((text, rect))
 
     def text_boxes(self) -> list[tuple[str, Any]]:
         """The last frame's texts and their rectangles in window pixels."""
@@ -307,37 +470,32 @@ class DemoWindow:
         pygame.draw.lines(self.scene, colour, False, points, width)
         for p in points[1:-1]:
             pygame.draw.circle(self.scene, colour, p, width // 2 + 2)
-        pygame.draw.circle(self.scene, INK if colour == LINK else colour, points[-1], hand_radius)
+        pygame.draw.circle(self.scene, self.palette.ink if colour == self.palette.link else colour, points[-1],
+                           hand_radius)
 
     def help_lines(self) -> list[str]:
         """The keys that work (actions: "p resume" while paused), on as few lines as the scene's width
         holds (a narrow window: two)."""
-        lines: list[str] = []
-        for item in ("p resume", *HELP[1:]) if self.paused else HELP:
-            if lines and self.small_font.size(lines[-1] + "   " + item)[0] <= self.scene_size[0] - 24:
-                lines[-1] += "   " + item
-            else:
-                lines.append(item)
-        return lines
+        items = ["p resume", *HELP[1:]] if self.paused else list(HELP)
+        return self._wrap_parts(items, self._sizes()[2], self.scene_size[0] - 24)
 
     def _draw_body(self, pose: tuple[float, float], points: list[tuple[int, int]]) -> None:
-        """The game's arm (``armgame.ui.body``): seen from above with its torso in the horizontal demos,
-        hanging from a fixed shoulder in the vertical ones; its muscles at rest (nothing drives them)."""
+        """The game's arm (``armgame.ui.body``): seen from above in the horizontal demos (its torso is in
+        the static layer), hanging from a fixed shoulder in the vertical ones; its muscles at rest."""
         q1, q2 = pose
         k = self.pixels_per_metre
+        p = self.palette
         world = self.run.arm_points(q1, q2)
         if len(world) < 3:  # the pendulum: one link, no elbow
-            pygame.draw.circle(self.scene, FAINT, self.shoulder, 11)
-            self._draw_arm(points, LINK, 14, 12)
+            pygame.draw.circle(self.scene, p.faint, self.shoulder, self.px(11))
+            self._draw_arm(points, p.link, self.px(14), self.px(12))
             return
         l1, l2 = math.dist(world[0], world[1]), math.dist(world[1], world[2])
-        if not self.info.vertical:
-            draw_torso(self.scene, self.shoulder, k, BODY_PALETTE)
-        else:
-            pygame.draw.circle(self.scene, FAINT, self.shoulder, max(11, round(0.06 * k)))
-        draw_arm(self.scene, self.shoulder, k, q1, q2, l1, l2, (0.0, 0.0, 0.0, 0.0), BODY_PALETTE,
+        if self.info.vertical:
+            pygame.draw.circle(self.scene, p.faint, self.shoulder, max(11, round(0.06 * k)))
+        draw_arm(self.scene, self.shoulder, k, q1, q2, l1, l2, (0.0, 0.0, 0.0, 0.0), p,
                  torso=not self.info.vertical)
-        pygame.draw.aacircle(self.scene, INK, points[-1], max(8, round(0.018 * k)))
+        pygame.draw.aacircle(self.scene, p.ink, points[-1], max(8, round(0.018 * k)))
 
     def _status(self) -> str:
         run = self.run
@@ -350,7 +508,7 @@ class DemoWindow:
         if self.name == "chaos":
             d = run.hand_distance()
             if self.parted_at is not None:
-                return f"hands {d:.2f} m apart: parted at t = {self.parted_at:.1f} s"
+                return f"hands {d:.2f} m apart:   parted at t = {self.parted_at:.1f} s"
             return f"hands {d:.1e} m apart"
         if self.name == "planning":
             jerk, torque_change = run.hand_speeds_now()
@@ -362,114 +520,160 @@ class DemoWindow:
     def _bar_rows(run: ReachRun) -> list[str]:
         return [k for k, _, _ in COMPONENTS if (k != "gravity" or run.gravity) and k != "damping"] + ["TOTAL"]
 
-    @classmethod
-    def _row_height(cls, run: ReachRun) -> int:
-        return 28 if len(cls._bar_rows(run)) <= 4 else 25
+    # ----------------------------------------------------------- the static layer
+    def _static_layer(self) -> Any:
+        """What never moves at this scene size and pause state, drawn once: the background, the
+        planned paths and the speed plot, the bars' axes and labels, the torso, caption and help."""
+        key = (self.scene_size, self.paused, self.palette.name)
+        if self._static is not None and self._static_key == key:
+            return self._static
+        self.static_builds += 1
+        p = self.palette
+        layer = pygame.Surface(self.scene_size)
+        layer.fill(p.scene)
+        placed: list[tuple[str, Any]] = []
+        caption, _, small = self._sizes()
+        run = self.run
+        if isinstance(run, ReachRun):
+            path = [self.to_scene(tuple(pt)) for pt in run.table.hand[:: max(1, len(run.table.hand) // 200)]]
+            pygame.draw.lines(layer, p.edge, False, path, self.line)
+            for end in (run.plan.home, run.plan.target):
+                pygame.draw.circle(layer, p.edge, self.to_scene(end), self.px(14), self.line)
+            self._static_bars(layer, placed, small)
+        if self.name == "planning":
+            self._static_planning(layer, placed, small)
+        if not self.info.vertical and len(run.arm_points(*run.states[0][:2])) >= 3:
+            draw_torso(layer, self.shoulder, self.pixels_per_metre, p)
+        y = self.edge
+        for line in self.caption_lines:
+            self._text(line, caption, p.ink, (self.margin, y), target=layer, placed=placed)
+            y += self.caption_pitch
+        lines = self.help_lines()
+        y = self.scene_size[1] - self.edge - self.help_pitch * (len(lines) - 1)
+        for line in lines:  # the help line last: the tests read the keys from the last text drawn
+            self._text(line, small, p.faint, (self.scene_size[0] - self.edge, y), "bottomright", layer, placed)
+            y += self.help_pitch
+        self._static, self._static_key, self._static_placed = layer, key, placed
+        return layer
 
+    def _static_bars(self, layer: Any, placed: list, small: int) -> None:
+        p = self.palette
+        run = self.run
+        top, row_h, centres, half, offset = self.bar_geometry
+        rows = self.bar_labels
+        scale = max(run.torque_scales())
+        for x, joint in zip(centres, ("shoulder", "elbow"), strict=True):
+            self._text(f"{joint} (N m)", small, p.ink, (x, top + row_h - self.font(small).get_linesize() - 4),
+                       "midtop", layer, placed)
+        for r, label in enumerate(rows):
+            self._text(label, small, p.ink, (self.margin, top + row_h + r * row_h + (0 if offset else 3)),
+                       target=layer, placed=placed)
+        axis_y = top + (len(rows) + 1) * row_h - 2
+        step = _tick_step(scale)
+        for x in centres:
+            pygame.draw.line(layer, p.faint, (x, top + row_h - 2), (x, axis_y), 1)
+            pygame.draw.line(layer, p.faint, (x - half, axis_y), (x + half, axis_y), 1)
+            for k in range(-int(scale // step), int(scale // step) + 1):
+                tx = x + round(half * k * step / scale)
+                pygame.draw.line(layer, p.faint, (tx, axis_y), (tx, axis_y + 5), 1)
+                self._text(f"{k * step:g}", small, p.faint, (tx, axis_y + 6), "midtop", layer, placed)
+
+    def _static_planning(self, layer: Any, placed: list, small: int) -> None:
+        """Both planned paths (dark: minimum jerk, orange: minimum torque change, as the caption and the
+        legend say), their ends, the speed plot's axes and curves, and the legend."""
+        p = self.palette
+        run = self.run
+        for path, colour in zip(run.paths, (p.link, ARM_B), strict=True):
+            pygame.draw.lines(layer, colour, False, [self.to_scene(tuple(pt)) for pt in path[::5]], self.line)
+        for end in (run.planning.start, run.planning.target):
+            pygame.draw.circle(layer, p.edge, self.to_scene(end), self.px(14), max(MIN_LINE, self.px(3)))
+        box = self.speed_plot
+        top = max(float(np.max(s)) for s in run.speeds)
+        pygame.draw.line(layer, p.faint, box.bottomleft, box.bottomright, 1)
+        pygame.draw.line(layer, p.faint, box.bottomleft, box.topleft, 1)
+        self._text("hand speed (m/s)", small, p.ink, (box.left, box.top - 6), "bottomleft", layer, placed)
+        for value, y in ((0.0, box.bottom), (top, box.top)):
+            self._text(f"{value:.1f}", small, p.faint, (box.left - 4, y), "midright", layer, placed)
+        every = max(1, len(run.speeds[0]) // 220)
+        for speeds, colour in zip(run.speeds, (p.link, ARM_B), strict=True):
+            points = [(box.left + round(box.width * i / len(speeds)), box.bottom - round(box.height * v / top))
+                      for i, v in list(enumerate(speeds))[::every]]
+            pygame.draw.lines(layer, colour, False, points, max(MIN_LINE, self.px(3)))
+        self._text("out", small, p.faint, (box.left + box.width // 4, box.bottom + 4), "midtop", layer, placed)
+        self._text("back", small, p.faint, (box.left + 3 * box.width // 4, box.bottom + 4), "midtop", layer, placed)
+        line = self.font(small).get_linesize() + 2
+        y = self.legend_top
+        for colour, lines in self.legend:
+            colour = p.link if colour is None else colour
+            pygame.draw.line(layer, colour, (self.margin, y + line // 2), (self.margin + 28, y + line // 2), 5)
+            for text in lines:
+                self._text(text, small, p.ink, (self.margin + round(36 * small / 30), y), target=layer, placed=placed)
+                y += line
+
+    # --------------------------------------------------------------- what moves
     def _draw_bars(self, run: ReachRun) -> None:
         parts, total = run.torques_now()
         # One N m scale for both joints, as in the figure, so the shoulder's larger torques look larger.
         scale = max(run.torque_scales())
-        rows = [(SHORT_LABELS[k], parts[k], _rgb(c)) for k, _, c in COMPONENTS
-                if (k != "gravity" or run.gravity) and k != "damping"]
-        rows.append(("TOTAL", total, INK))
-        row_h, half = self._row_height(run), 120
-        top = self.scene_size[1] - 58 - self.help_extra - (len(rows) + 1) * row_h
-        centres = (400, 660)
-        for x, joint in zip(centres, ("shoulder", "elbow"), strict=True):
-            self._text(f"{joint} (N m)", self.small_font, INK, (x, top), "midtop")
-        for r, (label, values, colour) in enumerate(rows):
-            y = top + row_h + r * row_h
-            self._text(label, self.small_font, INK, (20, y + 3))
+        rows = [(parts[k], _rgb(c)) for k, _, c in COMPONENTS if (k != "gravity" or run.gravity) and k != "damping"]
+        rows.append((total, self.palette.ink))
+        top, row_h, centres, half, offset = self.bar_geometry
+        small = self._sizes()[2]
+        for r, (values, colour) in enumerate(rows):
+            y = top + row_h + r * row_h + offset
             for x, v in zip(centres, values, strict=True):
                 length = round(half * v / scale)
-                pygame.draw.rect(self.scene, colour, pygame.Rect(min(x, x + length), y, abs(length), row_h - 6))
+                pygame.draw.rect(self.scene, colour,
+                                 pygame.Rect(min(x, x + length), y, abs(length), row_h - offset - 6))
                 # The value on the side the bar leaves free, so it never runs into the other joint's bars.
-                self._text(f"{v:+.1f}", self.small_font, INK, (x - 4, y + 3) if v >= 0 else (x + 4, y + 3),
+                dy = 0 if offset else 3  # stacked rows have no room to spare below the value
+                self._text(f"{v:+.1f}", small, self.palette.ink, (x - 4, y + dy) if v >= 0 else (x + 4, y + dy),
                            "topright" if v >= 0 else "topleft")
-        axis_y = top + (len(rows) + 1) * row_h - 2
-        step = _tick_step(scale)
-        for x in centres:
-            pygame.draw.line(self.scene, FAINT, (x, top + row_h - 2), (x, axis_y), 1)
-            pygame.draw.line(self.scene, FAINT, (x - half, axis_y), (x + half, axis_y), 1)
-            for k in range(-int(scale // step), int(scale // step) + 1):
-                tx = x + round(half * k * step / scale)
-                pygame.draw.line(self.scene, FAINT, (tx, axis_y), (tx, axis_y + 5), 1)
-                self._text(f"{k * step:g}", self.small_font, FAINT, (tx, axis_y + 6), "midtop")
-
-    def _draw_planning(self, run: Any) -> None:
-        """Both planned paths, the start and target, and the two speed profiles with a moving cursor."""
-        for path, colour in zip(run.paths, (TRAIL, TRAIL_B), strict=True):
-            pygame.draw.lines(self.scene, colour, False, [self.to_scene(tuple(p)) for p in path[::5]], 4)
-        for end in (run.planning.start, run.planning.target):
-            pygame.draw.circle(self.scene, PATH, self.to_scene(end), 14, 3)
-        box = self.speed_plot
-        top = max(float(np.max(s)) for s in run.speeds)
-        pygame.draw.line(self.scene, FAINT, box.bottomleft, box.bottomright, 1)
-        pygame.draw.line(self.scene, FAINT, box.bottomleft, box.topleft, 1)
-        self._text("hand speed (m/s)", self.small_font, INK, (box.left, box.top - 6), "bottomleft")
-        for value, y in ((0.0, box.bottom), (top, box.top)):
-            self._text(f"{value:.1f}", self.small_font, FAINT, (box.left - 4, y), "midright")
-        every = max(1, len(run.speeds[0]) // 220)
-        for speeds, colour in zip(run.speeds, (LINK, ARM_B), strict=True):
-            points = [(box.left + round(box.width * i / len(speeds)), box.bottom - round(box.height * v / top))
-                      for i, v in list(enumerate(speeds))[::every]]
-            pygame.draw.lines(self.scene, colour, False, points, 3)
-        cursor = box.left + round(box.width * (run.steps % len(run.speeds[0])) / len(run.speeds[0]))
-        pygame.draw.line(self.scene, FAINT, (cursor, box.top), (cursor, box.bottom), 1)
-        self._text("out", self.small_font, FAINT, (box.left + box.width // 4, box.bottom + 4), "midtop")
-        self._text("back", self.small_font, FAINT, (box.left + 3 * box.width // 4, box.bottom + 4), "midtop")
-        y = self.scene_size[1] - 92 - self.help_extra
-        for colour, text in ((LINK, "minimum jerk: straight, bell-shaped speed"),
-                             (ARM_B, "minimum torque change: the arm's dynamics curve it")):
-            pygame.draw.line(self.scene, colour, (20, y + 9), (48, y + 9), 5)
-            self._text(text, self.small_font, INK, (56, y))
-            y += 26
 
     def draw(self) -> None:
-        if self.scene_size != self.scene_shape(self.size or SCENE_SIZE):
-            self.frame_content()  # a new window shape: the scene laid out again for it
-            for trail in self.trails:
-                trail.clear()
+        laid_out = (self.scene_shape(self.size or SCENE_SIZE), self.paused)
+        if self._laid_out != laid_out:
+            if self._laid_out is not None and self._laid_out[0] != laid_out[0]:
+                for trail in self.trails:  # in the old shape's pixels
+                    trail.clear()
+            self.frame_content()  # a new window shape (or help line): the scene laid out again for it
+            self._laid_out = laid_out
         scene = self.scene
-        scene.fill(BACKGROUND)
+        scene.blit(self._static_layer(), (0, 0))
         self.placed = []
+        p = self.palette
         run = self.run
         poses = self.poses()
-        arms = [[self.to_scene(p) for p in run.arm_points(q1, q2)] for q1, q2 in poses]
+        arms = [[self.to_scene(pt) for pt in run.arm_points(q1, q2)] for q1, q2 in poses]
         for trail, arm in zip(self.trails, arms, strict=True):
             trail.append(arm[-1])
         if isinstance(run, ReachRun):
-            path = [self.to_scene(tuple(p)) for p in run.table.hand[:: max(1, len(run.table.hand) // 200)]]
-            pygame.draw.lines(scene, PATH, False, path, LINE)
-            for end in (run.plan.home, run.plan.target):
-                pygame.draw.circle(scene, PATH, self.to_scene(end), 14, LINE)
             self._draw_bars(run)
         if self.name == "planning":
-            self._draw_planning(run)
-        for trail, colour in zip(self.trails, (TRAIL, TRAIL_B), strict=False):
+            box = self.speed_plot
+            cursor = box.left + round(box.width * (run.steps % len(run.speeds[0])) / len(run.speeds[0]))
+            pygame.draw.line(scene, p.faint, (cursor, box.top), (cursor, box.bottom), 1)
+        for trail, colour in zip(self.trails, (p.trail, TRAIL_B), strict=False):
             if len(trail) > 1:
-                pygame.draw.lines(scene, colour, False, list(trail), LINE)
+                pygame.draw.lines(scene, colour, False, list(trail), self.line)
         self._draw_body(poses[0], arms[0])
         if len(arms) > 1:
-            self._draw_arm(arms[1], ARM_B, 6, 7)
-        y = 12
-        for line in self.caption_lines:
-            self._text(line, self.caption_font, INK, (20, y))
-            y += 31
-        speed = f"{self.speed:g}x" + ("   PAUSED" if self.paused else "")
-        self._text(f"t = {run.t:5.2f} s   speed {speed}", self.status_font, INK, (20, y + 8))
-        self._text(self._status(), self.status_font, INK, (20, y + 36))
-        y = self.scene_size[1] - 8
-        for line in reversed(self.help_lines()):
-            self._text(line, self.small_font, FAINT, (self.scene_size[0] - 12, y), "bottomright")
-            y -= 26
+            self._draw_arm(arms[1], ARM_B, self.px(6), self.px(7))
+        status = self._sizes()[1]
+        width = self.scene_size[0] - 2 * self.margin
+        lines = self._status_lines(width)
+        if len(lines) > self.status_rows:  # never more rows than laid out: the last one cut short
+            lines = [*lines[:self.status_rows - 1], self._fit("   ".join(lines[self.status_rows - 1:]), status, width)]
+        for i, line in enumerate(lines):
+            self._text(line, status, p.ink, (self.margin, self.status_top + i * self.status_pitch))
+        self.placed += self._static_placed
         screen = pygame.display.get_surface()
         scale, offset = self.view()
         size = (round(self.scene_size[0] * scale), round(self.scene_size[1] * scale))
+        # The scene is the window's size but for a frame drawn before a resize has reached it.
         shown = scene if size == self.scene_size else pygame.transform.smoothscale(scene, size)
-        # Shrinking turns white into 252 grey; margins of the same colour hide the scene's edge.
-        screen.fill(shown.get_at((0, 0)))
+        if offset != (0, 0) or size != screen.get_size():
+            screen.fill(shown.get_at((0, 0)))
         screen.blit(shown, offset)
 
     def frame(self) -> bool:
@@ -484,9 +688,10 @@ class DemoWindow:
 
 def run_window(name: str, run: Any, speed: float = 1.0, clock: Callable[[], float] = time.perf_counter,
                max_frames: int | None = None, frame_rate: float | None = 60.0, size: tuple[int, int] | None = None,
-               fullscreen: bool = False) -> DemoWindow:
+               fullscreen: bool = False, palette: str = "okabe-ito", text_scale: float = 1.0) -> DemoWindow:
     """Open the window and play demo ``name`` until Esc or close (or ``max_frames`` frames)."""
-    window = DemoWindow(name, run, speed=speed, clock=clock, size=size, fullscreen=fullscreen)
+    window = DemoWindow(name, run, speed=speed, clock=clock, size=size, fullscreen=fullscreen, palette=palette,
+                        text_scale=text_scale)
     window.open()
     # Clock.tick only paces the frames (it sleeps); the physics reads ``clock`` instead.
     pacer = pygame.time.Clock()

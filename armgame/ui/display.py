@@ -104,14 +104,17 @@ def fit_size(wanted: tuple[int, int] | None, default: tuple[int, int], desktop: 
 
 
 def open_window(size: tuple[int, int] | None = None, fullscreen: bool = False, caption: str = "armgame",
-                default: tuple[int, int] = (1024, 720)) -> pygame.Surface:
-    """A resizable window of ``size`` (fitted to the desktop), or the whole screen."""
+                default: tuple[int, int] | None = (1024, 720)) -> pygame.Surface:
+    """A resizable window of ``size`` (fitted to the desktop), or the whole screen. With no ``size``, one
+    of ``default``'s shape; ``default=None``: the desktop's own shape (a 4:3 projector, a 4:3 window)."""
     init_display()
     pygame.display.set_caption(caption)
     try:
         if fullscreen:
             return pygame.display.set_mode((0, 0), pygame.FULLSCREEN)
-        return pygame.display.set_mode(fit_size(size, default, desktop_size()), pygame.RESIZABLE)
+        desktop = desktop_size()
+        shape = default or (max(320, desktop[0] - DECORATION[0]), max(240, desktop[1] - DECORATION[1]))
+        return pygame.display.set_mode(fit_size(size, shape, desktop), pygame.RESIZABLE)
     except pygame.error as exc:
         pygame.display.quit()
         raise NoDisplayError(f"cannot open a window ({exc})") from None

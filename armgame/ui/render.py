@@ -210,6 +210,10 @@ class GameRenderer:
         #: Where the last frame drew over its background (None: draw the next frame whole).
         self._dirty: list[pygame.Rect] | None = None
         self._frame_key: tuple | None = None
+        #: The size of the window the text is read in, when this renderer draws only part of it (the
+        #: autopilot's two games): text sized for the whole window, as the back row sees it. None: the
+        #: surface drawn on is the window.
+        self.text_basis: tuple[int, int] | None = None
 
     # ------------------------------------------------------------------ text
     def font(self, height: int) -> pygame.font.Font:
@@ -279,13 +283,19 @@ class GameRenderer:
         u = min(w, h) / 720.0
         pad, gap = max(6, round(16 * u)), max(4, round(8 * u))
         k = self.text_scale
-        small = round(max(12, round(18 * u), min_text(size)) * k)
-        normal = max(round(max(13, round(22 * u)) * k), small + 2)
-        big = round(max(18, round(40 * u)) * k)
+        basis = self.text_basis or size
+        tu = min(basis) / 720.0
+        small = round(max(12, round(18 * tu), min_text(basis)) * k)
+        normal = max(round(max(13, round(22 * tu)) * k), small + 2)
+        big = round(max(18, round(40 * tu)) * k)
         p = self.palette
         landscape = w >= 1.15 * h
         if landscape:
-            side = min(max(round(w * 0.27), 200), 480, w - round(h * 0.55))
+            # Wide enough for the mode's words and the clock where the window allows (text sized for a
+            # larger window than this one: a half of the autopilot's).
+            needed = max([self.text_size(part, normal)[0] for part in hud.mode.split("   ")] +
+                         [self.text_size("Time 00.0", big)[0]]) + 2 * pad
+            side = min(max(round(w * 0.27), 200, needed), max(480, needed), w - round(h * 0.55))
             hud_area = pygame.Rect(pad, pad, side - 2 * pad, h - 2 * pad)
             scene = pygame.Rect(side, pad, w - side - pad, h - 2 * pad)
         else:
@@ -301,18 +311,24 @@ class GameRenderer:
             labels.append(self.label(line, normal, p.ink, "mode", topleft=(x0, y)))
             y = labels[-1].rect.bottom + gap // 2
         y += gap // 2
-        score = self.label(f"Score {board.score}", big, p.ink, "score", topleft=(x0, y))
+        # Score and clock share a line on a tall window: smaller than ``big`` where a narrow one (half of
+        # the autopilot's) would make them meet, never smaller than ``normal``.
+        head = big
+        while not landscape and head > normal and \
+                self.text_size("Score 000", head)[0] + 2 * gap + self.text_size("Time 00.0", head)[0] > hud_area.width:
+            head -= 1
+        score = self.label(f"Score {board.score}", head, p.ink, "score", topleft=(x0, y))
         clock_colour = p.warn if 0 < session.time_left <= WARN_SECONDS else p.ink
         clock = f"Time {clock_text(session.time_left)}"
         if landscape:
             labels.append(score)
             y = score.rect.bottom + gap
-            labels.append(self.label(clock, big, clock_colour, "clock", topleft=(x0, y)))
+            labels.append(self.label(clock, head, clock_colour, "clock", topleft=(x0, y)))
         else:
             labels.append(score)
             # Right-aligned, but sized for the widest clock so it never moves as the digits change.
-            widest = self.text_size("Time 00.0", big)[0]
-            labels.append(self.label(clock, big, clock_colour, "clock",
+            widest = self.text_size("Time 00.0", head)[0]
+            labels.append(self.label(clock, head, clock_colour, "clock",
                                      topleft=(hud_area.right - widest, y)))
         y = labels[-1].rect.bottom + 2 * gap
         # The replay's progress and speed.
@@ -342,9 +358,13 @@ class GameRenderer:
             block_h = max(block_h, panel_labels[1].rect.bottom - block_top)
         else:
             activation = session.muscles.activation
+            # A column too narrow for "f  posterior deltoid" names each muscle by its last word ("deltoid").
+            short = any(self.text_size(f"{key}  {name}", small)[0] > col_w
+                        for key, name in zip(self.key_labels, self.muscle_names, strict=True))
             for i, (key, name) in enumerate(zip(self.key_labels, self.muscle_names, strict=True)):
                 cx = x0 + (i % columns) * (col_w + 2 * pad)
                 ry = block_top + (i // columns) * row_h
+                name = name.split()[-1] if short and name.split() else name
                 label = self.label(self.fit_text(f"{key}  {name}", small, col_w), small, p.ink, "muscle",
                                    topleft=(cx, ry))
                 labels.append(label)
