@@ -5,9 +5,11 @@
 
 Each picture is a real frame of a real run: the game's model bot playing seed 10, the lab's adapting
 bot in the curl field (mid-reach, and the window's last screen with its learning curve), a live class's
-standings as ``armgame class show`` draws them (from standings made up here: no class is served), drawn by the
-windows' own renderers onto an off-screen surface (SDL's dummy
-video driver: no display needed), then scaled down to a small PNG for the README.
+standings as ``armgame class show`` draws them (from standings made up here: no class is served), the
+menu (as it opens, and its Settings page after choosing a bright room's looks), the planning and
+interaction demos and the autopilot race, drawn by the windows' own renderers onto an off-screen surface
+(SDL's dummy video driver: no display needed); the game and the lab scaled down to a small PNG for the
+README, the rest kept at a projector's 1024 x 768.
 """
 
 from __future__ import annotations
@@ -35,8 +37,9 @@ from armgame.ui.render import GameRenderer, Hud
 HERE = Path(__file__).resolve().parent
 #: Drawn at a projector's size, saved at half of it: small files, text still legible on GitHub.
 DRAW_SIZE, SAVE_SIZE = (1280, 720), (800, 450)
-#: The class's standings are drawn and saved at a projector's size: they are read from the back row.
-CLASS_SIZE = (1024, 768)
+#: The class's standings, the menu and the demos are drawn and saved at a projector's size, whole: they
+#: are read from the back row (text 19 px or more).
+CLASS_SIZE = PROJECTOR = (1024, 768)
 
 
 def _save(surface: pygame.Surface, path: Path) -> Path:
@@ -128,6 +131,99 @@ def class_frame(out: Path) -> Path:
     return path
 
 
+def _draw_menu(build, out: Path, name: str, palette: str = "okabe-ito", text_scale: float = 1.0,
+               status: str = "") -> Path:
+    from armgame.ui.menu import MenuWindow
+
+    menu = MenuWindow(build, palette=palette, text_scale=text_scale)
+    menu.status = status
+    menu.screen = pygame.Surface(PROJECTOR)
+    menu.draw()
+    path = out / name
+    pygame.image.save(menu.screen, str(path))
+    return path
+
+
+def menu_frame(out: Path) -> Path:
+    """`armgame` alone: the menu's first page at a projector's 1024 x 768, as it first opens."""
+    from armgame.commands.menu import main_page
+
+    return _draw_menu(lambda: main_page(lambda argv: 0), out, "menu.png")
+
+
+def menu_settings_frame(out: Path) -> Path:
+    """The menu's Settings page just after a teacher chose high-contrast and text size 1.5 there: the
+    menu is redrawn with them at once (a settings file of its own in a temporary folder)."""
+    import tempfile
+
+    from armgame.commands.menu import settings_page
+
+    with tempfile.TemporaryDirectory() as folder:
+        saved = os.environ.get("XDG_CONFIG_HOME")
+        os.environ["XDG_CONFIG_HOME"] = folder
+        try:
+            for item in (0, 0, 1, 1):  # text size 1x -> 1.25x -> 1.5x; okabe-ito -> classic -> high-contrast
+                settings_page().items[item].act()
+
+            def shown():  # the file's path is this script's temporary one: the page shows the usual one
+                page = settings_page()
+                page.lines = tuple("~/.config/armgame/settings.toml" if line.endswith("settings.toml") else line
+                                   for line in page.lines)
+                return page
+
+            return _draw_menu(shown, out, "menu_settings.png", "high-contrast", 1.5,
+                              "saved to ~/.config/armgame/settings.toml")
+        finally:
+            if saved is None:
+                del os.environ["XDG_CONFIG_HOME"]
+            else:
+                os.environ["XDG_CONFIG_HOME"] = saved
+
+
+def _demo(name: str, out: Path, seconds: float, palette: str = "okabe-ito", text_scale: float = 1.0) -> Path:
+    from armgame.demos.catalog import make_run
+    from armgame.ui.demo_window import DemoWindow
+
+    now = [0.0]
+    window = DemoWindow(name, make_run(name), clock=lambda: now[0], size=PROJECTOR, palette=palette,
+                        text_scale=text_scale)
+    window.open()
+    pygame.display.set_mode(PROJECTOR)
+    window.handle(pygame.event.Event(pygame.VIDEORESIZE, w=PROJECTOR[0], h=PROJECTOR[1], size=PROJECTOR))
+    while window.run.t < seconds:
+        now[0] += 1 / 60
+        window.frame()
+    path = out / f"demo_{name}.png"
+    pygame.image.save(pygame.display.get_surface(), str(path))
+    window.close()
+    return path
+
+
+def planning_frame(out: Path) -> Path:
+    """`armgame demo planning` at 1024 x 768 mid-reach: both plans, the speed plot, the legend."""
+    return _demo("planning", out, 0.7)
+
+
+def interaction_frame(out: Path) -> Path:
+    """`armgame demo interaction` at 1024 x 768 with a bright room's settings (high-contrast, 1.5)."""
+    return _demo("interaction", out, 0.55, "high-contrast", 1.5)
+
+
+def autopilot_frame(out: Path) -> Path:
+    """`armgame demo autopilot` at a 4:3 projector's 1024 x 768, 15 s into the race."""
+    from armgame.ui.autopilot_window import AutopilotWindow
+
+    pygame.display.init()
+    screen = pygame.display.set_mode(PROJECTOR)
+    window = AutopilotWindow(10, 60.0, screen, clock=lambda: 0.0)
+    window.skip(15.0)
+    window.frame(0.0)
+    path = out / "demo_autopilot.png"
+    pygame.image.save(pygame.display.get_surface(), str(path))
+    pygame.display.quit()
+    return path
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=HERE / "img", help="folder for the PNGs (default docs/img)")
@@ -136,8 +232,11 @@ def main(argv: list[str] | None = None) -> int:
     pygame.display.init()
     pygame.font.init()
     try:
-        for draw in (game_frame, lab_frame, lab_end_frame, class_frame):
+        for draw in (game_frame, lab_frame, lab_end_frame, class_frame, menu_frame, menu_settings_frame,
+                     planning_frame, interaction_frame, autopilot_frame):
             print(f"wrote {draw(args.out)}")
+            pygame.display.init()  # a demo window closes the display it opened
+            pygame.font.init()
     finally:
         pygame.quit()
     return 0
