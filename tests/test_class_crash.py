@@ -19,7 +19,9 @@ from armgame.classroom import client
 from armgame.records.scores import ScoreTable
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="SIGKILL is POSIX's")
-GAMES, CLIENTS, KILL_AFTER = 1000, 20, 300
+# 400 games from 20 clients: the kill lands with all 20 in flight, as with 1,000 (the first version of
+# this test), for under half the suite's CPU.
+GAMES, CLIENTS, KILL_AFTER = 400, 20, 120
 
 
 def free_port() -> int:
@@ -92,7 +94,7 @@ def test_every_acknowledged_game_survives_a_kill_in_a_burst(tmp_path, monkeypatc
     finally:
         proc.send_signal(signal.SIGINT)  # Ctrl-C
         out, _ = proc.communicate(timeout=30)
-    assert proc.returncode == 0 and "armgame class stopped: 1000 games kept" in out, out
+    assert proc.returncode == 0 and f"armgame class stopped: {GAMES} games kept" in out, out
     assert refused == [] and sorted(acked) == list(range(GAMES))
     entries, damage = ScoreTable(folder).read()
     assert damage is None and len(entries) == GAMES and len({e.game_sha256 for e in entries}) == GAMES

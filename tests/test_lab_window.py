@@ -1,6 +1,7 @@
 """The lab window under SDL's dummy driver: keys drive the task, the cursor and targets are drawn where the
 session says, and a bot in the window plays the same trials as headless."""
 
+import argparse
 import json
 import os
 from pathlib import Path
@@ -14,8 +15,9 @@ import pytest
 from armgame.game.bots import Autopilot
 from armgame.game.session import RealTimeDriver
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import Block, Perturbation, Protocol
+from armgame.lab.protocol import Block, Perturbation, Protocol, preset
 from armgame.lab.session import LabSession, lab_config
+from armgame.limits import MAX_GAME_SECONDS
 from armgame.ui.frontend import open_window
 from armgame.ui.lab_window import CURSOR, HOME, LabWindow
 from armgame.ui.render import PALETTES, Viewport
@@ -142,6 +144,40 @@ def test_a_person_quitting_early_keeps_a_replay_that_verifies(tmp_path, monkeypa
     data = json.loads(record.read_text())
     assert data["driven"] == "keyboard" and [e[1] for e in data["timeline"]] == ["j", "j"]
     assert len(data["task"]["trials"]) >= 2
+    # A person's clock (curl: 120 trials): three times the worst trials and two minutes more, not a
+    # program's one and a half times and one minute.
+    curl = preset("curl")
+    worst = curl.trials * (curl.delay[1] + curl.timeout)
+    assert data["config"]["time_limit"] == 3 * worst + 120 == lab_config(curl, 10, person=True).time_limit
+
+
+def test_a_persons_run_has_room_on_the_clock_and_says_when_it_ran_out(capsys):
+    """A volunteer slow to bring the hand home still finishes the lesson where a program's clock would
+    have ended the run; a run whose clock does run out says so, not just "stopped"."""
+    from armgame.commands.lab import _report
+
+    lesson = preset("lesson")
+    program, person = lab_config(lesson, 1).time_limit, lab_config(lesson, 1, person=True).time_limit
+    assert (program, person) == (204, 408)  # docs/lab.md, the task
+    assert person >= 2 * program and lab_config(preset("curl"), 1, person=True).time_limit <= MAX_GAME_SECONDS
+    slow = LabSession(lab_config(lesson, 1, person=True), lesson)
+    pilot, dawdled = Autopilot(slow, make_lab_bot("model")), -1
+    while not slow.over:
+        if slow.phase == "hold" and slow.trial_index != dawdled:  # 8 s off home before each trial, then home
+            dawdled = slow.trial_index
+            slow.key_event("k", "down")
+            slow.advance(round(8.0 / slow.config.dt))
+            slow.key_event("k", "up")
+            slow.key_event("space", "down")
+            slow.key_event("space", "up")
+        pilot.advance(1)
+    assert slow.finished and slow.steps > program / slow.config.dt  # past where a program's clock ends
+    idle = LabSession(lab_config(THREE, 1), THREE)
+    idle.key_event("k", "down")  # the hand never back home: no trial starts
+    while not idle.over:
+        idle.advance(idle.total_steps)
+    _report(idle, argparse.Namespace())
+    assert idle.out_of_time and "(its time ran out)" in capsys.readouterr().out
 
 
 THREE = Protocol("three", (Block("baseline", 2, Perturbation(), 0, "Reach straight."),

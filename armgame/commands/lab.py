@@ -143,8 +143,8 @@ def run(args: argparse.Namespace) -> int:
     from .classroom import join_class
 
     args.membership = join_class(args)  # before the run: a wrong code is said now, not after ten minutes
-    config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys)),
-                              str(args.protocol))
+    config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys),
+                                         person=not args.bot), str(args.protocol))
     session = LabSession(config, protocol)
     bot, rates = None, None
     if args.bot:
@@ -324,8 +324,9 @@ def _report(session, args: argparse.Namespace) -> None:
     from ..lab.analysis import block_summary, channel_summary, trial_rows
 
     done, total = len(session.outcomes), len(session.plans)
+    ending = "" if session.finished else " (its time ran out)" if session.out_of_time else " (stopped before the end)"
     print(f"lab {session.protocol.name}: {done} of {total} trials, {session.result().hits} hits, seed "
-          f"{session.config.seed}{'' if session.finished else ' (stopped before the end)'}")
+          f"{session.config.seed}{ending}")
     if session.outcomes:
         rows = trial_rows(session)
         for b in block_summary(rows):
@@ -376,7 +377,8 @@ def _hand_in(session, args: argparse.Namespace) -> str:
     from ..classroom.client import hand_in
 
     if not session.finished:
-        return "the run stopped before its last trial: not handed in to the class"
+        how = "ran out of time" if session.out_of_time else "stopped"
+        return f"the run {how} before its last trial: not handed in to the class"
     return hand_in(args.membership, _replay(session, args).to_bytes()).message
 
 

@@ -29,6 +29,7 @@ from ..errors import UserError
 from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
 from ..game.rules import GameConfig, Target
 from ..game.session import GameResult, GameSession
+from ..limits import MAX_GAME_SECONDS
 from ..physics.integrators import Integrator
 from ..physics.loads import ChannelField, Loads, loaded_arm
 from .perturbations import Display, display_for, loads_for
@@ -110,11 +111,19 @@ def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]
 
 
 def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = DEFAULT_MUSCLES,
-               **options: object) -> GameConfig:
+               person: bool = False, **options: object) -> GameConfig:
     """The ``GameConfig`` a lab run plays on: the game's arm and muscles, home as the start posture,
-    and a clock long enough for every trial (a run that fidgets at home past it ends there)."""
+    and a clock long enough for every trial (a run that fidgets at home past it ends there).
+
+    ``person``: a person at the keys gets three times the time every trial could take, and two minutes
+    more (``lesson``: 5 minutes of reaching, cards and paths not counted), where a program gets one and a
+    half times and one minute: a volunteer slow to bring the hand home, or talking to the class, must not
+    lose the run on the clock. Only a run that idles costs more to replay; a finished one ends at its last
+    trial."""
     worst = protocol.trials * (protocol.delay[1] + protocol.timeout)
-    time_limit = float(min(86400, math.ceil(1.5 * worst + 60.0)))
+    program = math.ceil(1.5 * worst + 60.0)
+    time_limit = float(min(86400, max(program, min(math.ceil(3.0 * worst + 120.0), MAX_GAME_SECONDS)) if person
+                           else program))
     home = tuple(math.radians(a) for a in protocol.home_posture_deg)
     return GameConfig(start_posture=home, time_limit=time_limit, seed=seed, muscles=muscles,  # type: ignore[arg-type]
                       target_radius=protocol.target_radius, scene=LAB_SCENE, **options)  # type: ignore[arg-type]
@@ -167,6 +176,11 @@ class LabSession(GameSession):
     @property
     def over(self) -> bool:
         return self.finished or self.steps >= self.total_steps
+
+    @property
+    def out_of_time(self) -> bool:
+        """The run's clock ran out before its last trial ended (``lab_config``)."""
+        return not self.finished and self.steps >= self.total_steps
 
     @property
     def plan(self) -> TrialPlan | None:

@@ -451,7 +451,7 @@ class LabWindow(GameWindow):
         rows = trial_rows(s)
         self.curve = learning_curve(rows, figure_metric(s.protocol))
         self.summary = f"{s.protocol.name}: {plural(len(s.outcomes), 'trial')}, {plural(s.result().hits, 'hit')}" + \
-            ("" if s.finished else " (stopped before the end)")
+            ("" if s.finished else " (its time ran out)" if s.out_of_time else " (stopped before the end)")
         if self.on_finish is not None:
             self.renderer.draw(self.screen, s, 1.0, self._lab_hud(saving=True))
             pygame.display.flip()
