@@ -30,13 +30,10 @@ from armgame.records.replay import Replay  # noqa: E402
 STUDENTS = [("Amira", 42), ("Ben", 30), ("Chloé", 55), ("Dmitri", 18), ("Eun-ji", 48), ("Farah", 25),
             ("Gabriel", 36), ("Hana", 12), ("Ife", 58), ("Jonas", 22), ("Kai", 40), ("Lucía", 33), ("Mateo", 8),
             ("Nour", 45), ("Oskar", 28)]
-LAB = ('name = "curl lesson"\ntargets = 4\ntimeout = 1.5\n[[blocks]]\nname = "baseline"\ntrials = 8\n'
-       '[[blocks]]\nname = "curl field"\ntrials = 24\nperturbation = "curl"\nb = -2.0\n'
-       '[[blocks]]\nname = "washout"\ntrials = 12\n')
-
-
+#: The volunteers run the guide's own protocol (docs/teaching.md): the lesson preset.
+LAB = "lesson"
 QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
-             'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 2\n')
+             'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')  # the after-effect at the edge
 #: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
 PICTURES = ("class_page.png", "class_lab.png")
 
@@ -50,11 +47,13 @@ def fill(opened, work: Path, quick: bool = False) -> None:
         client.hand_in(member, keyboard_game(seconds * 0.7, player=name).to_bytes())
         if i % 3 == 0:
             client.hand_in(member, keyboard_game(seconds * 0.5 + 1, player=name).to_bytes())
-    (work / "lesson.toml").write_text(QUICK_LAB if quick else LAB)
+    protocol = str(work / "quick.toml") if quick else LAB
+    if quick:
+        (work / "quick.toml").write_text(QUICK_LAB)
     for i, name in enumerate(("Amira", "Ben") if quick else ("Amira", "Ben", "Chloé", "Dmitri")):
         os.environ[client.CLIENT_ENV] = str(work / f"m{i}")
         record = work / f"lab{i}.json"
-        main(["lab", str(work / "lesson.toml"), "--bot", "adaptive", "--headless", "--seed", str(i + 1),
+        main(["lab", protocol, "--bot", "adaptive", "--headless", "--seed", str(i + 1),
               "--record", str(record)])
         replay = dataclasses.replace(Replay.load(record), driven="keyboard", driver=None, player=name)
         client.hand_in(client.join(address, code, name), replay.to_bytes())
@@ -85,6 +84,12 @@ def main_(argv: list[str] | None = None) -> int:
                 page.screenshot(path=str(out / f"class_page{suffix}.png"))
                 page.goto(f"http://127.0.0.1:{opened.port}/lab")
                 page.wait_for_selector(f"body[data-students='{2 if args.quick else 4}']", state="attached")
+                clipped = page.eval_on_selector_all(
+                    "svg text", "(texts) => { const box = texts[0].ownerSVGElement.getBoundingClientRect();"
+                    " return texts.filter(t => { const b = t.getBoundingClientRect();"
+                    " return b.left < box.left - 0.5 || b.right > box.right + 0.5; }).map(t => t.textContent); }")
+                if clipped:  # a label drawn past the curve's edge (the after-effect beside a short washout)
+                    raise SystemExit(f"the class curve at {width}x{height} cuts {clipped}")
                 page.screenshot(path=str(out / f"class_lab{suffix}.png"))
                 print(f"wrote {out / f'class_page{suffix}.png'} and class_lab{suffix}.png")
             browser.close()

@@ -329,9 +329,11 @@ def _report(session, args: argparse.Namespace) -> None:
           f"{session.config.seed}{ending}")
     if session.outcomes:
         rows = trial_rows(session)
-        for b in block_summary(rows):
-            print(f"  {b['block']}: {b['trials']} trials, {b['hits']} hits; max perpendicular error "
-                  f"first 8 {_cm(b['early'])}, last 8 {_cm(b['late'])}")
+        cycle = session.protocol.targets  # a cycle of targets: each direction's own offset averages out
+        for b in block_summary(rows, first=cycle):
+            where = (f"mean {_cm(b['early'])}" if b["trials"] <= cycle else
+                     f"first {cycle} {_cm(b['early'])}, last {cycle} {_cm(b['late'])}")
+            print(f"  {b['block']}: {b['trials']} trials, {b['hits']} hits; max perpendicular error {where}")
         for b in channel_summary(rows):
             print(f"  {b['block']}: {b['channels']} channel trials; adaptation index {b['first']:+.2f} on the first, "
                   f"mean of {b['cycle']}: first {b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} "
