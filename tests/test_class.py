@@ -213,3 +213,38 @@ def test_the_end_screen_says_in_one_line_that_a_game_is_kept_when_the_class_is_a
                           "time you join")
     assert "cannot reach the class at 127.0.0.1:1" in capsys.readouterr().err
     assert len(list(client.outbox(gone).glob("*.json"))) == 1
+
+
+def test_a_folder_printed_for_the_teacher_pastes_whole_into_the_shell(tmp_path):
+    """macOS keeps the class under "Application Support": the printed command must survive the space."""
+    import shlex
+
+    from armgame.classroom.serve import shell_path
+
+    folder = tmp_path / "Application Support" / "armgame" / "classes" / "it's 2026"
+    assert shlex.split(f"armgame class serve --folder {shell_path(folder)}")[-1] == str(folder)
+    assert shell_path(tmp_path / "plain") == str(tmp_path / "plain")
+
+
+def test_the_guide_shows_the_lines_the_class_prints(tmp_path):
+    """docs/teaching.md's copy of the banner: line for line what ``armgame class serve`` prints, only the code,
+    address, secret and folder differing."""
+    import re
+    from pathlib import Path
+
+    guide = (Path(__file__).resolve().parent.parent / "docs" / "teaching.md").read_text(encoding="utf-8")
+    shown = guide.split("It prints what the class needs", 1)[1].split("```text\n", 1)[1].split("```", 1)[0]
+    printed: list[str] = []
+    with running_class(tmp_path / "class", lines=printed):
+        pass
+    variable = {re.escape("FROG"): "[A-Z]{4}", re.escape("192.168.1.20:8765"): r"127\.0\.0\.1:\d+",
+                re.escape("x3H..."): r"\S+", re.escape("/home/teacher/.local/share/armgame/classes/2026-11-25"): r"\S+"}
+    patterns = []
+    for line in shown.splitlines():
+        pattern = re.escape(line)
+        for literal, general in variable.items():
+            pattern = pattern.replace(literal, general)
+        patterns.append(pattern)
+    assert len(printed) == len(patterns), printed
+    for pattern, line in zip(patterns, printed, strict=True):
+        assert re.fullmatch(pattern, line), (pattern, line)

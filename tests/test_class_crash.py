@@ -95,6 +95,8 @@ def test_every_acknowledged_game_survives_a_kill_in_a_burst(tmp_path, monkeypatc
         proc.send_signal(signal.SIGINT)  # Ctrl-C
         out, _ = proc.communicate(timeout=30)
     assert proc.returncode == 0 and f"armgame class stopped: {GAMES} games kept" in out, out
+    # Where the class's games are now, as commands to paste: no lab run, so no class curve offered.
+    assert f"armgame scores --scores {folder}" in out and "armgame analyze" not in out
     assert refused == [] and sorted(acked) == list(range(GAMES))
     entries, damage = ScoreTable(folder).read()
     assert damage is None and len(entries) == GAMES and len({e.game_sha256 for e in entries}) == GAMES

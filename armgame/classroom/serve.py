@@ -12,6 +12,8 @@ from __future__ import annotations
 import contextlib
 import errno
 import logging
+import os
+import shlex
 import signal
 import socket
 import sys
@@ -129,7 +131,7 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
             say(f"  this machine also answers at {', '.join(others)}, if students are on that network")
         say("  the first time, Windows or macOS may ask to allow incoming connections for Python: allow it on "
             "private networks")
-        say(f"  Ctrl-C stops the class; to go on with it later: armgame class serve --folder {folder}")
+        say(f"  Ctrl-C stops the class; to go on with it later: armgame class serve --folder {shell_path(folder)}")
         if on_ready is not None:
             on_ready(opened)
 
@@ -157,8 +159,23 @@ def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[s
     """Run the class in ``folder`` on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit status."""
     opened = open_class(folder, host, port, seed, say)
     opened.run()
+    where = shell_path(folder)
     say(f"armgame class stopped: {len(opened.clerk.entries)} games kept in {folder}")
+    say(f"  the standings, one row a student:  armgame scores --scores {where}")
+    if opened.clerk.lab_runs:
+        lab = shell_path(folder / "lab")
+        say(f"  the lab's class curve:             armgame analyze --class {lab} --out class-curve")
+    say(f"  to go on with the class:           armgame class serve --folder {where}")
     return 0
+
+
+def shell_path(path: Path) -> str:
+    """``path`` as it can be pasted into this platform's shell: quoted if it holds a space (macOS's data folder is
+    under "Application Support") or anything else the shell would read."""
+    text = str(path)
+    if os.name == "nt":
+        return f'"{text}"' if any(c in text for c in ' &()[]{}^=;!\'+,`~') else text
+    return shlex.quote(text)
 
 
 def _interrupt(signum: int, frame: object) -> None:
