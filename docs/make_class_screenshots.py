@@ -32,8 +32,9 @@ STUDENTS = [("Amira", 42), ("Ben", 30), ("Chloé", 55), ("Dmitri", 18), ("Eun-ji
             ("Nour", 45), ("Oskar", 28)]
 #: The volunteers run the guide's own protocol (docs/teaching.md): the lesson preset.
 LAB = "lesson"
+#: The washout one trial long: the after-effect's label at the curve's right edge, where it must stay inside.
 QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
-             'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')  # the after-effect at the edge
+             'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')
 #: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
 PICTURES = ("class_page.png", "class_lab.png")
 

@@ -82,8 +82,9 @@ def lab_frame(out: Path) -> Path:
 
 
 def lab_end_frame(out: Path) -> Path:
-    """The lab window's last screen: the lesson's learning curve, by the adapting bot (a volunteer's run,
-    kept with --record volunteers/v1.json, looks the same)."""
+    """The lab window's last screen at a projector's 1024 x 768, as a volunteer of the guide's lesson sees it
+    (``armgame lab lesson --join ...``): the learning curve (the adapting bot's run standing in), where each
+    file was kept, the run handed in to the class, r run again or Esc quit."""
     from armgame.commands.lab import kept_lines
     from armgame.lab.analysis import figure_metric, learning_curve, trial_rows
     from armgame.ui.lab_panels import draw_end
@@ -92,14 +93,36 @@ def lab_end_frame(out: Path) -> Path:
     session = LabSession(lab_config(protocol, 10), protocol)
     Autopilot(session, make_lab_bot("adaptive")).play()
     renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
-    surface = pygame.Surface(DRAW_SIZE)
+    surface = pygame.Surface(PROJECTOR)
     curve = learning_curve(trial_rows(session), figure_metric(protocol))
     folder = Path.home() / ".local/share/armgame/lab/2026-11-25_104500_lesson"  # shown as ~/ on any machine
-    kept = kept_lines([Path.home() / "class/volunteers/v1.json", folder / "trials.csv",
-                       folder / "learning.png", folder / "paths.png"])
+    kept = kept_lines([folder / "replay.json", folder / "trials.csv", folder / "learning.png", folder / "paths.png"])
     draw_end(renderer, surface, f"lesson: {len(session.outcomes)} trials, {session.result().hits} hits", curve,
-             kept, ("r run again", "Esc quit"))
-    return _save(surface, out / "lab_end.png")
+             [*kept, "Lab run handed in: in the class curve"], ("r run again", "Esc quit"))
+    path = out / "lab_end.png"
+    pygame.image.save(surface, str(path))
+    return path
+
+
+def game_end_frame(out: Path) -> Path:
+    """The game's end screen at a projector's 1024 x 768 for a student in the live class who also keeps
+    each game (``armgame play --join ... --record``): handed in, ranked, and the file it was saved as."""
+    from armgame.commands.play import _screen_line
+    from armgame.ui.render import Standing
+
+    session = GameSession(GameConfig(seed=10))
+    Autopilot(session, make_bot("model")).play()
+    renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
+    top = ((1, "Ife", 58), (2, "Chloé", 55), (3, "Ann B", session.result().score), (4, "Nour", 45), (5, "Amira", 42))
+    note = _screen_line("handed in: 3rd of 24 in the class (your best so far)")
+    standing = Standing(3, 24, top, "the class", note=note,
+                        saved="Saved as ann-b-game3.json")
+    surface = pygame.Surface(PROJECTOR)
+    renderer.draw(surface, session, hud=Hud(mode="PLAY", ended=True, standing=standing,
+                                            end_hint="Enter plays again    Esc quits"))
+    path = out / "game_end.png"
+    pygame.image.save(surface, str(path))
+    return path
 
 
 def class_frame(out: Path) -> Path:
@@ -232,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
     pygame.display.init()
     pygame.font.init()
     try:
-        for draw in (game_frame, lab_frame, lab_end_frame, class_frame, menu_frame, menu_settings_frame,
+        for draw in (game_frame, game_end_frame, lab_frame, lab_end_frame, class_frame, menu_frame, menu_settings_frame,
                      planning_frame, interaction_frame, autopilot_frame):
             print(f"wrote {draw(args.out)}")
             pygame.display.init()  # a demo window closes the display it opened
