@@ -56,7 +56,7 @@ def test_protocol_names_the_class_and_an_unknown_name_is_one_line(tmp_path, reco
     out = ["--out", str(tmp_path / "curve"), "--no-figures"]
     assert main(["analyze", "--class", str(folder), "--protocol", "tiny", *out]) == 1
     captured = capsys.readouterr()
-    assert "class curve of 1 students (1 left out), 1 trials" in captured.out
+    assert "class curve of 1 student (1 left out), 1 trial" in captured.out
     assert "student1.json: its protocol 'short' differs from the class's ('tiny', shared by 1 replays)" \
         in captured.err
     assert main(["analyze", "--class", str(folder), "--protocol", "nope", *out, "--force"]) == 2

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..errors import UserError
 from ..records.storage import user_path
+from ..words import plural
 from . import read_lab_replays
 
 #: A class folder is read up to this many replays: the work is bounded before it starts.
@@ -317,7 +318,8 @@ def _class(args: argparse.Namespace) -> int:
 
         class_figure(curve, out / "class_curve.png", metric=metric)
         written.append(out / "class_curve.png")
-    print(f"class curve of {len(students)} students ({skipped} left out), {len(curve)} trials, {metric}")
+    print(f"class curve of {plural(len(students), 'student')} ({skipped} left out), {plural(len(curve), 'trial')}, "
+          f"{metric}")
     for path in written:
         print(f"wrote {path}")
     return 1 if skipped else 0
