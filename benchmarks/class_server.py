@@ -215,7 +215,7 @@ class Server:
 
     def notices(self) -> dict[str, int]:
         """What the server printed after its banner (uvicorn's warnings too), each line with its count; its last
-        line ("armgame class stopped: ...") left out."""
+        lines ("armgame class stopped: ..." and the commands that read the class afterwards) left out."""
         while True:
             try:
                 line = self.lines.get_nowait()
@@ -224,9 +224,10 @@ class Server:
             if line is not None:
                 self.said.append(line)
         counts: dict[str, int] = {}
-        for line in self.said[self.banner:]:
-            if not line.startswith("armgame class stopped:"):
-                counts[line] = counts.get(line, 0) + 1
+        said = self.said[self.banner:]
+        stopped = next((i for i, line in enumerate(said) if line.startswith("armgame class stopped:")), len(said))
+        for line in said[:stopped]:
+            counts[line] = counts.get(line, 0) + 1
         return counts
 
     def cpu_seconds(self) -> float | None:
