@@ -19,6 +19,7 @@ from class_server import keyboard_game, running_class, tapped_game, tapped_games
 
 from armgame.classroom import app as class_app
 from armgame.classroom import client
+from armgame.classroom.roster import Roster
 
 
 @pytest.fixture
@@ -237,3 +238,33 @@ def test_a_full_class_does_not_flood_the_teachers_terminal(opened):
 
     assert not logger.filter(warning("Exceeded concurrency limit."))
     assert logger.filter(warning("Invalid HTTP request received."))
+
+
+def test_the_teacher_frees_a_name_for_a_students_new_machine(opened):
+    """Ann's laptop fails: another machine cannot take her name until the teacher frees it; then her new machine
+    joins under it and hands in, the old one no longer can, and her games stay one row of hers."""
+    code, secret = opened.clerk.roster.code, {"Authorization": f"Bearer {opened.clerk.roster.secret}"}
+    old = join(opened, "Ann")[1]["token"]
+    assert call(opened, "POST", "/api/handin", tapped_game(3, player="Ann").to_bytes(),
+                {"Authorization": f"Bearer {old}", "X-Armgame-Code": code})[0] == 200
+    status, answer = join(opened, "ann")  # the new laptop, the name typed in another case
+    assert status == 409 and "taken" in answer["error"]
+    student = {"Authorization": f"Bearer {old}"}
+    status, answer = call(opened, "POST", "/api/teacher/release", b'{"name": "Ann"}', student)
+    assert status == 403 and "teacher's secret" in answer["error"]  # a student cannot free names
+    status, answer = call(opened, "POST", "/api/teacher/release", b'{"name": "Bob"}', secret)
+    assert status == 404 and "no machine" in answer["error"]
+    assert call(opened, "POST", "/api/teacher/release", b'{"name": 7}', secret)[0] == 400
+    status, answer = call(opened, "POST", "/api/teacher/release", b'{"name": "ANN"}', secret)
+    assert status == 200 and "Ann is free" in answer["message"]
+    status, answer = join(opened, "Ann")
+    assert status == 200 and answer["token"] != old
+    new = answer["token"]
+    status, answer = call(opened, "POST", "/api/handin", tapped_game(4, player="Ann").to_bytes(),
+                          {"Authorization": f"Bearer {old}", "X-Armgame-Code": code})
+    assert status == 401  # the failed laptop, back from the dead, hands in nothing under her name
+    assert call(opened, "POST", "/api/handin", tapped_game(5, player="Ann").to_bytes(),
+                {"Authorization": f"Bearer {new}", "X-Armgame-Code": code})[0] == 200
+    students = call(opened, "GET", "/api/standings")[1]["students"]
+    assert [(r["name"], r["games"]) for r in students] == [("Ann", 2)]
+    assert Roster.open(opened.clerk.roster.folder, None)[0].player_of(new).name == "Ann"  # kept on disk

@@ -399,6 +399,12 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         message = await state.run(lambda: clerk.hide(body.get("name"), bool(body.get("hidden", True))))
         return _json({"ok": True, "message": message})
 
+    async def teacher_release(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.release(body.get("name")))
+        return _json({"ok": True, "message": message})
+
     async def teacher_close(request: Request) -> Response:
         _check_secret(state, request)
         body = await _json_body(request)
@@ -429,6 +435,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/join", _refusals(join), methods=["POST"]),
         Route("/api/handin", _refusals(hand_in), methods=["POST"]),
         Route("/api/teacher/hide", _refusals(teacher_hide), methods=["POST"]),
+        Route("/api/teacher/release", _refusals(teacher_release), methods=["POST"]),
         Route("/api/teacher/close", _refusals(teacher_close), methods=["POST"]),
         Route("/api/teacher/standings", _refusals(teacher_standings)),
         Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),

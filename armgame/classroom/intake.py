@@ -366,6 +366,26 @@ class Clerk:
         self.lab_version += 1
         return f"{name} is {'hidden from' if hidden else 'shown on'} the projector"
 
+    def release(self, name: object) -> str:
+        """The teacher lets another machine take a joined name (a student moved to another laptop): the old
+        machine's token no longer hands anything in; the next machine to join under the name gets it, and the
+        games already handed in stay the student's."""
+        if not isinstance(name, str):
+            raise RefusedError(400, "name must be a string")
+        key = player_key(name)
+        player = self.roster.players.get(key)
+        if player is None:
+            raise RefusedError(404, "no machine has joined under that name")
+        del self.roster.players[key]
+        try:
+            self.roster.save()
+        except (OSError, DataFileError):
+            self.roster.players[key] = player
+            raise
+        self.version += 1
+        return (f"{player.name} is free: the next machine to join under it takes it (the old one can no longer "
+                f"hand in); their games stay theirs")
+
     def close(self, closed: bool) -> str:
         self.roster.closed = bool(closed)
         self.roster.save()

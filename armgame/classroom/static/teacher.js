@@ -76,6 +76,10 @@ $("unlock").addEventListener("click", () => {
 });
 $("close").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: true}); } catch (e) { say(e.message); } refresh(); });
 $("open").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: false}); } catch (e) { say(e.message); } refresh(); });
+$("release").addEventListener("click", async () => {
+  try { say((await (await call("/api/teacher/release", {name: $("release-name").value.trim()})).json()).message); }
+  catch (e) { say(e.message); }
+});
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
 if (secret) refresh();
