@@ -608,3 +608,27 @@ def test_play_enter_plays_again_with_the_same_options_and_esc_keeps_the_replay(t
     assert main(add.replace("NAME", "Bo").split()[1:]) == 2
     assert "already in the table: entered by Ann" in capsys.readouterr().err
     assert [e.name for e in ScoreTable(scores).all_entries()] == ["Ann"]
+
+
+def test_the_end_screen_draws_a_name_in_any_script_as_it_is_typed(window, monkeypatch):
+    """A Hebrew name typed at the buzzer, and an Arabic one in the standings, are drawn with a font that has their
+    letters (names.TextRenderer), not the default font's empty boxes."""
+    def preview():
+        return Standing(2, 3, ((1, "محمد علي", 30), (2, "", 0)), "custom games", pending=True)
+
+    win, _ = window(time_limit=0.5, window_options={"ask_name": True, "standing": lambda name: None,
+                                                    "preview": preview})
+    for _ in range(80):
+        win.frame(1 / 60)
+    pygame.event.post(pygame.event.Event(pygame.TEXTINPUT, text="שירה"))
+    win.frame(0.0)
+    drawn: list[str] = []
+    original = win.renderer.draw_label
+    monkeypatch.setattr(win.renderer, "draw_label", lambda screen, label: (drawn.append(label.text),
+                                                                           original(screen, label))[1])
+    win.frame(0.0)
+    assert "שירה" in drawn and "محمد علي" in drawn
+    for name in ("שירה", "محمد علي"):
+        boxes = win.renderer.font(30).render(name, True, (0, 0, 0))
+        letters = win.renderer.text(name, 30, (0, 0, 0))
+        assert pygame.image.tobytes(letters, "RGBA") != pygame.image.tobytes(boxes, "RGBA")

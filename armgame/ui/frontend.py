@@ -27,8 +27,9 @@ from ..game.session import DOWN, UP, GameSession, InputEvent, RealTimeDriver
 from ..game.timeline import TimelineDriver
 from .display import open_window as _open_window
 from .display import toggle_fullscreen
+from .names import TextRenderer
 from .playback import MAX_FRAME, PLAYBACK_HELP, REPLAY_SPEEDS, SKIP_SECONDS, skip_sign, speed_after
-from .render import PLUS_ONE_TIME, GameRenderer, Hud, Standing
+from .render import PLUS_ONE_TIME, Hud, Standing
 from .settings import MIN_SIDE, Settings, SettingsError
 from .settings import load as load_settings
 from .settings import save as save_settings
@@ -159,7 +160,8 @@ class GameWindow:
         self.ended = False
         self._over_for = 0.0
         names = tuple(m.name for m in session.config.muscles)
-        self.renderer = GameRenderer(session.muscles.keys, names, palette)
+        # Any script: a student's name on the end screen and in the standings (names.TextRenderer).
+        self.renderer = TextRenderer(session.muscles.keys, names, palette)
         self.paused = False
         self.running = True
         self.fullscreen = bool(screen.get_flags() & pygame.FULLSCREEN)

@@ -238,6 +238,12 @@ class GameRenderer:
             surface = self._text[key] = self.font(height).render(string, True, colour)
         return surface
 
+    def draw_label(self, screen: pygame.Surface, label: Label) -> pygame.Rect:
+        """One label, in the default font (``names.TextRenderer`` draws any script)."""
+        if label.role == "name":  # changes with every key: not worth caching
+            return screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect)
+        return screen.blit(self.text(label.text, label.height, label.colour), label.rect)
+
     def text_size(self, text: str, height: int) -> tuple[int, int]:
         """``Font.size``, remembered: a layout measures the same strings frame after frame."""
         key = (text, height)
@@ -624,10 +630,7 @@ class GameRenderer:
             dirty.append(pygame.draw.rect(screen, p.scene, lay.name_box, border_radius=radius // 2))
             pygame.draw.rect(screen, p.ink, lay.name_box, max(1, round(2 * lay.unit)), border_radius=radius // 2)
         for label in lay.labels:
-            if label.role == "name":  # changes with every key: not worth caching
-                dirty.append(screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect))
-            else:
-                dirty.append(screen.blit(self.text(label.text, label.height, label.colour), label.rect))
+            dirty.append(self.draw_label(screen, label))
         self._dirty = _without_nested([r.inflate(2, 2) for r in dirty if r.width and r.height])
         return lay
 
