@@ -268,3 +268,28 @@ def test_the_teacher_frees_a_name_for_a_students_new_machine(opened):
     students = call(opened, "GET", "/api/standings")[1]["students"]
     assert [(r["name"], r["games"]) for r in students] == [("Ann", 2)]
     assert Roster.open(opened.clerk.roster.folder, None)[0].player_of(new).name == "Ann"  # kept on disk
+
+
+def test_a_lookalike_of_a_taken_name_is_the_taken_name(opened):
+    """A classmate joining as "\u0410nn" (a Cyrillic A) or "Ann  " with extra spaces is refused: on the projector it
+    would read as Ann."""
+    assert join(opened, "Ann B")[0] == 200
+    for lookalike in ("\u0410nn B", "ann   b", "\u0391NN B"):
+        status, answer = join(opened, lookalike)
+        assert status == 409 and "taken" in answer["error"], lookalike
+
+
+def test_a_class_from_before_lookalikes_counted_goes_on(tmp_path):
+    """class.json written under the older keys (inner spaces kept, lookalikes apart) opens, each player under
+    today's key, the first to join keeping a name two of them now share, hidden names still hidden."""
+    from armgame.classroom.roster import Player
+    from armgame.records.standings import legacy_player_key
+
+    roster, _ = Roster.open(tmp_path, None)
+    for name in ("Ann  B", "\u0410nn B", "Bo"):
+        roster.players[legacy_player_key(name)] = Player(name, "a" * 64, "2026-11-25T09:00:00+00:00")
+    roster.hidden = {legacy_player_key("Bo"), legacy_player_key("\u0410nn B")}
+    roster.save()
+    again, new = Roster.open(tmp_path, None)
+    assert not new and sorted(again.players) == ["ann b", "bo"] and again.players["ann b"].name == "Ann  B"
+    assert again.is_hidden("Bo") and again.is_hidden("Ann B")

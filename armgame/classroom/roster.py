@@ -29,7 +29,7 @@ from pathlib import Path
 
 from ..limits import DEFAULT_SEED
 from ..records.replay import check_date, check_name, now_iso
-from ..records.standings import player_key
+from ..records.standings import legacy_player_key, player_key
 from ..records.storage import (
     DataFileError,
     atomic_write_bytes,
@@ -134,8 +134,11 @@ class Roster:
             for key, item in d["players"].items():
                 p = check_keys(f"player {key!r}", item, {"name", "token_sha256", "joined"})
                 name = check_name(p["name"])
-                if player_key(name) != key:
+                if key not in (player_key(name), legacy_player_key(name)):
                     raise ValueError(f"player {key!r} is filed under another name's key")
+                key = player_key(name)  # a class from before lookalikes counted: filed again under today's key
+                if key in players:  # two names that are now one: the machine that joined first (filed first) keeps it
+                    continue
                 digest = check_str("token_sha256", p["token_sha256"], 64)
                 if not _HEX64.fullmatch(digest):
                     raise ValueError(f"player {name!r}: token_sha256 is not a SHA-256")
@@ -145,7 +148,8 @@ class Roster:
             created = check_date("created", d["created"])
         except ValueError as exc:
             raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
-        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, set(d["hidden"]), created)
+        hidden = {player_key(k) for k in d["hidden"]}  # player_key of an older key is today's key
+        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created)
 
     def save(self) -> None:
         data = dump_json({

@@ -7,8 +7,12 @@ top of the table. ``armgame scores`` (each of its lists, unless ``--all-games``)
 window's end screen (``rank_of``; before a name is typed, ``place_of_new``) all ask it, so "your
 rank" means the same thing everywhere.
 
-Players are told apart by ``player_key``: the name as typed, compatibility-normalised (NFKC: a
-full-width "Ａlice" is "Alice") and case-folded, so "alice" and "Alice " are one player.
+Players are told apart by ``player_key``: two names a projector shows alike are one player. The name
+as typed, compatibility-normalised (NFKC: a full-width "Ａlice" is "Alice"), case-folded, its spaces
+collapsed ("Ann  B" is "Ann B"), and its letters of other scripts that are drawn like a Latin letter
+read as that letter (a Cyrillic "Аnn" is "Ann"; ``LOOKALIKES``), so "alice", "Alice " and "Аlice" are
+one player, and a classmate cannot stand on the projector as a second "Ann". The name shown is always
+the one typed.
 """
 
 from __future__ import annotations
@@ -21,8 +25,27 @@ from typing import Generic, TypeVar
 T = TypeVar("T")
 
 
+#: After case folding, the letters of Cyrillic and Greek drawn, in capital or small form, like a Latin letter
+#: (Unicode's confusables, UTS #39, for the letters of these two scripts that fonts draw alike), and the
+#: digits drawn like letters. Not "I" and "l": alike in sans-serif capitals, but no case-blind key can
+#: part "Eli" from "Ell" and still join "Ian" with "ian".
+LOOKALIKES = str.maketrans({
+    "а": "a", "в": "b", "е": "e", "к": "k", "м": "m", "н": "h", "о": "o", "р": "p", "с": "c", "т": "t",
+    "у": "y", "х": "x", "і": "i", "ј": "j", "ѕ": "s", "ԁ": "d", "һ": "h", "ӏ": "l", "ԛ": "q", "ԝ": "w",
+    "α": "a", "β": "b", "ε": "e", "ζ": "z", "η": "h", "ι": "i", "κ": "k", "μ": "m", "ν": "n", "ο": "o",
+    "ρ": "p", "τ": "t", "υ": "y", "χ": "x", "0": "o", "1": "l",
+})
+
+
 def player_key(name: str) -> str:
-    """The key two names of one player share: NFKC-normalised, case-folded, surrounding spaces dropped."""
+    """The key two names of one player share (see the module): NFKC-normalised, case-folded, lookalike
+    letters read as Latin ones, runs of spaces as one, surrounding spaces dropped."""
+    return " ".join(unicodedata.normalize("NFKC", name).casefold().translate(LOOKALIKES).split())
+
+
+def legacy_player_key(name: str) -> str:
+    """The key before lookalikes and inner spaces counted (identity version 2's): files written then name
+    their players by it (a class's ``class.json``), and ``player_key`` of it is today's key."""
     return unicodedata.normalize("NFKC", name).casefold().strip()
 
 
