@@ -146,6 +146,28 @@ def test_a_copy_planted_in_the_table_is_flagged_and_ties_go_to_the_earlier_entry
     assert "thief: score" in out and "DUPLICATE: the same game as second's earlier entry" in out
 
 
+@pytest.mark.parametrize("planted", ["a copy under another name", "a copy naming a forged replay"])
+def test_an_entry_planted_under_an_honest_ones_id_never_pushes_it_out(tmp_path, planted):
+    """A copy of Ann's entry put above it in the file with her id: the table is damaged (said, and kept aside
+    at the next write), but the entry kept under the id is the one her replay file backs, so the next game
+    written leaves Ann's entry in and the copy out."""
+    table = ScoreTable(tmp_path)
+    ann = table.add(played("Ann", press=50))
+    data = json.loads(table.path.read_text())
+    copy = dict(data["entries"][0], name="Mallory")
+    if planted == "a copy naming a forged replay":
+        forged = table.save_replay(played("Ann", press=50).with_player("Mallory"))
+        copy.update(replay=forged.name, replay_sha256="0" * 64)
+    data["entries"].insert(0, copy)
+    table.path.write_text(json.dumps(data))
+    entries, damage = table.read()
+    assert damage is not None and "appears twice" in damage.reason
+    assert [(e.id, e.name) for e in entries] == [(ann.id, "Ann")]
+    table.add(played("Bo", press=70))
+    assert sorted(e.name for e in table.all_entries()) == ["Ann", "Bo"]
+    assert len(list(tmp_path.glob("scores.json.corrupt-*"))) == 1  # the planted file kept aside, not lost
+
+
 def test_an_old_table_gets_its_order_of_entry_once(tmp_path):
     table = ScoreTable(tmp_path)
     table.add(played("a", press=1))

@@ -142,7 +142,7 @@ class ScoreTable(TableFile, TableChecks):
         data = self._file_bytes()
         if data is None:
             return [], None
-        entries, damage, head = _parse(data)
+        entries, damage, head = _parse(data, self._replay_backs())
         entries, self._seed, self.notes = self._as_recorded(entries, head)
         return entries, damage
 

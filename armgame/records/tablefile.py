@@ -72,6 +72,8 @@ FORMAT = "armgame-scores"
 #: each entry's game digest, order of entry and whole-clock flag. Older tables are read (and rewritten as 3).
 FORMAT_VERSION = 3
 READS_FORMATS = (1, 2, 3)
+#: The most replay bytes one read of a table hashes to tell which of two entries sharing an id is the table's.
+MAX_TWIN_BYTES = 4 * MAX_REPLAY_BYTES
 #: Seconds a writer waits for the table's lock before saying the table is busy.
 LOCK_WAIT = 5.0
 #: The longest path the table makes inside its folder, in bytes, with room: a replay's temporary file,
@@ -111,6 +113,31 @@ class TableFile:
         self.warn = warn
         self.record = TeacherRecord(self.folder, records, warn)
         self._seed: int | None = None
+
+    def _replay_backs(self) -> Callable[[ScoreEntry], bool]:
+        """Whether an entry's replay file in ``replays/`` is the one it names (its SHA-256) and was played
+        under the entry's name (a copy of an honest entry with another name names the same file): asked
+        only of entries sharing an id (``_parse``), each file read once, and at most ``MAX_TWIN_BYTES`` of
+        them per read, so a table planted full of twins costs a bounded read."""
+        seen: dict[str, tuple[str, object] | None] = {}
+        left = [MAX_TWIN_BYTES]
+
+        def backs(entry: ScoreEntry) -> bool:
+            if entry.replay not in seen:
+                if left[0] <= 0:
+                    return False
+                try:
+                    data = read_limited(self.replays / entry.replay, MAX_REPLAY_BYTES, "replay", follow=False)
+                    left[0] -= len(data)
+                    player = parse_json(data).get("player")
+                except (DataFileError, OSError, ValueError, AttributeError):
+                    seen[entry.replay] = None
+                else:
+                    seen[entry.replay] = (hashlib.sha256(data).hexdigest(), player)
+            found = seen[entry.replay]
+            return found is not None and found == (entry.replay_sha256, entry.name)
+
+        return backs
 
     def _open_table(self) -> int | None:
         """A descriptor of the table file, or None if there is none. Never follows a symlink."""
@@ -211,7 +238,7 @@ class TableFile:
                 entries, damage, head = [], None, _Head()
             else:
                 data = _read_all(fd)
-                entries, damage, head = _parse(data)
+                entries, damage, head = _parse(data, self._replay_backs())
             record = self.record.load(fresh=True)  # under the lock: what this account's last write left
             if seed is not None:
                 if entries:
@@ -393,9 +420,14 @@ def parse_table(data: bytes) -> tuple[list[ScoreEntry], Damage | None]:
     return entries, damage
 
 
-def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
+def _parse(data: bytes, backed: Callable[[ScoreEntry], bool] | None = None
+           ) -> tuple[list[ScoreEntry], Damage | None, _Head]:
     """``parse_table`` and the table's head (``_Head``: a seed or counter that is not valid is said there,
-    not damage; a damaged table's head is what can be found of it)."""
+    not damage; a damaged table's head is what can be found of it).
+
+    Two entries with one id are damage, and one of them is kept: the one whose replay file ``backed``
+    says is its own (``TableFile._replay_backs``), else the first. A copy planted above an honest entry
+    under its id must not push the honest one out of the table at the next write."""
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
@@ -420,17 +452,21 @@ def _parse(data: bytes) -> tuple[list[ScoreEntry], Damage | None, _Head]:
     except ValueError as exc:
         return (*_salvage(text, str(exc)), head)
     entries: list[ScoreEntry] = []
-    seen: set[str] = set()
+    seen: dict[str, int] = {}
     problem = None
     for i, item in enumerate(table["entries"]):
         try:
             entry = ScoreEntry.from_dict(item)
-            if entry.id in seen:
-                raise ValueError(f"id {entry.id} appears twice")
         except ValueError as exc:
             problem = problem or f"entry {i + 1}: {exc}"
             continue
-        seen.add(entry.id)
+        first = seen.get(entry.id)
+        if first is not None:
+            problem = problem or f"entry {i + 1}: id {entry.id} appears twice"
+            if backed is not None and not backed(entries[first]) and backed(entry):
+                entries[first] = entry
+            continue
+        seen[entry.id] = len(entries)
         entries.append(entry)
     n = len(table["entries"])
     return entries, (Damage(problem, len(entries), n) if problem else None), head
