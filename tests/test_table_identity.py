@@ -18,6 +18,7 @@ import pytest
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
+from armgame.records import tablefile
 from armgame.records.identity import game_digest
 from armgame.records.replay import Replay
 from armgame.records.scores import PRACTICE, PROGRAMS, RANKED, ScoreTable, TableError, replay_claims
@@ -166,6 +167,7 @@ def test_an_entry_planted_under_an_honest_ones_id_never_pushes_it_out(tmp_path, 
     table.add(played("Bo", press=70))
     assert sorted(e.name for e in table.all_entries()) == ["Ann", "Bo"]
     assert len(list(tmp_path.glob("scores.json.corrupt-*"))) == 1  # the planted file kept aside, not lost
+    assert tablefile.MAX_TWIN_BYTES == 64 * 2**20  # what docs/scores.md says a read hashes at most
 
 
 def test_an_old_table_gets_its_order_of_entry_once(tmp_path):
