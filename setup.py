@@ -3,7 +3,8 @@
 ``armgame/game/_ckernel.c`` (the batched games) and ``armgame/game/_cbots.c`` (the bots' forward
 model) must compute exactly what the Python code computes, so their build turns off floating-point
 contraction (no fused multiply-add) and the compiler's own sin and cos (no merging them into
-sincos): see each file's opening comment. Both are optional: without a C compiler the install goes
+sincos; ``_ckernel.c`` calls glibc's sincos itself, after checking it against sin and cos): see
+each file's opening comment. Both are optional: without a C compiler the install goes
 on, ``BatchGameSession`` runs numpy and the bots run their Python loop, with the same results.
 """
 

@@ -349,3 +349,47 @@ def test_a_lab_run_with_the_compiled_step_is_the_python_loops_bit_for_bit():
 def test_rk4_step_refuses_bad_arguments(args, message):
     with pytest.raises((TypeError, ValueError), match=message):
         session_module._c_rk4_step(*args)
+
+
+@needs_loop
+@pytest.mark.parametrize("arm", list(ARMS))
+def test_rk4_run_is_the_python_step_bit_for_bit_and_stops_at_a_blow_up(arm):
+    """``_ckernel.rk4_run`` (the benchmark's compiled rows) against ``Integrator("rk4")``'s steps, with ``==``:
+    a torque row per step, the last row held, every second state kept."""
+    session = GameSession(GameConfig(arm=ARMS[arm]))
+    params, mode, step = session._compiled
+    buffer = np.frombuffer(params, dtype=float)
+    rng = random.Random(arm)
+    torques = np.array([(rng.uniform(-2, 2), rng.uniform(-2, 2)) for _ in range(150)])
+    start = (0.3, 1.2, 2.0, -1.0)
+    x, states = np.array(start), np.empty((101, 4))
+    assert session_module._ckernel.rk4_run(buffer, mode, 0.004, x, torques, 200, states, 2, 1e4) == 200
+    q = start
+    expected = [q]
+    for i in range(200):
+        q = step(*q, *torques[min(i, 149)], 0.004)
+        if i % 2 == 1:
+            expected.append(q)
+    assert [tuple(s) for s in states.tolist()] == expected and tuple(x.tolist()) == q
+    # Past the speed limit it stops after the step that crossed it, as the benchmark's Python run does.
+    x = np.array(start)
+    assert session_module._ckernel.rk4_run(buffer, mode, 0.004, x, torques, 200, np.empty((0, 4)), 1, 1.5) == 1
+
+
+@needs_loop
+@pytest.mark.parametrize(("change", "message"), [
+    ({"dt": 0.0}, "finite dt > 0"),
+    ({"every": 0}, "every >= 1"),
+    ({"torques": np.empty((0, 2))}, "a torque row"),
+    ({"torques": np.full((1, 2), math.nan)}, "a torque is not finite"),
+    ({"x": np.array([math.inf, 0.0, 0.0, 0.0])}, "x is not finite"),
+    ({"steps": 10**12}, "24 h"),
+    ({"x": np.zeros(3)}, "x: 24 bytes, expected 32"),
+])
+def test_rk4_run_refuses_bad_arguments_before_any_step(change, message):
+    session = GameSession(GameConfig())
+    args = {"params": np.frombuffer(session._compiled[0], dtype=float), "mode": session._compiled[1], "dt": 0.004,
+            "x": np.zeros(4), "torques": np.zeros((1, 2)), "steps": 10, "states": np.empty((0, 4)), "every": 1,
+            "limit": 1e4} | change
+    with pytest.raises(ValueError, match=message):
+        session_module._ckernel.rk4_run(*args.values())

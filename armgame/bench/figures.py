@@ -46,7 +46,7 @@ def _styles(rows: Sequence[Row]) -> dict[str, dict[str, Any]]:
 
     colours = colormaps["tab10"].colors
     methods = list(dict.fromkeys(r.method for r in rows))
-    ours = {r.method for r in rows if r.family == "armgame"}
+    ours = {r.method for r in rows if r.family in ("armgame", "compiled")}
     return {m: {"color": colours[i % len(colours)], "ls": "-" if m in ours else "--",
                 "marker": "o" if m in ours else "s", "ms": 6} for i, m in enumerate(methods)}
 

@@ -18,7 +18,7 @@ from ..physics.batch import BatchRK4
 from ..physics.integrators import SCHEMES, Integrator
 from ..physics.params import GAME_ARM
 from ..physics.twojoint import TwoJointArm
-from . import peers
+from . import compiled, peers
 from .measure import (
     ENERGY_WINDOW,
     ERROR_WINDOW,
@@ -103,6 +103,9 @@ def run_bench(options: Options, progress: Callable[[str], None] = lambda _m: Non
     notes: list[str] = []
     if mujoco is None:
         notes.append("MuJoCo is not installed (pip install 'armgame[bench]'): its rows and ratio are skipped")
+    if not compiled.available():
+        notes.append("the compiled loops are not built (no C compiler at install): the game runs the Python step, "
+                     "and the table and bars time that")
     rows: list[Row] = []
     cases: dict[str, Case] = {}
     for name in options.cases:
@@ -111,6 +114,8 @@ def run_bench(options: Options, progress: Callable[[str], None] = lambda _m: Non
         for integrator in options.integrators:
             for dt in steps:
                 rows.append(measure_scheme(case, integrator, dt, repeats))
+            if integrator in compiled.METHODS and compiled.available():
+                rows += [compiled.measure_compiled(case, dt, repeats) for dt in steps]
         if not options.peers:
             continue
         odeint_tols = (1e-6, peers.ODEINT_DEFAULT_TOL) if options.quick else peers.ODEINT_TOLS
@@ -191,26 +196,37 @@ def speed_bars(rows: Sequence[Row], mujoco: Any | None, quick: bool = False,
             good[0] if good else None)
         if pick is not None and pick.dt is not None:
             ours_s, odeint_s = pick.time_per_sim_s, ref.time_per_sim_s
+            python_s = ours_s
             how = "from the table's timings"
+            as_run = "Python step"
             if cases and "passive" in cases:
-                ours_run = scheme_run(cases["passive"], pick.method, pick.dt)
+                python_run = scheme_run(cases["passive"], pick.method, pick.dt)
                 odeint_run = peers.odeint_run(cases["passive"], peers.ODEINT_DEFAULT_TOL)
-                # Ours is some 20 times quicker: repeat it to last as long as one odeint run, so that
-                # both are equally likely to be interrupted on a busy machine.
-                reps = max(1, round(_per_step(lambda _k: odeint_run(), 1, 1) / _per_step(lambda _k: ours_run(), 1, 3)))
-
-                def ours_repeated(_k: int) -> None:
-                    for _ in range(reps):
-                        ours_run()
-
-                paired = _paired_per_step({"ours": ours_repeated, "odeint": lambda _k: odeint_run()}, 1, 3 * repeats)
-                ours_s, odeint_s = paired["ours"] / reps / ERROR_WINDOW, paired["odeint"] / ERROR_WINDOW
+                timed = {"python": python_run}
+                if pick.method in compiled.METHODS and compiled.available():
+                    # The game runs its default in C: that is the figure a student's game gets.
+                    timed["compiled"] = compiled.timed_run(cases["passive"], pick.dt)
+                    as_run = "compiled loop, as the game runs it"
+                odeint_once = _per_step(lambda _k: odeint_run(), 1, 1)
+                # Ours are 20 to 500 times quicker: each is repeated to last as long as one odeint run,
+                # so that all are equally likely to be interrupted on a busy machine.
+                runs: dict[str, Callable[[int], Any]] = {"odeint": lambda _k: odeint_run()}
+                reps: dict[str, int] = {}
+                for key, run in timed.items():
+                    reps[key] = max(1, round(odeint_once / compiled.seconds_per_run(run, 3)))
+                    runs[key] = lambda _k, run=run, r=reps[key]: [run() for _ in range(r)]
+                paired = _paired_per_step(runs, 1, 3 * repeats)
+                odeint_s = paired["odeint"] / ERROR_WINDOW
+                python_s = paired["python"] / reps["python"] / ERROR_WINDOW
+                ours_s = paired["compiled"] / reps["compiled"] / ERROR_WINDOW if "compiled" in paired else python_s
                 how = f"timed again taking turns, fastest of {3 * repeats} each"
             bars["odeint_ratio"] = odeint_s / ours_s
+            bars["odeint_ratio_python"] = odeint_s / python_s
+            bars["odeint_compiled"] = as_run != "Python step"
             bars["odeint_detail"] = (
-                f"{pick.method} {pick.setting}: {ours_s * 1e3:.3g} ms per simulated s, hand error "
-                f"{pick.hand_error:.2g} m; tutorial odeint (tol {ref.tol:.3g}): "
-                f"{odeint_s * 1e3:.3g} ms, {ref.hand_error:.2g} m; {how}")
+                f"{pick.method} {pick.setting}, {as_run}: {ours_s * 1e3:.3g} ms per simulated s, hand error "
+                f"{pick.hand_error:.2g} m; the Python step {python_s * 1e3:.3g} ms; tutorial odeint (tol "
+                f"{ref.tol:.3g}): {odeint_s * 1e3:.3g} ms, {ref.hand_error:.2g} m; {how}")
 
     # 2. One arm, one RK4 step, the game's way (torque set, one call), ours vs MuJoCo's.
     step = Integrator("rk4", arm).step_components
@@ -229,6 +245,13 @@ def speed_bars(rows: Sequence[Row], mujoco: Any | None, quick: bool = False,
 
     bars["rk4_numpy_single_step_us"] = _per_step(ours_numpy, n // 10, repeats) * 1e6
     runs: dict[str, Callable[[int], Any]] = {"rk4_step_us": ours_rk4}
+    if compiled.available():
+        # The game's own loop: muscles, RK4 and the hand's hit test every step (what the game runs), and
+        # RK4 alone in C under a held torque (what MuJoCo's C loop runs).
+        runs["game_step_us"] = compiled.game_loop(GAME_ARM, BATCH_DT, state)
+        held = compiled.runner(arm, BATCH_DT, state, np.array([0.2, -0.1]), n)
+        no_states = np.empty((0, 4))
+        runs["rk4_c_step_us"] = lambda _k: held(no_states)
     if mujoco is not None:
         model, data = build_model(mujoco, GAME_ARM, BATCH_DT, "RK4")
 
@@ -250,8 +273,12 @@ def speed_bars(rows: Sequence[Row], mujoco: Any | None, quick: bool = False,
         runs |= {"mujoco_rk4_step_us": mj_rk4, "mujoco_rk4_c_loop_step_us": mj_rk4_c_loop}
     bars |= {name: per * 1e6 for name, per in _paired_per_step(runs, n, 2 * repeats).items()}
     if mujoco is not None:
-        bars["mujoco_ratio"] = bars["mujoco_rk4_step_us"] / bars["rk4_step_us"]
-        bars["mujoco_c_loop_ratio"] = bars["mujoco_rk4_c_loop_step_us"] / bars["rk4_step_us"]
+        # Ours as the game runs it: the compiled loop where built, else the Python step.
+        ours_us = bars.get("game_step_us", bars["rk4_step_us"])
+        bars["mujoco_ratio"] = bars["mujoco_rk4_step_us"] / ours_us
+        bars["mujoco_c_loop_ratio"] = bars["mujoco_rk4_c_loop_step_us"] / ours_us
+        bars["mujoco_c_loop_ratio_python"] = bars["mujoco_rk4_c_loop_step_us"] / bars["rk4_step_us"]
+        bars["mujoco_ratio_python"] = bars["mujoco_rk4_step_us"] / bars["rk4_step_us"]
 
     # 3. A batch of 10,000 arms, RK4 at 1 ms.
     rng = np.random.default_rng(0)

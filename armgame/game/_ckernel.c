@@ -1,5 +1,6 @@
 /* The game's hot loop, compiled: muscles, RK4 and the hand's slack for many games (``run``), and
- * the single session's loop for one game (``game_steps``) and one RK4 step (``rk4_step``, the lab's).
+ * the single session's loop for one game (``game_steps``), one RK4 step (``rk4_step``, the lab's) and
+ * one arm's run of RK4 steps under given torques (``rk4_run``, the benchmark's table).
  *
  * Why C: a batch of a thousand games in numpy pays about 140 calls of call overhead per
  * physics step, and Python floats pay the interpreter per operation; here each game runs its
@@ -8,7 +9,8 @@
  * IEEE double operations in the same order (C evaluates a + b + c as (a + b) + c, as Python
  * does), and ``cos``/``sin`` are the C library's, which is what Python's ``math`` calls. The
  * build (setup.py) turns off floating-point contraction, so no multiply-add is fused, and the
- * builtin sin and cos, so the compiler cannot merge them into a ``sincos`` of its own choosing.
+ * builtin sin and cos, so the compiler cannot merge them into a ``sincos`` of its own choosing;
+ * the file calls glibc's sincos itself only where it has checked it (``sin_cos`` below).
  *
  * With ``fast`` set, the elbow's cos and sin come by angle addition instead (the numpy fast
  * kernel's method, see batch/numpy_kernel.py): round-off, not bit for bit, and the batch says so.
@@ -29,6 +31,50 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+
+/* Where the C library is glibc, whose sincos runs the very code of its sin and cos (one argument
+ * reduction for both: a pair costs 11 ns here against 17), the elbow's and the hand's pairs come from
+ * sincos. Nothing promises that elsewhere, so other libraries call sin and cos apart, and even glibc's
+ * sincos is used only after the module's start has found it equal to sin and cos, bit for bit, on
+ * angles from -1e6 to 1e6 (``SINCOS`` says whether it is used). */
+#if defined(__GLIBC__)
+extern void sincos(double x, double *s, double *c);
+#endif
+static int use_sincos = 0;
+
+static inline void sin_cos(double x, double *s, double *c)
+{
+#if defined(__GLIBC__)
+    if (use_sincos) {
+        sincos(x, s, c);
+        return;
+    }
+#endif
+    *s = sin(x);
+    *c = cos(x);
+}
+
+/* Whether sincos gives sin's and cos's bits on a spread of angles (small, game-sized and huge). */
+static int sincos_agrees(void)
+{
+#if defined(__GLIBC__)
+    uint64_t r = UINT64_C(88172645463325252);
+    for (int i = 0; i < 3000; i++) {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        const double scale = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 40.0 : 2e6);
+        const double x = ((double)(r >> 11) / 9007199254740992.0 - 0.5) * scale;
+        double s, c;
+        sincos(x, &s, &c);
+        if (s != sin(x) || c != cos(x))
+            return 0;
+    }
+    return 1;
+#else
+    return 0;
+#endif
+}
 
 /* Layout of the ``params`` buffer (doubles), as compiled.py's ``CompiledKernel`` writes it. */
 enum {
@@ -128,8 +174,10 @@ static inline void elbow(const Arm *arm, int fast, double q2, double delta, doub
                          double *oc, double *os)
 {
     if (!fast || !turned(bc, bs, delta, limit2, oc, os)) {
-        *oc = arm->b * cos(q2);
-        *os = arm->b * sin(q2);
+        double sn, cs;
+        sin_cos(q2, &sn, &cs);
+        *oc = arm->b * cs;
+        *os = arm->b * sn;
     }
 }
 
@@ -303,8 +351,10 @@ static PyObject *run(PyObject *self, PyObject *args)
             const double p1 = q1, p2 = q2;
             /* Stage 1's elbow trig: in full, or in the fast kernel carried from the last step. */
             if (!fast || anchor <= 0) {
-                bc = arm.b * cos(q2);
-                bs = arm.b * sin(q2);
+                double sn, cs;
+                sin_cos(q2, &sn, &cs);
+                bc = arm.b * cs;
+                bs = arm.b * sn;
                 anchor = REANCHOR;
             }
             anchor--;
@@ -339,8 +389,11 @@ static PyObject *run(PyObject *self, PyObject *args)
              * measured only when it runs out (see NumpyKernel.run). */
             sl -= fabs(q1 - p1) * reach1 + fabs(q2 - p2) * reach2;
             if (sl < 0.0) {
-                const double dx = l1 * cos(q1) + l2 * cos(q1 + q2) - x0;
-                const double dy = l1 * sin(q1) + l2 * sin(q1 + q2) - y0;
+                double sa, ca, sb, cb;
+                sin_cos(q1, &sa, &ca);
+                sin_cos(q1 + q2, &sb, &cb);
+                const double dx = l1 * ca + l2 * cb - x0;
+                const double dy = l1 * sa + l2 * sb - y0;
                 const double d2h = dx * dx + dy * dy;
                 sl = sqrt(d2h) - radius - 1e-9;
                 if (d2h <= near) {
@@ -374,7 +427,9 @@ done:
 static inline void accel_full(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
                               double *o1, double *o2)
 {
-    accel_trig(arm, q1, q2, arm->b * cos(q2), arm->b * sin(q2), w1, w2, t1, t2, o1, o2);
+    double sn, cs;
+    sin_cos(q2, &sn, &cs);
+    accel_trig(arm, q1, q2, arm->b * cs, arm->b * sn, w1, w2, t1, t2, o1, o2);
 }
 
 /* integrators._rk4, exactly: x (q1, q2, w1, w2) one step of dt on, torques t1, t2 held. h and k are
@@ -498,7 +553,8 @@ PyDoc_STRVAR(game_steps_doc,
 "GameSession._advance for one game, exactly: up to n steps of the muscles (activations a, goals g,\n"
 "rates r) and RK4 from state (q1, q2, w1, w2), stopping early after a step that leaves the hand\n"
 "(hx, hy) within a relative 1e-9 of the target disc (tx, ty, radius squared rr): near is then true,\n"
-"and the caller decides the hit with the session's own test. p1-p4 is the state before the last\n"
+"and the caller decides the hit with the session's own test (hx, hy are the hand after the last step\n"
+"only then: the hand is measured only when it may be near). p1-p4 is the state before the last\n"
 "step run. params is a bytes object of the P_* doubles (only the arm's, dt's and moments' are read).\n"
 "Refused before any step (ValueError): a value or param not finite, dt not positive, n past the steps\n"
 "of a 24 h game at dt.");
@@ -532,6 +588,10 @@ static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t na
     const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
     const double near = rr * (1.0 + NEAR_MARGIN);
     double previous[4] = {x[0], x[1], x[2], x[3]}, hx = 0.0, hy = 0.0;
+    /* |the hand's move| <= reach1 |dq1| + reach2 |dq2| (numpy_kernel.hand_move_bounds, a hair over). */
+    const double reach1 = (l1 + l2) * (1.0 + 1e-9), reach2 = l2 * (1.0 + 1e-9);
+    const double radius = rr > 0.0 ? sqrt(rr) : 0.0;
+    double slack = -1.0;  /* measured after the first step */
     Py_ssize_t ran = 0;
     int flagged = 0;
     while (ran < n) {
@@ -545,13 +605,23 @@ static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t na
         memcpy(previous, x, sizeof previous);
         rk4_exact(&arm, t1, t2, dt, x);
         ran++;
-        const double s12 = x[0] + x[1];
-        hx = l1 * cos(x[0]) + l2 * cos(s12);
-        hy = l1 * sin(x[0]) + l2 * sin(s12);
-        const double dx = hx - x0, dy = hy - y0;
-        if (dx * dx + dy * dy <= near) {
-            flagged = 1;
-            break;
+        /* The hand's four cos and sin cost a third of a step: it is measured only when a lower bound on its
+         * distance from the disc, lowered by a bound on each step's move, runs out (the batch's slack, see
+         * ``run``), which no hand outside the disc by 1e-9 m can skip past. */
+        slack -= fabs(x[0] - previous[0]) * reach1 + fabs(x[1] - previous[1]) * reach2;
+        if (slack < 0.0) {
+            double sa, ca, sb, cb;
+            sin_cos(x[0], &sa, &ca);
+            sin_cos(x[0] + x[1], &sb, &cb);
+            hx = l1 * ca + l2 * cb;
+            hy = l1 * sa + l2 * sb;
+            const double dx = hx - x0, dy = hy - y0;
+            const double d2h = dx * dx + dy * dy;
+            if (d2h <= near) {
+                flagged = 1;
+                break;
+            }
+            slack = sqrt(d2h) - radius - 1e-9;
         }
     }
     PyObject *out = PyTuple_New(16);
@@ -594,10 +664,86 @@ static PyObject *rk4_step(PyObject *self, PyObject *const *args, Py_ssize_t narg
     return Py_BuildValue("(dddd)", x[0], x[1], x[2], x[3]);
 }
 
+
+PyDoc_STRVAR(rk4_run_doc,
+"rk4_run(params, mode, dt, x, torques, steps, states, every, limit) -> int\n\n"
+"Steps of integrators._rk4 (rk4_step's operations) from x (4 float64: q1 q2 w1 w2), in place: step i holds\n"
+"torques row min(i, rows - 1) (float64 rows t1 t2), so one row holds a torque throughout. The state\n"
+"after every ``every``-th step goes to the next row of states (float64, 4 a row; row 0 is the start),\n"
+"while rows remain. Stops early after a step that leaves a value not finite or a joint speed at or past\n"
+"limit (a blow-up). Returns the steps run. For the benchmark's table: one arm in the compiled loop,\n"
+"without the game's muscles and hit tests. Refused (ValueError): params or x not finite, dt not\n"
+"positive, steps past a 24 h game at dt, every < 1, no torque row.");
+
+static PyObject *rk4_run(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *obj[4];
+    int mode;
+    double dt, limit;
+    Py_ssize_t steps, every;
+    if (!PyArg_ParseTuple(args, "OidOOnOnd", &obj[0], &mode, &dt, &obj[1], &obj[2], &steps, &obj[3], &every, &limit))
+        return NULL;
+    Buf b[4];
+    memset(b, 0, sizeof b);
+    PyObject *result = NULL;
+    const Py_ssize_t D = sizeof(double);
+    if (get(obj[0], &b[0], P_COUNT, D, 0, "params") < 0 || get(obj[1], &b[1], 4, D, 1, "x") < 0
+        || get(obj[2], &b[2], -1, 2 * D, 0, "torques") < 0 || get(obj[3], &b[3], -1, 4 * D, 1, "states") < 0)
+        goto done;
+    const double *p = b[0].view.buf;
+    double *x = b[1].view.buf, *out = b[3].view.buf;
+    const double *tq = b[2].view.buf;
+    const Py_ssize_t rows = b[2].view.len / (2 * D), slots = b[3].view.len / (4 * D);
+    if (check_params("rk4_run", p, 0) < 0)
+        goto done;
+    if (mode < MODE_UNFORCED || mode > MODE_GRAVITY || !(dt > 0.0) || !isfinite(dt) || rows < 1 || every < 1
+        || steps < 0 || ((double)steps - 1.0) * dt > MAX_GAME_SECONDS) {
+        PyErr_SetString(PyExc_ValueError, "rk4_run: expected mode 0-2, a finite dt > 0, a torque row, every >= 1 "
+                                          "and 0 to a 24 h game's steps");
+        goto done;
+    }
+    for (int i = 0; i < 4; i++) {
+        if (!isfinite(x[i])) {
+            PyErr_SetString(PyExc_ValueError, "rk4_run: x is not finite");
+            goto done;
+        }
+    }
+    for (Py_ssize_t i = 0; i < 2 * rows; i++) {
+        if (!isfinite(tq[i])) {
+            PyErr_SetString(PyExc_ValueError, "rk4_run: a torque is not finite");
+            goto done;
+        }
+    }
+    const Arm arm = {p[P_B], p[P_D], p[P_DET0], p[P_AMD], p[P_G1], p[P_G2], p[P_K1], p[P_K2], mode};
+    Py_ssize_t ran = 0, slot = 1;
+    if (slots > 0)
+        memcpy(out, x, 4 * sizeof(double));
+    Py_BEGIN_ALLOW_THREADS
+    while (ran < steps) {
+        const Py_ssize_t row = ran < rows ? ran : rows - 1;
+        rk4_exact(&arm, tq[2 * row], tq[2 * row + 1], dt, x);
+        ran++;
+        if (ran % every == 0 && slot < slots) {
+            memcpy(out + 4 * slot, x, 4 * sizeof(double));
+            slot++;
+        }
+        /* A blow-up: the benchmark's test (measure._finite_and_sane), so the run stops where Python's does. */
+        if (!(isfinite(x[0]) && isfinite(x[1]) && fabs(x[2]) < limit && fabs(x[3]) < limit))
+            break;
+    }
+    Py_END_ALLOW_THREADS
+    result = PyLong_FromSsize_t(ran);
+done:
+    release(b, 4);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"run", run, METH_VARARGS, run_doc},
     {"game_steps", (PyCFunction)(void (*)(void))game_steps, METH_FASTCALL, game_steps_doc},
     {"rk4_step", (PyCFunction)(void (*)(void))rk4_step, METH_FASTCALL, rk4_step_doc},
+    {"rk4_run", rk4_run, METH_VARARGS, rk4_run_doc},
     {NULL, NULL, 0, NULL},
 };
 
@@ -609,10 +755,12 @@ static struct PyModuleDef module = {
 
 PyMODINIT_FUNC PyInit__ckernel(void)
 {
+    use_sincos = sincos_agrees();
     PyObject *m = PyModule_Create(&module);
     /* VERSION changes with the calling convention, so a stale build is refused, not misread. */
     if (m != NULL && (PyModule_AddIntConstant(m, "PARAMS", P_COUNT) < 0
-                      || PyModule_AddIntConstant(m, "VERSION", 3) < 0)) {
+                      || PyModule_AddIntConstant(m, "VERSION", 4) < 0
+                      || PyModule_AddIntConstant(m, "SINCOS", use_sincos) < 0)) {
         Py_DECREF(m);
         return NULL;
     }
