@@ -291,4 +291,5 @@ def test_a_viscous_matrix_option_and_a_paradigm_it_cannot_stand_for():
     for name in ("savings", "spontaneous"):
         with pytest.raises(EnvArgumentError, match=r"2 different perturbations \(curl b=2 N s/m, curl b=-2 N s/m\)"):
             run_protocol(name, "curl")
-    assert run_protocol("spontaneous", None) == preset("spontaneous")
+    # with its probes placed as the versioned envs always placed them (issue 29: tests/test_lab_probes.py)
+    assert run_protocol("spontaneous", None) == dataclasses.replace(preset("spontaneous"), probe_schedule="random")

@@ -59,7 +59,7 @@ def perpendicular(session: LabSession, outcome) -> float:
 def test_presets_round_trip_through_plain_data(name):
     p = preset(name)
     assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
-    if name in ("savings", "spontaneous"):
+    if name in ("savings", "spontaneous", "generalization"):
         assert p.blocks[1].perturbation == Perturbation.make("curl", b=CURL_B)
         return
     assert [b.name for b in p.blocks] == ["baseline", "exposure", "washout"]
@@ -138,7 +138,8 @@ def test_unreachable_targets_are_refused():
 
 # ------------------------------------------------------------------- schedule
 def test_schedule_cycles_targets_and_draws_delays_and_catch_trials():
-    p = with_catch_trials(preset("curl"), 6)
+    # The placement replays recorded before issue 29 ran (the balanced one: tests/test_lab_probes.py).
+    p = replace(with_catch_trials(preset("curl"), 6), probe_schedule="random")
     config = lab_config(p, 5)
     plans = schedule(p, 5, config.dt, (0.0, 0.5))
     assert len(plans) == p.trials == 120

@@ -50,6 +50,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--fit-on", choices=("error", "index"), default="error",
                    help="with --fit: the errors of the reaches that are not channel trials (default; the measure "
                    "the learning figure plots), or the adaptation index of the channel trials")
+    p.add_argument("--subtract-baseline", action="store_true",
+                   help="each channel trial's adaptation_index less its direction's baseline: the mean index of the "
+                   "channel trials to that direction before the run's first perturbed block (empty for a direction "
+                   "with none); in the tables and with --fit-on index")
+    p.add_argument("--channel-traces", action="store_true",
+                   help="also write each run's channel trials' force over time, one row per physics step: "
+                   "REPLAY.channel_traces.csv beside the tables (trial, block, target_deg, time_s, channel_force_n, "
+                   "cancelling_force_n, hand_speed_m_per_s)")
     p.add_argument("--protocol", metavar="NAME", default=None,
                    help="with --class: the protocol (its name) whose replays make the curve (default: the one most "
                    "replays share)")
@@ -69,6 +77,8 @@ def _run(args: argparse.Namespace) -> int:
     if args.class_dir is not None:
         if args.replays:
             raise UserError("give replays or --class DIR, not both")
+        if args.subtract_baseline or args.channel_traces:
+            raise UserError("--subtract-baseline and --channel-traces apply to replays, not --class")
         if args.out is None:
             raise UserError("--class needs --out DIR: the folder for class_curve.csv and class_curve.png")
         return _class(args)
@@ -83,6 +93,8 @@ def _run(args: argparse.Namespace) -> int:
         raise UserError("--no-figures applies with --class or --fit only")
     if args.fit_on != "error" and not args.fit:
         raise UserError("--fit-on applies with --fit only")
+    if args.channel_traces and args.out is None:
+        raise UserError("--channel-traces needs --out: the traces are written beside the tables")
     if args.fit and not args.no_figures and args.out is not None:  # without --out no figure is drawn
         from ..lab.figures import require_matplotlib
 
@@ -182,6 +194,25 @@ def _replays(args: argparse.Namespace) -> int:
             skipped += 1
             continue
         print(f"{path}: verified: {session.protocol.name}, seed {session.config.seed}, {len(rows)} reaches")
+        if args.subtract_baseline:
+            from ..lab.analysis import baseline_offsets, subtract_baseline
+
+            offsets = baseline_offsets(session, rows)
+            try:
+                rows = subtract_baseline(session, rows)
+            except ValueError as exc:
+                print(f"armgame analyze: {path}: --subtract-baseline: {exc}", file=sys.stderr)
+                skipped += 1
+                continue
+            print("  adaptation index less each direction's baseline, which was: "
+                  + ", ".join(f"{deg:g} deg {value:+.2f}" for deg, value in offsets.items()))
+        if args.channel_traces:
+            from ..lab.analysis import write_channel_traces
+
+            traces = (out.parent if one_table else out) / f"{path.stem}.channel_traces.csv"
+            traces.parent.mkdir(parents=True, exist_ok=True)
+            write_channel_traces(traces, session)
+            written.append(traces)
         if args.fit:
             beside = None if out is None else (out.parent if one_table else out)  # the fit's files: by the table
             try:
@@ -343,11 +374,12 @@ def _fresh_outputs(args: argparse.Namespace):
     stems: dict[str, str] = {}
     for name in args.replays:
         stem = Path(name).stem
-        if stem in stems and (args.fit or not one_table):
+        if stem in stems and (args.fit or args.channel_traces or not one_table):
             raise UserError(f"{stems[stem]} and {name} would both write {stem}.* in {folder}: give --out a .csv "
                             "file for one table, or rename one")
         stems[stem] = name
         files += [] if one_table else [out / f"{stem}.trials.csv"]
         files += [folder / f"{stem}.fit.json"] if args.fit else []
+        files += [folder / f"{stem}.channel_traces.csv"] if args.channel_traces else []
         files += [folder / f"{stem}.fit.png"] if args.fit and figures else []
     return fresh_outputs(files, args.force, folder=folder)

@@ -73,6 +73,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="adaptive bot: the learner's retention rates A_f A_s (default: 0.59 0.992)")
     p.add_argument("--learning", type=_rate, nargs=2, metavar=("FAST", "SLOW"), default=None,
                    help="adaptive bot: the learner's learning rates B_f B_s (default: 0.21 0.02; 0 0 learns nothing)")
+    p.add_argument("--representation", choices=("global", "local"), default=None,
+                   help="adaptive bot: its internal model of the field, one estimate for every direction (global, "
+                   "the default) or Gaussian tuning over movement direction (local: what it learns falls off with "
+                   "the angle from where it learned it)")
+    p.add_argument("--tuning-width", type=float, default=None, metavar="DEG",
+                   help="with --representation local: the tuning's width, s.d. in degrees (5 to 180; default 30)")
     from ..ui.options import add_window_options
 
     add_window_options(p, sound=False)
@@ -116,7 +122,7 @@ def load_protocol_argument(text: str):
 
 def run(args: argparse.Namespace) -> int:
     from ..game.muscles import DEFAULT_MUSCLES, remap_keys
-    from ..lab.bots import LAB_BOT_NAMES, LearningRates, make_lab_bot
+    from ..lab.bots import LAB_BOT_NAMES, LearningRates
     from ..lab.protocol import with_catch_trials
     from ..lab.session import LabSession, lab_config
 
@@ -132,8 +138,11 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--headless needs a --bot to play (model, naive or adaptive); people play in the window")
     if args.bot and args.bot not in LAB_BOT_NAMES:
         raise UserError(unknown_name("lab bot", args.bot, LAB_BOT_NAMES))
-    if (args.retention or args.learning) and args.bot != "adaptive":
-        raise UserError("--retention and --learning set the adaptive bot's learner: add --bot adaptive")
+    if (args.retention or args.learning or args.representation) and args.bot != "adaptive":
+        raise UserError("--retention, --learning and --representation set the adaptive bot's learner: add --bot "
+                        "adaptive")
+    if args.tuning_width is not None and args.representation != "local":
+        raise UserError("--tuning-width sets the local learner's tuning: add --representation local")
     if args.no_figures and not args.out and args.headless:
         raise UserError("--no-figures applies with --out only (or to the run a window keeps)")
     if args.speed != 1.0 and not (args.bot and not args.headless):
@@ -151,7 +160,8 @@ def run(args: argparse.Namespace) -> int:
         defaults = LearningRates()
         rates = LearningRates(*(args.retention or (defaults.retention_fast, defaults.retention_slow)),
                               *(args.learning or (defaults.rate_fast, defaults.rate_slow)))
-        bot = make_lab_bot(args.bot, rates if args.bot == "adaptive" else None)
+        bot = _bot(args, rates)
+        args.learner_words = bot.describe()
     if args.headless:
         from ..game.bots import Autopilot
 
@@ -168,8 +178,7 @@ def run(args: argparse.Namespace) -> int:
         """Run ``number`` of this window (r on the last screen starts the next): the same protocol, seed,
         player and bot, kept apart from the one before."""
         fresh = session if number == 1 else LabSession(config, protocol)
-        player = bot if number == 1 else make_lab_bot(args.bot, rates if args.bot == "adaptive" else None) \
-            if args.bot else None
+        player = bot if number == 1 else _bot(args, rates) if args.bot else None
         return fresh, player, RunKeeper(args, number)
 
     def end_run(done, keeper: RunKeeper) -> None:
@@ -186,6 +195,16 @@ def run(args: argparse.Namespace) -> int:
 
     _play_in_window(args, new_run, end_run)
     return 0
+
+
+def _bot(args: argparse.Namespace, rates):
+    from ..lab.bots import make_lab_bot
+    from ..lab.learner import TUNING_WIDTH_DEG
+
+    if args.bot != "adaptive":
+        return make_lab_bot(args.bot)
+    width = TUNING_WIDTH_DEG if args.tuning_width is None else args.tuning_width
+    return make_lab_bot(args.bot, rates, args.representation or "global", width)
 
 
 def default_runs_dir() -> Path:
@@ -327,6 +346,8 @@ def _report(session, args: argparse.Namespace) -> None:
     ending = "" if session.finished else " (its time ran out)" if session.out_of_time else " (stopped before the end)"
     print(f"lab {session.protocol.name}: {done} of {total} trials, {session.result().hits} hits, seed "
           f"{session.config.seed}{ending}")
+    if getattr(args, "learner_words", ""):
+        print(f"  the adaptive bot's {args.learner_words}")
     if session.outcomes:
         rows = trial_rows(session)
         cycle = session.protocol.targets  # a cycle of targets: each direction's own offset averages out
@@ -338,6 +359,15 @@ def _report(session, args: argparse.Namespace) -> None:
             print(f"  {b['block']}: {b['channels']} channel trials; adaptation index {b['first']:+.2f} on the first, "
                   f"mean of {b['cycle']}: first {b['early']:+.2f}, last {b['late']:+.2f}, largest {b['largest']:+.2f} "
                   f"(from channel trial {b['at']})")
+        from ..lab.analysis import generalization
+
+        table = generalization(session, rows)
+        for name in dict.fromkeys(str(g["block"]) for g in table):
+            mine = [g for g in table if g["block"] == name]
+            subtracted = all(math.isfinite(float(g["index_less_baseline"])) for g in mine)  # type: ignore[arg-type]
+            key, how = ("index_less_baseline", "less each direction's baseline") if subtracted else ("index", "raw")
+            print(f"  {name}: adaptation index by angle from the trained {mine[0]['trained_deg']:g} deg ({how}): "
+                  + ", ".join(f"{g['angle_deg']:+g} {g[key]:+.2f}" for g in mine))
 
 
 def _home(path: Path) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import gymnasium as gym
@@ -104,7 +105,7 @@ def perturbation_option(value: object) -> Perturbation:
 
 def run_protocol(protocol: object, perturbation: object | None) -> Protocol:
     """The protocol an episode runs: ``protocol`` with ``perturbation`` (if given) in its perturbed blocks."""
-    chosen = protocol_option(protocol)
+    chosen = versioned_schedule(protocol_option(protocol))
     if perturbation is None:
         return chosen
     try:
@@ -113,6 +114,15 @@ def run_protocol(protocol: object, perturbation: object | None) -> Protocol:
         raise
     except UserError as exc:
         raise EnvArgumentError(str(exc)) from None
+
+
+def versioned_schedule(protocol: Protocol) -> Protocol:
+    """The protocol with the catch and channel trials placed as v0 and v1 always placed them (``random``), so
+    these versioned envs run the trials they ran before the lab's ``balanced`` placement (issue 29); a
+    protocol whose blocks name their directions (new with it, and needing it) keeps ``balanced``."""
+    if any(b.directions is not None or b.probe_directions is not None for b in protocol.blocks):
+        return protocol
+    return replace(protocol, probe_schedule="random")
 
 
 class CenterOutEnv(SessionEnv):

@@ -279,3 +279,110 @@ def learning_curve(rows: Sequence[Mapping[str, object]], metric: str) -> Learnin
                                  float(np.mean(values)) if values else math.nan))
         previous_perturbed = perturbed
     return LearningCurve(label, unit, tuple(points), tuple(blocks), after)
+
+
+# ------------------------------------------------------------------ probes by direction (issue 29)
+def baseline_offsets(session: LabSession, rows: Sequence[Mapping[str, object]]) -> dict[float, float]:
+    """Each direction's baseline adaptation index: the mean over the channel trials to it in the blocks before
+    the run's first perturbed block (a bot or a person that has learned nothing still reads an offset of its
+    own in each direction: the arm's dynamics differ by direction). Directions without such a trial are
+    missing."""
+    first = next((i for i, b in enumerate(session.protocol.blocks) if not b.perturbation.is_null),
+                 len(session.protocol.blocks))
+    seen: dict[float, list[float]] = {}
+    for o, r in zip(session.outcomes, rows, strict=True):
+        index = float(r["adaptation_index"])  # type: ignore[arg-type]
+        if o.plan.channel and o.plan.block < first and math.isfinite(index):
+            seen.setdefault(o.plan.target_deg, []).append(index)
+    return {deg: float(np.mean(v)) for deg, v in sorted(seen.items())}
+
+
+def subtract_baseline(session: LabSession, rows: Sequence[Mapping[str, object]]) -> list[dict[str, object]]:
+    """The rows with each channel trial's adaptation index less its direction's ``baseline_offsets`` (NaN for a
+    direction with no baseline channel trial). Raises ValueError for a run with no baseline channel trial."""
+    offsets = baseline_offsets(session, rows)
+    if not offsets:
+        raise ValueError("the run has no channel trial before its first perturbed block: no baseline to subtract")
+    out = []
+    for r in rows:
+        r = dict(r)
+        if r["perturbation"] == "channel":
+            r["adaptation_index"] = float(r["adaptation_index"]) - offsets.get(float(r["target_deg"]), math.nan)  # type: ignore[arg-type]
+        out.append(r)
+    return out
+
+
+def signed_angle(deg: float) -> float:
+    """An angle in (-180, 180]."""
+    a = (deg + 180.0) % 360.0 - 180.0
+    return 180.0 if a == -180.0 else a
+
+
+def generalization(session: LabSession, rows: Sequence[Mapping[str, object]]) -> list[dict[str, object]]:
+    """The generalization function of a train-on-one, probe-the-others run: for each block whose ordinary trials
+    go to one direction and whose channel trials probe others, per probed direction (by its angle from the
+    trained one, + counter-clockwise): the mean adaptation index of its channel trials, raw and less the
+    direction's baseline (``baseline_offsets``; NaN without one), and how many. Empty when no block is such."""
+    offsets = baseline_offsets(session, rows)
+    out: list[dict[str, object]] = []
+    for b, block in enumerate(session.protocol.blocks):
+        if block.directions is None or len(block.directions) != 1 or not block.channel_trials or block.channel_block:
+            continue
+        trained = session.protocol.target_angles_deg()[block.directions[0]] % 360.0
+        per: dict[float, list[float]] = {}
+        for o, r in zip(session.outcomes, rows, strict=True):
+            index = float(r["adaptation_index"])  # type: ignore[arg-type]
+            if o.plan.block == b and o.plan.channel and math.isfinite(index):
+                per.setdefault(o.plan.target_deg, []).append(index)
+        for deg, values in sorted(per.items(), key=lambda item: signed_angle(item[0] - trained)):
+            raw = float(np.mean(values))
+            out.append({"block": block.name, "trained_deg": trained, "target_deg": deg,
+                        "angle_deg": signed_angle(deg - trained), "n": len(values), "index": raw,
+                        "index_less_baseline": raw - offsets.get(deg, math.nan)})
+    return out
+
+
+CHANNEL_TRACE_COLUMNS = ("trial", "block", "target_deg", "time_s", "channel_force_n", "cancelling_force_n",
+                         "hand_speed_m_per_s")
+
+
+def channel_traces(session: LabSession) -> list[tuple[object, ...]]:
+    """Every channel trial's force over time, one row per physics step from the go cue to the trial's end
+    (``CHANNEL_TRACE_COLUMNS``): the force the arm pressed into the channel (N, + counter-clockwise side), the
+    force that would exactly cancel the reference field at that velocity (``-n . B v``, the adaptation index's
+    regressor; NaN with no reference field) and the hand's speed."""
+    out: list[tuple[object, ...]] = []
+    dt = session.config.dt
+    hx, hy = session.home
+    for o in session.outcomes:
+        if not o.plan.channel:
+            continue
+        tx, ty = o.plan.position
+        length = math.hypot(tx - hx, ty - hy)
+        normal = np.array([-(ty - hy) / length, (tx - hx) / length])
+        v = np.column_stack([o.vxs, o.vys]) if o.vxs else np.zeros((0, 2))
+        reference = session.protocol.reference_field(o.plan.block)
+        cancel = -(v @ np.asarray(reference.matrix).T) @ normal if reference is not None \
+            else np.full(len(v), math.nan)
+        speed = np.hypot(v[:, 0], v[:, 1])
+        for k, force in enumerate(o.channel_force):
+            out.append((o.plan.index + 1, o.plan.block_name, o.plan.target_deg, k * dt, force, float(cancel[k]),
+                        float(speed[k])))
+    return out
+
+
+def write_channel_traces(path: Path, session: LabSession) -> None:
+    """``channel_traces`` as CSV (numbers written exactly, NaN as an empty field), atomically."""
+    import csv
+    import io
+
+    from .metrics import _write_text
+
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(CHANNEL_TRACE_COLUMNS)
+    for trial, block, deg, t, force, cancel, speed in channel_traces(session):
+        block = f"'{block}" if str(block)[:1] in "=+-@" else block  # a spreadsheet would take it for a formula
+        writer.writerow([trial, block, repr(deg), repr(t), repr(force), "" if math.isnan(cancel) else repr(cancel),
+                         repr(speed)])
+    _write_text(Path(path), buffer.getvalue())

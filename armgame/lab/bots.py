@@ -45,10 +45,14 @@ import numpy as np
 from ..errors import UserError
 from ..game.bots import CurlLoad, MatrixLoad, ReachingBot
 from ..words import unknown_name
-from .learner import TwoRateLearner
+from .learner import TUNING_WIDTH_DEG, DirectionalLearner, TwoRateLearner
 from .session import LabSession
 
 LAB_BOT_NAMES = ("model", "naive", "adaptive")
+#: The adaptive bot's internal model of the curl field and the rotation: ``global`` (one estimate for every
+#: direction: it generalizes fully, by construction) or ``local`` (``DirectionalLearner``: Gaussian tuning over
+#: movement direction, so what it learns in one direction falls off with the angle from it).
+REPRESENTATIONS = ("global", "local")
 #: The viscous field's fit: the ridge toward no correction, as a fraction of the fit's mean curvature.
 RIDGE = 0.01
 
@@ -68,18 +72,28 @@ class LearningRates:
 class LabBot(ReachingBot):
     """A reaching bot for the lab: forgets its view at each new trial; learns if given rates."""
 
-    def __init__(self, name: str, interaction: bool, rates: LearningRates | None = None) -> None:
+    def __init__(self, name: str, interaction: bool, rates: LearningRates | None = None,
+                 representation: str = "global", width_deg: float = TUNING_WIDTH_DEG) -> None:
         super().__init__(name, interaction)
+        if representation not in REPRESENTATIONS:
+            raise UserError(unknown_name("learner representation", representation, REPRESENTATIONS))
         self.rates = rates
+        self.representation = representation
+        self.width_deg = float(width_deg)
         self._trial: int | None = None
+        #: The direction (degrees) of the trial it is on: where a local learner's estimates are read and taught.
+        self._direction = 0.0
         self._log: list[tuple[float, float, float, float, float, float, float, float, float, float]] = []
-        self.curl_learner: TwoRateLearner | None = None
-        self.rotation_learner: TwoRateLearner | None = None
+        self.curl_learner: TwoRateLearner | DirectionalLearner | None = None
+        self.rotation_learner: TwoRateLearner | DirectionalLearner | None = None
         if rates is not None:
             self.curl_learner = TwoRateLearner(rates.retention_fast, rates.retention_slow, rates.rate_fast,
                                                rates.rate_slow)
             self.rotation_learner = TwoRateLearner(rates.retention_fast, rates.retention_slow, rates.rate_fast,
                                                    rates.rate_slow)
+            if representation == "local":
+                self.curl_learner = DirectionalLearner(self.curl_learner, width_deg)
+                self.rotation_learner = DirectionalLearner(self.rotation_learner, width_deg)
         #: (trial, measured field b, estimate b^ it reached with; measured rotation, estimate) per trial.
         self.history: list[tuple[int, float, float, float, float]] = []
         #: With a viscous field in the protocol: the learner of ``B^`` (row by row, b11 b12 b21 b22), made at the
@@ -92,14 +106,37 @@ class LabBot(ReachingBot):
         self.known_field: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     # ------------------------------------------------------------- the estimates
+    def describe(self) -> str:
+        """Its learner's representation, in words, for every run's output (empty for a bot that does not learn)."""
+        if self.rates is None:
+            return ""
+        if self.representation == "local":
+            return (f"local learner: Gaussian tuning over movement direction, {self.width_deg:g} deg wide "
+                    "(learning falls off with the angle from the trained direction)")
+        return "global learner: one estimate for every direction (it generalizes fully)"
+
+    def _estimate_of(self, learner: TwoRateLearner | DirectionalLearner | None) -> float:
+        if learner is None:
+            return 0.0
+        if isinstance(learner, DirectionalLearner):
+            return learner.at(self._direction)
+        return float(learner.estimate)
+
+    def _teach(self, learner: TwoRateLearner | DirectionalLearner, error: float) -> None:
+        if isinstance(learner, DirectionalLearner):
+            learner.update(error, self._direction)
+        else:
+            learner.update(error)
+
     @property
     def curl_estimate(self) -> float:
-        return float(self.curl_learner.estimate) if self.curl_learner is not None else 0.0
+        """b^ (N s/m) for the trial it is on (a local learner's, in that trial's direction)."""
+        return self._estimate_of(self.curl_learner)
 
     @property
     def rotation_estimate(self) -> float:
-        """Radians, counter-clockwise."""
-        return float(self.rotation_learner.estimate) if self.rotation_learner is not None else 0.0
+        """Radians, counter-clockwise (a local learner's, in the direction of the trial it is on)."""
+        return self._estimate_of(self.rotation_learner)
 
     @property
     def matrix_estimate(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
@@ -156,6 +193,10 @@ class LabBot(ReachingBot):
             if self._trial is not None and self.rates is not None and session.outcomes:
                 self._learn(session)
             self._trial = session.trial_index
+            # The direction it will move in: its target's (the envs' policy sees no plan, and learns globally).
+            plan = getattr(session, "plan", None)
+            if plan is not None:
+                self._direction = plan.target_deg
             self._bind(session)  # the arm jumped home: what the bot saw before is no use now
             self._install(session)
             self._log = []
@@ -181,14 +222,14 @@ class LabBot(ReachingBot):
             self.matrix_history.append((outcome.plan.index, correction))
             self.matrix_learner.update(0.0 if outcome.plan.channel else correction)
         if outcome.plan.channel:  # held on the line: no error to learn from
-            self.curl_learner.update(0.0)
-            self.rotation_learner.update(0.0)
+            self._teach(self.curl_learner, 0.0)
+            self._teach(self.rotation_learner, 0.0)
             return
         if self.matrix_learner is not None:
-            self.rotation_learner.update(theta_seen - theta_hat)
+            self._teach(self.rotation_learner, theta_seen - theta_hat)
             return  # the matrix holds the curl too
-        self.curl_learner.update(b_seen - b_hat)
-        self.rotation_learner.update(theta_seen - theta_hat)
+        self._teach(self.curl_learner, b_seen - b_hat)
+        self._teach(self.rotation_learner, theta_seen - theta_hat)
 
     def _measure_curl(self, session: LabSession, log: list) -> float:
         """The curl field's b that best explains the external torque felt over the reach (0 if none moved)."""
@@ -277,12 +318,15 @@ def curl_unit_torque(l1: float, l2: float, q1: float, q2: float, fx: float, fy: 
     return (-l1 * s1 - l2 * s12) * fx + (l1 * c1 + l2 * c12) * fy, -l2 * s12 * fx + l2 * c12 * fy
 
 
-def make_lab_bot(name: str, rates: LearningRates | None = None) -> LabBot:
-    """``model``, ``naive`` (the game's bots) or ``adaptive`` (the model bot learning the perturbation)."""
+def make_lab_bot(name: str, rates: LearningRates | None = None, representation: str = "global",
+                 width_deg: float = TUNING_WIDTH_DEG) -> LabBot:
+    """``model``, ``naive`` (the game's bots) or ``adaptive`` (the model bot learning the perturbation, with a
+    ``global`` or ``local`` representation of it: ``REPRESENTATIONS``)."""
     if name == "model":
         return LabBot("model", interaction=True)
     if name == "naive":
         return LabBot("naive", interaction=False)
     if name == "adaptive":
-        return LabBot("adaptive", interaction=True, rates=rates or LearningRates())
+        return LabBot("adaptive", interaction=True, rates=rates or LearningRates(), representation=representation,
+                      width_deg=width_deg)
     raise UserError(unknown_name("lab bot", name, LAB_BOT_NAMES))

@@ -90,7 +90,12 @@ SPONTANEOUS_EXPOSURE = 160
 SPONTANEOUS_COUNTER = 4
 SPONTANEOUS_CLAMP = 48
 
+#: The generalization preset: the trained direction (one of the 8 targets) and the training, test and probe counts.
+GENERALIZATION_TRAINED_DEG = 90
+GENERALIZATION_BLOCKS = (64, 48, 16)
+
 MAX_BLOCKS = 20
+PROBE_SCHEDULES = ("balanced", "random")
 MAX_TRIALS = 2000
 MAX_TARGETS = 64
 
@@ -174,10 +179,26 @@ class Block:
     instruction: str = ""
     #: Error-clamp trials: the channel instead of the perturbation (all of the block's when equal to ``trials``).
     channel_trials: int = 0
+    #: The targets (indices into the protocol's directions) this block's ordinary trials go to; None: all of them.
+    directions: tuple[int, ...] | None = None
+    #: The targets its catch and channel trials go to (a generalization test probes directions never trained);
+    #: None: the block's own ``directions``.
+    probe_directions: tuple[int, ...] | None = None
 
     @property
     def channel_block(self) -> bool:
         return self.channel_trials == self.trials
+
+    @property
+    def probes(self) -> int:
+        """Its catch and channel trials."""
+        return self.catch_trials + self.channel_trials
+
+    def targets_of(self, protocol: Protocol) -> tuple[int, ...]:
+        return tuple(range(protocol.targets)) if self.directions is None else self.directions
+
+    def probe_targets_of(self, protocol: Protocol) -> tuple[int, ...]:
+        return self.targets_of(protocol) if self.probe_directions is None else self.probe_directions
 
 
 #: What a block's card asks, by block name. What to do, never what will happen ("something has changed",
@@ -213,10 +234,23 @@ class Protocol:
     #: The error-clamp channel's spring (N/m) and damper (N s/m) across the home-to-target line.
     channel_stiffness: float = CHANNEL_STIFFNESS
     channel_damping: float = CHANNEL_DAMPING
+    #: How a block's catch and channel trials are placed (``session.schedule``): ``balanced`` (spread evenly over
+    #: the block's probe directions and its trials, issue 29) or ``random`` (drawn uniformly among the block's
+    #: trials after its first cycle, as before; what a replay recorded without the key ran).
+    probe_schedule: str = "balanced"
+    #: ``balanced`` only: whether two probe trials may follow one another (never, unless asked).
+    consecutive_probes: bool = False
     perturbations: tuple[Perturbation, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "perturbations", tuple(dict.fromkeys(b.perturbation for b in self.blocks)))
+        if not self.has_probes:
+            # Without probe trials the settings change no trial: one form, so that an old replay's protocol
+            # and a new run's compare equal (the class curve groups runs by protocol).
+            object.__setattr__(self, "probe_schedule", "balanced")
+            object.__setattr__(self, "consecutive_probes", False)
+        if self.probe_schedule not in PROBE_SCHEDULES:
+            raise ValueError(f"probe_schedule must be one of {', '.join(PROBE_SCHEDULES)}, got {self.probe_schedule!r}")
 
     @property
     def trials(self) -> int:
@@ -225,6 +259,11 @@ class Protocol:
     @property
     def has_channels(self) -> bool:
         return any(b.channel_trials for b in self.blocks)
+
+    @property
+    def has_probes(self) -> bool:
+        """Whether any block has catch or channel trials (the only trials ``probe_schedule`` places)."""
+        return any(b.probes for b in self.blocks)
 
     def reference_field(self, block: int) -> Perturbation | None:
         """The field a channel trial of ``block`` is measured against (its adaptation index): the block's
@@ -244,6 +283,20 @@ class Protocol:
         custom = (self.channel_stiffness, self.channel_damping) != (CHANNEL_STIFFNESS, CHANNEL_DAMPING)
         channel = {"channel_stiffness": self.channel_stiffness, "channel_damping": self.channel_damping} \
             if self.has_channels or custom else {}
+        # Likewise the probe settings (a replay without them ran the ``random`` placement) and a block's
+        # directions.
+        probes: dict[str, object] = {"probe_schedule": self.probe_schedule} if self.has_probes else {}
+        if self.consecutive_probes:
+            probes["consecutive_probes"] = True
+        angles = self.target_angles_deg()
+
+        def directions(b: Block) -> dict[str, object]:
+            out: dict[str, object] = {}
+            if b.directions is not None:
+                out["directions_deg"] = [angles[t] % 360.0 for t in b.directions]
+            if b.probe_directions is not None:
+                out["probe_directions_deg"] = [angles[t] % 360.0 for t in b.probe_directions]
+            return out
         return {
             "name": self.name,
             "targets": self.targets,
@@ -258,9 +311,11 @@ class Protocol:
             "home_shoulder_deg": self.home_posture_deg[0],
             "home_elbow_deg": self.home_posture_deg[1],
             **channel,
+            **probes,
             "blocks": [
                 {"name": b.name, "trials": b.trials, "catch_trials": b.catch_trials, "instruction": b.instruction,
-                 **({"channel_trials": b.channel_trials} if b.channel_trials else {}), **b.perturbation.as_dict()}
+                 **({"channel_trials": b.channel_trials} if b.channel_trials else {}), **directions(b),
+                 **b.perturbation.as_dict()}
                 for b in self.blocks
             ],
         }
@@ -311,10 +366,13 @@ def preset(name: str) -> Protocol:
         return savings()
     if name == "spontaneous":
         return spontaneous()
+    if name == "generalization":
+        return generalization()
     raise UserError(unknown_name("lab preset", name, PRESETS, "or give a .toml file"))
 
 
-PRESETS = ("lesson", "null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous")
+PRESETS = ("lesson", "null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous",
+           "generalization")
 
 
 def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
@@ -354,6 +412,23 @@ def spontaneous() -> Protocol:
     )))
 
 
+def generalization() -> Protocol:
+    """Train on one direction, probe them all (Shadmehr & Mussa-Ivaldi 1994; Krakauer et al. 2000;
+    Donchin et al. 2003): a baseline to the 8 targets with a channel trial to each (the per-direction
+    baseline), training in the curl field to ``GENERALIZATION_TRAINED_DEG`` only, then a test block that
+    keeps training there while its channel trials probe every direction twice, spread evenly. The adaptation
+    index by angle from the trained direction is the generalization function (docs/lab.md)."""
+    curl = Perturbation.make("curl", b=CURL_B)
+    trained = (GENERALIZATION_TRAINED_DEG // 45,)
+    train, test, probes = GENERALIZATION_BLOCKS
+    return _checked(Protocol("generalization", (
+        Block("baseline", 24, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"], channel_trials=8),
+        Block("exposure", train, curl, 0, DEFAULT_INSTRUCTIONS["exposure"], directions=trained),
+        Block("test", test, curl, 0, DEFAULT_INSTRUCTIONS["exposure"], channel_trials=probes, directions=trained,
+              probe_directions=tuple(range(8))),
+    )))
+
+
 def with_catch_trials(protocol: Protocol, catch: int) -> Protocol:
     """The protocol with ``catch`` catch trials in each block that has a perturbation."""
     blocks = tuple(replace(b, catch_trials=catch) if b.perturbation.kind != "none" else b for b in protocol.blocks)
@@ -383,8 +458,27 @@ def with_perturbation(protocol: Protocol, perturbation: Perturbation) -> Protoco
 # ----------------------------------------------------------------- from data
 MAX_PROTOCOL_BYTES = 256 * 1024
 _TOP = {"name", "targets", "distance", "target_radius", "home_radius", "hold_time", "delay_min", "delay_max",
-        "timeout", "first_target_deg", "home_shoulder_deg", "home_elbow_deg", "channel_stiffness", "channel_damping"}
-_BLOCK = {"name", "trials", "catch_trials", "channel_trials", "instruction", "perturbation"}
+        "timeout", "first_target_deg", "home_shoulder_deg", "home_elbow_deg", "channel_stiffness", "channel_damping",
+        "probe_schedule", "consecutive_probes"}
+_BLOCK = {"name", "trials", "catch_trials", "channel_trials", "instruction", "perturbation", "directions_deg",
+          "probe_directions_deg"}
+
+
+def _directions(where: str, value: object, angles: tuple[float, ...]) -> tuple[int, ...]:
+    """A list of target directions (degrees, each one of the protocol's) as target indices, in the order given."""
+    if not isinstance(value, list) or not 1 <= len(value) <= len(angles):
+        raise ValueError(f"{where} must be a list of 1 to {len(angles)} of the targets' directions (degrees)")
+    out: list[int] = []
+    for i, item in enumerate(value):
+        deg = check_float(f"{where}[{i}]", item, -360.0, 360.0)
+        found = [t for t, a in enumerate(angles) if abs(((deg - a) + 180.0) % 360.0 - 180.0) < 1e-6]
+        if not found:
+            shown = ", ".join(f"{a % 360.0:g}" for a in angles)
+            raise ValueError(f"{where}[{i}]: {deg:g} deg is not a target's direction (they are {shown})")
+        if found[0] in out:
+            raise ValueError(f"{where}[{i}]: {deg:g} deg is named twice")
+        out.append(found[0])
+    return tuple(out)
 
 
 def viscous_matrix(where: str, value: object) -> dict[str, float]:
@@ -397,8 +491,11 @@ def viscous_matrix(where: str, value: object) -> dict[str, float]:
             for (i, j), name in zip(((0, 0), (0, 1), (1, 0), (1, 1)), ("b11", "b12", "b21", "b22"), strict=True)}
 
 
-def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
-    """Build and check a protocol from plain data (a TOML file's or a replay's); raises ValueError."""
+def protocol_from_dict(data: object, where: str = "protocol", recorded: bool = False) -> Protocol:
+    """Build and check a protocol from plain data (a TOML file's or a replay's); raises ValueError.
+
+    ``recorded``: the protocol of a replay. One recorded before ``probe_schedule`` existed says nothing of it and
+    ran the ``random`` placement; a file without the key gets today's default, ``balanced``."""
     optional = frozenset(_TOP - {"blocks"})
     d = check_keys(where, data, {"blocks"}, optional)
     defaults = Protocol("custom", ())
@@ -410,6 +507,9 @@ def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
     blocks_data = d["blocks"]
     if not isinstance(blocks_data, list) or not 1 <= len(blocks_data) <= MAX_BLOCKS:
         raise ValueError(f"blocks must be a list of 1 to {MAX_BLOCKS} blocks")
+    targets = check_int("targets", d["targets"], 1, MAX_TARGETS) if "targets" in d else defaults.targets
+    first_deg = number("first_target_deg", -360.0, 360.0, defaults.first_target_deg)
+    angles = replace(defaults, targets=targets, first_target_deg=first_deg).target_angles_deg()
     blocks = []
     for i, b in enumerate(blocks_data):
         w = f"blocks[{i}]"
@@ -433,22 +533,34 @@ def protocol_from_dict(data: object, where: str = "protocol") -> Protocol:
             check_int(f"{w}.catch_trials", b.get("catch_trials", 0), 0, MAX_TRIALS),
             check_str(f"{w}.instruction", b.get("instruction", DEFAULT_INSTRUCTIONS.get(block_name, "")), 200),
             check_int(f"{w}.channel_trials", b.get("channel_trials", 0), 0, MAX_TRIALS),
+            _directions(f"{w}.directions_deg", b["directions_deg"], angles) if "directions_deg" in b else None,
+            _directions(f"{w}.probe_directions_deg", b["probe_directions_deg"], angles)
+            if "probe_directions_deg" in b else None,
         ))
+    schedule = check_str("probe_schedule", d["probe_schedule"], 20) if "probe_schedule" in d \
+        else "random" if recorded else "balanced"
+    if schedule not in PROBE_SCHEDULES:
+        raise ValueError(f"probe_schedule must be one of {', '.join(PROBE_SCHEDULES)}, got {schedule!r}")
+    consecutive = d.get("consecutive_probes", False)
+    if not isinstance(consecutive, bool):
+        raise ValueError(f"consecutive_probes must be true or false, got {consecutive!r}")
     protocol = Protocol(
         name,
         tuple(blocks),
-        targets=check_int("targets", d["targets"], 1, MAX_TARGETS) if "targets" in d else defaults.targets,
+        targets=targets,
         distance=number("distance", 0.01, 0.3, defaults.distance),
         target_radius=number("target_radius", 0.002, 0.1, defaults.target_radius),
         home_radius=number("home_radius", 0.002, 0.1, defaults.home_radius),
         hold_time=number("hold_time", 0.0, 5.0, defaults.hold_time),
         delay=(number("delay_min", 0.0, 10.0, defaults.delay[0]), number("delay_max", 0.0, 10.0, defaults.delay[1])),
         timeout=number("timeout", 0.2, 60.0, defaults.timeout),
-        first_target_deg=number("first_target_deg", -360.0, 360.0, defaults.first_target_deg),
+        first_target_deg=first_deg,
         home_posture_deg=(number("home_shoulder_deg", -180.0, 180.0, defaults.home_posture_deg[0]),
                           number("home_elbow_deg", 5.0, 175.0, defaults.home_posture_deg[1])),
         channel_stiffness=number("channel_stiffness", 0.0, MAX_CHANNEL_STIFFNESS, CHANNEL_STIFFNESS, low_open=True),
         channel_damping=number("channel_damping", 0.0, MAX_CHANNEL_DAMPING, CHANNEL_DAMPING),
+        probe_schedule=schedule,
+        consecutive_probes=consecutive,
     )
     return _checked(protocol)
 
@@ -458,7 +570,16 @@ def _checked(p: Protocol) -> Protocol:
         raise ValueError(f"delay_min ({p.delay[0]:g} s) must not exceed delay_max ({p.delay[1]:g} s)")
     if p.trials > MAX_TRIALS:
         raise ValueError(f"the protocol has {p.trials} trials, more than {MAX_TRIALS}")
+    balanced = p.probe_schedule == "balanced"
     for i, b in enumerate(p.blocks):
+        for name, chosen in (("directions_deg", b.directions), ("probe_directions_deg", b.probe_directions)):
+            if chosen is not None and (not chosen or len(set(chosen)) != len(chosen)
+                                       or not all(0 <= t < p.targets for t in chosen)):
+                raise ValueError(f"blocks[{i}].{name} must name distinct targets of the protocol's {p.targets}")
+        if b.probe_directions is not None and not b.probes:
+            raise ValueError(f"blocks[{i}].probe_directions_deg: block {b.name!r} has no catch or channel trials")
+        if b.probe_directions is not None and not balanced:
+            raise ValueError(f"blocks[{i}].probe_directions_deg needs probe_schedule = \"balanced\"")
         if b.catch_trials and b.perturbation.kind == "none":
             raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} has no perturbation to switch off")
         if b.channel_trials > b.trials:
@@ -467,13 +588,19 @@ def _checked(p: Protocol) -> Protocol:
             if b.catch_trials:
                 raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} is all channel trials: none to catch")
             continue
-        if b.catch_trials > max(0, b.trials - p.targets):
+        cycle = len(b.targets_of(p))
+        if b.catch_trials > max(0, b.trials - cycle):
             raise ValueError(f"blocks[{i}].catch_trials must be at most trials - targets "
-                             f"({max(0, b.trials - p.targets)}): catch trials never fall in a block's first cycle")
-        if b.catch_trials + b.channel_trials > max(0, b.trials - p.targets):
+                             f"({max(0, b.trials - cycle)}): catch trials never fall in a block's first cycle")
+        if b.probes > max(0, b.trials - cycle):
             raise ValueError(f"blocks[{i}].channel_trials must be at most trials - targets - catch_trials "
-                             f"({max(0, b.trials - p.targets - b.catch_trials)}), or all of the block's trials: "
+                             f"({max(0, b.trials - cycle - b.catch_trials)}), or all of the block's trials: "
                              "channel trials never fall in a block's first cycle nor on a catch trial")
+        room = max(1, (b.trials - cycle) // 2)  # one probe a run of two trials or more (session.balanced_probes)
+        if balanced and not p.consecutive_probes and b.probes > room:
+            raise ValueError(f"blocks[{i}]: {b.probes} catch and channel trials in the {b.trials - cycle} trials after "
+                             f"its first cycle: at most {room} when no two follow one another "
+                             "(consecutive_probes = true allows it)")
     return p
 
 

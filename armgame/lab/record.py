@@ -59,7 +59,7 @@ class LabTask:
         if config.scene != LAB_SCENE:
             raise ValueError(f"a replay with a task must have scene {LAB_SCENE!r}, got {config.scene!r}")
         try:
-            protocol = protocol_from_dict(d["protocol"], "task.protocol")
+            protocol = protocol_from_dict(d["protocol"], "task.protocol", recorded=True)
         except ValueError as exc:
             raise ValueError(f"task.protocol: {exc}") from None
         trials_data = d["trials"]

@@ -33,7 +33,7 @@ from ..limits import MAX_GAME_SECONDS
 from ..physics.integrators import Integrator
 from ..physics.loads import ChannelField, Loads, loaded_arm
 from .perturbations import Display, display_for, loads_for
-from .protocol import MAX_CHANNEL_LAMBDA_DT, NONE, Perturbation, Protocol, target_positions
+from .protocol import MAX_CHANNEL_LAMBDA_DT, NONE, Block, Perturbation, Protocol, target_positions
 
 HOLD, REACH = "hold", "reach"
 _WENT, _ENDED = 1, 2
@@ -80,34 +80,89 @@ class TrialOutcome:
 
 
 def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]) -> tuple[TrialPlan, ...]:
-    """Every trial of the protocol: targets in shuffled cycles (each target once a cycle), go-cue delays,
-    catch trials and channel trials, all drawn from one ``random.Random(seed)`` in a fixed order (a block
-    without channel trials draws nothing for them, so the schedules of protocols without channels are
-    those they always were)."""
+    """Every trial of the protocol: targets in shuffled cycles (each of the block's targets once a cycle),
+    go-cue delays, catch trials and channel trials, all drawn from one ``random.Random(seed)`` in a fixed
+    order. A block without catch or channel trials draws nothing for them, so the schedules of protocols
+    without probes are those they always were; how the probes are placed is ``protocol.probe_schedule``'s
+    (``balanced_probes``, or ``random``: drawn uniformly among the trials after the block's first cycle)."""
     rng = random.Random(seed)
     positions = target_positions(protocol, home)
     angles = protocol.target_angles_deg()
     plans: list[TrialPlan] = []
     for b, block in enumerate(protocol.blocks):
-        order: list[int] = []
-        while len(order) < block.trials:
-            cycle = list(range(protocol.targets))
-            rng.shuffle(cycle)
-            order += cycle
-        catch = set(rng.sample(range(protocol.targets, block.trials), block.catch_trials))
+        own = block.targets_of(protocol)
         if block.channel_block:
+            order = _cycles(rng, block.probe_targets_of(protocol), block.trials)
+            catch: set[int] = set()
             channel = set(range(block.trials))
-        elif block.channel_trials:
-            free = [i for i in range(protocol.targets, block.trials) if i not in catch]
-            channel = set(rng.sample(free, block.channel_trials))
+        elif protocol.probe_schedule == "balanced" and block.probes:
+            order, catch, channel = balanced_probes(rng, block, own, block.probe_targets_of(protocol),
+                                                    protocol.consecutive_probes)
         else:
-            channel = set()
+            order = _cycles(rng, own, block.trials)
+            catch = set(rng.sample(range(len(own), block.trials), block.catch_trials))
+            if block.channel_trials:
+                free = [i for i in range(len(own), block.trials) if i not in catch]
+                channel = set(rng.sample(free, block.channel_trials))
+            else:
+                channel = set()
         for i in range(block.trials):
             delay = rng.uniform(*protocol.delay)
             t = order[i]
             plans.append(TrialPlan(len(plans), b, block.name, t, angles[t] % 360.0, positions[t],
                                    max(1, round(delay / dt)), block.perturbation, i in catch, i in channel))
     return tuple(plans)
+
+
+def _cycles(rng: random.Random, targets: tuple[int, ...], n: int) -> list[int]:
+    order: list[int] = []
+    while len(order) < n:
+        cycle = list(targets)
+        rng.shuffle(cycle)
+        order += cycle
+    return order
+
+
+def balanced_probes(rng: random.Random, block: Block, targets: tuple[int, ...], probe_targets: tuple[int, ...],
+                    consecutive: bool = False) -> tuple[list[int], set[int], set[int]]:
+    """A block's targets, catch trials and channel trials with its probes placed evenly (issue 29).
+
+    * When: the trials after the block's first cycle are cut into as many equal runs as there are probes
+      (catch plus channel trials), and each probe falls on a trial drawn within its run, never right after
+      the previous probe unless ``consecutive`` (the protocol's checks leave room: each run is two trials or
+      more). So probes are spread through the block, one a run.
+    * Which kind: catch and channel trials alternate as evenly as their counts allow (the j-th probe is a
+      channel trial when ``floor((j + 1) h / p)`` steps past ``floor(j h / p)``, with h channel trials of p).
+    * Where to: each probe, in order, goes to the probe direction with the fewest probes of its kind so far,
+      then the fewest of either kind, ties drawn from the seed. So each kind's probes differ by at most one
+      between directions, and every direction is probed before any twice.
+    * The other trials keep the block's shuffled cycles of its own targets, the first cycle whole before any
+      probe."""
+    n, k, p = block.trials, len(targets), block.probes
+    ordinary = iter(_cycles(rng, targets, n - p))
+    span = n - k
+    slots: list[int] = []
+    for j in range(p):
+        low, high = k + j * span // p, k + (j + 1) * span // p
+        if slots and not consecutive:
+            low = max(low, slots[-1] + 2)
+        slots.append(rng.randrange(low, high))
+    kinds = ["channel" if (j + 1) * block.channel_trials // p > j * block.channel_trials // p else "catch"
+             for j in range(p)]
+    counts = {kind: dict.fromkeys(probe_targets, 0) for kind in ("catch", "channel")}
+    total = dict.fromkeys(probe_targets, 0)
+    where: dict[int, int] = {}
+    for slot, kind in zip(slots, kinds, strict=True):
+        best = min((counts[kind][t], total[t]) for t in probe_targets)
+        tied = [t for t in probe_targets if (counts[kind][t], total[t]) == best]
+        chosen = tied[rng.randrange(len(tied))]
+        counts[kind][chosen] += 1
+        total[chosen] += 1
+        where[slot] = chosen
+    order = [where[i] if i in where else next(ordinary) for i in range(n)]
+    catch = {s for s, kind in zip(slots, kinds, strict=True) if kind == "catch"}
+    channel = {s for s, kind in zip(slots, kinds, strict=True) if kind == "channel"}
+    return order, catch, channel
 
 
 def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = DEFAULT_MUSCLES,
