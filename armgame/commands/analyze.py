@@ -23,7 +23,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "trials, and measure every reach: one row per reach (block, trial, target_deg, perturbation, "
         "reaction_time_s, movement_time_s, peak_speed_m_per_s, initial_direction_error_deg, max_perpendicular_error_m, "
         "path_length_ratio, hit, and on error-clamp trials channel_force_peak_n, channel_force_at_peak_speed_n, "
-        "adaptation_index). --fit two-rate fits the two-rate learner's rates to each run. A replay that does "
+        "adaptation_index). --fit two-rate (or one-rate) fits a learner's rates to each run by maximum likelihood, with "
+        "profile-likelihood intervals, AIC and BIC; --fit both fits the two and says which the data support. A replay "
+        "that does "
         "not verify is reported and left out. With --class DIR: "
         "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
         "per trial of --metric: class_curve.csv and class_curve.png in --out. The class's protocol is the one most "
@@ -43,10 +45,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "initial_direction_error_deg for visual transforms)")
     p.add_argument("--no-figures", action="store_true",
                    help="with --class or --fit: no figures (no matplotlib needed)")
-    p.add_argument("--fit", choices=("two-rate",),
-                   help="fit the two-rate model's retention and learning rates (A_f, A_s, B_f, B_s) to each replay's "
-                   "per-trial errors: the values with 95%% confidence intervals and the residual, and NAME.fit.png "
-                   "(the fit over the data) next to --out, if given")
+    p.add_argument("--fit", choices=("two-rate", "one-rate", "both"),
+                   help="fit a learner to each replay's per-trial errors by maximum likelihood (Gaussian noise): "
+                   "two-rate (A_f, A_s, B_f, B_s), one-rate (A, B), or both, compared by AIC, BIC and the likelihood "
+                   "ratio; the values with 95%% profile-likelihood intervals, the residual, the log-likelihood, and "
+                   "NAME.fit.json and NAME.fit.png (the fit over the data) next to --out, if given")
     p.add_argument("--fit-on", choices=("error", "index"), default="error",
                    help="with --fit: the errors of the reaches that are not channel trials (default; the measure "
                    "the learning figure plots), or the adaptation index of the channel trials")
@@ -216,7 +219,7 @@ def _replays(args: argparse.Namespace) -> int:
         if args.fit:
             beside = None if out is None else (out.parent if one_table else out)  # the fit's files: by the table
             try:
-                written += _fit(session, rows, args.fit_on, beside, path, replay.player, not args.no_figures)
+                written += _fit(session, rows, args.fit_on, beside, path, replay.player, not args.no_figures, args.fit)
             except UserError as exc:
                 print(f"armgame analyze: {path}: {exc}", file=sys.stderr)
                 skipped += 1
@@ -239,24 +242,36 @@ def _replays(args: argparse.Namespace) -> int:
     return 1 if skipped else 0
 
 
-def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | None, figures: bool) -> list[Path]:
-    """Fit the two-rate model to one verified run and print it; with ``beside`` (a folder), keep the fit
-    there as ``NAME.fit.json`` (and draw ``NAME.fit.png``)."""
+def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | None, figures: bool,
+         model: str = "two-rate") -> list[Path]:
+    """Fit ``model`` (``both``: the one-rate and two-rate models, compared) to one verified run and print it;
+    with ``beside`` (a folder), keep the fit there as ``NAME.fit.json`` (and draw ``NAME.fit.png``)."""
     from ..lab.analysis import figure_metric, fit_schedule
-    from ..lab.fit import fit_two_rate
+    from ..lab.fit import compare, fit_learner
 
     metric = figure_metric(session.protocol) if on == "error" else "adaptation_index"
+    comparison = None
     try:
         disturbance, clamped = fit_schedule(session)
         observed = [float(r[metric]) for r in rows]
-        fit = fit_two_rate(disturbance, clamped, observed, on)
+        if model == "both":
+            comparison = compare(disturbance, clamped, observed, on)
+            fits = [comparison.simple, comparison.full]
+        else:
+            fits = [fit_learner(model, disturbance, clamped, observed, on)]
     except ValueError as exc:
-        raise UserError(f"cannot fit the two-rate model to its {metric}: {exc}") from None
+        raise UserError(f"cannot fit the {'learners' if model == 'both' else model + ' model'} to its {metric}: "
+                        f"{exc}") from None
     unit = metric.rsplit("_", 1)[1] if metric != "adaptation_index" else ""
     shown, scale = ("cm", 100.0) if unit == "m" else (unit, 1.0)  # a student reads cm; the file keeps metres
-    print(f"  two-rate fit to {metric} ({fit.n} trials):")
-    for line in fit.lines(shown, scale):
-        print(line)
+    for fit in fits:
+        print(f"  {fit.model} fit to {metric} ({fit.n} trials; 95% intervals by profile likelihood):")
+        for line in fit.lines(shown, scale):
+            print(line)
+    if comparison is not None:
+        for line in comparison.lines():
+            print(line)
+    fit = fits[-1]  # the file's and the figure's: the two-rate model when both were fitted
     if beside is None:
         return []
     import json
@@ -272,6 +287,9 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
     check_regular_target(kept)
     record = {"replay": str(path), "player": player or "", "protocol": session.protocol.name,
               "seed": session.config.seed, "measure": metric, **fit.as_dict(unit)}
+    if comparison is not None:
+        record["compared_with"] = comparison.simple.as_dict(unit)
+        record["comparison"] = comparison.as_dict()
     try:
         atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
     except (OSError, ValueError) as exc:
@@ -281,7 +299,7 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
         from ..lab.figures import fit_figure
 
         figure = beside / f"{path.stem}.fit.png"
-        fit_figure(rows, fit, figure, metric)
+        fit_figure(rows, fit, figure, metric, None if comparison is None else comparison.simple)
         written.append(figure)
     return written
 

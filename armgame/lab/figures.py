@@ -387,9 +387,10 @@ def _save(fig: Any, path: Path) -> None:
 
 
 @_lab_style
-def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str) -> None:
-    """A two-rate fit (``armgame.lab.fit.TwoRateFit``) drawn over the data it was fitted to, blocks shaded,
-    the parameters in the title; ``metric`` the fitted column (``adaptation_index`` for indices)."""
+def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str, other: Any = None) -> None:
+    """A learner's fit (``armgame.lab.fit.LearnerFit``) drawn over the data it was fitted to, blocks shaded,
+    the parameters in the title; ``metric`` the fitted column (``adaptation_index`` for indices); ``other``, a
+    second model's fit to the same data, dashed beside it."""
     label, scale = ("adaptation index (channel trials)", 1.0) if metric == "adaptation_index" else _measure(metric)
     rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
     fig = _figure()
@@ -399,7 +400,11 @@ def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: 
     seen = np.isfinite(fit.observed)
     ax.plot(trial[seen], fit.observed[seen] * scale, "o", color=LINE, ms=_marker_size(len(rows)), label="data")
     shown = np.isfinite(fit.predicted) & (seen | (fit.observed_kind == "index"))
-    ax.plot(trial[shown], fit.predicted[shown] * scale, "-", color=CATCH, lw=2.0, label="two-rate fit")
+    ax.plot(trial[shown], fit.predicted[shown] * scale, "-", color=CATCH, lw=2.0,
+            label=f"{fit.model} fit (AIC {fit.aic:.1f})" if other is not None else f"{fit.model} fit")
+    if other is not None:
+        ax.plot(trial[shown], other.predicted[shown] * scale, "--", color=LINE, lw=1.5,
+                label=f"{other.model} fit (AIC {other.aic:.1f})")
     ax.axhline(0.0, color="black", lw=1.0)
     ax.set_xlabel("trial")
     ax.set_ylabel(label)
@@ -407,9 +412,9 @@ def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: 
     _headroom(ax, np.concatenate([fit.observed[seen], fit.predicted[shown]]) * scale)
     ax.grid(alpha=0.3, axis="y")
     v = fit.values
-    ax.set_title(f"Two-rate fit: A_f {v['retention_fast']:.3g}, A_s {v['retention_slow']:.4g}, "
-                 f"B_f {v['rate_fast']:.3g}, B_s {v['rate_slow']:.3g}; rms residual {fit.rms * scale:.3g}, "
-                 f"R² {fit.r_squared:.2f}")
+    rates = (f"A_f {v['retention_fast']:.3g}, A_s {v['retention_slow']:.4g}, B_f {v['rate_fast']:.3g}, "
+             f"B_s {v['rate_slow']:.3g}" if "rate_fast" in v else f"A {v['retention']:.4g}, B {v['rate']:.3g}")
+    ax.set_title(f"{fit.model.capitalize()} fit: {rates}; rms residual {fit.rms * scale:.3g}, R² {fit.r_squared:.2f}")
     _legend_below(fig, ax)
     _save(fig, path)
 
