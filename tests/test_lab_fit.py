@@ -1,10 +1,10 @@
 """Fitting the two-rate model to a run (armgame/lab/fit.py, armgame analyze --fit): recovered rates from
 learners with known rates, the constraints kept, one-line errors."""
 
+import math
+
 import numpy as np
 import pytest
-
-import math
 
 from armgame.lab.fit import CHI2_1_95, compare, fit_learner, fit_two_rate, run_model
 from armgame.lab.learner import TwoRateLearner, simulate
