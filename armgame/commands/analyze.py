@@ -264,7 +264,7 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
     unit = metric.rsplit("_", 1)[1] if metric != "adaptation_index" else ""
     shown, scale = ("cm", 100.0) if unit == "m" else (unit, 1.0)  # a student reads cm; the file keeps metres
     for fit in fits:
-        print(f"  {fit.model} fit to {metric} ({fit.n} trials; 95% intervals by profile likelihood):")
+        print(f"  {fit.model} fit to {metric} ({fit.n} trials), 95% intervals by profile likelihood:")
         for line in fit.lines(shown, scale):
             print(line)
     if comparison is not None:
