@@ -79,6 +79,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "the angle from where it learned it)")
     p.add_argument("--tuning-width", type=float, default=None, metavar="DEG",
                    help="with --representation local: the tuning's width, s.d. in degrees (5 to 180; default 30)")
+    p.add_argument("--motor-noise", type=_noise_level, default=0.0, metavar="LEVEL",
+                   help="a bot's signal-dependent motor noise: the s.d. of its command as a fraction of it (0 to 1), "
+                   f"or 'human' ({HUMAN_NOISE:g}, the level chosen to vary as people do); drawn from --seed, carried "
+                   "by the keys it presses (default: 0, none)")
     from ..ui.options import add_window_options
 
     add_window_options(p, sound=False)
@@ -87,6 +91,31 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help=f"a bot's run in the window starts at this speed ({_speeds()}; - and + change it as it "
                    "runs; default 1)")
     p.set_defaults(run=run, without_window=without_window)
+
+
+#: ``--motor-noise human``: a choice (docs/lab.md, "Motor noise"), not a fit to a published data set.
+HUMAN_NOISE = 0.3
+
+
+def _noise_level(text: str) -> float:
+    if text == "human":
+        return HUMAN_NOISE
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value <= 1.0:  # also refuses NaN
+        raise argparse.ArgumentTypeError(f"must be from 0 to 1, or human, got {text!r}")
+    return value
+
+
+def _motor_noise(args: argparse.Namespace):
+    """The bot's ``MotorNoise`` (its stream seeded by the run's seed), or None without --motor-noise."""
+    if not args.motor_noise:
+        return None
+    from ..game.bots import MotorNoise
+
+    return MotorNoise(args.motor_noise, args.seed)
 
 
 def _speeds() -> str:
@@ -138,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--headless needs a --bot to play (model, naive or adaptive); people play in the window")
     if args.bot and args.bot not in LAB_BOT_NAMES:
         raise UserError(unknown_name("lab bot", args.bot, LAB_BOT_NAMES))
+    if args.motor_noise and not args.bot:
+        raise UserError("--motor-noise sets a bot's motor noise: add --bot (a person brings their own)")
     if (args.retention or args.learning or args.representation) and args.bot != "adaptive":
         raise UserError("--retention, --learning and --representation set the adaptive bot's learner: add --bot "
                         "adaptive")
@@ -202,9 +233,9 @@ def _bot(args: argparse.Namespace, rates):
     from ..lab.learner import TUNING_WIDTH_DEG
 
     if args.bot != "adaptive":
-        return make_lab_bot(args.bot)
+        return make_lab_bot(args.bot, noise=_motor_noise(args))
     width = TUNING_WIDTH_DEG if args.tuning_width is None else args.tuning_width
-    return make_lab_bot(args.bot, rates, args.representation or "global", width)
+    return make_lab_bot(args.bot, rates, args.representation or "global", width, noise=_motor_noise(args))
 
 
 def default_runs_dir() -> Path:
@@ -420,7 +451,7 @@ def _replay(session, args: argparse.Namespace):
 
     driven = "bot" if args.bot else "keyboard"
     return Replay(session.config, tuple(session.timeline), session.result(), driven, args.bot, args.name, now_iso(),
-                  task=LabTask.of(session))
+                  task=LabTask.of(session, _motor_noise(args)))
 
 
 def _cm(value: object) -> str:

@@ -29,7 +29,10 @@ filter the presses, so one decision moves an activation by at most 5 percent of 
 ripple of at most 0.07 N m). Under a finer physics step the bot still decides every 4 ms, on
 whole steps, so its play hardly depends on the step.
 
-Nothing here is random: a bot's game is a function of the game's seed.
+Nothing here is random unless asked: a bot's game is a function of the game's seed. A bot given
+``MotorNoise`` (the lab's ``--motor-noise``; never the game's ranked bots) varies its motor command
+from a seeded stream of its own, before the command becomes keys: the keys it presses carry the noise,
+so its timeline replays (and verifies) bit for bit with no noise re-drawn.
 """
 
 from __future__ import annotations
@@ -66,6 +69,56 @@ class Bot(Protocol):
     def period_steps(self, dt: float) -> int: ...
 
     def act(self, session: GameSession) -> list[tuple[str, str]]: ...
+
+
+@dataclass(frozen=True)
+class MotorNoise:
+    """Signal-dependent noise on a bot's motor command (Harris & Wolpert 1998: the s.d. grows with the signal).
+
+    Each joint's commanded torque (the net activation of its muscle pair, times its moment) is multiplied by
+    ``1 + n``, where ``n`` is a Gaussian process of s.d. ``level`` (a coefficient of variation) correlated
+    over ``correlation_time`` seconds (first-order autoregressive, one draw per decision and joint): a
+    command held for a while is held with one error, as a force held by a person drifts, rather than
+    jittering every 4 ms where the muscles would filter it out. ``seed`` starts the stream (numpy's PCG64,
+    the same numbers on every machine)."""
+
+    level: float
+    seed: int
+    correlation_time: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.level) and 0.0 <= self.level <= 1.0):
+            raise UserError(f"motor noise must be from 0 to 1 (a coefficient of variation), got {self.level!r}")
+        if not (math.isfinite(self.correlation_time) and 0.0 < self.correlation_time <= 10.0):
+            raise UserError(f"the motor noise's correlation time must be from 0 to 10 s, got {self.correlation_time!r}")
+
+    def as_dict(self) -> dict[str, object]:
+        return {"level": self.level, "correlation_time_s": self.correlation_time, "seed": self.seed}
+
+
+class _NoiseStream:
+    """The noise factors of ``MotorNoise``, one pair per decision, drawn in blocks (a decision every 4 ms)."""
+
+    BLOCK = 2048
+
+    def __init__(self, noise: MotorNoise, period: float) -> None:
+        import numpy as np
+
+        self._rng = np.random.Generator(np.random.PCG64(noise.seed))
+        self._keep = math.exp(-period / noise.correlation_time)
+        self._fresh = noise.level * math.sqrt(1.0 - self._keep * self._keep)
+        # Started from its stationary spread, so the first reach is as noisy as the last.
+        first = self._rng.standard_normal(2) * noise.level
+        self.state = [float(first[0]), float(first[1])]
+        self._draws: list[float] = []
+
+    def next(self) -> tuple[float, float]:
+        if len(self._draws) < 2:
+            self._draws = self._rng.standard_normal(self.BLOCK).tolist()[::-1]
+        draws, keep, fresh, state = self._draws, self._keep, self._fresh, self.state
+        state[0] = keep * state[0] + fresh * draws.pop()
+        state[1] = keep * state[1] + fresh * draws.pop()
+        return state[0], state[1]
 
 
 # ---------------------------------------------------------------- internal models
@@ -302,6 +355,9 @@ class ReachingBot:
         #: (armgame/lab/bots.py) learns both.
         self.load_estimate: Callable[[float, float, float, float], tuple[float, float]] | None = None
         self.aim: Callable[[float, float], tuple[float, float]] | None = None
+        #: Noise on its motor command (``MotorNoise``), None for none: the game's bots never have any.
+        self.noise: MotorNoise | None = None
+        self._noise_stream: _NoiseStream | None = None
 
     def period_steps(self, dt: float) -> int:
         return max(1, round(self.control_period / dt))
@@ -367,6 +423,16 @@ class ReachingBot:
         history = self._history
         return self._model.predict(history[0][0], history, self._setup[0], self.load_estimate)
 
+    def _commanded(self, want1: float, want2: float) -> tuple[float, float]:
+        """The joints' torques the bot commands for the torques it wants: the same, or with its motor noise."""
+        if self.noise is None:
+            return want1, want2
+        if self._noise_stream is None:
+            assert self._setup is not None
+            self._noise_stream = _NoiseStream(self.noise, self._setup[0])
+        n1, n2 = self._noise_stream.next()
+        return want1 * (1.0 + n1), want2 * (1.0 + n2)
+
     # ----------------------------------------------------------------- act
     def act(self, session: GameSession) -> list[tuple[str, str]]:
         if session.over:
@@ -402,7 +468,7 @@ class ReachingBot:
         events: list[tuple[str, str]] = []
         act, held, keys = session.muscles.activation, session.held, session.muscles.keys
         applied = []
-        for (pos, neg, mp, mn, rp, dp, rn, dn), want in zip(joints, (i1 + c1, i2 + c2), strict=True):
+        for (pos, neg, mp, mn, rp, dp, rn, dn), want in zip(joints, self._commanded(i1 + c1, i2 + c2), strict=True):
             ap, an = act[pos], act[neg]
             # Predicted activations one period on, with each muscle's key down or up.
             ap_on, ap_off = ap + (1.0 - ap) * rp, ap - ap * dp

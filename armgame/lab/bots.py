@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UserError
-from ..game.bots import CurlLoad, MatrixLoad, ReachingBot
+from ..game.bots import CurlLoad, MatrixLoad, MotorNoise, ReachingBot
 from ..words import unknown_name
 from .learner import TUNING_WIDTH_DEG, DirectionalLearner, TwoRateLearner
 from .session import LabSession
@@ -319,14 +319,18 @@ def curl_unit_torque(l1: float, l2: float, q1: float, q2: float, fx: float, fy: 
 
 
 def make_lab_bot(name: str, rates: LearningRates | None = None, representation: str = "global",
-                 width_deg: float = TUNING_WIDTH_DEG) -> LabBot:
+                 width_deg: float = TUNING_WIDTH_DEG, noise: MotorNoise | None = None) -> LabBot:
     """``model``, ``naive`` (the game's bots) or ``adaptive`` (the model bot learning the perturbation, with a
-    ``global`` or ``local`` representation of it: ``REPRESENTATIONS``)."""
+    ``global`` or ``local`` representation of it: ``REPRESENTATIONS``), with ``noise`` on its motor command if
+    given (``MotorNoise``: the keys it presses carry it)."""
     if name == "model":
-        return LabBot("model", interaction=True)
-    if name == "naive":
-        return LabBot("naive", interaction=False)
-    if name == "adaptive":
-        return LabBot("adaptive", interaction=True, rates=rates or LearningRates(), representation=representation,
-                      width_deg=width_deg)
-    raise UserError(unknown_name("lab bot", name, LAB_BOT_NAMES))
+        bot = LabBot("model", interaction=True)
+    elif name == "naive":
+        bot = LabBot("naive", interaction=False)
+    elif name == "adaptive":
+        bot = LabBot("adaptive", interaction=True, rates=rates or LearningRates(), representation=representation,
+                     width_deg=width_deg)
+    else:
+        raise UserError(unknown_name("lab bot", name, LAB_BOT_NAMES))
+    bot.noise = noise
+    return bot

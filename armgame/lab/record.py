@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import UserError
+from ..game.bots import MotorNoise
 from ..game.rules import GameConfig
 from ..game.session import GameResult, InputEvent
 from ..records.replay import register_task, same_outcome
@@ -39,20 +41,24 @@ class LabTask:
     trials: tuple[Trial, ...]
     #: SHA-256 (hex) of the shown hand's path of every trial, in order.
     paths_sha256: str
+    #: The bot's motor noise, if it had any: what it was, for the reader (the keys carry its effect, so
+    #: verifying replays the timeline and draws nothing).
+    motor_noise: MotorNoise | None = None
 
     @classmethod
-    def of(cls, session: LabSession) -> LabTask:
+    def of(cls, session: LabSession, motor_noise: MotorNoise | None = None) -> LabTask:
         return cls(session.protocol, tuple((t, g, e, h) for t, g, e, h in session.trial_records()),  # type: ignore[misc]
-                   paths_digest(session))
+                   paths_digest(session), motor_noise)
 
     def as_dict(self) -> dict[str, object]:
+        noise = {} if self.motor_noise is None else {"motor_noise": self.motor_noise.as_dict()}
         return {"kind": TASK_KIND, "protocol": self.protocol.as_dict(), "trials": [list(t) for t in self.trials],
-                "paths_sha256": self.paths_sha256}
+                "paths_sha256": self.paths_sha256, **noise}
 
     @classmethod
     def from_dict(cls, data: object, config: GameConfig, last_step: int) -> LabTask:
         """Rebuild and check a task section; raises ValueError naming the bad field."""
-        d = check_keys("task", data, {"kind", "protocol", "trials", "paths_sha256"})
+        d = check_keys("task", data, {"kind", "protocol", "trials", "paths_sha256"}, frozenset({"motor_noise"}))
         kind = check_str("task.kind", d["kind"], 40)
         if kind != TASK_KIND:
             raise ValueError(f"task.kind must be {TASK_KIND!r}, got {kind!r}")
@@ -77,7 +83,7 @@ class LabTask:
         digest = check_str("task.paths_sha256", d["paths_sha256"], 64)
         if not _HEX64.fullmatch(digest):
             raise ValueError("task.paths_sha256 must be 64 hexadecimal digits")
-        return cls(protocol, tuple(trials), digest)
+        return cls(protocol, tuple(trials), digest, _motor_noise(d["motor_noise"]) if "motor_noise" in d else None)
 
     def new_session(self, config: GameConfig) -> LabSession:
         """A fresh session of this task, at its start (for a window to replay the timeline into)."""
@@ -96,6 +102,17 @@ class LabTask:
         same_trials = tuple(tuple(t) for t in session.trial_records()) == self.trials
         same_paths = paths_digest(session) == self.paths_sha256
         return same_outcome(recomputed, result) and same_trials and same_paths, recomputed, session
+
+
+def _motor_noise(data: object) -> MotorNoise:
+    d = check_keys("task.motor_noise", data, {"level", "correlation_time_s", "seed"})
+    level, time, seed = d["level"], d["correlation_time_s"], d["seed"]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (level, time)):
+        raise ValueError("task.motor_noise: level and correlation_time_s must be numbers")
+    try:
+        return MotorNoise(float(level), check_int("task.motor_noise.seed", seed, 0, 2 ** 63 - 1), float(time))
+    except UserError as exc:
+        raise ValueError(f"task.motor_noise: {exc}") from None
 
 
 def paths_digest(session: LabSession) -> str:
