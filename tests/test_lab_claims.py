@@ -1,0 +1,120 @@
+"""The numbers docs/lab.md and docs/physics.md state, measured: each is computed here (cheaply: the learner's
+equations, the arm's inertia, the presets, the code's limits) and looked for in the docs' text at its printed
+precision, so a change to the code or the docs that makes them disagree fails. The numbers of whole bot runs
+(the curl, lesson, viscous, savings and spontaneous tables, the field the bot measures, its speed) cost seconds
+each and are checked by ``benchmarks/lab_claims.py`` instead; docs/lab.md's "Motor noise" and the fits' table
+by ``benchmarks/fit_coverage.py`` and ``benchmarks/lab_claims.py``."""
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from armgame.lab.learner import TwoRateLearner, simulate
+from armgame.lab.protocol import CHANNEL_DAMPING, CHANNEL_STIFFNESS, SAVINGS_WASHOUT, preset, target_positions
+from armgame.lab.session import LabSession, lab_config
+
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+
+
+def _text(name: str) -> str:
+    """The doc's text with every run of whitespace one space (a number's sentence may wrap anywhere)."""
+    return re.sub(r"\s+", " ", (DOCS / name).read_text(encoding="utf-8"))
+
+
+LAB, PHYSICS = _text("lab.md"), _text("physics.md")
+
+
+def _says(text: str, *phrases: str) -> None:
+    for phrase in phrases:
+        assert phrase in text, f"the docs should say {phrase!r}"
+
+
+def _trials_to_half(estimate: np.ndarray) -> int:
+    """Trials learned from before the estimate first reaches half the field."""
+    return int(np.argmax(estimate >= 0.5))
+
+
+def test_the_learner_half_lives_and_savings():
+    r = TwoRateLearner()
+    _says(LAB, f"`A_f = {r.retention_fast:g}`, `A_s = {r.retention_slow:g}`, `B_f = {r.rate_fast:g}`, "
+               f"`B_s = {r.rate_slow:g}`",
+          f"the fast process halves in {math.log(0.5) / math.log(r.retention_fast):.1f} trials, the slow one in "
+          f"{math.log(0.5) / math.log(r.retention_slow):.0f})")
+    first = _trials_to_half(simulate(TwoRateLearner(), np.ones(80))["estimate"])
+    counter = TwoRateLearner()
+    simulate(counter, np.ones(80))
+    simulate(counter, -np.ones(4))
+    again = _trials_to_half(simulate(counter, np.ones(80))["estimate"])
+    _says(LAB, f"re-learns half the field in {again} trials, against {first} the first time")
+    washed = TwoRateLearner()
+    simulate(washed, np.ones(80))
+    simulate(washed, np.zeros(SAVINGS_WASHOUT))
+    left = float(washed.estimate)
+    slow = _trials_to_half(simulate(washed, np.ones(80))["estimate"])
+    _says(LAB, f"({SAVINGS_WASHOUT} trials: {100 * left:.1f}% of the field left)", f"re-learning takes {slow} trials")
+
+
+def test_the_viscous_field_and_its_scale():
+    published = np.array([[-10.1, -11.2], [-11.2, 11.1]])
+    scaled = np.asarray(preset("viscous").blocks[1].perturbation.matrix)
+    np.testing.assert_array_equal(scaled, published / 8)
+    low, high = np.linalg.eigvalsh(published)
+    assert np.array_equal(published, published.T)  # so it has no curl part at all: "symmetric", not "nearly"
+    _says(LAB, "Shadmehr & Mussa-Ivaldi's matrix is symmetric", f"(eigenvalues {high:.1f} and {low:.1f} N s/m)",
+          f"its largest singular value, {np.linalg.svd(published)[1][0]:.1f} N s/m",
+          f"one eighth of the matrix, largest gain {np.linalg.svd(scaled)[1][0]:.2f} N s/m",
+          "`[[-1.2625, -1.4], [-1.4, 1.3875]]`")
+    assert scaled.tolist() == [[-1.2625, -1.4], [-1.4, 1.3875]]
+
+
+def test_the_task_geometry_the_endpoint_mass_and_the_channel():
+    protocol = preset("curl")
+    session = LabSession(lab_config(protocol, 10), protocol)
+    arm = session.model
+    hx, hy = session.home
+    _says(LAB, f"({hx:.3f}, {hy:.3f}) m); {protocol.targets} targets lie {protocol.distance:.2f} m around it")
+    postures = [np.asarray(session.config.start_posture)]
+    postures += [arm.inverse_kinematics(np.array(t)) for t in target_positions(protocol, session.home)]
+    masses = [np.linalg.eigvalsh(np.linalg.inv(arm.jacobian(q) @ np.linalg.inv(arm.mass_matrix(q))
+                                               @ arm.jacobian(q).T)) for q in postures]
+    lightest = min(m[0] for m in masses)
+    _says(LAB, f"({lightest:.2f} kg in its lightest direction, {masses[0][1]:.1f} kg in its heaviest at home and "
+               f"up to {max(m[1] for m in masses[1:]):.2f} kg at the targets)")
+    k, c, dt = CHANNEL_STIFFNESS, CHANNEL_DAMPING, session.config.dt
+    s = np.roots([lightest, c, k])
+    _says(LAB, f"the low end, {k:,.0f} N/m", f"and {c:.0f} N s/m damps it well (damping ratio "
+               f"{c / (2 * math.sqrt(k * lightest)):.2f} at the lightest mass)",
+          f"The defaults give `|s| dt = {max(abs(s)) * dt:.2f}` at the game's {dt * 1000:.0f} ms")
+
+
+def test_the_presets_block_lengths():
+    def lengths(name: str) -> list[int]:
+        return [b.trials for b in preset(name).blocks]
+    curl, lesson = lengths("curl"), lengths("lesson")
+    _says(LAB, f"baseline {curl[0]} trials, exposure {curl[1]}, washout {curl[2]} (`lesson`: {lesson[0]}, "
+               f"{lesson[1]} and {lesson[2]}, to {preset('lesson').targets} targets)")
+    savings, spontaneous = lengths("savings"), lengths("spontaneous")
+    _says(LAB, f"`savings` (baseline {savings[0]}, exposure {savings[1]}, the opposite field for {savings[2]} "
+               f"trials, re-exposure {savings[3]})",
+          f"then {spontaneous[3]} error-clamp trials", f"Measured (seeds 10, 1 and 2; adaptation index; "
+          f"{sum(spontaneous)} trials")
+
+
+def test_the_physics_docs_numbers():
+    from armgame import limits, simulation
+    from armgame.physics.defaults import BLOWUP_SPEED
+    from armgame.physics.reference import REFERENCE_TOLERANCE
+    from armgame.scenes import get_scene
+
+    _says(PHYSICS, f"over the budget ({limits.MAX_SIMULATE_STEPS:,} steps or {limits.MAX_SIMULATE_ROWS:,} rows",
+          f"`--initial` takes angles within +-{math.degrees(simulation.MAX_INITIAL_ANGLE):.0f} deg and speeds within "
+          f"+-{math.degrees(simulation.MAX_INITIAL_SPEED):,.0f} deg/s",
+          f"a joint faster than 10^{math.log10(BLOWUP_SPEED):.0f} rad/s",
+          f"(scipy's adaptive solver at rtol = atol = {REFERENCE_TOLERANCE:.0e}, the reference)")
+    passive = get_scene("passive")
+    x, y = passive.model.hand(np.asarray(passive.initial[:2]))
+    _says(PHYSICS, f"hand starting at ({x:.4f}, {y:.4f}) m")
+    q1, q2 = lab_config(preset("curl"), 10).start_posture
+    _says(PHYSICS, f"The game's start posture is q1 = {math.degrees(q1):.0f} deg, q2 = {math.degrees(q2):.0f} deg")
