@@ -64,6 +64,7 @@ OLD_POSIX_ONLY_CODE = [
 ]
 
 
+@pytest.mark.skipif(SIMULATED, reason="starts its own simulated interpreters")
 @pytest.mark.parametrize("code", OLD_POSIX_ONLY_CODE)
 def test_posix_only_code_in_armgame_fails_under_the_simulation(code):
     """Run in a fresh interpreter, as a module of armgame: fails with the simulation, works without it."""
@@ -129,6 +130,7 @@ def test_a_lock_file_another_user_made_read_only_is_still_locked(tmp_path, monke
         os.close(fd)
 
 
+@pytest.mark.skipif(SIMULATED, reason="nothing of the platform in it")
 def test_the_supported_pythons_are_said_alike_everywhere():
     """requires-python, the classifiers, CI's oldest and the README agree on the oldest supported Python,
     and the classifiers name every minor version from it to the newest CI tests, none missing."""
