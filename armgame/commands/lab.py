@@ -40,7 +40,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "lab",
         help="adaptation experiments: centre-out reaches in a force field or a changed display",
         description="Reach from home to targets around it, in blocks: baseline (nothing changed), exposure "
-        "(a force field or a changed display), washout (back to normal). PROTOCOL is a preset ("
+        "(a force field or a changed display), washout (the perturbation removed). PROTOCOL is a preset ("
         + ", ".join(PRESETS) + ") or a TOML protocol file. In a window you play with the muscle keys (d f j k); "
         "--bot lets a bot play (model, naive, or adaptive: the model bot learning the perturbation trial by "
         "trial with a two-rate learner). --out DIR writes trials.csv (one row per reach), learning.png and "
