@@ -1,5 +1,5 @@
 """The projector's page in a real browser: a game handed in appears without a reload, every hostile name is
-shown as text, and the text reads from the back row at 1024x768."""
+shown as text, and the text reads from the back row at 1024x768; then the teacher's page, in the same browser."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from armgame.classroom import client
 HOSTILE = ['<img src=x onerror="alert(1)">', '"><script>alert(2)</script>', "\u05e9\u05dc\u05d5\u05dd <b>bold</b>"]
 
 
-def test_the_page_shows_games_as_they_arrive_and_names_as_text(tmp_path, monkeypatch):
+def test_the_page_shows_games_as_they_arrive_and_names_as_text_and_the_teacher_acts(tmp_path, monkeypatch):
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))
     with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
         address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
@@ -36,36 +36,33 @@ def test_the_page_shows_games_as_they_arrive_and_names_as_text(tmp_path, monkeyp
         assert min(sizes) >= 19
         assert page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
         page.screenshot(path=str(tmp_path / "class-1024x768.png"))
+        _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch)
     assert (tmp_path / "class-1024x768.png").stat().st_size > 10_000
 
 
-def test_the_teachers_page_unlocks_with_the_secret_hides_and_frees_a_name(tmp_path, monkeypatch):
-    """The teacher's page in a real browser: nothing without the secret; with it, every student listed (names as
-    text), Hide takes one off the projector, and a name is freed for a student's new machine."""
-    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))
-    with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
-        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
-        code = opened.clerk.roster.code
-        for i, name in enumerate(("Ann", HOSTILE[0])):
-            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / f"machine{i}"))
-            client.hand_in(client.join(address, code, name), tapped_game(i, player=name).to_bytes())
-        page.goto(f"http://127.0.0.1:{opened.port}/teacher")
-        page.fill("#secret", "a guess")
-        page.click("#unlock")
-        page.wait_for_selector("#status:has-text('secret')")
-        assert not page.is_visible("#controls")
-        page.fill("#secret", opened.clerk.roster.secret)
-        page.click("#unlock")
-        page.wait_for_selector("#everyone tr:nth-child(2)")
-        names = page.eval_on_selector_all("#everyone td:nth-child(2)", "cells => cells.map(c => c.textContent)")
-        assert sorted(names) == sorted(["Ann", HOSTILE[0]]) and page.dialogs == []
-        page.click("#everyone tr:has-text('Ann') button")
-        page.wait_for_selector("#everyone tr:has-text('Ann'):has-text('hidden on the projector')")
-        assert [r.name for r in opened.clerk.entries] and opened.clerk.roster.is_hidden("Ann")
-        page.fill("#release-name", "ann")
-        page.click("#release")
-        page.wait_for_selector("#status:has-text('Ann is free')")
-        assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == 1
+def _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch) -> None:
+    """The teacher's page, in the same browser (one chromium for both pages): nothing without the secret; with
+    it, every student listed (names as text), Hide takes one off the projector, and a name is freed for a
+    student's new machine."""
+    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann's machine"))
+    client.hand_in(client.join(address, code, "Ann"), tapped_game(7, player="Ann").to_bytes())
+    page.goto(f"http://127.0.0.1:{opened.port}/teacher")
+    page.fill("#secret", "a guess")
+    page.click("#unlock")
+    page.wait_for_selector("#status:has-text('secret')")
+    assert not page.is_visible("#controls")
+    page.fill("#secret", opened.clerk.roster.secret)
+    page.click("#unlock")
+    page.wait_for_selector(f"#everyone tr:nth-child({len(HOSTILE) + 1})")
+    names = page.eval_on_selector_all("#everyone td:nth-child(2)", "cells => cells.map(c => c.textContent)")
+    assert sorted(names) == sorted(["Ann", *HOSTILE]) and page.dialogs == []
+    page.click("#everyone tr:has-text('Ann') button")
+    page.wait_for_selector("#everyone tr:has-text('Ann'):has-text('hidden on the projector')")
+    assert opened.clerk.roster.is_hidden("Ann")
+    page.fill("#release-name", "ann")
+    page.click("#release")
+    page.wait_for_selector("#status:has-text('Ann is free')")
+    assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == len(HOSTILE)
 
 
 def test_the_class_screenshot_script_draws_every_class_picture(tmp_path, monkeypatch):
