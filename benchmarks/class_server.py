@@ -82,24 +82,6 @@ STOP_SECONDS = 30.0
 
 # ------------------------------------------------------------------ the games
 
-def student_keys(rng: random.Random, dt: float, seconds: float) -> list[Any]:
-    """A student's keys as ``class_speed.py`` makes them: one of the four switching every 0.1-0.5 s,
-    a reset after one switch in a hundred."""
-    from armgame.game.session import InputEvent
-
-    events, held, t = [], set(), 0.0
-    while True:
-        t += rng.uniform(0.1, 0.5)
-        if t >= seconds:
-            return events
-        step = round(t / dt)
-        key = rng.choice("dfjk")
-        events.append(InputEvent(step, key, "up" if key in held else "down"))
-        held ^= {key}
-        if rng.random() < 0.01:
-            events.append(InputEvent(step, "space", "down"))
-
-
 def is_bot(index: int, share: float) -> bool:
     """Whether game ``index`` is a bot's: evenly spread, ``share`` of them."""
     return math.floor((index + 1) * share) > math.floor(index * share)
@@ -113,6 +95,9 @@ def make_games(folder: Path, count: int, bot_share: float, seed: int) -> list[di
     from armgame.game.session import UP, GameSession, InputEvent
     from armgame.records.identity import game_digest
     from armgame.records.replay import Replay
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from class_speed import student_timeline  # a student's keys, as the class's other benchmark makes them
 
     config = GameConfig(seed=CLASS_SEED)
     bot_timeline: list[Any] = []
@@ -140,7 +125,7 @@ def make_games(folder: Path, count: int, bot_share: float, seed: int) -> list[di
             session.play(events)
             replay = Replay.from_session(session, "bot", "model")
         else:
-            session.play(student_keys(random.Random(f"{seed}-{tries[kind]}"), config.dt, config.time_limit))
+            session.play(student_timeline(random.Random(f"{seed}-{tries[kind]}"), config.dt, config.time_limit))
             replay = Replay.from_session(session, "keyboard")
         replay = dataclasses.replace(replay, date=GAME_DATE)
         digest = game_digest(replay)

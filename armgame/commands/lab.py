@@ -374,9 +374,8 @@ def _report(session, args: argparse.Namespace) -> None:
     from ..lab.analysis import block_summary, channel_summary, trial_rows
 
     done, total = len(session.outcomes), len(session.plans)
-    ending = "" if session.finished else " (its time ran out)" if session.out_of_time else " (stopped before the end)"
     print(f"lab {session.protocol.name}: {done} of {total} trials, {session.result().hits} hits, seed "
-          f"{session.config.seed}{ending}")
+          f"{session.config.seed}{session.ending}")
     if getattr(args, "learner_words", ""):
         print(f"  the adaptive bot's {args.learner_words}")
     if session.outcomes:

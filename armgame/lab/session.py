@@ -238,6 +238,11 @@ class LabSession(GameSession):
         return not self.finished and self.steps >= self.total_steps
 
     @property
+    def ending(self) -> str:
+        """How the run ended, as its summary line adds it: nothing for a whole run."""
+        return "" if self.finished else " (its time ran out)" if self.out_of_time else " (stopped before the end)"
+
+    @property
     def plan(self) -> TrialPlan | None:
         return self.plans[self.trial_index] if self.trial_index < len(self.plans) else None
 

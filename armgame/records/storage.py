@@ -240,6 +240,27 @@ def atomic_write_bytes(path: Path, data: bytes, what: str = "file", replace: boo
         f.write(data)
 
 
+def _durable_temporary(path: Path, data: bytes, what: str) -> Path:
+    """``data`` in a new temporary file beside ``path``, flushed to disk: ready to be given its name. Nothing is
+    left behind if writing it fails."""
+    try:
+        fd, tmp = _temporary(path.parent, path.name)
+    except OSError as exc:
+        raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
+        raise
+    return tmp
+
+
 #: The most numbered names ``write_new`` tries before it gives up: far more than any class makes.
 MAX_NUMBERED = 10_000
 
@@ -250,15 +271,8 @@ def write_new(name_of: Callable[[int], Path], first: int, data: bytes, what: str
     no file already there is ever replaced. All the names lie in one folder."""
     first_path = check_output_path(Path(name_of(first)), what)
     folder = first_path.parent
+    tmp = _durable_temporary(first_path, data, what)
     try:
-        fd, tmp = _temporary(folder, first_path.name)
-    except OSError as exc:
-        raise DataFileError(f"{show_path(first_path)}: cannot write the {what}: {exc.strerror or exc}") from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
         for n in range(first, first + MAX_NUMBERED):
             path = Path(name_of(n))
             if n != first:
@@ -288,15 +302,7 @@ def atomic_write_many(items: list[tuple[Path, bytes]], what: str = "file") -> No
     try:
         for path, data in items:
             path = check_output_path(Path(path), what)
-            try:
-                fd, tmp = _temporary(path.parent, path.name)
-            except OSError as exc:
-                raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
-            pending.append((tmp, path))
-            with os.fdopen(fd, "wb") as f:
-                f.write(data)
-                f.flush()
-                os.fsync(f.fileno())
+            pending.append((_durable_temporary(path, data, what), path))
         while pending:
             tmp, path = pending[0]
             check_output_path(path, what)

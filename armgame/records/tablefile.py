@@ -120,15 +120,16 @@ class TableFile:
         only of entries sharing an id (``_parse``), each file read once, and at most ``MAX_TWIN_BYTES`` of
         them per read, so a table planted full of twins costs a bounded read."""
         seen: dict[str, tuple[str, object] | None] = {}
-        left = [MAX_TWIN_BYTES]
+        left = MAX_TWIN_BYTES
 
         def backs(entry: ScoreEntry) -> bool:
+            nonlocal left
             if entry.replay not in seen:
-                if left[0] <= 0:
+                if left <= 0:
                     return False
                 try:
                     data = read_limited(self.replays / entry.replay, MAX_REPLAY_BYTES, "replay", follow=False)
-                    left[0] -= len(data)
+                    left -= len(data)
                     player = parse_json(data).get("player")
                 except (DataFileError, OSError, ValueError, AttributeError):
                     seen[entry.replay] = None

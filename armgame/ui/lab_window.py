@@ -450,8 +450,8 @@ class LabWindow(GameWindow):
         s = self.session
         rows = trial_rows(s)
         self.curve = learning_curve(rows, figure_metric(s.protocol))
-        self.summary = f"{s.protocol.name}: {plural(len(s.outcomes), 'trial')}, {plural(s.result().hits, 'hit')}" + \
-            ("" if s.finished else " (its time ran out)" if s.out_of_time else " (stopped before the end)")
+        self.summary = f"{s.protocol.name}: {plural(len(s.outcomes), 'trial')}, {plural(s.result().hits, 'hit')}" \
+            f"{s.ending}"
         if self.on_finish is not None:
             self.renderer.draw(self.screen, s, 1.0, self._lab_hud(saving=True))
             pygame.display.flip()

@@ -8,7 +8,7 @@ const MEASURES = {
 };
 
 // A label drawn past the drawing's edge (a short block's name at the right end) is moved in, whole.
-function keepInside(svg, node, W) {
+function keepInside(node, W) {
   const b = node.getBBox();
   const dx = Math.min(0, W - 2 - (b.x + b.width)) + Math.max(0, 2 - b.x);
   if (dx !== 0) node.setAttribute("x", String(Number(node.getAttribute("x")) + dx));
@@ -55,15 +55,15 @@ function draw(lab) {
         svg.appendChild(el("rect", {class: "block", x: x0, y: top, width: Math.max(x1 - x0, 1), height: bottom - top}));
       }
       shade = !shade;
-      keepInside(svg, svg.appendChild(el("text", {x: (x0 + x1) / 2, y: top - 8, "text-anchor": "middle"},
-                                         t[start].block)), W);
+      keepInside(svg.appendChild(el("text", {x: (x0 + x1) / 2, y: top - 8, "text-anchor": "middle"},
+                                 t[start].block)), W);
       // The after-effect: the first trial back without the perturbation after trials with it.
       if (start > 0 && t[start].perturbation === "none" && t[start - 1].perturbation !== "none") {
         svg.appendChild(el("line", {class: "marker", x1: x(t[start].trial), x2: x(t[start].trial), y1: top, y2: bottom}));
         // Past the plot's middle (a short washout) the label goes left of the line, inside the plot.
         const at = x(t[start].trial), leftward = at > (left + right) / 2;
-        keepInside(svg, svg.appendChild(el("text", {class: "news", x: leftward ? at - 6 : at + 6, y: top + 24,
-                                                    "text-anchor": leftward ? "end" : "start"}, "after-effect")), W);
+        keepInside(svg.appendChild(el("text", {class: "news", x: leftward ? at - 6 : at + 6, y: top + 24,
+                                            "text-anchor": leftward ? "end" : "start"}, "after-effect")), W);
       }
       start = i;
     }
