@@ -42,13 +42,21 @@ def test_a_class_from_join_to_standings_one_row_per_student(tmp_path, students, 
         assert main(["play", "--headless", "--bot", "model", "--join", f"127.0.0.1:{opened.port}", "--code", code,
                      "--name", "Dee's bot"]) == 0
         assert "among the programs" in capsys.readouterr().out
+        # A script's game from the command line, under a name this machine takes as it joins.
+        students("Eve")
+        script = tmp_path / "reach.txt"
+        script.write_text("0.5 d down\n1.25 d up\n", encoding="utf-8")
+        assert main(["play", "--headless", "--script", str(script), "--join", f"127.0.0.1:{opened.port}", "--code",
+                     code, "--name", "Eve's script"]) == 0
+        assert "handed in: " in capsys.readouterr().out
         s = standings(opened)
     people = [(r["name"], r["games"]) for r in s["students"]]
     assert sorted(people) == [("Ann", 3), ("Bo", 1), ("Cy", 2)]  # one row each, with their games played
-    assert [r["name"] for r in s["programs"]] == ["Dee's bot"] and s["programs"][0]["driver"] == "bot (model)"
-    assert s["joined"] == 4 and s["games"] == 7
+    programs = {r["name"]: r["driver"] for r in s["programs"]}
+    assert programs["Dee's bot"] == "bot (model)" and programs["Eve's script"].startswith("script")
+    assert s["joined"] == 5 and s["games"] == 8
     # The folder holds an ordinary table: armgame scores and verify read it afterwards.
-    assert len(ScoreTable(folder).all_entries()) == 7
+    assert len(ScoreTable(folder).all_entries()) == 8
     assert main(["verify", str(folder)]) == 0
 
 

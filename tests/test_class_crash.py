@@ -19,9 +19,8 @@ from armgame.classroom import client
 from armgame.records.scores import ScoreTable
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="SIGKILL is POSIX's")
-# 400 games from 20 clients: the kill lands with all 20 in flight, as with 1,000 (the first version of
-# this test), for under half the suite's CPU.
-GAMES, CLIENTS, KILL_AFTER = 400, 20, 120
+# The burst: 1,000 games from 20 clients, the kill landing with all 20 in flight.
+GAMES, CLIENTS, KILL_AFTER = 1000, 20, 300
 
 
 def free_port() -> int:

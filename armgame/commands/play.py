@@ -105,9 +105,9 @@ def run(args: argparse.Namespace) -> int:
 
     if args.script and (len(args.script) > 1 or user_path(args.script[0], "--script").is_dir()):
         return _play_class(args)
-    args.membership = _join(args)
     if args.script:
-        args.script = args.script[0]
+        args.script = args.script[0]  # before the join, which checks the score options (--script among them)
+    args.membership = _join(args)
     window = None if args.headless else _window_settings(args)  # before the game: its keys may come from there
     session = GameSession(game_config(args))
     _check_score_options(args)
