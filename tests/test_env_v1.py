@@ -26,6 +26,7 @@ from armgame.env.base import EnvArgumentError
 from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.env.vector import ReachV1VectorEnv
 from armgame.lab.protocol import Block, Protocol
+from armgame.lab.session import REACH as REACH_PHASE
 
 REACH, CONTINUOUS = "armgame/Reach-v1", "armgame/ReachContinuous-v1"
 CENTER_OUT, CENTER_OUT_CONTINUOUS = "armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1"
@@ -307,7 +308,7 @@ def test_the_vector_env_renders_each_games_frame_as_the_single_env_does():
 
 # ------------------------------------------------------------------ CenterOut-v1
 def test_a_random_policy_starts_center_out_trials_and_episodes_end_after_their_trials():
-    env = gym.make(CENTER_OUT)
+    env = gym.make(CENTER_OUT, continue_run=True)
     env.action_space.seed(0)
     obs, info = env.reset(seed=2)
     trials, episodes, reaches, steps = [], 0, [], 0
@@ -328,7 +329,7 @@ def test_a_random_policy_starts_center_out_trials_and_episodes_end_after_their_t
 
 def test_block_episodes_follow_the_protocols_blocks():
     protocol = Protocol("short", (Block("baseline", 2), Block("exposure", 3)))
-    env = gym.make(CENTER_OUT, protocol=protocol, episode_trials="block")
+    env = gym.make(CENTER_OUT, protocol=protocol, episode_trials="block", continue_run=True)
     env.action_space.seed(1)
     env.reset(seed=5)
     blocks = []
@@ -341,6 +342,44 @@ def test_block_episodes_follow_the_protocols_blocks():
     # The run's last trial ends it: the third episode is a new run, drawn from the env's generator.
     assert blocks == [("baseline", 2), ("exposure", 5), ("baseline", 2)]
     assert env.unwrapped.session.config.seed != 5
+
+
+def play_center_out(env, steps: int | None = None) -> dict:
+    """Random keys until the episode ends (or for ``steps`` steps); the last info."""
+    terminated, done = False, 0
+    while not terminated and done != steps:
+        *_, terminated, _, info = env.step(env.action_space.sample())
+        done += 1
+    return info
+
+
+def test_an_unseeded_center_out_reset_starts_a_fresh_run_unless_asked_to_continue():
+    protocol = Protocol("short", (Block("baseline", 2), Block("exposure", 3)))
+    fresh = gym.make(CENTER_OUT, protocol=protocol, episode_trials="block")
+    going_on = gym.make(CENTER_OUT, protocol=protocol, episode_trials="block", continue_run=True)
+    for env in (fresh, going_on):
+        env.action_space.seed(1)
+        env.reset(seed=5)
+        play_center_out(env)
+    obs, info = fresh.reset()
+    assert fresh.unwrapped.session.config.seed != 5 and info == {"trial": 0, "trials_done": 0, "hits": 0,
+                                                                  "block": "baseline"}
+    assert obs[14] == obs[15] == 0.0  # a hold, just begun
+    obs, info = going_on.reset()
+    assert going_on.unwrapped.session.config.seed == 5 and info["trial"] == 2 and info["block"] == "exposure"
+    # The trial ended within the last step, which ran on in the next trial's hold, the arm taken home.
+    assert obs[14] == 0.0 and 0.0 <= obs[15] < going_on.unwrapped.decision_time
+    # Mid-episode (the arm on its way, the trial under way) no reset goes on with it: a new run.
+    for env in (fresh, going_on):
+        seed = env.unwrapped.session.config.seed
+        play_center_out(env, 60)  # past the longest delay (1 s), short of a hit's 0.2 s in the target
+        assert not env.unwrapped._episode_over() and env.unwrapped.session.phase == REACH_PHASE  # a reach under way
+        obs, info = env.reset()
+        session = env.unwrapped.session
+        assert session.config.seed != seed and session.steps == 0 and info["trial"] == 0
+        assert obs[2] == obs[3] == 0.0 and obs[14] == obs[15] == 0.0  # at rest, a hold just begun
+    with pytest.raises(EnvArgumentError, match="continue_run"):
+        gym.make(CENTER_OUT, continue_run="yes")
 
 
 def test_center_out_dense_reward_is_progress_toward_the_shown_target():

@@ -21,6 +21,7 @@ import pytest
 import armgame.records.batch_verify as batch_verify
 import armgame.records.replay as replay_module
 import armgame.records.tablefile as tablefile_module
+from armgame import __version__
 from armgame.cli import main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, NonFiniteStateError
@@ -313,8 +314,9 @@ def test_a_planted_cache_beside_the_table_is_not_trusted(tmp_path, capsys):
     data["entries"][0].update(score=40, hits=40,
                               replay_sha256=hashlib.sha256(table.replay_path(entry).read_bytes()).hexdigest())
     table.path.write_text(json.dumps(data))
-    for name in ("verified-0.1.0.json", "cache.json"):  # whatever name a classmate guesses
-        (tmp_path / name).write_text(json.dumps({"format": "armgame-verified", "version": "0.1.0", "items": {
+    # Whatever name a classmate guesses, the running version's cache name among them.
+    for name in (f"verified-{__version__}.json", "cache.json"):
+        (tmp_path / name).write_text(json.dumps({"format": "armgame-verified", "version": __version__, "items": {
             data["entries"][0]["replay_sha256"]: {"ok": True, "label": "ok", "detail": "", "claims": None}}}))
     assert main(["verify", str(tmp_path)]) == 1
     assert "NOT REPRODUCED" in capsys.readouterr().out

@@ -105,13 +105,22 @@ class CenterOutV1Env(CenterOutEnv):
     ## Starting State and Episodes
 
     ``reset(seed=s)`` starts a run of the protocol with lab seed ``s`` (its trials' order and
-    delays), the arm at rest at home. An episode is ``episode_trials`` trials (default 8), or
-    with ``episode_trials="block"`` the rest of the current block; it ends **terminated** after its
-    last trial. A ``reset()`` without a seed (an autoreset) continues the same run at its next
-    trial, so a protocol's blocks follow one another over episodes, as a participant's do; once the
-    run's last trial is done, it starts a new run with a seed from the env's generator.
-    ``reset(options={"protocol": ..., "perturbation": ...})`` starts a new run of those. The episode
-    is truncated if the run's clock runs out (only possible with ``trial_start="hold"``).
+    delays), the arm at rest at home, at the start of the run's first trial. An episode is
+    ``episode_trials`` trials (default 8), or with ``episode_trials="block"`` the rest of the current
+    block; it ends **terminated** after its last trial. A ``reset()`` without a seed (an autoreset)
+    starts a fresh episode as Gymnasium's envs do: a new run, its lab seed drawn from the env's
+    generator, so every episode is a run's first trials, whenever the reset comes. Episodes then
+    never leave the first ``episode_trials`` trials: a protocol's later blocks (the ``curl``
+    preset's exposure after its baseline) need ``continue_run=True``.
+
+    ``continue_run=True`` makes a protocol's blocks follow one another over episodes, as a
+    participant's do: a ``reset()`` without a seed after an episode ended continues the same run at
+    its next trial (the arm went home at rest when the last trial ended, within the episode's last
+    step, so that episode starts at a trial's beginning too); once the run's last trial is done, or
+    if the reset comes mid-episode (the trial under way cannot end early), it starts a new run with
+    a seed from the env's generator. ``reset(options={"protocol": ..., "perturbation": ...})``
+    starts a new run of those. The episode is truncated if the run's clock runs out (only possible
+    with ``trial_start="hold"``).
 
     ``info``: ``trial`` (the index in the run of the trial under way, or of the next), ``trials_done``,
     ``hits``, ``block`` and, on a step in which trials ended, ``reaches``: their rows of the lab's
@@ -132,6 +141,9 @@ class CenterOutV1Env(CenterOutEnv):
     * ``protocol``, ``perturbation``, ``decision_steps``, ``render_mode``, ``render_size``: as v0.
     * ``trial_start``: ``"delay"`` (default) or ``"hold"`` (the lab's rule for people).
     * ``episode_trials``: trials per episode, 1 to 2000, or ``"block"`` (default 8).
+    * ``continue_run``: ``False`` (default): every reset starts a new run; ``True``: a reset after an
+      episode's end continues the run at its next trial, so episodes walk through the protocol's
+      blocks.
     * ``reward`` (``"dense"`` or ``"sparse"``), ``progress_weight``, ``hit_bonus``,
       ``observation_dtype`` (``"float32"`` or ``"float64"``): as ``armgame/Reach-v1``; ``time_cost``:
       reward lost per second, 0 to 10 (default 0).
@@ -140,7 +152,10 @@ class CenterOutV1Env(CenterOutEnv):
 
     * v1: trials start after their delay; episodes of a few trials or a block; the cursor, the
       hand's velocity and the cursor-to-target vector observed, float32, with no run clock or trial
-      count; a dense reward; continuous actions in [-1, 1]; ``info["trial"]`` (armgame 0.2).
+      count; a dense reward; continuous actions in [-1, 1]; ``info["trial"]``; a reset without a
+      seed starts a new run, ``continue_run=True`` continues the run over episodes (checkouts of
+      the v1 env before armgame 0.2.0, which still called themselves 0.1.0, always continued the
+      run, and a reset mid-episode changed nothing) (armgame 0.2).
     * v0: Initial version (armgame 0.1).
     """
 
@@ -149,7 +164,8 @@ class CenterOutV1Env(CenterOutEnv):
     def __init__(self, render_mode: str | None = None, *, protocol: str | Protocol = "null",
                  perturbation: object | None = None, decision_steps: int = DEFAULT_DECISION_STEPS,
                  continuous: bool = False, trial_start: str = "delay",
-                 episode_trials: int | str = DEFAULT_EPISODE_TRIALS, reward: str = "dense",
+                 episode_trials: int | str = DEFAULT_EPISODE_TRIALS, continue_run: bool = False,
+                 reward: str = "dense",
                  progress_weight: float = DEFAULT_PROGRESS_WEIGHT, hit_bonus: float = DEFAULT_HIT_BONUS,
                  time_cost: float = 0.0, observation_dtype: str = "float32",
                  render_size: tuple[int, int] = (600, 600)) -> None:
@@ -162,7 +178,10 @@ class CenterOutV1Env(CenterOutEnv):
                                           or not 1 <= episode_trials <= 2000):
             raise EnvArgumentError(f"episode_trials must be a whole number from 1 to 2000 or 'block', "
                                    f"got {episode_trials!r}")
+        if not isinstance(continue_run, bool | np.bool_):
+            raise EnvArgumentError(f"continue_run must be True or False, got {continue_run!r}")
         self.reward_kind, self.progress_weight, self.hit_bonus = check_reward(reward, progress_weight, hit_bonus)
+        self.continue_run = bool(continue_run)
         self.trial_start = trial_start
         self.hold_at_home = trial_start == "hold"
         self.episode_trials = episode_trials if episode_trials == "block" else int(episode_trials)
@@ -179,7 +198,10 @@ class CenterOutV1Env(CenterOutEnv):
     # --------------------------------------------------------------- internals
     def _start_episode(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
         session = self.session
-        if seed is None and not options and session is not None and not session.over:
+        # Only at an episode's end is the arm at rest at home at a trial's start: a reset mid-episode
+        # that went on with the trial under way would start nothing fresh.
+        if self.continue_run and seed is None and not options and session is not None and not session.over \
+                and self._episode_over():
             gym.Env.reset(self)  # an episode of the same run: its next trial
         else:
             self._new_run(seed, options)

@@ -32,7 +32,9 @@ def make_sb3_vec_env(env_id: str, num_envs: int, seed: int | None = None, **kwar
     """``num_envs`` games of ``env_id`` (an armgame id with a vector entry point) as one SB3 ``VecEnv``.
 
     ``seed`` seeds game ``i``'s first episode with ``seed + i`` (SB3's own ``VecEnv.seed`` does the same);
-    ``kwargs`` are the env's arguments.
+    ``kwargs`` are the env's arguments. For episode statistics (``evaluate_policy`` without its warning,
+    ``ep_rew_mean`` in the logs) wrap it as SB3's ``make_vec_env`` wraps its envs in ``Monitor``:
+    ``VecMonitor(make_sb3_vec_env(...), info_keywords=("hits",))``.
     """
     if "autoreset_mode" in kwargs:
         raise EnvArgumentError("the SB3 adapter sets autoreset_mode itself (SameStep, as SB3 expects)")
