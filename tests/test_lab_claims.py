@@ -98,8 +98,7 @@ def test_the_presets_block_lengths():
     savings, spontaneous = lengths("savings"), lengths("spontaneous")
     _says(LAB, f"`savings` (baseline {savings[0]}, exposure {savings[1]}, the opposite field for {savings[2]} "
                f"trials, re-exposure {savings[3]})",
-          f"then {spontaneous[3]} error-clamp trials", f"Measured (seeds 10, 1 and 2; adaptation index; "
-          f"{sum(spontaneous)} trials")
+          f"then {spontaneous[3]} error-clamp trials", f"adaptation index; {sum(spontaneous)} trials")
 
 
 def test_the_physics_docs_numbers():

@@ -2,6 +2,8 @@
 the bot presses so its replay verifies with nothing re-drawn, off for the game's bots, and refused in one line
 when out of range."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -64,14 +66,17 @@ def test_the_games_bots_have_no_noise_and_bad_levels_are_one_line_errors():
 ])
 def test_each_preset_brings_its_bot_a_motor_noise_that_the_option_overrides(argv, level):
     from armgame.cli import build_parser
-    from armgame.commands.lab import _motor_noise, _resolve_motor_noise
+    from armgame.commands.lab import _motor_noise, _noise_line, _resolve_motor_noise
     from armgame.lab.protocol import HUMAN_NOISE, PRESET_MOTOR_NOISE, PRESETS
 
     assert HUMAN_NOISE == 0.3 and {p for p in PRESETS if PRESET_MOTOR_NOISE[p]} == set(PRESETS) - {"lesson"}
-    args = build_parser().parse_args(["lab", *argv, "--seed", "7"])
+    args = build_parser().parse_args(["lab", *argv, "--seed", "10"])
     _resolve_motor_noise(args)
     assert args.motor_noise == level
-    assert _motor_noise(args) == (MotorNoise(level, 7) if level else None)
+    assert _motor_noise(args) == (MotorNoise(level, 10) if level else None)
+    if argv[0] in ("curl", "lesson") and len(argv) == 3:  # the two lines docs/lab.md quotes, as printed
+        line = _noise_line(args)
+        assert f"  {line}\n" in (Path(__file__).parent.parent / "docs" / "lab.md").read_text(encoding="utf-8")
 
 
 def test_a_replay_without_its_noise_recorded_still_verifies():
