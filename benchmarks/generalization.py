@@ -3,7 +3,8 @@ trained direction, each direction's baseline subtracted, with the local and the 
 
     python benchmarks/generalization.py --seeds 10 1 2
 
-Each run is ``armgame lab generalization --bot adaptive --headless --representation R --seed S``, in-process.
+Each run is ``armgame lab generalization --bot adaptive --headless --representation R --seed S``, in-process, with
+the preset's motor noise (``PRESET_MOTOR_NOISE``). ``benchmarks/lab_claims.py`` checks docs/lab.md's table of them.
 """
 
 from __future__ import annotations
@@ -11,17 +12,18 @@ from __future__ import annotations
 import argparse
 import math
 
-from armgame.game.bots import Autopilot
+from armgame.game.bots import Autopilot, MotorNoise
 from armgame.lab.analysis import baseline_offsets, generalization, trial_rows
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import preset
+from armgame.lab.protocol import PRESET_MOTOR_NOISE, preset
 from armgame.lab.session import LabSession, lab_config
 
 
 def run(representation: str, seed: int) -> tuple[list[dict[str, object]], dict[float, float]]:
     protocol = preset("generalization")
     session = LabSession(lab_config(protocol, seed), protocol)
-    Autopilot(session, make_lab_bot("adaptive", representation=representation)).play()  # type: ignore[arg-type]
+    noise = MotorNoise(PRESET_MOTOR_NOISE["generalization"], seed)
+    Autopilot(session, make_lab_bot("adaptive", representation=representation, noise=noise)).play()  # type: ignore[arg-type]
     rows = trial_rows(session)
     return generalization(session, rows), baseline_offsets(session, rows)
 

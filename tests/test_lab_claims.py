@@ -98,8 +98,7 @@ def test_the_presets_block_lengths():
     savings, spontaneous = lengths("savings"), lengths("spontaneous")
     _says(LAB, f"`savings` (baseline {savings[0]}, exposure {savings[1]}, the opposite field for {savings[2]} "
                f"trials, re-exposure {savings[3]})",
-          f"then {spontaneous[3]} error-clamp trials", f"Measured (seeds 10, 1 and 2; adaptation index; "
-          f"{sum(spontaneous)} trials")
+          f"then {spontaneous[3]} error-clamp trials", f"adaptation index; {sum(spontaneous)} trials")
 
 
 def test_the_physics_docs_numbers():
@@ -118,3 +117,62 @@ def test_the_physics_docs_numbers():
     _says(PHYSICS, f"hand starting at ({x:.4f}, {y:.4f}) m")
     q1, q2 = lab_config(preset("curl"), 10).start_posture
     _says(PHYSICS, f"The game's start posture is q1 = {math.degrees(q1):.0f} deg, q2 = {math.degrees(q2):.0f} deg")
+
+
+def test_the_task_protocol_and_option_numbers():
+    """The task's defaults, the clock, the limits of a protocol file and of the commands, as docs/lab.md says them."""
+    from armgame.commands.analyze import MAX_CLASS_FILES
+    from armgame.lab import fit
+    from armgame.lab.learner import MAX_TUNING_WIDTH_DEG as WIDEST
+    from armgame.lab.learner import MIN_TUNING_WIDTH_DEG as NARROWEST
+    from armgame.lab.learner import TUNING_CENTRES, TUNING_WIDTH_DEG, DirectionalLearner
+    from armgame.lab.protocol import MAX_CHANNEL_DAMPING, MAX_CHANNEL_STIFFNESS, PARAMETERS, Protocol
+    from armgame.ui.playback import REPLAY_SPEEDS
+
+    p = Protocol("defaults", preset("curl").blocks)
+    _says(LAB, f"{p.targets} targets lie {p.distance:.2f} m around it",
+          f"home and targets have a {p.target_radius:.2f} m radius",
+          f"for a random {p.delay[0]:.1f} to {p.delay[1]:.1f} s",
+          f"on the target for {p.hold_time:.1f} s",
+          f"a miss {p.timeout:g} s after the go cue",
+          # The protocol file's comment, its lines between the keys it sets:
+          f"defaults: targets = {p.targets}, distance = {p.distance:.2f},",
+          f"# target_radius = home_radius = {p.target_radius:.2f}, hold_time = {p.hold_time:.1f}, delay_min = "
+          f"{p.delay[0]:.1f},", f"# delay_max = {p.delay[1]:.1f}, timeout = {p.timeout:.1f}, first_target_deg = "
+          f"{p.first_target_deg:g},", f"# home_shoulder_deg = {p.home_posture_deg[0]:g}, home_elbow_deg = "
+          f"{p.home_posture_deg[1]:g}")
+    assert p.home_radius == p.target_radius
+    lesson = preset("lesson")
+    program, person = (lab_config(lesson, 10, person=who).time_limit for who in (False, True))
+    _says(LAB, f"(`lesson`: {program:.0f} s and {person:.0f} s)")
+    low, high = PARAMETERS["viscous"][0][1:3]
+    _says(LAB, f"each entry from {low:.0f} to {high:.0f})",
+          f"`channel_stiffness` (N/m, default {CHANNEL_STIFFNESS:.0f}, above 0 and at most "
+          f"{MAX_CHANNEL_STIFFNESS:,.0f})",
+          f"`channel_damping` (N s/m, default {CHANNEL_DAMPING:.0f}, 0 to {MAX_CHANNEL_DAMPING:.0f})",
+          f"(at most {MAX_CLASS_FILES})", f"({min(REPLAY_SPEEDS):g}x to {max(REPLAY_SPEEDS):g}x",
+          f"with {TUNING_CENTRES} Gaussian bases every {360 / TUNING_CENTRES:g} deg, normalised, of s.d. "
+          f"{TUNING_WIDTH_DEG:g} deg (`--tuning-width DEG`, {NARROWEST:g} to {WIDEST:g})")
+    local = DirectionalLearner(TwoRateLearner())
+    _says(LAB, f"{local.generalization(45):.2f} at 45 deg, {local.generalization(90):.3f} at 90 deg, "
+               f"{local.generalization(135):.3f} at 135 deg")
+    from scipy.stats import chi2
+
+    _says(LAB, f"each at most {fit.MAX_EVALUATIONS} evaluations",
+          f"within {chi2.ppf(0.95, 1) / 2:.2f} (half of chi-squared's 95th percentile, 1 degree of freedom)")
+
+
+def test_the_scenes_and_the_commands_numbers_in_physics():
+    from armgame.cli import build_parser
+    from armgame.commands.derive import MAX_STATES
+    from armgame.scenes import get_scene
+
+    pendulum, propeller, upright = (get_scene(n) for n in ("pendulum", "propeller", "upright"))
+    (_, torques), (off, rest) = propeller.torque_segments
+    _says(PHYSICS, f"the tutorial's one-joint arm from {math.degrees(pendulum.initial[0]) + 90:.0f} deg",
+          f"the game arm spun up by constant torques for {off:g} s, then free for {propeller.duration - off:g} s",
+          f"balanced straight up, {upright.initial[0] - math.pi / 2:.2f} rad off")
+    assert any(torques) and not any(rest)
+    simulate = build_parser().parse_args(["simulate", "--scene", "passive", "--out", "x.csv"])
+    _says(PHYSICS, f"(`--states`, 1 to {MAX_STATES:,}; `--seed`, 0 to 2^63 - 1)",
+          f"Rows come at `--sample-rate` ({simulate.sample_rate:.0f} Hz by default)")

@@ -33,10 +33,16 @@ trials = 4
 @pytest.fixture(scope="module")
 def curl_run(tmp_path_factory):
     """The issue's command, once: armgame lab curl --bot adaptive --headless --out DIR (and a replay)."""
+    import contextlib
+    import io
+
     out = tmp_path_factory.mktemp("curl")
-    code = main(["lab", "curl", "--bot", "adaptive", "--headless", "--out", str(out / "run"), "--no-figures",
-                 "--record", str(out / "curl.json")])
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        code = main(["lab", "curl", "--bot", "adaptive", "--headless", "--out", str(out / "run"), "--no-figures",
+                     "--record", str(out / "curl.json")])
     assert code == 0
+    (out / "printed.txt").write_text(printed.getvalue())
     return out
 
 
@@ -50,7 +56,7 @@ def test_adaptive_bot_draws_the_textbook_learning_curve(curl_run):
     rows = read_trials_csv(curl_run / "run" / "trials.csv")
     assert len(rows) == 120 and all(r["hit"] for r in rows)
     baseline, exposure, washout = (block_values(rows, b) for b in ("baseline", "exposure", "washout"))
-    assert np.all(np.abs(baseline) < 0.006) and abs(baseline.mean()) < 0.002
+    assert np.all(np.abs(baseline) < 0.012) and abs(baseline.mean()) < 0.002  # the motor noise's scatter, no bias
     early, late = exposure[:8].mean(), exposure[-8:].mean()
     assert early < -0.015  # centimetres to the right of the reach
     assert early < late < 0.0 and abs(late) < 0.6 * abs(early)
@@ -62,6 +68,16 @@ def test_adaptive_bot_draws_the_textbook_learning_curve(curl_run):
 def test_the_lab_replay_verifies(curl_run, capsys):
     assert main(["verify", str(curl_run / "curl.json")]) == 0
     assert "matches: lab run (curl, bot, seed 10, 120 trials)" in capsys.readouterr().out
+
+
+def test_the_curl_preset_bot_has_a_persons_motor_noise_and_says_so(curl_run):
+    """A lab report's preset: its bot carries the human level by default, seeded by the run's seed, stated in the
+    run's output and kept in the replay."""
+    printed = (curl_run / "printed.txt").read_text()
+    assert ("motor noise 0.3 (the s.d. of the command as a fraction of it, correlated over 50 ms, seed 10), the curl "
+            "preset's default (--motor-noise 0 turns it off)") in printed
+    task = json.loads((curl_run / "curl.json").read_text())["task"]
+    assert task["motor_noise"] == {"level": 0.3, "correlation_time_s": 0.05, "seed": 10}
 
 
 def test_a_folder_of_replays_verifies_lab_runs_and_games_each_by_their_own_rules(curl_run, tmp_path, capsys):
@@ -83,8 +99,9 @@ def test_a_folder_of_replays_verifies_lab_runs_and_games_each_by_their_own_rules
     assert "1 differ" in capsys.readouterr().out
 
 
-def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path):
+def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path, capsys):
     assert main(["analyze", str(curl_run / "curl.json"), "--out", str(tmp_path / "again.csv")]) == 0
+    assert "  adaptive bot, motor noise 0.3 (" in capsys.readouterr().out
     # One table leads each row with whose run it is; the measures that follow are the lab's, byte for byte.
     lines = (tmp_path / "again.csv").read_text().splitlines()
     replay = str(curl_run / "curl.json")
@@ -96,13 +113,15 @@ def test_analyze_recomputes_the_trials_table_bit_for_bit(curl_run, tmp_path):
 
 @pytest.fixture(scope="module")
 def short_class(tmp_path_factory):
-    """Three students' short lab runs (seeds 1, 2, 3), recorded once for the tests that analyse them."""
+    """Three students' short lab runs (seeds 1, 2, 3), recorded once for the tests that analyse them: the third
+    with motor noise (a class's curve may mix runs with it and without: the protocol is the same)."""
     where = tmp_path_factory.mktemp("short")
     protocol = where / "short.toml"
     protocol.write_text(SHORT)
     for seed in (1, 2, 3):
         assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--seed", str(seed),
-                     "--record", str(where / f"student{seed}.json"), "--name", f"Student {seed}"]) == 0
+                     "--record", str(where / f"student{seed}.json"), "--name", f"Student {seed}"]
+                    + ["--motor-noise", "human"] * (seed == 3)) == 0
     return where
 
 
@@ -164,6 +183,8 @@ def test_class_curve_merges_verified_students(short_class, tmp_path, capsys):
     lines = (tmp_path / "curve" / "class_curve.csv").read_text().splitlines()
     assert lines[0] == "trial,block,perturbation,mean_max_perpendicular_error_m,sem_max_perpendicular_error_m,n"
     assert "class curve of 3 students (2 left out), 16 trials, max_perpendicular_error_m" in captured.out
+    noise = [json.loads((folder / f"student{seed}.json").read_text())["task"].get("motor_noise") for seed in (1, 2, 3)]
+    assert noise[:2] == [None, None] and noise[2]["level"] == 0.3  # one protocol, with noise and without
     assert len(lines) == 17 and all(line.endswith(",3") for line in lines[1:])
     # The mean is the mean over the three students' own tables.
     students = []

@@ -2,6 +2,8 @@
 the bot presses so its replay verifies with nothing re-drawn, off for the game's bots, and refused in one line
 when out of range."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -52,3 +54,36 @@ def test_the_games_bots_have_no_noise_and_bad_levels_are_one_line_errors():
         LabTask.from_dict({**LabTask.of(_run(None)).as_dict(), "motor_noise": {"level": 3, "seed": 1,
                                                                               "correlation_time_s": 0.05}},
                           lab_config(SHORT, 10), 10 ** 6)
+
+
+@pytest.mark.parametrize("argv, level", [
+    (["curl", "--bot", "adaptive"], 0.3),  # an experiment a lab report runs: a person's noise, unless...
+    (["curl", "--bot", "adaptive", "--motor-noise", "0"], 0.0),  # ...turned off
+    (["lesson", "--bot", "adaptive"], 0.0),  # the class's demo: reproducible to the digit
+    (["lesson", "--bot", "model", "--motor-noise", "human"], 0.3),
+    (["short.toml", "--bot", "adaptive"], 0.0),  # a protocol file: none unless asked
+    (["spontaneous"], 0.0),  # a person at the keys brings their own
+])
+def test_each_preset_brings_its_bot_a_motor_noise_that_the_option_overrides(argv, level):
+    from armgame.cli import build_parser
+    from armgame.commands.lab import _motor_noise, _noise_line, _resolve_motor_noise
+    from armgame.lab.protocol import HUMAN_NOISE, PRESET_MOTOR_NOISE, PRESETS
+
+    assert HUMAN_NOISE == 0.3 and {p for p in PRESETS if PRESET_MOTOR_NOISE[p]} == set(PRESETS) - {"lesson"}
+    args = build_parser().parse_args(["lab", *argv, "--seed", "10"])
+    _resolve_motor_noise(args)
+    assert args.motor_noise == level
+    assert _motor_noise(args) == (MotorNoise(level, 10) if level else None)
+    if argv[0] in ("curl", "lesson") and len(argv) == 3:  # the two lines docs/lab.md quotes, as printed
+        line = _noise_line(args)
+        assert f"  {line}\n" in (Path(__file__).parent.parent / "docs" / "lab.md").read_text(encoding="utf-8")
+
+
+def test_a_replay_without_its_noise_recorded_still_verifies():
+    """The noise is in the keys: a replay whose task section names none (as every one before it did) re-simulates
+    to the same trials, bit for bit."""
+    noisy = _run(MotorNoise(0.3, 1))
+    data = LabTask.of(noisy, MotorNoise(0.3, 1)).as_dict()
+    del data["motor_noise"]
+    read = LabTask.from_dict(data, noisy.config, noisy.steps)
+    assert read.motor_noise is None and read.verify(noisy.config, noisy.timeline, noisy.result())[0]

@@ -196,6 +196,10 @@ def _replays(args: argparse.Namespace) -> int:
             skipped += 1
             continue
         print(f"{path}: verified: {session.protocol.name}, seed {session.config.seed}, {len(rows)} reaches")
+        if replay.driven == "bot":  # a person brings their own noise; a bot's is what its replay recorded
+            from ..lab.record import motor_noise_words
+
+            print(f"  {replay.driver} bot, {motor_noise_words(replay.task.motor_noise)}")
         if args.subtract_baseline:
             from ..lab.analysis import baseline_offsets, subtract_baseline
 

@@ -34,7 +34,7 @@ def _count(text: str) -> int:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from ..lab.protocol import PRESETS
+    from ..lab.protocol import HUMAN_NOISE, PRESETS
 
     p = subparsers.add_parser(
         "lab",
@@ -79,10 +79,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "the angle from where it learned it)")
     p.add_argument("--tuning-width", type=float, default=None, metavar="DEG",
                    help="with --representation local: the tuning's width, s.d. in degrees (5 to 180; default 30)")
-    p.add_argument("--motor-noise", type=_noise_level, default=0.0, metavar="LEVEL",
+    p.add_argument("--motor-noise", type=_noise_level, default=None, metavar="LEVEL",
                    help="a bot's signal-dependent motor noise: the s.d. of its command as a fraction of it (0 to 1), "
                    f"or 'human' ({HUMAN_NOISE:g}, the level chosen to vary as people do); drawn from --seed, carried "
-                   "by the keys it presses (default: 0, none)")
+                   "by the keys it presses (default: human for every preset but lesson, none for lesson and for a "
+                   "protocol file; 0 turns it off)")
     from ..ui.options import add_window_options
 
     add_window_options(p, sound=False)
@@ -93,11 +94,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run, without_window=without_window)
 
 
-#: ``--motor-noise human``: a choice (docs/lab.md, "Motor noise"), not a fit to a published data set.
-HUMAN_NOISE = 0.3
-
-
 def _noise_level(text: str) -> float:
+    from ..lab.protocol import HUMAN_NOISE
+
     if text == "human":
         return HUMAN_NOISE
     try:
@@ -109,8 +108,34 @@ def _noise_level(text: str) -> float:
     return value
 
 
+def _resolve_motor_noise(args: argparse.Namespace) -> None:
+    """``args.motor_noise`` as the run uses it: as given, else the preset's (``PRESET_MOTOR_NOISE``) for a bot,
+    else none; ``args.motor_noise_given`` says which, for the run's output."""
+    from ..lab.protocol import PRESET_MOTOR_NOISE
+
+    args.motor_noise_given = args.motor_noise is not None
+    if args.motor_noise is None:
+        args.motor_noise = PRESET_MOTOR_NOISE.get(args.protocol, 0.0) if args.bot else 0.0
+
+
+def _noise_line(args: argparse.Namespace) -> str:
+    """The motor noise a bot's run used and where its level came from, for the run's output."""
+    from ..lab.protocol import PRESETS
+    from ..lab.record import motor_noise_words
+
+    words = motor_noise_words(_motor_noise(args))
+    preset = args.protocol if args.protocol in PRESETS else None
+    if args.motor_noise_given:
+        return f"{words}, as --motor-noise asked"
+    if preset is None:
+        return f"{words}, a protocol file's default (--motor-noise human adds a person's)"
+    if args.motor_noise:
+        return f"{words}, the {preset} preset's default (--motor-noise 0 turns it off)"
+    return f"{words}, the {preset} preset's default (reproducible to the digit; --motor-noise human adds a person's)"
+
+
 def _motor_noise(args: argparse.Namespace):
-    """The bot's ``MotorNoise`` (its stream seeded by the run's seed), or None without --motor-noise."""
+    """The bot's ``MotorNoise`` (its stream seeded by the run's seed), or None for none."""
     if not args.motor_noise:
         return None
     from ..game.bots import MotorNoise
@@ -169,6 +194,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(unknown_name("lab bot", args.bot, LAB_BOT_NAMES))
     if args.motor_noise and not args.bot:
         raise UserError("--motor-noise sets a bot's motor noise: add --bot (a person brings their own)")
+    _resolve_motor_noise(args)
     if (args.retention or args.learning or args.representation) and args.bot != "adaptive":
         raise UserError("--retention, --learning and --representation set the adaptive bot's learner: add --bot "
                         "adaptive")
@@ -378,6 +404,8 @@ def _report(session, args: argparse.Namespace) -> None:
           f"{session.config.seed}{session.ending}")
     if getattr(args, "learner_words", ""):
         print(f"  the adaptive bot's {args.learner_words}")
+    if getattr(args, "bot", None):
+        print(f"  {_noise_line(args)}")
     if session.outcomes:
         rows = trial_rows(session)
         cycle = session.protocol.targets  # a cycle of targets: each direction's own offset averages out

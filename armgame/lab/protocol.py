@@ -346,7 +346,7 @@ def lesson() -> Protocol:
 
 def preset(name: str) -> Protocol:
     """A named protocol: ``lesson``, ``null``, ``curl``, ``rotation``, ``mirror``, ``jointspace``, ``viscous``,
-    ``savings`` or ``spontaneous``."""
+    ``savings``, ``spontaneous`` or ``generalization``."""
     if name == "lesson":
         return lesson()
     if name == "null":
@@ -373,6 +373,18 @@ def preset(name: str) -> Protocol:
 
 PRESETS = ("lesson", "null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous",
            "generalization")
+
+#: ``--motor-noise human``: the s.d. of a bot's motor command as a fraction of it. A choice, not a fit to a
+#: published data set (docs/lab.md, "Motor noise"): it makes the ``model`` bot's baseline reaches vary from trial
+#: to trial by a few degrees and millimetres, the order people show, while it still hits every target.
+HUMAN_NOISE = 0.3
+
+#: The motor noise a bot brings to each preset when ``--motor-noise`` does not say. The experiments a lab
+#: report runs, fits and compares carry a person's (a control group, ``null``, as much as the field it is the
+#: control for: a noiseless group beside a noisy one would differ by the noise alone); ``lesson`` is the class's
+#: demo, whose bot is shown beside the volunteers and rehearsed to the digit (docs/teaching.md): none. Seeded by
+#: the run's seed, so a noisy run is as reproducible as a quiet one; a protocol file's bot has none unless asked.
+PRESET_MOTOR_NOISE = {name: 0.0 if name == "lesson" else HUMAN_NOISE for name in PRESETS}
 
 
 def savings(counter: int = SAVINGS_COUNTER) -> Protocol:

@@ -115,6 +115,14 @@ def _motor_noise(data: object) -> MotorNoise:
         raise ValueError(f"task.motor_noise: {exc}") from None
 
 
+def motor_noise_words(noise: MotorNoise | None) -> str:
+    """A run's motor noise in words, as the lab's and analyze's output state it."""
+    if noise is None:
+        return "no motor noise"
+    return (f"motor noise {noise.level:g} (the s.d. of the command as a fraction of it, correlated over "
+            f"{1000 * noise.correlation_time:g} ms, seed {noise.seed})")
+
+
 def paths_digest(session: LabSession) -> str:
     h = hashlib.sha256()
     for o in session.outcomes:
