@@ -19,9 +19,10 @@
  */
 #include "_ckernel.h"
 
-/* Games side by side: 8 doubles fill two AVX2 registers (or four SSE2 ones, or one AVX-512); more
- * lanes than that only grow the tail, where fewer games than lanes are left. */
-#define LANES 8
+/* Games side by side. A step is a chain of four dependent stages, each waiting on a divide (13 cycles)
+ * and its series, so the lanes are there to hide latency as much as to fill a register: the fast kernel
+ * ran 65 M arm-steps/s with 8 lanes, 78 M with 16 and 77 M with 32 (benchmarks/kernel_speed.py). */
+#define LANES 16
 
 /* Where the compiler and platform can build one function for several instruction sets and pick
  * the one the CPU has when the module loads (GCC and Clang on x86-64 Linux: an ifunc), the lanes'
@@ -57,13 +58,13 @@ typedef struct {
     const int64_t *halt, *ev_end, *ev_step, *ev_muscle;
     const double *ev_goal, *ev_rate;
     uint8_t *flags;
-    double *trig;   /* (4, n): cos q1, sin q1, cos(q1 + q2), sin(q1 + q2) after a game's last step, or NULL */
-    uint8_t *fresh; /* (n,): 1 where trig was written */
+    double *trig;   /* (6, n): cos q1, sin q1, cos(q1 + q2), sin(q1 + q2), q1, q2 after a game's last step, or NULL */
     double dt, h, k, l1, l2, radius, near, reach1, reach2, limit2;
     double s[4], e[4];
 } Batch;
 
-/* The hand's trig of game i, for the caller's observations (the single session's cos and sin). */
+/* The hand's trig of game i, for the caller's observations (the single session's cos and sin), with the
+ * angles it is of: the caller knows it current while they are the game's. */
 static inline void write_trig(const Batch *B, Py_ssize_t i, double q1, double q2)
 {
     if (B->trig == NULL)
@@ -76,7 +77,8 @@ static inline void write_trig(const Batch *B, Py_ssize_t i, double q1, double q2
     B->trig[n + i] = sa;
     B->trig[2 * n + i] = cb;
     B->trig[3 * n + i] = sb;
-    B->fresh[i] = 1;
+    B->trig[4 * n + i] = q1;
+    B->trig[5 * n + i] = q2;
 }
 
 /* One game at a time: the loop the lanes replaced, kept for the arm with gravity and as their reference
@@ -418,8 +420,8 @@ static void store_lane(const Batch *B, const Lanes *L, int l)
     write_trig(B, i, L->q1[l], L->q2[l]);
 }
 
-/* The muscle commands due at lane l's step, then whether its game goes on (else it is stored); sets the
- * step of its next event or stop. */
+/* The muscle commands due at lane l's step, then whether its game goes on (else the caller stores it);
+ * sets the step of its next event or stop. */
 static int due_lane(const Batch *B, Lanes *L, int l)
 {
     int64_t c = L->c[l];
@@ -431,10 +433,8 @@ static int due_lane(const Batch *B, Lanes *L, int l)
         c++;
     }
     L->c[l] = c;
-    if (s >= L->stop[l]) {
-        store_lane(B, L, l);
+    if (s >= L->stop[l])
         return 0;
-    }
     L->next[l] = c < end && B->ev_step[c] < L->stop[l] ? B->ev_step[c] : L->stop[l];
     return 1;
 }
@@ -451,9 +451,79 @@ static void fill_lane(const Batch *B, Lanes *L, int l, Py_ssize_t *queue)
         load_lane(B, L, l, i);
         if (due_lane(B, L, l))
             return;
+        store_lane(B, L, l);
     }
     load_lane(B, L, l, -1);
 }
+
+/* The games of the lanes back into the arrays, as ``store_lane`` for each, where they are LANES
+ * consecutive games (the lockstep of a vector env: every game stops at the same step): one contiguous
+ * copy a quantity, which the compiler vectorises, instead of LANES scattered ones. */
+static void store_block(const Batch *B, const Lanes *L)
+{
+    const Py_ssize_t n = B->n, i = L->game[0];
+    for (int l = 0; l < LANES; l++) {
+        B->x[i + l] = L->q1[l];
+        B->x[n + i + l] = L->q2[l];
+        B->x[2 * n + i + l] = L->w1[l];
+        B->x[3 * n + i + l] = L->w2[l];
+        B->slack[i + l] = L->sl[l];
+        B->steps[i + l] = L->s[l];
+        B->cursor[i + l] = L->c[l];
+    }
+    for (int m = 0; m < 4; m++) {
+        for (int l = 0; l < LANES; l++) {
+            B->act[m * n + i + l] = L->a[m][l];
+            B->goal[m * n + i + l] = L->g[m][l];
+            B->rate[m * n + i + l] = L->r[m][l];
+        }
+    }
+    for (int l = 0; l < LANES; l++)
+        write_trig(B, i + l, L->q1[l], L->q2[l]);
+}
+
+/* The next LANES games into the lanes as ``fill_lane`` would take them, where each has steps to run:
+ * contiguous copies (see ``store_block``). Returns 0, touching nothing, where they are not so. */
+static int fill_block(const Batch *B, Lanes *L, Py_ssize_t *queue)
+{
+    const Py_ssize_t n = B->n, i = *queue;
+    if (n - i < LANES)
+        return 0;
+    for (int l = 0; l < LANES; l++)
+        if (B->steps[i + l] >= B->halt[i + l])
+            return 0;
+    for (int l = 0; l < LANES; l++) {
+        B->flags[i + l] = 0;
+        L->game[l] = i + l;
+        L->anchor[l] = 0;
+        L->bc[l] = L->bs[l] = 0.0;
+        L->q1[l] = B->x[i + l];
+        L->q2[l] = B->x[n + i + l];
+        L->w1[l] = B->x[2 * n + i + l];
+        L->w2[l] = B->x[3 * n + i + l];
+        L->sl[l] = B->slack[i + l];
+        L->x0[l] = B->tx[i + l];
+        L->y0[l] = B->ty[i + l];
+        L->s[l] = B->steps[i + l];
+        L->stop[l] = B->halt[i + l];
+        L->c[l] = B->cursor[i + l];
+        L->end[l] = B->ev_end[i + l];
+    }
+    for (int m = 0; m < 4; m++) {
+        for (int l = 0; l < LANES; l++) {
+            L->a[m][l] = B->act[m * n + i + l];
+            L->g[m][l] = B->goal[m * n + i + l];
+            L->r[m][l] = B->rate[m * n + i + l];
+        }
+    }
+    *queue = i + LANES;
+    for (int l = 0; l < LANES; l++)
+        due_lane(B, L, l);  /* each has steps before its halt: none stops here */
+    return 1;
+}
+
+/* Steps the other lanes may still run while a freed lane waits for them (see ``run_lanes``). */
+#define WAIT_STEPS 16
 
 /* The lanes: ``run_scalar``'s games, LANES at a time. Returns the games flagged. */
 static Py_ssize_t run_lanes(const Batch *B)
@@ -483,8 +553,10 @@ static Py_ssize_t run_lanes(const Batch *B)
                 break;
             }
         }
+        int done[LANES], finished = 0;
         for (int l = 0; l < LANES; l++) {
             const Py_ssize_t i = L.game[l];
+            done[l] = 0;
             if (i < 0)
                 continue;
             if (short_ && L.sl[l] < 0.0) {
@@ -499,16 +571,43 @@ static Py_ssize_t run_lanes(const Batch *B)
                 if (d2h <= B->near) {
                     B->flags[i] = 1;
                     flagged++;
-                    store_lane(B, &L, l);
-                    fill_lane(B, &L, l, &queue);
-                    busy -= L.game[l] < 0;
+                    done[l] = 1;
+                    finished++;
                     continue;
                 }
             }
             if (L.s[l] >= L.next[l] && !due_lane(B, &L, l)) {
-                fill_lane(B, &L, l, &queue);
-                busy -= L.game[l] < 0;
+                done[l] = 1;
+                finished++;
             }
+        }
+        if (!finished)
+            continue;
+        /* Every lane's game done at once, and consecutive games: the lockstep's block copies. */
+        int block = finished == LANES;
+        for (int l = 1; block && l < LANES; l++)
+            block = L.game[l] == L.game[0] + l;
+        if (block)
+            store_block(B, &L);
+        int64_t longest = 0;  /* the most steps a lane still running has before its stop */
+        for (int l = 0; l < LANES; l++) {
+            if (done[l]) {
+                if (!block)
+                    store_lane(B, &L, l);
+                load_lane(B, &L, l, -1);
+            } else if (L.game[l] >= 0 && L.stop[l] - L.s[l] > longest) {
+                longest = L.stop[l] - L.s[l];
+            }
+        }
+        if (longest == 0 && fill_block(B, &L, &queue))
+            continue;
+        /* A lane freed while the others are about to stop (a hit in a vector env's few steps) waits for
+         * them, so that the lanes fill as a block again; otherwise it takes the next game now. */
+        busy = 0;
+        for (int l = 0; l < LANES; l++) {
+            if (L.game[l] < 0 && (longest == 0 || longest > WAIT_STEPS))
+                fill_lane(B, &L, l, &queue);
+            busy += L.game[l] >= 0;
         }
     }
     return flagged;
@@ -516,15 +615,15 @@ static Py_ssize_t run_lanes(const Batch *B)
 
 const char armgame_run_doc[] =
 "run(params, mode, fast, n, x, act, goal, rate, slack, tx, ty, steps, halt, cursor, ev_end, ev_step, ev_muscle,\n"
-"    ev_goal, ev_rate, flags, trig, fresh, lanes) -> int\n\n"
+"    ev_goal, ev_rate, flags, trig, lanes) -> int\n\n"
 "Step every game i from steps[i] up to halt[i], applying its muscle events on the way, and\n"
 "stop it early after a step that leaves its hand near its target (flags[i] = 1). Returns how\n"
 "many games were flagged. Arrays: x (4+, n) float64 rows q1 q2 w1 w2; act, goal, rate (4, n);\n"
 "slack, tx, ty (n,); steps, halt, cursor, ev_end (n,) int64; game i's events are\n"
 "cursor[i]:ev_end[i] of ev_step (int64), ev_muscle (int64, 0-3), ev_goal, ev_rate (float64),\n"
 "sorted by step; an event at step s applies before the step from s; flags (n,) uint8.\n"
-"trig (4, n) float64 and fresh (n,) uint8, or both None: for every game stepped, cos q1, sin q1,\n"
-"cos(q1 + q2), sin(q1 + q2) after its last step (the C library's), and fresh[i] = 1.\n"
+"trig (6, n) float64 or None: for every game stepped, cos q1, sin q1, cos(q1 + q2), sin(q1 + q2)\n"
+"after its last step (the C library's) and the q1, q2 they are of.\n"
 "With fast true, RK4's elbow trig comes by angle addition (the numpy fast kernel's method):\n"
 "round-off, not bit for bit. lanes: step several games side by side (the same results; false: one\n"
 "at a time, the reference). Refused before any step (ValueError): params not finite or dt not positive,\n"
@@ -533,12 +632,12 @@ const char armgame_run_doc[] =
 PyObject *armgame_run(PyObject *self, PyObject *args)
 {
     (void)self;
-    PyObject *obj[19];
+    PyObject *obj[18];
     int mode, fast, lanes;
     Py_ssize_t n;
-    if (!PyArg_ParseTuple(args, "OipnOOOOOOOOOOOOOOOOOOp", &obj[0], &mode, &fast, &n, &obj[1], &obj[2], &obj[3],
+    if (!PyArg_ParseTuple(args, "OipnOOOOOOOOOOOOOOOOOp", &obj[0], &mode, &fast, &n, &obj[1], &obj[2], &obj[3],
                           &obj[4], &obj[5], &obj[6], &obj[7], &obj[8], &obj[9], &obj[10], &obj[11], &obj[12],
-                          &obj[13], &obj[14], &obj[15], &obj[16], &obj[17], &obj[18], &lanes))
+                          &obj[13], &obj[14], &obj[15], &obj[16], &obj[17], &lanes))
         return NULL;
     /* n bounded first: every size below is n times at most 4 * 8 bytes, which must not overflow (a wrapped
        n * D of 0 would divide by zero below: SIGFPE, the process gone). */
@@ -547,8 +646,8 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
                      n, PY_SSIZE_T_MAX / (4 * (Py_ssize_t)sizeof(double)));
         return NULL;
     }
-    const int with_trig = obj[17] != Py_None || obj[18] != Py_None;
-    Buf b[19];
+    const int with_trig = obj[17] != Py_None;
+    Buf b[18];
     memset(b, 0, sizeof b);
     PyObject *result = NULL;
     const Py_ssize_t D = sizeof(double), I = sizeof(int64_t);
@@ -570,7 +669,7 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
     if (get(obj[13], &b[13], events, I, 0, "ev_muscle") < 0 || get(obj[14], &b[14], events, D, 0, "ev_goal") < 0
         || get(obj[15], &b[15], events, D, 0, "ev_rate") < 0 || get(obj[16], &b[16], n, 1, 1, "flags") < 0)
         goto done;
-    if (with_trig && (get(obj[17], &b[17], 4 * n, D, 1, "trig") < 0 || get(obj[18], &b[18], n, 1, 1, "fresh") < 0))
+    if (with_trig && get(obj[17], &b[17], 6 * n, D, 1, "trig") < 0)
         goto done;
 
     const double *p = b[0].view.buf;
@@ -584,7 +683,7 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
         .steps = b[8].view.buf, .halt = b[9].view.buf, .cursor = b[10].view.buf, .ev_end = b[11].view.buf,
         .ev_step = b[12].view.buf, .ev_muscle = b[13].view.buf, .ev_goal = b[14].view.buf,
         .ev_rate = b[15].view.buf, .flags = b[16].view.buf,
-        .trig = with_trig ? b[17].view.buf : NULL, .fresh = with_trig ? b[18].view.buf : NULL,
+        .trig = with_trig ? b[17].view.buf : NULL,
         .dt = p[P_DT], .h = p[P_H], .k = p[P_K], .l1 = p[P_L1], .l2 = p[P_L2], .radius = p[P_RADIUS],
         .near = p[P_NEAR], .reach1 = p[P_REACH1], .reach2 = p[P_REACH2], .limit2 = p[P_LIMIT2],
         .s = {p[P_S0], p[P_S1], p[P_S2], p[P_S3]}, .e = {p[P_E0], p[P_E1], p[P_E2], p[P_E3]},
@@ -624,6 +723,6 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
     Py_END_ALLOW_THREADS
     result = PyLong_FromSsize_t(flagged);
 done:
-    release(b, 19);
+    release(b, 18);
     return result;
 }

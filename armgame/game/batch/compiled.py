@@ -81,7 +81,7 @@ class CompiledKernel:
         halt = np.ascontiguousarray(halt, dtype=np.int64)
         while _ckernel.run(self.params, self.mode, self.fast, b.n, b._xs, b._act, b._goal, b._rate, b._slack,
                            b.target_x, b.target_y, b.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal,
-                           ev.rate, self.flags, None, None, LANES):
+                           ev.rate, self.flags, b._trig, LANES):
             for i in np.flatnonzero(self.flags).tolist():
                 b._hit_test(i, b._x[:, i], int(b.steps[i]))
 
