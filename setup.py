@@ -24,7 +24,8 @@ class BuildExactExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c", "armgame/game/_cbatch.c"],
+    ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c", "armgame/game/_cbatch.c",
+                                                     "armgame/game/_clanes.c"],
                            depends=["armgame/game/_ckernel.h"], optional=True),
                  Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},

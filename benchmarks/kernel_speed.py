@@ -68,7 +68,9 @@ PROBE_C = r"""
 #include <math.h>
 #include <time.h>
 typedef double v4 __attribute__((vector_size(32)));
-static double now(void) { struct timespec t; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
+static double now(void) {
+    struct timespec t; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec;
+}
 double sincos_ns(long n) {  /* the C library's sincos on independent angles: its throughput */
     volatile double sink = 0.0; double acc = 0.0, t = now();
     for (long i = 0; i < n; i++) { double s, c; sincos(0.1 + 2.5e-8 * (double)i, &s, &c); acc += s + c; }

@@ -73,7 +73,7 @@ def test_the_hands_trig_is_the_c_librarys_of_the_games_angles():
     assert s12 == [math.sin(a + b) for a, b in zip(q1, q2, strict=True)]
     batch.reset_arms(np.ones(20, dtype=bool) & ~batch.over)  # the arm moved outside the kernel: trig anew
     batch._x[0, 0] = 0.5
-    hx, hy = batch.hand()
+    hx, _ = batch.hand()
     arm = batch.config.arm
     assert math.isclose(hx[0], arm.l1 * math.cos(0.5) + arm.l2 * math.cos(0.5 + batch.q2[0]), abs_tol=1e-15)
 
@@ -91,3 +91,18 @@ def test_an_install_without_a_c_compiler_plays_the_same_games(monkeypatch):
     assert batch.compiled is None
     assert replay_many(configs, timelines, exact=True) == built
     assert session_module.GameSession(configs[0]).play(timelines[0]) == built[0]
+
+
+@needs_build
+def test_the_kernel_benchmark_runs():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "kernel_speed.py"
+    spec = importlib.util.spec_from_file_location("kernel_speed", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    result = bench.measure(4, 0.2, 1)
+    rates = result["switching"]["rates"]
+    assert set(rates) == {"single", "exact lanes", "fast lanes", "exact one by one", "fast one by one"}
+    assert all(r[0] > 0 for r in rates.values()) and bench.bounds(None) is None

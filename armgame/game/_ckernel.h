@@ -171,8 +171,44 @@ static inline int get(PyObject *obj, Buf *buf, Py_ssize_t count, Py_ssize_t item
     return 0;
 }
 
-/* The batch (_cbatch.c). */
+/* The batch (_cbatch.c: the call, one game at a time; _clanes.c: games side by side). */
+/* A call's arrays and constants (the arguments of ``run``, checked). */
+typedef struct {
+    Arm arm;
+    int fast;
+    Py_ssize_t n;
+    double *x, *act, *goal, *rate, *slack;
+    const double *tx, *ty;
+    int64_t *steps, *cursor;
+    const int64_t *halt, *ev_end, *ev_step, *ev_muscle;
+    const double *ev_goal, *ev_rate;
+    uint8_t *flags;
+    double *trig;   /* (6, n): cos q1, sin q1, cos(q1 + q2), sin(q1 + q2), q1, q2 after a game's last step, or NULL */
+    double dt, h, k, l1, l2, radius, near, reach1, reach2, limit2;
+    double s[4], e[4];
+} Batch;
+
+/* The hand's trig of game i, for the caller's observations (the single session's cos and sin), with the
+ * angles it is of: the caller knows it current while they are the game's. */
+static inline void write_trig(const Batch *B, Py_ssize_t i, double q1, double q2)
+{
+    if (B->trig == NULL)
+        return;
+    const Py_ssize_t n = B->n;
+    double sa, ca, sb, cb;
+    sin_cos(q1, &sa, &ca);
+    sin_cos(q1 + q2, &sb, &cb);
+    B->trig[i] = ca;
+    B->trig[n + i] = sa;
+    B->trig[2 * n + i] = cb;
+    B->trig[3 * n + i] = sb;
+    B->trig[4 * n + i] = q1;
+    B->trig[5 * n + i] = q2;
+}
+
 PyObject *armgame_run(PyObject *self, PyObject *args);
 extern const char armgame_run_doc[];
+/* The games of a checked call, LANES at a time: returns the games flagged (_clanes.c). */
+Py_ssize_t armgame_run_lanes(const Batch *B);
 
 #endif

@@ -243,7 +243,8 @@ class BatchGameSession:
             else:
                 a, b = q1[stale], q2[stale]
             s12 = a + b
-            trig[0, stale], trig[1, stale], trig[2, stale], trig[3, stale] = np.cos(a), np.sin(a), np.cos(s12), np.sin(s12)
+            trig[0, stale], trig[1, stale] = np.cos(a), np.sin(a)
+            trig[2, stale], trig[3, stale] = np.cos(s12), np.sin(s12)
             trig[4, stale], trig[5, stale] = a, b
         return trig[:4]
 
