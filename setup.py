@@ -12,7 +12,7 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 # GCC and Clang; MSVC's default /fp:precise neither contracts nor replaces sin and cos.
-EXACT_FLAGS = ["-O2", "-ffp-contract=off", "-fno-builtin-sin", "-fno-builtin-cos", "-fno-fast-math"]
+EXACT_FLAGS = ["-O3", "-ffp-contract=off", "-fno-builtin-sin", "-fno-builtin-cos", "-fno-fast-math"]
 
 
 class BuildExactExt(build_ext):
@@ -24,7 +24,9 @@ class BuildExactExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c"], optional=True),
+    ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c", "armgame/game/_cbatch.c",
+                                                     "armgame/game/_clanes.c"],
+                           depends=["armgame/game/_ckernel.h"], optional=True),
                  Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},
 )

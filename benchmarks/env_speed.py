@@ -1,6 +1,6 @@
 """Speed of the Gymnasium envs, beside Gymnasium's Acrobot-v1 measured in the same run.
 
-    python benchmarks/env_speed.py              # about a minute
+    python benchmarks/env_speed.py              # about three minutes
     python benchmarks/env_speed.py --quick      # a few seconds a figure, fewer repeats
     python benchmarks/env_speed.py --json       # one JSON object
 
@@ -10,8 +10,10 @@ reset as they end:
 
 * single env, both through ``gymnasium.make`` (with its checker and order wrappers), and Reach-v1
   against Reach-v0 (what the v1 observation and reward cost);
-* vector env at 1, 64, 1,024 and 8,192 envs: armgame's native ``ReachVectorEnv``
-  (``make_vec(..., vectorization_mode="vector_entry_point")``) and Acrobot's ``SyncVectorEnv``.
+* vector env at 1, 4, 16, 64, 1,024 and 8,192 envs: armgame's native ``ReachVectorEnv``
+  (``make_vec(..., vectorization_mode="vector_entry_point")``) and Acrobot's ``SyncVectorEnv``; and
+  Reach-v1's native vector env against ``SyncVectorEnv`` of Reach-v1 single envs, side by side
+  (issue 28: no slower at any size; at least 4 M env-steps/s at 8,192 envs).
 
 Each figure is measured in several repeats, interleaved with its peer so that load from
 elsewhere falls on both; the report gives the median and the range over repeats, and the
@@ -34,9 +36,10 @@ import numpy as np
 
 import armgame.env  # noqa: F401  (registers armgame/Reach-v0)
 
-VECTOR_SIZES = (1, 64, 1024, 8192)
+VECTOR_SIZES = (1, 4, 16, 64, 1024, 8192)
 SINGLE_GOAL = 1.0  # Reach-v0 steps per second over Acrobot-v1's
-VECTOR_GOAL = 1e6  # env-steps per second at 8,192 envs
+VECTOR_GOAL = 1e6  # env-steps per second at 8,192 envs (v0)
+V1_VECTOR_GOAL = 4e6  # Reach-v1's, at 8,192 envs (issue 28)
 
 
 def single_runner(env_id: str) -> Callable[[float], tuple[float, float]]:
@@ -98,7 +101,7 @@ def paired(runners: dict[str, Callable[[float], tuple[float, float]]], seconds: 
             wall[name].append(w)
             cpu[name].append(c)
     return {name: {"wall": spread(wall[name]), "cpu": spread(cpu[name]),
-                   "wall_rates": wall[name]}  # type: ignore[dict-item]
+                   "wall_rates": wall[name], "cpu_rates": cpu[name]}  # type: ignore[dict-item]
             for name in runners}
 
 
@@ -117,7 +120,11 @@ def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float |
     vector = {}
     for n in sizes:
         vector[n] = paired({"reach": vector_runner("armgame/Reach-v0", n, "vector_entry_point"),
-                            "acrobot_sync": vector_runner("Acrobot-v1", n, "sync")}, seconds, repeats)
+                            "acrobot_sync": vector_runner("Acrobot-v1", n, "sync"),
+                            "reach_v1": vector_runner("armgame/Reach-v1", n, "vector_entry_point"),
+                            "reach_v1_sync": vector_runner("armgame/Reach-v1", n, "sync")}, seconds, repeats)
+        vector[n]["v1_ratio"] = spread([a / b for a, b in zip(vector[n]["reach_v1"]["cpu_rates"],
+                                                              vector[n]["reach_v1_sync"]["cpu_rates"], strict=True)])
     return {
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
                    f"numpy {np.__version__}, gymnasium {gym.__version__}",
@@ -180,6 +187,15 @@ def report(result: dict) -> None:
     top = result["vector"][n]["reach"]
     print(f"vector env at {n:,} envs: {top['wall']['median'] / 1e6:.2f} M env-steps/s wall, "
           f"{top['cpu']['median'] / 1e6:.2f} M per CPU second (goal >= {VECTOR_GOAL / 1e6:g} M)")
+    print(f"{'envs':>6}  {'Reach-v1 vector env':>32} {cpu:>11}  {'Reach-v1 SyncVectorEnv':>30} {cpu:>11}  "
+          f"native / sync per CPU s")
+    for n, rates in result["vector"].items():
+        ours, theirs, r = rates["reach_v1"], rates["reach_v1_sync"], rates["v1_ratio"]
+        print(f"{n:>6}  {fmt(ours['wall']):>32} {ours['cpu']['median']:>11,.0f}  {fmt(theirs['wall']):>30} "
+              f"{theirs['cpu']['median']:>11,.0f}  {r['median']:.2f} [{r['min']:.2f} - {r['max']:.2f}]")
+    top = result["vector"][n]["reach_v1"]
+    print(f"Reach-v1 vector env at {n:,} envs: {top['wall']['median'] / 1e6:.2f} M env-steps/s wall, "
+          f"{top['cpu']['median'] / 1e6:.2f} M per CPU second (goal >= {V1_VECTOR_GOAL / 1e6:g} M)")
 
 
 def main() -> None:

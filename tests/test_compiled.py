@@ -36,7 +36,7 @@ def arrays(n: int = 3) -> dict:
             "tx": batch.target_x, "ty": batch.target_y, "steps": batch.steps,
             "halt": np.full(n, 50, dtype=np.int64), "cursor": events.cursor, "ev_end": events.end,
             "ev_step": events.step, "ev_muscle": events.muscle, "ev_goal": events.goal, "ev_rate": events.rate,
-            "flags": np.zeros(n, dtype=np.uint8)}
+            "flags": np.zeros(n, dtype=np.uint8), "trig": None, "lanes": True}
 
 
 def call(args: dict) -> int:

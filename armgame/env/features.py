@@ -45,11 +45,12 @@ REWARDS = ("dense", "sparse")
 
 
 def hand_velocity(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray,
-                  w2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The hand's velocity (m/s), the Jacobian times the joint velocities."""
-    s12, w12 = q1 + q2, w1 + w2
-    return (-arm.l1 * np.sin(q1) * w1 - arm.l2 * np.sin(s12) * w12,
-            arm.l1 * np.cos(q1) * w1 + arm.l2 * np.cos(s12) * w12)
+                  w2: np.ndarray, trig: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The hand's velocity (m/s), the Jacobian times the joint velocities; ``trig``: the angles' cos q1, sin q1,
+    cos(q1 + q2), sin(q1 + q2) where known (``BatchGameSession.hand_trig``: numpy's trig was most of a step)."""
+    c1, s1, c12, s12 = (np.cos(q1), np.sin(q1), np.cos(q1 + q2), np.sin(q1 + q2)) if trig is None else trig
+    w12 = w1 + w2
+    return -arm.l1 * s1 * w1 - arm.l2 * s12 * w12, arm.l1 * c1 * w1 + arm.l2 * c12 * w12
 
 
 def hand_and_velocity(arm: TwoJointParams, q1: float, q2: float, w1: float,
@@ -127,10 +128,11 @@ def wrap_angles(q: np.ndarray) -> np.ndarray:
 def reach_observations_v1(arm: TwoJointParams, hand: tuple[np.ndarray, np.ndarray], q1: np.ndarray,
                           q2: np.ndarray, w1: np.ndarray, w2: np.ndarray, activation: np.ndarray,
                           target_x: np.ndarray, target_y: np.ndarray, time_left_fraction: np.ndarray,
-                          dtype: str = "float32") -> np.ndarray:
-    """Reach-v1 observations, one row per game; ``hand`` is ``BatchGameSession.hand()``, ``activation`` (n, 4)."""
+                          dtype: str = "float32", trig: np.ndarray | None = None) -> np.ndarray:
+    """Reach-v1 observations, one row per game; ``hand`` is ``BatchGameSession.hand()``, ``activation`` (n, 4),
+    ``trig`` as ``hand_velocity``'s."""
     hx, hy = hand
-    vx, vy = hand_velocity(arm, q1, q2, w1, w2)
+    vx, vy = hand_velocity(arm, q1, q2, w1, w2, trig)
     obs = np.empty((len(q1), 15), dtype=dtype)
     obs[:, 0] = wrap_angles(q1)
     obs[:, 1] = wrap_angles(q2)

@@ -376,5 +376,6 @@ class ReachV1VectorEnv(ReachVectorEnv):
         for part, batch in self.parts:
             left = (batch.total_steps - np.minimum(batch.steps, batch.total_steps)) / batch.total_steps
             obs[part] = reach_observations_v1(self.config.arm, batch.hand(), batch.q1, batch.q2, batch.w1, batch.w2,
-                                              batch.activation, batch.target_x, batch.target_y, left, dtype)
+                                              batch.activation, batch.target_x, batch.target_y, left, dtype,
+                                              batch.hand_trig())
         return obs

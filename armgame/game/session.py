@@ -32,7 +32,7 @@ except ImportError:
 
 #: The calling convention of ``_ckernel.c`` this package speaks: this module's one game and
 #: ``batch/compiled.py``'s batches. A build of another (a stale ``.so``) is not used.
-KERNEL_VERSION = 4
+KERNEL_VERSION = 5
 #: How many doubles the kernel's params hold (its P_* enum).
 KERNEL_PARAMS = 26
 

@@ -44,6 +44,10 @@ __all__ = ["AVAILABLE", "KERNEL_VERSION", "CompiledKernel", "available", "speaks
 #: Whether the compiled kernel is here to use.
 AVAILABLE = _ckernel is not None
 
+#: Whether ``run`` steps games side by side (``_cbatch.c``'s lanes) or one at a time, its reference. The same
+#: results either way (tests/test_lanes.py); the lanes are the faster, so only the tests switch them off.
+LANES = True
+
 
 def available() -> bool:
     """``AVAILABLE``, read when asked (tests switch it off): how ``session`` asks, importing this module's
@@ -77,7 +81,7 @@ class CompiledKernel:
         halt = np.ascontiguousarray(halt, dtype=np.int64)
         while _ckernel.run(self.params, self.mode, self.fast, b.n, b._xs, b._act, b._goal, b._rate, b._slack,
                            b.target_x, b.target_y, b.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal,
-                           ev.rate, self.flags):
+                           ev.rate, self.flags, b._trig, LANES):
             for i in np.flatnonzero(self.flags).tolist():
                 b._hit_test(i, b._x[:, i], int(b.steps[i]))
 

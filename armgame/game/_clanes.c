@@ -1,0 +1,452 @@
+/* The batch's games side by side (``_ckernel.run`` with lanes, the default): LANES games at a time, one
+ * array per quantity with a game per element (structure of arrays), so that every arithmetic line is one
+ * loop over the lanes that the compiler turns into vector instructions. See _cbatch.c's opening comment
+ * for why the results are the one-at-a-time loop's, bit for bit. */
+#include "_ckernel.h"
+
+/* Games side by side. A step is a chain of four dependent stages, each waiting on a divide (13 cycles)
+ * and its series, so the lanes are there to hide latency as much as to fill a register: the fast kernel
+ * ran 65 M arm-steps/s with 8 lanes, 78 M with 16 and 77 M with 32 (benchmarks/kernel_speed.py). */
+#define LANES 16
+
+/* Where the compiler and platform can build one function for several instruction sets and pick
+ * the one the CPU has when the module loads (GCC and Clang on x86-64 Linux: an ifunc), the lanes'
+ * step is built for AVX2 and for the baseline (SSE2). Elsewhere (MSVC, macOS, ARM's NEON is
+ * baseline) it is built once for the baseline. Either way the same IEEE operations in the same
+ * order: the results do not depend on which runs. */
+#if defined(__x86_64__) && defined(__linux__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define LANES_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+#ifndef LANES_CLONES
+#define LANES_CLONES
+#endif
+
+/* The lanes' helpers go inside each build of the step, so their loops are built for its instructions. */
+#if defined(__GNUC__) || defined(__clang__)
+#define LANES_INLINE static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define LANES_INLINE static __forceinline
+#else
+#define LANES_INLINE static inline
+#endif
+
+
+/* The lanes' state: one array per quantity, a game per element. */
+typedef struct {
+    double q1[LANES], q2[LANES], w1[LANES], w2[LANES];
+    double a[4][LANES], g[4][LANES], r[4][LANES];
+    double sl[LANES], x0[LANES], y0[LANES];
+    double bc[LANES], bs[LANES];        /* stage 1's b cos q2, b sin q2 (the fast kernel carries them) */
+    double qs[LANES], ds[LANES];        /* a stage's elbow angle and, in the fast kernel, its increment */
+    double ec[LANES], es[LANES];        /* that stage's b cos and b sin of it */
+    int ok[LANES];                      /* the fast kernel's series held for the lane (else: in full) */
+    int anchor[LANES];
+    int64_t s[LANES], stop[LANES], next[LANES], c[LANES], end[LANES];
+    Py_ssize_t game[LANES];             /* the lane's game, or -1 */
+} Lanes;
+
+/* The step's constants, the same for every lane. */
+typedef struct {
+    double b, d, det0, amd, k1, k2, dt, h, k, limit2, reach1, reach2;
+    double s[4], e[4];
+    int damping, fast;
+} Step;
+
+/* TwoJointArm's accel_unforced or accel_with_damping (``accel_trig``) for every lane, the lanes' stage
+ * angles in q1, q2, speeds in w1, w2, elbow trig in L->ec, L->es. */
+LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, const double *w1,
+                               const double *w2, const double *t1, const double *t2, double *o1, double *o2)
+{
+    (void)q1;
+    for (int l = 0; l < LANES; l++) {
+        const double bc = L->ec[l], h = L->es[l];
+        const double m12 = k->d + bc;
+        double f1 = t1[l] + h * (w1[l] + w1[l] + w2[l]) * w2[l];
+        double f2 = t2[l] - h * w1[l] * w1[l];
+        if (k->damping) {
+            f1 = f1 - k->k1 * w1[l];
+            f2 = f2 - k->k2 * w2[l];
+        }
+        const double r = 1.0 / (k->det0 - bc * bc);
+        o1[l] = (k->d * f1 - m12 * f2) * r;
+        o2[l] = ((m12 + k->amd + bc) * f2 - m12 * f1) * r;
+    }
+}
+
+/* A stage's elbow trig for every lane: in full from the C library (the exact kernel, and the fast
+ * kernel's lanes whose increment is past the series' range), else turned from stage 1's by the series. */
+LANES_INLINE void elbow_lanes(const Step *k, Lanes *L)
+{
+    int all = 1;
+    if (k->fast) {
+        for (int l = 0; l < LANES; l++) {
+            const double delta = L->ds[l], d2 = delta * delta;
+            const double c = 1.0 + d2 * (-0.5 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 * (1.0 / 40320.0))));
+            const double s = delta * (1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0
+                                                                                      + d2 * (1.0 / 362880.0)))));
+            L->ec[l] = L->bc[l] * c - L->bs[l] * s;
+            L->es[l] = L->bs[l] * c + L->bc[l] * s;
+            L->ok[l] = d2 <= k->limit2;
+        }
+        for (int l = 0; l < LANES; l++)
+            all &= L->ok[l];
+        if (all)
+            return;
+    }
+    for (int l = 0; l < LANES; l++) {
+        if (!k->fast || !L->ok[l]) {
+            double sn, cs;
+            sin_cos(L->qs[l], &sn, &cs);
+            L->ec[l] = k->b * cs;
+            L->es[l] = k->b * sn;
+        }
+    }
+}
+
+/* One RK4 step of every lane (``run_scalar``'s step, lane by lane): the muscles, the four stages, the
+ * fast kernel's trig carried to the next step, and the slack. Returns whether some lane's slack ran out. */
+LANES_CLONES
+static int step_lanes(const Step *k, Lanes *L)
+{
+    double t1[LANES], t2[LANES], p1[LANES], p2[LANES];
+    double a1[LANES], a2[LANES], b1[LANES], b2[LANES], c1[LANES], c2[LANES], d1[LANES], d2[LANES];
+    double v1[LANES], v2[LANES], u1[LANES], u2[LANES], z1[LANES], z2[LANES], qa[LANES];
+    for (int l = 0; l < LANES; l++) {
+        double a0 = L->a[0][l], a1_ = L->a[1][l], a2_ = L->a[2][l], a3 = L->a[3][l];
+        t1[l] = a0 * k->s[0] + a1_ * k->s[1] + a2_ * k->s[2] + a3 * k->s[3];
+        t2[l] = a0 * k->e[0] + a1_ * k->e[1] + a2_ * k->e[2] + a3 * k->e[3];
+    }
+    for (int m = 0; m < 4; m++)
+        for (int l = 0; l < LANES; l++)
+            L->a[m][l] += (L->g[m][l] - L->a[m][l]) * L->r[m][l];
+    /* Stage 1's elbow trig: in full, or in the fast kernel carried from the last step. */
+    for (int l = 0; l < LANES; l++) {
+        if (!k->fast || L->anchor[l] <= 0) {
+            double sn, cs;
+            sin_cos(L->q2[l], &sn, &cs);
+            L->bc[l] = k->b * cs;
+            L->bs[l] = k->b * sn;
+            L->anchor[l] = REANCHOR;
+        }
+        L->anchor[l]--;
+    }
+    for (int l = 0; l < LANES; l++) {
+        p1[l] = L->q1[l];
+        p2[l] = L->q2[l];
+        L->ec[l] = L->bc[l];
+        L->es[l] = L->bs[l];
+    }
+    accel_lanes(k, L, L->q1, L->w1, L->w2, t1, t2, a1, a2);
+    for (int l = 0; l < LANES; l++) {
+        v1[l] = L->w1[l] + k->h * a1[l];
+        v2[l] = L->w2[l] + k->h * a2[l];
+        L->qs[l] = L->q2[l] + k->h * L->w2[l];
+        L->ds[l] = k->h * L->w2[l];
+        qa[l] = L->q1[l] + k->h * L->w1[l];
+    }
+    elbow_lanes(k, L);
+    accel_lanes(k, L, qa, v1, v2, t1, t2, b1, b2);
+    for (int l = 0; l < LANES; l++) {
+        u1[l] = L->w1[l] + k->h * b1[l];
+        u2[l] = L->w2[l] + k->h * b2[l];
+        L->qs[l] = L->q2[l] + k->h * v2[l];
+        L->ds[l] = k->h * v2[l];
+        qa[l] = L->q1[l] + k->h * v1[l];
+    }
+    elbow_lanes(k, L);
+    accel_lanes(k, L, qa, u1, u2, t1, t2, c1, c2);
+    for (int l = 0; l < LANES; l++) {
+        z1[l] = L->w1[l] + k->dt * c1[l];
+        z2[l] = L->w2[l] + k->dt * c2[l];
+        L->qs[l] = L->q2[l] + k->dt * u2[l];
+        L->ds[l] = k->dt * u2[l];
+        qa[l] = L->q1[l] + k->dt * u1[l];
+    }
+    elbow_lanes(k, L);
+    accel_lanes(k, L, qa, z1, z2, t1, t2, d1, d2);
+    int out = 0;
+    for (int l = 0; l < LANES; l++) {
+        const double w1 = L->w1[l], w2 = L->w2[l];
+        const double q1 = p1[l] + k->k * (w1 + z1[l] + 2.0 * (v1[l] + u1[l]));
+        const double q2 = p2[l] + k->k * (w2 + z2[l] + 2.0 * (v2[l] + u2[l]));
+        L->w1[l] = w1 + k->k * (a1[l] + d1[l] + 2.0 * (b1[l] + c1[l]));
+        L->w2[l] = w2 + k->k * (a2[l] + d2[l] + 2.0 * (b2[l] + c2[l]));
+        L->q1[l] = q1;
+        L->q2[l] = q2;
+        L->s[l]++;
+        /* A lower bound on the hand's distance from the disc, lowered by a bound on its move. */
+        L->sl[l] -= fabs(q1 - p1[l]) * k->reach1 + fabs(q2 - p2[l]) * k->reach2;
+        out |= L->sl[l] < 0.0;
+    }
+    if (k->fast) {
+        /* The next step's elbow trig: this one's turned by the step's change of q2 (``turned``); where the
+         * series does not hold, the next step computes it in full. */
+        for (int l = 0; l < LANES; l++)
+            L->ds[l] = L->q2[l] - p2[l];
+        for (int l = 0; l < LANES; l++) {
+            const double delta = L->ds[l], d2_ = delta * delta;
+            const double c = 1.0 + d2_ * (-0.5 + d2_ * (1.0 / 24.0 + d2_ * (-1.0 / 720.0 + d2_ * (1.0 / 40320.0))));
+            const double s = delta * (1.0 + d2_ * (-1.0 / 6.0 + d2_ * (1.0 / 120.0 + d2_ * (-1.0 / 5040.0
+                                                                                         + d2_ * (1.0 / 362880.0)))));
+            const int ok = d2_ <= k->limit2;
+            const double nc = L->bc[l] * c - L->bs[l] * s, ns = L->bs[l] * c + L->bc[l] * s;
+            L->bc[l] = ok ? nc : L->bc[l];
+            L->bs[l] = ok ? ns : L->bs[l];
+            L->ok[l] = ok;
+        }
+        for (int l = 0; l < LANES; l++)
+            if (!L->ok[l])
+                L->anchor[l] = 0;
+    }
+    return out;
+}
+
+/* Game i's arrays into lane l; no game (i < 0): a still arm that never needs attention. */
+static void load_lane(const Batch *B, Lanes *L, int l, Py_ssize_t i)
+{
+    const Py_ssize_t n = B->n;
+    L->game[l] = i;
+    L->anchor[l] = 0;
+    L->bc[l] = L->bs[l] = 0.0;
+    if (i < 0) {
+        L->q1[l] = L->q2[l] = L->w1[l] = L->w2[l] = 0.0;
+        for (int m = 0; m < 4; m++)
+            L->a[m][l] = L->g[m][l] = L->r[m][l] = 0.0;
+        L->sl[l] = INFINITY;
+        L->x0[l] = L->y0[l] = 0.0;
+        L->s[l] = 0;
+        L->stop[l] = L->next[l] = INT64_MAX;
+        L->c[l] = L->end[l] = 0;
+        return;
+    }
+    L->q1[l] = B->x[i];
+    L->q2[l] = B->x[n + i];
+    L->w1[l] = B->x[2 * n + i];
+    L->w2[l] = B->x[3 * n + i];
+    for (int m = 0; m < 4; m++) {
+        L->a[m][l] = B->act[m * n + i];
+        L->g[m][l] = B->goal[m * n + i];
+        L->r[m][l] = B->rate[m * n + i];
+    }
+    L->sl[l] = B->slack[i];
+    L->x0[l] = B->tx[i];
+    L->y0[l] = B->ty[i];
+    L->s[l] = B->steps[i];
+    L->stop[l] = B->halt[i];
+    L->c[l] = B->cursor[i];
+    L->end[l] = B->ev_end[i];
+}
+
+/* Lane l's game back into the arrays. */
+static void store_lane(const Batch *B, const Lanes *L, int l)
+{
+    const Py_ssize_t n = B->n, i = L->game[l];
+    B->x[i] = L->q1[l];
+    B->x[n + i] = L->q2[l];
+    B->x[2 * n + i] = L->w1[l];
+    B->x[3 * n + i] = L->w2[l];
+    for (int m = 0; m < 4; m++) {
+        B->act[m * n + i] = L->a[m][l];
+        B->goal[m * n + i] = L->g[m][l];
+        B->rate[m * n + i] = L->r[m][l];
+    }
+    B->slack[i] = L->sl[l];
+    B->steps[i] = L->s[l];
+    B->cursor[i] = L->c[l];
+    write_trig(B, i, L->q1[l], L->q2[l]);
+}
+
+/* The muscle commands due at lane l's step, then whether its game goes on (else the caller stores it);
+ * sets the step of its next event or stop. */
+static int due_lane(const Batch *B, Lanes *L, int l)
+{
+    int64_t c = L->c[l];
+    const int64_t s = L->s[l], end = L->end[l];
+    while (c < end && B->ev_step[c] <= s) {
+        const int64_t m = B->ev_muscle[c];
+        L->g[m][l] = B->ev_goal[c];
+        L->r[m][l] = B->ev_rate[c];
+        c++;
+    }
+    L->c[l] = c;
+    if (s >= L->stop[l])
+        return 0;
+    L->next[l] = c < end && B->ev_step[c] < L->stop[l] ? B->ev_step[c] : L->stop[l];
+    return 1;
+}
+
+/* Lane l takes the next game with steps or commands due (from *queue on), or none. */
+static void fill_lane(const Batch *B, Lanes *L, int l, Py_ssize_t *queue)
+{
+    while (*queue < B->n) {
+        const Py_ssize_t i = (*queue)++;
+        const int64_t s = B->steps[i], c = B->cursor[i];
+        B->flags[i] = 0;
+        if (s >= B->halt[i] && (c >= B->ev_end[i] || B->ev_step[c] > s))
+            continue;
+        load_lane(B, L, l, i);
+        if (due_lane(B, L, l))
+            return;
+        store_lane(B, L, l);
+    }
+    load_lane(B, L, l, -1);
+}
+
+/* The games of the lanes back into the arrays, as ``store_lane`` for each, where they are LANES
+ * consecutive games (the lockstep of a vector env: every game stops at the same step): one contiguous
+ * copy a quantity, which the compiler vectorises, instead of LANES scattered ones. */
+static void store_block(const Batch *B, const Lanes *L)
+{
+    const Py_ssize_t n = B->n, i = L->game[0];
+    for (int l = 0; l < LANES; l++) {
+        B->x[i + l] = L->q1[l];
+        B->x[n + i + l] = L->q2[l];
+        B->x[2 * n + i + l] = L->w1[l];
+        B->x[3 * n + i + l] = L->w2[l];
+        B->slack[i + l] = L->sl[l];
+        B->steps[i + l] = L->s[l];
+        B->cursor[i + l] = L->c[l];
+    }
+    for (int m = 0; m < 4; m++) {
+        for (int l = 0; l < LANES; l++) {
+            B->act[m * n + i + l] = L->a[m][l];
+            B->goal[m * n + i + l] = L->g[m][l];
+            B->rate[m * n + i + l] = L->r[m][l];
+        }
+    }
+    for (int l = 0; l < LANES; l++)
+        write_trig(B, i + l, L->q1[l], L->q2[l]);
+}
+
+/* The next LANES games into the lanes as ``fill_lane`` would take them, where each has steps to run:
+ * contiguous copies (see ``store_block``). Returns 0, touching nothing, where they are not so. */
+static int fill_block(const Batch *B, Lanes *L, Py_ssize_t *queue)
+{
+    const Py_ssize_t n = B->n, i = *queue;
+    if (n - i < LANES)
+        return 0;
+    for (int l = 0; l < LANES; l++)
+        if (B->steps[i + l] >= B->halt[i + l])
+            return 0;
+    for (int l = 0; l < LANES; l++) {
+        B->flags[i + l] = 0;
+        L->game[l] = i + l;
+        L->anchor[l] = 0;
+        L->bc[l] = L->bs[l] = 0.0;
+        L->q1[l] = B->x[i + l];
+        L->q2[l] = B->x[n + i + l];
+        L->w1[l] = B->x[2 * n + i + l];
+        L->w2[l] = B->x[3 * n + i + l];
+        L->sl[l] = B->slack[i + l];
+        L->x0[l] = B->tx[i + l];
+        L->y0[l] = B->ty[i + l];
+        L->s[l] = B->steps[i + l];
+        L->stop[l] = B->halt[i + l];
+        L->c[l] = B->cursor[i + l];
+        L->end[l] = B->ev_end[i + l];
+    }
+    for (int m = 0; m < 4; m++) {
+        for (int l = 0; l < LANES; l++) {
+            L->a[m][l] = B->act[m * n + i + l];
+            L->g[m][l] = B->goal[m * n + i + l];
+            L->r[m][l] = B->rate[m * n + i + l];
+        }
+    }
+    *queue = i + LANES;
+    for (int l = 0; l < LANES; l++)
+        due_lane(B, L, l);  /* each has steps before its halt: none stops here */
+    return 1;
+}
+
+/* Steps the other lanes may still run while a freed lane waits for them (see ``armgame_run_lanes``). */
+#define WAIT_STEPS 16
+
+/* The lanes: ``run_scalar``'s games, LANES at a time. Returns the games flagged. */
+Py_ssize_t armgame_run_lanes(const Batch *B)
+{
+    Lanes L;
+    const Arm *arm = &B->arm;
+    const Step k = {arm->b, arm->d, arm->det0, arm->amd, arm->k1, arm->k2, B->dt, B->h, B->k, B->limit2,
+                    B->reach1, B->reach2, {B->s[0], B->s[1], B->s[2], B->s[3]},
+                    {B->e[0], B->e[1], B->e[2], B->e[3]}, arm->mode == MODE_DAMPING, B->fast};
+    Py_ssize_t queue = 0, flagged = 0;
+    int busy = 0;
+    for (int l = 0; l < LANES; l++) {
+        fill_lane(B, &L, l, &queue);
+        busy += L.game[l] >= 0;
+    }
+    while (busy) {
+        /* Steps every lane can run before one needs its commands or its stop. */
+        int64_t run = INT64_MAX;
+        for (int l = 0; l < LANES; l++)
+            if (L.game[l] >= 0 && L.next[l] - L.s[l] < run)
+                run = L.next[l] - L.s[l];
+        int short_ = 0;
+        while (run > 0) {
+            run--;
+            if (step_lanes(&k, &L)) {
+                short_ = 1;
+                break;
+            }
+        }
+        int done[LANES], finished = 0;
+        for (int l = 0; l < LANES; l++) {
+            const Py_ssize_t i = L.game[l];
+            done[l] = 0;
+            if (i < 0)
+                continue;
+            if (short_ && L.sl[l] < 0.0) {
+                /* The slack ran out: measure the hand (as the single session does, on its floats). */
+                double sa, ca, sb, cb;
+                sin_cos(L.q1[l], &sa, &ca);
+                sin_cos(L.q1[l] + L.q2[l], &sb, &cb);
+                const double dx = B->l1 * ca + B->l2 * cb - L.x0[l];
+                const double dy = B->l1 * sa + B->l2 * sb - L.y0[l];
+                const double d2h = dx * dx + dy * dy;
+                L.sl[l] = sqrt(d2h) - B->radius - 1e-9;
+                if (d2h <= B->near) {
+                    B->flags[i] = 1;
+                    flagged++;
+                    done[l] = 1;
+                    finished++;
+                    continue;
+                }
+            }
+            if (L.s[l] >= L.next[l] && !due_lane(B, &L, l)) {
+                done[l] = 1;
+                finished++;
+            }
+        }
+        if (!finished)
+            continue;
+        /* Every lane's game done at once, and consecutive games: the lockstep's block copies. */
+        int block = finished == LANES;
+        for (int l = 1; block && l < LANES; l++)
+            block = L.game[l] == L.game[0] + l;
+        if (block)
+            store_block(B, &L);
+        int64_t longest = 0;  /* the most steps a lane still running has before its stop */
+        for (int l = 0; l < LANES; l++) {
+            if (done[l]) {
+                if (!block)
+                    store_lane(B, &L, l);
+                load_lane(B, &L, l, -1);
+            } else if (L.game[l] >= 0 && L.stop[l] - L.s[l] > longest) {
+                longest = L.stop[l] - L.s[l];
+            }
+        }
+        if (longest == 0 && fill_block(B, &L, &queue))
+            continue;
+        /* A lane freed while the others are about to stop (a hit in a vector env's few steps) waits for
+         * them, so that the lanes fill as a block again; otherwise it takes the next game now. */
+        busy = 0;
+        for (int l = 0; l < LANES; l++) {
+            if (L.game[l] < 0 && (longest == 0 || longest > WAIT_STEPS))
+                fill_lane(B, &L, l, &queue);
+            busy += L.game[l] >= 0;
+        }
+    }
+    return flagged;
+}
