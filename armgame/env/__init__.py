@@ -33,6 +33,8 @@ from __future__ import annotations
 
 import gymnasium
 
+from .suite import SUITE
+
 ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
 CENTER_OUT_IDS = ("armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0")
 V1_IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1")
@@ -69,6 +71,14 @@ def _register() -> None:
             gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
                                vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
+    for name, arguments in SUITE.items():
+        for continuous in (False, True):
+            env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
+            if env_id not in gymnasium.registry:
+                gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
+                                   vector_entry_point="armgame.env.suite:ReachVariantVectorEnv",
+                                   kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
+                                   nondeterministic=False)
 
 
 _register()

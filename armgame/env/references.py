@@ -1,0 +1,3 @@
+"""Reference scores of the suite: filled from benchmarks/reference_scores.py."""
+
+REFERENCE_HITS: dict[str, dict[str, float]] = {}

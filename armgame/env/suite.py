@@ -1,0 +1,74 @@
+"""The benchmark suite: the harder Reach ids, their vector env, and the seeds kept for evaluation.
+
+``SUITE`` maps each harder id to the ``armgame/Reach-v1`` arguments it fixes
+(``armgame.env.variants``); ``armgame.env`` registers them. Their vector entry point,
+``ReachVariantVectorEnv``, is Gymnasium's ``SyncVectorEnv`` of single envs: the batch kernel steps
+only the game itself, so ``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they
+take ``Reach-v1``.
+
+``EVALUATION_SEEDS`` are game seeds no training example uses (``examples/`` train on seeds below
+``TRAINING_SEED_LIMIT``): ``armgame.env.evaluate`` plays them, so scores in different papers are
+scores on the same games.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
+
+from .errors import EnvArgumentError
+from .vector_common import AutoresetBook
+
+#: The harder Reach ids and the arguments each fixes; each has a ``Continuous`` twin.
+#: Chosen so that the model bot still scores (docs/programs.md's reference table) while each
+#: breaks one thing a policy of the plain game relies on.
+SUITE: dict[str, dict[str, Any]] = {
+    # A hit needs the hand to stay 0.2 s in the target: the hand must stop, not fly through.
+    "ReachHold": {"hold_time": 0.2},
+    # Signal-dependent force noise of 30 % (a coefficient of variation), correlated over 50 ms.
+    "ReachNoisy": {"motor_noise": 0.3},
+    # The observation is 100 ms old (5 decisions): a visual reaction time's worth.
+    "ReachDelay": {"observation_delay": 5},
+    # The lab's curl field at the hand all game long (b = 2 N s/m).
+    "ReachField": {"field": "curl", "field_strength": 2.0},
+    # All four at once, and targets of 3 cm.
+    "ReachHard": {"hold_time": 0.2, "motor_noise": 0.3, "observation_delay": 5, "field": "curl",
+                  "field_strength": 2.0, "target_radius": 0.03},
+}
+
+#: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
+EVALUATION_SEED_START = 10**9
+EVALUATION_SEED_COUNT = 10**6
+EVALUATION_SEEDS = range(EVALUATION_SEED_START, EVALUATION_SEED_START + EVALUATION_SEED_COUNT)
+#: Training examples (``examples/train_ppo.py``) seed their games below this.
+TRAINING_SEED_LIMIT = EVALUATION_SEED_START
+
+
+def suite_ids() -> tuple[str, ...]:
+    """Every id of the suite, key and continuous, in ``SUITE``'s order."""
+    return tuple(f"armgame/{name}{kind}-v1" for name in SUITE for kind in ("", "Continuous"))
+
+
+class ReachVariantVectorEnv(SyncVectorEnv):
+    """``num_envs`` envs of a harder Reach id as one vector env (its vector entry point).
+
+    It is Gymnasium's ``SyncVectorEnv`` (reset masks, the three autoreset modes), made from the env's
+    arguments, so that ``gymnasium.make_vec`` and the SB3 adapter (``armgame.env.sb3``) take the
+    suite's ids.
+    """
+
+    MAX_ENVS = 4096
+
+    def __init__(self, num_envs: int = 1, *, autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
+                 **kwargs: Any) -> None:
+        from .reach_v1 import ReachV1Env
+
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) \
+                or not 1 <= num_envs <= self.MAX_ENVS:
+            raise EnvArgumentError(f"num_envs must be a whole number from 1 to {self.MAX_ENVS}, got {num_envs!r}")
+        mode = AutoresetBook(1, autoreset_mode).mode  # checked in one line
+        first = ReachV1Env(**kwargs)  # checks the arguments (one line for a bad one) before the others are made
+        envs = iter([first] + [ReachV1Env(**kwargs) for _ in range(int(num_envs) - 1)])
+        super().__init__([lambda: next(envs) for _ in range(int(num_envs))], autoreset_mode=mode)

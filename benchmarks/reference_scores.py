@@ -1,0 +1,126 @@
+"""The suite's reference scores: random, the naive bot, the model bot and PPO on every Reach id.
+
+    python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
+    python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
+    python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
+
+Every score is ``armgame.env.evaluate`` on the evaluation seeds (the first 100 of
+``EVALUATION_SEEDS``), so the numbers here and a paper's are hits on the same games. PPO is
+``examples/train_ppo.py``'s recipe (SB3's defaults but ``n_steps=128``, ``batch_size=256`` over 32
+envs, one torch thread), trained for a fixed budget of env steps (``PPO_STEPS``) on game seeds below
+the evaluation range, then its deterministic policy evaluated. Each result is one JSON file in
+``--out``; ``table`` reads them all. ``armgame/env/references.py`` holds the table's numbers that
+``evaluate`` normalises by (random and the model bot) and ``tests/test_env_suite.py`` checks them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import armgame.env  # noqa: F401  (registers the ids)
+from armgame.env.evaluation import evaluate, mean_interval
+from armgame.env.suite import suite_ids
+
+GAMES = 100
+PPO_STEPS = 500_000
+REACH_IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", *suite_ids())
+
+
+def slug(env_id: str) -> str:
+    return env_id.split("/")[-1]
+
+
+def run_bots(out: Path, ids: tuple[str, ...], games: int) -> None:
+    for env_id in ids:
+        for policy in ("random", "naive", "model"):
+            start = time.perf_counter()
+            result = evaluate(policy, env_id, games=games)
+            write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start)
+            print(result.summary(), flush=True)
+
+
+def run_ppo(out: Path, env_id: str, seed: int, steps: int, games: int) -> None:
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from armgame.env.sb3 import make_sb3_vec_env
+
+    torch.set_num_threads(1)
+    start = time.perf_counter()
+    envs = VecMonitor(make_sb3_vec_env(env_id, 32, seed=seed * 1000))
+    model = PPO("MlpPolicy", envs, n_steps=128, batch_size=256, seed=seed, device="cpu", verbose=0)
+    model.learn(steps)
+    trained = time.perf_counter() - start
+    result = evaluate(model, env_id, games=games)
+    write(out / f"{slug(env_id)}.ppo-{seed}.json", env_id, f"ppo-{seed}", result.hits, trained,
+          {"steps": steps, "train_seconds": round(trained, 1)})
+    print(f"{result.summary()} after {steps:,} steps in {trained:.0f} s", flush=True)
+
+
+def write(path: Path, env_id: str, policy: str, hits: tuple[int, ...], seconds: float,
+          extra: dict | None = None) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    record = {"env_id": env_id, "policy": policy, "games": len(hits), "mean_hits": float(np.mean(hits)),
+              "hits": list(hits), "seconds": round(seconds, 1), "machine": platform.processor() or platform.machine(),
+              **(extra or {})}
+    path.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+
+
+def table(folder: Path) -> str:
+    records: dict[str, dict[str, dict]] = {}
+    for path in sorted(folder.glob("*.json")):
+        r = json.loads(path.read_text(encoding="utf-8"))
+        records.setdefault(r["env_id"], {})[r["policy"]] = r
+    lines = ["| id | random | naive bot | model bot | PPO (3 seeds) | PPO normalised |",
+             "|---|---|---|---|---|---|"]
+    for env_id in sorted(records, key=lambda i: REACH_IDS.index(i) if i in REACH_IDS else len(REACH_IDS)):
+        row = records[env_id]
+        ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
+        low, high = row["random"]["mean_hits"], row["model"]["mean_hits"]
+        cells = [f"{row[p]['mean_hits']:.1f}" for p in ("random", "naive", "model")]
+        if ppo:
+            mean = float(np.mean(ppo))
+            lo, hi = mean_interval(ppo) if len(ppo) > 1 else (mean, mean)
+            cells.append(f"{mean:.1f} ({', '.join(f'{p:.1f}' for p in ppo)})")
+            cells.append(f"{(mean - low) / (high - low):.2f}")
+        else:
+            cells += ["", ""]
+        lines.append(f"| `{env_id.split('/')[-1]}` | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    bots = sub.add_parser("bots")
+    bots.add_argument("--out", type=Path, required=True)
+    bots.add_argument("--games", type=int, default=GAMES)
+    bots.add_argument("--ids", nargs="*", default=list(REACH_IDS))
+    ppo = sub.add_parser("ppo")
+    ppo.add_argument("env_id")
+    ppo.add_argument("--seed", type=int, default=0)
+    ppo.add_argument("--steps", type=int, default=PPO_STEPS)
+    ppo.add_argument("--games", type=int, default=GAMES)
+    ppo.add_argument("--out", type=Path, required=True)
+    tab = sub.add_parser("table")
+    tab.add_argument("folder", type=Path)
+    args = parser.parse_args(argv)
+    if args.command == "bots":
+        run_bots(args.out, tuple(args.ids), args.games)
+    elif args.command == "ppo":
+        run_ppo(args.out, args.env_id, args.seed, args.steps, args.games)
+    else:
+        print(table(args.folder))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
