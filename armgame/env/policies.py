@@ -11,6 +11,7 @@ and with a decision step equal to its control period it plays exactly the game's
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 import numpy as np
@@ -121,6 +122,68 @@ class BotPolicy:
         seen.state = state  # type: ignore[assignment]
         seen.muscles.activation = list(activation)
         seen.time = (self.total_steps - round(time_left / self.dt)) * self.dt  # as GameSession.time
+        keys = self._muscles.keys
+        for key, action in self.bot.act(seen):  # type: ignore[arg-type]  # quacks like a GameSession
+            seen.held[keys.index(key)] = action == DOWN
+        if self.continuous:
+            return np.where(seen.held, 1.0, -1.0).astype(np.float32)
+        return np.array(seen.held, dtype=np.int8)
+
+
+class CenterOutBotPolicy:
+    """A bot (``"model"`` or ``"naive"``) playing ``armgame/CenterOut-v1`` (or a variant) from its observations.
+
+    The shown target is the cursor plus the cursor-to-target vector (home during a hold): the bot reaches for
+    it with the hand, as the game's bots reach for a target, and holds the posture there, which is what a
+    trial's hold asks. It keeps its own clock (decisions times the decision step): the observation's time
+    runs per phase, and the bot needs only time that moves on. Under a visual perturbation it aims the hand
+    at the shown target, as a person does before adapting.
+
+    >>> import gymnasium as gym
+    >>> import armgame.env
+    >>> env = gym.make("armgame/CenterOut-v1")
+    >>> policy = CenterOutBotPolicy("model", env)
+    >>> obs, info = env.reset(seed=3)
+    >>> done = False
+    >>> while not done:
+    ...     obs, reward, terminated, truncated, info = env.step(policy(obs))
+    ...     done = terminated or truncated
+    >>> info["hits"]
+    8
+    """
+
+    def __init__(self, bot: str, env: Any) -> None:
+        base = env.unwrapped
+        if getattr(base, "family", None) != "CenterOut" or getattr(base, "version", 0) < 1:
+            raise ValueError("CenterOutBotPolicy plays armgame/CenterOut-v1 and its variants")
+        make_bot(bot)  # refuses unknown names in the game's words
+        from ..lab.session import lab_config  # the lab's arm, muscles and home, as the env's runs have them
+
+        self.continuous = base.continuous
+        self.protocol = base.protocol
+        self.config: GameConfig = lab_config(self.protocol, 0)
+        self.decision_time = base.decision_steps * self.config.dt
+        self.bot = ReachingBot(bot, interaction=bot == "model", control_period=self.decision_time)
+        p = self.config.arm
+        q1, q2 = self.config.start_posture
+        self.home = (p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2))
+        self._muscles = MuscleSet(self.config.muscles, self.config.dt)
+        self._seen = _SeenGame(self.config, self._muscles, Target(*self.home, self.protocol.home_radius))
+        self._decisions = 0
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        (q1, q2, w1, w2, a0, a1, a2, a3, cx, cy, _, _, dx, dy, phase, _) = \
+            np.asarray(observation, dtype=np.float64).tolist()
+        seen = self._seen
+        tx, ty = self.home[0] + cx + dx, self.home[1] + cy + dy
+        radius = self.protocol.target_radius if phase >= 0.5 else self.protocol.home_radius
+        target = seen.rules.target
+        if math.hypot(tx - target.x, ty - target.y) > BotPolicy.SAME_TARGET:
+            seen.rules.target = Target(tx, ty, radius)
+        seen.state = (q1, q2, w1, w2)
+        seen.muscles.activation = [a0, a1, a2, a3]
+        seen.time = self._decisions * self.decision_time
+        self._decisions += 1
         keys = self._muscles.keys
         for key, action in self.bot.act(seen):  # type: ignore[arg-type]  # quacks like a GameSession
             seen.held[keys.index(key)] = action == DOWN
