@@ -1,8 +1,9 @@
-"""The suite's reference scores: random, the naive bot, the model bot and PPO on every Reach id.
+"""The suite's reference scores: random, the naive bot, the model bot and PPO on every v1 id.
 
     python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
     python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
     python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
+    python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
 
 Every score is ``armgame.env.evaluate`` on the evaluation seeds (the first 100 of
 ``EVALUATION_SEEDS``), so the numbers here and a paper's are hits on the same games. PPO is
@@ -25,12 +26,13 @@ from pathlib import Path
 import numpy as np
 
 import armgame.env  # noqa: F401  (registers the ids)
-from armgame.env.evaluation import evaluate, mean_interval
+from armgame.env.evaluation import evaluate
 from armgame.env.suite import suite_ids
 
 GAMES = 100
 PPO_STEPS = 500_000
-REACH_IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", *suite_ids())
+IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", "armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1",
+       *suite_ids())
 
 
 def slug(env_id: str) -> str:
@@ -81,19 +83,44 @@ def table(folder: Path) -> str:
         records.setdefault(r["env_id"], {})[r["policy"]] = r
     lines = ["| id | random | naive bot | model bot | PPO (3 seeds) | PPO normalised |",
              "|---|---|---|---|---|---|"]
-    for env_id in sorted(records, key=lambda i: REACH_IDS.index(i) if i in REACH_IDS else len(REACH_IDS)):
+    for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
         row = records[env_id]
+        if not {"random", "naive", "model"} <= set(row):  # its bots' runs are not all done
+            continue
         ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
         low, high = row["random"]["mean_hits"], row["model"]["mean_hits"]
         cells = [f"{row[p]['mean_hits']:.1f}" for p in ("random", "naive", "model")]
         if ppo:
             mean = float(np.mean(ppo))
-            lo, hi = mean_interval(ppo) if len(ppo) > 1 else (mean, mean)
             cells.append(f"{mean:.1f} ({', '.join(f'{p:.1f}' for p in ppo)})")
             cells.append(f"{(mean - low) / (high - low):.2f}")
         else:
             cells += ["", ""]
         lines.append(f"| `{env_id.split('/')[-1]}` | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def references(folder: Path, first: int = 5) -> str:
+    """``armgame/env/references.py``'s dict: each id's mean hits by policy (PPO: the mean of its seeds' means),
+    and the first ``first`` games' hits of random and the model bot, which the tests replay."""
+    records: dict[str, dict[str, dict]] = {}
+    for path in sorted(folder.glob("*.json")):
+        r = json.loads(path.read_text(encoding="utf-8"))
+        records.setdefault(r["env_id"], {})[r["policy"]] = r
+    lines = ["REFERENCE_HITS: dict[str, dict[str, Any]] = {"]
+    for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
+        row = records[env_id]
+        if not {"random", "naive", "model"} <= set(row):
+            continue
+        ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
+        entry = {p: round(row[p]["mean_hits"], 2) for p in ("random", "naive", "model")}
+        if ppo:
+            entry["ppo"] = round(float(np.mean(ppo)), 2)
+            entry["ppo_seeds"] = [round(v, 2) for v in ppo]
+        entry["random_first"] = row["random"]["hits"][:first]
+        entry["model_first"] = row["model"]["hits"][:first]
+        lines.append(f"    {env_id!r}: {entry!r},")
+    lines.append("}")
     return "\n".join(lines)
 
 
@@ -103,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     bots = sub.add_parser("bots")
     bots.add_argument("--out", type=Path, required=True)
     bots.add_argument("--games", type=int, default=GAMES)
-    bots.add_argument("--ids", nargs="*", default=list(REACH_IDS))
+    bots.add_argument("--ids", nargs="*", default=list(IDS))
     ppo = sub.add_parser("ppo")
     ppo.add_argument("env_id")
     ppo.add_argument("--seed", type=int, default=0)
@@ -112,11 +139,15 @@ def main(argv: list[str] | None = None) -> int:
     ppo.add_argument("--out", type=Path, required=True)
     tab = sub.add_parser("table")
     tab.add_argument("folder", type=Path)
+    refs = sub.add_parser("references")
+    refs.add_argument("folder", type=Path)
     args = parser.parse_args(argv)
     if args.command == "bots":
         run_bots(args.out, tuple(args.ids), args.games)
     elif args.command == "ppo":
         run_ppo(args.out, args.env_id, args.seed, args.steps, args.games)
+    elif args.command == "references":
+        print(references(args.folder))
     else:
         print(table(args.folder))
     return 0

@@ -1,8 +1,10 @@
 """The harder Reach tasks and the evaluation protocol: the dwell and the delay against hand-built timelines,
 the noise and the field as documented, the score reward's return, checkers on every suite id, evaluate()."""
 
+import importlib.util
 import math
 import warnings
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -11,16 +13,18 @@ from gymnasium.utils.env_checker import check_env
 
 import armgame.env
 from armgame.env.base import EnvArgumentError
+from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.env.evaluation import evaluate, mean_interval
-from armgame.env.policies import BotPolicy
+from armgame.env.policies import BotPolicy, bot_policy
 from armgame.env.references import REFERENCE_HITS
-from armgame.env.suite import EVALUATION_SEEDS, SUITE, ReachVariantVectorEnv, suite_ids
+from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, ReachVariantVectorEnv, suite_ids
 from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
 from armgame.errors import UserError
-from armgame.game.rules import DwellRules, GameConfig, GameRules
+from armgame.game.rules import DwellRules, GameConfig
 from armgame.game.session import GameSession
 
 REACH = "armgame/Reach-v1"
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
 def play(env, policy, seed):
@@ -44,9 +48,13 @@ def test_gymnasiums_checker_passes_on_every_suite_id(env_id):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped, skip_render_check=True)
-    assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, ReachVariantVectorEnv)
     assert env.unwrapped.continuous == ("Continuous" in env_id)
     name = env_id.split("/")[1].removesuffix("-v1").removesuffix("Continuous")
+    if name in CENTER_OUT_SUITE:
+        assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, CenterOutVectorEnv)
+        assert env.unwrapped.trial_start == CENTER_OUT_SUITE[name]["trial_start"]
+        return
+    assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, ReachVariantVectorEnv)
     for argument, value in SUITE[name].items():  # the id's arguments are the env's
         if argument == "target_radius":
             assert env.unwrapped.config.target_radius == value
@@ -161,7 +169,7 @@ def test_motor_noise_scales_each_muscles_force_by_a_seeded_factor():
         noisy.unwrapped._noise.apply(session)
         factors.append(session.muscles.moments[0][0] / base)
     factors = np.array(factors)
-    assert 0.0 <= factors.min() and factors.max() <= NOISE_FACTOR_MAX
+    assert factors.min() >= 0.0 and factors.max() <= NOISE_FACTOR_MAX
     assert abs(factors.mean() - 1.0) < 0.05 and abs(factors.std() - 0.3) < 0.05, (factors.mean(), factors.std())
     # Correlated over 50 ms: decisions 20 ms apart keep exp(-0.4) of the last draw.
     lag = np.corrcoef(factors[:-1], factors[1:])[0, 1]
@@ -194,6 +202,9 @@ def test_the_model_bot_still_scores_on_every_suite_task():
         env = gym.make(f"armgame/{name}-v1", time_limit=20.0)
         hits = play(env, BotPolicy("model", env), EVALUATION_SEEDS[0])[2]["hits"]
         assert hits >= (2 if name == "ReachHard" else 5), (name, hits)  # in a third of a game
+    for name in CENTER_OUT_SUITE:  # a stop at home and in the target, every trial
+        env = gym.make(f"armgame/{name}-v1")
+        assert play(env, bot_policy("model", env), EVALUATION_SEEDS[0])[2]["hits"] == 8
 
 
 # ------------------------------------------------------------------ the score reward
@@ -259,3 +270,16 @@ def test_the_registry_lists_every_id_the_docs_name():
     assert {ReachVariant.of(**{k: v for k, v in args.items() if k != "target_radius"}).plain
             for args in SUITE.values()} == {False}
     assert armgame.env.SUITE is SUITE
+
+
+def test_the_small_learner_still_beats_random_play_on_a_harder_task():
+    """examples/train_es.py's cross-entropy method, smaller than tests/test_env_v1.py runs it, on the delayed game."""
+    spec = importlib.util.spec_from_file_location("train_es", EXAMPLES / "train_es.py")
+    es = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(es)
+    env_id = "armgame/ReachDelayContinuous-v1"
+    policy, history = es.cem(generations=10, population=32, seconds=2.0, seed=0, env_id=env_id)
+    learned = es.hits_per_game(policy, games=8, seconds=10.0, seed=100, env_id=env_id)
+    random = es.hits_per_game(None, games=8, seconds=10.0, seed=100, env_id=env_id)
+    assert history[-1][1] > history[0][1]  # the population's return rose
+    assert learned.mean() >= 1.0 and learned.mean() >= 4 * random.mean(), (learned, random)

@@ -146,9 +146,12 @@ def _policy(policy: Any, env: gym.Env, deterministic: bool) -> tuple[Policy, str
         if policy == "random":
             space = env.action_space
             return (lambda _observation: space.sample()), policy
-        from .policies import BotPolicy
+        from .policies import bot_policy
 
-        return BotPolicy(policy, env), policy
+        try:
+            return bot_policy(policy, env), policy
+        except ValueError as exc:  # an env the game's bots do not play
+            raise EnvArgumentError(str(exc)) from None
     if hasattr(policy, "predict"):
         return (lambda observation: policy.predict(observation, deterministic=deterministic)[0]), \
             type(policy).__name__

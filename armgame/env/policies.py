@@ -130,7 +130,7 @@ class BotPolicy:
         return np.array(seen.held, dtype=np.int8)
 
 
-class CenterOutBotPolicy:
+class CenterOutV1BotPolicy:
     """A bot (``"model"`` or ``"naive"``) playing ``armgame/CenterOut-v1`` (or a variant) from its observations.
 
     The shown target is the cursor plus the cursor-to-target vector (home during a hold): the bot reaches for
@@ -142,7 +142,7 @@ class CenterOutBotPolicy:
     >>> import gymnasium as gym
     >>> import armgame.env
     >>> env = gym.make("armgame/CenterOut-v1")
-    >>> policy = CenterOutBotPolicy("model", env)
+    >>> policy = CenterOutV1BotPolicy("model", env)
     >>> obs, info = env.reset(seed=3)
     >>> done = False
     >>> while not done:
@@ -155,7 +155,7 @@ class CenterOutBotPolicy:
     def __init__(self, bot: str, env: Any) -> None:
         base = env.unwrapped
         if getattr(base, "family", None) != "CenterOut" or getattr(base, "version", 0) < 1:
-            raise ValueError("CenterOutBotPolicy plays armgame/CenterOut-v1 and its variants")
+            raise ValueError("CenterOutV1BotPolicy plays armgame/CenterOut-v1 and its variants")
         make_bot(bot)  # refuses unknown names in the game's words
         from ..lab.session import lab_config  # the lab's arm, muscles and home, as the env's runs have them
 
@@ -190,3 +190,10 @@ class CenterOutBotPolicy:
         if self.continuous:
             return np.where(seen.held, 1.0, -1.0).astype(np.float32)
         return np.array(seen.held, dtype=np.int8)
+
+
+def bot_policy(bot: str, env: Any) -> BotPolicy | CenterOutV1BotPolicy:
+    """The game's bot ``"naive"`` or ``"model"`` as a policy for ``env``: a Reach env (v0 or v1) or CenterOut-v1."""
+    if getattr(env.unwrapped, "family", None) == "CenterOut":
+        return CenterOutV1BotPolicy(bot, env)
+    return BotPolicy(bot, env)

@@ -49,7 +49,7 @@ class ReachSettings:
     hit_bonus: float = 1.0
     observation_dtype: str = "float64"
     #: v1's harder tasks (``armgame.env.variants``); the game itself by default.
-    variant: ReachVariant = ReachVariant()
+    variant: ReachVariant = dataclasses.field(default_factory=ReachVariant)
 
     @classmethod
     def of(cls, config: GameConfig | None, time_limit: float | None, decision_steps: int, continuous: bool,

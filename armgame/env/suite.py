@@ -1,7 +1,8 @@
-"""The benchmark suite: the harder Reach ids, their vector env, and the seeds kept for evaluation.
+"""The benchmark suite: the harder ids, their vector env, and the seeds kept for evaluation.
 
-``SUITE`` maps each harder id to the ``armgame/Reach-v1`` arguments it fixes
-(``armgame.env.variants``); ``armgame.env`` registers them. Their vector entry point,
+``SUITE`` maps each harder Reach id to the ``armgame/Reach-v1`` arguments it fixes
+(``armgame.env.variants``), ``CENTER_OUT_SUITE`` each harder CenterOut id to
+``armgame/CenterOut-v1``'s; ``armgame.env`` registers them. Their vector entry point,
 ``ReachVariantVectorEnv``, is Gymnasium's ``SyncVectorEnv`` of single envs: the batch kernel steps
 only the game itself, so ``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they
 take ``Reach-v1``.
@@ -38,6 +39,13 @@ SUITE: dict[str, dict[str, Any]] = {
                   "field_strength": 2.0, "target_radius": 0.03},
 }
 
+#: The harder CenterOut ids and the ``armgame/CenterOut-v1`` arguments each fixes; each has a ``Continuous`` twin.
+CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
+    # A person's rule: the go cue waits for the cursor to stay in home (0.5 to 1.0 s), so every trial
+    # needs a stop at home as well as the 0.2 s stay in the target.
+    "CenterOutHold": {"trial_start": "hold"},
+}
+
 #: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
 EVALUATION_SEED_START = 10**9
 EVALUATION_SEED_COUNT = 10**6
@@ -47,8 +55,8 @@ TRAINING_SEED_LIMIT = EVALUATION_SEED_START
 
 
 def suite_ids() -> tuple[str, ...]:
-    """Every id of the suite, key and continuous, in ``SUITE``'s order."""
-    return tuple(f"armgame/{name}{kind}-v1" for name in SUITE for kind in ("", "Continuous"))
+    """Every harder id, key and continuous, in ``SUITE``'s and then ``CENTER_OUT_SUITE``'s order."""
+    return tuple(f"armgame/{name}{kind}-v1" for name in (*SUITE, *CENTER_OUT_SUITE) for kind in ("", "Continuous"))
 
 
 class ReachVariantVectorEnv(SyncVectorEnv):
