@@ -255,6 +255,25 @@ def test_evaluate_is_deterministic_and_reports_an_interval():
         evaluate("clever", REACH, games=1)
 
 
+class Model:
+    """A model with SB3's ``predict``: a fixed linear policy of the observation (one row or many)."""
+
+    def __init__(self, size):
+        self.weights = np.random.default_rng(1).standard_normal((size, 4))
+
+    def predict(self, observation, deterministic=True):
+        return (np.asarray(observation) @ self.weights > 0).astype(np.int8), None
+
+
+@pytest.mark.parametrize("env_id", [REACH, "armgame/CenterOut-v1"])
+def test_a_models_games_played_together_are_its_games_played_one_by_one(env_id):
+    model = Model(gym.make(env_id).observation_space.shape[0])
+    kwargs = {"time_limit": 3.0} if env_id == REACH else {}
+    together = evaluate(model, env_id, seeds=[3, 4, 5], **kwargs)
+    alone = evaluate(lambda obs: model.predict(obs[None])[0][0], env_id, seeds=[3, 4, 5], **kwargs)
+    assert together.hits == alone.hits and together.scores == alone.scores and together.policy == "Model"
+
+
 def test_the_reference_scores_are_evaluates_own():
     """The random and model-bot references that normalise every score: the first games of their runs."""
     assert set(REFERENCE_HITS) == {REACH, "armgame/ReachContinuous-v1", *suite_ids()}

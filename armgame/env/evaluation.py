@@ -115,6 +115,10 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
         raise EnvArgumentError(f"seeds must hold 1 to {MAX_GAMES} game seeds, got {len(seeds)}")
     import armgame.env  # noqa: F401  (registers the ids)
 
+    if not isinstance(policy, str) and hasattr(policy, "predict"):
+        hits, scores, minutes = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
+        normalised = normalised_score(env_id, float(np.mean(hits))) if not env_kwargs else None
+        return Evaluation(env_id, type(policy).__name__, seeds, hits, scores, minutes, normalised)
     env = gym.make(env_id, **env_kwargs)
     try:
         act, name = _policy(policy, env, deterministic)
@@ -136,6 +140,47 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     if not env_kwargs:
         normalised = normalised_score(env_id, float(np.mean(hits)))
     return Evaluation(env_id, name, seeds, tuple(hits), tuple(scores), minutes, normalised)
+
+
+#: Games a model's evaluation steps together: one ``predict`` call a step for all of them.
+BATCH = 100
+
+
+def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
+                  env_kwargs: dict[str, Any]) -> tuple[tuple[int, ...], tuple[int, ...], float]:
+    """A model's games, ``BATCH`` at a time in Gymnasium's ``SyncVectorEnv`` of single envs (each game the single
+    env's, seeded alike), the model asked once a step for all of them: a network's forward pass costs
+    about as much for a hundred observations as for one."""
+    from gymnasium.vector import AutoresetMode
+
+    hits: list[int] = []
+    scores: list[int] = []
+    minutes = math.nan
+    for start in range(0, len(seeds), BATCH):
+        part = list(seeds[start:start + BATCH])
+        envs = gym.make_vec(env_id, num_envs=len(part), vectorization_mode="sync",
+                            vector_kwargs={"autoreset_mode": AutoresetMode.DISABLED}, **env_kwargs)
+        try:
+            observation, info = envs.reset(seed=part)
+            done = np.zeros(len(part), dtype=bool)
+            final_hits = np.zeros(len(part), dtype=np.int64)
+            final_scores = np.zeros(len(part), dtype=np.int64)
+            while not done.all():
+                action, _ = model.predict(observation, deterministic=deterministic)
+                observation, _, terminated, truncated, info = envs.step(action)
+                ended = (terminated | truncated) & ~done
+                final_hits[ended] = info["hits"][ended]
+                final_scores[ended] = info["score"][ended] if "score" in info else info["hits"][ended]
+                done |= ended
+                if ended.any() and not done.all():
+                    # Finished games stand still until the others end: a masked reset keeps them out of the way.
+                    envs.reset(options={"reset_mask": ended})
+            minutes = _game_minutes(envs.envs[0])
+        finally:
+            envs.close()
+        hits += final_hits.tolist()
+        scores += final_scores.tolist()
+    return tuple(hits), tuple(scores), minutes
 
 
 def _policy(policy: Any, env: gym.Env, deterministic: bool) -> tuple[Policy, str]:
