@@ -17,8 +17,10 @@ from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.env.evaluation import evaluate, mean_interval
 from armgame.env.policies import BotPolicy, bot_policy
 from armgame.env.references import REFERENCE_HITS
-from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, ReachVariantVectorEnv, suite_ids
+from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, suite_ids
 from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
+from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv
+from armgame.env.vector_common import SingleEnvsVectorEnv
 from armgame.errors import UserError
 from armgame.game.rules import DwellRules, GameConfig
 from armgame.game.session import GameSession
@@ -54,7 +56,7 @@ def test_gymnasiums_checker_passes_on_every_suite_id(env_id):
         assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, CenterOutVectorEnv)
         assert env.unwrapped.trial_start == CENTER_OUT_SUITE[name]["trial_start"]
         return
-    assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, ReachVariantVectorEnv)
+    assert isinstance(gym.make_vec(env_id, num_envs=8).unwrapped, SingleEnvsVectorEnv)  # the batch plays no variant
     for argument, value in SUITE[name].items():  # the id's arguments are the env's
         if argument == "target_radius":
             assert env.unwrapped.config.target_radius == value
@@ -68,6 +70,29 @@ def test_the_sb3_checker_passes_on_the_suite():
 
     for env_id in suite_ids():
         sb3_check_env(gym.make(env_id).unwrapped, warn=True)
+
+
+@pytest.mark.parametrize("env_id", ["armgame/Reach-v0", REACH, "armgame/ReachContinuous-v1"])
+def test_make_vec_steps_single_envs_below_the_batchs_size_and_for_what_the_batch_does_not_play(env_id):
+    native = ReachV1VectorEnv if env_id.endswith("v1") else ReachVectorEnv
+    for n in (1, BATCH_MIN_ENVS - 1):
+        envs = gym.make_vec(env_id, num_envs=n, time_limit=0.2)
+        assert isinstance(envs.unwrapped, SingleEnvsVectorEnv) and envs.num_envs == n
+        singles = gym.vector.SyncVectorEnv([lambda: gym.make(env_id, time_limit=0.2) for _ in range(n)])
+        envs.action_space.seed(0)
+        assert gym.utils.env_checker.data_equivalence(envs.reset(seed=2), singles.reset(seed=2), exact=True)
+        for _ in range(12):  # past the end: the next-step autoreset as SyncVectorEnv does it
+            actions = envs.action_space.sample()
+            assert gym.utils.env_checker.data_equivalence(envs.step(actions), singles.step(actions), exact=True)
+    assert type(gym.make_vec(env_id, num_envs=BATCH_MIN_ENVS).unwrapped) is native
+    if env_id.endswith("v1"):
+        assert isinstance(gym.make_vec(env_id, num_envs=16, reward="score").unwrapped, SingleEnvsVectorEnv)
+        assert isinstance(gym.make_vec(env_id, num_envs=16, hold_time=0.1).unwrapped, SingleEnvsVectorEnv)
+        with pytest.raises(EnvArgumentError, match="score"):
+            ReachV1VectorEnv(2, reward="score")
+    for bad in (0, 10**9, 2.5):
+        with pytest.raises(EnvArgumentError, match="num_envs"):
+            gym.make_vec(env_id, num_envs=bad)
 
 
 def test_bad_variant_arguments_are_refused_in_one_line():

@@ -21,10 +21,10 @@ Importing this package registers, with ``gymnasium.register``:
   ``armgame/CenterOutContinuous-v0``: the first versions, unchanged (``reach``, ``center_out``).
 
 Every id but the two CenterOut-v0 ones has a vector entry point, so ``gymnasium.make_vec(id,
-num_envs=N)`` gives one vector env: for Reach, ``vector.ReachVectorEnv`` stepping N games as numpy
-arrays on ``BatchGameSession``; for CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``; for the
-suite's Reach ids, ``suite.ReachVariantVectorEnv`` (a ``SyncVectorEnv``: the batch kernel steps only
-the game itself). ``sb3`` adapts
+num_envs=N)`` gives one vector env: for Reach, from 8 games, ``vector.ReachVectorEnv`` stepping N
+games as numpy arrays on ``BatchGameSession`` (below 8, for the suite's harder tasks and for the score
+reward, ``vector_common.SingleEnvsVectorEnv``, Gymnasium's ``SyncVectorEnv`` of single envs); for
+CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
 them to Stable-Baselines3 (and is the only module that imports it). ``import armgame`` imports neither
 gymnasium nor this package, and nothing here imports pygame until an env renders::
 
@@ -55,7 +55,7 @@ def _register() -> None:
         gymnasium.register(
             id=env_id,
             entry_point="armgame.env.reach:ReachEnv",
-            vector_entry_point="armgame.env.vector:ReachVectorEnv",
+            vector_entry_point="armgame.env.vector:reach_vector_env",
             kwargs={"continuous": continuous},
             # The game ends itself at its time limit (a truncation); no TimeLimit wrapper on top.
             max_episode_steps=None,
@@ -64,7 +64,7 @@ def _register() -> None:
     for env_id, continuous in zip(V1_IDS, (False, True), strict=True):
         if env_id not in gymnasium.registry:
             gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
-                               vector_entry_point="armgame.env.vector:ReachV1VectorEnv",
+                               vector_entry_point="armgame.env.vector:reach_v1_vector_env",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
     for env_id, continuous in zip(CENTER_OUT_IDS, (False, True), strict=True):
         if env_id not in gymnasium.registry:
@@ -83,7 +83,7 @@ def _register() -> None:
             env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
             if env_id not in gymnasium.registry:
                 gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
-                                   vector_entry_point="armgame.env.suite:ReachVariantVectorEnv",
+                                   vector_entry_point="armgame.env.vector:reach_v1_vector_env",
                                    kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
                                    nondeterministic=False)
     for name, arguments in CENTER_OUT_SUITE.items():

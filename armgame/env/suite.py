@@ -2,10 +2,10 @@
 
 ``SUITE`` maps each harder Reach id to the ``armgame/Reach-v1`` arguments it fixes
 (``armgame.env.variants``), ``CENTER_OUT_SUITE`` each harder CenterOut id to
-``armgame/CenterOut-v1``'s; ``armgame.env`` registers them. Their vector entry point,
-``ReachVariantVectorEnv``, is Gymnasium's ``SyncVectorEnv`` of single envs: the batch kernel steps
-only the game itself, so ``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they
-take ``Reach-v1``.
+``armgame/CenterOut-v1``'s; ``armgame.env`` registers them. Their vector entry points are
+``Reach-v1``'s and ``CenterOut-v1``'s (``vector.reach_v1_vector_env`` gives Gymnasium's
+``SyncVectorEnv`` of single envs for the harder tasks: the batch kernel steps only the game itself), so
+``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they take ``Reach-v1``.
 
 ``EVALUATION_SEEDS`` are game seeds no training example uses (``examples/`` train on seeds below
 ``TRAINING_SEED_LIMIT``): ``armgame.env.evaluate`` plays them, so scores in different papers are
@@ -15,12 +15,6 @@ scores on the same games.
 from __future__ import annotations
 
 from typing import Any
-
-import numpy as np
-from gymnasium.vector import AutoresetMode, SyncVectorEnv
-
-from .errors import EnvArgumentError
-from .vector_common import AutoresetBook
 
 #: The harder Reach ids and the arguments each fixes; each has a ``Continuous`` twin.
 #: Chosen so that the model bot still scores (docs/programs.md's reference table) while each
@@ -57,26 +51,3 @@ TRAINING_SEED_LIMIT = EVALUATION_SEED_START
 def suite_ids() -> tuple[str, ...]:
     """Every harder id, key and continuous, in ``SUITE``'s and then ``CENTER_OUT_SUITE``'s order."""
     return tuple(f"armgame/{name}{kind}-v1" for name in (*SUITE, *CENTER_OUT_SUITE) for kind in ("", "Continuous"))
-
-
-class ReachVariantVectorEnv(SyncVectorEnv):
-    """``num_envs`` envs of a harder Reach id as one vector env (its vector entry point).
-
-    It is Gymnasium's ``SyncVectorEnv`` (reset masks, the three autoreset modes), made from the env's
-    arguments, so that ``gymnasium.make_vec`` and the SB3 adapter (``armgame.env.sb3``) take the
-    suite's ids.
-    """
-
-    MAX_ENVS = 4096
-
-    def __init__(self, num_envs: int = 1, *, autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
-                 **kwargs: Any) -> None:
-        from .reach_v1 import ReachV1Env
-
-        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) \
-                or not 1 <= num_envs <= self.MAX_ENVS:
-            raise EnvArgumentError(f"num_envs must be a whole number from 1 to {self.MAX_ENVS}, got {num_envs!r}")
-        mode = AutoresetBook(1, autoreset_mode).mode  # checked in one line
-        first = ReachV1Env(**kwargs)  # checks the arguments (one line for a bad one) before the others are made
-        envs = iter([first] + [ReachV1Env(**kwargs) for _ in range(int(num_envs) - 1)])
-        super().__init__([lambda: next(envs) for _ in range(int(num_envs))], autoreset_mode=mode)
