@@ -95,6 +95,22 @@ def test_make_vec_steps_single_envs_below_the_batchs_size_and_for_what_the_batch
             gym.make_vec(env_id, num_envs=bad)
 
 
+def test_the_sb3_adapter_gives_sb3s_own_vec_env_where_no_batch_is_faster():
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from armgame.env.sb3 import ADAPTER_MIN_ENVS, SB3VecEnv, make_sb3_vec_env
+
+    assert isinstance(make_sb3_vec_env(REACH, ADAPTER_MIN_ENVS), SB3VecEnv)
+    for env_id, n, kwargs in ((REACH, ADAPTER_MIN_ENVS - 1, {}), (REACH, 1, {}), ("armgame/ReachHold-v1", 32, {}),
+                              (REACH, 32, {"reward": "score"}), ("armgame/CenterOut-v1", 2, {})):
+        envs = make_sb3_vec_env(env_id, n, seed=4, **kwargs)
+        assert isinstance(envs, DummyVecEnv) and envs.num_envs == n, env_id
+        first = envs.reset()
+        single = gym.make(env_id, **kwargs)
+        assert np.array_equal(first[-1], single.reset(seed=4 + n - 1)[0])  # seeded as the adapter seeds
+
+
 def test_bad_variant_arguments_are_refused_in_one_line():
     for kwargs, words in (({"hold_time": -0.1}, "hold_time"), ({"hold_time": math.nan}, "hold_time"),
                           ({"motor_noise": 1.5}, "motor_noise"), ({"observation_delay": 0.5}, "observation_delay"),

@@ -411,6 +411,19 @@ def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
     return _chosen(ReachV1VectorEnv, ReachV1Env, _NATIVE_V1 if native_reward else frozenset(), num_envs, kwargs)
 
 
+def batch_plays(env_id: str, kwargs: dict[str, Any]) -> bool:
+    """Whether ``gymnasium.make_vec(env_id, num_envs=N, **kwargs)`` steps a batch from ``BATCH_MIN_ENVS`` games."""
+    import gymnasium
+
+    entry = gymnasium.spec(env_id).vector_entry_point
+    arguments = {**gymnasium.spec(env_id).kwargs, **kwargs}
+    if entry == "armgame.env.vector:reach_vector_env":
+        return set(arguments) <= _NATIVE_V0
+    if entry == "armgame.env.vector:reach_v1_vector_env":
+        return set(arguments) <= _NATIVE_V1 and arguments.get("reward", "dense") != "score"
+    return False
+
+
 def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozenset[str], num_envs: Any,
             kwargs: dict[str, Any]) -> VectorEnv:
     if kwargs.get("render_mode") not in (None, "rgb_array"):
