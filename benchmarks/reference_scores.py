@@ -20,8 +20,10 @@ import argparse
 import json
 import platform
 import sys
+import textwrap
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -81,21 +83,22 @@ def table(folder: Path) -> str:
     for path in sorted(folder.glob("*.json")):
         r = json.loads(path.read_text(encoding="utf-8"))
         records.setdefault(r["env_id"], {})[r["policy"]] = r
-    lines = ["| id | random | naive bot | model bot | PPO (3 seeds) | PPO normalised |",
+    lines = ["| id | random | naive bot | model bot | PPO: mean (each training seed) | PPO normalised |",
              "|---|---|---|---|---|---|"]
     for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
         row = records[env_id]
         if not {"random", "naive", "model"} <= set(row):  # its bots' runs are not all done
             continue
         ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
-        low, high = row["random"]["mean_hits"], row["model"]["mean_hits"]
+        # As references.py keeps them, so that the normalised score here is the one evaluate() gives.
+        low, high = round(row["random"]["mean_hits"], 2), round(row["model"]["mean_hits"], 2)
         cells = [f"{row[p]['mean_hits']:.1f}" for p in ("random", "naive", "model")]
         if ppo:
-            mean = float(np.mean(ppo))
+            mean = round(float(np.mean(ppo)), 4)
             cells.append(f"{mean:.1f} ({', '.join(f'{p:.1f}' for p in ppo)})")
             cells.append(f"{(mean - low) / (high - low):.2f}")
         else:
-            cells += ["", ""]
+            cells += ["not measured", ""]
         lines.append(f"| `{env_id.split('/')[-1]}` | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
@@ -107,7 +110,7 @@ def references(folder: Path, first: int = 5) -> str:
     for path in sorted(folder.glob("*.json")):
         r = json.loads(path.read_text(encoding="utf-8"))
         records.setdefault(r["env_id"], {})[r["policy"]] = r
-    lines = ["REFERENCE_HITS: dict[str, dict[str, Any]] = {"]
+    table: dict[str, dict[str, Any]] = {}
     for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
         row = records[env_id]
         if not {"random", "naive", "model"} <= set(row):
@@ -115,11 +118,17 @@ def references(folder: Path, first: int = 5) -> str:
         ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
         entry = {p: round(row[p]["mean_hits"], 2) for p in ("random", "naive", "model")}
         if ppo:
-            entry["ppo"] = round(float(np.mean(ppo)), 2)
+            entry["ppo"] = round(float(np.mean(ppo)), 4)
             entry["ppo_seeds"] = [round(v, 2) for v in ppo]
         entry["random_first"] = row["random"]["hits"][:first]
         entry["model_first"] = row["model"]["hits"][:first]
-        lines.append(f"    {env_id!r}: {entry!r},")
+        table[env_id] = entry
+    lines = ["REFERENCE_HITS: dict[str, dict[str, Any]] = {"]
+    for env_id, entry in table.items():
+        items = ", ".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in entry.items())
+        lines.append(f"    {json.dumps(env_id)}: {{")
+        lines.append(textwrap.fill(items, width=116, initial_indent=" " * 8, subsequent_indent=" " * 8))
+        lines.append("    },")
     lines.append("}")
     return "\n".join(lines)
 

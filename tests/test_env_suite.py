@@ -317,7 +317,8 @@ def test_a_models_games_played_together_are_its_games_played_one_by_one(env_id):
 
 def test_the_reference_scores_are_evaluates_own():
     """The random and model-bot references that normalise every score: the first games of their runs."""
-    assert set(REFERENCE_HITS) == {REACH, "armgame/ReachContinuous-v1", *suite_ids()}
+    assert set(REFERENCE_HITS) == {REACH, "armgame/ReachContinuous-v1", "armgame/CenterOut-v1",
+                                   "armgame/CenterOutContinuous-v1", *suite_ids()}
     for env_id in (REACH, "armgame/ReachHold-v1"):
         for policy in ("random", "model"):
             reference = REFERENCE_HITS[env_id]
@@ -343,3 +344,24 @@ def test_the_small_learner_still_beats_random_play_on_a_harder_task():
     random = es.hits_per_game(None, games=8, seconds=10.0, seed=100, env_id=env_id)
     assert history[-1][1] > history[0][1]  # the population's return rose
     assert learned.mean() >= 1.0 and learned.mean() >= 4 * random.mean(), (learned, random)
+
+
+def test_the_docs_reference_table_is_the_references():
+    """docs/programs.md's table, row by row, against armgame/env/references.py (both from one benchmark run)."""
+    text = (Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
+    rows = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 6 and cells[0].startswith("`") and f"armgame/{cells[0].strip('`')}" in REFERENCE_HITS:
+            rows[f"armgame/{cells[0].strip('`')}"] = cells
+    assert set(rows) == set(REFERENCE_HITS)
+    for env_id, cells in rows.items():
+        reference = REFERENCE_HITS[env_id]
+        assert cells[1:4] == [f"{reference[p]:.1f}" for p in ("random", "naive", "model")], env_id
+        if "ppo" in reference:
+            assert cells[4].startswith(f"{reference['ppo']:.1f} ("), env_id
+            low, high = reference["random"], reference["model"]
+            assert cells[5] == f"{(reference['ppo'] - low) / (high - low):.2f}", env_id
+        else:
+            assert cells[4] == "not measured", env_id
+
