@@ -313,6 +313,7 @@ def test_a_models_games_played_together_are_its_games_played_one_by_one(env_id):
     together = evaluate(model, env_id, seeds=[3, 4, 5], **kwargs)
     alone = evaluate(lambda obs: model.predict(obs[None])[0][0], env_id, seeds=[3, 4, 5], **kwargs)
     assert together.hits == alone.hits and together.scores == alone.scores and together.policy == "Model"
+    assert together.minutes == alone.minutes > 0
 
 
 def test_the_reference_scores_are_evaluates_own():
@@ -364,4 +365,14 @@ def test_the_docs_reference_table_is_the_references():
             assert cells[5] == f"{(reference['ppo'] - low) / (high - low):.2f}", env_id
         else:
             assert cells[4] == "not measured", env_id
+
+
+def test_the_off_policy_recipe_runs(capsys):
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    spec = importlib.util.spec_from_file_location("train_sac", EXAMPLES / "train_sac.py")
+    sac = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sac)
+    assert sac.main(["--minutes", "0.05", "--envs", "2", "--eval-every", "400", "--games", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "hits per game" in out and "best mean hits per game" in out
 

@@ -47,7 +47,7 @@ class Evaluation:
     seeds: tuple[int, ...]
     hits: tuple[int, ...]
     scores: tuple[int, ...]
-    minutes: float  # of game time per game
+    minutes: float  # of game time a game, on average (an episode of CenterOut lasts as its trials do)
     normalised: float | None
 
     @property
@@ -122,7 +122,7 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     env = gym.make(env_id, **env_kwargs)
     try:
         act, name = _policy(policy, env, deterministic)
-        hits, scores = [], []
+        hits, scores, durations = [], [], []
         for seed in seeds:
             observation, info = env.reset(seed=seed)
             if name == "random":
@@ -133,7 +133,8 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
                 done = terminated or truncated
             hits.append(int(info["hits"]))
             scores.append(int(info.get("score", info["hits"])))
-        minutes = _game_minutes(env)
+            durations.append(_game_minutes(env))
+        minutes = float(np.mean(durations))
     finally:
         env.close()
     normalised = None
@@ -155,7 +156,7 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
 
     hits: list[int] = []
     scores: list[int] = []
-    minutes = math.nan
+    durations: list[float] = []
     for start in range(0, len(seeds), BATCH):
         part = list(seeds[start:start + BATCH])
         envs = gym.make_vec(env_id, num_envs=len(part), vectorization_mode="sync",
@@ -165,22 +166,25 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
             done = np.zeros(len(part), dtype=bool)
             final_hits = np.zeros(len(part), dtype=np.int64)
             final_scores = np.zeros(len(part), dtype=np.int64)
+            final_minutes = np.zeros(len(part))
             while not done.all():
                 action, _ = model.predict(observation, deterministic=deterministic)
                 observation, _, terminated, truncated, info = envs.step(action)
                 ended = (terminated | truncated) & ~done
                 final_hits[ended] = info["hits"][ended]
                 final_scores[ended] = info["score"][ended] if "score" in info else info["hits"][ended]
+                for i in np.flatnonzero(ended):
+                    final_minutes[i] = _game_minutes(envs.envs[i])
                 done |= ended
                 if ended.any() and not done.all():
                     # Finished games stand still until the others end: a masked reset keeps them out of the way.
                     envs.reset(options={"reset_mask": ended})
-            minutes = _game_minutes(envs.envs[0])
         finally:
             envs.close()
         hits += final_hits.tolist()
         scores += final_scores.tolist()
-    return tuple(hits), tuple(scores), minutes
+        durations += final_minutes.tolist()
+    return tuple(hits), tuple(scores), float(np.mean(durations))
 
 
 def _policy(policy: Any, env: gym.Env, deterministic: bool) -> tuple[Policy, str]:

@@ -28,32 +28,32 @@ REFERENCE_HITS: dict[str, dict[str, Any]] = {
         "random": 0.43, "naive": 1.57, "model": 8.0, "random_first": [0, 0, 0, 1, 1], "model_first": [8, 8, 8, 8, 8]
     },
     "armgame/ReachHold-v1": {
-        "random": 0.46, "naive": 8.29, "model": 45.87, "ppo": 60.92, "ppo_seeds": [60.92], "random_first": [0, 1, 0,
-        0, 1], "model_first": [45, 45, 47, 47, 47]
+        "random": 0.46, "naive": 8.29, "model": 45.87, "ppo": 60.805, "ppo_seeds": [60.92, 60.69], "random_first":
+        [0, 1, 0, 0, 1], "model_first": [45, 45, 47, 47, 47]
     },
     "armgame/ReachHoldContinuous-v1": {
         "random": 0.39, "naive": 8.29, "model": 45.87, "random_first": [0, 0, 0, 0, 0], "model_first": [45, 45, 47,
         47, 47]
     },
     "armgame/ReachNoisy-v1": {
-        "random": 0.8, "naive": 20.76, "model": 51.39, "ppo": 67.05, "ppo_seeds": [67.05], "random_first": [0, 1, 2,
-        0, 0], "model_first": [52, 48, 54, 52, 52]
+        "random": 0.8, "naive": 20.76, "model": 51.39, "ppo": 68.575, "ppo_seeds": [67.05, 70.1], "random_first":
+        [0, 1, 2, 0, 0], "model_first": [52, 48, 54, 52, 52]
     },
     "armgame/ReachNoisyContinuous-v1": {
         "random": 0.61, "naive": 20.76, "model": 51.39, "random_first": [0, 0, 0, 1, 0], "model_first": [52, 48, 54,
         52, 52]
     },
     "armgame/ReachDelay-v1": {
-        "random": 0.53, "naive": 14.36, "model": 30.75, "ppo": 60.28, "ppo_seeds": [60.28], "random_first": [0, 1,
-        0, 0, 1], "model_first": [26, 32, 31, 33, 35]
+        "random": 0.53, "naive": 14.36, "model": 30.75, "ppo": 60.755, "ppo_seeds": [60.28, 61.23], "random_first":
+        [0, 1, 0, 0, 1], "model_first": [26, 32, 31, 33, 35]
     },
     "armgame/ReachDelayContinuous-v1": {
         "random": 0.37, "naive": 14.36, "model": 30.75, "random_first": [0, 0, 0, 0, 0], "model_first": [26, 32, 31,
         33, 35]
     },
     "armgame/ReachField-v1": {
-        "random": 0.51, "naive": 19.2, "model": 45.63, "ppo": 77.02, "ppo_seeds": [77.02], "random_first": [1, 1, 0,
-        0, 1], "model_first": [45, 44, 46, 50, 48]
+        "random": 0.51, "naive": 19.2, "model": 45.63, "ppo": 75.685, "ppo_seeds": [77.02, 74.35], "random_first":
+        [1, 1, 0, 0, 1], "model_first": [45, 44, 46, 50, 48]
     },
     "armgame/ReachFieldContinuous-v1": {
         "random": 0.43, "naive": 19.2, "model": 45.63, "random_first": [0, 0, 0, 2, 0], "model_first": [45, 44, 46,
