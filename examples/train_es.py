@@ -27,10 +27,10 @@ ENV_ID = "armgame/ReachContinuous-v1"
 TYPICAL = np.array([1.0, 1.0, 5.0, 5.0, 1.0, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0, 1.0, 0.2, 0.2, 1.0])
 
 
-def play(weights: np.ndarray, seconds: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+def play(weights: np.ndarray, seconds: float, seed: int, env_id: str = ENV_ID) -> tuple[np.ndarray, np.ndarray]:
     """Returns and hits of games of ``seconds``, game ``i`` played by linear policy ``weights[i]`` (n, 4, 16)."""
     n = len(weights)
-    envs = gym.make_vec(ENV_ID, num_envs=n, vectorization_mode="vector_entry_point", time_limit=seconds)
+    envs = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", time_limit=seconds)
     obs, info = envs.reset(seed=seed)
     returns = np.zeros(n)
     while True:
@@ -42,12 +42,12 @@ def play(weights: np.ndarray, seconds: float, seed: int) -> tuple[np.ndarray, np
 
 
 def cem(generations: int = 30, population: int = 64, seconds: float = 10.0, elite: float = 0.2, seed: int = 0,
-        init_std: float = 0.5,
-        report: bool = False) -> tuple[np.ndarray, list[tuple[int, float, float]]]:
+        init_std: float = 0.5, report: bool = False,
+        env_id: str = ENV_ID) -> tuple[np.ndarray, list[tuple[int, float, float]]]:
     """The mean policy after ``generations`` of the cross-entropy method, and each generation's
     (generation, mean return, mean hits) of its population."""
     rng = np.random.default_rng(seed)
-    obs_size = gym.make(ENV_ID).observation_space.shape[0]
+    obs_size = gym.make(env_id).observation_space.shape[0]
     mean = np.zeros((4, obs_size + 1))
     std = np.full_like(mean, init_std)
     keep = max(2, round(elite * population))
@@ -55,7 +55,7 @@ def cem(generations: int = 30, population: int = 64, seconds: float = 10.0, elit
     for generation in range(generations):
         weights = mean + std * rng.standard_normal((population, *mean.shape))
         # Every candidate of a generation plays the same targets; the targets change between generations.
-        returns, hits = play(weights, seconds, seed=int(rng.integers(2**31)) // population * population)
+        returns, hits = play(weights, seconds, int(rng.integers(2**31)) // population * population, env_id)
         best = weights[np.argsort(returns)[-keep:]]
         mean, std = best.mean(axis=0), best.std(axis=0) + 0.02
         history.append((generation, float(returns.mean()), float(hits.mean())))
@@ -65,11 +65,12 @@ def cem(generations: int = 30, population: int = 64, seconds: float = 10.0, elit
     return mean, history
 
 
-def hits_per_game(policy: np.ndarray | None, games: int = 10, seconds: float = 60.0, seed: int = 0) -> np.ndarray:
+def hits_per_game(policy: np.ndarray | None, games: int = 10, seconds: float = 60.0, seed: int = 0,
+                  env_id: str = ENV_ID) -> np.ndarray:
     """Hits in ``games`` games (seeds ``seed`` ...) of the linear policy, or of random play for None."""
     if policy is not None:
-        return play(np.repeat(policy[None], games, axis=0), seconds, seed)[1]
-    envs = gym.make_vec(ENV_ID, num_envs=games, vectorization_mode="vector_entry_point", time_limit=seconds)
+        return play(np.repeat(policy[None], games, axis=0), seconds, seed, env_id)[1]
+    envs = gym.make_vec(env_id, num_envs=games, vectorization_mode="vector_entry_point", time_limit=seconds)
     envs.reset(seed=seed)
     envs.action_space.seed(seed)
     while True:

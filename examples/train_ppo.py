@@ -5,8 +5,9 @@
     python examples/train_ppo.py --minutes 2 --out ppo-run
 
 The heart of it is five lines: make the native vector env through the SB3 adapter, hand it to
-PPO, learn, and play deterministic games. Every ``--eval-every`` steps it plays 10 whole games (game
-seeds 0 to 9, the deterministic policy) and prints their mean hits, the number to compare with the
+PPO, learn, and play deterministic games. Every ``--eval-every`` steps it plays 10 whole games (the
+first 10 of the suite's evaluation seeds, which training never plays; the deterministic policy) and
+prints their mean hits, the number to compare with the
 game's bots (``armgame play --bot naive``: about 22 a game) and with players. ``--out`` keeps the
 curve (``curve.csv``: env steps, wall seconds, mean/min/max hits), the model (``model.zip``) and, for
 the keys env, the policy's game of seed 0 as a replay anyone can watch (``armgame replay
@@ -30,13 +31,15 @@ from stable_baselines3.common.vec_env import VecMonitor
 
 import armgame.env  # noqa: F401  (registers the ids)
 from armgame.env.sb3 import make_sb3_vec_env
+from armgame.env.suite import EVALUATION_SEEDS
 from armgame.records.replay import Replay
 
-EVAL_SEEDS = list(range(10))
+# Held-out games: the suite's evaluation seeds, which training never plays (armgame.env.suite).
+EVAL_SEEDS = list(EVALUATION_SEEDS[:10])
 
 
 def evaluate(model: PPO, env_id: str) -> np.ndarray:
-    """Hits in each of 10 whole games (seeds 0-9) played by the deterministic policy."""
+    """Hits in each of 10 whole games (the first 10 evaluation seeds) played by the deterministic policy."""
     envs = gym.make_vec(env_id, num_envs=len(EVAL_SEEDS), vectorization_mode="vector_entry_point")
     obs, info = envs.reset(seed=EVAL_SEEDS)
     while True:

@@ -44,7 +44,7 @@ def rollout(env, seed, steps, action_seed=0):
 def test_ids_are_registered_by_the_package():
     assert set(armgame.env.ENV_IDS) <= set(gym.registry)
     assert gym.spec(REACH).entry_point == "armgame.env.reach:ReachEnv"
-    assert gym.spec(CONTINUOUS).vector_entry_point == "armgame.env.vector:ReachVectorEnv"
+    assert gym.spec(CONTINUOUS).vector_entry_point == "armgame.env.vector:reach_vector_env"
 
 
 @pytest.mark.parametrize(("env_id", "kwargs"), [(REACH, {}), (REACH, {"reset_key": True}),

@@ -33,6 +33,13 @@ CENTER_OUT, CENTER_OUT_CONTINUOUS = "armgame/CenterOut-v1", "armgame/CenterOutCo
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
+@pytest.fixture(autouse=True)
+def batch_at_every_size(monkeypatch):
+    """These tests hold the batched vector env to single envs on a few games, where make_vec would otherwise
+    step single envs (``BATCH_MIN_ENVS``); tests/test_env_suite.py tests that choice."""
+    monkeypatch.setattr(armgame.env.vector, "BATCH_MIN_ENVS", 1)
+
+
 def example(name):
     spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
     module = importlib.util.module_from_spec(spec)

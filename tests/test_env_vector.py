@@ -19,6 +19,13 @@ from armgame.game.batch import STATE_TOLERANCE
 REACH, CONTINUOUS = "armgame/Reach-v0", "armgame/ReachContinuous-v0"
 
 
+@pytest.fixture(autouse=True)
+def batch_at_every_size(monkeypatch):
+    """These tests hold the batched vector env to single envs on a few games, where make_vec would otherwise
+    step single envs (``BATCH_MIN_ENVS``); tests/test_env_suite.py tests that choice."""
+    monkeypatch.setattr(armgame.env.vector, "BATCH_MIN_ENVS", 1)
+
+
 def make_pair(env_id, n, **kwargs):
     native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kwargs)
     singles = SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(n)])

@@ -12,12 +12,19 @@ Importing this package registers, with ``gymnasium.register``:
   dense reward (``features``), keys as ``MultiBinary(4)`` or muscle levels as ``Box(-1, 1, (4,))``;
 * ``armgame/CenterOut-v1`` and ``armgame/CenterOutContinuous-v1`` (``center_out_v1.CenterOutV1Env``):
   the lab's centre-out task, trials that start on their own, episodes of a few trials;
+* the suite (``suite``): ``armgame/ReachHold-v1``, ``ReachNoisy-v1``, ``ReachDelay-v1``,
+  ``ReachField-v1``, ``ReachHard-v1`` (Reach-v1 with a dwell, motor noise, a feedback delay, a force
+  field, and all four on smaller targets: ``variants``) and ``armgame/CenterOutHold-v1`` (the go cue
+  waits for a stop at home), each with a ``Continuous`` twin; ``evaluation.evaluate`` scores a policy
+  on the held-out evaluation seeds against the reference scores (``references``);
 * ``armgame/Reach-v0``, ``armgame/ReachContinuous-v0``, ``armgame/CenterOut-v0``,
   ``armgame/CenterOutContinuous-v0``: the first versions, unchanged (``reach``, ``center_out``).
 
 Every id but the two CenterOut-v0 ones has a vector entry point, so ``gymnasium.make_vec(id,
-num_envs=N)`` gives one vector env: for Reach, ``vector.ReachVectorEnv`` stepping N games as numpy
-arrays on ``BatchGameSession``; for CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
+num_envs=N)`` gives one vector env: for Reach, from 8 games, ``vector.ReachVectorEnv`` stepping N
+games as numpy arrays on ``BatchGameSession`` (below 8, for the suite's harder tasks and for the score
+reward, ``vector_common.SingleEnvsVectorEnv``, Gymnasium's ``SyncVectorEnv`` of single envs); for
+CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
 them to Stable-Baselines3 (and is the only module that imports it). ``import armgame`` imports neither
 gymnasium nor this package, and nothing here imports pygame until an env renders::
 
@@ -33,6 +40,8 @@ from __future__ import annotations
 
 import gymnasium
 
+from .suite import CENTER_OUT_SUITE, SUITE
+
 ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
 CENTER_OUT_IDS = ("armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0")
 V1_IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1")
@@ -46,7 +55,7 @@ def _register() -> None:
         gymnasium.register(
             id=env_id,
             entry_point="armgame.env.reach:ReachEnv",
-            vector_entry_point="armgame.env.vector:ReachVectorEnv",
+            vector_entry_point="armgame.env.vector:reach_vector_env",
             kwargs={"continuous": continuous},
             # The game ends itself at its time limit (a truncation); no TimeLimit wrapper on top.
             max_episode_steps=None,
@@ -55,7 +64,7 @@ def _register() -> None:
     for env_id, continuous in zip(V1_IDS, (False, True), strict=True):
         if env_id not in gymnasium.registry:
             gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
-                               vector_entry_point="armgame.env.vector:ReachV1VectorEnv",
+                               vector_entry_point="armgame.env.vector:reach_v1_vector_env",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
     for env_id, continuous in zip(CENTER_OUT_IDS, (False, True), strict=True):
         if env_id not in gymnasium.registry:
@@ -69,6 +78,22 @@ def _register() -> None:
             gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
                                vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
+    for name, arguments in SUITE.items():
+        for continuous in (False, True):
+            env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
+            if env_id not in gymnasium.registry:
+                gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
+                                   vector_entry_point="armgame.env.vector:reach_v1_vector_env",
+                                   kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
+                                   nondeterministic=False)
+    for name, arguments in CENTER_OUT_SUITE.items():
+        for continuous in (False, True):
+            env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
+            if env_id not in gymnasium.registry:
+                gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
+                                   vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
+                                   kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
+                                   nondeterministic=False)
 
 
 _register()

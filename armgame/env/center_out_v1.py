@@ -66,7 +66,9 @@ class CenterOutV1Env(CenterOutEnv):
 
     By default (``trial_start="delay"``) the go cue comes the trial's delay after the trial began,
     wherever the cursor is: a policy that cannot hold still yet still meets targets. With
-    ``trial_start="hold"`` the cue waits, as for a person, for the cursor to stay in home that long.
+    ``trial_start="hold"`` the cue waits, as for a person, for the cursor to stay in home that long:
+    ``armgame/CenterOutHold-v1`` (and ``CenterOutHoldContinuous-v1``) fixes it, the suite's
+    CenterOut task that needs a stop at home before every reach as well as at the target.
 
     ## Action Space
 
@@ -155,7 +157,8 @@ class CenterOutV1Env(CenterOutEnv):
       count; a dense reward; continuous actions in [-1, 1]; ``info["trial"]``; a reset without a
       seed starts a new run, ``continue_run=True`` continues the run over episodes (checkouts of
       the v1 env before armgame 0.2.0, which still called themselves 0.1.0, always continued the
-      run, and a reset mid-episode changed nothing) (armgame 0.2).
+      run, and a reset mid-episode changed nothing); ``armgame/CenterOutHold-v1`` and its
+      ``Continuous`` twin registered, ``trial_start="hold"`` fixed (armgame 0.2).
     * v0: Initial version (armgame 0.1).
     """
 

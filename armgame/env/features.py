@@ -42,6 +42,8 @@ DEFAULT_PROGRESS_WEIGHT = 10.0
 #: Reward per hit, on top of the progress that reached it.
 DEFAULT_HIT_BONUS = 1.0
 REWARDS = ("dense", "sparse")
+#: Reach-v1's rewards: ``"score"`` too, whose return is the game's score (``score_shaping``).
+REACH_REWARDS = ("dense", "sparse", "score")
 
 
 def hand_velocity(arm: TwoJointParams, q1: np.ndarray, q2: np.ndarray, w1: np.ndarray,
@@ -95,10 +97,12 @@ def check_dtype(value: object) -> str:
     return str(name)
 
 
-def check_reward(reward: object, progress_weight: object, hit_bonus: object) -> tuple[str, float, float]:
+def check_reward(reward: object, progress_weight: object, hit_bonus: object,
+                 kinds: tuple[str, ...] = REWARDS) -> tuple[str, float, float]:
     """The reward arguments of a v1 env, checked: one line naming a bad one."""
-    if reward not in REWARDS:
-        raise EnvArgumentError(f"reward must be 'dense' or 'sparse', got {reward!r}")
+    if reward not in kinds:
+        names = ", ".join(repr(k) for k in kinds[:-1]) + f" or {kinds[-1]!r}"
+        raise EnvArgumentError(f"reward must be {names}, got {reward!r}")
     for name, value in (("progress_weight", progress_weight), ("hit_bonus", hit_bonus)):
         if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value <= 1000.0:
             raise EnvArgumentError(f"{name} must be a number from 0 to 1000, got {value!r}")

@@ -21,7 +21,8 @@ from ..errors import UserError
 from ..game.rules import GameConfig
 from ..game.session import GameSession
 from .base import EnvArgumentError, SessionEnv
-from .features import check_dtype, check_reward, reach_bounds_v1
+from .features import REACH_REWARDS, check_dtype, check_reward, reach_bounds_v1
+from .variants import ReachVariant
 
 #: Decision step of the standard envs in physics steps: 5 x 4 ms = 20 ms, a 50 Hz controller.
 DEFAULT_DECISION_STEPS = 5
@@ -47,11 +48,14 @@ class ReachSettings:
     progress_weight: float = 0.0
     hit_bonus: float = 1.0
     observation_dtype: str = "float64"
+    #: v1's harder tasks (``armgame.env.variants``); the game itself by default.
+    variant: ReachVariant = dataclasses.field(default_factory=ReachVariant)
 
     @classmethod
     def of(cls, config: GameConfig | None, time_limit: float | None, decision_steps: int, continuous: bool,
            reset_key: bool, version: int = 0, reward: str = "sparse", progress_weight: float = 0.0,
-           hit_bonus: float = 1.0, observation_dtype: object = "float32") -> ReachSettings:
+           hit_bonus: float = 1.0, observation_dtype: object = "float32",
+           variant: ReachVariant | None = None) -> ReachSettings:
         if config is None:
             config = GameConfig()
         elif not isinstance(config, GameConfig):
@@ -80,9 +84,9 @@ class ReachSettings:
                 raise EnvArgumentError(f"{name} must be True or False, got {flag!r}")
         if version == 0:
             return cls(config, int(decision_steps), bool(continuous), bool(reset_key))
-        reward, progress_weight, hit_bonus = check_reward(reward, progress_weight, hit_bonus)
+        reward, progress_weight, hit_bonus = check_reward(reward, progress_weight, hit_bonus, REACH_REWARDS)
         return cls(config, int(decision_steps), bool(continuous), bool(reset_key), 1, reward, progress_weight,
-                   hit_bonus, check_dtype(observation_dtype))
+                   hit_bonus, check_dtype(observation_dtype), variant or ReachVariant())
 
     @property
     def decision_time(self) -> float:
@@ -110,7 +114,10 @@ class ReachSettings:
 
     def observation_space(self) -> spaces.Box:
         if self.version:
-            low, high = reach_bounds_v1(self.config, speed_bound(self.config))
+            variant = self.variant
+            # A viscous field's symmetric part does work on the arm: no energy bound holds under it.
+            joint_speed = math.inf if variant.field == "viscous" else speed_bound(variant.bound_config(self.config))
+            low, high = reach_bounds_v1(self.config, joint_speed)
             dtype = np.dtype(self.observation_dtype)
             return spaces.Box(low.astype(dtype), high.astype(dtype), dtype=dtype)
         low, high = observation_bounds(self.config)
@@ -306,7 +313,7 @@ class ReachEnv(SessionEnv):
             seed = check_seed(seed)
         super().reset(seed=seed)
         game_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
-        self.session = GameSession(self.settings.game(game_seed))
+        self.session = self._new_session(self.settings.game(game_seed))
         if self.render_mode == "human":
             self.render()
         return self._observation(), self._info()
@@ -323,6 +330,7 @@ class ReachEnv(SessionEnv):
             self._set_levels(action, self.action_space.shape[0])
         else:
             self._press_keys(action, self.action_space.n)
+        self._before_advance(session)
         session.advance(self.decision_steps)
         reward = self._reward(board.hits - hits, board.resets - resets)
         if self.render_mode == "human":
@@ -330,6 +338,12 @@ class ReachEnv(SessionEnv):
         return self._observation(), reward, False, session.over, self._info()
 
     # --------------------------------------------------------------- internals
+    def _new_session(self, config: GameConfig) -> GameSession:
+        return GameSession(config)
+
+    def _before_advance(self, session: GameSession) -> None:
+        """What a variant does to the game before each decision's physics steps (v0: nothing)."""
+
     def _reward(self, hits: int, resets: int) -> float:
         """The step's reward from its hits and reset presses (v0: the game's score change, never floored)."""
         return float(hits - self.config.reset_cost * resets)

@@ -8,14 +8,18 @@ in a float32 observation, a dense reward (``armgame.env.features``), and centred
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
 import numpy as np
 
 from ..game.rules import GameConfig
+from ..game.session import GameSession
+from .errors import EnvArgumentError
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, hand_and_velocity
 from .reach import DEFAULT_DECISION_STEPS, ReachEnv, ReachSettings, wrap_angle
+from .variants import DelayedObservations, MuscleNoise, ReachVariant
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
                         "to_target_x", "to_target_y", "time_left_fraction")
@@ -70,8 +74,12 @@ class ReachV1Env(ReachEnv):
     ``w = progress_weight`` (10 per metre), ``bonus = hit_bonus`` (1) and ``c`` the reset cost (1).
     Summed over a game it is ``w (sum of each target's starting distance - the last target's final
     distance) + bonus H - c R`` (``armgame.env.features``). ``reward="sparse"``: one per hit less the
-    reset cost, as v0. Either way ``info`` carries the game's ``score``, ``hits`` and ``resets``:
-    compare agents with players and bots by ``info["hits"]`` at the episode's end.
+    reset cost, as v0. ``reward="score"``: the game's score as it changes (hits less the reset cost,
+    never below 0) plus ``w (phi' - phi)``, ``phi = -e``, with ``phi = 0`` at the reset and at the
+    game's end: a potential-based shaping that sums to exactly nothing, so **the return is the game's
+    score** (to round-off). Report the score (``info["score"]``, or ``armgame.env.evaluate``): the
+    dense return tracks it only loosely within a policy (docs/programs.md measures both). Either way
+    ``info`` carries the game's ``score``, ``hits`` and ``resets``.
 
     ## Starting State
 
@@ -81,7 +89,8 @@ class ReachV1Env(ReachEnv):
 
     ## Episode End
 
-    Never terminated; truncated when the game's clock runs out (60 s: 3,000 steps of 20 ms).
+    Never terminated; truncated when the game's clock runs out (60 s: 3,000 steps of 20 ms). A shorter
+    ``time_limit`` gives shorter episodes; compare them by hits (or score) per minute.
 
     ## Arguments
 
@@ -100,8 +109,18 @@ class ReachV1Env(ReachEnv):
 
     * ``observation_dtype``: ``"float32"`` (default) or ``"float64"`` (the game's state exactly, for
       a controller that models the arm; the bounds are the same).
-    * ``reward``: ``"dense"`` (default) or ``"sparse"``; ``progress_weight`` (0 to 1000 per metre,
-      default 10) and ``hit_bonus`` (0 to 1000, default 1) weigh the dense one.
+    * ``reward``: ``"dense"`` (default), ``"sparse"`` or ``"score"``; ``progress_weight`` (0 to 1000 per
+      metre, default 10) weighs the dense and the score rewards' shaping, ``hit_bonus`` (0 to 1000,
+      default 1) the dense one's hits.
+    * The harder tasks (``armgame.env.variants``; each off by default, the game itself):
+      ``hold_time`` (s, 0 to 5: a hit counts once the hand has stayed in the target that long),
+      ``motor_noise`` (0 to 1: signal-dependent noise, each muscle's force times ``1 + n``,
+      ``n`` of that s.d., correlated over 50 ms), ``observation_delay`` (env steps, 0 to 100),
+      ``field`` (``"curl"`` or ``"viscous"``) with ``field_strength`` (curl: ``b`` in N s/m, -50 to
+      50; viscous: the lab's matrix times it; default 1), ``target_radius`` (m, 0.001 to 0.2;
+      default the game's 0.05). The suite's ids fix them: ``ReachHold-v1``, ``ReachNoisy-v1``,
+      ``ReachDelay-v1``, ``ReachField-v1``, ``ReachHard-v1`` and their ``Continuous`` twins
+      (``armgame.env.suite``).
     * ``time_limit``, ``decision_steps`` (default 5: a 20 ms step), ``reset_key``, ``config``,
       ``render_mode`` (``"rgb_array"`` or ``"human"``), ``render_size``: as ``armgame/Reach-v0``.
 
@@ -109,7 +128,8 @@ class ReachV1Env(ReachEnv):
 
     * v1: hand position and velocity and the hand-to-target vector observed, float32; the
       fraction of time left instead of seconds; the target's position only relative to the hand;
-      a dense reward by default; continuous actions in [-1, 1] (armgame 0.2).
+      a dense reward by default; continuous actions in [-1, 1]; the score reward, the harder
+      tasks' arguments and the suite's ids (armgame 0.2).
     * v0: Initial version (armgame 0.1).
     """
 
@@ -117,11 +137,20 @@ class ReachV1Env(ReachEnv):
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
                  hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
+                 hold_time: float = 0.0, motor_noise: float = 0.0, observation_delay: int = 0,
+                 field: str | None = None, field_strength: float | None = None, target_radius: float | None = None,
                  config: GameConfig | None = None, render_size: tuple[int, int] = (600, 600)) -> None:
+        variant = ReachVariant.of(hold_time, motor_noise, observation_delay, field, field_strength)
+        if target_radius is not None:
+            config = with_target_radius(config or GameConfig(), target_radius)
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
-                                    progress_weight, hit_bonus, observation_dtype)
+                                    progress_weight, hit_bonus, observation_dtype, variant)
         self._configure(settings, render_mode, render_size)
+        self.variant = variant
         self._edge = 0.0
+        self._score = 0
+        self._noise: MuscleNoise | None = None
+        self._delayed = DelayedObservations(variant.observation_delay) if variant.observation_delay else None
 
     @property
     def reward_kind(self) -> str:
@@ -130,7 +159,29 @@ class ReachV1Env(ReachEnv):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
         observation, info = super().reset(seed=seed, options=options)
         self._edge = self._edge_now()
+        self._score = 0
+        if self._delayed is not None:
+            observation = self._delayed.reset(observation)
         return observation, info
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
+        observation, reward, terminated, truncated, info = super().step(action)
+        if self._delayed is not None:
+            observation = self._delayed.step(observation)
+        return observation, reward, terminated, truncated, info
+
+    def _new_session(self, config: GameConfig) -> GameSession:
+        variant = self.variant
+        if variant.plain:
+            return GameSession(config)
+        session = variant.session(config)
+        self._noise = MuscleNoise(variant.motor_noise, config.seed, self.decision_time, session) \
+            if variant.motor_noise else None
+        return session
+
+    def _before_advance(self, session: GameSession) -> None:
+        if self._noise is not None:
+            self._noise.apply(session)
 
     def _edge_now(self) -> float:
         session = self.session
@@ -143,9 +194,22 @@ class ReachV1Env(ReachEnv):
         s = self.settings
         if s.reward == "sparse":
             return super()._reward(hits, resets)
+        if s.reward == "score":
+            return self._score_reward()
         before, self._edge = self._edge, self._edge_now()
         progress = before - (0.0 if hits else self._edge)
         return s.progress_weight * progress + s.hit_bonus * hits - self.config.reset_cost * resets
+
+    def _score_reward(self) -> float:
+        """The score's change plus ``w (phi' - phi)``, ``phi = -e`` (the edge distance), with ``phi = 0`` at the
+        reset and at the game's end, so the shaping sums to exactly nothing over a game."""
+        session = self.session
+        assert session is not None
+        score, self._score = self._score, session.rules.board.score
+        first = session.steps <= self.decision_steps
+        before = 0.0 if first else self._edge
+        self._edge = 0.0 if session.over else self._edge_now()
+        return float(self._score - score) + self.settings.progress_weight * (before - self._edge)
 
     def _observation(self) -> np.ndarray:
         session = self.session
@@ -157,3 +221,12 @@ class ReachV1Env(ReachEnv):
         left = (total - min(session.steps, total)) / total
         return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *session.muscles.activation, hx, hy, vx, vy,
                          target.x - hx, target.y - hy, left), dtype=self.settings.observation_dtype)
+
+
+def with_target_radius(config: GameConfig, radius: object) -> GameConfig:
+    """``config`` with targets of ``radius`` metres (1 mm to 20 cm)."""
+    if isinstance(radius, bool) or not isinstance(radius, int | float | np.floating) \
+            or not (math.isfinite(radius) and 0.001 <= radius <= 0.2):
+        raise EnvArgumentError(f"target_radius must be a number of metres from 0.001 to 0.2, got {radius!r}")
+    return dataclasses.replace(config, target_radius=float(radius))
+

@@ -19,6 +19,7 @@ target's edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``).
 
 from __future__ import annotations
 
+import inspect
 from types import SimpleNamespace
 from typing import Any
 
@@ -45,7 +46,7 @@ from .reach import (
     _check_size,
     check_seed,
 )
-from .vector_common import AutoresetBook, check_reset_mask
+from .vector_common import AutoresetBook, SingleEnvsVectorEnv, check_reset_mask
 
 #: Memory one game of a vector env takes at its peak (reset and the first step): 5.1-5.2 KB measured at
 #: 20,000 and 60,000 games (peak RSS over the games), rounded up.
@@ -348,6 +349,9 @@ class ReachV1VectorEnv(ReachVectorEnv):
                  config: GameConfig | None = None, render_mode: str | None = None,
                  render_size: tuple[int, int] = (600, 600),
                  autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
+        if reward == "score":  # its shaping needs each game's reset and end: make_vec plays it on single envs
+            raise EnvArgumentError("the batched vector env has no reward='score': gymnasium.make_vec gives single "
+                                   "envs for it")
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
                                     progress_weight, hit_bonus, observation_dtype)
         self._configure(num_envs, settings, render_mode, render_size, autoreset_mode)
@@ -379,3 +383,57 @@ class ReachV1VectorEnv(ReachVectorEnv):
                                               batch.activation, batch.target_x, batch.target_y, left, dtype,
                                               batch.hand_trig())
         return obs
+
+
+#: Below this many games, ``gymnasium.make_vec`` of a Reach id steps single envs (``SingleEnvsVectorEnv``):
+#: a game's compiled loop costs less than a batch's fixed numpy work a step (benchmarks/env_speed.py: the
+#: batch at 0.25 times single envs' speed at 1 env, 0.77 at 4, 2.5 at 16).
+BATCH_MIN_ENVS = 8
+_NATIVE_V0 = frozenset(inspect.signature(ReachVectorEnv.__init__).parameters) - {"self", "num_envs"}
+_NATIVE_V1 = frozenset(inspect.signature(ReachV1VectorEnv.__init__).parameters) - {"self", "num_envs"}
+
+
+def reach_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
+    """The vector entry point of ``armgame/Reach-v0`` and ``ReachContinuous-v0``: ``ReachVectorEnv`` from
+    ``BATCH_MIN_ENVS`` games, Gymnasium's ``SyncVectorEnv`` of single envs below (the same games, faster)."""
+    from .reach import ReachEnv
+
+    return _chosen(ReachVectorEnv, ReachEnv, _NATIVE_V0, num_envs, kwargs)
+
+
+def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
+    """The vector entry point of ``armgame/Reach-v1``, ``ReachContinuous-v1`` and the suite's harder Reach ids:
+    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games of the game itself, else ``SyncVectorEnv`` of single
+    envs: below that size, and for a harder task or the score reward, which the batch does not play."""
+    from .reach_v1 import ReachV1Env
+
+    native_reward = kwargs.get("reward", "dense") != "score"
+    return _chosen(ReachV1VectorEnv, ReachV1Env, _NATIVE_V1 if native_reward else frozenset(), num_envs, kwargs)
+
+
+def batch_plays(env_id: str, kwargs: dict[str, Any]) -> bool:
+    """Whether ``gymnasium.make_vec(env_id, num_envs=N, **kwargs)`` steps a batch from ``BATCH_MIN_ENVS`` games."""
+    import gymnasium
+
+    entry = gymnasium.spec(env_id).vector_entry_point
+    arguments = {**gymnasium.spec(env_id).kwargs, **kwargs}
+    if entry == "armgame.env.vector:reach_vector_env":
+        return set(arguments) <= _NATIVE_V0
+    if entry == "armgame.env.vector:reach_v1_vector_env":
+        return set(arguments) <= _NATIVE_V1 and arguments.get("reward", "dense") != "score"
+    return False
+
+
+def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozenset[str], num_envs: Any,
+            kwargs: dict[str, Any]) -> VectorEnv:
+    if kwargs.get("render_mode") not in (None, "rgb_array"):
+        raise EnvArgumentError(f"a vector env renders with render_mode='rgb_array' (a frame per game) or None, "
+                               f"got {kwargs['render_mode']!r}: for a window, render one game with gymnasium.make")
+    if set(kwargs) <= native_arguments and not _small(num_envs):  # a bad count meets the native env's check
+        return native(num_envs, **kwargs)
+    return SingleEnvsVectorEnv(single, num_envs, **kwargs)
+
+
+def _small(num_envs: Any) -> bool:
+    """Whether ``num_envs`` is a valid count below ``BATCH_MIN_ENVS`` (a bad one goes to the native env's check)."""
+    return isinstance(num_envs, int | np.integer) and not isinstance(num_envs, bool) and 1 <= num_envs < BATCH_MIN_ENVS

@@ -1,4 +1,5 @@
-"""What both native vector envs share: Gymnasium's reset masks and the three autoreset modes, kept once.
+"""What the vector envs share: Gymnasium's reset masks and the three autoreset modes, kept once, and
+``SingleEnvsVectorEnv``, the vector env of single envs where no batch is faster.
 
 ``SyncVectorEnv`` is the reference: a native vector env must give what N single envs under it give,
 so a mask is checked as it checks one, and ``AutoresetBook`` decides, game by game, when an ended
@@ -9,11 +10,12 @@ caller resets it with a mask).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from gymnasium.error import ResetNeeded
-from gymnasium.vector import AutoresetMode
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
 from .base import EnvArgumentError
 
@@ -62,3 +64,22 @@ class AutoresetBook:
 
     def reset(self, games: np.ndarray) -> None:
         self.ended &= ~games
+
+
+class SingleEnvsVectorEnv(SyncVectorEnv):
+    """``num_envs`` single envs of one class and arguments as one vector env: Gymnasium's ``SyncVectorEnv``
+    (reset masks, the three autoreset modes, ``render()`` a tuple of frames), made from the env's arguments
+    so that a vector entry point can return it. The first env checks the arguments (one line for a bad
+    one) before the others are made."""
+
+    MAX_ENVS = 4096
+
+    def __init__(self, env_class: Callable[..., Any], num_envs: int = 1, *,
+                 autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP, **kwargs: Any) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) \
+                or not 1 <= num_envs <= self.MAX_ENVS:
+            raise EnvArgumentError(f"num_envs must be a whole number from 1 to {self.MAX_ENVS}, got {num_envs!r}")
+        mode = AutoresetBook(1, autoreset_mode).mode  # checked in one line
+        first = env_class(**kwargs)
+        envs = iter([first] + [env_class(**kwargs) for _ in range(int(num_envs) - 1)])
+        super().__init__([lambda: next(envs) for _ in range(int(num_envs))], autoreset_mode=mode)

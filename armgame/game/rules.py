@@ -142,3 +142,34 @@ class GameRules:
 
     def toggle_arm(self) -> None:
         self.arm_visible = not self.arm_visible
+
+
+class DwellRules(GameRules):
+    """The game's rules with a dwell: a hit counts once the hand has stayed in the target ``hold_steps``
+    physics steps in a row (``armgame/ReachHold-v1``).
+
+    Both of the session's loops call ``hand_moved`` after every step that ends with the hand in the
+    target, and only then, so a gap in the steps seen here is a step outside: the dwell starts again.
+    Staying in a target of radius ``r`` for a time ``T`` holds the hand's mean speed over the dwell
+    below ``2 r / T``: a hand that flies through scores nothing.
+    """
+
+    def __init__(self, config: GameConfig, hold_steps: int) -> None:
+        if isinstance(hold_steps, bool) or not isinstance(hold_steps, int) or hold_steps < 1:
+            raise UserError(f"the dwell must be a whole number of physics steps from 1, got {hold_steps!r}")
+        super().__init__(config)
+        self.hold_steps = hold_steps
+        self.dwell = 0
+        self._last_step = -2
+
+    def hand_moved(self, x: float, y: float, t: float) -> bool:
+        if not self.target.contains(x, y):
+            return False
+        step = round(t / self.config.dt)
+        self.dwell = self.dwell + 1 if step == self._last_step + 1 else 1
+        self._last_step = step
+        if self.dwell < self.hold_steps:
+            return False
+        self.dwell, self._last_step = 0, -2
+        return super().hand_moved(x, y, t)
+

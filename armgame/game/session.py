@@ -109,13 +109,16 @@ class GameSession:
     compiled one to (``==``); other integrators always run it.
     """
 
-    def __init__(self, config: GameConfig, *, compiled: bool = True) -> None:
+    def __init__(self, config: GameConfig, *, compiled: bool = True, rules: GameRules | None = None) -> None:
         self.config = config
         self.model = TwoJointArm(config.arm)
         self._physics_step = Integrator(config.integrator, self.model).step_components
         self.muscles = MuscleSet(config.muscles, config.dt)
         self._compiled = self._compiled_loop() if compiled else None
-        self.rules = GameRules(config)
+        if rules is not None and rules.config is not config:
+            raise ValueError("the rules given must be made from the session's own config")
+        #: The game's rules, or a variant's (``rules.DwellRules``): both loops call its ``hand_moved``.
+        self.rules = rules if rules is not None else GameRules(config)
         self.keys = (*self.muscles.keys, RESET_KEY, TOGGLE_ARM_KEY)
         self.steps = 0
         self.total_steps = config.total_steps

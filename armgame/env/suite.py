@@ -1,0 +1,53 @@
+"""The benchmark suite: the harder ids, their vector env, and the seeds kept for evaluation.
+
+``SUITE`` maps each harder Reach id to the ``armgame/Reach-v1`` arguments it fixes
+(``armgame.env.variants``), ``CENTER_OUT_SUITE`` each harder CenterOut id to
+``armgame/CenterOut-v1``'s; ``armgame.env`` registers them. Their vector entry points are
+``Reach-v1``'s and ``CenterOut-v1``'s (``vector.reach_v1_vector_env`` gives Gymnasium's
+``SyncVectorEnv`` of single envs for the harder tasks: the batch kernel steps only the game itself), so
+``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they take ``Reach-v1``.
+
+``EVALUATION_SEEDS`` are game seeds no training example uses (``examples/`` train on seeds below
+``TRAINING_SEED_LIMIT``): ``armgame.env.evaluate`` plays them, so scores in different papers are
+scores on the same games.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: The harder Reach ids and the arguments each fixes; each has a ``Continuous`` twin.
+#: Chosen so that the model bot still scores (docs/programs.md's reference table) while each
+#: breaks one thing a policy of the plain game relies on.
+SUITE: dict[str, dict[str, Any]] = {
+    # A hit needs the hand to stay 0.2 s in the target: the hand must stop, not fly through.
+    "ReachHold": {"hold_time": 0.2},
+    # Signal-dependent force noise of 30 % (a coefficient of variation), correlated over 50 ms.
+    "ReachNoisy": {"motor_noise": 0.3},
+    # The observation is 100 ms old (5 decisions): a visual reaction time's worth.
+    "ReachDelay": {"observation_delay": 5},
+    # The lab's curl field at the hand all game long (b = 2 N s/m).
+    "ReachField": {"field": "curl", "field_strength": 2.0},
+    # All four at once, and targets of 3 cm.
+    "ReachHard": {"hold_time": 0.2, "motor_noise": 0.3, "observation_delay": 5, "field": "curl",
+                  "field_strength": 2.0, "target_radius": 0.03},
+}
+
+#: The harder CenterOut ids and the ``armgame/CenterOut-v1`` arguments each fixes; each has a ``Continuous`` twin.
+CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
+    # A person's rule: the go cue waits for the cursor to stay in home (0.5 to 1.0 s), so every trial
+    # needs a stop at home as well as the 0.2 s stay in the target.
+    "CenterOutHold": {"trial_start": "hold"},
+}
+
+#: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
+EVALUATION_SEED_START = 10**9
+EVALUATION_SEED_COUNT = 10**6
+EVALUATION_SEEDS = range(EVALUATION_SEED_START, EVALUATION_SEED_START + EVALUATION_SEED_COUNT)
+#: Training examples (``examples/train_ppo.py``) seed their games below this.
+TRAINING_SEED_LIMIT = EVALUATION_SEED_START
+
+
+def suite_ids() -> tuple[str, ...]:
+    """Every harder id, key and continuous, in ``SUITE``'s and then ``CENTER_OUT_SUITE``'s order."""
+    return tuple(f"armgame/{name}{kind}-v1" for name in (*SUITE, *CENTER_OUT_SUITE) for kind in ("", "Continuous"))

@@ -1,0 +1,166 @@
+"""The suite's reference scores: random, the naive bot, the model bot and PPO on every v1 id.
+
+    python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
+    python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
+    python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
+    python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
+
+Every score is ``armgame.env.evaluate`` on the evaluation seeds (the first 100 of
+``EVALUATION_SEEDS``), so the numbers here and a paper's are hits on the same games. PPO is
+``examples/train_ppo.py``'s recipe (SB3's defaults but ``n_steps=128``, ``batch_size=256`` over 32
+envs, one torch thread), trained for a fixed budget of env steps (``PPO_STEPS``) on game seeds below
+the evaluation range, then its deterministic policy evaluated. Each result is one JSON file in
+``--out``; ``table`` reads them all. ``armgame/env/references.py`` holds the table's numbers that
+``evaluate`` normalises by (random and the model bot) and ``tests/test_env_suite.py`` checks them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import sys
+import textwrap
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import armgame.env  # noqa: F401  (registers the ids)
+from armgame.env.evaluation import evaluate
+from armgame.env.suite import suite_ids
+
+GAMES = 100
+PPO_STEPS = 500_000
+IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", "armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1",
+       *suite_ids())
+
+
+def slug(env_id: str) -> str:
+    return env_id.split("/")[-1]
+
+
+def run_bots(out: Path, ids: tuple[str, ...], games: int) -> None:
+    for env_id in ids:
+        for policy in ("random", "naive", "model"):
+            start = time.perf_counter()
+            result = evaluate(policy, env_id, games=games)
+            write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start)
+            print(result.summary(), flush=True)
+
+
+def run_ppo(out: Path, env_id: str, seed: int, steps: int, games: int) -> None:
+    import torch
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from armgame.env.sb3 import make_sb3_vec_env
+
+    torch.set_num_threads(1)
+    start = time.perf_counter()
+    envs = VecMonitor(make_sb3_vec_env(env_id, 32, seed=seed * 1000))
+    model = PPO("MlpPolicy", envs, n_steps=128, batch_size=256, seed=seed, device="cpu", verbose=0)
+    model.learn(steps)
+    trained = time.perf_counter() - start
+    result = evaluate(model, env_id, games=games)
+    write(out / f"{slug(env_id)}.ppo-{seed}.json", env_id, f"ppo-{seed}", result.hits, trained,
+          {"steps": steps, "train_seconds": round(trained, 1)})
+    print(f"{result.summary()} after {steps:,} steps in {trained:.0f} s", flush=True)
+
+
+def write(path: Path, env_id: str, policy: str, hits: tuple[int, ...], seconds: float,
+          extra: dict | None = None) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    record = {"env_id": env_id, "policy": policy, "games": len(hits), "mean_hits": float(np.mean(hits)),
+              "hits": list(hits), "seconds": round(seconds, 1), "machine": platform.processor() or platform.machine(),
+              **(extra or {})}
+    path.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+
+
+def table(folder: Path) -> str:
+    records: dict[str, dict[str, dict]] = {}
+    for path in sorted(folder.glob("*.json")):
+        r = json.loads(path.read_text(encoding="utf-8"))
+        records.setdefault(r["env_id"], {})[r["policy"]] = r
+    lines = ["| id | random | naive bot | model bot | PPO: mean (each training seed) | PPO normalised |",
+             "|---|---|---|---|---|---|"]
+    for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
+        row = records[env_id]
+        if not {"random", "naive", "model"} <= set(row):  # its bots' runs are not all done
+            continue
+        ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
+        # As references.py keeps them, so that the normalised score here is the one evaluate() gives.
+        low, high = round(row["random"]["mean_hits"], 2), round(row["model"]["mean_hits"], 2)
+        cells = [f"{row[p]['mean_hits']:.1f}" for p in ("random", "naive", "model")]
+        if ppo:
+            mean = round(float(np.mean(ppo)), 4)
+            cells.append(f"{mean:.1f} ({', '.join(f'{p:.1f}' for p in ppo)})")
+            cells.append(f"{(mean - low) / (high - low):.2f}")
+        else:
+            cells += ["not measured", ""]
+        lines.append(f"| `{env_id.split('/')[-1]}` | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def references(folder: Path, first: int = 5) -> str:
+    """``armgame/env/references.py``'s dict: each id's mean hits by policy (PPO: the mean of its seeds' means),
+    and the first ``first`` games' hits of random and the model bot, which the tests replay."""
+    records: dict[str, dict[str, dict]] = {}
+    for path in sorted(folder.glob("*.json")):
+        r = json.loads(path.read_text(encoding="utf-8"))
+        records.setdefault(r["env_id"], {})[r["policy"]] = r
+    table: dict[str, dict[str, Any]] = {}
+    for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
+        row = records[env_id]
+        if not {"random", "naive", "model"} <= set(row):
+            continue
+        ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
+        entry = {p: round(row[p]["mean_hits"], 2) for p in ("random", "naive", "model")}
+        if ppo:
+            entry["ppo"] = round(float(np.mean(ppo)), 4)
+            entry["ppo_seeds"] = [round(v, 2) for v in ppo]
+        entry["random_first"] = row["random"]["hits"][:first]
+        entry["model_first"] = row["model"]["hits"][:first]
+        table[env_id] = entry
+    lines = ["REFERENCE_HITS: dict[str, dict[str, Any]] = {"]
+    for env_id, entry in table.items():
+        items = ", ".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in entry.items())
+        lines.append(f"    {json.dumps(env_id)}: {{")
+        lines.append(textwrap.fill(items, width=116, initial_indent=" " * 8, subsequent_indent=" " * 8))
+        lines.append("    },")
+    lines.append("}")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    bots = sub.add_parser("bots")
+    bots.add_argument("--out", type=Path, required=True)
+    bots.add_argument("--games", type=int, default=GAMES)
+    bots.add_argument("--ids", nargs="*", default=list(IDS))
+    ppo = sub.add_parser("ppo")
+    ppo.add_argument("env_id")
+    ppo.add_argument("--seed", type=int, default=0)
+    ppo.add_argument("--steps", type=int, default=PPO_STEPS)
+    ppo.add_argument("--games", type=int, default=GAMES)
+    ppo.add_argument("--out", type=Path, required=True)
+    tab = sub.add_parser("table")
+    tab.add_argument("folder", type=Path)
+    refs = sub.add_parser("references")
+    refs.add_argument("folder", type=Path)
+    args = parser.parse_args(argv)
+    if args.command == "bots":
+        run_bots(args.out, tuple(args.ids), args.games)
+    elif args.command == "ppo":
+        run_ppo(args.out, args.env_id, args.seed, args.steps, args.games)
+    elif args.command == "references":
+        print(references(args.folder))
+    else:
+        print(table(args.folder))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,378 @@
+"""The harder Reach tasks and the evaluation protocol: the dwell and the delay against hand-built timelines,
+the noise and the field as documented, the score reward's return, checkers on every suite id, evaluate()."""
+
+import importlib.util
+import math
+import warnings
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import armgame.env
+from armgame.env.base import EnvArgumentError
+from armgame.env.center_out_v1 import CenterOutVectorEnv
+from armgame.env.evaluation import evaluate, mean_interval
+from armgame.env.policies import BotPolicy, bot_policy
+from armgame.env.references import REFERENCE_HITS
+from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, suite_ids
+from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
+from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv
+from armgame.env.vector_common import SingleEnvsVectorEnv
+from armgame.errors import UserError
+from armgame.game.rules import DwellRules, GameConfig
+from armgame.game.session import GameSession
+
+REACH = "armgame/Reach-v1"
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def play(env, policy, seed):
+    """One whole episode; (observations, rewards, last info)."""
+    obs, info = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    observations, rewards = [obs], []
+    done = False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(obs) if policy else env.action_space.sample())
+        observations.append(obs)
+        rewards.append(reward)
+        done = terminated or truncated
+    return observations, rewards, info
+
+
+# ------------------------------------------------------------------ the ids
+@pytest.mark.parametrize("env_id", suite_ids())
+def test_gymnasiums_checker_passes_on_every_suite_id(env_id):
+    env = gym.make(env_id)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=True)
+    assert env.unwrapped.continuous == ("Continuous" in env_id)
+    name = env_id.split("/")[1].removesuffix("-v1").removesuffix("Continuous")
+    if name in CENTER_OUT_SUITE:
+        assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, CenterOutVectorEnv)
+        assert env.unwrapped.trial_start == CENTER_OUT_SUITE[name]["trial_start"]
+        return
+    assert isinstance(gym.make_vec(env_id, num_envs=8).unwrapped, SingleEnvsVectorEnv)  # the batch plays no variant
+    for argument, value in SUITE[name].items():  # the id's arguments are the env's
+        if argument == "target_radius":
+            assert env.unwrapped.config.target_radius == value
+        else:
+            assert getattr(env.unwrapped.variant, argument) == value
+
+
+def test_the_sb3_checker_passes_on_the_suite():
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    for env_id in suite_ids():
+        sb3_check_env(gym.make(env_id).unwrapped, warn=True)
+
+
+@pytest.mark.parametrize("env_id", ["armgame/Reach-v0", REACH, "armgame/ReachContinuous-v1"])
+def test_make_vec_steps_single_envs_below_the_batchs_size_and_for_what_the_batch_does_not_play(env_id):
+    native = ReachV1VectorEnv if env_id.endswith("v1") else ReachVectorEnv
+    for n in (1, BATCH_MIN_ENVS - 1):
+        envs = gym.make_vec(env_id, num_envs=n, time_limit=0.2)
+        assert isinstance(envs.unwrapped, SingleEnvsVectorEnv) and envs.num_envs == n
+        singles = gym.vector.SyncVectorEnv([lambda: gym.make(env_id, time_limit=0.2) for _ in range(n)])
+        envs.action_space.seed(0)
+        assert gym.utils.env_checker.data_equivalence(envs.reset(seed=2), singles.reset(seed=2), exact=True)
+        for _ in range(12):  # past the end: the next-step autoreset as SyncVectorEnv does it
+            actions = envs.action_space.sample()
+            assert gym.utils.env_checker.data_equivalence(envs.step(actions), singles.step(actions), exact=True)
+    assert type(gym.make_vec(env_id, num_envs=BATCH_MIN_ENVS).unwrapped) is native
+    if env_id.endswith("v1"):
+        assert isinstance(gym.make_vec(env_id, num_envs=16, reward="score").unwrapped, SingleEnvsVectorEnv)
+        assert isinstance(gym.make_vec(env_id, num_envs=16, hold_time=0.1).unwrapped, SingleEnvsVectorEnv)
+        with pytest.raises(EnvArgumentError, match="score"):
+            ReachV1VectorEnv(2, reward="score")
+    for bad in (0, 10**9, 2.5):
+        with pytest.raises(EnvArgumentError, match="num_envs"):
+            gym.make_vec(env_id, num_envs=bad)
+
+
+def test_the_sb3_adapter_gives_sb3s_own_vec_env_where_no_batch_is_faster():
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from armgame.env.sb3 import ADAPTER_MIN_ENVS, SB3VecEnv, make_sb3_vec_env
+
+    assert isinstance(make_sb3_vec_env(REACH, ADAPTER_MIN_ENVS), SB3VecEnv)
+    for env_id, n, kwargs in ((REACH, ADAPTER_MIN_ENVS - 1, {}), (REACH, 1, {}), ("armgame/ReachHold-v1", 32, {}),
+                              (REACH, 32, {"reward": "score"}), ("armgame/CenterOut-v1", 2, {})):
+        envs = make_sb3_vec_env(env_id, n, seed=4, **kwargs)
+        assert isinstance(envs, DummyVecEnv) and envs.num_envs == n, env_id
+        first = envs.reset()
+        single = gym.make(env_id, **kwargs)
+        assert np.array_equal(first[-1], single.reset(seed=4 + n - 1)[0])  # seeded as the adapter seeds
+
+
+def test_bad_variant_arguments_are_refused_in_one_line():
+    for kwargs, words in (({"hold_time": -0.1}, "hold_time"), ({"hold_time": math.nan}, "hold_time"),
+                          ({"motor_noise": 1.5}, "motor_noise"), ({"observation_delay": 0.5}, "observation_delay"),
+                          ({"observation_delay": 101}, "observation_delay"), ({"field": "magnetic"}, "field"),
+                          ({"field_strength": 2.0}, "needs a field"), ({"field": "curl", "field_strength": 99},
+                                                                       "field_strength"),
+                          ({"target_radius": 0.0}, "target_radius"), ({"reward": "hits"}, "'score'")):
+        with pytest.raises(EnvArgumentError, match=words) as caught:
+            gym.make(REACH, **kwargs)
+        assert "\n" not in str(caught.value)
+
+
+# ------------------------------------------------------------------ the dwell
+def test_the_dwell_counts_consecutive_steps_in_the_target_and_starts_again_outside():
+    config = GameConfig(seed=3)
+    rules = DwellRules(config, 3)
+    target, dt = rules.target, config.dt
+    inside, outside = (target.x, target.y), (target.x + 2 * target.radius, target.y)
+    # Hand-built: in at steps 1 and 2, out at 3, in at 4, 5 and 6: the hit comes at step 6, not before.
+    for step, (x, y) in enumerate([inside, inside, outside, inside, inside], start=1):
+        if (x, y) == inside:  # the session calls hand_moved only on steps that end in the target
+            assert not rules.hand_moved(x, y, step * dt)
+    assert rules.board.hits == 0
+    assert rules.hand_moved(*inside, 6 * dt) and rules.board.hits == 1 and rules.board.hit_times == [6 * dt]
+    assert rules.target != target  # a new target, as the game draws it
+    with pytest.raises(UserError, match="dwell"):
+        DwellRules(config, 0)
+
+
+def test_a_dwell_hit_is_the_step_the_hand_completes_its_stay_in_both_loops():
+    """The game's hits under a dwell, step by step, against an oracle that watches the hand."""
+    hold = 10
+    config = GameConfig(seed=7, time_limit=20.0)
+    env = gym.make(REACH, time_limit=20.0, observation_dtype="float64")
+    policy = BotPolicy("model", env)
+    # The model bot's keys in the plain game: a timeline that puts the hand in many targets.
+    env.reset(seed=7)
+    done = False
+    obs = env.unwrapped._observation()
+    while not done:
+        obs, _, _, done, _ = env.step(policy(obs))
+    timeline = env.unwrapped.session.timeline
+    results = []
+    for compiled in (True, False):
+        session = GameSession(config, compiled=compiled, rules=DwellRules(config, hold))
+        events, stay, hits_seen = iter(timeline), 0, []
+        pending = next(events, None)
+        while not session.over:
+            while pending is not None and pending.step == session.steps:
+                session.key_event(pending.key, pending.action)
+                pending = next(events, None)
+            target = session.rules.target
+            hits = session.rules.board.hits
+            session.advance(1)
+            stay = stay + 1 if target.contains(*session.hand()) else 0
+            if session.rules.board.hits != hits:
+                hits_seen.append(session.steps)
+                assert stay == hold, (session.steps, stay)  # a hit exactly when the stay reaches the dwell
+                stay = 0
+            else:
+                assert stay < hold
+        results.append((hits_seen, session.state))
+    assert results[0] == results[1] and len(results[0][0]) >= 5  # both loops, the same game
+
+
+# ------------------------------------------------------------------ the delay
+def test_a_delayed_observation_is_the_one_so_many_steps_before():
+    delay = 4
+    late, now = gym.make(REACH, observation_delay=delay, time_limit=1.0), gym.make(REACH, time_limit=1.0)
+    rng = np.random.default_rng(0)
+    actions = rng.integers(0, 2, (50, 4))
+    seen = [late.reset(seed=5)[0]]
+    truth = [now.reset(seed=5)[0]]
+    for action in actions:
+        a, ra, _, _, ia = late.step(action)
+        b, rb, _, _, ib = now.step(action)
+        seen.append(a)
+        truth.append(b)
+        assert (ra, ia) == (rb, ib)  # the reward and the bookkeeping are not delayed
+    for t, observation in enumerate(seen):
+        assert np.array_equal(observation, truth[max(0, t - delay)]), t
+    assert seen[-1] is not seen[-2]  # every observation is new data
+
+
+# ------------------------------------------------------------------ noise and field
+def test_motor_noise_scales_each_muscles_force_by_a_seeded_factor():
+    noisy = gym.make(REACH, motor_noise=0.3, time_limit=4.0)
+    plain = gym.make(REACH, time_limit=4.0)
+    run = [play(noisy, None, 11), play(noisy, None, 11), play(plain, None, 11)]
+    assert np.array_equal(np.array(run[0][0]), np.array(run[1][0]))  # seeded: the same game twice
+    assert not np.array_equal(np.array(run[0][0]), np.array(run[2][0]))  # and not the plain game
+    factors = []
+    noisy.reset(seed=12)
+    session = noisy.unwrapped.session
+    base = np.array(GameConfig().muscles[0].moment[0])
+    for _ in range(2000):
+        noisy.unwrapped._noise.apply(session)
+        factors.append(session.muscles.moments[0][0] / base)
+    factors = np.array(factors)
+    assert factors.min() >= 0.0 and factors.max() <= NOISE_FACTOR_MAX
+    assert abs(factors.mean() - 1.0) < 0.05 and abs(factors.std() - 0.3) < 0.05, (factors.mean(), factors.std())
+    # Correlated over 50 ms: decisions 20 ms apart keep exp(-0.4) of the last draw.
+    lag = np.corrcoef(factors[:-1], factors[1:])[0, 1]
+    assert abs(lag - math.exp(-0.02 / 0.05)) < 0.05, lag
+
+
+def test_a_zero_variant_is_the_game_itself():
+    plain, zero = gym.make(REACH, time_limit=3.0), gym.make(REACH, time_limit=3.0, hold_time=0.0, motor_noise=0.0,
+                                                           observation_delay=0, field=None)
+    assert zero.unwrapped.variant.plain
+    a, b = play(plain, None, 4), play(zero, None, 4)
+    assert np.array_equal(np.array(a[0]), np.array(b[0])) and a[1] == b[1]
+
+
+def test_the_curl_field_pushes_across_the_motion_and_keeps_the_speed_bound():
+    field = gym.make(REACH, field="curl", field_strength=2.0, time_limit=5.0)
+    plain = gym.make(REACH, time_limit=5.0)
+    assert field.observation_space == plain.observation_space  # the curl field does no work
+    effort = np.array([1, 0, 1, 0])
+    a = [field.reset(seed=1)[0]] + [field.step(effort)[0] for _ in range(40)]
+    b = [plain.reset(seed=1)[0]] + [plain.step(effort)[0] for _ in range(40)]
+    assert not np.allclose(a[-1], b[-1])
+    assert all(field.observation_space.contains(o) for o in a)
+    viscous = gym.make(REACH, field="viscous")
+    assert math.isinf(viscous.observation_space.high[2])  # a viscous field can do work: no bound holds
+
+
+def test_the_model_bot_still_scores_on_every_suite_task():
+    for name in SUITE:
+        env = gym.make(f"armgame/{name}-v1", time_limit=20.0)
+        hits = play(env, BotPolicy("model", env), EVALUATION_SEEDS[0])[2]["hits"]
+        assert hits >= (2 if name == "ReachHard" else 5), (name, hits)  # in a third of a game
+    for name in CENTER_OUT_SUITE:  # a stop at home and in the target, every trial
+        env = gym.make(f"armgame/{name}-v1")
+        assert play(env, bot_policy("model", env), EVALUATION_SEEDS[0])[2]["hits"] == 8
+
+
+# ------------------------------------------------------------------ the score reward
+@pytest.mark.parametrize("kwargs", [{}, {"reset_key": True}, {"hold_time": 0.2, "motor_noise": 0.2},
+                                    {"progress_weight": 0.0}])
+def test_the_score_rewards_return_is_the_games_score(kwargs):
+    env = gym.make(REACH, reward="score", time_limit=12.0, **kwargs)
+    bot = None if kwargs.get("reset_key") else BotPolicy("model", env)
+    for seed in (1, 2):
+        _, rewards, info = play(env, bot, seed)
+        assert math.isclose(sum(rewards), info["score"], abs_tol=1e-9), (sum(rewards), info)
+        if bot is not None:
+            assert info["score"] >= 3
+
+
+def test_the_score_reward_is_the_score_change_plus_a_potentials_difference():
+    env = gym.make(REACH, reward="score", progress_weight=10.0, time_limit=2.0)
+    env.reset(seed=3)
+    base = env.unwrapped
+    edges, score = [], 0
+    for t in range(100):
+        before = base.session.rules.board.score
+        _, reward, _, truncated, info = env.step(np.array([1, 0, 0, 1]) if t % 20 < 10 else np.array([0, 1, 1, 0]))
+        edge = 0.0 if truncated else base._edge_now()
+        phi_before = 0.0 if t == 0 else -edges[-1]
+        assert math.isclose(reward, (info["score"] - before) + 10.0 * (-edge - phi_before), abs_tol=1e-12)
+        edges.append(edge)
+        score = info["score"]
+    assert truncated and score == info["score"]
+
+
+# ------------------------------------------------------------------ evaluate
+def test_evaluate_is_deterministic_and_reports_an_interval():
+    a = evaluate("random", REACH, games=3, time_limit=5.0)
+    b = evaluate("random", REACH, games=3, time_limit=5.0)
+    assert a == b and a.seeds == tuple(EVALUATION_SEEDS[:3])
+    low, high = a.ci95
+    assert low <= a.mean_hits <= high
+    assert a.hits_per_minute == pytest.approx(a.mean_hits * 12.0)
+    assert a.normalised is None  # another time limit than the references': no normalised score
+    model = evaluate("model", REACH, seeds=[5, 6])
+    assert model.normalised is not None and 0.5 < model.normalised < 1.5
+    assert mean_interval([2, 4]) == pytest.approx((3 - 12.706 * 1.0, 3 + 12.706 * 1.0), abs=1e-3)
+    for bad in ({"games": 0}, {"games": 1.5}, {"seeds": []}):
+        with pytest.raises(EnvArgumentError):
+            evaluate("random", REACH, **bad)
+    with pytest.raises(EnvArgumentError, match="policy"):
+        evaluate("clever", REACH, games=1)
+
+
+class Model:
+    """A model with SB3's ``predict``: a fixed linear policy of the observation (one row or many)."""
+
+    def __init__(self, size):
+        self.weights = np.random.default_rng(1).standard_normal((size, 4))
+
+    def predict(self, observation, deterministic=True):
+        return (np.asarray(observation) @ self.weights > 0).astype(np.int8), None
+
+
+@pytest.mark.parametrize("env_id", [REACH, "armgame/CenterOut-v1"])
+def test_a_models_games_played_together_are_its_games_played_one_by_one(env_id):
+    model = Model(gym.make(env_id).observation_space.shape[0])
+    kwargs = {"time_limit": 3.0} if env_id == REACH else {}
+    together = evaluate(model, env_id, seeds=[3, 4, 5], **kwargs)
+    alone = evaluate(lambda obs: model.predict(obs[None])[0][0], env_id, seeds=[3, 4, 5], **kwargs)
+    assert together.hits == alone.hits and together.scores == alone.scores and together.policy == "Model"
+    assert together.minutes == alone.minutes > 0
+
+
+def test_the_reference_scores_are_evaluates_own():
+    """The random and model-bot references that normalise every score: the first games of their runs."""
+    assert set(REFERENCE_HITS) == {REACH, "armgame/ReachContinuous-v1", "armgame/CenterOut-v1",
+                                   "armgame/CenterOutContinuous-v1", *suite_ids()}
+    for env_id in (REACH, "armgame/ReachHold-v1"):
+        for policy in ("random", "model"):
+            reference = REFERENCE_HITS[env_id]
+            result = evaluate(policy, env_id, games=len(reference[f"{policy}_first"]))
+            assert list(result.hits) == reference[f"{policy}_first"], (env_id, policy)
+
+
+def test_the_registry_lists_every_id_the_docs_name():
+    assert set(suite_ids()) <= set(gym.registry)
+    assert {ReachVariant.of(**{k: v for k, v in args.items() if k != "target_radius"}).plain
+            for args in SUITE.values()} == {False}
+    assert armgame.env.SUITE is SUITE
+
+
+def test_the_small_learner_still_beats_random_play_on_a_harder_task():
+    """examples/train_es.py's cross-entropy method, smaller than tests/test_env_v1.py runs it, on the delayed game."""
+    spec = importlib.util.spec_from_file_location("train_es", EXAMPLES / "train_es.py")
+    es = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(es)
+    env_id = "armgame/ReachDelayContinuous-v1"
+    policy, history = es.cem(generations=10, population=32, seconds=2.0, seed=0, env_id=env_id)
+    learned = es.hits_per_game(policy, games=8, seconds=10.0, seed=100, env_id=env_id)
+    random = es.hits_per_game(None, games=8, seconds=10.0, seed=100, env_id=env_id)
+    assert history[-1][1] > history[0][1]  # the population's return rose
+    assert learned.mean() >= 1.0 and learned.mean() >= 4 * random.mean(), (learned, random)
+
+
+def test_the_docs_reference_table_is_the_references():
+    """docs/programs.md's table, row by row, against armgame/env/references.py (both from one benchmark run)."""
+    text = (Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
+    rows = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 6 and cells[0].startswith("`") and f"armgame/{cells[0].strip('`')}" in REFERENCE_HITS:
+            rows[f"armgame/{cells[0].strip('`')}"] = cells
+    assert set(rows) == set(REFERENCE_HITS)
+    for env_id, cells in rows.items():
+        reference = REFERENCE_HITS[env_id]
+        assert cells[1:4] == [f"{reference[p]:.1f}" for p in ("random", "naive", "model")], env_id
+        if "ppo" in reference:
+            assert cells[4].startswith(f"{reference['ppo']:.1f} ("), env_id
+            low, high = reference["random"], reference["model"]
+            assert cells[5] == f"{(reference['ppo'] - low) / (high - low):.2f}", env_id
+        else:
+            assert cells[4] == "not measured", env_id
+
+
+def test_the_off_policy_recipe_runs(capsys):
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    spec = importlib.util.spec_from_file_location("train_sac", EXAMPLES / "train_sac.py")
+    sac = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sac)
+    assert sac.main(["--minutes", "0.05", "--envs", "2", "--eval-every", "400", "--games", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "hits per game" in out and "best mean hits per game" in out
+
