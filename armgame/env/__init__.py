@@ -78,22 +78,16 @@ def _register() -> None:
             gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
                                vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
-    for name, arguments in SUITE.items():
-        for continuous in (False, True):
-            env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
-            if env_id not in gymnasium.registry:
-                gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
-                                   vector_entry_point="armgame.env.vector:reach_v1_vector_env",
-                                   kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
-                                   nondeterministic=False)
-    for name, arguments in CENTER_OUT_SUITE.items():
-        for continuous in (False, True):
-            env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
-            if env_id not in gymnasium.registry:
-                gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
-                                   vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
-                                   kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
-                                   nondeterministic=False)
-
+    suites = ((SUITE, "armgame.env.reach_v1:ReachV1Env", "armgame.env.vector:reach_v1_vector_env"),
+              (CENTER_OUT_SUITE, "armgame.env.center_out_v1:CenterOutV1Env",
+               "armgame.env.center_out_v1:CenterOutVectorEnv"))
+    for suite, entry_point, vector_entry_point in suites:
+        for name, arguments in suite.items():
+            for continuous in (False, True):
+                env_id = f"armgame/{name}{'Continuous' if continuous else ''}-v1"
+                if env_id not in gymnasium.registry:
+                    gymnasium.register(id=env_id, entry_point=entry_point, vector_entry_point=vector_entry_point,
+                                       kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
+                                       nondeterministic=False)
 
 _register()

@@ -43,6 +43,16 @@ class _SeenGame:
         self.time = 0.0
 
 
+def _act(bot: ReachingBot, seen: _SeenGame, continuous: bool) -> np.ndarray:
+    """The bot's decision on what it has seen, as an action: keys held, or levels -1 and 1, which act as keys."""
+    keys = seen.muscles.keys
+    for key, action in bot.act(seen):  # type: ignore[arg-type]  # quacks like a GameSession
+        seen.held[keys.index(key)] = action == DOWN
+    if continuous:
+        return np.where(seen.held, 1.0, -1.0).astype(np.float32)
+    return np.array(seen.held, dtype=np.int8)
+
+
 class BotPolicy:
     """A bot (``"model"``, ``"naive"`` or a ``ReachingBot``) playing through a Reach env, v0 or v1.
 
@@ -122,12 +132,7 @@ class BotPolicy:
         seen.state = state  # type: ignore[assignment]
         seen.muscles.activation = list(activation)
         seen.time = (self.total_steps - round(time_left / self.dt)) * self.dt  # as GameSession.time
-        keys = self._muscles.keys
-        for key, action in self.bot.act(seen):  # type: ignore[arg-type]  # quacks like a GameSession
-            seen.held[keys.index(key)] = action == DOWN
-        if self.continuous:
-            return np.where(seen.held, 1.0, -1.0).astype(np.float32)
-        return np.array(seen.held, dtype=np.int8)
+        return _act(self.bot, seen, self.continuous)
 
 
 class CenterOutV1BotPolicy:
@@ -184,12 +189,7 @@ class CenterOutV1BotPolicy:
         seen.muscles.activation = [a0, a1, a2, a3]
         seen.time = self._decisions * self.decision_time
         self._decisions += 1
-        keys = self._muscles.keys
-        for key, action in self.bot.act(seen):  # type: ignore[arg-type]  # quacks like a GameSession
-            seen.held[keys.index(key)] = action == DOWN
-        if self.continuous:
-            return np.where(seen.held, 1.0, -1.0).astype(np.float32)
-        return np.array(seen.held, dtype=np.int8)
+        return _act(self.bot, seen, self.continuous)
 
 
 def bot_policy(bot: str, env: Any) -> BotPolicy | CenterOutV1BotPolicy:
