@@ -103,6 +103,14 @@ def curl() -> None:
     says(f"the error jumps when the field comes on, shrinks to {shrunk:.0%} of it over the exposure")
     first_exposure = block_rows(rows, "exposure")[0]["max_perpendicular_error_m"]
     first_washout = block_rows(rows, "washout")[0]["max_perpendicular_error_m"]
+    # The window-time table's bot row for curl is worked out from this run: a 1x window adds each path's
+    # second and the cards to the reaching (benchmarks/lab_slot.py measures the lesson's window for real).
+    from armgame.ui.lab_window import BOT_CARD_SECONDS, FEEDBACK_SECONDS
+
+    trials = len(session.outcomes)
+    window = session.time + trials * FEEDBACK_SECONDS + BOT_CARD_SECONDS * len(session.protocol.blocks)
+    says(f"about {window / 60:.0f} min at 1x ({session.time / trials:.1f} s of reaching and {FEEDBACK_SECONDS:.1f} s "
+         "of path a trial)")
     says(f"The first exposure reach errs by {cm(first_exposure)[0] if first_exposure < 0 else ''}"
          f"{abs(100 * first_exposure):.2f} cm and the first washout reach by {cm(first_washout)} cm")
 
@@ -244,6 +252,8 @@ def generalization() -> None:
     low, high = min(mean_offsets, key=mean_offsets.get), max(mean_offsets, key=mean_offsets.get)
     says(f"from {mean_offsets[low]:+.2f} at {low:g} deg to {mean_offsets[high]:+.2f} at {high:g} deg, the mean of "
          "seeds 10, 1 and 2")
+    says(f"(each direction has an offset of its own, up to about {max(abs(v) for v in mean_offsets.values()):.1f} "
+         "for one target")
 
 
 def noise() -> None:

@@ -76,13 +76,25 @@ def main() -> None:
     protocol = load_protocol_argument(args.protocol)
     print(f"{protocol.name}: {protocol.trials} trials in {len(protocol.blocks)} blocks; the bot's cards "
           f"{BOT_CARD_SECONDS:g} s, each path {FEEDBACK_SECONDS:g} s, both divided by the speed")
+    walls = []
     for speed in args.speeds:
         wall, simulated, frames = bot_run(protocol, args.seed, speed)
+        walls.append(wall)
         print(f"  adapting bot at {speed:g}x: {wall:.1f} s in the window ({wall / 60:.2f} min; {simulated:.1f} s "
               f"of reaching, {frames} frames at {frames / wall:.0f} a second)")
     typical, worst = person_estimate(protocol)
     print(f"  a person at the keys (worked out): about {typical:.0f} s ({typical / 60:.1f} min), at most "
           f"{worst:.0f} s ({worst / 60:.1f} min) if every reach times out")
+    # The wall times depend on the machine and its load, so they are printed in docs/lab.md's form to copy,
+    # not compared; the person's column is the protocol's arithmetic, which tests/test_lab_claims.py checks.
+    print(f"docs/lab.md's row: | `{protocol.name}` | {protocol.trials} | {', '.join(f'{w:.0f}' for w in walls)} s | "
+          f"{person_cell(protocol)} |")
+
+
+def person_cell(protocol) -> str:
+    """A person's run in docs/lab.md's window-time table."""
+    typical, worst = person_estimate(protocol)
+    return f"about {typical / 60:.0f} min, at most {worst / 60:.1f} min (every reach timed out)"
 
 
 if __name__ == "__main__":

@@ -85,6 +85,16 @@ def main() -> None:
     game = best["game"]
     print(json.dumps({name: {"wall_seconds": round(t, 4), "times_real_time": round(SECONDS / t, 1),
                              "cost_vs_game": round(t / game, 3)} for name, t in best.items()}, indent=1))
+    # Timings move with the machine and its load, so docs/lab.md's "Cost" takes them from this line, in its
+    # words, with the machine named; nothing compares them.
+    if children:
+        print(f"the game from this checkout and from the base, each in a fresh process, "
+              f"{best['game, child process (this checkout)']:.3f} and {best['game, child process (base)']:.3f} s")
+    cost = {name: best[f"lab, {name}"] / game for name in ("no perturbation", "rotation", "curl field")}
+    slowest = max(best[f"lab, {name}"] for name in cost)
+    print(f"the lab's session costs {cost['no perturbation']:.2f} times as much with no perturbation, "
+          f"{cost['rotation']:.2f} with a rotation, and {cost['curl field']:.1f} with a curl field; "
+          f"{SECONDS / slowest:.0f} times faster than real time at its slowest")
 
 
 if __name__ == "__main__":

@@ -78,3 +78,12 @@ def test_mass_coriolis_gravity_equal_the_euler_lagrange_derivation():
     point = {**subs, **dict(zip(d.q, q, strict=True)), **dict(zip(d.qd, qd, strict=True))}
     assert float(d.T.subs(point)) == np.float64(arm.kinetic_energy(q, qd)).item() or np.isclose(
         float(d.T.subs(point)), arm.kinetic_energy(q, qd), rtol=1e-13)
+
+
+def test_the_seed_range_docs_physics_states(capsys):
+    """docs/physics.md: "`--seed`, 0 to 2^63 - 1" (tests/test_lab_claims.py finds the phrase): both ends pass
+    the check and the first seed past either is refused."""
+    assert main(["derive", "one", "--states", "1", "--seed", str(2**63 - 1)]) == 0
+    for seed in (-1, 2**63):
+        assert main(["derive", "one", "--states", "1", "--seed", str(seed)]) != 0
+        assert f"from 0 to 2^63 - 1, got {seed}" in capsys.readouterr().err

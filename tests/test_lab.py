@@ -4,6 +4,7 @@ perturbations per trial, determinism, and lab replays that verify."""
 import json
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -508,6 +509,10 @@ def test_viscous_scaling_deflects_the_model_bot_and_a_bot_that_knows_it_counters
 QUICK = {"timeout": 1.5, "delay": (0.1, 0.1), "hold_time": 0.1}
 
 
+#: How far (m) a channel trial may let the hand off its line.
+CHANNEL_HOLD = 0.0015
+
+
 def channel_run(b_hat: float, trials: int = 8):
     p = Protocol("clamp", (Block("clamp", trials, Perturbation.make("curl", b=CURL_B), channel_trials=trials),),
                  **QUICK)
@@ -523,11 +528,12 @@ def test_the_channel_holds_the_hand_on_the_line_and_the_index_reads_what_was_lea
     it: index about 1; expecting none, about 0. The hand stays within a millimetre of the line."""
     from armgame.lab.analysis import trial_rows
 
-    indices = {}
+    indices, worst = {}, 0.0
     for b_hat in (0.0, CURL_B):
         session = channel_run(b_hat)
         assert session.result().hits == 8
-        assert max(abs(perpendicular(session, o)) for o in session.outcomes) < 0.0015
+        worst = max(worst, *(abs(perpendicular(session, o)) for o in session.outcomes))
+        assert worst < CHANNEL_HOLD
         rows = trial_rows(session)
         assert all(r["perturbation"] == "channel" for r in rows)
         assert all(len(o.channel_force) == len(o.xs) for o in session.outcomes)
@@ -535,6 +541,11 @@ def test_the_channel_holds_the_hand_on_the_line_and_the_index_reads_what_was_lea
         peak = np.array([r["channel_force_peak_n"] for r in rows])
         assert np.all(np.isfinite(peak))
     assert abs(indices[0.0]) < 0.1 and abs(indices[CURL_B] - 1.0) < 0.1, indices
+    # docs/lab.md quotes this test's bound and what it measured: neither may drift from the code.
+    doc = " ".join((Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8").split())
+    assert (f"within {math.ceil(10_000 * worst) / 10:.1f} mm of the line in the tests' channel trials (which allow "
+            f"{1000 * CHANNEL_HOLD:.1f} mm)") in doc
+    assert f"and the hand stays within {1000 * CHANNEL_HOLD:.1f} mm of the line" in doc
 
 
 def test_the_adaptive_bot_learns_nothing_from_a_channel_trial():

@@ -176,3 +176,74 @@ def test_the_scenes_and_the_commands_numbers_in_physics():
     simulate = build_parser().parse_args(["simulate", "--scene", "passive", "--out", "x.csv"])
     _says(PHYSICS, f"(`--states`, 1 to {MAX_STATES:,}; `--seed`, 0 to 2^63 - 1)",
           f"Rows come at `--sample-rate` ({simulate.sample_rate:.0f} Hz by default)")
+
+
+def test_the_channel_step_limit_and_rk4s_stability():
+    """The channel's |s| dt limit is the code's, and RK4's stability limits are where its amplification
+    factor R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24 reaches 1 along each ray (a root of |R| = 1, bracketed)."""
+    from scipy.optimize import brentq
+
+    from armgame.lab.protocol import MAX_CHANNEL_LAMBDA_DT
+
+    def limit(angle: float) -> float:
+        ray = np.exp(1j * angle)
+        return brentq(lambda r: abs(np.polyval([1 / 24, 1 / 6, 1 / 2, 1, 1], r * ray)) - 1.0, 0.5, 3.5)
+
+    protocol = preset("curl")
+    session = LabSession(lab_config(protocol, 10), protocol)
+    arm = session.model
+    postures = [np.asarray(session.config.start_posture)]
+    postures += [arm.inverse_kinematics(np.array(t)) for t in target_positions(protocol, session.home)]
+    lightest = min(np.linalg.eigvalsh(np.linalg.inv(arm.jacobian(q) @ np.linalg.inv(arm.mass_matrix(q))
+                                                    @ arm.jacobian(q).T))[0] for q in postures)
+    mode = np.roots([lightest, CHANNEL_DAMPING, CHANNEL_STIFFNESS])[0]
+    _says(LAB, f"the fastest mode must satisfy `|s| dt <= {MAX_CHANNEL_LAMBDA_DT:g}` (RK4 is stable to `|s| dt` of "
+               f"{limit(np.angle(mode)):.2f} along the direction of these modes, {limit(math.pi):.2f} for a pure "
+               f"decay and {limit(math.pi / 2):.2f} for a pure oscillation;")
+
+
+def test_the_measures_definitions_are_the_codes_defaults():
+    import inspect
+
+    from armgame.lab import figures
+    from armgame.lab.metrics import reach_metrics
+
+    defaults = {k: p.default for k, p in inspect.signature(reach_metrics).parameters.items()}
+    _says(LAB, f"rises through {100 * defaults['threshold']:g}% of that reach's peak speed",
+          f"over the first {1000 * defaults['direction_delay']:g} ms after onset",
+          f"the hand never reaches {defaults['min_peak_speed']:g} m/s",
+          f"**Figures** ({figures.WIDTH * figures.DPI:.0f} x {figures.HEIGHT * figures.DPI:.0f}, for a projector)")
+
+
+def test_the_window_times_worked_out_and_the_muscles():
+    """A person's column of the window-time table is benchmarks/lab_slot.py's arithmetic on the protocol (the
+    bot's columns are wall times, measured there and not checkable here)."""
+    import importlib.util
+
+    from armgame.game.muscles import ELBOW_MAX_TORQUE, SHOULDER_MAX_TORQUE
+    from armgame.ui.lab_window import BOT_CARD_SECONDS, FEEDBACK_SECONDS
+
+    spec = importlib.util.spec_from_file_location("lab_slot", DOCS.parent / "benchmarks" / "lab_slot.py")
+    slot = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(slot)
+    p = preset("lesson")
+    _says(LAB, f"(per reach: {p.delay[0]:.1f} to {p.delay[1]:g} s at home, the reach, {p.hold_time:.1f} s on the "
+               f"target, {FEEDBACK_SECONDS:.1f} s of its path; a person's reach taken as {slot.PERSON_REACH:g} s, the "
+               f"cards read in {slot.PERSON_FIRST_CARD:g} s and {slot.PERSON_BLOCK_CARD:g} s;",
+          f"the path and its cards of {BOT_CARD_SECONDS:g} s:",
+          f"and {FEEDBACK_SECONDS:.1f} s of path a trial)")
+    for name in ("lesson", "curl"):
+        _says(LAB, f"| `{name}` | {preset(name).trials} |", f"| {slot.person_cell(preset(name))} |")
+    _says(LAB, f"game's {SHOULDER_MAX_TORQUE:g} and {ELBOW_MAX_TORQUE:g} N m muscles")
+
+
+def test_the_physics_docs_remaining_numbers():
+    from armgame import simulation
+    from armgame.scenes import get_scene
+
+    q1, q2 = get_scene("passive").initial[:2]
+    assert q1 == -math.pi / 2  # "upper arm hanging": straight down from the shoulder in our convention
+    _says(PHYSICS, f"upper arm hanging and elbow at {math.degrees(q2):.0f} deg")
+    # "memory stays a few thousand rows": the writer's chunk.
+    assert 2000 <= simulation._CHUNK_ROWS < 10_000 and "memory stays a few thousand rows" in PHYSICS
+    # derive's "`--seed`, 0 to 2^63 - 1" is held by tests/test_derive.py, where SymPy is imported anyway.

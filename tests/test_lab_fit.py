@@ -2,6 +2,7 @@
 learners with known rates, the constraints kept, one-line errors."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -41,6 +42,10 @@ def test_errors_of_a_learner_with_known_rates_give_them_back_within_the_interval
     assert 0 < v["retention_fast"] < v["retention_slow"] < 1 and 0 < v["rate_slow"] < v["rate_fast"] < 1
     assert 0.0007 < fit.rms < 0.0013 and fit.r_squared > 0.9 and fit.n == f.size
     assert any("A_f = " in line for line in fit.lines()) and "residual: rms" in fit.lines()[-2]
+    # docs/lab.md counts the parameters AIC and BIC charge for: the counts these fits use.
+    doc = " ".join((Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8").split())
+    assert (f"({fit.n_parameters} for the two-rate model fitted to errors, {comparison.simple.n_parameters} for the "
+            "one-rate)") in doc
 
 
 def test_channel_indices_of_the_spontaneous_recovery_paradigm_give_the_rates_back():

@@ -2,6 +2,7 @@
 xfrc_applied and the virtual work; a curl field does no work; a game without loads does not move."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,8 +25,16 @@ from armgame.physics.loads import (
     loaded_arm,
 )
 
+#: The tolerances and the strong curl field docs/lab.md ("Perturbations in the physics") quotes:
+#: test_the_docs_quote_these_tests holds the text to them.
+MUJOCO_TOLERANCE = 1e-9  # joint accelerations against MuJoCo's xfrc_applied
+STRONG_CURL = 13.0  # N s/m
+DRIFT_TOLERANCE = 1e-7  # a passive arm's relative energy change, with the strong curl field and without
+DRIFT_DT, DRIFT_STEPS = 0.001, 3000
+WORK_TOLERANCE = 1e-3  # the viscous field's work against the energy change, relative to the change
+
 FIELDS = {
-    "curl": CurlField(13.0),
+    "curl": CurlField(STRONG_CURL),
     "viscous": ViscousField(((-10.1, -11.2), (-11.2, 11.1))),
     "channel": ChannelField(2000.0, 50.0, (0.1, 0.5), (0.6, 0.8)),
     "constant": ConstantForce(3.0, -2.0),
@@ -67,7 +76,7 @@ def test_hand_force_accelerates_the_arm_as_mujoco_xfrc_applied_does(name, params
         free = arm.forward_dynamics([q1, q2], [w1, w2], [0.3, -0.2])
         data.qfrc_applied[:] = (0.3, -0.2)
         mujoco.mj_forward(model, data)
-        np.testing.assert_allclose(ours, data.qacc, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(ours, data.qacc, rtol=MUJOCO_TOLERANCE, atol=MUJOCO_TOLERANCE)
         assert np.max(np.abs(np.subtract(ours, free))) > 1e-3  # the force did something
         data.qfrc_applied[:] = 0.0
 
@@ -117,13 +126,14 @@ def test_curl_field_does_no_work(params, integrator):
     """v . B v = 0: a passive arm's energy with a strong curl field on holds exactly as without it,
     to the integrator's error, while the field visibly bends the motion."""
     arm = TwoJointArm(params)
-    start, dt, steps = (0.3, 1.4, 3.0, -2.0), 0.001, 3000
+    start, dt, steps = (0.3, 1.4, 3.0, -2.0), DRIFT_DT, DRIFT_STEPS
     free = Integrator(integrator, arm).run(start, (0.0, 0.0), dt, steps)
-    curled = Integrator(integrator, LoadedArm(arm, Loads(hand=CurlField(13.0)))).run(start, (0.0, 0.0), dt, steps)
+    curl = LoadedArm(arm, Loads(hand=CurlField(STRONG_CURL)))
+    curled = Integrator(integrator, curl).run(start, (0.0, 0.0), dt, steps)
     e0 = float(arm.energy(start[:2], start[2:]))
     drift_free = np.max(np.abs(arm.energy(free[:, :2], free[:, 2:]) - e0)) / e0
     drift_curl = np.max(np.abs(arm.energy(curled[:, :2], curled[:, 2:]) - e0)) / e0
-    assert drift_curl < 1e-7 and drift_free < 1e-7, (drift_curl, drift_free)
+    assert drift_curl < DRIFT_TOLERANCE and drift_free < DRIFT_TOLERANCE, (drift_curl, drift_free)
     apart = np.max(np.linalg.norm(arm.hand(curled[:, :2]) - arm.hand(free[:, :2]), axis=-1))
     assert apart > 0.05  # the field acted: centimetres apart
     # A field that does work (a spring pulling the hand) changes the arm's own energy by far more.
@@ -196,8 +206,13 @@ def test_viscous_field_does_the_work_of_its_symmetric_part(integrator):
     power = np.einsum("ni,ij,nj->n", v, np.asarray(PUBLISHED_VISCOUS_B), v)
     work = np.concatenate([[0.0], np.cumsum((power[1:] + power[:-1]) * dt / 2.0)])  # trapezoid: O(dt^2)
     change = energy - energy[0]
-    assert np.max(np.abs(change)) > 10.0 * energy[0]  # it pumps the arm: 1.4 J to 22 J in 0.3 s
-    np.testing.assert_allclose(change, work, atol=1e-3 * np.max(np.abs(change)))  # the trapezoid's error: 1e-4
+    assert np.max(np.abs(change)) > 10.0 * energy[0]  # it pumps the arm
+    np.testing.assert_allclose(change, work, atol=WORK_TOLERANCE * np.max(np.abs(change)))
+    # What docs/lab.md says this run measures: the start, the gain, and the trapezoid's error (one digit).
+    off = float(np.max(np.abs(change - work)) / np.max(np.abs(change)))
+    _doc_says(f"a passive arm started at {energy[0]:.1f} J gains {change[-1]:.0f} J in {steps * dt:.1f} s",
+              f"to {off:.0e} of the change".replace("e-0", "e-"), f"(the trapezoid's error, the test allowing "
+              f"{WORK_TOLERANCE:.0e}".replace("e-0", "e-"))
     # The antisymmetric part alone (a curl field) does none: the symmetric part does it all.
     b = np.asarray(PUBLISHED_VISCOUS_B)
     assert np.allclose(np.einsum("ni,ij,nj->n", v, (b - b.T) / 2.0, v), 0.0, atol=1e-12)
@@ -213,3 +228,16 @@ def test_channel_holds_the_hand_on_its_line_and_lets_it_run_along():
     fx, fy = channel.force(0.1, 0.5, -0.8, 0.6, 0.0)  # moving left across the line at 1 m/s
     assert (fx, fy) == pytest.approx((50.0 * 0.8, -50.0 * 0.6))
     assert channel.lateral(0.1, 0.5, -0.8, 0.6) == pytest.approx(-50.0)
+
+
+def _doc_says(*phrases: str) -> None:
+    doc = " ".join((Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8").split())
+    for phrase in phrases:
+        assert phrase in doc, f"docs/lab.md should say {phrase!r}"
+
+
+def test_the_docs_quote_these_tests():
+    """docs/lab.md states these tests' tolerances as what they check: the text and the constants are one."""
+    _doc_says(f"gives the same joint accelerations to {MUJOCO_TOLERANCE:.0e})".replace("e-0", "e-"),
+              f"a passive arm's energy with b = {STRONG_CURL:g} N s/m on holds as well as with it off (relative "
+              f"change below {DRIFT_TOLERANCE:.0e} over {DRIFT_DT * DRIFT_STEPS:g} s)".replace("e-0", "e-"))

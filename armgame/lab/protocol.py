@@ -71,9 +71,9 @@ VISCOUS_SCALE = 0.125
 VISCOUS_B = tuple(tuple(VISCOUS_SCALE * v for v in row) for row in PUBLISHED_VISCOUS_B)
 #: The force channel of error-clamp trials (docs/lab.md): this arm's lightest endpoint mass is 0.77 kg
 #: (a human arm's), its fields push with about 1 N, so the low end of the robots' 2,000-6,000 N/m holds
-#: the hand within about 0.5 mm of the line (2% of the field's 2.9 cm deflection), and the robots' 50 N s/m
-#: damps it (damping ratio 0.64 at the lightest mass). ``LabSession`` checks a protocol's channel
-#: against the physics step: its fastest mode must satisfy |lambda| dt <= ``MAX_CHANNEL_LAMBDA_DT``.
+#: the hand within about 1 mm of the line (tests/test_lab.py; the field deflects a free reach by 2.9 cm),
+#: and the robots' 50 N s/m damps it (damping ratio 0.64 at the lightest mass). ``LabSession`` checks a
+#: protocol's channel against the physics step: its fastest mode must satisfy |lambda| dt <= ``MAX_CHANNEL_LAMBDA_DT``.
 CHANNEL_STIFFNESS = 2000.0
 CHANNEL_DAMPING = 50.0
 MAX_CHANNEL_LAMBDA_DT = 1.0
