@@ -1,7 +1,7 @@
 """The one thing pyproject.toml cannot say: how to build the optional compiled loops.
 
 ``armgame/game/_ckernel.c`` (the batched games), ``armgame/game/_cbots.c`` (the bots' forward
-model) and ``armgame/env/_cobs.c`` (Reach-v1's observations of a batch) must compute exactly what
+model) and ``armgame/env/_cvector.c`` (Reach-v1's observations of a batch) must compute exactly what
 the Python code computes, so their build turns off floating-point
 contraction (no fused multiply-add) and the compiler's own sin and cos (no merging them into
 sincos; ``_ckernel.c`` calls glibc's sincos itself, after checking it against sin and cos): see
@@ -30,6 +30,6 @@ setup(
                                                      "armgame/game/_clanes.c"],
                            depends=["armgame/game/_ckernel.h"], optional=True),
                  Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True),
-                 Extension("armgame.env._cobs", ["armgame/env/_cobs.c"], optional=True)],
+                 Extension("armgame.env._cvector", ["armgame/env/_cvector.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},
 )

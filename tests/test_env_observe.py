@@ -12,7 +12,7 @@ from armgame.game.batch import BatchGameSession
 from armgame.game.rules import GameConfig
 
 needs_build = pytest.mark.skipif(not (features._c_observe_v1 or os.environ.get("ARMGAME_REQUIRE_COMPILED")),
-                                 reason="armgame.env._cobs is not built here")
+                                 reason="armgame.env._cvector is not built here")
 
 
 def played_batch(n=48, steps=40):
@@ -83,3 +83,23 @@ def test_wrap_angles_fast_path_is_the_general_formula():
     mixed = np.array([0.0, 7.0, -math.pi, 3.2, -40.0])
     assert np.array_equal(features.wrap_angles(mixed), np.where(np.abs(mixed) <= math.pi, mixed, np.clip(
         mixed - math.tau * np.rint(mixed / math.tau), -math.pi, math.pi)))
+
+
+@needs_build
+def test_the_compiled_keys_are_set_held():
+    """``hold_keys``, which the discrete vector envs call, changes what ``set_held`` changes, to the bit: games
+    over untouched, keys unchanged keep their goal and rate (here a level set before, not 0 or 1)."""
+    batches = [played_batch(n=40, steps=3) for _ in range(2)]
+    rng = np.random.default_rng(5)
+    levels = rng.uniform(0.0, 1.0, (40, 4))
+    for batch in batches:
+        batch.set_levels(levels)
+        batch.steps[[3, 17]] = batch.total_steps[[3, 17]]  # over: neither may touch them
+    for _ in range(3):
+        pressed = rng.integers(0, 2, (40, 4)).astype(bool)
+        batches[0].set_held(pressed)
+        b = batches[1]
+        features._c_hold_keys(pressed, b.steps, b.total_steps, b._held, b._goal, b._rate, b._rise, b._decay)
+        for name in ("_held", "_goal", "_rate"):
+            assert getattr(batches[0], name).tobytes() == getattr(b, name).tobytes(), name
+    assert not np.all(batches[0]._goal == batches[0]._held)  # some goals are still the levels

@@ -38,12 +38,15 @@ from ..physics.params import TwoJointParams
 from .errors import EnvArgumentError
 
 try:
-    from . import _cobs  # armgame/env/_cobs.c, built by pip install where a C compiler exists
+    from . import _cvector  # armgame/env/_cvector.c, built by pip install where a C compiler exists
 except ImportError:
-    _cobs = None
-#: ``_cobs.observe_v1``, unless not built or built from another version of _cobs.c (its calling convention
-#: may differ): then ``observe_v1`` runs numpy.
-_c_observe_v1 = _cobs.observe_v1 if getattr(_cobs, "VERSION", None) == 1 else None
+    _cvector = None
+if getattr(_cvector, "VERSION", None) != 1:  # not built, or built from another _cvector.c: its calling convention
+    _cvector = None                            # may differ, so numpy's twins run
+#: ``_cvector.observe_v1`` (None: ``observe_v1`` runs numpy).
+_c_observe_v1 = None if _cvector is None else _cvector.observe_v1
+#: ``_cvector.hold_keys``: ``BatchGameSession.set_held`` in one pass, for the vector envs (None: they call it).
+_c_hold_keys = None if _cvector is None else _cvector.hold_keys
 
 #: Reward per metre of progress toward the current target's edge (1 per 10 cm).
 DEFAULT_PROGRESS_WEIGHT = 10.0
@@ -148,14 +151,14 @@ def observe_v1(arm: TwoJointParams, radius: float, x: np.ndarray, trig: np.ndarr
 
     ``x``: rows q1, q2, w1, w2 (a batch's state, at least 4 rows of n); ``trig``: rows cos q1, sin q1,
     cos(q1 + q2), sin(q1 + q2) (``BatchGameSession.hand_trig``); ``activation``: the 4 muscles' rows (4, n);
-    ``steps``, ``total_steps``: int64. ``compiled``: ``_cobs.c``'s one pass (None: where built), else numpy's
+    ``steps``, ``total_steps``: int64. ``compiled``: ``_cvector.c``'s one pass (None: where built), else numpy's
     passes; the two give the same bits (tests/test_env_observe.py).
     """
     if compiled is None:
         compiled = _c_observe_v1 is not None
     if compiled:
         if _c_observe_v1 is None:
-            raise RuntimeError("armgame.env._cobs is not built (reinstall with a C compiler: pip install -e .)")
+            raise RuntimeError("armgame.env._cvector is not built (reinstall with a C compiler: pip install -e .)")
         _c_observe_v1(x, trig, activation, target_x, target_y, steps, total_steps, obs, edges,
                       float(arm.l1), float(arm.l2), float(radius))
         return
