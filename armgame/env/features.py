@@ -37,6 +37,17 @@ from ..game.rules import GameConfig
 from ..physics.params import TwoJointParams
 from .errors import EnvArgumentError
 
+try:
+    from . import _cvector  # armgame/env/_cvector.c, built by pip install where a C compiler exists
+except ImportError:
+    _cvector = None
+if getattr(_cvector, "VERSION", None) != 1:  # not built, or built from another _cvector.c: its calling convention
+    _cvector = None                            # may differ, so numpy's twins run
+#: ``_cvector.observe_v1`` (None: ``observe_v1`` runs numpy).
+_c_observe_v1 = None if _cvector is None else _cvector.observe_v1
+#: ``_cvector.hold_keys``: ``BatchGameSession.set_held`` in one pass, for the vector envs (None: they call it).
+_c_hold_keys = None if _cvector is None else _cvector.hold_keys
+
 #: Reward per metre of progress toward the current target's edge (1 per 10 cm).
 DEFAULT_PROGRESS_WEIGHT = 10.0
 #: Reward per hit, on top of the progress that reached it.
@@ -124,30 +135,68 @@ def reach_bounds_v1(config: GameConfig, joint_speed: float) -> tuple[np.ndarray,
 
 def wrap_angles(q: np.ndarray) -> np.ndarray:
     """Angles in [-pi, pi]: themselves when already there, else ``q - 2 pi round(q / 2 pi)``."""
+    # The usual case, every angle already in range, costs two reductions instead of six passes and three arrays.
+    if q.size and -math.pi <= q.min() and q.max() <= math.pi:
+        return q
     wrapped = q - math.tau * np.rint(q / math.tau)
     np.clip(wrapped, -math.pi, math.pi, out=wrapped)
     return np.where(np.abs(q) <= math.pi, q, wrapped)
 
 
-def reach_observations_v1(arm: TwoJointParams, hand: tuple[np.ndarray, np.ndarray], q1: np.ndarray,
-                          q2: np.ndarray, w1: np.ndarray, w2: np.ndarray, activation: np.ndarray,
-                          target_x: np.ndarray, target_y: np.ndarray, time_left_fraction: np.ndarray,
-                          dtype: str = "float32", trig: np.ndarray | None = None) -> np.ndarray:
-    """Reach-v1 observations, one row per game; ``hand`` is ``BatchGameSession.hand()``, ``activation`` (n, 4),
-    ``trig`` as ``hand_velocity``'s."""
-    hx, hy = hand
-    vx, vy = hand_velocity(arm, q1, q2, w1, w2, trig)
-    obs = np.empty((len(q1), 15), dtype=dtype)
+def observe_v1(arm: TwoJointParams, radius: float, x: np.ndarray, trig: np.ndarray, activation: np.ndarray,
+               target_x: np.ndarray, target_y: np.ndarray, steps: np.ndarray, total_steps: np.ndarray,
+               obs: np.ndarray, edges: np.ndarray | None = None, compiled: bool | None = None) -> None:
+    """Reach-v1 observations of ``n`` games into ``obs`` ((n, 15), float32 or float64, C-contiguous) and,
+    unless None, the hands' distances to their targets' edges (``edge_distance``) into ``edges`` (n,).
+
+    ``x``: rows q1, q2, w1, w2 (a batch's state, at least 4 rows of n); ``trig``: rows cos q1, sin q1,
+    cos(q1 + q2), sin(q1 + q2) (``BatchGameSession.hand_trig``); ``activation``: the 4 muscles' rows (4, n);
+    ``steps``, ``total_steps``: int64. ``compiled``: ``_cvector.c``'s one pass (None: where built), else numpy's
+    passes; the two give the same bits (tests/test_env_observe.py).
+    """
+    if compiled is None:
+        compiled = _c_observe_v1 is not None
+    if compiled:
+        if _c_observe_v1 is None:
+            raise RuntimeError("armgame.env._cvector is not built (reinstall with a C compiler: pip install -e .)")
+        _c_observe_v1(x, trig, activation, target_x, target_y, steps, total_steps, obs, edges,
+                      float(arm.l1), float(arm.l2), float(radius))
+        return
+    l1, l2 = arm.l1, arm.l2
+    q1, q2, w1, w2 = x[0], x[1], x[2], x[3]
+    c1, s1, c12, s12 = trig[0], trig[1], trig[2], trig[3]
+    # The hand once, for both the observation and the distance; products into scratch arrays, no temporaries.
+    hx = l1 * c1
+    scratch = np.multiply(l2, c12)
+    hx += scratch
+    hy = np.multiply(l1, s1)
+    hy += np.multiply(l2, s12, out=scratch)
     obs[:, 0] = wrap_angles(q1)
     obs[:, 1] = wrap_angles(q2)
     obs[:, 2] = w1
     obs[:, 3] = w2
-    obs[:, 4:8] = activation
+    obs[:, 4:8] = activation.T
     obs[:, 8] = hx
     obs[:, 9] = hy
-    obs[:, 10] = vx
-    obs[:, 11] = vy
-    obs[:, 12] = target_x - hx
-    obs[:, 13] = target_y - hy
-    obs[:, 14] = time_left_fraction
-    return obs
+    # hand_velocity's operations, in its order: (-l1 s1) w1 - (l2 s12) w12 and (l1 c1) w1 + (l2 c12) w12.
+    w12 = w1 + w2
+    v = np.multiply(-l1, s1)
+    v *= w1
+    np.multiply(l2, s12, out=scratch)
+    scratch *= w12
+    v -= scratch
+    obs[:, 10] = v
+    np.multiply(l1, c1, out=v)
+    v *= w1
+    np.multiply(l2, c12, out=scratch)
+    scratch *= w12
+    v += scratch
+    obs[:, 11] = v
+    obs[:, 12] = np.subtract(target_x, hx, out=v)
+    obs[:, 13] = np.subtract(target_y, hy, out=scratch)
+    obs[:, 14] = (total_steps - np.minimum(steps, total_steps)) / total_steps
+    if edges is not None:
+        # hypot's sign-symmetric, so the way to the target serves as the distance's legs.
+        np.hypot(v, scratch, out=edges)
+        edges -= radius
+        np.maximum(0.0, edges, out=edges)

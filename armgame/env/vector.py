@@ -30,12 +30,13 @@ from gymnasium.vector.utils import batch_space
 
 from ..game.batch import BatchGameSession
 from ..game.rules import GameConfig
+from . import features
 from .features import (
     DEFAULT_HIT_BONUS,
     DEFAULT_PROGRESS_WEIGHT,
     edge_distance,
     muscle_levels,
-    reach_observations_v1,
+    observe_v1,
     wrap_angles,
 )
 from .reach import (
@@ -285,7 +286,11 @@ class ReachVectorEnv(VectorEnv):
             batch.set_levels(actions[:, :4])
             press = actions[:, 4] >= 0.5 if self._width == 5 else None
         else:
-            batch.set_held(actions[:, :4])
+            if features._c_hold_keys is None:
+                batch.set_held(actions[:, :4])
+            else:  # set_held's numpy passes were a tenth of a step at 8,192 games; the same copies in one pass
+                features._c_hold_keys(np.ascontiguousarray(actions[:, :4]), batch.steps, batch.total_steps,
+                                      batch._held, batch._goal, batch._rate, batch._rise, batch._decay)
             press = actions[:, 4] if self._width == 5 else None
         if press is not None and press.any():
             batch.reset_arms(press)
@@ -356,12 +361,23 @@ class ReachV1VectorEnv(ReachVectorEnv):
                                     progress_weight, hit_bonus, observation_dtype)
         self._configure(num_envs, settings, render_mode, render_size, autoreset_mode)
         self._edges = np.zeros(self.num_envs)
+        self._edges_new = np.zeros(self.num_envs)
+        # This step's observations, measured with the distances for the dense reward (one pass over each
+        # batch: the hand and its trig once, where the observation and the reward each took them): valid until
+        # a game restarts, and handed out once, as each step returns a new array.
+        self._measured: np.ndarray | None = None
+
+    def _measure(self, part: slice, batch: BatchGameSession, obs: np.ndarray, edges: np.ndarray | None) -> None:
+        """Part ``part``'s observation rows into ``obs[part]`` and, unless None, its edge distances into ``edges``."""
+        observe_v1(self.config.arm, self.config.target_radius, batch._xs, batch.hand_trig(), batch._act,
+                   batch.target_x, batch.target_y, batch.steps, batch.total_steps, obs[part], edges)
 
     def _edges_now(self, batch: BatchGameSession) -> np.ndarray:
         hx, hy = batch.hand()
         return edge_distance(hx, hy, batch.target_x, batch.target_y, self.config.target_radius)
 
     def _started(self, games: np.ndarray) -> None:
+        self._measured = None  # restarted games have new states and targets
         for part, batch in self.parts:
             self._edges[part] = np.where(games[part], self._edges_now(batch), self._edges[part])
 
@@ -369,19 +385,30 @@ class ReachV1VectorEnv(ReachVectorEnv):
         s = self.settings
         if s.reward == "sparse":
             return super()._rewards(part, batch, hits, resets)
-        before = self._edges[part].copy()
-        self._edges[part] = now = self._edges_now(batch)
-        progress = before - np.where(hits > 0, 0.0, now)
-        return s.progress_weight * progress + s.hit_bonus * hits - self.config.reset_cost * resets
+        if part.start == 0:
+            self._measured = np.empty((self.num_envs, 15), dtype=s.observation_dtype)
+        now = self._edges_new[part]
+        self._measure(part, batch, self._measured, now)  # type: ignore[arg-type]
+        before = self._edges[part]
+        # before - where(hits > 0, 0, now), its bits: x - 0.0 is x.
+        progress = before - now
+        hit = hits > 0
+        if hit.any():
+            progress[hit] = before[hit]
+        before[...] = now
+        progress *= s.progress_weight
+        progress += s.hit_bonus * hits
+        if self.config.reset_cost:
+            progress -= self.config.reset_cost * resets
+        return progress
 
     def _observations(self) -> np.ndarray:
-        dtype = self.settings.observation_dtype
-        obs = np.empty((self.num_envs, 15), dtype=dtype)
+        obs, self._measured = self._measured, None
+        if obs is not None:
+            return obs
+        obs = np.empty((self.num_envs, 15), dtype=self.settings.observation_dtype)
         for part, batch in self.parts:
-            left = (batch.total_steps - np.minimum(batch.steps, batch.total_steps)) / batch.total_steps
-            obs[part] = reach_observations_v1(self.config.arm, batch.hand(), batch.q1, batch.q2, batch.w1, batch.w2,
-                                              batch.activation, batch.target_x, batch.target_y, left, dtype,
-                                              batch.hand_trig())
+            self._measure(part, batch, obs, None)
         return obs
 
 
