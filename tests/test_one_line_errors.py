@@ -303,6 +303,21 @@ def test_verify_of_a_hit_storm_is_one_line_in_bounded_time(tmp_path, capsys, sma
     assert "matches" in capsys.readouterr().out.splitlines()[-1]
 
 
+def test_a_headless_replay_of_a_hit_storm_is_one_line_in_bounded_time(tmp_path, capsys, small_budget):
+    import time
+
+    path = tmp_path / "storm.json"
+    _storm(5000).save(path)
+    start = time.perf_counter()
+    (line,) = error_lines(capsys, ["replay", "--headless", path])
+    assert time.perf_counter() - start < 2.0
+    assert line.startswith(f"armgame replay: error: {path}: not replayed: by step ")
+    assert line.endswith("its targets keep landing on the hand (--max-work N spends up to N)")
+    _storm(150).save(path)  # past the default budget, within a --max-work that asks for more
+    assert main(["replay", "--headless", str(path), "--max-work", "1000000"]) == 0
+    assert "score 150 (150 hits, 0 resets), as recorded" in capsys.readouterr().out
+
+
 def test_verify_of_a_folder_or_a_table_goes_on_past_a_hit_storm(tmp_path, capsys, small_budget):
     from armgame.records.scores import ScoreTable
 

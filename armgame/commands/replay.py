@@ -6,6 +6,7 @@ import argparse
 
 from ..words import plural
 from . import read_lab_replays
+from .verify import work_arg
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,6 +23,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("file", metavar="FILE", help="the replay file (JSON)")
     p.add_argument("--headless", action="store_true", help="no window: recompute the game at once")
+    p.add_argument("--max-work", type=work_arg, metavar="N",
+                   help="with --headless: recompute no game whose replay counts more than N steps of work "
+                        "(default: the budget armgame verify spends; a hit storm of a stranger's stops there)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     add_window_options(p, sound=True, trail=True)
     p.add_argument("--fps", type=int, default=60, help="frame-rate cap of the window (default: 60)")
@@ -38,7 +42,14 @@ def run(args: argparse.Namespace) -> int:
     read_lab_replays()
     replay = Replay.load(user_path(args.file, "FILE"))
     if args.headless:
-        result = replay.replay()
+        from .. import limits  # read now: the budget is the one verify spends
+        from ..records.replay import VerifyCostError
+
+        limit = limits.MAX_VERIFY_WORK if args.max_work is None else args.max_work
+        try:
+            result = replay.replay(max_work=limit)
+        except VerifyCostError as exc:
+            raise UserError(f"{args.file}: not replayed: {exc} (--max-work N spends up to N)") from None
         played = result.steps
     else:
         if not 1 <= args.fps <= 1000:

@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "table, 3 if nothing differs but some games were left unchecked (--max-work).",
     )
     p.add_argument("file", metavar="FILE", help="a replay file, a scores.json, a scores folder or a folder of replays")
-    p.add_argument("--max-work", type=_work_arg, metavar="N", help="check no game whose replay counts more than N "
+    p.add_argument("--max-work", type=work_arg, metavar="N", help="check no game whose replay counts more than N "
                    "physics steps of work (its steps, 100 a claimed hit under the standard rules and 6,000 under "
                    "others, 20 an input event: counted before it runs; a standard game is 15,000 and its hits and "
                    "events): such games are reported NOT CHECKED. For a folder from a stranger: bounds the run "
@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
-def _work_arg(text: str) -> int:
+def work_arg(text: str) -> int:
     try:
         value = int(text)
     except ValueError:

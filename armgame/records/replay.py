@@ -339,11 +339,14 @@ class Replay:
         return Replay(self.config, self.timeline, self.result, self.driven, self.driver, check_name(player),
                       self.date, self.version, self.task)
 
-    def replay(self) -> GameResult:
-        """Recompute the result: the timeline replayed on a fresh session, no clock."""
+    def replay(self, max_work: int | None = None) -> GameResult:
+        """Recompute the result: the timeline replayed on a fresh session, no clock. With ``max_work``, a game
+        that would cost more (``verify``'s units: a hit storm) raises ``VerifyCostError`` on the way."""
         if self.task is not None:
             return self.task.session(self.config, self.timeline, self.result.steps).result()
-        return GameSession(self.config).play(self.timeline, self.result.steps)
+        if max_work is None:
+            return GameSession(self.config).play(self.timeline, self.result.steps)
+        return self._run(max_work, stop_at_excess=False)
 
     def verify(self, max_work: int | None = MAX_VERIFY_WORK) -> tuple[bool, GameResult]:
         """Replay and compare. Bounded: the game is at most ``MAX_GAME_STEPS`` long (checked at load),
@@ -359,6 +362,12 @@ class Replay:
         if self.task is not None:
             ok, recomputed, _ = self.task.verify(self.config, self.timeline, self.result)
             return ok, recomputed
+        recomputed = self._run(max_work, stop_at_excess=True)
+        return same_outcome(recomputed, self.result), recomputed
+
+    def _run(self, max_work: int | None, stop_at_excess: bool) -> GameResult:
+        """The game replayed in chunks within ``max_work``; ``stop_at_excess``: stop once it scores more hits
+        or resets than recorded (a verifier's answer is known then)."""
         claimed = self.result
         fixed = EVENT_WORK * len(self.timeline)
         if max_work is not None and claimed.steps + fixed > max_work:
@@ -383,10 +392,9 @@ class Replay:
                 chunk = min(chunk, max(1, left // (1 + TRY_WORK * MAX_TRIES)))
             step = min(step + chunk, claimed.steps)
             feed.run_to(session, step)
-            if board.hits > claimed.hits or board.resets > claimed.resets:
+            if stop_at_excess and (board.hits > claimed.hits or board.resets > claimed.resets):
                 break
-        recomputed = session.result()
-        return same_outcome(recomputed, self.result), recomputed
+        return session.result()
 
     # ------------------------------------------------------------------ files
     def as_dict(self) -> dict[str, object]:
