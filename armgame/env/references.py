@@ -14,63 +14,67 @@ from typing import Any
 
 REFERENCE_HITS: dict[str, dict[str, Any]] = {
     "armgame/Reach-v1": {
-        "random": 0.53, "naive": 20.03, "model": 53.21, "ppo": 68.145, "ppo_seeds": [67.23, 69.06], "random_first":
-        [0, 1, 0, 0, 1], "model_first": [53, 52, 54, 55, 55]
+        "random": 0.53, "naive": 20.03, "model": 53.21, "ppo": 69.6867, "ppo_seeds": [67.23, 69.06, 72.77],
+        "random_first": [0, 1, 0, 0, 1], "model_first": [53, 52, 54, 55, 55]
     },
     "armgame/ReachContinuous-v1": {
-        "random": 0.37, "naive": 20.03, "model": 53.21, "random_first": [0, 0, 0, 0, 0], "model_first": [53, 52, 54,
-        55, 55]
+        "random": 0.37, "naive": 20.03, "model": 53.21, "ppo": 68.7133, "ppo_seeds": [68.45, 68.21, 69.48],
+        "random_first": [0, 0, 0, 0, 0], "model_first": [53, 52, 54, 55, 55]
     },
     "armgame/CenterOut-v1": {
-        "random": 0.28, "naive": 1.57, "model": 8.0, "random_first": [2, 0, 1, 0, 0], "model_first": [8, 8, 8, 8, 8]
+        "random": 0.28, "naive": 1.57, "model": 8.0, "ppo": 8.0, "ppo_seeds": [8.0, 8.0, 8.0], "random_first": [2,
+        0, 1, 0, 0], "model_first": [8, 8, 8, 8, 8]
     },
     "armgame/CenterOutContinuous-v1": {
-        "random": 0.43, "naive": 1.57, "model": 8.0, "random_first": [0, 0, 0, 1, 1], "model_first": [8, 8, 8, 8, 8]
+        "random": 0.43, "naive": 1.57, "model": 8.0, "ppo": 8.0, "ppo_seeds": [8.0, 8.0, 8.0], "random_first": [0,
+        0, 0, 1, 1], "model_first": [8, 8, 8, 8, 8]
     },
     "armgame/ReachHold-v1": {
-        "random": 0.46, "naive": 8.29, "model": 45.87, "ppo": 60.805, "ppo_seeds": [60.92, 60.69], "random_first":
-        [0, 1, 0, 0, 1], "model_first": [45, 45, 47, 47, 47]
+        "random": 0.46, "naive": 8.29, "model": 45.87, "ppo": 61.3, "ppo_seeds": [60.92, 60.69, 62.29],
+        "random_first": [0, 1, 0, 0, 1], "model_first": [45, 45, 47, 47, 47]
     },
     "armgame/ReachHoldContinuous-v1": {
-        "random": 0.39, "naive": 8.29, "model": 45.87, "random_first": [0, 0, 0, 0, 0], "model_first": [45, 45, 47,
-        47, 47]
+        "random": 0.39, "naive": 8.29, "model": 45.87, "ppo": 62.4033, "ppo_seeds": [61.6, 62.27, 63.34],
+        "random_first": [0, 0, 0, 0, 0], "model_first": [45, 45, 47, 47, 47]
     },
     "armgame/ReachNoisy-v1": {
-        "random": 0.8, "naive": 20.76, "model": 51.39, "ppo": 68.575, "ppo_seeds": [67.05, 70.1], "random_first":
-        [0, 1, 2, 0, 0], "model_first": [52, 48, 54, 52, 52]
+        "random": 0.8, "naive": 20.76, "model": 51.39, "ppo": 68.5867, "ppo_seeds": [67.05, 70.1, 68.61],
+        "random_first": [0, 1, 2, 0, 0], "model_first": [52, 48, 54, 52, 52]
     },
     "armgame/ReachNoisyContinuous-v1": {
-        "random": 0.61, "naive": 20.76, "model": 51.39, "random_first": [0, 0, 0, 1, 0], "model_first": [52, 48, 54,
-        52, 52]
+        "random": 0.61, "naive": 20.76, "model": 51.39, "ppo": 66.6433, "ppo_seeds": [63.76, 70.13, 66.04],
+        "random_first": [0, 0, 0, 1, 0], "model_first": [52, 48, 54, 52, 52]
     },
     "armgame/ReachDelay-v1": {
-        "random": 0.53, "naive": 14.36, "model": 30.75, "ppo": 60.755, "ppo_seeds": [60.28, 61.23], "random_first":
-        [0, 1, 0, 0, 1], "model_first": [26, 32, 31, 33, 35]
+        "random": 0.53, "naive": 14.36, "model": 30.75, "ppo": 62.7867, "ppo_seeds": [60.28, 61.23, 66.85],
+        "random_first": [0, 1, 0, 0, 1], "model_first": [26, 32, 31, 33, 35]
     },
     "armgame/ReachDelayContinuous-v1": {
-        "random": 0.37, "naive": 14.36, "model": 30.75, "random_first": [0, 0, 0, 0, 0], "model_first": [26, 32, 31,
-        33, 35]
+        "random": 0.37, "naive": 14.36, "model": 30.75, "ppo": 53.46, "ppo_seeds": [48.81, 63.54, 48.03],
+        "random_first": [0, 0, 0, 0, 0], "model_first": [26, 32, 31, 33, 35]
     },
     "armgame/ReachField-v1": {
-        "random": 0.51, "naive": 19.2, "model": 45.63, "ppo": 75.685, "ppo_seeds": [77.02, 74.35], "random_first":
-        [1, 1, 0, 0, 1], "model_first": [45, 44, 46, 50, 48]
+        "random": 0.51, "naive": 19.2, "model": 45.63, "ppo": 76.4333, "ppo_seeds": [77.02, 74.35, 77.93],
+        "random_first": [1, 1, 0, 0, 1], "model_first": [45, 44, 46, 50, 48]
     },
     "armgame/ReachFieldContinuous-v1": {
-        "random": 0.43, "naive": 19.2, "model": 45.63, "random_first": [0, 0, 0, 2, 0], "model_first": [45, 44, 46,
-        50, 48]
+        "random": 0.43, "naive": 19.2, "model": 45.63, "ppo": 69.0533, "ppo_seeds": [60.72, 76.12, 70.32],
+        "random_first": [0, 0, 0, 2, 0], "model_first": [45, 44, 46, 50, 48]
     },
     "armgame/ReachHard-v1": {
-        "random": 0.21, "naive": 0.17, "model": 7.24, "ppo": 30.35, "ppo_seeds": [30.35], "random_first": [0, 0, 0,
-        0, 0], "model_first": [7, 9, 9, 10, 8]
+        "random": 0.21, "naive": 0.17, "model": 7.24, "ppo": 28.6733, "ppo_seeds": [30.35, 35.45, 20.22],
+        "random_first": [0, 0, 0, 0, 0], "model_first": [7, 9, 9, 10, 8]
     },
     "armgame/ReachHardContinuous-v1": {
-        "random": 0.23, "naive": 0.17, "model": 7.24, "random_first": [0, 0, 0, 0, 0], "model_first": [7, 9, 9, 10,
-        8]
+        "random": 0.23, "naive": 0.17, "model": 7.24, "ppo": 38.9067, "ppo_seeds": [37.6, 38.99, 40.13],
+        "random_first": [0, 0, 0, 0, 0], "model_first": [7, 9, 9, 10, 8]
     },
     "armgame/CenterOutHold-v1": {
-        "random": 0.0, "naive": 0.0, "model": 8.0, "random_first": [0, 0, 0, 0, 0], "model_first": [8, 8, 8, 8, 8]
+        "random": 0.0, "naive": 0.0, "model": 8.0, "ppo": 7.88, "ppo_seeds": [8.0, 8.0, 7.64], "random_first": [0,
+        0, 0, 0, 0], "model_first": [8, 8, 8, 8, 8]
     },
     "armgame/CenterOutHoldContinuous-v1": {
-        "random": 0.02, "naive": 0.0, "model": 8.0, "random_first": [0, 0, 0, 0, 0], "model_first": [8, 8, 8, 8, 8]
+        "random": 0.02, "naive": 0.0, "model": 8.0, "ppo": 8.0, "ppo_seeds": [8.0, 8.0, 8.0], "random_first": [0, 0,
+        0, 0, 0], "model_first": [8, 8, 8, 8, 8]
     },
 }
