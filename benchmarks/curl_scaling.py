@@ -20,11 +20,10 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
-from pathlib import Path
 
 import numpy as np
+from doc_text import Claims
 
 from armgame.game.bots import Autopilot
 from armgame.game.muscles import ELBOW_MAX_TORQUE, SHOULDER_MAX_TORQUE
@@ -36,15 +35,8 @@ SEED, REACHES = 3, 16
 CURL_BS = (1.0, 2.0, 3.0, 4.0, 6.0)
 CHOSEN_B = 2.0
 VISCOUS_SCALES = (1.0, 0.5, 1.5)  # times the preset's matrix
-DOC = re.sub(r"\s+", " ", (Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8"))
-failures: list[str] = []
-
-
-def says(phrase: str) -> None:
-    ok = phrase in DOC
-    print(f"  {'ok     ' if ok else 'DIFFERS'} {phrase}")
-    if not ok:
-        failures.append(phrase)
+CLAIMS = Claims()
+DOC, failures, says = CLAIMS.text, CLAIMS.failures, CLAIMS.says
 
 
 def perpendicular(session: LabSession, outcome) -> float:

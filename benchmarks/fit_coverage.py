@@ -19,12 +19,11 @@ moves a coverage by one draw in 200 must be written into the doc.
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
+from doc_text import LAB_DOC
 
 from armgame.lab.fit import SYMBOLS, compare
 from armgame.lab.learner import TwoRateLearner, simulate
@@ -40,7 +39,7 @@ GAIN, NOISE = -0.02, 0.001
 LABELS = {"two-rate": ("two-rate, the bot's default rates", "a counter-field"),
           "one-rate": ("one-rate, A {retention:g}, B {rate:g}", "exposure, washout")}
 DOC_RUN = {"repeats": 200, "seed": 1}
-DOC = re.sub(r"\s+", " ", (Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8"))
+DOC = LAB_DOC
 
 
 def percent(share: float) -> str:

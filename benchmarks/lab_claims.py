@@ -20,12 +20,11 @@ at its printed precision, or "DIFFERS" with the text it should hold. Measured he
 
 from __future__ import annotations
 
-import re
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
+from doc_text import Claims
 
 from armgame.game.bots import Autopilot, MotorNoise
 from armgame.lab.analysis import block_summary, channel_summary, figure_metric, fit_schedule, trial_rows
@@ -34,16 +33,9 @@ from armgame.lab.fit import compare
 from armgame.lab.protocol import HUMAN_NOISE, PRESET_MOTOR_NOISE, Block, Perturbation, Protocol, preset
 from armgame.lab.session import LabSession, lab_config
 
-DOC = re.sub(r"\s+", " ", (Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8"))
+CLAIMS = Claims()
+DOC, failures, says = CLAIMS.text, CLAIMS.failures, CLAIMS.says
 SEEDS = (10, 1, 2)
-failures: list[str] = []
-
-
-def says(phrase: str) -> None:
-    ok = phrase in DOC
-    print(f"  {'ok     ' if ok else 'DIFFERS'} {phrase}")
-    if not ok:
-        failures.append(phrase)
 
 
 def play(protocol: Protocol, seed: int, bot: str = "adaptive", noise: MotorNoise | str | None = "preset",
