@@ -78,24 +78,39 @@ def write(path: Path, env_id: str, policy: str, hits: tuple[int, ...], seconds: 
     path.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
 
 
-def table(folder: Path) -> str:
-    records: dict[str, dict[str, dict]] = {}
+def references_of(folder: Path, first: int = 5) -> dict[str, dict[str, Any]]:
+    """Each id's reference entry from the runs in ``folder``, in ``IDS``' order (an id whose three bots have not all
+    run is left out): mean hits by policy (PPO: the mean of its seeds' means) and the first ``first`` games'
+    hits of random and the model bot, which the tests replay. The table and references.py are both this."""
+    runs: dict[str, dict[str, dict]] = {}
     for path in sorted(folder.glob("*.json")):
         r = json.loads(path.read_text(encoding="utf-8"))
-        records.setdefault(r["env_id"], {})[r["policy"]] = r
-    lines = ["| id | random | naive bot | model bot | PPO: mean (each training seed) | PPO normalised |",
-             "|---|---|---|---|---|---|"]
-    for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
-        row = records[env_id]
-        if not {"random", "naive", "model"} <= set(row):  # its bots' runs are not all done
+        runs.setdefault(r["env_id"], {})[r["policy"]] = r
+    entries: dict[str, dict[str, Any]] = {}
+    for env_id in sorted(runs, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
+        row = runs[env_id]
+        if not {"random", "naive", "model"} <= set(row):
             continue
         ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
-        # As references.py keeps them, so that the normalised score here is the one evaluate() gives.
-        low, high = round(row["random"]["mean_hits"], 2), round(row["model"]["mean_hits"], 2)
-        cells = [f"{row[p]['mean_hits']:.1f}" for p in ("random", "naive", "model")]
+        entry: dict[str, Any] = {p: round(row[p]["mean_hits"], 2) for p in ("random", "naive", "model")}
         if ppo:
-            mean = round(float(np.mean(ppo)), 4)
-            cells.append(f"{mean:.1f} ({', '.join(f'{p:.1f}' for p in ppo)})")
+            entry["ppo"] = round(float(np.mean(ppo)), 4)
+            entry["ppo_seeds"] = [round(v, 2) for v in ppo]
+        entry["random_first"] = row["random"]["hits"][:first]
+        entry["model_first"] = row["model"]["hits"][:first]
+        entries[env_id] = entry
+    return entries
+
+
+def table(folder: Path) -> str:
+    """docs/programs.md's table: the reference entries, the normalised score as ``evaluate`` gives it."""
+    lines = ["| id | random | naive bot | model bot | PPO: mean (each training seed) | PPO normalised |",
+             "|---|---|---|---|---|---|"]
+    for env_id, entry in references_of(folder).items():
+        cells = [f"{entry[p]:.1f}" for p in ("random", "naive", "model")]
+        if "ppo" in entry:
+            low, high, mean = entry["random"], entry["model"], entry["ppo"]
+            cells.append(f"{mean:.1f} ({', '.join(f'{p:.1f}' for p in entry['ppo_seeds'])})")
             cells.append(f"{(mean - low) / (high - low):.2f}")
         else:
             cells += ["not measured", ""]
@@ -103,28 +118,10 @@ def table(folder: Path) -> str:
     return "\n".join(lines)
 
 
-def references(folder: Path, first: int = 5) -> str:
-    """``armgame/env/references.py``'s dict: each id's mean hits by policy (PPO: the mean of its seeds' means),
-    and the first ``first`` games' hits of random and the model bot, which the tests replay."""
-    records: dict[str, dict[str, dict]] = {}
-    for path in sorted(folder.glob("*.json")):
-        r = json.loads(path.read_text(encoding="utf-8"))
-        records.setdefault(r["env_id"], {})[r["policy"]] = r
-    table: dict[str, dict[str, Any]] = {}
-    for env_id in sorted(records, key=lambda i: IDS.index(i) if i in IDS else len(IDS)):
-        row = records[env_id]
-        if not {"random", "naive", "model"} <= set(row):
-            continue
-        ppo = [row[k]["mean_hits"] for k in sorted(row) if k.startswith("ppo-")]
-        entry = {p: round(row[p]["mean_hits"], 2) for p in ("random", "naive", "model")}
-        if ppo:
-            entry["ppo"] = round(float(np.mean(ppo)), 4)
-            entry["ppo_seeds"] = [round(v, 2) for v in ppo]
-        entry["random_first"] = row["random"]["hits"][:first]
-        entry["model_first"] = row["model"]["hits"][:first]
-        table[env_id] = entry
+def references(folder: Path) -> str:
+    """``armgame/env/references.py``'s dict, as Python source."""
     lines = ["REFERENCE_HITS: dict[str, dict[str, Any]] = {"]
-    for env_id, entry in table.items():
+    for env_id, entry in references_of(folder).items():
         items = ", ".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in entry.items())
         lines.append(f"    {json.dumps(env_id)}: {{")
         lines.append(textwrap.fill(items, width=116, initial_indent=" " * 8, subsequent_indent=" " * 8))

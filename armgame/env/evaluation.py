@@ -116,9 +116,17 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     import armgame.env  # noqa: F401  (registers the ids)
 
     if not isinstance(policy, str) and hasattr(policy, "predict"):
+        name = type(policy).__name__
         hits, scores, minutes = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
-        normalised = normalised_score(env_id, float(np.mean(hits))) if not env_kwargs else None
-        return Evaluation(env_id, type(policy).__name__, seeds, hits, scores, minutes, normalised)
+    else:
+        name, hits, scores, minutes = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs)
+    normalised = None if env_kwargs else normalised_score(env_id, float(np.mean(hits)))
+    return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised)
+
+
+def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
+                     env_kwargs: dict[str, Any]) -> tuple[str, tuple[int, ...], tuple[int, ...], float]:
+    """The games one after another in one single env: (the policy's name, hits, scores, minutes a game)."""
     env = gym.make(env_id, **env_kwargs)
     try:
         act, name = _policy(policy, env, deterministic)
@@ -134,13 +142,9 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
             hits.append(int(info["hits"]))
             scores.append(int(info.get("score", info["hits"])))
             durations.append(_game_minutes(env))
-        minutes = float(np.mean(durations))
     finally:
         env.close()
-    normalised = None
-    if not env_kwargs:
-        normalised = normalised_score(env_id, float(np.mean(hits)))
-    return Evaluation(env_id, name, seeds, tuple(hits), tuple(scores), minutes, normalised)
+    return name, tuple(hits), tuple(scores), float(np.mean(durations))
 
 
 #: Games a model's evaluation steps together: one ``predict`` call a step for all of them.

@@ -20,6 +20,7 @@ from ..game.bots import ReachingBot, make_bot
 from ..game.muscles import MuscleSet
 from ..game.rules import GameConfig, Target
 from ..game.session import DOWN
+from .features import hand_and_velocity
 
 
 class _Rules:
@@ -169,9 +170,7 @@ class CenterOutV1BotPolicy:
         self.config: GameConfig = lab_config(self.protocol, 0)
         self.decision_time = base.decision_steps * self.config.dt
         self.bot = ReachingBot(bot, interaction=bot == "model", control_period=self.decision_time)
-        p = self.config.arm
-        q1, q2 = self.config.start_posture
-        self.home = (p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2))
+        self.home = hand_and_velocity(self.config.arm, *self.config.start_posture, 0.0, 0.0)[:2]
         self._muscles = MuscleSet(self.config.muscles, self.config.dt)
         self._seen = _SeenGame(self.config, self._muscles, Target(*self.home, self.protocol.home_radius))
         self._decisions = 0

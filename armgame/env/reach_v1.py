@@ -158,7 +158,8 @@ class ReachV1Env(ReachEnv):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
         observation, info = super().reset(seed=seed, options=options)
-        self._edge = self._edge_now()
+        # The score reward's potential is 0 at the reset by convention, so its shaping sums to nothing.
+        self._edge = 0.0 if self.settings.reward == "score" else self._edge_now()
         self._score = 0
         if self._delayed is not None:
             observation = self._delayed.reset(observation)
@@ -206,9 +207,7 @@ class ReachV1Env(ReachEnv):
         session = self.session
         assert session is not None
         score, self._score = self._score, session.rules.board.score
-        first = session.steps <= self.decision_steps
-        before = 0.0 if first else self._edge
-        self._edge = 0.0 if session.over else self._edge_now()
+        before, self._edge = self._edge, 0.0 if session.over else self._edge_now()
         return float(self._score - score) + self.settings.progress_weight * (before - self._edge)
 
     def _observation(self) -> np.ndarray:

@@ -111,7 +111,8 @@ class ReachVariant:
     def session(self, config: GameConfig) -> GameSession:
         """The game of ``config`` with this variant's rules and physics."""
         rules: GameRules | None = DwellRules(config, self.hold_steps(config.dt)) if self.hold_time else None
-        session = GameSession(config, rules=rules)
+        # Noise rescales the muscles' moments between decisions, which only the Python loop reads afresh.
+        session = GameSession(config, compiled=not self.motor_noise, rules=rules)
         loads = self.loads()
         if loads is not None:
             # The session runs a step swapped in through its Python loop (the compiled one has no loads).
@@ -138,8 +139,8 @@ class MuscleNoise:
     """``ReachVariant.motor_noise`` on a session's muscles: ``apply`` before each decision's steps.
 
     The factors scale each muscle's moments (its force at full activation), so the force noise is
-    proportional to the activation, and the session then runs its Python loop, which reads the
-    moments afresh each call (the compiled loop packs them once)."""
+    proportional to the activation; ``ReachVariant.session`` gives a noisy game the Python loop, which reads
+    the moments afresh each call (the compiled loop packs them once)."""
 
     def __init__(self, level: float, seed: int, decision_time: float, session: GameSession) -> None:
         self.level = level
@@ -149,7 +150,6 @@ class MuscleNoise:
         # Started from its stationary spread, so the first decision is as noisy as the last.
         self.state = self._rng.standard_normal(4) * level
         self._moments = session.muscles.moments
-        session._compiled = None
 
     def apply(self, session: GameSession) -> None:
         self.state = self._keep * self.state + self._fresh * self._rng.standard_normal(4)

@@ -434,21 +434,23 @@ def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
     envs: below that size, and for a harder task or the score reward, which the batch does not play."""
     from .reach_v1 import ReachV1Env
 
-    native_reward = kwargs.get("reward", "dense") != "score"
-    return _chosen(ReachV1VectorEnv, ReachV1Env, _NATIVE_V1 if native_reward else frozenset(), num_envs, kwargs)
+    return _chosen(ReachV1VectorEnv, ReachV1Env, _NATIVE_V1, num_envs, kwargs)
 
 
 def batch_plays(env_id: str, kwargs: dict[str, Any]) -> bool:
     """Whether ``gymnasium.make_vec(env_id, num_envs=N, **kwargs)`` steps a batch from ``BATCH_MIN_ENVS`` games."""
     import gymnasium
 
-    entry = gymnasium.spec(env_id).vector_entry_point
-    arguments = {**gymnasium.spec(env_id).kwargs, **kwargs}
-    if entry == "armgame.env.vector:reach_vector_env":
-        return set(arguments) <= _NATIVE_V0
-    if entry == "armgame.env.vector:reach_v1_vector_env":
-        return set(arguments) <= _NATIVE_V1 and arguments.get("reward", "dense") != "score"
-    return False
+    spec = gymnasium.spec(env_id)
+    native = {"armgame.env.vector:reach_vector_env": _NATIVE_V0,
+              "armgame.env.vector:reach_v1_vector_env": _NATIVE_V1}.get(str(spec.vector_entry_point))
+    return native is not None and _batch_takes({**spec.kwargs, **kwargs}, native)
+
+
+def _batch_takes(kwargs: dict[str, Any], native_arguments: frozenset[str]) -> bool:
+    """Whether the batch plays a game of these arguments: its own arguments only, and no score reward (whose
+    shaping needs each game's reset and end)."""
+    return set(kwargs) <= native_arguments and kwargs.get("reward", "dense") != "score"
 
 
 def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozenset[str], num_envs: Any,
@@ -456,7 +458,7 @@ def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozen
     if kwargs.get("render_mode") not in (None, "rgb_array"):
         raise EnvArgumentError(f"a vector env renders with render_mode='rgb_array' (a frame per game) or None, "
                                f"got {kwargs['render_mode']!r}: for a window, render one game with gymnasium.make")
-    if set(kwargs) <= native_arguments and not _small(num_envs):  # a bad count meets the native env's check
+    if _batch_takes(kwargs, native_arguments) and not _small(num_envs):  # a bad count meets the native env's check
         return native(num_envs, **kwargs)
     return SingleEnvsVectorEnv(single, num_envs, **kwargs)
 

@@ -247,18 +247,24 @@ def _durable_temporary(path: Path, data: bytes, what: str) -> Path:
         fd, tmp = _temporary(path.parent, path.name)
     except OSError as exc:
         raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
+    with _removed_on_failure(tmp, path, what), os.fdopen(fd, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    return tmp
+
+
+@contextlib.contextmanager
+def _removed_on_failure(tmp: str, path: Path, what: str) -> Iterator[None]:
+    """Removes the temporary file ``tmp`` if the block fails; an OS error becomes one line naming ``path``."""
     try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
+        yield
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         if isinstance(exc, OSError):
             raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
         raise
-    return tmp
 
 
 #: The most numbered names ``write_new`` tries before it gives up: far more than any class makes.
@@ -272,7 +278,7 @@ def write_new(name_of: Callable[[int], Path], first: int, data: bytes, what: str
     first_path = check_output_path(Path(name_of(first)), what)
     folder = first_path.parent
     tmp = _durable_temporary(first_path, data, what)
-    try:
+    with _removed_on_failure(tmp, first_path, what):
         for n in range(first, first + MAX_NUMBERED):
             path = Path(name_of(n))
             if n != first:
@@ -284,12 +290,6 @@ def write_new(name_of: Callable[[int], Path], first: int, data: bytes, what: str
             fsync_folder(folder)
             return path
         raise DataFileError(f"{show_path(first_path)}: {MAX_NUMBERED:,} numbered names after it are all taken")
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise DataFileError(f"{show_path(first_path)}: cannot write the {what}: {exc.strerror or exc}") from None
-        raise
 
 
 def atomic_write_many(items: list[tuple[Path, bytes]], what: str = "file") -> None:
