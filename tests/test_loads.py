@@ -162,8 +162,10 @@ def test_standard_game_result_does_not_move():
         "0x1.be116ee580589p-1", "0x1.c7a92f22260cfp+0", "0x1.4dd9b49736ff0p-2", "-0x1.cd9878e368207p-2"]
     model = play_bot(GameConfig(time_limit=20.0, seed=3), "model")
     assert (model.result().hits, len(model.timeline)) == (18, 5083)
+    # Version 0.3's own trig for the arm (physics.trig) moved this state by 2.2e-15 at most from the pin
+    # taken with the C library's (0x1.5e45eb6859be3p+0, -0x1.6f2bf513505aap-3): the same hits and keys.
     assert [x.hex() for x in model.state] == [
-        "0x1.5e45eb6859be3p+0", "0x1.83b541fb0a4f4p+0", "-0x1.6f2bf513505aap-3", "-0x1.134f2fb4bb288p-1"]
+        "0x1.5e45eb6859bedp+0", "0x1.83b541fb0a4f4p+0", "-0x1.6f2bf513505a6p-3", "-0x1.134f2fb4bb288p-1"]
 
 
 def test_curl_sign_pushes_clockwise_of_the_motion():

@@ -6,16 +6,15 @@
  * over the lanes that the compiler turns into vector instructions (SSE2's two doubles, AVX2's four
  * where the CPU has it: _clanes.c's ``LANES_CLONES``); a lane whose game ends takes the next game, so the lanes
  * stay full whatever the games' lengths. ``run_scalar`` runs one game at a time (the loop before
- * the lanes; the arm with gravity, whose cos q1 would need the C library in every stage, runs it).
+ * the lanes; the arm with gravity, whose cos q1 and cos(q1 + q2) the lanes do not compute, runs it).
  *
  * Why the lanes equal the single session bit for bit: vectorising across games changes no game's
  * operations or their order, only how many games one instruction serves. Addition, multiplication,
  * division and sqrt are correctly rounded IEEE operations whether scalar or vector, the build turns
  * off contraction (no fused multiply-add is formed from a * b + c) and fast-math (no reassociation),
- * and the C library's sin and cos (or its sincos, where checked) are called for each lane as the
- * single session calls them: the exact kernel calls them four times a step, and at some 10 ns each
- * (their throughput here) they are its bound. The fast kernel (``fast``) needs them once in 32 steps
- * and at a hand's check, so it is arithmetic only, and the lanes make it several times faster.
+ * and the arm's sin and cos (``arm_sin_cos``, _ckernel.h) are made of those operations alone, so they
+ * vectorise too: the exact kernel computes them four times a step for every lane at once. The fast
+ * kernel (``fast``) needs them once in 32 steps and carries them by angle addition in between.
  */
 #include "_ckernel.h"
 
@@ -65,7 +64,7 @@ static Py_ssize_t run_scalar(const Batch *B)
             /* Stage 1's elbow trig: in full, or in the fast kernel carried from the last step. */
             if (!fast || anchor <= 0) {
                 double sn, cs;
-                sin_cos(q2, &sn, &cs);
+                arm_sin_cos(q2, &sn, &cs);
                 bc = arm.b * cs;
                 bs = arm.b * sn;
                 anchor = REANCHOR;

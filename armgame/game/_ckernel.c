@@ -56,7 +56,7 @@ static inline void accel_full(const Arm *arm, double q1, double q2, double w1, d
                               double *o1, double *o2)
 {
     double sn, cs;
-    sin_cos(q2, &sn, &cs);
+    arm_sin_cos(q2, &sn, &cs);
     accel_trig(arm, q1, q2, arm->b * cs, arm->b * sn, w1, w2, t1, t2, o1, o2);
 }
 

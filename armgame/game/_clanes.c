@@ -75,8 +75,9 @@ LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, c
     }
 }
 
-/* A stage's elbow trig for every lane: in full from the C library (the exact kernel, and the fast
- * kernel's lanes whose increment is past the series' range), else turned from stage 1's by the series. */
+/* A stage's elbow trig for every lane: in full (``arm_sin_cos``: the exact kernel, every lane in one
+ * vector loop; the fast kernel's lanes whose increment is past the series' range), else turned from
+ * stage 1's by the series. */
 LANES_INLINE void elbow_lanes(const Step *k, Lanes *L)
 {
     int all = 1;
@@ -95,10 +96,19 @@ LANES_INLINE void elbow_lanes(const Step *k, Lanes *L)
         if (all)
             return;
     }
-    for (int l = 0; l < LANES; l++) {
-        if (!k->fast || !L->ok[l]) {
+    if (!k->fast) {
+        for (int l = 0; l < LANES; l++) {
             double sn, cs;
-            sin_cos(L->qs[l], &sn, &cs);
+            arm_sin_cos(L->qs[l], &sn, &cs);
+            L->ec[l] = k->b * cs;
+            L->es[l] = k->b * sn;
+        }
+        return;
+    }
+    for (int l = 0; l < LANES; l++) {
+        if (!L->ok[l]) {
+            double sn, cs;
+            arm_sin_cos(L->qs[l], &sn, &cs);
             L->ec[l] = k->b * cs;
             L->es[l] = k->b * sn;
         }
@@ -122,15 +132,24 @@ static int step_lanes(const Step *k, Lanes *L)
         for (int l = 0; l < LANES; l++)
             L->a[m][l] += (L->g[m][l] - L->a[m][l]) * L->r[m][l];
     /* Stage 1's elbow trig: in full, or in the fast kernel carried from the last step. */
-    for (int l = 0; l < LANES; l++) {
-        if (!k->fast || L->anchor[l] <= 0) {
+    if (!k->fast) {
+        for (int l = 0; l < LANES; l++) {
             double sn, cs;
-            sin_cos(L->q2[l], &sn, &cs);
+            arm_sin_cos(L->q2[l], &sn, &cs);
             L->bc[l] = k->b * cs;
             L->bs[l] = k->b * sn;
-            L->anchor[l] = REANCHOR;
         }
-        L->anchor[l]--;
+    } else {
+        for (int l = 0; l < LANES; l++) {
+            if (L->anchor[l] <= 0) {
+                double sn, cs;
+                arm_sin_cos(L->q2[l], &sn, &cs);
+                L->bc[l] = k->b * cs;
+                L->bs[l] = k->b * sn;
+                L->anchor[l] = REANCHOR;
+            }
+            L->anchor[l]--;
+        }
     }
     for (int l = 0; l < LANES; l++) {
         p1[l] = L->q1[l];

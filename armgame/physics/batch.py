@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .trig import cos_array, sin_cos_array
 from .twojoint import TwoJointArm
 
 FloatArray = NDArray[np.float64]
@@ -88,11 +89,11 @@ class BatchRK4:
         np.subtract(self.t2, f2, out=f2)
         if self._gravity:
             np.add(q1, q2, out=tmp)
-            np.cos(tmp, out=tmp)
+            cos_array(tmp, tmp)
             tmp *= m.g2
             f1 -= tmp
             f2 -= tmp
-            np.cos(q1, out=tmp)
+            cos_array(q1, tmp)
             tmp *= m.g1
             f1 -= tmp
         if self._damping:
@@ -122,8 +123,7 @@ class BatchRK4:
         bc, bs, c0, s0 = s["bc"], s["bs"], s["c0"], s["s0"]
         if float(np.max(np.abs(delta))) > SERIES_LIMIT:
             np.add(self.q2, delta, out=bc)
-            np.sin(bc, out=bs)
-            np.cos(bc, out=bc)
+            sin_cos_array(bc, bs, bc)
         else:
             d2, cd, sd = s["d2"], s["cd"], s["sd"]
             np.multiply(delta, delta, out=d2)
@@ -160,8 +160,7 @@ class BatchRK4:
         b = self.model.b
         h = 0.5 * dt
         # Stage 1: slopes (w, a) at the start.
-        np.cos(q2, out=c0)
-        np.sin(q2, out=s0)
+        sin_cos_array(q2, s0, c0)
         np.multiply(c0, b, out=s["bc"])
         np.multiply(s0, b, out=s["bs"])
         self._accel(q1, q2, w1, w2, a1, a2)

@@ -30,7 +30,6 @@ Two forms of the same equations live here:
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -39,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import UserError
+from .trig import sin_cos, sin_cos_array
 from .params import TwoJointParams
 
 FloatArray = NDArray[np.float64]
@@ -205,14 +205,19 @@ class TwoJointArm:
         """The equations of motion as closures on components: ``"float"`` or ``"numpy"``."""
         if backend not in self._components:
             if backend == "float":
-                self._components[backend] = self._build_components(math.cos, math.sin, largest_abs_float)
+                self._components[backend] = self._build_components(sin_cos, lambda x: sin_cos(x)[1], lambda x: sin_cos(x)[0],
+                                                                   largest_abs_float)
             elif backend == "numpy":
-                self._components[backend] = self._build_components(np.cos, np.sin, largest_abs_array)
+                self._components[backend] = self._build_components(
+                    sin_cos_array, lambda x: sin_cos_array(x)[1], lambda x: sin_cos_array(x)[0],
+                    largest_abs_array)
             else:
                 raise ValueError(f"unknown backend {backend!r}: use 'float' or 'numpy'")
         return self._components[backend]
 
-    def _build_components(self, cos: Callable, sin: Callable, largest: Callable) -> ComponentDynamics:
+    def _build_components(self, sin_cos: Callable, cos: Callable, sin: Callable,
+                          largest: Callable) -> ComponentDynamics:
+        # The joint angles' trig is the arm's own (physics.trig), the same bits in C, numpy and Python.
         a, b, d = self.a, self.b, self.d
         g1, g2 = self.g1, self.g2
         k1, k2 = self.params.damping1, self.params.damping2
@@ -225,8 +230,9 @@ class TwoJointArm:
 
         def accel_unforced(q1, q2, w1, w2, t1, t2):
             # Only the bias of a horizontal, undamped arm: the common game case pays for nothing else.
-            bc = b * cos(q2)
-            h = b * sin(q2)
+            sn, cs = sin_cos(q2)
+            bc = b * cs
+            h = b * sn
             m12 = d + bc
             f1 = t1 + h * (w1 + w1 + w2) * w2
             f2 = t2 - h * w1 * w1
@@ -236,8 +242,9 @@ class TwoJointArm:
         def accel_with_gravity_and_damping(q1, q2, w1, w2, t1, t2):
             # accel_unforced written out again: a nested call would cost a tenth of an RK4 step.
             gc12 = g2 * cos(q1 + q2)
-            bc = b * cos(q2)
-            h = b * sin(q2)
+            sn, cs = sin_cos(q2)
+            bc = b * cs
+            h = b * sn
             m12 = d + bc
             f1 = t1 + h * (w1 + w1 + w2) * w2 - g1 * cos(q1) - gc12 - k1 * w1
             f2 = t2 - h * w1 * w1 - gc12 - k2 * w2
@@ -246,8 +253,9 @@ class TwoJointArm:
 
         def accel_with_damping(q1, q2, w1, w2, t1, t2):
             # The game's arm: viscous joints in the horizontal plane, and no gravity to pay for.
-            bc = b * cos(q2)
-            h = b * sin(q2)
+            sn, cs = sin_cos(q2)
+            bc = b * cs
+            h = b * sn
             m12 = d + bc
             f1 = t1 + h * (w1 + w1 + w2) * w2 - k1 * w1
             f2 = t2 - h * w1 * w1 - k2 * w2

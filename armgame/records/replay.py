@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, Protocol
@@ -247,8 +247,8 @@ def result_from_dict(data: object) -> GameResult:
 
 def same_outcome(a: GameResult, b: GameResult) -> bool:
     """Whether two results are the same game outcome; the armgame version may differ."""
-    return {k: v for k, v in a.as_dict().items() if k != "version"} == \
-        {k: v for k, v in b.as_dict().items() if k != "version"}
+    # replace() rather than as_dict(): asdict's deep copies were a tenth of a batch's verification.
+    return replace(a, version=b.version) == b
 
 
 # ------------------------------------------------------------------- task sections

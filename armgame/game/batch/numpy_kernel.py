@@ -12,13 +12,8 @@ operation (or, in the fast mode, stays within ``session.STATE_TOLERANCE``):
   loop, step and accelerations written out operation for operation on arrays (``NumpyKernel``);
   for the Euler schemes the very closures of ``Integrator(name, model, "numpy")``. Every array
   element goes through the same IEEE operations in the same order as the Python floats of one
-  game, with numpy's sin and cos for ``math``'s. Where numpy's float64 sin and cos are the C
-  library's (checked on x86-64 with AVX2, numpy 2.4: identical on 6 million arguments), a batched
-  game is bit for bit the single one. Where numpy uses its own vectorised sin and cos (AVX-512
-  builds), they may differ by an ulp, and the states differ by round-off: ``STATE_TOLERANCE``
-  bounds that over a 60 s game. A hit could then differ only if the hand crossed a target's edge
-  within about 1e-13 m of it, where it moves about 1e-3 m a step: a chance of the order of 1e-10
-  per crossing.
+  game, the joint angles' trig included (``physics.trig.sin_cos_array``, the arm's own sine, made of
+  numpy's correctly rounded +, - and *): a batched game is bit for bit the single one.
 * The kernel never decides a hit: it only flags games whose hand may be within a relative 1e-6
   of a target's edge (``NEAR``; a conservative bound on how far each hand has moved since it was
   last measured, so the batch does not pay four more sin and cos per step). The session decides
@@ -41,6 +36,8 @@ from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from ...physics.trig import cos_array, sin_cos_array
 
 if TYPE_CHECKING:
     from .session import BatchGameSession
@@ -97,7 +94,7 @@ class NumpyKernel:
         dt = config.dt
         H, DT, SIXTH = const(0.5 * dt), const(dt), const(dt * (1.0 / 6.0))
         REACH1, REACH2 = (const(c) for c in hand_move_bounds(p.l1, p.l2))
-        mul, add, sub, div, cos, sin = np.multiply, np.add, np.subtract, np.divide, np.cos, np.sin
+        mul, add, sub, div = np.multiply, np.add, np.subtract, np.divide
         empty = np.empty
         trig, force, inertia, pair = empty((2, m)), empty((2, m)), empty((2, m)), empty((2, m))
         bc, hs = trig
@@ -126,8 +123,7 @@ class NumpyKernel:
         exact = generic is not None or not batch._rounds or m < batch._series_from
 
         def elbow(q2):
-            cos(q2, bc)
-            sin(q2, hs)
+            sin_cos_array(q2, hs, bc)
             mul(trig, B, trig)  # bc = b cos q2, h = b sin q2
 
         # The fast kernel's elbow trig: stage 1's b cos q2, b sin q2 (``base``) and the same turned a
@@ -159,9 +155,9 @@ class NumpyKernel:
             sub(t2, tmp, f2)
             if gravity:
                 add(q1, q2, gc12)
-                cos(gc12, gc12)
+                cos_array(gc12, gc12)
                 mul(gc12, G2, gc12)
-                cos(q1, tmp)
+                cos_array(q1, tmp)
                 mul(tmp, G1, tmp)
                 sub(f1, tmp, f1)
                 sub(f1, gc12, f1)
@@ -201,8 +197,7 @@ class NumpyKernel:
             # ``base`` carries over from the last step, turned by its change of q2 (see ``step``), for up
             # to ``REANCHOR`` steps of one ``run``; then, and at the start of each run, full cos and sin.
             if anchor[0] <= 0:
-                cos(x[1], base[0])
-                sin(x[1], base[1])
+                sin_cos_array(x[1], base[1], base[0])
                 mul(base, B, base)
                 anchor[0] = REANCHOR
             anchor[0] -= 1
