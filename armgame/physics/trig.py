@@ -77,6 +77,11 @@ def cos(x: float) -> float:
     return sin_cos(x)[1]
 
 
+def sin_array(x: FloatArray, out: FloatArray | None = None) -> FloatArray:
+    """``sin`` of every element of a float64 array, bit for bit; into ``out`` if given."""
+    return sin_cos_array(x, out, None)[0]
+
+
 def cos_array(x: FloatArray, out: FloatArray | None = None) -> FloatArray:
     """``cos`` of every element of a float64 array, bit for bit; into ``out`` if given."""
     return sin_cos_array(x, None, out)[1]

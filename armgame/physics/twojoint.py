@@ -38,8 +38,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import UserError
-from .trig import sin_cos, sin_cos_array
 from .params import TwoJointParams
+from .trig import cos as trig_cos
+from .trig import cos_array, sin_array, sin_cos, sin_cos_array
+from .trig import sin as trig_sin
 
 FloatArray = NDArray[np.float64]
 
@@ -205,12 +207,11 @@ class TwoJointArm:
         """The equations of motion as closures on components: ``"float"`` or ``"numpy"``."""
         if backend not in self._components:
             if backend == "float":
-                self._components[backend] = self._build_components(sin_cos, lambda x: sin_cos(x)[1], lambda x: sin_cos(x)[0],
+                self._components[backend] = self._build_components(sin_cos, trig_cos, trig_sin,
                                                                    largest_abs_float)
             elif backend == "numpy":
-                self._components[backend] = self._build_components(
-                    sin_cos_array, lambda x: sin_cos_array(x)[1], lambda x: sin_cos_array(x)[0],
-                    largest_abs_array)
+                self._components[backend] = self._build_components(sin_cos_array, cos_array, sin_array,
+                                                                   largest_abs_array)
             else:
                 raise ValueError(f"unknown backend {backend!r}: use 'float' or 'numpy'")
         return self._components[backend]
