@@ -1,13 +1,13 @@
 """The one thing pyproject.toml cannot say: how to build the optional compiled loops.
 
-``armgame/game/_ckernel.c`` (the batched games), ``armgame/game/_cbots.c`` (the bots' forward
-model) and ``armgame/env/_cvector.c`` (Reach-v1's observations of a batch) must compute exactly what
-the Python code computes, so their build turns off floating-point
-contraction (no fused multiply-add) and the compiler's own sin and cos (no merging them into
-sincos; ``_ckernel.c`` calls glibc's sincos itself, after checking it against sin and cos): see
-each file's opening comment. All are optional: without a C compiler the install goes
-on, ``BatchGameSession`` and the v1 vector env's observations run numpy and the bots run their Python loop,
-with the same results.
+``armgame/game/_ckernel.c`` (the games' loops), ``armgame/physics/_ctrig.c`` (the arm's sine for the
+Python step), ``armgame/game/_cbots.c`` (the bots' forward model) and ``armgame/env/_cvector.c``
+(Reach-v1's observations of a batch) must compute exactly what the Python code computes, so their build
+turns off floating-point contraction (no fused multiply-add) and the compiler's own sin and cos (no
+merging them into sincos; ``_ckernel.c`` calls glibc's sincos itself for the hand, after checking it
+against sin and cos): see each file's opening comment. All are optional: without a C compiler the
+install goes on, ``BatchGameSession`` and the v1 vector env's observations run numpy, the arm's sine and
+the bots run in Python, with the same results.
 """
 
 from setuptools import Extension, setup
@@ -28,7 +28,9 @@ class BuildExactExt(build_ext):
 setup(
     ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c", "armgame/game/_cbatch.c",
                                                      "armgame/game/_clanes.c"],
-                           depends=["armgame/game/_ckernel.h"], optional=True),
+                           depends=["armgame/game/_ckernel.h", "armgame/physics/_trig.h"], optional=True),
+                 Extension("armgame.physics._ctrig", ["armgame/physics/_ctrig.c"],
+                           depends=["armgame/physics/_trig.h"], optional=True),
                  Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True),
                  Extension("armgame.env._cvector", ["armgame/env/_cvector.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},

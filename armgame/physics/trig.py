@@ -45,8 +45,9 @@ _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.1359
 _NAN = float("nan")
 
 
-def sin_cos(x: float) -> tuple[float, float]:
-    """(sin x, cos x) as the arm's equations of motion take them (see the module's docstring)."""
+def sin_cos_python(x: float) -> tuple[float, float]:
+    """(sin x, cos x) as the arm's equations of motion take them (see the module's docstring), in Python:
+    what ``sin_cos`` is where the compiled ``_ctrig`` was not built."""
     if not -MAX_ANGLE <= x <= MAX_ANGLE:
         return _NAN, _NAN
     k = (x * _INV_PIO2 + _SHIFT) - _SHIFT
@@ -67,14 +68,20 @@ def sin_cos(x: float) -> tuple[float, float]:
     return -c, s
 
 
-def sin(x: float) -> float:
-    """sin x as the arm's equations of motion take it."""
-    return sin_cos(x)[0]
+def sin_python(x: float) -> float:
+    """sin x as the arm's equations of motion take it, in Python."""
+    return sin_cos_python(x)[0]
 
 
-def cos(x: float) -> float:
-    """cos x as the arm's equations of motion take it."""
-    return sin_cos(x)[1]
+def cos_python(x: float) -> float:
+    """cos x as the arm's equations of motion take it, in Python."""
+    return sin_cos_python(x)[1]
+
+
+try:  # the same operations in C (_trig.h, _ctrig.c): some 0.06 us a call against 0.44 us
+    from ._ctrig import cos, sin, sin_cos
+except ImportError:
+    sin_cos, sin, cos = sin_cos_python, sin_python, cos_python
 
 
 def sin_array(x: FloatArray, out: FloatArray | None = None) -> FloatArray:
