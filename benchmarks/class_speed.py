@@ -17,7 +17,8 @@ C compiler runs, and as every game ran before the loop was compiled). "Batched" 
 (``--exact``: the exact kernel, bit for bit the single session), timed whole; the results of
 the sampled games are checked equal to the sequential ones. Verification is the same comparison
 for replays: ``Replay.verify`` one by one against ``records.batch_verify.verify_replays``
-(recomputation only, files already read).
+(recomputation only, files already read); the last line is the batch's verification over its play,
+within each repeat.
 
 Each ratio is measured within one repeat, so both sides see the same machine load; the
 spread over repeats is printed beside the median. CPU-time ratios are printed too: on a
@@ -112,7 +113,8 @@ def one_repeat(configs: list[GameConfig], timelines: list[list[InputEvent]], sam
     vbatch_wall, vbatch_cpu, vbatch = timed(lambda: verify_replays(replays, kernel=kernel))
     if not all(ok for ok, _ in vbatch):
         sys.exit("class_speed: batched verification refused a game the batch played: a bug")
-    out |= {"batched_wall_s": batch_wall, "verify_batched_wall_s": vbatch_wall}
+    out |= {"batched_wall_s": batch_wall, "verify_batched_wall_s": vbatch_wall,
+            "verify_over_play_wall": vbatch_wall / batch_wall, "verify_over_play_cpu": vbatch_cpu / batch_cpu}
     for loop in LOOPS:
         with single_loop(loop):
             # Games one after another (a sample, scaled), then the same games verified as replays one by one.
@@ -179,6 +181,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"        one after another, {loop} loop: {seq['median']:6.1f} s (first {args.sample} timed, "
                   f"scaled); batched is {wall['median']:.1f}x wall [{wall['min']:.1f}-{wall['max']:.1f}], "
                   f"{cpu['median']:.1f}x CPU [{cpu['min']:.1f}-{cpu['max']:.1f}]")
+    ratio, cpu = report["verify_over_play_wall"], report["verify_over_play_cpu"]
+    print(f"verify / play, batched: {ratio['median']:.2f}x wall [{ratio['min']:.2f}-{ratio['max']:.2f}], "
+          f"{cpu['median']:.2f}x CPU [{cpu['min']:.2f}-{cpu['max']:.2f}]")
     return 0
 
 

@@ -21,11 +21,14 @@ loop runs a game in one call, as the batch does) and ``switching`` (a key change
 in a student's game: the batch applies the commands in C; the single loop is called once between
 commands, as ``GameSession`` calls it).
 
-The bound: the exact kernel calls the C library's sincos four times a step (one per RK4 stage) and
-cannot go faster than four of them; the fast kernel is arithmetic, bounded by the core's floating-point
-pipes. Where a C compiler is found, a probe built on the spot measures both on this machine in the same
-run (the library's sincos on independent angles; independent vector multiplies, adds and divides at
-the width the lanes use); the fast bound is the step's operations (``FAST_STEP_OPS``) over those rates.
+The bound: both kernels are arithmetic (since version 0.3 the exact one's trig is the arm's own sine,
+``arm_sin_cos``, made of multiplies and adds), bounded by the core's floating-point pipes. Where a C
+compiler is found, a probe built on the spot measures them on this machine in the same run
+(independent vector multiplies, adds and divides at the width the lanes use here: AVX-512's 8
+doubles where the CPU has x86-64-v4, else AVX2's 4); each bound is its step's
+operations (``EXACT_STEP_OPS``, ``FAST_STEP_OPS``) over those rates. The probe also times one sine after
+another, each angle from the last (the latency the single loop's chain of stages waits on): the arm's
+``arm_sin_cos`` against the C library's ``sincos``, which the single loop used before 0.3.
 """
 
 from __future__ import annotations
@@ -60,26 +63,46 @@ from armgame.game.session import GameSession
 #: are bit operations); so is the occasional full sincos (one step in 32) and the hand's check.
 FAST_STEP_OPS = {"mul": 12 + 4 * 13 + 3 * 4 + 4 * 14 + 8 + 2, "add": 14 + 4 * 12 + 3 * 4 + 4 * 10 + 16 + 4,
                  "div": 4}
-#: The exact step calls sincos once per RK4 stage.
-EXACT_STEP_SINCOS = 4
+#: The arm's sine and cosine of one angle (``arm_sin_cos``, physics/_trig.h): the reduction (4 and 5),
+#: the squares (2), sin's polynomial (8 and 5), cos's (9 and 10); its quadrant's selections are bit
+#: operations, left out as above. The stage's b cos and b sin add 2 multiplies.
+ARM_SIN_COS_OPS = {"mul": 4 + 2 + 8 + 9 + 2, "add": 5 + 5 + 10}
+#: The exact step: the fast one with its four series turns of the elbow's trig replaced by four full ones.
+EXACT_STEP_OPS = {"mul": FAST_STEP_OPS["mul"] - 4 * 14 + 4 * ARM_SIN_COS_OPS["mul"],
+                  "add": FAST_STEP_OPS["add"] - 4 * 10 + 4 * ARM_SIN_COS_OPS["add"], "div": 4}
 
 PROBE_C = r"""
 #define _GNU_SOURCE
 #include <math.h>
 #include <time.h>
+#include "_trig.h"
 typedef double v4 __attribute__((vector_size(32)));
 static double now(void) {
     struct timespec t; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); return t.tv_sec + 1e-9 * t.tv_nsec;
 }
-double sincos_ns(long n) {  /* the C library's sincos on independent angles: its throughput */
-    volatile double sink = 0.0; double acc = 0.0, t = now();
-    for (long i = 0; i < n; i++) { double s, c; sincos(0.1 + 2.5e-8 * (double)i, &s, &c); acc += s + c; }
-    t = now() - t; sink = acc; (void)sink; return t / n * 1e9;
+double chain_ns(long n, int own) {  /* one sine after another, each angle from the last: the latency */
+    double x = 0.3, s, c, t = now();
+    for (long i = 0; i < n; i++) {
+        if (own)
+            arm_sin_cos(x, &s, &c);
+        else
+            sincos(x, &s, &c);
+        x = 1.0 + 0.5 * s * c + x * 1e-3;
+    }
+    t = now() - t;
+    volatile double sink = x; (void)sink;
+    return t / n * 1e9;
 }
-double addmul_per_ns(long n) {  /* independent 4-wide multiplies and adds, 6 chains of each, in registers */
-    const v4 f = {1.0000001, 1.0000001, 1.0000001, 1.0000001}, g = {1e-9, 1e-9, 1e-9, 1e-9};
-    v4 m0 = {1, 2, 3, 4}, m1 = m0 + 1, m2 = m0 + 2, m3 = m0 + 3, m4 = m0 + 4, m5 = m0 + 5;
-    v4 a0 = m0, a1 = m1, a2 = m2, a3 = m3, a4 = m4, a5 = m5;
+#if defined(__AVX512F__)
+typedef double vec __attribute__((vector_size(64)));  /* the lanes' AVX-512 build */
+#else
+typedef double vec __attribute__((vector_size(32)));  /* their AVX2 build */
+#endif
+#define WIDTH (sizeof(vec) / sizeof(double))
+double addmul_per_ns(long n) {  /* independent multiplies and adds at the lanes' width, 6 chains of each */
+    const vec zero = {0}, f = zero + 1.0000001, g = zero + 1e-9;
+    vec m0 = zero + 1, m1 = zero + 2, m2 = zero + 3, m3 = zero + 4, m4 = zero + 5, m5 = zero + 6;
+    vec a0 = m0, a1 = m1, a2 = m2, a3 = m3, a4 = m4, a5 = m5;
     double t = now();
     for (long i = 0; i < n; i++) {
         m0 = m0 * f; m1 = m1 * f; m2 = m2 * f; m3 = m3 * f; m4 = m4 * f; m5 = m5 * f;
@@ -87,20 +110,25 @@ double addmul_per_ns(long n) {  /* independent 4-wide multiplies and adds, 6 cha
     }
     t = now() - t;
     volatile double sink = (m0 + m1 + m2 + m3 + m4 + m5 + a0 + a1 + a2 + a3 + a4 + a5)[0]; (void)sink;
-    return 2.0 * 6 * 4 * n / (t * 1e9);
+    return 2.0 * 6 * WIDTH * n / (t * 1e9);
 }
-double div_per_ns(long n) {  /* independent 4-wide divides, 6 chains, in registers */
-    const v4 c = {1.5, 1.5, 1.5, 1.5};
-    v4 x0 = {1, 1.1, 1.2, 1.3}, x1 = x0 + 1, x2 = x0 + 2, x3 = x0 + 3, x4 = x0 + 4, x5 = x0 + 5;
+double div_per_ns(long n) {  /* independent divides at the lanes' width, 6 chains */
+    const vec zero = {0}, c = zero + 1.5;
+    vec x0 = zero + 1, x1 = zero + 1.1, x2 = zero + 1.2, x3 = zero + 1.3, x4 = zero + 1.4, x5 = zero + 1.5;
     double t = now();
     for (long i = 0; i < n; i++) {
         x0 = c / x0; x1 = c / x1; x2 = c / x2; x3 = c / x3; x4 = c / x4; x5 = c / x5;
     }
     t = now() - t;
     volatile double sink = (x0 + x1 + x2 + x3 + x4 + x5)[0]; (void)sink;
-    return 6.0 * 4 * n / (t * 1e9);
+    return 6.0 * WIDTH * n / (t * 1e9);
 }
+double width(void) { return (double)WIDTH; }
 """
+
+
+#: The CPU flags of x86-64-v4, the lanes' widest build (``LANES_CLONES`` in _clanes.c).
+AVX512 = ("avx512f", "avx512bw", "avx512cd", "avx512dq", "avx512vl")
 
 
 def probe() -> ctypes.CDLL | None:
@@ -111,17 +139,24 @@ def probe() -> ctypes.CDLL | None:
     folder = Path(tempfile.mkdtemp(prefix="armgame-probe-"))
     source, library = folder / "probe.c", folder / "probe.so"
     source.write_text(PROBE_C)
-    flags = ["-O2", "-ffp-contract=off", "-fno-builtin-sin", "-fno-builtin-cos", "-shared", "-fPIC"]
+    flags = ["-O2", "-ffp-contract=off", "-fno-builtin-sin", "-fno-builtin-cos", "-shared", "-fPIC",
+             f"-I{Path(__file__).resolve().parent.parent / 'armgame' / 'physics'}"]
     with open("/proc/cpuinfo") as f:
-        if " avx2" in f.read():
-            flags.append("-mavx2")
+        cpu = f.read()
+    if all(f" {flag}" in cpu for flag in AVX512):  # the lanes' x86-64-v4 build runs here
+        flags += [f"-m{flag}" for flag in AVX512]
+    elif " avx2" in cpu:
+        flags.append("-mavx2")
     built = subprocess.run([cc, *flags, str(source), "-o", str(library), "-lm"], capture_output=True)
     if built.returncode:
         return None
     lib = ctypes.CDLL(str(library))
-    for name in ("sincos_ns", "addmul_per_ns", "div_per_ns"):
+    for name in ("addmul_per_ns", "div_per_ns"):
         getattr(lib, name).restype = ctypes.c_double
         getattr(lib, name).argtypes = [ctypes.c_long]
+    lib.width.restype = ctypes.c_double
+    lib.chain_ns.restype = ctypes.c_double
+    lib.chain_ns.argtypes = [ctypes.c_long, ctypes.c_int]
     return lib
 
 
@@ -229,13 +264,17 @@ def measure(n: int, seconds: float, repeats: int) -> dict[str, object]:
 def bounds(lib: ctypes.CDLL | None) -> dict[str, float] | None:
     if lib is None:
         return None
-    sincos = min(lib.sincos_ns(2_000_000) for _ in range(3))
     addmul = max(lib.addmul_per_ns(5_000_000) for _ in range(3))
     div = max(lib.div_per_ns(2_000_000) for _ in range(3))
-    ops = FAST_STEP_OPS
-    fast_ns = max((ops["mul"] + ops["add"]) / addmul, ops["div"] / div)
-    return {"sincos_ns": sincos, "addmul_per_ns": addmul, "div_per_ns": div,
-            "exact_bound_per_s": 1e9 / (EXACT_STEP_SINCOS * sincos), "fast_bound_per_s": 1e9 / fast_ns}
+
+    def bound(ops: dict[str, int]) -> float:
+        return 1e9 / max((ops["mul"] + ops["add"]) / addmul, ops["div"] / div)
+
+    return {"width": lib.width(), "addmul_per_ns": addmul, "div_per_ns": div,
+            "exact_bound_per_s": bound(EXACT_STEP_OPS),
+            "fast_bound_per_s": bound(FAST_STEP_OPS),
+            "arm_sin_cos_chain_ns": min(lib.chain_ns(2_000_000, 1) for _ in range(3)),
+            "libm_sincos_chain_ns": min(lib.chain_ns(2_000_000, 0) for _ in range(3))}
 
 
 def spread(values: list[float]) -> str:
@@ -277,11 +316,13 @@ def main(argv: list[str] | None = None) -> int:
         print("bound: no C compiler here to build the probe")
     else:
         held = result["held"]["rates"]
-        print(f"bound, measured here: sincos {b['sincos_ns']:.1f} ns -> exact <= {b['exact_bound_per_s'] / 1e6:.1f} M "
-              f"arm-steps/s (lanes at {statistics.median(held['exact lanes']) / b['exact_bound_per_s']:.0%}); "
-              f"{b['addmul_per_ns']:.1f} multiplies and adds per ns, {b['div_per_ns']:.2f} divides per ns -> fast <= "
-              f"{b['fast_bound_per_s'] / 1e6:.0f} M (lanes at "
-              f"{statistics.median(held['fast lanes']) / b['fast_bound_per_s']:.0%})")
+        exact, fast = (statistics.median(held[k]) for k in ("exact lanes", "fast lanes"))
+        print(f"bound, measured here at {b['width']:.0f} doubles a vector: {b['addmul_per_ns']:.1f} multiplies and "
+              f"adds per ns, {b['div_per_ns']:.2f} divides per ns -> exact <= {b['exact_bound_per_s'] / 1e6:.0f} M "
+              f"arm-steps/s (lanes at {exact / b['exact_bound_per_s']:.0%}), fast <= "
+              f"{b['fast_bound_per_s'] / 1e6:.0f} M (lanes at {fast / b['fast_bound_per_s']:.0%})")
+        print(f"one sine after another (the single loop's chain): the arm's {b['arm_sin_cos_chain_ns']:.1f} ns, "
+              f"the C library's sincos {b['libm_sincos_chain_ns']:.1f} ns")
     return 0
 
 

@@ -80,7 +80,7 @@ def test_the_hands_trig_is_the_c_librarys_of_the_games_angles():
 
 def test_an_install_without_a_c_compiler_plays_the_same_games(monkeypatch):
     """No compiled loop at all (pip install with no compiler): the numpy kernel and the Python loop give the
-    compiled build's results (bit for bit where numpy's sin and cos are the C library's, see test_batch)."""
+    compiled build's results bit for bit (the arm's sine is the same Python, numpy and C, see test_trig)."""
     rng = random.Random(2)
     configs = [GameConfig(seed=i, time_limit=3.0) for i in range(6)]
     timelines = [student_timeline(rng, configs[0].dt, 3.0) for _ in configs]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import random
 import struct
+from pathlib import Path
 
 import mpmath
 import numpy as np
@@ -46,9 +47,12 @@ def test_within_the_stated_ulps_of_the_true_sine(scale):
     assert worst > 0.5  # not the C library's (nor correctly rounded): the measurement sees the method
 
 
-def test_the_docstring_states_the_measured_bounds():
-    text = " ".join(trig.__doc__.split())
-    assert f"within {STATED[100.0]:g} ulp for |x| <= 100 rad, {STATED[1e5]:g} ulp up to 1e5" in text
+def test_the_docstring_and_the_physics_page_state_the_measured_bounds():
+    physics = (Path(__file__).resolve().parent.parent / "docs" / "physics.md").read_text()
+    claim = f"within {STATED[100.0]:g} ulp for |x| <= 100 rad, {STATED[1e5]:g} ulp up to 1e5"
+    for text in (trig.__doc__, physics):
+        assert claim in " ".join(text.split())
+    assert f"beyond {trig.MAX_ANGLE:.0e}".replace("e+", "e") in " ".join(physics.split())
 
 
 def test_python_and_numpy_give_the_same_bits():

@@ -85,10 +85,12 @@ def test_each_env_history_starts_at_its_own_version_and_runs_back_in_order(env_i
     assert named[0] <= VERSION[:2]
 
 
-def test_the_newest_env_version_names_the_current_armgame():
-    # The v1 envs are what 0.2 brought; a release that changes no env would relax this to "<=".
+def test_the_newest_env_version_names_no_newer_armgame():
+    # The v1 envs are what 0.2 brought; 0.3 changed no env (its own sine moved states by round-off and no
+    # game's result: docs/performance.md, "The arm's own sine"), so the newest may be older than the package.
     newest = max(history(i)[0][1] for i in armgame_ids())
-    assert newest == VERSION[:2], f"the newest env version says armgame {newest}, the package is {armgame.__version__}"
+    assert (0, 2) <= newest <= VERSION[:2], \
+        f"the newest env version says armgame {newest}, the package is {armgame.__version__}"
 
 
 # ------------------------------------------------------------------ CITATION.cff

@@ -7,10 +7,12 @@
  * own steps in registers. Why it equals the single session bit for bit: every expression is
  * ``GameSession._advance``'s, ``integrators._rk4``'s and ``TwoJointArm``'s accel, with the same
  * IEEE double operations in the same order (C evaluates a + b + c as (a + b) + c, as Python
- * does), and ``cos``/``sin`` are the C library's, which is what Python's ``math`` calls. The
- * build (setup.py) turns off floating-point contraction, so no multiply-add is fused, and the
- * builtin sin and cos, so the compiler cannot merge them into a ``sincos`` of its own choosing;
- * the file calls glibc's sincos itself only where it has checked it (``sin_cos`` below).
+ * does); the joint angles' cos and sin are the arm's own (``arm_sin_cos``, physics/_trig.h, which is
+ * ``physics.trig.sin_cos`` operation for operation), and the hand's are the C library's, which is what
+ * Python's ``math`` calls. The build (setup.py) turns off floating-point contraction, so no
+ * multiply-add is fused, and the builtin sin and cos, so the compiler cannot merge them into a
+ * ``sincos`` of its own choosing; the file calls glibc's sincos itself, for the hand, only where it
+ * has checked it (``sin_cos`` below).
  *
  * With ``fast`` set, the elbow's cos and sin come by angle addition instead (the numpy fast
  * kernel's method, see batch/numpy_kernel.py): round-off, not bit for bit, and the batch says so.

@@ -11,12 +11,17 @@
 
 /* Where the compiler and platform can build one function for several instruction sets and pick
  * the one the CPU has when the module loads (GCC and Clang on x86-64 Linux: an ifunc), the lanes'
- * step is built for AVX2 and for the baseline (SSE2). Elsewhere (MSVC, macOS, ARM's NEON is
- * baseline) it is built once for the baseline. Either way the same IEEE operations in the same
- * order: the results do not depend on which runs. */
+ * step is built for x86-64-v4 (AVX-512: 8 doubles a vector), for AVX2 (4) and for the baseline (SSE2,
+ * 2). Elsewhere (MSVC, macOS, ARM's NEON is baseline) it is built once for the baseline. Either way
+ * the same IEEE operations in the same order: the results do not depend on which runs. */
 #if defined(__x86_64__) && defined(__linux__) && defined(__has_attribute)
 #if __has_attribute(target_clones)
+/* GCC names x86-64-v4 from 11 on, Clang's target_clones takes it from 14 on; older ones get AVX2. */
+#if (defined(__clang__) && __clang_major__ >= 14) || (!defined(__clang__) && __GNUC__ >= 11)
+#define LANES_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+#else
 #define LANES_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
 #endif
 #endif
 #ifndef LANES_CLONES

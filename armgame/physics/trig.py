@@ -43,6 +43,8 @@ _S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969
 _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
 _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
 _NAN = float("nan")
+_SIN_SIGN = np.array([1.0, 1.0, -1.0, -1.0])  # by k mod 4: sin x = s, c, -s, -c
+_COS_SIGN = np.array([1.0, -1.0, -1.0, 1.0])  # cos x = c, -s, -c, s
 
 
 def sin_cos_python(x: float) -> tuple[float, float]:
@@ -99,9 +101,10 @@ def sin_cos_array(x: FloatArray, sin_out: FloatArray | None = None,
     """``sin_cos`` of every element of a float64 array, bit for bit; into ``sin_out``, ``cos_out`` if given
     (either may be ``x`` itself)."""
     x = np.asarray(x, dtype=np.float64)
-    bad = ~(np.abs(x) <= MAX_ANGLE)
-    any_bad = bool(bad.any())
-    if any_bad:  # reduced as 0 (no warnings of inf - inf), then NaN
+    largest = float(np.max(np.abs(x))) if x.size else 0.0
+    bad = None
+    if not largest <= MAX_ANGLE:  # reduced as 0 (no warnings of inf - inf), then NaN
+        bad = ~(np.abs(x) <= MAX_ANGLE)
         x = np.where(bad, 0.0, x)
     y = x * _INV_PIO2
     y += _SHIFT
@@ -144,12 +147,14 @@ def sin_cos_array(x: FloatArray, sin_out: FloatArray | None = None,
     t += p
     c = v + t
     n = y.view(np.int64) & 3
-    odd = (n & 1).astype(bool)
+    odd = n == 1
+    odd |= n == 3
+    # The quadrant's signs as a multiplication by +-1: exact, and a zero's sign flips as negation flips it.
     sin_result = np.where(odd, c, s)
+    sin_result *= _SIN_SIGN[n]
     cos_result = np.where(odd, s, c)
-    np.negative(sin_result, out=sin_result, where=(n & 2).astype(bool))
-    np.negative(cos_result, out=cos_result, where=((n + 1) & 2).astype(bool))
-    if any_bad:
+    cos_result *= _COS_SIGN[n]
+    if bad is not None:
         sin_result[bad] = np.nan
         cos_result[bad] = np.nan
     if sin_out is None:

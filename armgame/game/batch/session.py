@@ -7,9 +7,9 @@ batches). The physics steps run in a kernel (``numpy_kernel`` or ``compiled``); 
 commands in ``schedule``.
 
 Invariant: each game of a batch equals the single ``GameSession`` fed the same inputs: hits,
-score, resets and steps exactly, and its joint state bit for bit (the compiled kernel, and numpy's
-where its sin and cos are the C library's) or within ``STATE_TOLERANCE`` (numpy's own sin and cos,
-and the fast kernels of ``exact=False``). It keeps it so:
+score, resets and steps exactly, and its joint state bit for bit (both kernels: the same operations,
+the arm's sine included, ``physics.trig``) or within ``STATE_TOLERANCE`` (the fast kernels of
+``exact=False``). It keeps it so:
 
 * Events (keys, resets, tab) are applied between physics steps exactly where the single session
   applies them (``schedule``); ``play`` advances every game to the next step at which any game has
@@ -66,11 +66,11 @@ BATCH_INTEGRATORS = ("rk4", "euler", "symplectic-euler")
 #: Fields a batch's games may differ in; every other field of ``GameConfig`` must be equal.
 PER_GAME_FIELDS = ("seed", "time_limit", "scene")
 
-#: Largest joint-state difference (rad, rad/s) from the single session that a batch allows itself.
-#: Where numpy's sin and cos are the C library's the difference is zero (every test checks). Where
-#: they are not, they may be an ulp off: with sin and cos an ulp off in half their calls, 20 student
-#: games of 60 s stayed within 1.1e-13 of the exact ones, with the same results (the viscous arm
-#: forgets round-off rather than amplifying it; tests/test_batch.py repeats this on two games).
+#: Largest joint-state difference (rad, rad/s) from the single session that a fast batch
+#: (``exact=False``) allows itself; an exact one differs by zero (every test checks). Round-off stays
+#: far below it: with sin and cos an ulp off in half their calls, 20 student games of 60 s stayed
+#: within 1.1e-13 of the exact ones, with the same results (the viscous arm forgets round-off rather
+#: than amplifying it; tests/test_batch.py repeats this on two games).
 STATE_TOLERANCE = 1e-10
 
 #: The fast kernel's series pay from about this many games; smaller batches (where a numpy call's
