@@ -80,6 +80,17 @@ LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, c
     }
 }
 
+/* b cos and b sin of every lane's angle q into oc and os, in full (``arm_sin_cos``, one vector loop). */
+LANES_INLINE void trig_lanes(const Step *k, const double *q, double *oc, double *os)
+{
+    for (int l = 0; l < LANES; l++) {
+        double sn, cs;
+        arm_sin_cos(q[l], &sn, &cs);
+        oc[l] = k->b * cs;
+        os[l] = k->b * sn;
+    }
+}
+
 /* A stage's elbow trig for every lane: in full (``arm_sin_cos``: the exact kernel, every lane in one
  * vector loop; the fast kernel's lanes whose increment is past the series' range), else turned from
  * stage 1's by the series. */
@@ -102,12 +113,7 @@ LANES_INLINE void elbow_lanes(const Step *k, Lanes *L)
             return;
     }
     if (!k->fast) {
-        for (int l = 0; l < LANES; l++) {
-            double sn, cs;
-            arm_sin_cos(L->qs[l], &sn, &cs);
-            L->ec[l] = k->b * cs;
-            L->es[l] = k->b * sn;
-        }
+        trig_lanes(k, L->qs, L->ec, L->es);
         return;
     }
     for (int l = 0; l < LANES; l++) {
@@ -138,12 +144,7 @@ static int step_lanes(const Step *k, Lanes *L)
             L->a[m][l] += (L->g[m][l] - L->a[m][l]) * L->r[m][l];
     /* Stage 1's elbow trig: in full, or in the fast kernel carried from the last step. */
     if (!k->fast) {
-        for (int l = 0; l < LANES; l++) {
-            double sn, cs;
-            arm_sin_cos(L->q2[l], &sn, &cs);
-            L->bc[l] = k->b * cs;
-            L->bs[l] = k->b * sn;
-        }
+        trig_lanes(k, L->q2, L->bc, L->bs);
     } else {
         for (int l = 0; l < LANES; l++) {
             if (L->anchor[l] <= 0) {

@@ -43,24 +43,26 @@ static PyObject *py_sin_cos(PyObject *self, PyObject *arg)
     return pair;
 }
 
+/* sin x (which = 0) or cos x (1) of the argument. */
+static PyObject *one(PyObject *arg, int which)
+{
+    double x, sc[2];
+    if (as_double(arg, &x) < 0)
+        return NULL;
+    arm_sin_cos(x, &sc[0], &sc[1]);
+    return PyFloat_FromDouble(sc[which]);
+}
+
 static PyObject *py_sin(PyObject *self, PyObject *arg)
 {
     (void)self;
-    double x, s, c;
-    if (as_double(arg, &x) < 0)
-        return NULL;
-    arm_sin_cos(x, &s, &c);
-    return PyFloat_FromDouble(s);
+    return one(arg, 0);
 }
 
 static PyObject *py_cos(PyObject *self, PyObject *arg)
 {
     (void)self;
-    double x, s, c;
-    if (as_double(arg, &x) < 0)
-        return NULL;
-    arm_sin_cos(x, &s, &c);
-    return PyFloat_FromDouble(c);
+    return one(arg, 1);
 }
 
 static PyMethodDef methods[] = {
