@@ -3,8 +3,8 @@
  *
  * Two loops compute the same thing. ``armgame_run_lanes`` (_clanes.c) steps LANES games side by side, one array per
  * quantity with a game per element (structure of arrays), so that every arithmetic line is one loop
- * over the lanes that the compiler turns into vector instructions (SSE2's two doubles, AVX2's four
- * where the CPU has it: _clanes.c's ``LANES_CLONES``); a lane whose game ends takes the next game, so the lanes
+ * over the lanes that the compiler turns into vector instructions (SSE2's two doubles, AVX2's four,
+ * AVX-512's eight, where the CPU has them: _clanes.c's ``LANES_CLONES``); a lane whose game ends takes the next game, so the lanes
  * stay full whatever the games' lengths. ``run_scalar`` runs one game at a time (the loop before
  * the lanes; the arm with gravity, whose cos q1 and cos(q1 + q2) the lanes do not compute, runs it).
  *
@@ -12,7 +12,7 @@
  * operations or their order, only how many games one instruction serves. Addition, multiplication,
  * division and sqrt are correctly rounded IEEE operations whether scalar or vector, the build turns
  * off contraction (no fused multiply-add is formed from a * b + c) and fast-math (no reassociation),
- * and the arm's sin and cos (``arm_sin_cos``, _ckernel.h) are made of those operations alone, so they
+ * and the arm's sin and cos (``arm_sin_cos``, physics/_trig.h) are made of those operations alone, so they
  * vectorise too: the exact kernel computes them four times a step for every lane at once. The fast
  * kernel (``fast``) needs them once in 32 steps and carries them by angle addition in between.
  */

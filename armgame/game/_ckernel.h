@@ -1,6 +1,6 @@
 /* What the compiled loops share (_ckernel.c: one game and the module; _cbatch.c: the batch): the
- * params' layout, the arm's trig and accel, the fast kernel's trig, the C library's sincos where checked, and
- * the buffers' checks. See _ckernel.c's opening comment for why each is exactly the Python it replaces. */
+ * params' layout, the arm's trig (physics/_trig.h) and accel, the fast kernel's trig, the C library's
+ * sincos where checked, and the buffers' checks. See _ckernel.c's opening comment for why each is exactly the Python it replaces. */
 #ifndef ARMGAME_CKERNEL_H
 #define ARMGAME_CKERNEL_H
 #define PY_SSIZE_T_CLEAN

@@ -2,7 +2,8 @@
 
 Owns ``sin_cos`` (one angle, Python floats) and ``sin_cos_array`` (numpy arrays), which the arm's
 equations of motion use for every cos and sin of a joint angle (``TwoJointArm.component_dynamics``,
-the batched kernels, and their C twins in ``armgame/game/_ckernel.h``, ``arm_sin_cos``). Kinematics
+the batched kernels, and their C twin ``arm_sin_cos`` in ``armgame/physics/_trig.h``, which the
+compiled loops inline and ``_ctrig`` gives Python as ``sin_cos`` where it was built). Kinematics
 (where the hand is, the targets, the picture) keep the C library's ``math.cos`` and ``math.sin``.
 
 Why not the C library's: its sine is a scalar function whose bits differ between glibc, macOS and
@@ -80,7 +81,7 @@ def cos_python(x: float) -> float:
     return sin_cos_python(x)[1]
 
 
-try:  # the same operations in C (_trig.h, _ctrig.c): some 0.06 us a call against 0.44 us
+try:  # the same operations in C (_trig.h, _ctrig.c): some 0.05 us a call against 0.5 (benchmarks/trig_change.py)
     from ._ctrig import cos, sin, sin_cos
 except ImportError:
     sin_cos, sin, cos = sin_cos_python, sin_python, cos_python
