@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import chain, repeat
+from operator import attrgetter, eq
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -38,52 +40,101 @@ class Schedule(NamedTuple):
     rate: np.ndarray
     #: Resets and tab presses as (step, game, key).
     specials: list[tuple[int, int, str]]
-    #: The muscle keys held at the end, by game.
-    held_at_end: dict[int, list[bool]]
+    #: The muscle keys held at the end, (4, n) as the batch keeps them.
+    held_at_end: np.ndarray
+
+
+#: Event codes beyond the muscles' 0-3; -1: a key the game ignores.
+_RESET, _TOGGLE = 4, 5
+
+
+def _event_columns(timelines: Sequence[Sequence[InputEvent]], codes: dict[str, int]) -> tuple[np.ndarray, ...]:
+    """Every event of every timeline as columns (step, code, down), in order: the only per-event Python."""
+    events = list(chain.from_iterable(timelines))
+    count = len(events)
+    steps_list = list(map(attrgetter("step"), events))
+    try:
+        steps = np.fromiter(steps_list, dtype=np.int64, count=count)
+    except OverflowError:  # a step no game reaches, either way: past every stop, or before every clock
+        steps = np.fromiter((min(max(s, -1), _FAR) for s in steps_list), dtype=np.int64, count=count)
+    code = np.fromiter(map(codes.get, map(attrgetter("key"), events), repeat(-1)), dtype=np.int64, count=count)
+    down = np.fromiter(map(eq, map(attrgetter("action"), events), repeat(DOWN)), dtype=bool, count=count)
+    return steps, code, down
+
+
+#: Larger than any step a game has (24 h at any dt the configuration allows), smaller than int64's end.
+_FAR = 2**62
 
 
 def schedule(batch: BatchGameSession, timelines: Sequence[Sequence[InputEvent]], now: int,
              limit: list[int]) -> Schedule:
-    """What each timeline does to ``batch`` and when, from step ``now`` to game i's stop ``limit[i]``."""
-    index = {key: m for m, key in enumerate(batch.muscle_keys)}
-    rise, decay = batch._rise.tolist(), batch._decay.tolist()
-    n, totals = batch.n, batch.total_steps.tolist()
-    steps: list[int] = []
-    flat: list[int] = []
-    goal: list[float] = []
-    rate: list[float] = []
-    specials: list[tuple[int, int, str]] = []
-    held_at_end: dict[int, list[bool]] = {}
-    for i, events in enumerate(timelines):
-        clock, stop, end = now, limit[i], totals[i]
-        held = batch.held[i].tolist()
-        last = [(-1, -1)] * len(held)  # per muscle: (step, position in the lists) of its last command
-        for e in events:
-            if e.step > stop:
-                break
-            clock = max(clock, e.step)
-            if clock >= end:
-                continue
-            m = index.get(e.key)
-            if m is not None:
-                down = e.action == DOWN
-                if held[m] == down:
-                    continue
-                held[m] = down
-                values = (1.0, rise[m]) if down else (0.0, decay[m])
-                if last[m][0] == clock:
-                    goal[last[m][1]], rate[last[m][1]] = values
-                else:
-                    last[m] = (clock, len(steps))
-                    steps.append(clock)
-                    flat.append(m * n + i)
-                    goal.append(values[0])
-                    rate.append(values[1])
-            elif e.key in (RESET_KEY, TOGGLE_ARM_KEY) and e.action == DOWN:
-                specials.append((clock, i, e.key))
-        held_at_end[i] = held
-    return Schedule(np.array(steps, dtype=np.int64), np.array(flat, dtype=np.intp), np.array(goal), np.array(rate),
-                    specials, held_at_end)
+    """What each timeline does to ``batch`` and when, from step ``now`` to game i's stop ``limit[i]``.
+
+    The single session's rules (``TimelineInput``, ``GameSession.key_event``), in numpy over all the
+    events at once rather than in a loop per event (0.23 s of a class's 1,000 games before):
+
+    * a game's events stop at its first event past its stop;
+    * an event takes effect at its game's clock, the latest step so far (and at least ``now``), and
+      none at or after the game's end;
+    * a muscle key's event changes something only if it differs from the key's state before it, which
+      is the previous event's of that key (each event leaves the key as it says) or the batch's;
+    * of one muscle's changes at one step the last wins, in the first's place; a reset or tab counts
+      when pressed.
+    """
+    n = batch.n
+    codes = {RESET_KEY: _RESET, TOGGLE_ARM_KEY: _TOGGLE} | {key: m for m, key in enumerate(batch.muscle_keys)}
+    counts = np.fromiter(map(len, timelines), dtype=np.int64, count=n)
+    steps, code, down = _event_columns(timelines, codes)
+    game = np.repeat(np.arange(n, dtype=np.int64), counts)
+    stop = np.asarray(limit, dtype=np.int64)
+    end = batch.total_steps.astype(np.int64)
+    # Past a game's stop: its first such event and all after it (a running count within the game).
+    past = np.cumsum(steps > stop[game])
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    before = np.concatenate([[0], past])[starts]
+    kept = past == before[game]
+    # The clock: a running maximum within each game, each game lifted above the last one's values.
+    top = np.maximum(stop, now - 1) + 1  # an event past its stop is dropped whatever its value
+    clipped = np.clip(steps, now, top[game])
+    lift = game * (int(top.max(initial=now)) - now + 1)
+    clock = np.maximum.accumulate(clipped + lift) - lift
+    kept &= clock < end[game]
+    # Resets and tab, when pressed, in timeline order.
+    special = np.flatnonzero(kept & (code >= _RESET) & down)
+    names = {_RESET: RESET_KEY, _TOGGLE: TOGGLE_ARM_KEY}
+    specials = [(c, g, names[k]) for c, g, k in zip(clock[special].tolist(), game[special].tolist(),
+                                                  code[special].tolist(), strict=True)]
+    # Muscle events by key (game * 4 + muscle), each key's in timeline order.
+    index = np.flatnonzero(kept & (code >= 0) & (code < _RESET))
+    key = game[index] * 4 + code[index]
+    order = np.argsort(key, kind="stable")
+    index, key = index[order], key[order]
+    now_down = down[index]
+    first = np.ones(len(index), dtype=bool)
+    first[1:] = key[1:] != key[:-1]
+    held = batch._held.T.reshape(-1)  # by game * 4 + muscle
+    was_down = np.empty_like(now_down)
+    was_down[1:] = now_down[:-1]
+    was_down[first] = held[key[first]]
+    last = np.ones(len(index), dtype=bool)
+    last[:-1] = key[:-1] != key[1:]
+    held_at_end = held.copy()
+    held_at_end[key[last]] = now_down[last]
+    change = now_down != was_down
+    index, key, now_down = index[change], key[change], now_down[change]
+    # One command per key and step: the first change's place, the last change's value.
+    run_clock = clock[index]
+    new_run = np.ones(len(index), dtype=bool)
+    new_run[1:] = (key[1:] != key[:-1]) | (run_clock[1:] != run_clock[:-1])
+    starts_of_runs = np.flatnonzero(new_run)
+    ends_of_runs = np.concatenate([starts_of_runs[1:], [len(index)]]) - 1
+    place = np.argsort(index[starts_of_runs], kind="stable")
+    run_start, run_end = starts_of_runs[place], ends_of_runs[place]
+    muscle, games = key[run_start] % 4, key[run_start] // 4
+    pressed = now_down[run_end]
+    return Schedule(run_clock[run_start], (muscle * n + games).astype(np.intp), pressed.astype(np.float64),
+                    np.where(pressed, batch._rise[muscle], batch._decay[muscle]), specials,
+                    held_at_end.reshape(n, 4).T.copy())
 
 
 @dataclass

@@ -495,8 +495,7 @@ class BatchGameSession:
         limits = np.array(limit, dtype=np.int64)
         if self.compiled is not None:
             self.compiled.play(MuscleEvents.by_game(self.n, muscle_steps, flat, goal, rate), specials, limits)
-            for i, row in held.items():
-                self.held[i] = row
+            self._held[...] = held
             return [self.result(i) for i in range(self.n)]
         # Lockstep: every game's commands by step (stable: a game's order within a step is kept).
         order = np.argsort(muscle_steps, kind="stable")
@@ -541,8 +540,7 @@ class BatchGameSession:
                 alive = alive[limits[alive] > now]
         for i, (x, act) in stopped.items():
             self._x[:, i], self._act[:, i], self._slack[i] = x, act, -1.0
-        for i, row in held.items():
-            self.held[i] = row
+        self._held[...] = held
         return [self.result(i) for i in range(self.n)]
 
 
