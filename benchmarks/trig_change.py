@@ -13,6 +13,8 @@ under 0.2's physics as they were then) and its recorded timeline is replayed und
 many games have the same result (score, hits, resets, steps) and the largest final joint-state
 difference. Exit status 1 if any result differs.
 
+**Accuracy**: the largest error in ulps against mpmath, the arm's sine and the C library's.
+
 **Speed of the sine itself**, one call and a thousand angles: the pure Python ``sin_cos`` (an install
 without a C compiler), the compiled one (``_ctrig``), ``math.sin`` and ``math.cos``; numpy's
 ``sin_cos_array`` against ``numpy.sin`` and ``numpy.cos``; and a 60 s game in ``GameSession``'s Python
@@ -79,6 +81,23 @@ def outcomes(students: int, bots: int) -> dict[str, object]:
     return {"games": len(games), "same_result": same, "largest_state_difference": worst, "differ": differ[:10]}
 
 
+def accuracy(count: int = 20_000) -> dict[str, float]:
+    """The largest error in ulps, against mpmath, of the arm's sine and cosine and of the C library's, on
+    ``count`` angles in [-100, 100] rad."""
+    import mpmath
+
+    rng = random.Random(5)
+    worst = {"arm": 0.0, "c_library": 0.0}
+    for _ in range(count):
+        x = rng.uniform(-100.0, 100.0)
+        with mpmath.workdps(40):
+            true = (mpmath.sin(mpmath.mpf(x)), mpmath.cos(mpmath.mpf(x)))
+        for name, got in (("arm", trig.sin_cos_python(x)), ("c_library", (math.sin(x), math.cos(x)))):
+            for value, want in zip(got, true, strict=True):
+                worst[name] = max(worst[name], float(abs(mpmath.mpf(value) - want)) / math.ulp(float(want)))
+    return worst
+
+
 def speeds(repeats: int) -> dict[str, float]:
     def per_call(f: object, arg: object, number: int) -> float:
         return min(timeit.repeat(lambda: f(arg), number=number, repeat=repeats)) / number * 1e6
@@ -125,7 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     report = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
                          f"Python {platform.python_version()}, numpy {np.__version__}",
               "load_before": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
-              "speeds": speeds(args.repeats), "outcomes": outcomes(args.students, args.bots)}
+              "speeds": speeds(args.repeats), "ulps": accuracy(),
+              "outcomes": outcomes(args.students, args.bots)}
     found = report["outcomes"]
     if args.json:
         print(json.dumps(report, indent=1))
@@ -137,6 +157,8 @@ def main(argv: list[str] | None = None) -> int:
               f"{sp['math_sin_and_cos_us']:.3f} us")
         print(f"1,000 angles: sin_cos_array {sp['numpy_own_1000_us']:.1f} us, numpy.sin and numpy.cos "
               f"{sp['numpy_sin_and_cos_1000_us']:.1f} us")
+        print(f"largest error on 20,000 angles in [-100, 100] rad, against mpmath: the arm's sine "
+              f"{report['ulps']['arm']:.2f} ulp, the C library's {report['ulps']['c_library']:.2f} ulp")
         print(f"a 60 s game in the Python loop: {sp['python_loop_game_ms']:.1f} ms with the sine as built here, "
               f"{sp['python_loop_game_pure_python_sine_ms']:.1f} ms with the pure Python one")
         print(f"{found['same_result']:,} of {found['games']:,} games recorded with 0.2's sine have the same result "
