@@ -19,8 +19,9 @@ multiple k of pi/2 (pi/2 in three parts, the first two of 33 bits, so k times th
 |k| < 2^20), then minimax polynomials for sin and cos on [-pi/4, pi/4] (FreeBSD's ``__kernel_sin``
 and ``__kernel_cos``, without the reduced angle's tail), and the quadrant k mod 4. Measured against
 mpmath (``tests/test_trig.py``): within 1.5 ulp for |x| <= 100 rad, 2.5 ulp up to 1e5 (glibc's is
-within about 0.5: ``benchmarks/trig_change.py`` measures both). Angles beyond ``MAX_ANGLE`` (no arm gets there: 1e15 rad is 10^14 turns)
-and non-finite ones give NaN, which the sessions stop as a state gone non-finite.
+within about 0.5: ``benchmarks/trig_change.py`` measures both). Angles beyond ``MAX_ANGLE`` (no arm
+gets there: 1e15 rad is 10^14 turns) and non-finite ones give NaN, which the sessions stop as a state
+gone non-finite.
 """
 
 from __future__ import annotations
