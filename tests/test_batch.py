@@ -27,14 +27,7 @@ from armgame.records.replay import Replay
 KEYS = ("d", "f", "j", "k")
 
 
-#: Both kernels are bit for bit the single session: the same operations in the same order, the arm's
-#: trig included (``physics.trig``: numpy's and C's are the Python one's, operation for operation).
-TOLERANCE = 0.0
 KERNELS = ["numpy", "compiled"] if compiled.AVAILABLE or os.environ.get("ARMGAME_REQUIRE_COMPILED") else ["numpy"]
-
-
-def tolerance(batch: BatchGameSession) -> float:
-    return 0.0 if batch.compiled is not None else TOLERANCE
 
 
 def batch_of(configs, kernel: str) -> BatchGameSession:
@@ -72,8 +65,10 @@ def assert_same_game(batch: BatchGameSession, i: int, single: GameSession) -> No
     assert (batch.target_x[i], batch.target_y[i]) == (single.rules.target.x, single.rules.target.y)
     assert bool(batch.arm_visible[i]) == single.rules.arm_visible
     assert batch.held[i].tolist() == single.held
-    np.testing.assert_allclose(batch.state(i), single.state, rtol=0.0, atol=tolerance(batch))
-    np.testing.assert_allclose(batch.activation[i], single.muscles.activation, rtol=0.0, atol=tolerance(batch))
+    # Both kernels are bit for bit the single session: the same operations in the same order, the arm's
+    # trig included (physics.trig: numpy's and C's are the Python one's, operation for operation).
+    assert batch.state(i) == single.state
+    assert batch.activation[i].tolist() == list(single.muscles.activation)
 
 
 @pytest.mark.parametrize("kernel", KERNELS)
@@ -150,7 +145,7 @@ def test_many_long_games_equal_the_single_session(kernel):
         assert_same_game(batch, i, single)
         worst = max(worst, max(abs(a - b) for a, b in zip(batch.state(i), single.state, strict=True)))
     assert sum(r.hits for r in results) > 50 and sum(r.resets for r in results) > 0
-    assert worst <= tolerance(batch)
+    assert worst == 0.0
 
 
 def test_round_off_in_sin_and_cos_stays_well_within_the_stated_tolerance():
