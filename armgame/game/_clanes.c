@@ -80,15 +80,20 @@ LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, c
     }
 }
 
-/* b cos and b sin of every lane's angle q into oc and os, in full (``arm_sin_cos``, one vector loop). */
+/* b cos q and b sin q in full (``arm_sin_cos``) into *oc and *os. */
+LANES_INLINE void trig_lane(const Step *k, double q, double *oc, double *os)
+{
+    double sn, cs;
+    arm_sin_cos(q, &sn, &cs);
+    *oc = k->b * cs;
+    *os = k->b * sn;
+}
+
+/* The same for every lane's angle q, into oc and os: one vector loop. */
 LANES_INLINE void trig_lanes(const Step *k, const double *q, double *oc, double *os)
 {
-    for (int l = 0; l < LANES; l++) {
-        double sn, cs;
-        arm_sin_cos(q[l], &sn, &cs);
-        oc[l] = k->b * cs;
-        os[l] = k->b * sn;
-    }
+    for (int l = 0; l < LANES; l++)
+        trig_lane(k, q[l], &oc[l], &os[l]);
 }
 
 /* A stage's elbow trig for every lane: in full (``arm_sin_cos``: the exact kernel, every lane in one
@@ -116,14 +121,9 @@ LANES_INLINE void elbow_lanes(const Step *k, Lanes *L)
         trig_lanes(k, L->qs, L->ec, L->es);
         return;
     }
-    for (int l = 0; l < LANES; l++) {
-        if (!L->ok[l]) {
-            double sn, cs;
-            arm_sin_cos(L->qs[l], &sn, &cs);
-            L->ec[l] = k->b * cs;
-            L->es[l] = k->b * sn;
-        }
-    }
+    for (int l = 0; l < LANES; l++)
+        if (!L->ok[l])
+            trig_lane(k, L->qs[l], &L->ec[l], &L->es[l]);
 }
 
 /* One RK4 step of every lane (``run_scalar``'s step, lane by lane): the muscles, the four stages, the
@@ -148,10 +148,7 @@ static int step_lanes(const Step *k, Lanes *L)
     } else {
         for (int l = 0; l < LANES; l++) {
             if (L->anchor[l] <= 0) {
-                double sn, cs;
-                arm_sin_cos(L->q2[l], &sn, &cs);
-                L->bc[l] = k->b * cs;
-                L->bs[l] = k->b * sn;
+                trig_lane(k, L->q2[l], &L->bc[l], &L->bs[l]);
                 L->anchor[l] = REANCHOR;
             }
             L->anchor[l]--;

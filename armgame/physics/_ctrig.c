@@ -1,7 +1,7 @@
 /* The arm's sine for Python: ``sin_cos(x)``, ``sin(x)`` and ``cos(x)`` as armgame.physics.trig's pure
  * Python ones, from the C the compiled loops use (_trig.h), so the same bits (tests/test_trig.py holds
  * them equal). Why: the Python step of the arm takes four of them a step, and the Python ones cost
- * 0.44 us each against some 0.06 us here; an install without a C compiler runs the Python ones, with the
+ * some 0.5 us each against 0.05 us here (benchmarks/trig_change.py); an install without a C compiler runs the Python ones, with the
  * same results. Built as the other extensions are, without contraction (setup.py). */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>

@@ -1,6 +1,6 @@
 /* The arm's trig in C: ``arm_sin_cos`` is armgame.physics.trig.sin_cos, operation for operation. Included
  * by the game's compiled loops (game/_ckernel.h) and by physics/_ctrig.c, which gives Python the same
- * function. Needs <math.h>, <stdint.h> and <string.h>. */
+ * function. */
 #ifndef ARMGAME_TRIG_H
 #define ARMGAME_TRIG_H
 #include <math.h>

@@ -47,6 +47,9 @@ class Schedule(NamedTuple):
 #: Event codes beyond the muscles' 0-3; -1: a key the game ignores.
 _RESET, _TOGGLE = 4, 5
 
+#: Larger than any step a game has (24 h at any dt the configuration allows), smaller than int64's end.
+_FAR = 2**62
+
 
 def _event_columns(timelines: Sequence[Sequence[InputEvent]], codes: dict[str, int]) -> tuple[np.ndarray, ...]:
     """Every event of every timeline as columns (step, code, down), in order: the only per-event Python."""
@@ -60,10 +63,6 @@ def _event_columns(timelines: Sequence[Sequence[InputEvent]], codes: dict[str, i
     code = np.fromiter(map(codes.get, map(attrgetter("key"), events), repeat(-1)), dtype=np.int64, count=count)
     down = np.fromiter(map(eq, map(attrgetter("action"), events), repeat(DOWN)), dtype=bool, count=count)
     return steps, code, down
-
-
-#: Larger than any step a game has (24 h at any dt the configuration allows), smaller than int64's end.
-_FAR = 2**62
 
 
 def schedule(batch: BatchGameSession, timelines: Sequence[Sequence[InputEvent]], now: int,
