@@ -39,6 +39,14 @@ QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "fi
 PICTURES = ("class_page.png", "class_lab.png")
 
 
+def curve_protocol(work: Path, quick: bool) -> str:
+    """The lab protocol the volunteers run, the class curve's (``--lab``)."""
+    if not quick:
+        return LAB
+    (work / "quick.toml").write_text(QUICK_LAB)
+    return str(work / "quick.toml")
+
+
 def fill(opened, work: Path, quick: bool = False) -> None:
     address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
     code = opened.clerk.roster.code
@@ -73,7 +81,8 @@ def main_(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     sizes = [(1024, 768)] if args.out is None or args.quick else [(1024, 768), (1920, 1080)]
     out = args.out or HERE / "img"
-    with tempfile.TemporaryDirectory() as tmp, running_class(Path(tmp) / "class") as opened:
+    with tempfile.TemporaryDirectory() as tmp, \
+            running_class(Path(tmp) / "class", lab=curve_protocol(Path(tmp), args.quick)) as opened:
         fill(opened, Path(tmp), args.quick)
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=chromium_path(), args=FLAGS)

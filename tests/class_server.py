@@ -17,11 +17,13 @@ from armgame.records.replay import Replay
 
 
 @contextlib.contextmanager
-def running_class(folder: Path, seed: int | None = None, lines: list[str] | None = None) -> Iterator[ClassServer]:
-    """The class in ``folder`` served on 127.0.0.1 (a free port) until the block ends."""
+def running_class(folder: Path, seed: int | None = None, lines: list[str] | None = None,
+                  lab: str | None = None) -> Iterator[ClassServer]:
+    """The class in ``folder`` served on 127.0.0.1 (a free port) until the block ends (``lab``: its curve's
+    protocol, as ``--lab``)."""
     ready = threading.Event()
     said = lines if lines is not None else []
-    opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set())
+    opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set(), lab=lab)
     thread = threading.Thread(target=opened.run, daemon=True)
     thread.start()
     try:

@@ -29,9 +29,14 @@ def opened(tmp_path, monkeypatch):
         yield served
 
 
-def call(opened, method: str, path: str, body: bytes | None = None, headers: dict | None = None):
-    """(status, parsed JSON or text) of one request, whatever the status."""
-    conn = http.client.HTTPConnection("127.0.0.1", opened.port, timeout=20)
+def call(opened, method: str, path: str, body: bytes | None = None, headers: dict | None = None,
+         source: str | None = None):
+    """(status, parsed JSON or text) of one request, whatever the status; from ``source`` (another loopback
+    address, 127.0.0.2 and up: another machine than the teacher's) if given."""
+    conn = http.client.HTTPConnection("127.0.0.1", opened.port, timeout=20,
+                                      source_address=(source, 0) if source else None)
+    if method == "POST":  # the class's own client's and pages' way: JSON, said so
+        headers = {"Content-Type": "application/json", **(headers or {})}
     conn.request(method, path, body=body, headers=headers or {})
     response = conn.getresponse()
     data = response.read()
@@ -42,20 +47,22 @@ def call(opened, method: str, path: str, body: bytes | None = None, headers: dic
         return response.status, data.decode("utf-8", "replace")
 
 
-def join(opened, name: str, code: str | None = None):
+def join(opened, name: str, code: str | None = None, source: str | None = None):
     return call(opened, "POST", "/api/join", json.dumps({"code": code or opened.clerk.roster.code,
                                                          "name": name}).encode(),
-                {"Content-Type": "application/json"})
+                {"Content-Type": "application/json"}, source)
 
 
-def test_a_wrong_code_is_refused_and_guessing_is_stopped(opened):
-    status, answer = join(opened, "Ann", "QQQQ")
+def test_a_wrong_code_is_refused_and_guessing_stops_the_guesser_only(opened):
+    status, answer = join(opened, "Ann", "QQQQ", source="127.0.0.2")
     assert status == 403 and answer == {"ok": False, "error": "wrong class code: check the code on the projector"}
-    for _ in range(class_app.MAX_FAILURES - 1):
-        join(opened, "Ann", "QQQQ")
-    status, answer = join(opened, "Ann")  # the right code too, once this machine has guessed too often
-    assert status == 429 and "too many wrong codes" in answer["error"]
+    for _ in range(class_app.FREE_GUESSES - 1):
+        join(opened, "Ann", "QQQQ", source="127.0.0.2")
+    status, answer = join(opened, "Ann", source="127.0.0.2")  # while it waits, no answer of its is looked at
+    assert status == 429 and "too many wrong codes" in answer["error"] and "wait 60 s" in answer["error"]
     assert opened.clerk.roster.players == {}
+    status, answer = join(opened, "Ben", source="127.0.0.3")  # the neighbour with the right code: at once
+    assert status == 200 and answer["name"] == "Ben"
 
 
 def test_bad_bodies_are_refused_in_one_line_and_nothing_is_entered(opened):
@@ -86,7 +93,8 @@ def test_a_body_over_the_limit_is_cut_off_as_it_arrives_and_a_slow_one_in_time(o
     # the connection, so the sender is cut off long before it has sent it all (or reads the 413 first).
     sent, reply = 0, b""
     with socket.create_connection(("127.0.0.1", opened.port), timeout=20) as s:
-        s.sendall(f"POST /api/handin HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\nX-Armgame-Code: "
+        s.sendall(f"POST /api/handin HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+                  f"Transfer-Encoding: chunked\r\nX-Armgame-Code: "
                   f"{headers['X-Armgame-Code']}\r\nAuthorization: {headers['Authorization']}\r\n\r\n".encode())
         with contextlib.suppress(OSError):
             for _ in range(1000):  # 64 MB
@@ -101,7 +109,8 @@ def test_a_body_over_the_limit_is_cut_off_as_it_arrives_and_a_slow_one_in_time(o
     assert opened.clerk.entries == []
     monkeypatch.setattr(class_app, "BODY_SECONDS", 0.3)
     with socket.create_connection(("127.0.0.1", opened.port), timeout=20) as s:
-        s.sendall(f"POST /api/handin HTTP/1.1\r\nHost: x\r\nContent-Length: 1000\r\nX-Armgame-Code: "
+        s.sendall(f"POST /api/handin HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+                  f"Content-Length: 1000\r\nX-Armgame-Code: "
                   f"{opened.clerk.roster.code}\r\nAuthorization: Bearer {answer['token']}\r\n\r\n{{".encode())
         reply = b""
         while chunk := s.recv(4096):

@@ -8,7 +8,8 @@ from class_server import running_class, tapped_game
 
 from armgame.classroom import client
 
-HOSTILE = ['<img src=x onerror="alert(1)">', '"><script>alert(2)</script>', "\u05e9\u05dc\u05d5\u05dd <b>bold</b>"]
+HOSTILE = ['<img src=x onerror="alert(1)">', '"><script>alert(2)</script>',
+           "\u05e9\u05dc\u05d5\u05dd <\u05d1>\u05d1\u05d5\u05dc\u05d3</\u05d1>"]
 
 
 def test_the_page_shows_games_as_they_arrive_and_names_as_text_and_the_teacher_acts(tmp_path, monkeypatch):

@@ -1,19 +1,35 @@
 """The class's ASGI application: Starlette routes in front of the clerk thread.
 
-Every request is hostile until checked, and what it can cost is bounded before any work starts:
+Every request is hostile until checked, and what it can cost is bounded before any work starts
+(a connection's own costs, before it is a request, are ``guard``'s):
 
-* a join code or a teacher's secret that does not match counts against the client's address;
-  past ``MAX_FAILURES`` in ``FAILURE_WINDOW`` seconds the address is refused (429) until the
-  window passes, so a four-letter code cannot be guessed by trying;
+* only the class's own pages can change anything: a state-changing request must be JSON
+  (``Content-Type: application/json``, which a page on another site cannot send without a
+  preflight the class never grants), and its ``Origin`` and ``Sec-Fetch-Site``, where sent, must
+  be the class's own; every request must name the class by an address, never by a domain name
+  (``Host``), so a hostile page cannot rebind its own name to the class;
+* wrong join codes, wrong teacher's secrets and wrong tokens are counted apart, per client address
+  (``Guesses``): ``FREE_GUESSES`` of each, then a wait that doubles with every further wrong one,
+  so a four-letter code (160,000 of them) is beyond guessing (about a dozen tries an hour from an
+  address) while a student who mistyped it waits a minute; a right answer clears the count, and
+  the teacher's own machine is never locked out of the teacher's routes;
+* new names are limited per address (``JOINS_PER_MINUTE``) and for the whole class
+  (``CLASS_JOINS_PER_MINUTE``); the teacher sees which names came from one address, removes them
+  at once, and can lock the roster;
 * a body over its limit is refused from its declared length, or cut off as it arrives (413);
   a body slower than ``BODY_SECONDS`` is cut off (408); at most ``UPLOADS`` bodies are read at
-  once, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES`` whatever arrives;
+  once, ``UPLOADS_PER_ADDRESS`` from one address, and a hand-in's code and token are checked
+  from its headers before its body is read, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES``
+  whatever arrives;
 * changes go to one worker thread (the ``Clerk``), never the event loop; at most ``QUEUE_LIMIT``
   wait for it, and past that a client is told to come back (503 with Retry-After): its replay
   stays on its machine, and the client hands it in again;
 * a hand-in is answered only after the clerk has written it durably (fsynced file and folder);
 * the projector's event stream sends the latest standings, never a backlog, to at most
-  ``MAX_STREAMS`` pages.
+  ``MAX_STREAMS`` pages, ``STREAMS_PER_ADDRESS`` from one address; the projector's own page
+  (its link's key, or the teacher's machine) always gets its stream;
+* the join code is in no answer a stranger can fetch: the standings carry it only to the projector's
+  link (``?key=``, printed in the teacher's terminal) and to the teacher's machine.
 
 Responses are JSON (``{"ok": false, "error": "one line"}`` when refused) or the static pages,
 served with a content security policy that allows no inline script: names reach a page only as
@@ -23,13 +39,18 @@ data that its script sets as text.
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import hmac
+import ipaddress
 import json
+import math
 import queue
+import socket
 import sys
 import threading
 import time
-from collections import OrderedDict, deque
-from collections.abc import AsyncIterator, Callable
+from collections import Counter, OrderedDict, deque
+from collections.abc import AsyncIterator, Callable, Iterator
 from concurrent.futures import Future
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field
@@ -42,51 +63,92 @@ from starlette.routing import Route
 
 from ..errors import UserError
 from . import page
+from .guard import Guard
 from .intake import MAX_HANDIN_BYTES, Clerk, RefusedError
 
 QUEUE_LIMIT = 64
 #: Hand-ins entered with one table write at the most.
 BATCH = 32
-UPLOADS = 8
-BODY_SECONDS = 30.0
+UPLOADS = 16
+UPLOADS_PER_ADDRESS = 2
+#: Within the connection's own deadline (``guard.REQUEST_SECONDS``), so the app answers 408 first.
+BODY_SECONDS = 12.0
 MAX_JSON_BYTES = 4096
 MAX_STREAMS = 64
+STREAMS_PER_ADDRESS = 4
 HEARTBEAT_SECONDS = 15.0
-MAX_FAILURES = 10
-FAILURE_WINDOW = 60.0
+#: Wrong answers of one kind an address may give before it waits; then ``GUESS_WAIT`` seconds, doubled
+#: for every further wrong one (at most ``MAX_GUESS_WAIT``).
+FREE_GUESSES = 5
+GUESS_WAIT = 60.0
+MAX_GUESS_WAIT = 3600.0
 MAX_TRACKED_ADDRESSES = 10_000
+JOINS_PER_MINUTE = 3
+CLASS_JOINS_PER_MINUTE = 120
+BUSY = "the class is busy: your game is kept and will be handed in in a moment"
 SECURITY_HEADERS = {
     "Content-Security-Policy": "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
                                "img-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'",
+    "Cross-Origin-Resource-Policy": "same-origin",
     "X-Content-Type-Options": "nosniff",
     "Referrer-Policy": "no-referrer",
     "Cache-Control": "no-store",
 }
 
 
-class Failures:
-    """Wrong codes and secrets per client address, in a sliding window; bounded in addresses kept."""
+class Guesses:
+    """Wrong answers of one kind (codes, secrets or tokens) per client address: ``FREE_GUESSES``, then a
+    wait that doubles with each further wrong one; a right answer clears the address. Bounded in
+    addresses kept (the oldest forgotten first)."""
 
-    def __init__(self, limit: int = MAX_FAILURES, window: float = FAILURE_WINDOW,
+    def __init__(self, free: int = FREE_GUESSES, wait: float = GUESS_WAIT,
                  clock: Callable[[], float] = time.monotonic) -> None:
-        self.limit, self.window, self.clock = limit, window, clock
-        self.seen: OrderedDict[str, deque[float]] = OrderedDict()
+        self.free, self.wait, self.clock = free, wait, clock
+        self.seen: OrderedDict[str, tuple[int, float]] = OrderedDict()  # address: (wrong so far, blocked until)
 
-    def _recent(self, address: str) -> deque[float]:
-        now = self.clock()
-        times = self.seen.setdefault(address, deque())
-        self.seen.move_to_end(address)
-        while times and times[0] <= now - self.window:
-            times.popleft()
-        while len(self.seen) > MAX_TRACKED_ADDRESSES:
-            self.seen.popitem(last=False)
-        return times
+    def blocked_for(self, address: str) -> float:
+        """Seconds ``address`` must still wait before its answer is looked at (0: none)."""
+        until = self.seen.get(address, (0, 0.0))[1]
+        return max(0.0, until - self.clock())
 
     def blocked(self, address: str) -> bool:
-        return len(self._recent(address)) >= self.limit
+        return self.blocked_for(address) > 0.0
 
     def failed(self, address: str) -> None:
-        self._recent(address).append(self.clock())
+        wrong, _ = self.seen.pop(address, (0, 0.0))
+        wrong += 1
+        until = 0.0
+        if wrong >= self.free:
+            until = self.clock() + min(MAX_GUESS_WAIT, self.wait * 2 ** min(wrong - self.free, 20))
+        self.seen[address] = (wrong, until)
+        while len(self.seen) > MAX_TRACKED_ADDRESSES:
+            self.seen.popitem(last=False)
+
+    def succeeded(self, address: str) -> None:
+        self.seen.pop(address, None)
+
+
+class Window:
+    """Events per key in a sliding window (joins per address): bounded in keys kept."""
+
+    def __init__(self, limit: int, seconds: float = 60.0, clock: Callable[[], float] = time.monotonic) -> None:
+        self.limit, self.seconds, self.clock = limit, seconds, clock
+        self.seen: OrderedDict[str, deque[float]] = OrderedDict()
+
+    def full(self, key: str) -> bool:
+        times = self.seen.get(key)
+        if times is None:
+            return False
+        while times and times[0] <= self.clock() - self.seconds:
+            times.popleft()
+        return len(times) >= self.limit
+
+    def add(self, key: str) -> None:
+        times = self.seen.setdefault(key, deque())
+        self.seen.move_to_end(key)
+        times.append(self.clock())
+        while len(self.seen) > MAX_TRACKED_ADDRESSES:
+            self.seen.popitem(last=False)
 
 
 class ClerkThread:
@@ -177,12 +239,21 @@ class ClassState:
 
     clerk: Clerk
     join_line: str
+    guard: Guard = field(default_factory=Guard)
     worker: ClerkThread | None = None
     waiting: int = 0
-    failures: Failures = field(default_factory=Failures)
+    codes: Guesses = field(default_factory=Guesses)
+    secrets: Guesses = field(default_factory=Guesses)
+    tokens: Guesses = field(default_factory=Guesses)
+    joins: Window = field(default_factory=lambda: Window(JOINS_PER_MINUTE))
+    class_joins: Window = field(default_factory=lambda: Window(CLASS_JOINS_PER_MINUTE))
     uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(UPLOADS))
+    uploading: Counter[str] = field(default_factory=Counter)
     streams: int = 0
+    streaming: Counter[str] = field(default_factory=Counter)
+    #: What anyone may read, and what the projector's link and the teacher's machine read (the join line).
     snapshot: bytes = b"{}"
+    projector_snapshot: bytes = b"{}"
     lab: bytes = b"{}"
     seen_version: int = -1
     seen_lab_version: int = -1
@@ -194,17 +265,23 @@ class ClassState:
         if self.clerk.version != self.seen_version:
             self.seen_version = self.clerk.version
             standings = self.clerk.standings()
-            standings["join"] = self.join_line
-            self.snapshot = json.dumps(standings, ensure_ascii=True).encode()
+            self.snapshot = json.dumps({**standings, "join": None}, ensure_ascii=True).encode()
+            self.projector_snapshot = json.dumps({**standings, "join": self.join_line}, ensure_ascii=True).encode()
         if self.clerk.lab_version != self.seen_lab_version:  # a game handed in leaves the curve as it was
             self.seen_lab_version = self.clerk.lab_version
             self.lab = json.dumps(self.clerk.lab_curve(), ensure_ascii=True, allow_nan=False).encode()
+
+    def projector(self, request: Request) -> bool:
+        """Whether ``request`` is the projector's (its link's key) or the teacher's machine's."""
+        key = request.query_params.get("key", "")
+        return self.guard.is_own(_address(request)) or (
+            len(key) <= 64 and hmac.compare_digest(key.encode(), self.clerk.roster.projector_key().encode()))
 
     async def run(self, job: Callable[[], Any], kind: str = "job") -> Any:
         """``job`` on the clerk's thread (or, for "hand-in", ``job`` is (token, body)), if the queue has
         room; the pages are told of any change."""
         if self.waiting >= QUEUE_LIMIT:
-            raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
+            raise RefusedError(503, BUSY)
         assert self.worker is not None, "the class is not serving"
         self.waiting += 1
         try:
@@ -221,8 +298,8 @@ def _json(data: object, status: int = 200, headers: dict[str, str] | None = None
 
 
 def _refusal(exc: RefusedError) -> Response:
-    headers = {"Retry-After": "2"} if exc.status in (429, 503) else {}
-    if exc.status in (400, 408, 413):  # a body may be left unread: the connection is not used again
+    headers = {"Retry-After": str(getattr(exc, "retry_after", 2))} if exc.status in (429, 503) else {}
+    if exc.status in (400, 401, 403, 408, 413, 415, 429):  # a body may be left unread: the connection is not used again
         headers["Connection"] = "close"
     return _json({"ok": False, "error": exc.message}, exc.status, headers)
 
@@ -235,6 +312,46 @@ def _bearer(request: Request) -> str | None:
     value = request.headers.get("authorization", "")
     scheme, _, token = value.partition(" ")
     return token.strip() or None if scheme.lower() == "bearer" and len(token) <= 200 else None
+
+
+def _waiting(guesses: Guesses, address: str, what: str) -> None:
+    wait = guesses.blocked_for(address)
+    if wait > 0:
+        refusal = RefusedError(429, f"too many wrong {what} from this machine: wait {math.ceil(wait)} s, then check "
+                                    f"it again")
+        refusal.retry_after = math.ceil(wait)  # type: ignore[attr-defined]
+        raise refusal
+
+
+def _named_by_address(host: str) -> bool:
+    """Whether a ``Host`` header names this server by an address (or localhost), never by a domain name a
+    hostile page could point at the class (DNS rebinding)."""
+    name = host.rsplit(":", 1)[0] if not host.endswith("]") else host
+    name = name.strip("[]").lower()
+    if name in ("localhost", socket.gethostname().lower(), socket.gethostname().lower() + ".local"):
+        return True
+    try:
+        ipaddress.ip_address(name)
+    except ValueError:
+        return False
+    return True
+
+
+def _same_site(request: Request) -> None:
+    """A request the class's own pages or the student's client could have sent (see the module); else refused."""
+    if not _named_by_address(request.headers.get("host", "")):
+        raise RefusedError(421, "this class answers at its address only (as printed in the teacher's terminal)")
+    if request.method == "GET":
+        return
+    media = request.headers.get("content-type", "").split(";", 1)[0].strip().lower()
+    if media != "application/json":
+        raise RefusedError(415, "the class takes JSON only (Content-Type: application/json)")
+    if request.headers.get("sec-fetch-site", "same-origin") not in ("same-origin", "none"):
+        raise RefusedError(403, "the class takes changes from its own pages only")
+    origin = request.headers.get("origin")
+    if origin is not None and origin not in (f"http://{request.headers.get('host', '')}",
+                                             f"https://{request.headers.get('host', '')}"):
+        raise RefusedError(403, "the class takes changes from its own pages only")
 
 
 async def _body(request: Request, limit: int) -> bytes:
@@ -270,32 +387,52 @@ async def _json_body(request: Request) -> dict[str, Any]:
 
 def _check_code(state: ClassState, request: Request, typed: object) -> None:
     address = _address(request)
-    if state.failures.blocked(address):
-        raise RefusedError(429, "too many wrong codes from this machine: wait a minute, then check the code on the "
-                           "projector")
+    _waiting(state.codes, address, "codes")
     if not isinstance(typed, str) or len(typed) > 20 or not state.clerk.roster.code_matches(typed):
-        state.failures.failed(address)
+        state.codes.failed(address)
         raise RefusedError(403, "wrong class code: check the code on the projector")
+    state.codes.succeeded(address)
 
 
 def _check_secret(state: ClassState, request: Request) -> None:
+    """The teacher's secret, from the Authorization header. The teacher's own machine is never made to wait:
+    a guesser elsewhere cannot lock the teacher out."""
     address = _address(request)
-    if state.failures.blocked(address):
-        raise RefusedError(429, "too many wrong secrets from this machine: wait a minute")
+    own = state.guard.is_own(address)
+    if not own:
+        _waiting(state.secrets, address, "secrets")
     secret = _bearer(request)
     if secret is None or not state.clerk.roster.secret_matches(secret):
-        state.failures.failed(address)
+        if not own:
+            state.secrets.failed(address)
         raise RefusedError(403, "the teacher's secret is needed for this (it is printed in the teacher's terminal)")
+    state.secrets.succeeded(address)
+
+
+def _check_token(state: ClassState, request: Request) -> str:
+    """The hand-in's token, a joined player's, from its headers (before any body is read)."""
+    address = _address(request)
+    _waiting(state.tokens, address, "tokens")
+    token = _bearer(request)
+    if token is None or state.clerk.roster.player_of(token) is None:
+        state.tokens.failed(address)
+        raise RefusedError(401, "this machine has not joined the class under that name: join first "
+                                "(armgame play --join HOST:PORT --code CODE --name NAME)")
+    state.tokens.succeeded(address)
+    return token
 
 
 def _refusals(handler: Callable[[Request], Any]) -> Callable[[Request], Any]:
     async def wrapped(request: Request) -> Response:
         try:
+            _same_site(request)
             return await handler(request)
         except RefusedError as exc:
             return _refusal(exc)
-        except UserError as exc:  # a file the clerk could not write: one line, nothing entered
-            return _refusal(RefusedError(503, str(exc)))
+        except UserError as exc:  # a file the clerk could not write: one line, nothing entered; no path for the room
+            print(f"armgame class: {request.method} {request.url.path}: {exc}"[:300], file=sys.stderr)
+            return _refusal(RefusedError(503, "the class could not write this down (the teacher's terminal says "
+                                              "why); nothing was entered, and your machine keeps what it sent"))
         except Exception as exc:  # a bug: the request gets one line, the teacher's terminal one line, the class goes on
             print(f"armgame class: {request.method} {request.url.path}: {type(exc).__name__}: {exc}"[:300],
                   file=sys.stderr)
@@ -304,11 +441,26 @@ def _refusals(handler: Callable[[Request], Any]) -> Callable[[Request], Any]:
     return wrapped
 
 
+@contextlib.contextmanager
+def _share(counter: Counter[str], address: str, limit: int, own: bool, what: str) -> Iterator[None]:
+    """One of ``address``'s ``limit`` places in ``counter`` for the block (the teacher's machine: no limit)."""
+    if not own and counter[address] >= limit:
+        raise RefusedError(503, what)
+    counter[address] += 1
+    try:
+        yield
+    finally:
+        counter[address] -= 1
+        if counter[address] <= 0:
+            del counter[address]
+
+
 def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None = None,
-              say: Callable[[str], None] = lambda line: None) -> Starlette:
+              say: Callable[[str], None] = lambda line: None, guard: Guard | None = None) -> Starlette:
     """The class's app over ``clerk`` (already open on its folder); ``join_line`` is what students type;
-    ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher."""
-    state = ClassState(clerk, join_line)
+    ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher;
+    ``guard`` knows the teacher's own machine's addresses (``guard.Guard``)."""
+    state = ClassState(clerk, join_line, guard or Guard())
 
     async def load_lab() -> None:
         for problem in await state.run(clerk.load_lab):
@@ -343,22 +495,30 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         return page.response(request.path_params["name"], SECURITY_HEADERS)
 
     async def standings(request: Request) -> Response:
-        return Response(state.snapshot, 200, SECURITY_HEADERS, media_type="application/json")
+        data = state.projector_snapshot if state.projector(request) else state.snapshot
+        return Response(data, 200, SECURITY_HEADERS, media_type="application/json")
 
     async def lab(request: Request) -> Response:
         return Response(state.lab, 200, SECURITY_HEADERS, media_type="application/json")
 
     async def events(request: Request) -> Response:
-        if state.streams >= MAX_STREAMS:
+        address = _address(request)
+        projector = state.projector(request)
+        own = state.guard.is_own(address)
+        if state.streams >= MAX_STREAMS and not projector:
             raise RefusedError(503, "too many pages are open on this class")
+        if not own and state.streaming[address] >= STREAMS_PER_ADDRESS:
+            raise RefusedError(503, "too many pages of this class are open on this machine: close one")
         state.streams += 1
+        state.streaming[address] += 1
 
         async def stream() -> AsyncIterator[bytes]:
             try:
                 sent = None
                 while not state.stopping.is_set():
-                    if state.snapshot is not sent:
-                        sent = state.snapshot
+                    current = state.projector_snapshot if projector else state.snapshot
+                    if current is not sent:
+                        sent = current
                         yield b"event: standings\ndata: " + sent + b"\n\n"
                         yield b"event: lab\ndata: " + state.lab + b"\n\n"
                     changed = state.changed
@@ -368,29 +528,48 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
                         yield b": still here\n\n"
             finally:
                 state.streams -= 1
+                state.streaming[address] -= 1
+                if state.streaming[address] <= 0:
+                    del state.streaming[address]
 
         return StreamingResponse(stream(), headers={**SECURITY_HEADERS, "X-Accel-Buffering": "no"},
                                  media_type="text/event-stream")
 
     async def join(request: Request) -> Response:
+        address = _address(request)
         body = await _json_body(request)
         _check_code(state, request, body.get("code"))
         token = body.get("token")
         if token is not None and (not isinstance(token, str) or len(token) > 200):
             raise RefusedError(400, "token must be a string")
-        player, new_token = await state.run(lambda: clerk.join(body.get("name"), token))
+        own = state.guard.is_own(address)
+        known = token is not None and clerk.roster.player_of(token) is not None
+        if not known and not own:
+            if state.joins.full(address):
+                raise RefusedError(429, f"this machine has joined {JOINS_PER_MINUTE} names in the last minute: one "
+                                        f"name a student; ask the teacher if you need another")
+            if state.class_joins.full("class"):
+                raise RefusedError(503, "many names are joining at once: try again in a moment")
+        player, new_token = await state.run(lambda: clerk.join(body.get("name"), token, address))
+        if new_token is not None and not own:
+            state.joins.add(address)
+            state.class_joins.add("class")
         return _json({"ok": True, "name": player.name, "token": new_token or token, "seed": clerk.roster.seed,
                       "closed": clerk.roster.closed,
                       "message": f"joined the class as {player.name}" if new_token is None
                       else f"joined the class as {player.name} (the name is now this machine's)"})
 
     async def hand_in(request: Request) -> Response:
+        address = _address(request)
         _check_code(state, request, request.headers.get("x-armgame-code"))
-        token = _bearer(request)
+        token = _check_token(state, request)
+        if clerk.roster.closed:
+            raise RefusedError(403, "the class is closed: no more games are taken (your replay stays on your machine)")
         if state.uploads.locked():
-            raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
-        async with state.uploads:
-            data = await _body(request, MAX_HANDIN_BYTES)
+            raise RefusedError(503, BUSY)
+        with _share(state.uploading, address, UPLOADS_PER_ADDRESS, state.guard.is_own(address), BUSY):
+            async with state.uploads:
+                data = await _body(request, MAX_HANDIN_BYTES)
         return _json(await state.run((token, data), "hand-in"))
 
     async def teacher_hide(request: Request) -> Response:
@@ -405,10 +584,28 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         message = await state.run(lambda: clerk.release(body.get("name")))
         return _json({"ok": True, "message": message})
 
+    async def teacher_remove(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.remove(body.get("names")))
+        return _json({"ok": True, "message": message})
+
     async def teacher_close(request: Request) -> Response:
         _check_secret(state, request)
         body = await _json_body(request)
         message = await state.run(lambda: clerk.close(bool(body.get("closed", True))))
+        return _json({"ok": True, "message": message})
+
+    async def teacher_lock(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.lock(bool(body.get("locked", True))))
+        return _json({"ok": True, "message": message})
+
+    async def teacher_lab(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.choose_lab(body.get("protocol")))
         return _json({"ok": True, "message": message})
 
     async def teacher_standings(request: Request) -> Response:
@@ -436,7 +633,10 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/handin", _refusals(hand_in), methods=["POST"]),
         Route("/api/teacher/hide", _refusals(teacher_hide), methods=["POST"]),
         Route("/api/teacher/release", _refusals(teacher_release), methods=["POST"]),
+        Route("/api/teacher/remove", _refusals(teacher_remove), methods=["POST"]),
         Route("/api/teacher/close", _refusals(teacher_close), methods=["POST"]),
+        Route("/api/teacher/lock", _refusals(teacher_lock), methods=["POST"]),
+        Route("/api/teacher/lab", _refusals(teacher_lab), methods=["POST"]),
         Route("/api/teacher/standings", _refusals(teacher_standings)),
         Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),
         Route("/api/teacher/lab.csv", _refusals(csv_route(clerk.lab_csv, "class-lab-reaches.csv"))),

@@ -219,7 +219,7 @@ def _remember(m: Membership) -> None:
     folder = client_folder()
     folder.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(_memberships_path(), json.dumps(data, indent=1, ensure_ascii=False).encode(),
-                       "class memberships")
+                       "class memberships", private=True)  # the tokens prove the names: the owner's alone
 
 
 def join(address: ClassAddress, code: str, name: str | None) -> Membership:
@@ -291,12 +291,14 @@ def hand_in(m: Membership, data: bytes, keep: bool = True) -> HandIn:
         answer = _request(m.address, "/api/handin", data, headers)
     except RefusalError as exc:
         if exc.status == 503 and keep:  # still busy after a minute: nothing lost, it goes at the next join
-            return _kept(m, data, str(exc))
+            return _kept(m, data, "the class is busy")
         return HandIn(f"not handed in: {exc}", refused=True)
-    except UnreachableError as exc:
+    except UnreachableError:
         if not keep:
             raise
-        return _kept(m, data, str(exc))
+        # This machine joined, so the network reached the class: a class that does not answer now is busy or
+        # stopped for a moment, not a matter of the Wi-Fi.
+        return _kept(m, data, f"the class at {m.address.label} did not answer (busy, or stopped for a moment)")
     return HandIn(str(answer.get("message", "handed in")), answer)
 
 
@@ -310,7 +312,8 @@ def _kept(m: Membership, data: bytes, why: str) -> HandIn:
         atomic_write_bytes(path, data, "replay")
     except (OSError, DataFileError) as exc:
         return HandIn(f"not handed in ({why}); and the replay could not be kept: {exc}", refused=True)
-    return HandIn(f"not handed in yet: {why}. Your game is kept and is handed in the next time you join", kept=path)
+    return HandIn(f"not handed in yet: {why}; your game is kept and will be handed in the next time you join",
+                  kept=path)
 
 
 def send_outbox(m: Membership) -> list[str]:

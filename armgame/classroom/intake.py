@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import hashlib
+import hmac
 import io
 import math
 import os
@@ -33,6 +34,7 @@ from typing import Any
 
 from ..errors import UserError
 from ..records.identity import game_digest, game_digests
+from ..records.lookalikes import name_problem
 from ..records.replay import Replay, check_name, now_iso
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
@@ -90,6 +92,8 @@ class LabRun:
     protocol: Any
     rows: list[dict[str, object]]
     path: Path
+    #: A person's first run of its protocol (in ``lab/``): the only kind the class curve reads.
+    first: bool = True
 
 
 def ordinal(n: int) -> str:
@@ -129,9 +133,10 @@ class Clerk:
                             stale.unlink()
 
     # ------------------------------------------------------------------ joining
-    def join(self, name: object, token: str | None) -> tuple[Player, str | None]:
+    def join(self, name: object, token: str | None, address: str = "") -> tuple[Player, str | None]:
         """The player ``name`` for this client: (player, a new token) for a new name, (player, None)
-        when ``token`` proves the name is already theirs. RefusedError if another client holds the name."""
+        when ``token`` proves the name is already theirs. RefusedError if another client holds the name
+        or one a reader would take it for, if the name hides part of itself, or if the roster is locked."""
         try:
             name = check_name(name)
         except ValueError as exc:
@@ -139,22 +144,27 @@ class Clerk:
         key = player_key(name)
         player = self.roster.players.get(key)
         if player is not None:
-            if token is not None and token_digest(token) == player.token_sha256:
+            if token is not None and hmac.compare_digest(token_digest(token), player.token_sha256):
                 return player, None
             raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
                                f"name (or join from the machine that took it)")
+        problem = name_problem(name)
+        if problem is not None:
+            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "
+                               f"letters")
+        alike = self.roster.lookalike_of(name)
+        if alike is not None:
+            raise RefusedError(409, f"that name reads like {alike.name}, who is in this class already: choose a name "
+                               f"nobody could mistake for a classmate's")
         if self.roster.closed:
             raise RefusedError(403, "the class is closed to new players")
+        if self.roster.locked:
+            raise RefusedError(403, "the class takes no new names now (the teacher locked the list): ask the teacher")
         if len(self.roster.players) >= MAX_PLAYERS:
             raise RefusedError(403, f"the class has {MAX_PLAYERS} players, as many as it takes")
         new_token = secrets.token_urlsafe(24)
-        player = Player(name, token_digest(new_token), now_iso())
-        self.roster.players[key] = player
-        try:
-            self.roster.save()
-        except (OSError, DataFileError):
-            del self.roster.players[key]
-            raise
+        player = Player(name, token_digest(new_token), now_iso(), address[:64])
+        self.roster.add(key, player)
         self.version += 1
         return player, new_token
 
@@ -282,21 +292,25 @@ class Clerk:
         if not ok:
             raise RefusedError(422, "the lab run does not reproduce its trials: not taken")
         protocol = replay.task.protocol  # type: ignore[union-attr]
-        first = not any(run.protocol == protocol and player_key(run.player) == player_key(player.name)
-                        for run in self.lab_runs)
-        path = self.folder / (LAB_DIR if first else LAB_MORE_DIR) / f"{name_slug(player.name)}-{game[:12]}.json"
-        path.parent.mkdir(exist_ok=True)
+        person = replay.driven == "keyboard"
+        # A person's first run of a protocol is the one in the curve; a program's run never takes that place.
+        first = person and not any(run.protocol == protocol and not run.program and
+                                   player_key(run.player) == player_key(player.name) for run in self.lab_runs)
+        folder = self.folder / (LAB_DIR if first else LAB_MORE_DIR)
+        _real_folder(folder)
+        path = folder / f"{name_slug(player.name)}-{game[:12]}.json"
         atomic_write_bytes(path, replay.to_bytes(), "lab run")
         self.lab_digests.add(game)
-        if first:
-            self.lab_runs.append(LabRun(player.name, replay.driven != "keyboard", protocol, trial_rows(session),
-                                        path))
-            self.version += 1
-            self.lab_version += 1
-        if replay.driven != "keyboard":
-            counted = "a program's run: kept apart, not in the class curve"
-        elif first:
+        self.lab_runs.append(LabRun(player.name, not person, protocol, trial_rows(session) if first or not person
+                                    else [], path, first))
+        self.version += 1
+        self.lab_version += 1
+        if not person:
+            counted = "a program's run: kept apart, never in the class curve"
+        elif first and self._curve_protocol() == protocol:
             counted = "in the class curve"
+        elif first:
+            counted = "kept (the class curve shows the protocol the teacher chose)"
         else:
             counted = "kept (your first run of this protocol is the one in the curve)"
         return {"ok": True, "already": False, "message": f"lab run handed in: {counted}"}
@@ -311,6 +325,8 @@ class Clerk:
                 replay = _read_run(path)
                 if replay.task is None or replay.player is None:
                     raise UserError(f"{path}: not a lab run with a player's name")
+                if replay.driven != "keyboard":
+                    raise UserError(f"{path}: a program's run (kept, never in the class curve)")
                 ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)
                 if not ok:
                     raise UserError(f"{path}: does not reproduce its trials")
@@ -322,29 +338,45 @@ class Clerk:
                                         trial_rows(session), path))
         for path in _runs_in(self.folder / LAB_MORE_DIR):
             with contextlib.suppress(UserError):
-                self.lab_digests.add(_lab_identity(_read_run(path)))
+                replay = _read_run(path)
+                self.lab_digests.add(_lab_identity(replay))
+                if replay.task is None or replay.player is None:
+                    continue
+                rows: list[dict[str, object]] = []
+                if replay.driven != "keyboard":  # a program's run: its reaches are in the teacher's CSV
+                    ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)
+                    if not ok:
+                        continue
+                    rows = trial_rows(session)
+                self.lab_runs.append(LabRun(replay.player, replay.driven != "keyboard", replay.task.protocol, rows,
+                                            path, first=False))
         if self.lab_runs:
             self.version += 1
             self.lab_version += 1
         return problems
 
+    def _curve_protocol(self) -> Any:
+        """The protocol the teacher chose for the class curve (``Roster.lab``), or None."""
+        from ..lab.protocol import preset, protocol_from_dict
+
+        lab = self.roster.lab
+        if isinstance(lab, dict):
+            return protocol_from_dict(lab, "lab")
+        return preset(lab) if lab else None
+
     def lab_curve(self) -> dict[str, object]:
-        """The class curve of the protocol most students ran (people's runs; programs' counted apart)."""
+        """The class curve of the protocol the teacher chose: each person's first run of it (programs' runs
+        and hidden names never in it; the programs counted apart)."""
         from ..lab.analysis import display_unit, figure_metric
         from ..lab.figures import class_curve
 
-        people = [run for run in self.lab_runs if not run.program and not self.roster.is_hidden(run.player)]
-        groups: list[tuple[Any, list[LabRun]]] = []
-        for run in people:
-            group = next((g for g in groups if g[0] == run.protocol), None)
-            if group is None:
-                groups.append((run.protocol, [run]))
-            else:
-                group[1].append(run)
+        protocol = self._curve_protocol()
+        runs = [run for run in self.lab_runs if run.first and not run.program and run.protocol == protocol
+                and not self.roster.is_hidden(run.player)]
         programs = sum(run.program for run in self.lab_runs)
-        if not groups:
-            return {"protocol": None, "students": 0, "programs": programs, "metric": None, "trials": []}
-        protocol, runs = max(groups, key=lambda g: len(g[1]))
+        if protocol is None or not runs:
+            return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": programs,
+                    "metric": None, "trials": []}
         metric = figure_metric(protocol)
         curve = class_curve([run.rows for run in runs], metric)
         scale, unit = display_unit(metric)
@@ -360,8 +392,7 @@ class Clerk:
                 set(self.roster.players):
             raise RefusedError(404, "no such name in this class")
         key = player_key(name)
-        (self.roster.hidden.add if hidden else self.roster.hidden.discard)(key)
-        self.roster.save()
+        self.roster.changed(hidden=self.roster.hidden | {key} if hidden else self.roster.hidden - {key})
         self.version += 1
         self.lab_version += 1
         return f"{name} is {'hidden from' if hidden else 'shown on'} the projector"
@@ -373,24 +404,52 @@ class Clerk:
         if not isinstance(name, str):
             raise RefusedError(400, "name must be a string")
         key = player_key(name)
-        player = self.roster.players.get(key)
-        if player is None:
+        if key not in self.roster.players:
             raise RefusedError(404, "no machine has joined under that name")
-        del self.roster.players[key]
-        try:
-            self.roster.save()
-        except (OSError, DataFileError):
-            self.roster.players[key] = player
-            raise
+        player = self.roster.remove(key)
         self.version += 1
         return (f"{player.name} is free: the next machine to join under it takes it (the old one can no longer "
                 f"hand in); their games stay theirs")
 
+    def remove(self, names: object) -> str:
+        """Names taken off the class at once (a flood of names from one machine): each one's machine can no
+        longer hand in, the names are hidden from the projector, and their games stay in the table (the
+        teacher's CSV keeps them). One save for all; nothing changed if it fails."""
+        if not isinstance(names, list) or not names or len(names) > MAX_PLAYERS or \
+                not all(isinstance(n, str) for n in names):
+            raise RefusedError(400, "names must be a list of names")
+        keys = {player_key(n) for n in names}
+        known = keys & (set(self.roster.players) | {player_key(e.name) for e in self.entries})
+        if not known:
+            raise RefusedError(404, "none of those names is in this class")
+        players = {k: p for k, p in self.roster.players.items() if k not in known}
+        self.roster.changed(players=players, hidden=self.roster.hidden | known)
+        self.version += 1
+        self.lab_version += 1
+        names = f"{len(known)} name{'s' if len(known) != 1 else ''}"
+        return f"{names} removed: hidden, and their machines can no longer hand in"
+
     def close(self, closed: bool) -> str:
-        self.roster.closed = bool(closed)
-        self.roster.save()
+        self.roster.changed(closed=bool(closed))
         self.version += 1
         return "the class is closed to new games" if closed else "the class takes games again"
+
+    def lock(self, locked: bool) -> str:
+        """No new names (the students already in play on); or new names again."""
+        self.roster.changed(locked=bool(locked))
+        self.version += 1
+        return "the class takes no new names" if locked else "the class takes new names again"
+
+    def choose_lab(self, protocol: object) -> str:
+        """The protocol the class curve shows (the teacher's choice; None: none until chosen)."""
+        from ..lab.protocol import PRESETS
+
+        if protocol is not None and (not isinstance(protocol, str) or protocol not in PRESETS):
+            raise RefusedError(400, f"the class curve shows one of the presets: {', '.join(sorted(PRESETS))}")
+        self.roster.changed(lab=protocol)
+        self.version += 1
+        self.lab_version += 1
+        return f"the class curve shows {protocol}" if protocol else "the class curve shows no protocol"
 
     # ------------------------------------------------------------------ what the page shows
     def standings(self, teacher: bool = False) -> dict[str, object]:
@@ -432,7 +491,22 @@ class Clerk:
 
         columns = ("player", "program", "protocol", "replay", *TRIAL_COLUMNS)
         return _csv(columns, ([run.player, run.program, run.protocol.name, run.path.name,
-                               *(row[c] for c in TRIAL_COLUMNS)] for run in self.lab_runs for row in run.rows))
+                               *(row[c] for c in TRIAL_COLUMNS)] for run in self.lab_runs for row in run.rows
+                              if run.first or run.program))
+
+
+def _real_folder(folder: Path) -> None:
+    """``folder`` made if missing; refused if anything but a real folder is there (a planted link would
+    carry the class's writes out of its folder)."""
+    try:
+        os.mkdir(folder, 0o700)
+    except FileExistsError:
+        pass
+    except OSError as exc:
+        raise UserError(f"cannot make the class's {folder.name}/ folder: {exc.strerror or exc}") from None
+    if not stat.S_ISDIR(os.lstat(folder).st_mode):
+        raise UserError(f"the class's {folder.name}/ is not a folder (a link or a file was put there): nothing was "
+                        f"written")
 
 
 def _runs_in(folder: Path) -> list[Path]:

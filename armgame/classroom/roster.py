@@ -3,13 +3,21 @@
 Kept in the class's folder beside its table, written only by the server (one writer: the clerk
 thread), atomically and fsynced before a join is acknowledged::
 
-    class.json        {"format": "armgame-class", "code": "FROG", "seed": 10, "closed": false,
-                       "players": {key: {"name", "token_sha256", "joined"}}, "hidden": [key, ...]}
+    class.json        {"format": "armgame-class", "format_version": 2, "code": "FROG", "seed": 10,
+                       "closed": false, "locked": false, "lab": "lesson", a protocol or null,
+                       "players": {key: {"name", "token_sha256", "joined", "address"}},
+                       "hidden": [key, ...]}
     teacher.secret    the teacher's secret, created once with owner-only permissions
 
 A student's name is theirs: the first client to take it receives a random token, and only the
 token's SHA-256 is kept here, so the folder itself never holds what would let someone else hand
-in under that name. Names are compared by ``records.standings.player_key`` ("alice" is "Alice").
+in under that name. Names are compared by ``records.standings.player_key`` ("alice" is "Alice"),
+and a new name is refused if a reader would take it for one already in (``lookalike_of``: the
+skeletons of ``records.lookalikes``) or if it hides part of itself (``records.lookalikes.name_problem``).
+The address each name joined from is kept for the teacher (which names came from one machine).
+A ``locked`` roster takes no new names; ``lab`` is the protocol the class curve shows, the
+teacher's choice (``--lab``), never the one most names happened to run. Format 1 (before these)
+is read as it is and written back as 2.
 
 The join code is four letters from an alphabet with nothing a projector font confuses (no O/0,
 I/l/1, S/5, Z/2, B/8): short to type from the back row, and read case-insensitively.
@@ -28,6 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..limits import DEFAULT_SEED
+from ..records.lookalikes import skeletons
 from ..records.replay import check_date, check_name, now_iso
 from ..records.standings import legacy_player_key, player_key
 from ..records.storage import (
@@ -44,7 +53,7 @@ from ..records.storage import (
 ROSTER_NAME = "class.json"
 SECRET_NAME = "teacher.secret"
 FORMAT = "armgame-class"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 CODE_ALPHABET = "ACDEFGHJKMNPQRTUVWXY"
 CODE_LENGTH = 4
 #: Names one class holds: a lecture hall of students, each with a program or two, with room.
@@ -72,6 +81,8 @@ class Player:
     name: str
     token_sha256: str
     joined: str
+    #: The client address the name joined from ("" in a class from before addresses were kept).
+    address: str = ""
 
 
 @dataclass
@@ -86,6 +97,57 @@ class Roster:
     players: dict[str, Player] = field(default_factory=dict)
     hidden: set[str] = field(default_factory=set)
     created: str = field(default_factory=now_iso)
+    locked: bool = False
+    #: The class curve's protocol: a preset's name, a protocol file's ``as_dict`` (the teacher's own), or None.
+    lab: str | dict | None = None
+
+    def __post_init__(self) -> None:
+        self._index()
+
+    def _index(self) -> None:
+        """The lookups the server's event loop makes while the clerk's thread changes the roster: rebuilt
+        whole and swapped in, so a reader on another thread sees the old index or the new, never half."""
+        self.by_token = {p.token_sha256: key for key, p in self.players.items()}
+        self.by_skeleton = {s: key for key, p in self.players.items() for s in skeletons(p.name)}
+
+    def add(self, key: str, player: Player) -> None:
+        """``player`` under ``key``, saved; nothing changed if the save fails."""
+        self.players[key] = player
+        try:
+            self.save()
+        except BaseException:
+            del self.players[key]
+            raise
+        finally:
+            self._index()
+
+    def remove(self, key: str) -> Player:
+        """The player under ``key`` taken out, saved; nothing changed if the save fails."""
+        player = self.players.pop(key)
+        try:
+            self.save()
+        except BaseException:
+            self.players[key] = player
+            raise
+        finally:
+            self._index()
+        return player
+
+    def changed(self, **values: object) -> None:
+        """Fields set and saved together; all put back if the save fails (memory never disagrees with disk)."""
+        before = {name: getattr(self, name) for name in values}
+        before_hidden = set(self.hidden)
+        for name, value in values.items():
+            setattr(self, name, value)
+        try:
+            self.save()
+        except BaseException:
+            for name, value in before.items():
+                setattr(self, name, value)
+            self.hidden = before_hidden
+            raise
+        finally:
+            self._index()
 
     @property
     def path(self) -> Path:
@@ -118,10 +180,12 @@ class Roster:
             d = parse_json(data)
             if not isinstance(d, dict) or d.get("format") != FORMAT:
                 raise ValueError(f"not an armgame class record (no \"format\": \"{FORMAT}\")")
+            version = check_int("format_version", d.get("format_version"), 1, 10**6)
+            if version > FORMAT_VERSION:
+                raise ValueError(f"class record format {version} is newer than this armgame reads: update armgame")
+            later = {"locked", "lab"} if version >= 2 else set()
             d = check_keys("class record", d, {"format", "format_version", "code", "seed", "closed", "players",
-                                               "hidden", "created"})
-            if check_int("format_version", d["format_version"], 1, 10**6) != FORMAT_VERSION:
-                raise ValueError(f"class record format {d['format_version']} is not one this armgame reads")
+                                               "hidden", "created", *later})
             code = check_str("code", d["code"], CODE_LENGTH)
             if len(code) != CODE_LENGTH or any(c not in CODE_ALPHABET for c in code):
                 raise ValueError(f"code must be {CODE_LENGTH} letters of {CODE_ALPHABET}, got {code!r}")
@@ -132,7 +196,8 @@ class Roster:
                 raise ValueError(f"players must be an object of at most {MAX_PLAYERS} names")
             players = {}
             for key, item in d["players"].items():
-                p = check_keys(f"player {key!r}", item, {"name", "token_sha256", "joined"})
+                p = check_keys(f"player {key!r}", item, {"name", "token_sha256", "joined",
+                                                         *({"address"} if version >= 2 else ())})
                 name = check_name(p["name"])
                 if key not in (player_key(name), legacy_player_key(name)):
                     raise ValueError(f"player {key!r} is filed under another name's key")
@@ -142,20 +207,32 @@ class Roster:
                 digest = check_str("token_sha256", p["token_sha256"], 64)
                 if not _HEX64.fullmatch(digest):
                     raise ValueError(f"player {name!r}: token_sha256 is not a SHA-256")
-                players[key] = Player(name, digest, check_date("joined", p["joined"]))
+                address = check_str("address", p["address"], 64) if version >= 2 else ""
+                players[key] = Player(name, digest, check_date("joined", p["joined"]), address)
             if not isinstance(d["hidden"], list) or not all(isinstance(k, str) for k in d["hidden"]):
                 raise ValueError("hidden must be a list of names")
             created = check_date("created", d["created"])
+            locked = d.get("locked", False)
+            if not isinstance(locked, bool):
+                raise ValueError("locked must be true or false")
+            lab = d.get("lab")
+            if isinstance(lab, dict):
+                from ..lab.protocol import protocol_from_dict
+
+                protocol_from_dict(lab, "lab")  # a class record's own protocol is checked like any other
+            elif lab is not None:
+                lab = check_str("lab", lab, 80)
         except ValueError as exc:
             raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
         hidden = {player_key(k) for k in d["hidden"]}  # player_key of an older key is today's key
-        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created)
+        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab)
 
     def save(self) -> None:
         data = dump_json({
             "format": FORMAT, "format_version": FORMAT_VERSION, "code": self.code, "seed": self.seed,
-            "closed": self.closed, "created": self.created, "hidden": sorted(self.hidden),
-            "players": {k: {"name": p.name, "token_sha256": p.token_sha256, "joined": p.joined}
+            "closed": self.closed, "locked": self.locked, "lab": self.lab, "created": self.created,
+            "hidden": sorted(self.hidden),
+            "players": {k: {"name": p.name, "token_sha256": p.token_sha256, "joined": p.joined, "address": p.address}
                         for k, p in self.players.items()},
         })
         atomic_write_bytes(self.path, data, "class record")
@@ -168,8 +245,20 @@ class Roster:
         return hmac.compare_digest(typed.encode("utf-8", "surrogatepass"), self.secret.encode())
 
     def player_of(self, token: str) -> Player | None:
-        digest = token_digest(token)
-        return next((p for p in self.players.values() if hmac.compare_digest(p.token_sha256, digest)), None)
+        """The player whose token this is (safe from another thread: one lookup in the swapped-in index)."""
+        key = self.by_token.get(token_digest(token))
+        return None if key is None else self.players.get(key)
+
+    def lookalike_of(self, name: str) -> Player | None:
+        """The player already in whose name a reader would take ``name`` for (not the same key's)."""
+        key = player_key(name)
+        index = self.by_skeleton
+        return next((self.players[k] for s in skeletons(name) if (k := index.get(s)) not in (None, key)
+                     and k in self.players), None)
+
+    def projector_key(self) -> str:
+        """The key in the projector's link: it shows the join code; derived from the secret, never the secret."""
+        return hmac.new(self.secret.encode(), b"armgame projector", hashlib.sha256).hexdigest()[:20]
 
     def is_hidden(self, name: str) -> bool:
         return player_key(name) in self.hidden

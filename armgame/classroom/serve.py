@@ -5,6 +5,12 @@ interface that holds the default route (the one the students' laptops share with
 found without sending a packet; ``--host 127.0.0.1`` keeps a trial on one machine. Ctrl-C stops the
 server: requests in flight get ``GRACE_SECONDS`` to finish, a hand-in being written is finished,
 the projector's stream is closed, and nothing is half-written.
+
+uvicorn runs with the class's guard on its h11 protocol (``guard``: deadlines and a share of the
+connections per address), and without proxy headers: a client's address is its socket's, never an
+``X-Forwarded-For`` it wrote, unless the teacher names a proxy (``--proxy ADDRESS``). One server at
+a time serves a folder: it holds ``server.lock`` (owner-only) for its life, and a second one says so
+in one line and stops.
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ from typing import Any
 from ..errors import UserError
 
 GRACE_SECONDS = 3
+SERVER_LOCK = "server.lock"
 
 
 def lan_address() -> str:
@@ -70,6 +77,7 @@ class ClassServer:
     server: Any
     join_line: str
     new: bool
+    held: Any = None
 
     @property
     def port(self) -> int:
@@ -89,6 +97,8 @@ class ClassServer:
             pass
         finally:
             self.sock.close()
+            if self.held is not None:
+                self.held.release()
             if main:
                 signal.signal(signal.SIGTERM, before)
 
@@ -97,34 +107,48 @@ class ClassServer:
 
 
 def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
-               on_ready: Callable[[ClassServer], None] | None = None) -> ClassServer:
+               on_ready: Callable[[ClassServer], None] | None = None, lab: str | None = None,
+               proxy: str | None = None) -> ClassServer:
     """The class in ``folder`` (gone on with, or new) bound to ``host:port`` (0: a free port), not yet serving.
 
-    ``say`` gets the teacher's lines: the banner once the server takes requests, notices after."""
+    ``say`` gets the teacher's lines: the banner once the server takes requests, notices after. ``lab``:
+    the preset the class curve shows (a new class: ``lesson`` unless given; a class gone on with keeps its
+    own unless given). ``proxy``: the address of a reverse proxy whose ``X-Forwarded-For`` is believed."""
     import uvicorn
 
     from ..lab.record import register
     from .app import build_app
+    from .guard import Guard, guarded_protocol
     from .intake import Clerk
     from .roster import Roster
 
+    curve = _curve_protocol(lab)
     register()  # lab runs are read as replays with their task section
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
     except OSError as exc:
         raise UserError(f"--folder {folder}: cannot create it: {exc.strerror or exc}") from None
-    roster, new = Roster.open(folder, seed)
-    clerk = Clerk(folder, roster)
-    sock = _bind(host, port)
+    held = _hold_folder(folder)
+    try:
+        roster, new = Roster.open(folder, seed)
+        if (new and roster.lab is None) or (curve is not None and curve != roster.lab):
+            roster.changed(lab=curve or "lesson")
+        clerk = Clerk(folder, roster)
+        sock = _bind(host, port)
+    except BaseException:
+        held.release()
+        raise
     port = sock.getsockname()[1]
     join_line = f"armgame play --join {_label(host)}:{port} --code {roster.code}"
+    own = {"127.0.0.1", "::1", host, *other_addresses(host)}
 
     def ready() -> None:
         others = other_addresses(host) if host not in ("127.0.0.1", "localhost", "::1") else []
         say(f"armgame class {'started' if new else 'goes on'}: code {roster.code}, seed {roster.seed}, "
             f"{len(clerk.entries)} games so far, kept in {folder}")
         say(f"  students type:  {join_line} --name NAME")
-        say(f"  projector:      http://{_label(host)}:{port}/   (the lab's class curve: /lab)")
+        say(f"  projector:      http://{_label(host)}:{port}/?key={roster.projector_key()}   (shows the code; "
+            f"the lab's class curve: /lab)")
         say(f"  teacher only:   http://{_label(host)}:{port}/teacher   secret: {roster.secret}   "
             f"(never on the projector)")
         if others:
@@ -135,15 +159,68 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
         if on_ready is not None:
             on_ready(opened)
 
-    app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"))
+    guard = Guard(own=frozenset(own))
+    app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), guard=guard)
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="on",
-                            timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5, limit_concurrency=400,
-                            h11_max_incomplete_event_size=16 * 1024)
+                            timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5,
+                            limit_concurrency=_connection_limit(), h11_max_incomplete_event_size=16 * 1024,
+                            http=guarded_protocol(guard), proxy_headers=proxy is not None,
+                            forwarded_allow_ips=proxy or "")
     errors = logging.getLogger("uvicorn.error")  # configured by uvicorn.Config, just above
     if not any(isinstance(f, _QuietWhenFull) for f in errors.filters):
         errors.addFilter(_QuietWhenFull())
-    opened = ClassServer(clerk, sock, uvicorn.Server(config), join_line, new)
+    opened = ClassServer(clerk, sock, uvicorn.Server(config), join_line, new, held)
     return opened
+
+
+def _curve_protocol(lab: str | None) -> str | dict | None:
+    """``--lab``: a preset's name as it is, a protocol file as its ``as_dict`` (kept in the class record, so the
+    curve stays the file's protocol whatever becomes of the file)."""
+    from ..lab.protocol import PRESETS, load_protocol
+    from ..records.storage import user_path
+
+    if lab is None or lab in PRESETS:
+        return lab
+    if not lab.endswith(".toml"):
+        raise UserError(f"--lab {lab}: a preset ({', '.join(PRESETS)}) or a protocol's .toml file")
+    return load_protocol(user_path(lab, "--lab")).as_dict()
+
+
+def _hold_folder(folder: Path) -> Any:
+    """The folder's server lock, held (``filelock``: the kernel's lock, dropped when this process ends, even by
+    kill -9); UserError in one line if another server holds it."""
+    import filelock
+
+    path = folder / SERVER_LOCK
+    if path.is_symlink():
+        raise UserError(f"{path}: is a link, not armgame's lock file: remove it")
+    lock = filelock.FileLock(str(path), timeout=0, mode=0o600, thread_local=False)
+    try:
+        lock.acquire()
+    except filelock.Timeout:
+        raise UserError(f"another armgame class serve is serving {folder}: stop it first (one server a "
+                        f"class)") from None
+    except OSError as exc:
+        raise UserError(f"{path}: cannot lock the class's folder: {exc.strerror or exc}") from None
+    with contextlib.suppress(OSError):
+        os.chmod(path, 0o600)
+    return lock
+
+
+def _connection_limit() -> int:
+    """Connections the server holds at once: what the process may open, less room for its own files. The
+    per-address share (``guard.PER_ADDRESS``) keeps one laptop from filling it."""
+    limit = 1000
+    with contextlib.suppress(ImportError, ValueError, OSError):
+        import resource
+
+        soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+        wanted = 4096 if hard == resource.RLIM_INFINITY else min(4096, hard)
+        if soft != resource.RLIM_INFINITY and soft < wanted:
+            resource.setrlimit(resource.RLIMIT_NOFILE, (wanted, hard))
+            soft = wanted
+        limit = min(2000, max(100, (soft if soft != resource.RLIM_INFINITY else 4096) - 100))
+    return limit
 
 
 class _QuietWhenFull(logging.Filter):
@@ -155,9 +232,10 @@ class _QuietWhenFull(logging.Filter):
         return record.getMessage() != "Exceeded concurrency limit."
 
 
-def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[str], None] = print) -> int:
+def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
+          lab: str | None = None, proxy: str | None = None) -> int:
     """Run the class in ``folder`` on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit status."""
-    opened = open_class(folder, host, port, seed, say)
+    opened = open_class(folder, host, port, seed, say, lab=lab, proxy=proxy)
     opened.run()
     where = shell_path(folder)
     say(f"armgame class stopped: {len(opened.clerk.entries)} games kept in {folder}")

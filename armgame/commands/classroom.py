@@ -47,6 +47,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        "address; 127.0.0.1 for a trial on one machine)")
     serve.add_argument("--port", type=_port, default=DEFAULT_PORT, help=f"the port (default: {DEFAULT_PORT})")
     serve.add_argument("--seed", type=_seed, default=None, help="the seed the class ranks (a new class: default 10)")
+    serve.add_argument("--lab", metavar="PRESET", help="the lab preset the class curve shows (a new class: lesson; "
+                       "the teacher's page can change it)")
+    serve.add_argument("--proxy", metavar="ADDRESS", help="believe X-Forwarded-For from this address only (a reverse "
+                       "proxy in front of the class; default: none, a client's address is its socket's)")
     serve.set_defaults(run=run_serve)
     submit = sub.add_parser("submit", help="hand replay files in to a class (games or lab runs)",
                             description="Hand replays in by hand: games kept while the class could not be reached, "
@@ -76,7 +80,8 @@ def run_serve(args: argparse.Namespace) -> int:
 
         raise UserError(f"--folder {folder}: not a folder")
     host = args.host or lan_address()
-    return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True))
+    return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True), lab=args.lab,
+                 proxy=args.proxy)
 
 
 def run_submit(args: argparse.Namespace) -> int:

@@ -122,11 +122,13 @@ def check_writable_folder(folder: Path, what: str = "folder", room: int = 0) -> 
         raise DataFileError(f"{what} {show_path(folder)}: {show_path(probe)} cannot be written by you")
 
 
-def _temporary(folder: Path, name: str) -> tuple[int, Path]:
+def _temporary(folder: Path, name: str, private: bool = False) -> tuple[int, Path]:
+    """A new temporary file beside ``name``: readable by all the umask allows, or by its owner only (``private``)."""
+    mode = 0o600 if private else 0o666 & ~_UMASK
     for _ in range(100):
         tmp = folder / f".{name}.{secrets.token_hex(6)}.tmp"
         try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666 & ~_UMASK)
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, mode)
         except FileExistsError:
             continue
         return fd, tmp
@@ -198,19 +200,21 @@ def link_new(tmp: Path, path: Path) -> None:
 
 
 @contextlib.contextmanager
-def atomic_writer(path: Path, what: str = "file", replace: bool | None = None) -> Iterator[BinaryIO]:
+def atomic_writer(path: Path, what: str = "file", replace: bool | None = None,
+                  private: bool = False) -> Iterator[BinaryIO]:
     """Yield a binary file whose content replaces ``path`` atomically when the block ends cleanly.
 
     Rows can be streamed into it (``simulate`` writes as it integrates); on any error the
     temporary file is removed and the target stays as it was. ``replace=False`` makes a new file or
     fails if ``path`` is taken (``link_new``); None: False for the targets of ``fresh_files``, else True.
+    ``private``: the file is its owner's to read (a token that proves a name, say).
     """
     path = check_output_path(Path(path), what)
     if replace is None:
         replace = not _is_fresh(path)
     folder = path.parent
     try:
-        fd, tmp = _temporary(folder, path.name)
+        fd, tmp = _temporary(folder, path.name, private)
     except OSError as exc:
         raise DataFileError(f"{show_path(path)}: cannot write the {what}: {exc.strerror or exc}") from None
     try:
@@ -235,8 +239,9 @@ def atomic_writer(path: Path, what: str = "file", replace: bool | None = None) -
     fsync_folder(folder)
 
 
-def atomic_write_bytes(path: Path, data: bytes, what: str = "file", replace: bool | None = None) -> None:
-    with atomic_writer(path, what, replace) as f:
+def atomic_write_bytes(path: Path, data: bytes, what: str = "file", replace: bool | None = None,
+                       private: bool = False) -> None:
+    with atomic_writer(path, what, replace, private) as f:
         f.write(data)
 
 
