@@ -612,6 +612,10 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         _check_secret(state, request)
         return _json(await state.run(lambda: clerk.standings(teacher=True)))
 
+    async def teacher_roster(request: Request) -> Response:
+        _check_secret(state, request)
+        return _json(await state.run(clerk.roster_view))
+
     def csv_route(make: Callable[[], str], filename: str) -> Callable[[Request], Any]:
         async def route(request: Request) -> Response:
             _check_secret(state, request)
@@ -638,6 +642,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/teacher/lock", _refusals(teacher_lock), methods=["POST"]),
         Route("/api/teacher/lab", _refusals(teacher_lab), methods=["POST"]),
         Route("/api/teacher/standings", _refusals(teacher_standings)),
+        Route("/api/teacher/roster", _refusals(teacher_roster)),
         Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),
         Route("/api/teacher/lab.csv", _refusals(csv_route(clerk.lab_csv, "class-lab-reaches.csv"))),
     ]

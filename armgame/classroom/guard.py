@@ -94,7 +94,9 @@ def guarded_protocol(guard: Guard) -> type[asyncio.Protocol]:
 
         def on_response_complete(self) -> None:
             super().on_response_complete()
-            if not self.transport.is_closing():
+            # A new request may begin: its headers have their deadline. A body still arriving after the answer
+            # (a route that never read it) keeps the request's deadline, armed when its headers came.
+            if not self.transport.is_closing() and self.conn.their_state is h11.IDLE:
                 self._await_headers()
 
         def _await_headers(self) -> None:

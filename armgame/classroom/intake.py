@@ -108,6 +108,10 @@ class Clerk:
         self.folder = Path(folder)
         self.roster = roster
         self.table = ScoreTable(self.folder, warn=lambda message: None)
+        self.table.lock_mode = 0o600  # only the server writes a class's table: nobody else may open its lock
+        with contextlib.suppress(OSError):
+            if stat.S_ISREG(os.lstat(self.table.lock_path).st_mode):
+                os.chmod(self.table.lock_path, 0o600)  # a class from before this armgame
         if not self.table.path.exists():
             self.table.new(roster.seed)
         elif self.table.seed != roster.seed:
@@ -477,6 +481,30 @@ class Clerk:
                 "arrival": None if not shown else {"seq": arrival.seq, "name": arrival.name,  # type: ignore[union-attr]
                                                    "score": arrival.score, "note": arrival.note,  # type: ignore[union-attr]
                                                    "program": arrival.program}}  # type: ignore[union-attr]
+
+    def roster_view(self) -> dict[str, object]:
+        """For the teacher's page: every joined name with the machine (address) it joined from and its games
+        (0: joined, not played yet), grouped by address, most names first; whether the list is locked, and the
+        class curve's protocol."""
+        from ..lab.protocol import PRESETS
+
+        played: dict[str, int] = {}
+        for entry in self.entries:
+            key = player_key(entry.name)
+            played[key] = played.get(key, 0) + 1
+        machines: dict[str, list[dict[str, object]]] = {}
+        for key, p in self.roster.players.items():
+            machines.setdefault(p.address or "unknown", []).append(
+                {"name": p.name, "joined": p.joined, "games": played.get(key, 0),
+                 "hidden": key in self.roster.hidden})
+        groups = [{"address": address, "names": sorted(names, key=lambda n: str(n["joined"]))}
+                  for address, names in machines.items()]
+        groups.sort(key=lambda g: (-len(g["names"]), g["address"]))  # type: ignore[arg-type]
+        lab = self.roster.lab
+        return {"machines": groups, "joined": len(self.roster.players),
+                "waiting": sum(1 for k in self.roster.players if not played.get(k)),
+                "locked": self.roster.locked, "closed": self.roster.closed,
+                "lab": lab.get("name") if isinstance(lab, dict) else lab, "presets": list(PRESETS)}
 
     def games_csv(self) -> str:
         columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_at",

@@ -30,17 +30,18 @@ class LockError(Exception):
 
 
 @contextlib.contextmanager
-def file_lock(path: Path, wait: float) -> Iterator[None]:
+def file_lock(path: Path, wait: float, mode: int = 0o666) -> Iterator[None]:
     """Hold the exclusive lock on ``path`` (created if need be) for the ``with`` block.
 
     Raises ``LockBusyError`` after ``wait`` seconds, ``LockError`` if the lock file cannot be opened;
-    whatever the block raises passes through unchanged.
+    whatever the block raises passes through unchanged. ``mode``: the lock file's permissions (0o600 for a
+    folder one program writes, such as a live class's, so nobody else can open the file to stall it).
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "only soft file lock is available": said in the docs, not at every save
         import filelock
 
-    lock = filelock.FileLock(str(path), timeout=wait, mode=0o666, thread_local=False)
+    lock = filelock.FileLock(str(path), timeout=wait, mode=mode, thread_local=False)
     try:
         lock.acquire(poll_interval=0.05)
     except filelock.Timeout:

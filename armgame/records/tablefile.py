@@ -109,6 +109,8 @@ class TableFile:
         self.folder = Path(folder)
         self.path = self.folder / TABLE_NAME
         self.lock_path = self.folder / LOCK_NAME
+        #: The lock file's permissions: everyone's for a table classmates share, the owner's for a live class's.
+        self.lock_mode = 0o666
         self.replays = self.folder / REPLAYS_DIR
         self.warn = warn
         self.record = TeacherRecord(self.folder, records, warn)
@@ -191,7 +193,7 @@ class TableFile:
     def _locked(self, wait: float | None = None) -> Iterator[None]:
         wait = LOCK_WAIT if wait is None else wait
         try:
-            with file_lock(self.lock_path, wait):
+            with file_lock(self.lock_path, wait, self.lock_mode):
                 yield
         except LockBusyError:
             raise TableBusyError(f"the table in {self.folder} is busy (another program has held its "

@@ -91,7 +91,9 @@ function announce(a) {
 }
 
 function render(s) {
-  showJoin(s.join || "");
+  // The join line comes only to the projector's own link (its key) and the teacher's machine: a page
+  // anyone on the network opens shows the standings without the code.
+  showJoin(s.join || "armgame play --join \u2026 (the code is on the teacher's projector)");
   document.getElementById("joined").textContent = String(s.joined);
   document.getElementById("games").textContent = String(s.games);
   document.getElementById("seed").textContent = String(s.seed);
@@ -106,7 +108,8 @@ function render(s) {
 }
 
 let latest = null;
-const source = new EventSource("/events");
+const key = new URLSearchParams(location.search).get("key");
+const source = new EventSource(key ? "/events?key=" + encodeURIComponent(key) : "/events");
 source.addEventListener("standings", (e) => {
   latest = JSON.parse(e.data);
   document.getElementById("link").hidden = true;

@@ -43,8 +43,72 @@ function row(table, r, kind) {
   table.appendChild(tr);
 }
 
+function button(text, action) {
+  const b = document.createElement("button");
+  b.textContent = text;
+  b.addEventListener("click", async () => {
+    try { say((await (await action()).json()).message); } catch (e) { say(e.message); }
+    refresh();
+  });
+  return b;
+}
+
+function machines(view) {
+  const box = $("machines");
+  box.replaceChildren();
+  $("waiting").textContent = view.joined + " joined; " + view.waiting + " of them have not handed a game in yet.";
+  $("list-state").textContent = view.locked ? "The list is locked: no new names." : "New names can join.";
+  const select = $("lab-protocol");
+  if (select.options.length === 0) {
+    for (const name of view.presets) {
+      const option = document.createElement("option");
+      option.value = name;
+      option.textContent = name;
+      select.appendChild(option);
+    }
+  }
+  if (view.lab && !view.presets.includes(view.lab)) {
+    const option = document.createElement("option");
+    option.value = "";
+    option.textContent = view.lab + " (the class's own file)";
+    select.appendChild(option);
+    select.value = "";
+  } else {
+    select.value = view.lab || "";
+  }
+  for (const m of view.machines) {
+    const group = document.createElement("div");
+    group.className = "machine";
+    const head = document.createElement("p");
+    const count = m.names.length === 1 ? "1 name" : m.names.length + " names";
+    head.textContent = "Machine " + m.address + ": " + count + " ";
+    if (m.names.length > 1) {
+      head.appendChild(button("Remove all " + m.names.length,
+        () => call("/api/teacher/remove", {names: m.names.map((n) => n.name)})));
+    }
+    group.appendChild(head);
+    const table = document.createElement("table");
+    for (const n of m.names) {
+      const tr = document.createElement("tr");
+      const games = n.games === 0 ? "joined, no game yet" : (n.games === 1 ? "1 game" : n.games + " games");
+      for (const text of [n.name, games, n.hidden ? "hidden on the projector" : "shown"]) {
+        const td = document.createElement("td");
+        td.textContent = text;
+        tr.appendChild(td);
+      }
+      const td = document.createElement("td");
+      td.appendChild(button("Remove", () => call("/api/teacher/remove", {names: [n.name]})));
+      tr.appendChild(td);
+      table.appendChild(tr);
+    }
+    group.appendChild(table);
+    box.appendChild(group);
+  }
+}
+
 async function refresh() {
   try {
+    machines(await (await call("/api/teacher/roster")).json());
     const s = await (await call("/api/teacher/standings")).json();
     $("controls").hidden = false;
     const table = $("everyone");
@@ -79,6 +143,14 @@ $("open").addEventListener("click", async () => { try { await call("/api/teacher
 $("release").addEventListener("click", async () => {
   try { say((await (await call("/api/teacher/release", {name: $("release-name").value.trim()})).json()).message); }
   catch (e) { say(e.message); }
+});
+$("lock").addEventListener("click", async () => { try { say((await (await call("/api/teacher/lock", {locked: true})).json()).message); } catch (e) { say(e.message); } refresh(); });
+$("unlock-list").addEventListener("click", async () => { try { say((await (await call("/api/teacher/lock", {locked: false})).json()).message); } catch (e) { say(e.message); } refresh(); });
+$("lab-protocol").addEventListener("change", async () => {
+  if (!$("lab-protocol").value) return;
+  try { say((await (await call("/api/teacher/lab", {protocol: $("lab-protocol").value})).json()).message); }
+  catch (e) { say(e.message); }
+  refresh();
 });
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
