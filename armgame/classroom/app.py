@@ -177,6 +177,7 @@ class ClassState:
 
     clerk: Clerk
     join_line: str
+    play_url: str = ""
     worker: ClerkThread | None = None
     waiting: int = 0
     failures: Failures = field(default_factory=Failures)
@@ -195,6 +196,7 @@ class ClassState:
             self.seen_version = self.clerk.version
             standings = self.clerk.standings()
             standings["join"] = self.join_line
+            standings["play"] = self.play_url
             self.snapshot = json.dumps(standings, ensure_ascii=True).encode()
         if self.clerk.lab_version != self.seen_lab_version:  # a game handed in leaves the curve as it was
             self.seen_lab_version = self.clerk.lab_version
@@ -305,10 +307,11 @@ def _refusals(handler: Callable[[Request], Any]) -> Callable[[Request], Any]:
 
 
 def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None = None,
-              say: Callable[[str], None] = lambda line: None) -> Starlette:
+              say: Callable[[str], None] = lambda line: None, play_url: str = "") -> Starlette:
     """The class's app over ``clerk`` (already open on its folder); ``join_line`` is what students type;
-    ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher."""
-    state = ClassState(clerk, join_line)
+    ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher;
+    ``play_url`` is the browser game's address (``/play``) as students reach it, for the projector's QR code."""
+    state = ClassState(clerk, join_line, play_url)
 
     async def load_lab() -> None:
         for problem in await state.run(clerk.load_lab):
@@ -338,6 +341,14 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
 
     async def teacher_page(request: Request) -> Response:
         return page.response("teacher.html", SECURITY_HEADERS)
+
+    async def play_page(request: Request) -> Response:
+        return page.response("play.html", SECURITY_HEADERS)
+
+    async def play_qr(request: Request) -> Response:
+        if not play_url:
+            raise RefusedError(404, "no such page")
+        return Response(page.qr_svg(play_url), 200, SECURITY_HEADERS, media_type="image/svg+xml")
 
     async def asset(request: Request) -> Response:
         return page.response(request.path_params["name"], SECURITY_HEADERS)
@@ -428,6 +439,8 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/", _refusals(home)),
         Route("/lab", _refusals(lab_page)),
         Route("/teacher", _refusals(teacher_page)),
+        Route("/play", _refusals(play_page)),
+        Route("/play.svg", _refusals(play_qr)),
         Route("/static/{name}", _refusals(asset)),
         Route("/api/standings", _refusals(standings)),
         Route("/api/lab", _refusals(lab)),

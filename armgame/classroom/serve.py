@@ -118,12 +118,14 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
     sock = _bind(host, port)
     port = sock.getsockname()[1]
     join_line = f"armgame play --join {_label(host)}:{port} --code {roster.code}"
+    play_url = f"http://{_label(host)}:{port}/play"
 
     def ready() -> None:
         others = other_addresses(host) if host not in ("127.0.0.1", "localhost", "::1") else []
         say(f"armgame class {'started' if new else 'goes on'}: code {roster.code}, seed {roster.seed}, "
             f"{len(clerk.entries)} games so far, kept in {folder}")
         say(f"  students type:  {join_line} --name NAME")
+        say(f"  browser:        {play_url}   (Chromebooks, tablets: nothing to install)")
         say(f"  projector:      http://{_label(host)}:{port}/   (the lab's class curve: /lab)")
         say(f"  teacher only:   http://{_label(host)}:{port}/teacher   secret: {roster.secret}   "
             f"(never on the projector)")
@@ -135,7 +137,7 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
         if on_ready is not None:
             on_ready(opened)
 
-    app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"))
+    app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), play_url=play_url)
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="on",
                             timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5, limit_concurrency=400,
                             h11_max_incomplete_event_size=16 * 1024)
