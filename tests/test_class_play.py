@@ -11,7 +11,7 @@ from browser import browser_page
 from class_server import running_class
 from play_page import join, open_page, play_keys, run_for, to_the_end
 
-from armgame.game.session import DOWN
+from armgame.game.session import DOWN, UP
 from armgame.records.replay import Replay
 
 
@@ -28,15 +28,23 @@ def test_a_game_with_keys_is_handed_in_shown_on_the_projector_and_kept_when_the_
         page.click("#join-button")
         page.wait_for_selector("#join-error:has-text('wrong class code')")
         join(page, opened.clerk.roster.code.lower(), "Zoë")  # typed as it comes: the code is case-insensitive
-        sent = []
-        page.on("request", lambda r: sent.append(r.post_data) if r.url.endswith("/api/handin") else None)
+        sent, asked = [], []
+        page.on("request", lambda r: (asked.append(r.url), sent.append(r.post_data) if r.url.endswith("/api/handin")
+                                      else None))
         play_keys(page)
+        page.keyboard.down("k")
+        run_for(page, 300)
+        page.evaluate("window.dispatchEvent(new Event('blur'))")  # the tab loses the focus with k held
         to_the_end(page)
         page.wait_for_selector("#end-answer:has-text('handed in: 1st of 1 in the class')")
         shown = int(page.inner_text("#end-score").rsplit(" ", 1)[1])
         assert _scores(opened, "Zoë") == [shown]  # the score the page showed is the one the server verified
         timeline = Replay.from_bytes(sent[0].encode(), "sent").timeline
-        assert {(e.key, e.action) for e in timeline} >= {("d", DOWN), ("j", DOWN), ("space", DOWN)}
+        assert {(e.key, e.action) for e in timeline} >= {("d", DOWN), ("j", DOWN), ("space", DOWN), ("k", UP)}
+        assert all(url.startswith(base + "/") for url in asked)  # nothing from anywhere but the class
+        page.keyboard.up("k")
+        page.keyboard.press("Enter")  # plays again
+        page.wait_for_selector("#end", state="hidden")
 
         # A reload keeps the name: no form, the same player (its token), and the second game is theirs too.
         page.reload()
@@ -80,6 +88,8 @@ def test_a_game_with_keys_is_handed_in_shown_on_the_projector_and_kept_when_the_
         assert page.inner_text("#students tr[data-name='Zoë'] td.score") == str(max(_scores(opened, "Zoë")))
         assert page.inner_text("#play-url").replace("\u200b", "") == f"127.0.0.1:{opened.port}/play"
         assert page.evaluate("document.querySelector('#play img').naturalWidth") > 0  # the QR code, from /play.svg
+        page.goto(base + "/teacher")  # the teacher's page shows the way too
+        page.wait_for_selector(f"#play-url:has-text('{base}/play')")
         assert page.dialogs == []
 
 
@@ -114,4 +124,6 @@ def test_on_a_phone_several_fingers_hold_several_muscles(tmp_path):
         sizes = page.eval_on_selector_all("#end p, #touch button", "els => els.map("
                                           "e => parseFloat(getComputedStyle(e).fontSize))")
         assert min(sizes) >= 19 and len(_scores(opened, "Łucja")) == 1
+        page.click("#not-me")  # another student on this phone: the name is asked again
+        page.wait_for_selector("#join", state="visible")
         assert errors == []

@@ -541,9 +541,18 @@ function draw() {
   // The HUD's top: the mode, the score and the clock.
   const labels = [];
   let y = hud.y;
-  const mode = fit("PLAY   seed " + member.seed + "   " + member.name, normal, hud.w);
-  labels.push([mode, hud.x, y, normal, p.ink, false]);
-  y += Math.round(normal * 1.2) + gap;
+  // The mode's parts share a line where they fit (a long name goes on a line of its own), as in the window.
+  const modeLines = [];
+  for (const part of ["PLAY", "seed " + member.seed, member.name]) {
+    const line = modeLines.length ? modeLines[modeLines.length - 1] + "   " + part : null;
+    if (line !== null && width(line, normal) <= hud.w) modeLines[modeLines.length - 1] = line;
+    else modeLines.push(fit(part, normal, hud.w));
+  }
+  for (const line of modeLines) {
+    labels.push([line, hud.x, y, normal, p.ink, false]);
+    y += Math.round(normal * 1.2) + gap / 2;
+  }
+  y += gap / 2;
   let head = big;
   const score = "Score " + game.score, clockLine = "Time " + clockText(game.timeLeft);
   const warn = game.timeLeft > 0 && game.timeLeft <= WARN_SECONDS;
