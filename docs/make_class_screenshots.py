@@ -1,4 +1,5 @@
-"""Draw the live class's pages as a projector shows them: docs/img/class_page.png and class_lab.png.
+"""Draw the live class's pages as a projector shows them: docs/img/class_page.png and class_lab.png; and the
+browser game (/play) as a student's laptop shows it, mid-game and at its end: class_play.png, class_play_end.png.
 
     python docs/make_class_screenshots.py             # writes docs/img/class_*.png
     python docs/make_class_screenshots.py --out DIR   # somewhere else, at 1024x768 and 1920x1080 both
@@ -22,6 +23,7 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 
 from browser import FLAGS, chromium_path  # noqa: E402
 from class_server import keyboard_game, running_class  # noqa: E402
+from play_page import join, open_page, play_keys, run_for, to_the_end  # noqa: E402
 
 from armgame.classroom import client  # noqa: E402
 from armgame.cli import main  # noqa: E402
@@ -36,7 +38,7 @@ LAB = "lesson"
 QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
              'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')
 #: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
-PICTURES = ("class_page.png", "class_lab.png")
+PICTURES = ("class_page.png", "class_lab.png", "class_play.png", "class_play_end.png")
 
 
 def curve_protocol(work: Path, quick: bool) -> str:
@@ -72,6 +74,24 @@ def fill(opened, work: Path, quick: bool = False) -> None:
               "--name", name])
 
 
+def play(browser, opened, size: tuple[int, int], out: Path, suffix: str) -> None:
+    """A student on a Chromebook joins the class in the browser and plays: mid-game, then the end."""
+    page = browser.new_page(viewport={"width": size[0], "height": size[1]})
+    errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+    join(page, opened.clerk.roster.code, "Pablo" if size[0] < 1500 else "Quinn")
+    play_keys(page, rounds=3)
+    page.keyboard.down("j")  # a muscle held as the picture is taken: its bar and its belly show it
+    run_for(page, 300)
+    page.screenshot(path=str(out / f"class_play{suffix}.png"))
+    page.keyboard.up("j")
+    to_the_end(page)
+    page.wait_for_selector("#end-answer:has-text('handed in')")
+    page.screenshot(path=str(out / f"class_play_end{suffix}.png"))
+    page.close()
+    if errors:
+        raise SystemExit(f"the browser game at {size[0]}x{size[1]} logged {errors}")
+
+
 def main_(argv: list[str] | None = None) -> int:
     from playwright.sync_api import sync_playwright
 
@@ -101,7 +121,9 @@ def main_(argv: list[str] | None = None) -> int:
                 if clipped:  # a label drawn past the curve's edge (the after-effect beside a short washout)
                     raise SystemExit(f"the class curve at {width}x{height} cuts {clipped}")
                 page.screenshot(path=str(out / f"class_lab{suffix}.png"))
-                print(f"wrote {out / f'class_page{suffix}.png'} and class_lab{suffix}.png")
+                page.close()
+                play(browser, opened, (width, height), out, suffix)
+                print(f"wrote {out / f'class_page{suffix}.png'}, class_lab{suffix}.png and class_play*{suffix}.png")
             browser.close()
     return 0
 

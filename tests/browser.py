@@ -27,14 +27,15 @@ def chromium_path() -> str:
 
 
 @contextlib.contextmanager
-def browser_page(width: int, height: int) -> Iterator[object]:
-    """A page of a fresh headless chromium at ``width`` x ``height``; its dialogs are counted in
-    ``page.dialogs`` (and dismissed), so a test sees any script a name could have smuggled in."""
+def browser_page(width: int, height: int, **options: object) -> Iterator[object]:
+    """A page of a fresh headless chromium at ``width`` x ``height`` (``options``: Playwright's ``new_page``
+    ones, e.g. ``has_touch=True``); its dialogs are counted in ``page.dialogs`` (and dismissed), so a test
+    sees any script a name could have smuggled in."""
     sync_api = pytest.importorskip("playwright.sync_api")
     with sync_api.sync_playwright() as p:
         browser = p.chromium.launch(executable_path=chromium_path(), args=FLAGS)
         try:
-            page = browser.new_page(viewport={"width": width, "height": height})
+            page = browser.new_page(viewport={"width": width, "height": height}, **options)
             page.dialogs = []
             page.on("dialog", lambda dialog: (page.dialogs.append(dialog.message), dialog.dismiss()))
             yield page

@@ -240,6 +240,7 @@ class ClassState:
     clerk: Clerk
     join_line: str
     guard: Guard = field(default_factory=Guard)
+    play_url: str = ""
     worker: ClerkThread | None = None
     waiting: int = 0
     codes: Guesses = field(default_factory=Guesses)
@@ -265,6 +266,7 @@ class ClassState:
         if self.clerk.version != self.seen_version:
             self.seen_version = self.clerk.version
             standings = self.clerk.standings()
+            standings["play"] = self.play_url
             self.snapshot = json.dumps({**standings, "join": None}, ensure_ascii=True).encode()
             self.projector_snapshot = json.dumps({**standings, "join": self.join_line}, ensure_ascii=True).encode()
         if self.clerk.lab_version != self.seen_lab_version:  # a game handed in leaves the curve as it was
@@ -456,11 +458,13 @@ def _share(counter: Counter[str], address: str, limit: int, own: bool, what: str
 
 
 def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None = None,
-              say: Callable[[str], None] = lambda line: None, guard: Guard | None = None) -> Starlette:
+              say: Callable[[str], None] = lambda line: None, guard: Guard | None = None,
+              play_url: str = "") -> Starlette:
     """The class's app over ``clerk`` (already open on its folder); ``join_line`` is what students type;
     ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher;
-    ``guard`` knows the teacher's own machine's addresses (``guard.Guard``)."""
-    state = ClassState(clerk, join_line, guard or Guard())
+    ``guard`` knows the teacher's own machine's addresses (``guard.Guard``); ``play_url`` is the browser
+    game's address (``/play``) as students reach it, for the projector's QR code."""
+    state = ClassState(clerk, join_line, guard or Guard(), play_url)
 
     async def load_lab() -> None:
         for problem in await state.run(clerk.load_lab):
@@ -490,6 +494,14 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
 
     async def teacher_page(request: Request) -> Response:
         return page.response("teacher.html", SECURITY_HEADERS)
+
+    async def play_page(request: Request) -> Response:
+        return page.response("play.html", SECURITY_HEADERS)
+
+    async def play_qr(request: Request) -> Response:
+        if not play_url:
+            raise RefusedError(404, "no such page")
+        return Response(page.qr_svg(play_url), 200, SECURITY_HEADERS, media_type="image/svg+xml")
 
     async def asset(request: Request) -> Response:
         return page.response(request.path_params["name"], SECURITY_HEADERS)
@@ -629,6 +641,8 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/", _refusals(home)),
         Route("/lab", _refusals(lab_page)),
         Route("/teacher", _refusals(teacher_page)),
+        Route("/play", _refusals(play_page)),
+        Route("/play.svg", _refusals(play_qr)),
         Route("/static/{name}", _refusals(asset)),
         Route("/api/standings", _refusals(standings)),
         Route("/api/lab", _refusals(lab)),

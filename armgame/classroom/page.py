@@ -6,6 +6,7 @@ event stream for JSON and sets every name and number as text (``textContent``), 
 ``<script>`` or one with right-to-left marks shows as the characters it is. The projector's sizes
 follow the window (CSS viewport units, 19 px at the least at 1024x768) in the high-contrast palette
 of the game's windows (``ui.render.PALETTES["high-contrast"]``): black on white, red for news.
+``play.html`` is the game itself for a browser (``/play``): ``engine.js`` plays it, ``play.js`` draws it.
 """
 
 from __future__ import annotations
@@ -25,6 +26,11 @@ PAGES = {
     "standings.js": "text/javascript; charset=utf-8",
     "lab.js": "text/javascript; charset=utf-8",
     "teacher.js": "text/javascript; charset=utf-8",
+    "play.html": "text/html; charset=utf-8",
+    "play.css": "text/css; charset=utf-8",
+    "play.js": "text/javascript; charset=utf-8",
+    "engine.js": "text/javascript; charset=utf-8",
+    "icon.svg": "image/svg+xml",
 }
 
 
@@ -39,3 +45,17 @@ def response(name: str, headers: dict[str, str]) -> Response:
     if media is None:
         raise RefusedError(404, "no such page")
     return Response(_read(name), 200, headers, media_type=media)
+
+
+@cache
+def qr_svg(url: str) -> bytes:
+    """``url`` as a QR code in SVG (made once): black on white, sized by the page, a quiet zone of 4 modules
+    (what the standard asks, so a phone's camera finds the code on any background)."""
+    import io
+
+    import segno
+
+    out = io.BytesIO()
+    segno.make(url, error="m").save(out, kind="svg", border=4, omitsize=True, xmldecl=False, dark="#000",
+                                    light="#fff")
+    return out.getvalue()

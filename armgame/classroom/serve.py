@@ -141,12 +141,14 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
     port = sock.getsockname()[1]
     join_line = f"armgame play --join {_label(host)}:{port} --code {roster.code}"
     own = {"127.0.0.1", "::1", host, *other_addresses(host)}
+    play_url = f"http://{_label(host)}:{port}/play"
 
     def ready() -> None:
         others = other_addresses(host) if host not in ("127.0.0.1", "localhost", "::1") else []
         say(f"armgame class {'started' if new else 'goes on'}: code {roster.code}, seed {roster.seed}, "
             f"{len(clerk.entries)} games so far, kept in {folder}")
         say(f"  students type:  {join_line} --name NAME")
+        say(f"  browser:        {play_url}   (Chromebooks, tablets: nothing to install)")
         say(f"  projector:      http://{_label(host)}:{port}/?key={roster.projector_key()}   (shows the code; "
             f"the lab's class curve: /lab)")
         say(f"  teacher only:   http://{_label(host)}:{port}/teacher   secret: {roster.secret}   "
@@ -160,7 +162,8 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
             on_ready(opened)
 
     guard = Guard(own=frozenset(own))
-    app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), guard=guard)
+    app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), guard=guard,
+                    play_url=play_url)
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="on",
                             timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5,
                             limit_concurrency=_connection_limit(), h11_max_incomplete_event_size=16 * 1024,

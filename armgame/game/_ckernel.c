@@ -8,11 +8,14 @@
  * ``GameSession._advance``'s, ``integrators._rk4``'s and ``TwoJointArm``'s accel, with the same
  * IEEE double operations in the same order (C evaluates a + b + c as (a + b) + c, as Python
  * does); the joint angles' cos and sin are the arm's own (``arm_sin_cos``, physics/_trig.h, which is
- * ``physics.trig.sin_cos`` operation for operation), and the hand's are the C library's, which is what
- * Python's ``math`` calls. The build (setup.py) turns off floating-point contraction, so no
- * multiply-add is fused, and the builtin sin and cos, so the compiler cannot merge them into a
- * ``sincos`` of its own choosing; the file calls glibc's sincos itself, for the hand, only where it
- * has checked it (``sin_cos`` below).
+ * ``physics.trig.sin_cos`` operation for operation), and so, since armgame 0.4, are the hand's where a hit
+ * is decided on them (``game_steps``: ``rules.hand_position``). The batch's "near" filters (``run``,
+ * _clanes.c) and the observations' trig (``write_trig``) keep the C library's, as Python's ``math`` is:
+ * the filters only pick which hands Python tests (with a margin far above the two sines' few-ulp
+ * difference), and the observations are not the rules. The build (setup.py) turns off floating-point
+ * contraction, so no multiply-add is fused, and the builtin sin and cos, so the compiler cannot merge
+ * them into a ``sincos`` of its own choosing; the file calls glibc's sincos itself only where it has
+ * checked it (``sin_cos`` below).
  *
  * With ``fast`` set, the elbow's cos and sin come by angle addition instead (the numpy fast
  * kernel's method, see batch/numpy_kernel.py): round-off, not bit for bit, and the batch says so.
@@ -241,8 +244,8 @@ static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t na
         slack -= fabs(x[0] - previous[0]) * reach1 + fabs(x[1] - previous[1]) * reach2;
         if (slack < 0.0) {
             double sa, ca, sb, cb;
-            sin_cos(x[0], &sa, &ca);
-            sin_cos(x[0] + x[1], &sb, &cb);
+            arm_sin_cos(x[0], &sa, &ca);  /* the rules' hand (rules.hand_position): the caller decides on it */
+            arm_sin_cos(x[0] + x[1], &sb, &cb);
             hx = l1 * ca + l2 * cb;
             hy = l1 * sa + l2 * sb;
             const double dx = hx - x0, dy = hy - y0;

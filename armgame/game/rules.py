@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from ..errors import UserError
 from ..physics.defaults import GAME_DT, GAME_INTEGRATOR
 from ..physics.params import GAME_ARM, TwoJointParams
+from ..physics.trig import sin_cos
 from .muscles import DEFAULT_MUSCLES, MuscleSpec
 
 #: The 2012 game's screen (800 x 800 px, shoulder at (400, 600), 500 px/m) in metres.
@@ -67,7 +68,17 @@ class Target:
     radius: float
 
     def contains(self, x: float, y: float) -> bool:
-        return (x - self.x) ** 2 + (y - self.y) ** 2 <= self.radius * self.radius
+        dx, dy = x - self.x, y - self.y
+        return dx * dx + dy * dy <= self.radius * self.radius
+
+
+def hand_position(l1: float, l2: float, q1: float, q2: float) -> tuple[float, float]:
+    """Where the rules see the hand of joint angles (q1, q2): the arm's own sine (``physics.trig``), + and *
+    only, so the browser's engine (``classroom/static/engine.js``) and every loop of this one find the same
+    bits on any machine (the C library's ``math.cos`` differs between systems and from JavaScript's)."""
+    s1, c1 = sin_cos(q1)
+    s12, c12 = sin_cos(q1 + q2)
+    return l1 * c1 + l2 * c12, l1 * s1 + l2 * s12
 
 
 @dataclass
@@ -98,7 +109,7 @@ class GameRules:
 
     def _hand(self, q1: float, q2: float) -> tuple[float, float]:
         p = self.config.arm
-        return (p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2))
+        return hand_position(p.l1, p.l2, q1, q2)
 
     def _draw_target(self, hand: tuple[float, float]) -> Target:
         """A target centred on the hand of a random posture: reachable by construction.
@@ -108,6 +119,10 @@ class GameRules:
         c = self.config
         xmin, xmax, ymin, ymax = c.view
         r = c.target_radius
+        # Squared distances, not math.dist: CPython's own norm (vector_norm), which JavaScript would have to copy.
+        clear = 3.0 * r
+        clear2 = clear * clear
+        hx, hy = hand
         best, best_distance = None, -1.0
         for tries in range(1, MAX_TRIES + 1):
             q1 = math.radians(self._rng.uniform(*c.target_shoulder_range))
@@ -115,8 +130,9 @@ class GameRules:
             x, y = self._hand(q1, q2)
             if not (xmin + r <= x <= xmax - r and ymin + r <= y <= ymax - r):
                 continue
-            distance = math.dist((x, y), hand)
-            if distance > 3.0 * r:
+            dx, dy = x - hx, y - hy
+            distance = dx * dx + dy * dy
+            if distance > clear2:
                 self.tries += tries
                 return Target(x, y, r)
             if distance > best_distance:

@@ -21,6 +21,7 @@ from ..errors import UserError
 from ..limits import MAX_EVENTS
 from ..physics.integrators import _SIXTH, Integrator
 from ..physics.params import TwoJointParams
+from ..physics.trig import sin_cos
 from ..physics.twojoint import TwoJointArm
 from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
@@ -262,7 +263,7 @@ class GameSession:
         dt = self.config.dt
         arm = self.config.arm
         l1, l2 = arm.l1, arm.l2
-        cos, sin = math.cos, math.sin
+        trig = sin_cos  # the rules' hand (rules.hand_position): the arm's own sine, the same bits everywhere
         rules = self.rules
         target = rules.target
         tx, ty, rr = target.x, target.y, target.radius * target.radius
@@ -283,10 +284,12 @@ class GameSession:
             a3 += (g3 - a3) * r3
             previous = (q1, q2, w1, w2)
             q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
-            s12 = q1 + q2
-            hx = l1 * cos(q1) + l2 * cos(s12)
-            hy = l1 * sin(q1) + l2 * sin(s12)
-            if (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
+            sn1, cs1 = trig(q1)
+            sn12, cs12 = trig(q1 + q2)
+            hx = l1 * cs1 + l2 * cs12
+            hy = l1 * sn1 + l2 * sn12
+            dx, dy = hx - tx, hy - ty
+            if dx * dx + dy * dy <= rr:
                 rules.hand_moved(hx, hy, (start + k + 1) * dt)
                 target = rules.target
                 tx, ty, rr = target.x, target.y, target.radius * target.radius
@@ -319,7 +322,7 @@ class GameSession:
                 params, mode, n - done, q1, q2, w1, w2, a0, a1, a2, a3, g0, g1, g2, g3, r0, r1, r2, r3, tx, ty, rr)
             previous = (p1, p2, p3, p4)
             done += ran
-            if near and (hx - tx) ** 2 + (hy - ty) ** 2 <= rr:
+            if near and (hx - tx) * (hx - tx) + (hy - ty) * (hy - ty) <= rr:
                 rules.hand_moved(hx, hy, (start + done) * dt)
                 target = rules.target
                 tx, ty, rr = target.x, target.y, target.radius * target.radius

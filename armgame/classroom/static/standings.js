@@ -90,10 +90,19 @@ function announce(a) {
   newsTimer = setTimeout(() => { news.hidden = true; }, 6000);
 }
 
+// The browser game's address (and its QR code, /play.svg) for students with no Python: without "http://",
+// which every browser adds, so it is short enough to type.
+function showPlay(url) {
+  document.getElementById("play").hidden = !url;
+  document.getElementById("play-url").textContent = (url || "").replace(/^http:\/\//, "")
+    .replace(/\/play$/, "\u200b/play");  // if the column is narrow, the line breaks there and nowhere else
+}
+
 function render(s) {
   // The join line comes only to the projector's own link (its key) and the teacher's machine: a page
   // anyone on the network opens shows the standings without the code.
   showJoin(s.join || "armgame play --join \u2026 (the code is on the teacher's projector)");
+  showPlay(s.play);
   document.getElementById("joined").textContent = String(s.joined);
   document.getElementById("games").textContent = String(s.games);
   document.getElementById("seed").textContent = String(s.seed);

@@ -155,3 +155,10 @@ $("lab-protocol").addEventListener("change", async () => {
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
 if (secret) refresh();
+
+// The browser game's address (public: the projector shows it too), for students who cannot install Python.
+fetch("/api/standings").then((r) => r.json()).then((s) => {
+  if (!s.play) return;
+  $("play-url").textContent = s.play;
+  $("play").hidden = false;
+}).catch(() => { /* the class is not reached: the terminal's banner has the address too */ });

@@ -50,7 +50,7 @@ from ...physics.batch import SERIES_LIMIT
 from ...physics.integrators import Integrator
 from ...physics.twojoint import TwoJointArm
 from ..muscles import MuscleLevelError, MuscleSet
-from ..rules import GameConfig, GameRules
+from ..rules import GameConfig, GameRules, hand_position
 from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
 from .compiled import CompiledKernel
 from .compiled import available as compiled_available
@@ -446,12 +446,11 @@ class BatchGameSession:
         """The single session's hit test and scoring, on Python floats, for game ``i`` after step ``step``."""
         p = self.config.arm
         q1, q2 = float(state[0]), float(state[1])
-        s12 = q1 + q2
-        hx = p.l1 * math.cos(q1) + p.l2 * math.cos(s12)
-        hy = p.l1 * math.sin(q1) + p.l2 * math.sin(s12)
+        hx, hy = hand_position(p.l1, p.l2, q1, q2)
         rules = self.rules[i]
         target = rules.target
-        d2 = (hx - target.x) ** 2 + (hy - target.y) ** 2
+        dx, dy = hx - target.x, hy - target.y
+        d2 = dx * dx + dy * dy
         if self._rounds and abs(math.sqrt(d2) - target.radius) <= KNIFE_EDGE:
             self.knife_edge[i] = True
         if d2 <= target.radius * target.radius:

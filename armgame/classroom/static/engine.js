@@ -1,0 +1,620 @@
+// The game's engine for a browser tab: armgame.game.session.GameSession, bit for bit.
+//
+// Every number a result depends on is computed here with the operations the Python computes it with, in the
+// same order, in IEEE doubles: the muscles (game/muscles.py), RK4 (physics/integrators.py), the arm's accel
+// (physics/twojoint.py), the arm's own sine (physics/trig.py: + - * only, never Math.sin), the rules' hand
+// and targets (game/rules.py), and Python's random.Random (MT19937, seeded as CPython seeds from an int).
+// JavaScript numbers are IEEE doubles and JavaScript never fuses a*b+c, so the same expressions give the
+// same bits; tests/test_browser_engine.py holds this file to GameSession on thousands of games in Node.
+// The server re-simulates every hand-in anyway (records.replay.Replay.verify): this engine only has to
+// show the student the game the server will find.
+//
+// No dependencies, no build step, no eval: it runs as it is under a CSP of script-src 'self', and in Node.
+
+/** The arithmetic's version: bumped whenever a result could change. */
+export const ENGINE_VERSION = "1";
+/** The armgame (Python package) version whose GameSession this engine reproduces; replays name it. */
+export const ARMGAME_VERSION = "0.4.0";
+
+const MAX_EVENTS = 200000; // armgame.limits.MAX_EVENTS
+const MAX_GAME_STEPS = 900000; // armgame.limits.MAX_GAME_STEPS
+const MAX_TRIES = 1000; // game/rules.py
+const RESET_KEY = "space";
+const TOGGLE_ARM_KEY = "tab";
+const DEG_TO_RAD = Math.PI / 180.0; // CPython's math.radians: x * degToRad, degToRad = pi / 180
+const SIXTH = 1.0 / 6.0;
+
+// ------------------------------------------------------------------ the arm's sine (physics/trig.py)
+const MAX_ANGLE = 1e15;
+const INV_PIO2 = 6.36619772367581382433e-01;
+const SHIFT = 6755399441055744.0;
+const PIO2_1 = 1.57079632673412561417e+00;
+const PIO2_2 = 6.07710050630396597660e-11;
+const PIO2_3 = 2.02226624871116645580e-21;
+const S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03, S3 = -1.98412698298579493134e-04;
+const S4 = 2.75573137070700676789e-06, S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+const C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03, C3 = 2.48015872894767294178e-05;
+const C4 = -2.75573143513906633035e-07, C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+
+/** [sin x, cos x] as armgame.physics.trig.sin_cos gives them, bit for bit. */
+export function sinCos(x) {
+  if (!(-MAX_ANGLE <= x && x <= MAX_ANGLE)) return [NaN, NaN];
+  const k = (x * INV_PIO2 + SHIFT) - SHIFT;
+  const r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
+  const z = r * r;
+  const w = z * z;
+  const s = r + z * r * (S1 + z * (S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6)));
+  const hz = 0.5 * z;
+  const v = 1.0 - hz;
+  const c = v + (((1.0 - v) - hz) + z * (z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6))));
+  const n = k - 4 * Math.floor(k / 4); // k mod 4, exact: k is a whole number below 2^51
+  if (n === 0) return [s, c];
+  if (n === 1) return [c, -s];
+  if (n === 2) return [-s, -c];
+  return [-c, s];
+}
+
+// ---------------------------------------------- Python's random.Random(seed): MT19937, CPython's seeding
+const MASK64 = (1n << 64n) - 1n;
+
+/** Python's random.Random seeded from a whole number 0 <= seed < 2^63 (a BigInt). */
+export class PythonRandom {
+  constructor(seed) {
+    const mt = new Uint32Array(624);
+    this.mt = mt;
+    // CPython's random_seed: the int's absolute value as 32-bit words, least significant first (one at least).
+    let n = BigInt(seed);
+    if (n < 0n) n = -n;
+    const key = [];
+    while (n > 0n) {
+      key.push(Number(n & 0xffffffffn));
+      n >>= 32n;
+    }
+    if (key.length === 0) key.push(0);
+    // init_genrand(19650218) then init_by_array(key), as in CPython's _randommodule.c.
+    mt[0] = 19650218;
+    for (let i = 1; i < 624; i++) {
+      const prev = mt[i - 1] ^ (mt[i - 1] >>> 30);
+      mt[i] = (Math.imul(1812433253, prev) + i) >>> 0;
+    }
+    let i = 1, j = 0;
+    for (let k = Math.max(624, key.length); k > 0; k--) {
+      const prev = mt[i - 1] ^ (mt[i - 1] >>> 30);
+      mt[i] = ((mt[i] ^ Math.imul(prev, 1664525)) + key[j] + j) >>> 0;
+      i++; j++;
+      if (i >= 624) { mt[0] = mt[623]; i = 1; }
+      if (j >= key.length) j = 0;
+    }
+    for (let k = 623; k > 0; k--) {
+      const prev = mt[i - 1] ^ (mt[i - 1] >>> 30);
+      mt[i] = ((mt[i] ^ Math.imul(prev, 1566083941)) - i) >>> 0;
+      i++;
+      if (i >= 624) { mt[0] = mt[623]; i = 1; }
+    }
+    mt[0] = 0x80000000;
+    this.index = 624;
+  }
+
+  _next() {
+    const mt = this.mt;
+    if (this.index >= 624) {
+      for (let k = 0; k < 624; k++) {
+        const y = (mt[k] & 0x80000000) | (mt[(k + 1) % 624] & 0x7fffffff);
+        mt[k] = mt[(k + 397) % 624] ^ (y >>> 1) ^ ((y & 1) ? 0x9908b0df : 0);
+      }
+      this.index = 0;
+    }
+    let y = mt[this.index++];
+    y ^= y >>> 11;
+    y ^= (y << 7) & 0x9d2c5680;
+    y ^= (y << 15) & 0xefc60000;
+    y ^= y >>> 18;
+    return y >>> 0;
+  }
+
+  /** random(): 53 random bits, as CPython's random_random. */
+  random() {
+    const a = this._next() >>> 5, b = this._next() >>> 6;
+    return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+  }
+
+  /** uniform(a, b) = a + (b - a) * random(), as Python's random.py. */
+  uniform(a, b) {
+    return a + (b - a) * this.random();
+  }
+}
+
+// ------------------------------------------------------------------------------------- small helpers
+/** Python's round(x) of a float to an int: the nearest, ties to even. */
+function roundHalfEven(x) {
+  const r = Math.round(x); // ties toward +infinity, exactly
+  return (r - x === 0.5 && r % 2 !== 0) ? r - 1 : r;
+}
+
+function ulpOf(x) {
+  const view = new DataView(new ArrayBuffer(8));
+  view.setFloat64(0, Math.abs(x));
+  const exponent = (view.getUint16(0) >>> 4) & 0x7ff;
+  return Math.pow(2, Math.max(exponent, 1) - 1075);
+}
+
+/** x * x, which is what Python's x ** 2 (the C library's pow) gives unless x * x lies within 0.02 ulp of a
+ * rounding tie: glibc's pow is within 0.52 ulp, so farther from a tie it returns the correctly rounded
+ * square. Nearer, the browser cannot know which way the server's pow rounds: refused. */
+function square(x, name) {
+  const p = x * x;
+  const c = 134217729.0 * x; // Veltkamp's split: x = hi + lo exactly, each half 26 bits
+  const hi = c - (c - x), lo = x - hi;
+  const err = ((hi * hi - p) + 2.0 * hi * lo) + lo * lo; // exact(x^2) - p (Dekker)
+  if (Math.abs(err) > 0.48 * ulpOf(p)) {
+    throw new Error(`the arm's ${name} ${x} has a square too near a rounding tie to reproduce in the browser`);
+  }
+  return p;
+}
+
+// fdlibm's expm1 (Sun, 1993), the C library's method: the muscles' rates are -expm1(-dt / T).
+const O_THRESHOLD = 7.09782712893383973096e+02, LN2_HI = 6.93147180369123816490e-01;
+const LN2_LO = 1.90821492927058770002e-10, INVLN2 = 1.44269504088896338700e+00;
+const Q1 = -3.33333333333331316428e-02, Q2 = 1.58730158725481460165e-03, Q3 = -7.93650757867487942473e-05;
+const Q4 = 4.00821782732936239552e-06, Q5 = -2.01099218183624371326e-07;
+
+function highWord(x) {
+  const view = new DataView(new ArrayBuffer(8));
+  view.setFloat64(0, x);
+  return view.getInt32(0);
+}
+
+function withHighWord(x, high) {
+  const view = new DataView(new ArrayBuffer(8));
+  view.setFloat64(0, x);
+  view.setInt32(0, high);
+  return view.getFloat64(0);
+}
+
+export function expm1(x) {
+  let hx = highWord(x);
+  const xsb = hx & 0x80000000;
+  hx &= 0x7fffffff;
+  let y, hi, lo, c = 0, k, t;
+  if (hx >= 0x4043687A) { // |x| >= 56 ln 2
+    if (hx >= 0x40862E42) {
+      if (hx >= 0x7ff00000) return Number.isNaN(x) ? x + x : (xsb === 0 ? x : -1.0);
+      if (x > O_THRESHOLD) return Infinity;
+    }
+    if (xsb !== 0) return -1.0;
+  }
+  if (hx > 0x3fd62e42) { // |x| > 0.5 ln 2
+    if (hx < 0x3FF0A2B2) { // and < 1.5 ln 2
+      if (xsb === 0) { hi = x - LN2_HI; lo = LN2_LO; k = 1; } else { hi = x + LN2_HI; lo = -LN2_LO; k = -1; }
+    } else {
+      k = Math.trunc(INVLN2 * x + ((xsb === 0) ? 0.5 : -0.5));
+      t = k;
+      hi = x - t * LN2_HI;
+      lo = t * LN2_LO;
+    }
+    x = hi - lo;
+    c = (hi - x) - lo;
+  } else if (hx < 0x3c900000) { // |x| < 2^-54
+    return x;
+  } else {
+    k = 0;
+  }
+  const hfx = 0.5 * x;
+  const hxs = x * hfx;
+  const r1 = 1.0 + hxs * (Q1 + hxs * (Q2 + hxs * (Q3 + hxs * (Q4 + hxs * Q5))));
+  t = 3.0 - r1 * hfx;
+  let e = hxs * ((r1 - t) / (6.0 - x * t));
+  if (k === 0) return x - (x * e - hxs);
+  e = (x * (e - c) - c);
+  e -= hxs;
+  if (k === -1) return 0.5 * (x - e) - 0.5;
+  if (k === 1) {
+    if (x < -0.25) return -2.0 * (e - (x + 0.5));
+    return 1.0 + 2.0 * (x - e);
+  }
+  if (k <= -2 || k > 56) {
+    y = 1.0 - (e - x);
+    y = k === 1024 ? y * 2.0 * 8.98846567431158e307 : withHighWord(y, highWord(y) + (k << 20));
+    return y - 1.0;
+  }
+  if (k < 20) {
+    t = withHighWord(0, 0x3ff00000 - (0x200000 >> k)); // 1 - 2^-k
+    y = t - (e - x);
+    return withHighWord(y, highWord(y) + (k << 20));
+  }
+  t = withHighWord(0, (0x3ff - k) << 20); // 2^-k
+  y = x - (e + t);
+  y += 1.0;
+  return withHighWord(y, highWord(y) + (k << 20));
+}
+
+function fail(message) {
+  throw new Error(message);
+}
+
+function number(value, name, low = -Infinity, high = Infinity) {
+  if (typeof value !== "number" || !Number.isFinite(value) || value < low || value > high) {
+    fail(`config.${name} must be a finite number from ${low} to ${high}, got ${JSON.stringify(value)}`);
+  }
+  return value;
+}
+
+function numbers(value, name, count, low, high) {
+  if (!Array.isArray(value) || value.length !== count) fail(`config.${name} must be a list of ${count} numbers`);
+  return value.map((v, i) => number(v, `${name}[${i}]`, low, high));
+}
+
+/** A seed (Number, BigInt or decimal string) as a BigInt, checked as GameConfig checks it. */
+function seedOf(seed) {
+  let big;
+  if (typeof seed === "bigint") big = seed;
+  else if (typeof seed === "number" && Number.isSafeInteger(seed)) big = BigInt(seed);
+  else if (typeof seed === "string" && /^[0-9]{1,19}$/.test(seed)) big = BigInt(seed);
+  else fail(`the seed must be a whole number from 0 to 2^63 - 1 (a decimal string above 2^53), got ${String(seed)}`);
+  if (big < 0n || big >= (1n << 63n)) fail(`the seed must be from 0 to 2^63 - 1, got ${big}`);
+  return big;
+}
+
+/** A BigInt seed as JSON data: a Number where it is exact, else the BigInt (JSON.stringify refuses it:
+ * use replayJSON, which writes its digits). */
+function seedValue(big) {
+  return big <= BigInt(Number.MAX_SAFE_INTEGER) ? Number(big) : big;
+}
+
+/** JSON text of plain data whose BigInts are written as their digits (JSON's numbers have no size limit). */
+export function toJSON(value) {
+  if (typeof value === "bigint") return value.toString();
+  if (Array.isArray(value)) return "[" + value.map(toJSON).join(", ") + "]";
+  if (value !== null && typeof value === "object") {
+    return "{" + Object.keys(value).map((k) => JSON.stringify(k) + ": " + toJSON(value[k])).join(", ") + "}";
+  }
+  return JSON.stringify(value);
+}
+
+// ---------------------------------------------------------------------------- the standard game
+const STANDARD_MUSCLES = [
+  ["pectoralis", "d", [1.5, 0.0]],
+  ["posterior deltoid", "f", [-1.5, 0.0]],
+  ["biceps", "j", [0.0, 1.125]],
+  ["triceps", "k", [0.0, -1.125]],
+];
+
+/** The replay "config" of the class's standard game (records.replay.config_to_dict(GameConfig(seed=seed))). */
+export function standardConfig(seed) {
+  return {
+    arm: { l1: 0.34, l2: 0.46, r1: 0.17, r2: 0.23, m1: 2.1, m2: 1.65, i1: 0.025, i2: 0.075, gravity: 0.0,
+      damping1: 0.36, damping2: 0.27 },
+    start_posture: [45.0 * DEG_TO_RAD, 90.0 * DEG_TO_RAD],
+    time_limit: 60.0,
+    target_radius: 0.05,
+    target_shoulder_range: [15.0, 90.0],
+    target_elbow_range: [45.0, 90.0],
+    seed: seedValue(seedOf(seed)),
+    muscles: STANDARD_MUSCLES.map(([name, key, moment]) => (
+      { name, key, moment: [...moment], rise_time: 0.08, decay_time: 0.1 })),
+    integrator: "rk4",
+    dt: 0.004,
+    reset_cost: 1,
+    view: [-0.8, 0.8, -0.4, 1.2],
+    scene: "game",
+  };
+}
+
+/** An ISO 8601 date as records.replay.now_iso writes it: UTC, microseconds, "+00:00". */
+function nowIso() {
+  return new Date().toISOString().replace(/\.(\d{3})Z$/, ".$1000+00:00");
+}
+
+// ------------------------------------------------------------------------------------------- the game
+/** One game: GameSession's input, steps and rules, and the replay the server verifies. */
+export class Game {
+  constructor(config) {
+    if (config === null || typeof config !== "object") fail("the game's config must be an object");
+    const known = ["arm", "start_posture", "time_limit", "target_radius", "target_shoulder_range",
+      "target_elbow_range", "seed", "muscles", "integrator", "dt", "reset_cost", "view", "scene"];
+    for (const name of known) if (!(name in config)) fail(`config.${name} is missing`);
+    if (config.integrator !== "rk4") {
+      fail(`the browser plays only RK4 games, this one uses ${JSON.stringify(config.integrator)}`);
+    }
+    const arm = config.arm ?? {};
+    const p = {};
+    for (const k of ["l1", "l2", "r1", "r2", "m1", "m2", "i1", "i2", "gravity", "damping1", "damping2"]) {
+      p[k] = number(arm[k], `arm.${k}`);
+    }
+    const dt = number(config.dt, "dt", 1e-4, 0.02);
+    const timeLimit = number(config.time_limit, "time_limit", 0, 3600);
+    const totalSteps = roundHalfEven(timeLimit / dt);
+    if (!(timeLimit > 0) || totalSteps > MAX_GAME_STEPS) fail(`config.time_limit ${timeLimit} s is not a game's`);
+    if (!Array.isArray(config.muscles) || config.muscles.length !== 4) fail("config.muscles must be 4 muscles");
+    const keys = config.muscles.map((m, i) => {
+      if (typeof m.key !== "string") fail(`config.muscles[${i}].key must be text`);
+      return m.key;
+    });
+    if (new Set(keys).size !== 4 || keys.includes(RESET_KEY) || keys.includes(TOGGLE_ARM_KEY)) {
+      fail(`config.muscles keys must differ from each other and from space and tab, got ${keys.join(" ")}`);
+    }
+    this._config = config;
+    this._seed = seedOf(config.seed);
+    this._dt = dt;
+    this._totalSteps = totalSteps;
+    this._l1 = p.l1;
+    this._l2 = p.l2;
+
+    // TwoJointArm's constants and kernel_params' (the ** 2 are the C library's pow: see square()).
+    const a = p.i1 + p.i2 + p.m1 * square(p.r1, "r1") + p.m2 * (square(p.l1, "l1") + square(p.r2, "r2"));
+    const b = p.m2 * p.l1 * p.r2;
+    const d = p.i2 + p.m2 * square(p.r2, "r2");
+    const g1 = p.gravity * (p.m1 * p.r1 + p.m2 * p.l1);
+    const g2 = p.gravity * p.m2 * p.r2;
+    const k1 = p.damping1, k2 = p.damping2;
+    const det0 = a * d - d * d;
+    const aMinusD = a - d;
+    // TwoJointArm._build_components: which accel, with its operations in its order.
+    let accel;
+    if (p.gravity !== 0.0) {
+      accel = (q1, q2, w1, w2, t1, t2) => {
+        const gc12 = g2 * sinCos(q1 + q2)[1];
+        const [sn, cs] = sinCos(q2);
+        const bc = b * cs, h = b * sn, m12 = d + bc;
+        const f1 = t1 + h * (w1 + w1 + w2) * w2 - g1 * sinCos(q1)[1] - gc12 - k1 * w1;
+        const f2 = t2 - h * w1 * w1 - gc12 - k2 * w2;
+        const r = 1.0 / (det0 - bc * bc);
+        return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+      };
+    } else if (k1 !== 0.0 || k2 !== 0.0) {
+      accel = (q1, q2, w1, w2, t1, t2) => {
+        const [sn, cs] = sinCos(q2);
+        const bc = b * cs, h = b * sn, m12 = d + bc;
+        const f1 = t1 + h * (w1 + w1 + w2) * w2 - k1 * w1;
+        const f2 = t2 - h * w1 * w1 - k2 * w2;
+        const r = 1.0 / (det0 - bc * bc);
+        return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+      };
+    } else {
+      accel = (q1, q2, w1, w2, t1, t2) => {
+        const [sn, cs] = sinCos(q2);
+        const bc = b * cs, h = b * sn, m12 = d + bc;
+        const f1 = t1 + h * (w1 + w1 + w2) * w2;
+        const f2 = t2 - h * w1 * w1;
+        const r = 1.0 / (det0 - bc * bc);
+        return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+      };
+    }
+    this._accel = accel;
+
+    // MuscleSet.
+    this._muscleKeys = keys;
+    this._moments = config.muscles.map((m, i) => numbers(m.moment, `muscles[${i}].moment`, 2, -50, 50));
+    this._rise = config.muscles.map((m, i) => -expm1(-dt / number(m.rise_time, `muscles[${i}].rise_time`, dt, 10)));
+    this._decay = config.muscles.map((m, i) => -expm1(-dt / number(m.decay_time, `muscles[${i}].decay_time`, dt, 10)));
+    this._activation = [0.0, 0.0, 0.0, 0.0];
+    this._goal = [0.0, 0.0, 0.0, 0.0];
+    this._rate = [...this._decay];
+    this._held = [false, false, false, false];
+
+    // GameRules.
+    this._start = numbers(config.start_posture, "start_posture", 2, -7, 7);
+    this._radius = number(config.target_radius, "target_radius", 0.005, 0.5);
+    this._shoulderRange = numbers(config.target_shoulder_range, "target_shoulder_range", 2, -360, 360);
+    this._elbowRange = numbers(config.target_elbow_range, "target_elbow_range", 2, -360, 360);
+    this._view = numbers(config.view, "view", 4, -20, 20);
+    this._resetCost = config.reset_cost;
+    if (!Number.isInteger(this._resetCost) || this._resetCost < 0) fail("config.reset_cost must be a whole number");
+    this._rng = new PythonRandom(this._seed);
+    this._score = 0;
+    this._hits = 0;
+    this._resets = 0;
+    this._hitTimes = [];
+    this._armVisible = true;
+    this.tries = 0;
+
+    // GameSession.
+    this._steps = 0;
+    const [q1, q2] = this._start;
+    this._state = [q1, q2, 0.0, 0.0];
+    this._previous = this._state;
+    this._timeline = [];
+    this._target = this._drawTarget(this._handAt(q1, q2));
+  }
+
+  // ------------------------------------------------------------------------------------ the rules
+  /** rules.hand_position: the arm's own sine, the same bits as Python's. */
+  _handAt(q1, q2) {
+    const [s1, c1] = sinCos(q1);
+    const [s12, c12] = sinCos(q1 + q2);
+    return [this._l1 * c1 + this._l2 * c12, this._l1 * s1 + this._l2 * s12];
+  }
+
+  /** GameRules._draw_target. */
+  _drawTarget(hand) {
+    const [xmin, xmax, ymin, ymax] = this._view;
+    const r = this._radius;
+    const clear = 3.0 * r;
+    const clear2 = clear * clear;
+    const [hx, hy] = hand;
+    let best = null, bestDistance = -1.0;
+    for (let tries = 1; tries <= MAX_TRIES; tries++) {
+      const q1 = this._rng.uniform(this._shoulderRange[0], this._shoulderRange[1]) * DEG_TO_RAD;
+      const q2 = this._rng.uniform(this._elbowRange[0], this._elbowRange[1]) * DEG_TO_RAD;
+      const [x, y] = this._handAt(q1, q2);
+      if (!(xmin + r <= x && x <= xmax - r && ymin + r <= y && y <= ymax - r)) continue;
+      const dx = x - hx, dy = y - hy;
+      const distance = dx * dx + dy * dy;
+      if (distance > clear2) {
+        this.tries += tries;
+        return { x, y, radius: r };
+      }
+      if (distance > bestDistance) {
+        best = { x, y, radius: r };
+        bestDistance = distance;
+      }
+    }
+    this.tries += MAX_TRIES;
+    if (best === null) fail("no target fits on screen with these settings (target radius or ranges too large)");
+    return best;
+  }
+
+  _contains(x, y) {
+    const t = this._target;
+    const dx = x - t.x, dy = y - t.y;
+    return dx * dx + dy * dy <= t.radius * t.radius;
+  }
+
+  /** GameRules.hand_moved. */
+  _handMoved(x, y, t) {
+    if (!this._contains(x, y)) return false;
+    this._score += 1;
+    this._hits += 1;
+    this._hitTimes.push(t);
+    this._target = this._drawTarget([x, y]);
+    return true;
+  }
+
+  // ------------------------------------------------------------------------------------ input
+  /** GameSession.key_event: a key ("d", "space", "tab"...) going "down" or "up" before the next step. */
+  keyEvent(key, action) {
+    if (this.over) return false;
+    if (this._timeline.length >= MAX_EVENTS) {
+      this._totalSteps = this._steps; // the game stops here, as the Python's does
+      return false;
+    }
+    const i = this._muscleKeys.indexOf(key);
+    if (i >= 0) {
+      const down = action === "down";
+      if (this._held[i] === down) return false;
+      this._held[i] = down;
+      this._goal[i] = down ? 1.0 : 0.0;
+      this._rate[i] = down ? this._rise[i] : this._decay[i];
+    } else if (key === RESET_KEY && action === "down") {
+      const [q1, q2] = this._start;
+      this._state = this._previous = [q1, q2, 0.0, 0.0];
+      this._activation = [0.0, 0.0, 0.0, 0.0];
+      this._resets += 1;
+      this._score = Math.max(0, this._score - this._resetCost);
+    } else if (key === TOGGLE_ARM_KEY && action === "down") {
+      this._armVisible = !this._armVisible;
+    } else {
+      return false;
+    }
+    this._timeline.push([this._steps, key, action]);
+    return true;
+  }
+
+  // ---------------------------------------------------------------------------------- physics
+  /** GameSession.advance: up to n physics steps (fewer at the clock's end); returns how many ran. */
+  advance(n) {
+    if (!Number.isInteger(n)) fail(`advance takes a whole number of steps, got ${n}`);
+    n = Math.min(n, this._totalSteps - this._steps);
+    if (n <= 0) return 0;
+    const accel = this._accel, dt = this._dt, l1 = this._l1, l2 = this._l2;
+    const h = 0.5 * dt, k = dt * SIXTH;
+    let [a0, a1, a2, a3] = this._activation;
+    const [g0, g1, g2, g3] = this._goal;
+    const [r0, r1, r2, r3] = this._rate;
+    const [[s0, e0], [s1, e1], [s2, e2], [s3, e3]] = this._moments;
+    let [q1, q2, w1, w2] = this._state;
+    let previous = this._state;
+    let target = this._target;
+    let tx = target.x, ty = target.y, rr = target.radius * target.radius;
+    const start = this._steps;
+    for (let step = 0; step < n; step++) {
+      const t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
+      const t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
+      a0 += (g0 - a0) * r0;
+      a1 += (g1 - a1) * r1;
+      a2 += (g2 - a2) * r2;
+      a3 += (g3 - a3) * r3;
+      previous = [q1, q2, w1, w2];
+      // integrators._rk4
+      const [ka1, ka2] = accel(q1, q2, w1, w2, t1, t2);
+      const v1 = w1 + h * ka1, v2 = w2 + h * ka2;
+      const [kb1, kb2] = accel(q1 + h * w1, q2 + h * w2, v1, v2, t1, t2);
+      const u1 = w1 + h * kb1, u2 = w2 + h * kb2;
+      const [kc1, kc2] = accel(q1 + h * v1, q2 + h * v2, u1, u2, t1, t2);
+      const z1 = w1 + dt * kc1, z2 = w2 + dt * kc2;
+      const [kd1, kd2] = accel(q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2);
+      const n1 = q1 + k * (w1 + z1 + 2.0 * (v1 + u1));
+      const n2 = q2 + k * (w2 + z2 + 2.0 * (v2 + u2));
+      const m1 = w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1));
+      const m2 = w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
+      q1 = n1; q2 = n2; w1 = m1; w2 = m2;
+      const [hx, hy] = this._handAt(q1, q2);
+      const dx = hx - tx, dy = hy - ty;
+      if (dx * dx + dy * dy <= rr) {
+        this._handMoved(hx, hy, (start + step + 1) * dt);
+        target = this._target;
+        tx = target.x; ty = target.y; rr = target.radius * target.radius;
+      }
+    }
+    this._activation = [a0, a1, a2, a3];
+    this._steps = start + n;
+    this._state = [q1, q2, w1, w2];
+    this._previous = previous;
+    if (!Number.isFinite(q1 + q2 + w1 + w2)) {
+      fail(`the arm's state became non-finite between t = ${start * dt} and ${(start + n) * dt} s`);
+    }
+    return n;
+  }
+
+  // ---------------------------------------------------------------------------------- queries
+  get steps() { return this._steps; }
+  get totalSteps() { return this._totalSteps; }
+  get dt() { return this._dt; }
+  get over() { return this._steps >= this._totalSteps; }
+  get timeLeft() { return Math.max(0.0, (this._totalSteps - this._steps) * this._dt); }
+  get state() { return [...this._state]; }
+  get target() { return { ...this._target }; }
+  get score() { return this._score; }
+  get hits() { return this._hits; }
+  get resets() { return this._resets; }
+  get hitTimes() { return [...this._hitTimes]; }
+  get armVisible() { return this._armVisible; }
+  get muscleActivation() { return [...this._activation]; }
+  get muscleKeys() { return [...this._muscleKeys]; }
+  get view() { return [...this._view]; }
+  get timeline() { return this._timeline.map((e) => [...e]); }
+
+  /** GameSession.interpolated_angles: the joint angles a fraction alpha of a step past the previous state. */
+  interpolatedAngles(alpha) {
+    const [p1, p2] = this._previous, [c1, c2] = this._state;
+    return [p1 + alpha * (c1 - p1), p2 + alpha * (c2 - p2)];
+  }
+
+  /** The hand [x, y] in metres (world coordinates), where the rules see it. */
+  hand() {
+    return this._handAt(this._state[0], this._state[1]);
+  }
+
+  /** GameSession.result() as JSON data. */
+  result() {
+    const c = this._config;
+    return { score: this._score, hits: this._hits, resets: this._resets, seed: seedValue(this._seed),
+      duration: c.time_limit, steps: this._steps, scene: c.scene, integrator: c.integrator, dt: c.dt,
+      version: ARMGAME_VERSION };
+  }
+
+  /** The replay as records.replay.Replay.as_dict writes a keyboard game's (driver null, as the Python
+   * client's: a named driver would list the game among the programs). A seed above 2^53 is a BigInt,
+   * which JSON.stringify refuses: replayJSON writes it. */
+  replay(player) {
+    const config = { ...this._config, seed: seedValue(this._seed) };
+    return {
+      format: "armgame-replay",
+      format_version: 1,
+      armgame_version: ARMGAME_VERSION,
+      date: nowIso(),
+      player: player ?? null,
+      driven: "keyboard",
+      driver: null,
+      scene: this._config.scene,
+      config,
+      timeline: this.timeline,
+      result: this.result(),
+    };
+  }
+
+  /** The replay as JSON text, any seed's digits exact: what the page hands in. */
+  replayJSON(player) {
+    return toJSON(this.replay(player));
+  }
+}

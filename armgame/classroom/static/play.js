@@ -1,0 +1,772 @@
+// The class's game in a browser tab (/play): the engine (engine.js, the game's physics and rules ported
+// bit for bit) plays the class's seed; this page joins, draws, reads keys and fingers, and hands the game in.
+// Everything a student or the server wrote is set as text (textContent, fillText), never as HTML.
+import { Game, standardConfig } from "./engine.js";
+
+// ------------------------------------------------------------------ what is kept on this machine
+// The name's token and the class's code: a reload, or the next game, plays under the same name.
+const MEMBER = "armgame.play.member";
+// Games finished but not yet taken by the class, oldest first: handed in at the next chance (the next
+// page load, the next game's end, a timer while the page is open).
+const OUTBOX = "armgame.play.outbox";
+const RETRY_MS = 5000;
+
+function load(key, fallback) {
+  try { return JSON.parse(localStorage.getItem(key)) ?? fallback; } catch { return fallback; }
+}
+function save(key, value) {
+  try { localStorage.setItem(key, JSON.stringify(value)); return true; } catch { return false; }
+}
+
+// ------------------------------------------------------------------ the looks (ui/palette.py, ui/render.py)
+// PALETTES["high-contrast"]: black on white, every colour at least 4.5:1 on white (a bright classroom).
+const PALETTE = {
+  window: "rgb(255,255,255)", scene: "rgb(255,255,255)", workspace: "rgb(236,236,236)", edge: "rgb(0,0,0)",
+  ink: "rgb(0,0,0)", faint: "rgb(0,0,0)", link: "rgb(0,0,0)", hand: "rgb(0,0,0)", target: [200, 0, 0],
+  flash: "rgb(255,210,0)", warn: "rgb(170,0,0)", barBack: "rgb(200,200,200)",
+  muscles: [[0, 80, 220], [180, 90, 0], [0, 120, 60], [160, 0, 160]], panel: "rgb(255,255,255)",
+  skin: [225, 225, 225],
+};
+const FONT = '"DejaVu Sans", "Segoe UI", Helvetica, Arial, sans-serif';
+const MIN_TEXT_AT_720 = 14, MIN_TEXT_FRACTION = 0.025, MIN_LINE = 3;
+const FLASH_TIME = 0.35, PLUS_ONE_TIME = 0.9, FADE_IN = 0.3, WARN_SECONDS = 10;
+const COUNTDOWN = 3;
+// A frame longer than this (a stalled tab) is clamped: the game slows for a moment rather than jumping.
+const MAX_FRAME = 0.25;
+// The body (ui/body.py), in metres.
+const UPPER_ARM = [0.048, 0.034], FOREARM = [0.034, 0.022], HAND = [0.036, 0.030];
+const MUSCLE_REST = 0.011, MUSCLE_GAIN = 0.02, BREADTH = [1.4, 1.4, 1.0, 1.0], MUSCLE_TINT = 0.45;
+const TORSO = [[-0.19, -0.035], [0.23, 0.11]], HEAD = [[-0.19, -0.02], 0.085];
+const SPINDLE = Array.from({ length: 9 }, (_, k) => [k / 8, Math.sin(Math.PI * k / 8) ** 1.2]);
+const PALM = Array.from({ length: 14 }, (_, j) => {
+  const t = 2 * Math.PI * j / 14;
+  return [Math.sign(Math.cos(t)) * Math.abs(Math.cos(t)) ** 0.6, Math.sign(Math.sin(t)) * Math.abs(Math.sin(t)) ** 0.6];
+});
+
+function rgb(c) { return `rgb(${c[0]},${c[1]},${c[2]})`; }
+function blend(a, b, k) { return a.map((x, i) => Math.round(x + (b[i] - x) * k)); }
+const MUSCLE_EDGE = PALETTE.muscles.map((c) => rgb(blend(c, [0, 0, 0], 0.35)));
+
+// ------------------------------------------------------------------ the page's parts
+const canvas = document.getElementById("game");
+const ctx = canvas.getContext("2d", { alpha: false });
+const touch = document.getElementById("touch");
+const joinForm = document.getElementById("join");
+const endCard = document.getElementById("end");
+const statusLine = document.getElementById("status");
+// The last frames' times (ms of script and drawing each): benchmarks/browser_page.py and the tests read them.
+canvas.frameTimes = [];
+
+let member = load(MEMBER, null);  // {code, name, token, seed}
+let config = null, game = null, names = [], keys = [];
+let phase = "join";  // join, countdown, playing, over
+let countdownLeft = 0, clock = 0, taken = 0, last = null, alpha = 1;
+const held = new Set();  // keys this page has pressed in the game and not yet released
+const fingers = new Map();  // pointer id -> the key its button holds
+let hits = [], seenHits = 0, lastTarget = null, touchMode = false;
+let background = null, backgroundKey = "";
+
+// ------------------------------------------------------------------ the class's API (same origin only)
+async function post(path, body, headers = {}) {
+  let response;
+  try {
+    response = await fetch(path, { method: "POST", body, credentials: "omit",
+      headers: { "Content-Type": "application/json", ...headers } });
+  } catch {
+    return { status: 0, data: null };  // not reached: no answer at all
+  }
+  let data = null;
+  try { data = await response.json(); } catch { data = null; }
+  return { status: response.status, data };
+}
+
+function refusal(answer) {
+  return answer.data && typeof answer.data.error === "string" ? answer.data.error : "the class refused (" + answer.status + ")";
+}
+
+async function join(code, name, token) {
+  const body = { code, name };
+  if (token) body.token = token;
+  return post("/api/join", JSON.stringify(body));
+}
+
+// A refusal that will be the same every time (a game the class does not take): dropped from the outbox.
+function final(status) { return status >= 400 && status < 500 && status !== 408 && status !== 429; }
+
+let flushing = null;
+// Every kept game handed in, oldest first; returns the answers ({game, answer}) to show.
+function flushOutbox() {
+  if (flushing === null) flushing = doFlush().finally(() => { flushing = null; });
+  return flushing;
+}
+async function doFlush() {
+  const results = [];
+  for (;;) {
+    const box = load(OUTBOX, []);
+    if (box.length === 0) break;
+    const item = box[0];
+    const answer = await post("/api/handin", item.body,
+      { Authorization: "Bearer " + item.token, "X-Armgame-Code": item.code });
+    if (answer.status === 200 && answer.data && answer.data.ok) {
+      results.push({ id: item.id, answer });
+    } else if (final(answer.status)) {
+      results.push({ id: item.id, answer });
+    } else {
+      results.push({ id: item.id, answer });
+      scheduleRetry();
+      break;  // busy or unreachable: the rest wait with it
+    }
+    save(OUTBOX, load(OUTBOX, []).filter((g) => g.id !== item.id));
+  }
+  showOutbox();
+  return results;
+}
+
+let retryTimer = null;
+function scheduleRetry() {
+  if (retryTimer !== null) return;
+  retryTimer = setTimeout(() => { retryTimer = null; flushOutbox().then(showAnswers); }, RETRY_MS);
+}
+
+function showOutbox() {
+  const kept = load(OUTBOX, []).length;
+  statusLine.replaceChildren();
+  if (member) statusLine.append("playing as " + member.name + " ");
+  if (kept > 0) statusLine.append("· " + (kept === 1 ? "1 game" : kept + " games") + " kept, to hand in ");
+  if (member && phase !== "playing") {
+    const change = document.createElement("button");
+    change.type = "button";
+    change.id = "not-me";
+    change.textContent = "not " + member.name + "?";
+    change.addEventListener("click", forget);
+    statusLine.append(change);
+  }
+}
+
+// ------------------------------------------------------------------ joining
+function askToJoin(error) {
+  phase = "join";
+  joinForm.hidden = false;
+  endCard.hidden = true;
+  document.getElementById("join-error").textContent = error || "";
+  if (member) {
+    document.getElementById("code").value = member.code;
+    document.getElementById("name").value = member.name;
+  }
+  document.getElementById(member ? "name" : "code").focus();
+  showOutbox();
+}
+
+function forget() {
+  member = null;
+  localStorage.removeItem(MEMBER);
+  askToJoin("");
+}
+
+joinForm.addEventListener("submit", async (event) => {
+  event.preventDefault();
+  const code = document.getElementById("code").value.trim();
+  const name = document.getElementById("name").value.trim();
+  const button = document.getElementById("join-button");
+  button.disabled = true;
+  // The same name again on this machine keeps its token (the class knows it); another name starts afresh.
+  const token = member && member.name.toLowerCase() === name.toLowerCase() ? member.token : null;
+  const answer = await join(code, name, token);
+  button.disabled = false;
+  if (answer.status === 0) {
+    document.getElementById("join-error").textContent = "the class could not be reached: is this the address on the projector?";
+    return;
+  }
+  if (!(answer.data && answer.data.ok)) {
+    document.getElementById("join-error").textContent = refusal(answer);
+    return;
+  }
+  joined(code, answer.data);
+});
+
+function joined(code, data) {
+  member = { code, name: data.name, token: data.token, seed: data.seed };
+  save(MEMBER, member);
+  joinForm.hidden = true;
+  statusLine.textContent = data.closed ? "the class is closed to new games" : "";
+  newGame();
+  flushOutbox().then(showAnswers);
+}
+
+// ------------------------------------------------------------------ a game
+function newGame() {
+  config = standardConfig(member.seed);
+  game = new Game(config);
+  names = config.muscles.map((m) => m.name);
+  keys = game.muscleKeys;
+  touch.querySelectorAll("button.muscle").forEach((b) => {
+    const i = Number(b.dataset.index);
+    b.textContent = keys[i] + " " + names[i].split(" ").pop();
+    b.dataset.key = keys[i];
+  });
+  phase = "countdown";
+  countdownLeft = COUNTDOWN;
+  clock = 0; taken = 0; alpha = 1; hits = []; seenHits = 0; lastTarget = game.target;
+  held.clear();
+  fingers.clear();
+  endCard.hidden = true;
+  showOutbox();
+}
+
+function press(key) {
+  if (phase === "countdown") { start(); return; }  // any key starts, and is not the game's input
+  if (phase !== "playing" || held.has(key)) return;
+  held.add(key);
+  game.keyEvent(key, "down");
+}
+
+function lift(key) {
+  if (!held.delete(key)) return;
+  if (phase === "playing") game.keyEvent(key, "up");
+}
+
+// Every held key let go, into the game as key-ups (the tab lost focus; a finger left the screen unseen).
+function releaseAll() {
+  for (const key of [...held]) lift(key);
+  fingers.clear();
+  touch.querySelectorAll("button.held").forEach((b) => b.classList.remove("held"));
+}
+
+function start() {
+  phase = "playing";
+  showOutbox();
+}
+
+async function finish() {
+  phase = "over";
+  held.clear();
+  fingers.clear();
+  const body = JSON.stringify(game.replay(member.name));
+  const id = Date.now().toString(36) + Math.random().toString(36).slice(2, 8);
+  // Kept first, then sent: a page closed while the answer is on its way hands the game in next time.
+  const kept = save(OUTBOX, [...load(OUTBOX, []), { id, code: member.code, token: member.token, body }]);
+  showEnd(kept ? "handing in…" : "handing in (this browser keeps nothing: stay on the page)…", "");
+  const results = await flushOutbox();
+  const mine = results.find((r) => r.id === id);
+  showAnswers(results.filter((r) => r.id !== id));
+  if (mine === undefined) {
+    showEnd("the class is busy, your game is kept and will be handed in", "kept");
+  } else {
+    showHandIn(mine.answer);
+  }
+}
+
+function showHandIn(answer) {
+  if (answer.status === 200 && answer.data && answer.data.ok) {
+    showEnd(answer.data.message, "", answer.data);
+  } else if (answer.status === 0) {
+    showEnd("the class could not be reached: your game is kept and will be handed in", "kept");
+  } else if (answer.status === 503 || answer.status === 429 || answer.status === 408 || answer.status >= 500) {
+    showEnd("the class is busy, your game is kept and will be handed in", "kept");
+  } else {
+    showEnd("not handed in: " + refusal(answer), "kept");
+  }
+}
+
+// Games from before (the outbox) handed in now: one line for the student, under whatever is on screen.
+function showAnswers(results) {
+  const taken = results.filter((r) => r.answer.status === 200 && r.answer.data && r.answer.data.ok);
+  if (taken.length > 0) {
+    const last = taken[taken.length - 1].answer.data;
+    statusLine.textContent = (taken.length === 1 ? "a kept game was " : taken.length + " kept games were ") +
+      last.message;
+  }
+  if (phase === "over" && endCard.dataset.kept === "kept" && load(OUTBOX, []).length === 0 && taken.length > 0) {
+    const mine = taken[taken.length - 1];
+    showHandIn(mine.answer);
+  }
+}
+
+function showEnd(line, kind, data) {
+  endCard.hidden = false;
+  endCard.dataset.kept = kind;
+  document.getElementById("end-score").textContent = "Your score: " + game.score;
+  document.getElementById("end-hits").textContent = plural(game.hits, "hit") + ", " + plural(game.resets, "reset");
+  const answer = document.getElementById("end-answer");
+  answer.textContent = line;
+  answer.className = kind;
+  const table = document.getElementById("end-top");
+  table.replaceChildren();
+  if (data && Array.isArray(data.top)) {
+    for (const [rank, name, score] of data.top) {
+      const row = table.insertRow();
+      if (rank === data.rank) row.className = "mine";
+      for (const [text, kind] of [[rank + ".", "rank"], [name, "name"], [String(score), "score"]]) {
+        const cell = row.insertCell();
+        cell.className = kind;
+        cell.textContent = text;
+      }
+    }
+  }
+  document.getElementById("end-hint").textContent = touchMode ? "" : "Enter plays again";
+  document.getElementById("again").focus();
+}
+
+function plural(n, word) { return n + " " + word + (n === 1 ? "" : "s"); }
+
+document.getElementById("again").addEventListener("click", () => { if (phase === "over") newGame(); });
+
+// ------------------------------------------------------------------ keys and fingers
+const SPECIAL = { " ": "space", "Tab": "tab" };
+function gameKey(event) {
+  const key = SPECIAL[event.key] ?? event.key.toLowerCase();
+  return key === "space" || key === "tab" || keys.includes(key) ? key : null;
+}
+
+window.addEventListener("keydown", (event) => {
+  if (phase === "join") return;
+  if (phase === "over") {
+    if (event.key === "Enter") { event.preventDefault(); newGame(); }
+    return;
+  }
+  const key = gameKey(event);
+  if (phase === "countdown" && !event.repeat && !event.ctrlKey && !event.metaKey && !event.altKey) {
+    if (key !== null) event.preventDefault();
+    start();
+    return;
+  }
+  if (key === null || event.ctrlKey || event.metaKey || event.altKey) return;
+  event.preventDefault();  // tab must not leave the page, space must not scroll it
+  if (!event.repeat) press(key);
+});
+window.addEventListener("keyup", (event) => {
+  const key = gameKey(event);
+  if (key !== null && held.has(key)) { event.preventDefault(); lift(key); }
+});
+window.addEventListener("blur", releaseAll);
+document.addEventListener("visibilitychange", () => { if (document.hidden) releaseAll(); });
+
+// Each finger is its own pointer: two thumbs on two buttons hold two keys; a button stays held while any
+// finger is on it.
+function fingerDown(event) {
+  const button = event.currentTarget;
+  const key = button.id === "reset" ? "space" : button.dataset.key;
+  event.preventDefault();
+  touchMode = true;
+  if (button.setPointerCapture) { try { button.setPointerCapture(event.pointerId); } catch { /* synthetic */ } }
+  if (phase === "countdown") { start(); }
+  if (phase !== "playing") return;
+  fingers.set(event.pointerId, key);
+  button.classList.add("held");
+  press(key);
+}
+function fingerUp(event) {
+  const key = fingers.get(event.pointerId);
+  if (key === undefined) return;
+  fingers.delete(event.pointerId);
+  if (![...fingers.values()].includes(key)) {
+    event.currentTarget.classList.remove("held");
+    lift(key);
+  }
+}
+for (const button of touch.querySelectorAll("button")) {
+  button.addEventListener("pointerdown", fingerDown);
+  button.addEventListener("pointerup", fingerUp);
+  button.addEventListener("pointercancel", fingerUp);
+  button.addEventListener("lostpointercapture", fingerUp);
+  button.addEventListener("contextmenu", (e) => e.preventDefault());
+}
+// A touch anywhere shows the buttons (a laptop with a touch screen too); so does a coarse pointer at load.
+function showTouch() {
+  if (!touch.hidden) return;
+  touch.hidden = false;
+  touchMode = true;
+  backgroundKey = "";
+}
+window.addEventListener("pointerdown", (e) => { if (e.pointerType === "touch") showTouch(); }, true);
+canvas.addEventListener("pointerdown", () => { if (phase === "countdown") start(); });
+if (matchMedia("(pointer: coarse)").matches) showTouch();
+
+// ------------------------------------------------------------------ the frame loop
+function frame() {
+  requestAnimationFrame(frame);
+  const began = performance.now();
+  const elapsed = last === null ? 0 : (began - last) / 1000;
+  last = began;
+  if (phase === "countdown") {
+    countdownLeft -= Math.max(elapsed, 0);
+    if (countdownLeft <= 0) start();
+  } else if (phase === "playing") {
+    // Real time consumed in fixed steps, kept as a running total (RealTimeDriver in game/session.py): a
+    // 30 Hz and a 144 Hz display reach the same step at the same moment.
+    const dt = game.dt;
+    clock += Math.min(Math.max(elapsed, 0), MAX_FRAME);
+    const due = Math.floor(clock / dt + 1e-9);
+    if (due > taken) {
+      game.advance(due - taken);
+      taken = due;
+    }
+    alpha = Math.min(Math.max(clock / dt - due, 0), 1);
+    noteHits();
+    if (game.over) { alpha = 1; finish(); }
+  }
+  if (game !== null) draw();
+  const times = canvas.frameTimes;
+  times.push(performance.now() - began);
+  if (times.length > 600) times.splice(0, times.length - 600);
+}
+
+function noteHits() {
+  const now = game.steps * game.dt;
+  if (game.hits > seenHits && lastTarget !== null) hits.push([lastTarget.x, lastTarget.y, now]);
+  seenHits = game.hits;
+  lastTarget = game.target;
+  hits = hits.filter((h) => now - h[2] < Math.max(PLUS_ONE_TIME, FADE_IN));
+}
+
+// ------------------------------------------------------------------ drawing (ui/render.py's GameRenderer)
+function textSizes(w, h) {
+  const m = Math.min(w, h), u = m / 720;
+  const minText = Math.max(Math.round(MIN_TEXT_AT_720 * m / 720), Math.round(MIN_TEXT_FRACTION * h));
+  const small = Math.max(12, Math.round(18 * u), minText);
+  return { small, normal: Math.max(Math.max(13, Math.round(22 * u)), small + 2), big: Math.max(18, Math.round(40 * u)) };
+}
+
+function font(size, bold) { return (bold ? "bold " : "") + size + "px " + FONT; }
+
+function width(text, size, bold) { ctx.font = font(size, bold); return ctx.measureText(text).width; }
+
+function fit(text, size, room) {
+  if (width(text, size) <= room) return text;
+  while (text && width(text + "…", size) > room) text = text.slice(0, -1);
+  return text + "…";
+}
+
+function clockText(seconds) {
+  if (seconds < 100) return seconds.toFixed(1).padStart(4, " ");
+  const whole = Math.ceil(seconds);
+  return Math.floor(whole / 60) + ":" + String(whole % 60).padStart(2, "0");
+}
+
+function layout(w, h) {
+  const u = Math.min(w, h) / 720;
+  const pad = Math.max(6, Math.round(16 * u)), gap = Math.max(4, Math.round(8 * u));
+  const { small, normal, big } = textSizes(w, h);
+  const band = touch.hidden ? 0 : Math.round(Math.max(h * 0.17, 64));
+  const hh = h - band;
+  const landscape = w >= 1.15 * hh;
+  let hud, scene;
+  if (landscape) {
+    const needed = width("Time 00.0", big, true) + 2 * pad;
+    const side = Math.min(Math.max(Math.round(w * 0.27), 200, needed), Math.max(480, needed), w - Math.round(hh * 0.55));
+    hud = { x: pad, y: pad, w: side - 2 * pad, h: hh - 2 * pad };
+    scene = { x: side, y: pad, w: w - side - pad, h: hh - 2 * pad };
+  } else {
+    hud = { x: pad, y: pad, w: w - 2 * pad, h: hh - 2 * pad };
+    scene = { x: pad, y: 0, w: w - 2 * pad, h: 0 };
+  }
+  return { w, h, u, pad, gap, small, normal, big, band, landscape, hud, scene };
+}
+
+function viewport(scene, world) {
+  const [xmin, xmax, ymin, ymax] = world;
+  const scale = Math.min(scene.w / (xmax - xmin), scene.h / (ymax - ymin));
+  const left = scene.x + (scene.w - scale * (xmax - xmin)) / 2, top = scene.y + (scene.h - scale * (ymax - ymin)) / 2;
+  return { scale, ox: left - xmin * scale, oy: top + ymax * scale };
+}
+
+function roundRect(x, y, w, h, r, fill, stroke, line) {
+  ctx.beginPath();
+  ctx.roundRect(x, y, w, h, r);
+  if (fill) { ctx.fillStyle = fill; ctx.fill(); }
+  if (stroke) { ctx.lineWidth = line; ctx.strokeStyle = stroke; ctx.stroke(); }
+}
+
+function circle(g, x, y, r, fill, stroke, line) {
+  g.beginPath();
+  g.arc(x, y, Math.max(r, 0.5), 0, 2 * Math.PI);
+  if (fill) { g.fillStyle = fill; g.fill(); }
+  if (stroke) { g.lineWidth = line; g.strokeStyle = stroke; g.stroke(); }
+}
+
+// What never moves (the window, the scene, the reachable annulus, the torso): drawn once per size.
+function drawBackground(lay, view) {
+  const dpr = window.devicePixelRatio || 1;
+  const off = document.createElement("canvas");
+  off.width = canvas.width; off.height = canvas.height;
+  const g = off.getContext("2d", { alpha: false });
+  g.scale(dpr, dpr);
+  g.fillStyle = PALETTE.window;
+  g.fillRect(0, 0, lay.w, lay.h);
+  const s = lay.scene;
+  g.beginPath();
+  g.roundRect(s.x, s.y, s.w, s.h, Math.max(4, Math.round(12 * lay.u)));
+  g.fillStyle = PALETTE.scene;
+  g.fill();
+  g.save();
+  g.beginPath();
+  g.rect(s.x, s.y, s.w, s.h);
+  g.clip();
+  const { l1, l2 } = config.arm;
+  const line = Math.max(MIN_LINE, Math.round(2 * lay.u));
+  circle(g, view.ox, view.oy, (l1 + l2) * view.scale, PALETTE.workspace, PALETTE.edge, line);
+  circle(g, view.ox, view.oy, Math.abs(l1 - l2) * view.scale, PALETTE.scene, PALETTE.edge, line);
+  const k = view.scale, body = Math.max(3, Math.round(k * 0.005));
+  const px = (x, y) => [view.ox + x * k, view.oy - y * k];
+  const [[cx, cy], [hw, hh]] = TORSO;
+  const [left, top] = px(cx - hw, cy + hh);
+  g.beginPath();
+  g.roundRect(left, top, 2 * hw * k, 2 * hh * k, hh * k);
+  g.fillStyle = rgb(PALETTE.skin);
+  g.fill();
+  g.lineWidth = body; g.strokeStyle = PALETTE.link; g.stroke();
+  const [[hx, hy], r] = HEAD;
+  circle(g, ...px(hx, hy + r * 0.95), 0.022 * k, rgb(PALETTE.skin), PALETTE.link, body);
+  circle(g, ...px(hx, hy), r * k, rgb(PALETTE.skin), PALETTE.link, body);
+  circle(g, ...px(-0.38, 0), 0.03 * k, rgb(PALETTE.skin), PALETTE.link, body);
+  g.restore();
+  return off;
+}
+
+function resize() {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.round(window.innerWidth * dpr), h = Math.round(window.innerHeight * dpr);
+  if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; backgroundKey = ""; }
+}
+
+function draw() {
+  resize();
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.width / dpr, h = canvas.height / dpr;
+  const lay = layout(w, h);
+  const p = PALETTE, { hud, gap, small, normal, big } = lay;
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.textBaseline = "top";
+  ctx.textAlign = "left";
+  // The HUD's top: the mode, the score and the clock.
+  const labels = [];
+  let y = hud.y;
+  // The mode's parts share a line where they fit (a long name goes on a line of its own), as in the window.
+  const modeLines = [];
+  for (const part of ["PLAY", "seed " + member.seed, member.name]) {
+    const line = modeLines.length ? modeLines[modeLines.length - 1] + "   " + part : null;
+    if (line !== null && width(line, normal) <= hud.w) modeLines[modeLines.length - 1] = line;
+    else modeLines.push(fit(part, normal, hud.w));
+  }
+  for (const line of modeLines) {
+    labels.push([line, hud.x, y, normal, p.ink, false]);
+    y += Math.round(normal * 1.2) + gap / 2;
+  }
+  y += gap / 2;
+  let head = big;
+  const score = "Score " + game.score, clockLine = "Time " + clockText(game.timeLeft);
+  const warn = game.timeLeft > 0 && game.timeLeft <= WARN_SECONDS;
+  if (lay.landscape) {
+    labels.push([score, hud.x, y, head, p.ink, true]);
+    y += Math.round(head * 1.2) + gap;
+    labels.push([clockLine, hud.x, y, head, warn ? p.warn : p.ink, true]);
+  } else {
+    while (head > normal && width("Score 000", head, true) + 2 * gap + width("Time 00.0", head, true) > hud.w) head -= 1;
+    labels.push([score, hud.x, y, head, p.ink, true]);
+    labels.push([clockLine, hud.x + hud.w - width("Time 00.0", head, true), y, head, warn ? p.warn : p.ink, true]);
+  }
+  y += Math.round(head * 1.2) + 2 * gap;
+  // The muscle bars: one column beside the scene, two above it on a tall window.
+  const columns = lay.landscape ? 1 : 2;
+  const colW = (hud.w - (columns - 1) * 2 * lay.pad) / columns;
+  const barH = Math.max(5, Math.round(10 * lay.u));
+  const rowH = Math.round(small * 1.2) + gap / 2 + barH + gap;
+  const short = names.some((n, i) => width(keys[i] + "  " + n, small) > colW);
+  const bars = [];
+  const activation = game.muscleActivation;
+  for (let i = 0; i < 4; i++) {
+    const cx = hud.x + (i % columns) * (colW + 2 * lay.pad), ry = y + Math.floor(i / columns) * rowH;
+    const name = short ? names[i].split(" ").pop() : names[i];
+    labels.push([fit(keys[i] + "  " + name, small, colW), cx, ry, small, p.ink, false]);
+    bars.push([cx, ry + Math.round(small * 1.2) + gap / 2, colW, barH, i, Math.min(Math.max(activation[i], 0), 1)]);
+  }
+  y += rowH * (4 / columns) + gap;
+  // The help line(s), at the bottom of the HUD (the touch buttons say what they do themselves).
+  const items = touchMode ? ["the buttons pull the muscles", "reset costs " + config.reset_cost]
+    : [keys[0] + "/" + keys[1] + " shoulder", keys[2] + "/" + keys[3] + " elbow", "space reset (-" + config.reset_cost + ")",
+      "tab hide arm"];
+  const lines = [];
+  for (const item of items) {
+    if (lines.length && width(lines[lines.length - 1] + "    " + item, small) <= hud.w) lines[lines.length - 1] += "    " + item;
+    else lines.push(fit(item, small, hud.w));
+  }
+  const lineH = Math.round(small * 1.2);
+  const helpTop = hud.y + hud.h - lines.length * (lineH + gap / 2);
+  lines.forEach((line, i) => {
+    const ly = helpTop + i * (lineH + gap / 2);
+    labels.push([line, lay.landscape ? hud.x : (w - width(line, small)) / 2, ly, small, p.faint, false]);
+  });
+  if (!lay.landscape) { lay.scene.y = y; lay.scene.h = Math.max(helpTop - gap - y, 10); }
+  const view = viewport(lay.scene, game.view);
+  const key = [w, h, dpr, lay.scene.x, lay.scene.y, lay.scene.w, lay.scene.h].join(",");
+  if (key !== backgroundKey) { background = drawBackground(lay, view); backgroundKey = key; }
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.drawImage(background, 0, 0);
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  // The scene: target, arm, hand, clipped to it.
+  const s = lay.scene;
+  ctx.save();
+  ctx.beginPath();
+  ctx.rect(s.x, s.y, s.w, s.h);
+  ctx.clip();
+  const now = game.steps * game.dt;
+  drawTarget(view, now);
+  const [q1, q2] = game.interpolatedAngles(alpha);
+  const { l1, l2 } = config.arm;
+  const elbow = [l1 * Math.cos(q1), l1 * Math.sin(q1)];
+  const hand = [elbow[0] + l2 * Math.cos(q1 + q2), elbow[1] + l2 * Math.sin(q1 + q2)];
+  if (game.armVisible) drawArm(view, q1, q2, l1, l2, activation);
+  circle(ctx, view.ox + hand[0] * view.scale, view.oy - hand[1] * view.scale, Math.max(1, 0.02 * view.scale), p.hand);
+  for (const [x, yy, t] of hits) {
+    const age = now - t;
+    if (age < PLUS_ONE_TIME) {
+      const r = game.target.radius * view.scale;
+      labels.push(["+1", view.ox + x * view.scale + r + gap, view.oy - yy * view.scale - age / PLUS_ONE_TIME * 2 * r - big / 2,
+        big, p.ink, true]);
+    }
+  }
+  ctx.restore();
+  if (phase === "over") {  // the end card is HTML, over the veiled game
+    ctx.fillStyle = "rgba(255,255,255,0.67)";
+    ctx.fillRect(0, 0, w, h);
+  }
+  for (const [x, by, bw, bh, i, a] of bars) {
+    roundRect(x, by, bw, bh, bh / 2, p.barBack);
+    if (a > 0.002) roundRect(x, by, Math.max(bh, Math.round(bw * a)), bh, bh / 2, rgb(p.muscles[i]));
+  }
+  for (const [text, x, ly, size, colour, bold] of labels) {
+    ctx.font = font(size, bold);
+    ctx.fillStyle = colour;
+    ctx.fillText(text, x, ly);
+  }
+  if (phase === "countdown") drawCountdown(lay);
+}
+
+function drawTarget(view, now) {
+  const t = game.target, k = view.scale;
+  const x = view.ox + t.x * k, y = view.oy - t.y * k, r = Math.max(1, t.radius * k);
+  const newest = hits.length ? now - hits[hits.length - 1][2] : null;
+  const fade = newest === null ? 1 : Math.min(Math.max(newest / FADE_IN, 0), 1);
+  const colour = rgb(blend([255, 255, 255], PALETTE.target, fade));
+  circle(ctx, x, y, r - Math.max(MIN_LINE, r / 3) / 2, null, colour, Math.max(MIN_LINE, r / 3));
+  circle(ctx, x, y, Math.max(2, r / 4), colour);
+  for (const [hx, hy, when] of hits) {
+    const age = now - when;
+    if (age < FLASH_TIME) {
+      const rr = r * (1 + 0.8 * age / FLASH_TIME);
+      circle(ctx, view.ox + hx * k, view.oy - hy * k, rr, PALETTE.flash, rgb(PALETTE.target), Math.max(2, r / 5));
+    }
+  }
+}
+
+function drawCountdown(lay) {
+  const s = lay.scene, size = Math.max(lay.big, Math.round(s.h * 0.2));
+  const number = String(Math.max(1, Math.ceil(countdownLeft)));
+  const hint = touchMode ? "a tap starts" : "any key starts";
+  const w = Math.max(width(number, size, true), width(hint, lay.normal)) + 6 * lay.gap;
+  const h = size * 1.2 + lay.normal * 1.2 + 4 * lay.gap;
+  const x = s.x + s.w / 2 - w / 2, y = s.y + s.h / 2 - h / 2;
+  roundRect(x, y, w, h, Math.max(4, Math.round(12 * lay.u)), PALETTE.panel, PALETTE.edge, Math.max(MIN_LINE, Math.round(2 * lay.u)));
+  ctx.textAlign = "center";
+  ctx.fillStyle = PALETTE.ink;
+  ctx.font = font(size, true);
+  ctx.fillText(number, s.x + s.w / 2, y + 1.5 * lay.gap);
+  ctx.font = font(lay.normal, false);
+  ctx.fillText(hint, s.x + s.w / 2, y + 1.5 * lay.gap + size * 1.2 + lay.gap);
+  ctx.textAlign = "left";
+}
+
+// The arm (ui/body.py's draw_arm): limbs and joints outlined, the palm, the four muscles swelling with
+// their activation in their keys' colours.
+function drawArm(view, q1, q2, l1, l2, activation) {
+  const k = view.scale, line = Math.max(3, Math.round(k * 0.005)), grow = line / k;
+  const shoulder = [0, 0], elbow = [l1 * Math.cos(q1), l1 * Math.sin(q1)];
+  const hand = [elbow[0] + l2 * Math.cos(q1 + q2), elbow[1] + l2 * Math.sin(q1 + q2)];
+  const wf = Math.max(0, 1 - HAND[0] / l2);
+  const wrist = [elbow[0] + wf * (hand[0] - elbow[0]), elbow[1] + wf * (hand[1] - elbow[1])];
+  const poly = (points, fill, stroke) => {
+    ctx.beginPath();
+    points.forEach(([x, y], i) => (i ? ctx.lineTo : ctx.moveTo).call(ctx, view.ox + x * k, view.oy - y * k));
+    ctx.closePath();
+    ctx.fillStyle = fill; ctx.fill();
+    if (stroke) { ctx.lineWidth = 1; ctx.strokeStyle = stroke; ctx.stroke(); }
+  };
+  const joints = [[shoulder, UPPER_ARM[0]], [elbow, UPPER_ARM[1]], [wrist, FOREARM[1]]];
+  const skin = rgb(PALETTE.skin), edge = PALETTE.link;
+  const limbs = [[shoulder, elbow, UPPER_ARM], [elbow, wrist, FOREARM]];
+  for (const [a, b, wd] of limbs) poly(limbOutline(a, b, [wd[0] + grow, wd[1] + grow]), edge);
+  for (const [c, r] of joints) circle(ctx, view.ox + c[0] * k, view.oy - c[1] * k, r * k + line, edge);
+  poly(palm(wrist, hand, grow), edge);
+  for (const [a, b, wd] of limbs) poly(limbOutline(a, b, wd), skin);
+  for (const [c, r] of joints) circle(ctx, view.ox + c[0] * k, view.oy - c[1] * k, r * k, skin);
+  poly(palm(wrist, hand, 0), skin);
+  for (const i of [1, 0, 3, 2]) {  // the shoulder pair under the elbow pair, where they cross
+    const a = Math.min(Math.max(activation[i], 0), 1);
+    const fill = rgb(blend(PALETTE.skin, PALETTE.muscles[i], MUSCLE_TINT + (1 - MUSCLE_TINT) * Math.round(64 * a) / 64));
+    poly(muscleOutline(i, q1, q2, l1, l2, a), fill, MUSCLE_EDGE[i]);
+  }
+}
+
+function along(o, d, n, a, b) { return [o[0] + a * d[0] + b * n[0], o[1] + a * d[1] + b * n[1]]; }
+
+function muscleEnds(i, q1, q2, l1, l2) {
+  const elbow = [l1 * Math.cos(q1), l1 * Math.sin(q1)];
+  const u = [Math.cos(q1), Math.sin(q1)], n = [-u[1], u[0]];
+  const f = [Math.cos(q1 + q2), Math.sin(q1 + q2)], nf = [-f[1], f[0]];
+  const s = [0, 0];
+  if (i === 0) return [[-0.12, 0.05], along(s, u, n, 0.30 * l1, 0.6 * UPPER_ARM[0])];
+  if (i === 1) return [[-0.07, -0.085], along(s, u, n, 0.28 * l1, -0.6 * UPPER_ARM[0])];
+  if (i === 2) return [along(s, u, n, 0.12 * l1, 0.55 * UPPER_ARM[0]), along(elbow, f, nf, 0.12 * l2, 0.4 * FOREARM[0])];
+  return [along(s, u, n, 0.12 * l1, -0.55 * UPPER_ARM[0]), along(elbow, u, n, 0.02, -0.5 * UPPER_ARM[1])];
+}
+
+function muscleOutline(i, q1, q2, l1, l2, a) {
+  const [[x0, y0], [x1, y1]] = muscleEnds(i, q1, q2, l1, l2);
+  const dx = x1 - x0, dy = y1 - y0, length = Math.hypot(dx, dy) || 1e-9;
+  const nx = -dy / length, ny = dx / length, belly = (MUSCLE_REST + MUSCLE_GAIN * a) * BREADTH[i];
+  const side = [], other = [];
+  for (const [s, shape] of SPINDLE) {
+    const w = 0.002 + belly * shape, cx = x0 + s * dx, cy = y0 + s * dy;
+    side.push([cx + w * nx, cy + w * ny]);
+    other.push([cx - w * nx, cy - w * ny]);
+  }
+  return side.concat(other.reverse());
+}
+
+function limbOutline(start, end, [w0, w1]) {
+  const dx = end[0] - start[0], dy = end[1] - start[1], length = Math.hypot(dx, dy) || 1e-9;
+  const nx = -dy / length, ny = dx / length;
+  return [[start[0] + w0 * nx, start[1] + w0 * ny], [end[0] + w1 * nx, end[1] + w1 * ny],
+    [end[0] - w1 * nx, end[1] - w1 * ny], [start[0] - w0 * nx, start[1] - w0 * ny]];
+}
+
+function palm(wrist, hand, grow) {
+  const dx = hand[0] - wrist[0], dy = hand[1] - wrist[1], length = Math.hypot(dx, dy) || 1e-9;
+  const ux = dx / length, uy = dy / length, nx = -uy, ny = ux;
+  const halfL = HAND[0] * 1.1 + grow, halfW = HAND[1] + grow;
+  const cx = hand[0] - 0.2 * HAND[0] * ux, cy = hand[1] - 0.2 * HAND[0] * uy;
+  return PALM.map(([c, s]) => [cx + c * halfL * ux + s * halfW * nx, cy + c * halfL * uy + s * halfW * ny]);
+}
+
+// ------------------------------------------------------------------ the start
+async function begin() {
+  showOutbox();
+  requestAnimationFrame(frame);
+  if (member === null) { askToJoin(""); flushOutbox().then(showAnswers); return; }
+  const answer = await join(member.code, member.name, member.token);
+  if (answer.status === 200 && answer.data && answer.data.ok) {
+    joined(member.code, answer.data);
+  } else if (answer.status === 0 || answer.status === 503 || answer.status === 429) {
+    // Not reached (or busy): the class's seed is known from before, so the game is played, kept, and
+    // handed in when the class answers again.
+    joinForm.hidden = true;
+    newGame();
+    statusLine.textContent = answer.status === 0 ? "the class cannot be reached: your games are kept and handed in later"
+      : "the class is busy: your games are kept and handed in later";
+    scheduleRetry();
+  } else {
+    askToJoin(refusal(answer));
+  }
+}
+
+begin();
