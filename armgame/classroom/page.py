@@ -25,6 +25,7 @@ PAGES = {
     "standings.js": "text/javascript; charset=utf-8",
     "lab.js": "text/javascript; charset=utf-8",
     "teacher.js": "text/javascript; charset=utf-8",
+    "engine.js": "text/javascript; charset=utf-8",  # the game's engine, an ES module (the student's page imports it)
 }
 
 
