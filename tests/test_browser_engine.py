@@ -318,3 +318,38 @@ def test_a_hit_is_decided_on_the_rules_hand():
         session.rules.hand_moved, session.advance = record, one_step
         Autopilot(session, make_bot("model")).play()
         assert session.rules.board.hits >= 3
+
+
+def test_an_arm_whose_square_python_rounds_otherwise_is_refused():
+    """Python's ``x ** 2`` is the C library's ``pow``, which glibc rounds within 0.52 ulp, not always as
+    ``x * x``: the engine, which squares by multiplying, refuses an arm whose square lies that near a tie."""
+    from fractions import Fraction
+
+    rng = random.Random(6)
+    near_ties = []
+    for _ in range(100_000):
+        x = rng.uniform(0.1, 0.3)
+        square = x * x
+        if abs(Fraction(x) ** 2 - Fraction(square)) > Fraction(math.ulp(square)) * 49 / 100:
+            near_ties.append(x)
+            if len(near_ties) == 3:
+                break
+    assert len(near_ties) == 3
+    # The presets are far from ties (the engine plays them: the games above).
+    arms = [GAME_PLAY_ARM.replace(r1=x) for x in near_ties]
+    answer = run_node({"games": [{"config": config_dict(GameConfig(arm=arm)), "events": []} for arm in arms]})
+    for got in answer["games"]:
+        assert "r1" in got["error"] and "rounding tie" in got["error"] and "\n" not in got["error"]
+
+
+def test_the_engine_is_served_and_needs_nothing_a_strict_page_refuses():
+    """Served by name as JavaScript (an ES module must be); no imports, no eval, no C library trig."""
+    from armgame.classroom import page
+
+    source = (ROOT / "armgame" / "classroom" / "static" / "engine.js").read_text(encoding="utf-8")
+    served = page.response("engine.js", {})
+    assert served.status_code == 200 and served.media_type.startswith("text/javascript")
+    assert served.body == source.encode("utf-8")
+    code = "\n".join(line.split("//")[0] for line in source.splitlines())
+    for banned in ("eval(", "new Function", "import ", "import(", "Math.sin", "Math.cos", "WebAssembly", "require("):
+        assert banned not in code, banned

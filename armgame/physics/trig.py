@@ -3,8 +3,10 @@
 Owns ``sin_cos`` (one angle, Python floats) and ``sin_cos_array`` (numpy arrays), which the arm's
 equations of motion use for every cos and sin of a joint angle (``TwoJointArm.component_dynamics``,
 the batched kernels, and their C twin ``arm_sin_cos`` in ``armgame/physics/_trig.h``, which the
-compiled loops inline and ``_ctrig`` gives Python as ``sin_cos`` where it was built). Kinematics
-(where the hand is, the targets, the picture) keep the C library's ``math.cos`` and ``math.sin``.
+compiled loops inline and ``_ctrig`` gives Python as ``sin_cos`` where it was built), and since armgame 0.4
+the rules' hand too (``game.rules.hand_position``: the hit test and the targets, which the browser's engine
+must find to the bit). The picture, the envs' observations and the batch's "near" filters keep the C
+library's ``math.cos`` and ``math.sin``.
 
 Why not the C library's: its sine is a scalar function whose bits differ between glibc, macOS and
 Windows and between glibc's builds for CPUs with and without FMA, and none is proven equal to any
