@@ -250,7 +250,7 @@ def test_full_games_hand_in_replays_the_server_verifies(played):
         ok, recomputed = replay.verify()
         assert ok, recomputed
         assert replay.config == config and replay.player == f"Player {start + j}"
-        assert (replay.driven, replay.driver, replay.version) == ("keyboard", None, armgame.__version__)
+        assert (replay.driven, replay.driver, replay.version) == ("keyboard", "browser", armgame.__version__)
         python_replay = Replay.from_session(session, "keyboard", None, "someone")
         assert replay.result == python_replay.result
         assert game_digest(replay) == game_digest(python_replay)

@@ -16,7 +16,10 @@ from armgame.records.replay import Replay
 
 
 def _scores(opened, name: str) -> list[int]:
-    return sorted(e.score for e in opened.clerk.entries if e.name == name)
+    """The scores the class entered for ``name``: a person's games, played in a browser (never a program's)."""
+    entries = [e for e in opened.clerk.entries if e.name == name]
+    assert all(not e.program and (e.driven, e.driver) == ("keyboard", "browser") for e in entries), entries
+    return sorted(e.score for e in entries)
 
 
 def test_a_game_with_keys_is_handed_in_shown_on_the_projector_and_kept_when_the_class_is_away(tmp_path):

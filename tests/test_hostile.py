@@ -491,7 +491,8 @@ def test_a_busy_table_keeps_the_game_and_says_how_to_enter_it(tmp_path, monkeypa
     ScoreTable(folder).add(game("first"))
     holder = file_lock(folder / "scores.lock", 1.0)
     waits = []  # counted, not timed: play asks for the lock once, for LOCK_WAIT, and gives up
-    monkeypatch.setattr(tablefile_module, "file_lock", lambda path, wait: waits.append(wait) or file_lock(path, wait))
+    monkeypatch.setattr(tablefile_module, "file_lock",
+                        lambda path, wait, *mode: waits.append(wait) or file_lock(path, wait, *mode))
     holder.__enter__()  # someone else holds the table
     try:
         code = main(["play", "--headless", "--duration", "0.5", "--name", "Late", "--scores", str(folder)])

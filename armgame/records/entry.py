@@ -15,7 +15,7 @@ from dataclasses import dataclass, fields
 from datetime import datetime
 
 from .identity import identity_claims
-from .replay import DRIVEN, Replay, check_date, check_name, check_word
+from .replay import DRIVEN, KEYBOARD_DEVICES, Replay, check_date, check_name, check_word
 from .rulesets import config_digest, ruleset_name
 from .storage import check_float, check_int, check_keys, check_str
 
@@ -65,8 +65,9 @@ class ScoreEntry:
 
     @property
     def program(self) -> bool:
-        """Whether the game says a program played it: anything but the keyboard with no driver named."""
-        return self.driven != "keyboard" or self.driver is not None
+        """Whether the game says a program played it: anything but the keyboard with no driver named, or with
+        only the device a person played it on (``KEYBOARD_DEVICES``: the class's browser game)."""
+        return self.driven != "keyboard" or (self.driver is not None and self.driver not in KEYBOARD_DEVICES)
 
     @classmethod
     def from_dict(cls, data: object) -> ScoreEntry:

@@ -51,6 +51,9 @@ FORMAT_VERSION = 1
 #: Shared with the writers (``armgame.limits``): nothing is recorded that this reader refuses.
 MAX_STEPS = MAX_GAME_STEPS
 DRIVEN = ("keyboard", "script", "bot")
+#: What a keyboard game may name as its driver and still be a person's: the device it was played on (the
+#: class's browser game, ``/play``). Any other driver named makes the game a program's.
+KEYBOARD_DEVICES = ("browser",)
 MAX_NAME = 40
 _WORD = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]*")
 

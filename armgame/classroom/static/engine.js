@@ -593,9 +593,9 @@ export class Game {
       version: ARMGAME_VERSION };
   }
 
-  /** The replay as records.replay.Replay.as_dict writes a keyboard game's (driver null, as the Python
-   * client's: a named driver would list the game among the programs). A seed above 2^53 is a BigInt,
-   * which JSON.stringify refuses: replayJSON writes it. */
+  /** The replay as records.replay.Replay.as_dict writes a keyboard game's, its driver the device a person
+   * played it on ("browser", one of records.replay.KEYBOARD_DEVICES: still a person's game, not a program's).
+   * A seed above 2^53 is a BigInt, which JSON.stringify refuses: replayJSON writes it. */
   replay(player) {
     const config = { ...this._config, seed: seedValue(this._seed) };
     return {
@@ -605,7 +605,7 @@ export class Game {
       date: nowIso(),
       player: player ?? null,
       driven: "keyboard",
-      driver: null,
+      driver: "browser",
       scene: this._config.scene,
       config,
       timeline: this.timeline,

@@ -241,7 +241,7 @@ async function finish() {
   phase = "over";
   held.clear();
   fingers.clear();
-  const body = JSON.stringify(game.replay(member.name));
+  const body = game.replayJSON(member.name);  // any seed's digits exact (a seed past 2^53 is a BigInt)
   const id = Date.now().toString(36) + Math.random().toString(36).slice(2, 8);
   // Kept first, then sent: a page closed while the answer is on its way hands the game in next time.
   const kept = save(OUTBOX, [...load(OUTBOX, []), { id, code: member.code, token: member.token, body }]);
@@ -405,7 +405,7 @@ function frame() {
     noteHits();
     if (game.over) { alpha = 1; finish(); }
   }
-  if (game !== null) draw();
+  if (game !== null && member !== null) draw();  // "not me?" forgets the name while the last game is on screen
   const times = canvas.frameTimes;
   times.push(performance.now() - began);
   if (times.length > 600) times.splice(0, times.length - 600);
