@@ -432,3 +432,26 @@ def test_a_refusal_names_no_path_of_the_teachers_machine_and_a_failed_save_chang
     roster = opened.clerk.roster
     assert (roster.hidden, roster.closed, roster.locked, set(roster.players)) == (set(), False, False, {"ann"})
     assert roster.player_of(ann["token"]) is not None and roster.lookalike_of("Bo") is None
+
+
+def test_the_class_stops_at_once_with_pages_open_and_says_nothing_more(tmp_path, capfd):
+    ready = threading.Event()
+    opened = open_class(tmp_path / "class", "127.0.0.1", 0, None, say=lambda line: None,
+                        on_ready=lambda _: ready.set())
+    thread = threading.Thread(target=opened.run, daemon=True)
+    thread.start()
+    assert ready.wait(20)
+    pages = []
+    for source in (LAPTOP, OTHER, "127.0.0.1"):
+        conn = http.client.HTTPConnection("127.0.0.1", opened.port, timeout=10, source_address=(source, 0))
+        conn.request("GET", "/events")
+        conn.getresponse().fp.readline()
+        pages.append(conn)
+    started = time.perf_counter()
+    opened.stop()
+    thread.join(10)
+    assert not thread.is_alive() and time.perf_counter() - started < 1.5
+    for conn in pages:
+        conn.close()
+    captured = capfd.readouterr()
+    assert "Traceback" not in captured.err and "Cancel" not in captured.err, captured.err

@@ -172,8 +172,21 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
     errors = logging.getLogger("uvicorn.error")  # configured by uvicorn.Config, just above
     if not any(isinstance(f, _QuietWhenFull) for f in errors.filters):
         errors.addFilter(_QuietWhenFull())
-    opened = ClassServer(clerk, sock, uvicorn.Server(config), join_line, new, held)
+    opened = ClassServer(clerk, sock, _class_uvicorn(config, app.state.armgame.end_streams), join_line, new, held)
     return opened
+
+
+def _class_uvicorn(config: Any, end_streams: Callable[[], None]) -> Any:
+    """uvicorn's server, which first ends the pages' event streams when it stops: a stream never ends by
+    itself, so uvicorn would wait out its grace period for it and then cancel it with a traceback per page."""
+    import uvicorn
+
+    class ClassUvicorn(uvicorn.Server):
+        async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
+            end_streams()
+            await super().shutdown(sockets)
+
+    return ClassUvicorn(config)
 
 
 def _curve_protocol(lab: str | None) -> str | dict | None:
