@@ -455,3 +455,22 @@ def test_the_class_stops_at_once_with_pages_open_and_says_nothing_more(tmp_path,
         conn.close()
     captured = capfd.readouterr()
     assert "Traceback" not in captured.err and "Cancel" not in captured.err, captured.err
+
+
+def test_the_guide_states_the_class_limits_as_they_are():
+    from pathlib import Path
+
+    from armgame.classroom import guard
+
+    guide = (Path(__file__).resolve().parent.parent / "docs" / "teaching.md").read_text(encoding="utf-8")
+    section = guide.split("## One student with a script and a grudge", 1)[1].split("\n## ", 1)[0]
+    for claim in (f"headers must arrive within {guard.HEADER_SECONDS:g} s",
+                  f"whole request within {guard.REQUEST_SECONDS:g} s",
+                  f"one machine holds at most {guard.PER_ADDRESS}",
+                  f"{class_app.STREAMS_PER_ADDRESS} of the projector's live pages",
+                  f"{class_app.UPLOADS_PER_ADDRESS} hand-ins being uploaded",
+                  f"{class_app.FREE_GUESSES} free, then a wait of {class_app.GUESS_WAIT / 60:g} minute",
+                  "10 tries an hour",  # test_the_wait_doubles_and_a_right_code_clears_it counts them
+                  f"at most {class_app.JOINS_PER_MINUTE} new names a minute (the class",
+                  f"{class_app.CLASS_JOINS_PER_MINUTE})"):
+        assert claim in " ".join(section.split()), claim
