@@ -81,3 +81,37 @@ def test_volunteers_runs_fill_the_class_curve_one_run_each(tmp_path, runs, monke
 
             time.sleep(0.05)
     assert again == lab
+
+
+def test_a_programs_run_handed_in_first_never_takes_the_persons_place(tmp_path, runs, monkeypatch):
+    with running_class(tmp_path / "class", lab=str(runs / "short.toml")) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "eve"))
+        eve = client.join(address, opened.clerk.roster.code, "Eve")
+        program = Replay.load(runs / "run1.json")  # the adapting bot's, as it says
+        assert program.driven != "keyboard"
+        first = client.hand_in(eve, dataclasses.replace(program, player="Eve").to_bytes())
+        assert "a program's run" in first.message and "never in the class curve" in first.message
+        mine = client.hand_in(eve, as_person(runs / "run2.json", "Eve"))
+        assert mine.message == "lab run handed in: in the class curve"
+        lab = json.loads(get(opened, "/api/lab"))
+    assert (lab["students"], lab["programs"]) == (1, 1)
+    assert len(list((tmp_path / "class" / "lab").glob("*.json"))) == 1
+
+
+def test_the_curve_is_the_teachers_protocol_not_the_one_most_names_ran(tmp_path, runs, monkeypatch):
+    with running_class(tmp_path / "class") as opened:  # a new class's curve: the lesson's
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        for i, name in enumerate(("Ann", "Bo", "Cy"), 1):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            member = client.join(address, opened.clerk.roster.code, name)
+            answer = client.hand_in(member, as_person(runs / f"run{i}.json", name))
+            assert answer.message == "lab run handed in: kept (the class curve shows the protocol the teacher chose)"
+        lab = json.loads(get(opened, "/api/lab"))
+        assert (lab["protocol"], lab["students"]) == ("lesson", 0)
+        secret = opened.clerk.roster.secret
+        req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/lab", data=b'{"protocol": "curl"}',
+                                     headers={"Authorization": f"Bearer {secret}", "Content-Type": "application/json"})
+        with urllib.request.urlopen(req, timeout=10) as r:
+            assert json.loads(r.read())["message"] == "the class curve shows curl"
+        assert json.loads(get(opened, "/api/lab"))["protocol"] == "curl"

@@ -63,6 +63,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     submit.set_defaults(run=run_submit)
     show = sub.add_parser("show", help="the class's standings in a window (for a room without a browser)")
     show.add_argument("address", metavar="HOST:PORT")
+    show.add_argument("--key", metavar="KEY", help="the projector link's key (after ?key= in the link the class "
+                      "prints): shows the join code; not needed on the teacher's own machine")
     from ..ui.options import add_window_options
 
     add_window_options(show)
@@ -118,7 +120,11 @@ def run_show(args: argparse.Namespace) -> int:
 
     address = ClassAddress.parse(args.address, "HOST:PORT")
     settings, _ = window_settings(args)
-    return show_class(address, settings, fullscreen=args.fullscreen)
+    if args.key is not None and (len(args.key) > 64 or not args.key.isalnum()):
+        from ..errors import UserError
+
+        raise UserError("--key: the letters and digits after ?key= in the projector's link")
+    return show_class(address, settings, fullscreen=args.fullscreen, key=args.key)
 
 
 def join_class(args: argparse.Namespace):

@@ -145,7 +145,7 @@ def parse_standings(data: bytes) -> Standings:
                           _text(arrival.get("name"), "an arrival's name", MAX_NAME),
                           _number(arrival.get("score"), "an arrival's score"),
                           "" if note is None else _text(note, "an arrival's note", MAX_WORDS), arrival["program"])
-    join = value.get("join", "")
+    join = value.get("join") or ""  # null: a window that is not the projector's (no --key) shows no code
     return Standings(_number(value.get("version"), "'version'"), _number(value.get("seed"), "'seed'"), closed,
                      _number(value.get("joined"), "'joined'"), _number(value.get("games"), "'games'"),
                      _rows(value.get("students"), "'students'"), _rows(value.get("programs"), "'programs'"),
@@ -572,10 +572,14 @@ class ClassWindow:
 
 
 def show_class(address: ClassAddress, settings: Settings, fullscreen: bool = False, max_frames: int | None = None,
-               screenshot: Path | None = None) -> int:
+               screenshot: Path | None = None, key: str | None = None) -> int:
     """The class's standings in a window until Esc or close (``max_frames``: the tests' end). ``screenshot``:
-    the first frame with standings on it (or the last frame, if none came) is saved there as a PNG."""
-    poller = StandingsPoller(address.url("/api/standings"), address.label).start()
+    the first frame with standings on it (or the last frame, if none came) is saved there as a PNG. ``key``: the
+    projector link's key, which shows the join code (the teacher's own machine sees it without)."""
+    from urllib.parse import quote
+
+    path = "/api/standings" + (f"?key={quote(key, safe='')}" if key else "")
+    poller = StandingsPoller(address.url(path), address.label).start()
     try:
         screen = open_window(settings.size, fullscreen, f"armgame: the class at {address.label}", DEFAULT_SIZE)
         window = ClassWindow(address.label, screen, poller, settings.palette, settings.text_scale)
