@@ -258,3 +258,20 @@ def test_the_guide_shows_the_lines_the_class_prints(tmp_path):
     assert len(printed) == len(patterns), printed
     for pattern, line in zip(patterns, printed, strict=True):
         assert re.fullmatch(pattern, line), (pattern, line)
+
+
+def test_a_closed_class_refuses_a_game_before_it_is_played(tmp_path, students, capsys):
+    import time
+
+    with running_class(tmp_path / "class") as opened:
+        students("ann")
+        client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Ann")
+        req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/close", method="POST",
+                                     data=b'{"closed": true}', headers={"Content-Type": "application/json"})
+        urllib.request.urlopen(req, timeout=10).close()
+        started = time.perf_counter()
+        assert main(["play", "--headless", "--bot", "model", "--join", f"127.0.0.1:{opened.port}", "--code",
+                     opened.clerk.roster.code, "--name", "Ann"]) == 2
+        err = capsys.readouterr().err
+        assert "is closed: it takes no more games" in err and len(err.strip().splitlines()) == 1
+        assert time.perf_counter() - started < 5  # refused at the join, not after a 60 s game
