@@ -29,6 +29,7 @@ import secrets
 import stat
 from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
@@ -510,11 +511,13 @@ class Clerk:
                 "lab": lab.get("name") if isinstance(lab, dict) else lab, "presets": list(PRESETS)}
 
     def games_csv(self) -> str:
-        columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_at",
-                   "hidden", "replay")
+        """Every game entered, in order; ``entered_local`` is the teacher's clock (what a teacher compares with
+        the lesson), ``entered_at`` the same moment in UTC as the table keeps it."""
+        columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_local",
+                   "entered_at", "hidden", "replay")
         ordered = sorted(self.entries, key=lambda e: e.entered or 0)
         return _csv(columns, ([e.entered, e.name, "programs" if e.program else "students", e.driven, e.driver or "",
-                               e.score, e.hits, e.resets, e.seed, e.entered_at or "",
+                               e.score, e.hits, e.resets, e.seed, local_time(e.entered_at), e.entered_at or "",
                                self.roster.is_hidden(e.name), e.replay] for e in ordered))
 
     def lab_csv(self) -> str:
@@ -575,8 +578,21 @@ def csv_cell(value: object) -> str:
     return "'" + text if text.startswith(_FORMULA) else text
 
 
+def local_time(utc: str | None) -> str:
+    """An ISO time with its zone as this machine's local time, to the second (the teacher's clock)."""
+    if not utc:
+        return ""
+    try:
+        return datetime.fromisoformat(utc).astimezone().strftime("%Y-%m-%d %H:%M:%S")
+    except (ValueError, OverflowError, OSError):
+        return ""
+
+
 def _csv(columns: Sequence[str], rows) -> str:
+    """The CSV text, with a byte-order mark first: the one sign a spreadsheet (Excel) reads to take the file as
+    UTF-8, so an accented name is not garbled."""
     out = io.StringIO()
+    out.write("\ufeff")
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(columns)
     for row in rows:
