@@ -359,14 +359,16 @@ def _add(table, args: argparse.Namespace) -> int:
 
 
 def _already_in(table, replay):
-    """The entry that holds ``replay``'s game under its own player's name, or None (another name's copy of it is
-    refused by the table, as before)."""
+    """The entry that holds ``replay``'s game, as it claims it, under its own player's name; or None (another
+    name's copy, or other claims for the same game, go on to the checks that refuse them)."""
     from ..records.identity import game_digests
     from ..records.standings import player_key
 
     digests = set(game_digests(replay))
+    r = replay.result
     return next((e for e in table.all_entries() if e.game_sha256 in digests
-                 and player_key(e.name) == player_key(replay.player)), None)
+                 and player_key(e.name) == player_key(replay.player)
+                 and (e.score, e.hits, e.resets) == (r.score, r.hits, r.resets)), None)
 
 
 def where_it_went(table, entry) -> str:
