@@ -269,6 +269,19 @@ class GameRenderer:
             text = text[:-1]
         return text + "..."
 
+    def wrap_text(self, text: str, height: int, width: int, max_lines: int = 3) -> list[str]:
+        """``text`` on as many lines of ``width`` px as it needs, broken between words, at most ``max_lines`` (the
+        last cut with an ellipsis only if even those do not hold it): a message is read whole, not cut off."""
+        lines: list[str] = []
+        for word in text.split():
+            if lines and self.text_size(lines[-1] + " " + word, height)[0] <= width:
+                lines[-1] += " " + word
+            else:
+                lines.append(word)
+        if len(lines) > max_lines:
+            lines = [*lines[:max_lines - 1], " ".join(lines[max_lines - 1:])]
+        return [self.fit_text(line, height, width) for line in lines]
+
     def wrap_items(self, items: Sequence[str], height: int, width: int, gap: int) -> list[str]:
         """Help items on as few lines as fit ``width``; an item is never split."""
         sep = " " * 4
