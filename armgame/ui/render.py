@@ -467,6 +467,9 @@ class GameRenderer:
             rows = list(standing.top)
         margin = max(8, round(24 * lay.unit))
         panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
+        # A long line (the class's answer, "your game is kept ...") wraps in the panel rather than being cut off.
+        lines = [(part, size, colour) for text, size, colour in lines
+                 for part in self.wrap_text(text, size, panel_w - 2 * margin, max_lines=6)]
         heading = bool(rows) and standing is not None
         content_h = sum(self.font(size).get_height() + gap for _, size, _ in lines)
         if heading:
