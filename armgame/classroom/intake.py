@@ -29,7 +29,7 @@ import secrets
 import stat
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import datetime
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -43,6 +43,7 @@ from ..records.standings import one_row_per_player, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
 from ..records.tablefile import name_slug
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
+from .rounds import Round, new_round, round_view
 
 #: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
 #: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
@@ -124,6 +125,7 @@ class Clerk:
         self.lab_runs: list[LabRun] = []
         self.lab_digests: set[str] = set()
         self.arrival: Arrival | None = None
+        self.round_over = False  # the current round's winners have been shown
         self.version = 0  # bumped at every change the projector should see
         self.lab_version = 0  # and at every change of the class curve (a lab run, a name hidden)
 
@@ -481,10 +483,48 @@ class Clerk:
         shown = arrival is not None and not self.roster.is_hidden(arrival.name)
         return {"version": self.version, "seed": self.roster.seed, "closed": self.roster.closed,
                 "joined": len(self.roster.players), "games": len(self.entries),
+                "round": None if teacher else self.round_view(),
                 "students": rows(False), "programs": rows(True),
                 "arrival": None if not shown else {"seq": arrival.seq, "name": arrival.name,  # type: ignore[union-attr]
                                                    "score": arrival.score, "note": arrival.note,  # type: ignore[union-attr]
                                                    "program": arrival.program}}  # type: ignore[union-attr]
+
+    # ------------------------------------------------------------------ rounds
+    def current_round(self) -> Round | None:
+        return None if self.roster.round is None else Round.from_dict(self.roster.round)
+
+    def start_round(self, minutes: object) -> str:
+        """A new round of ``minutes``, from now (the last one ends here if it was still on)."""
+        try:
+            rnd = new_round(self.current_round(), minutes, max((e.entered or 0 for e in self.entries), default=0))
+        except ValueError as exc:
+            raise RefusedError(400, str(exc)) from None
+        self.roster.changed(round=rnd.as_dict())
+        self.version += 1
+        self.round_over = False
+        return f"round {rnd.number}: {rnd.minutes} min, from now"
+
+    def stop_round(self) -> str:
+        rnd = self.current_round()
+        if rnd is None:
+            raise RefusedError(404, "no round has been started")
+        self.roster.changed(round=None)
+        self.version += 1
+        return f"round {rnd.number} is off the projector"
+
+    def round_ended(self, now: datetime | None = None) -> bool:
+        """Whether the round's results just became final (its clock and grace run out): the projector is told
+        once, and shows its winners."""
+        rnd = self.current_round()
+        if rnd is None or self.round_over or not rnd.over(now or datetime.now(UTC)):
+            return False
+        self.round_over = True
+        self.version += 1
+        return True
+
+    def round_view(self, now: datetime | None = None) -> dict[str, object] | None:
+        return round_view(self.current_round(), self.entries, self.roster.hidden, now or datetime.now(UTC),
+                          STANDINGS_ROWS)
 
     def roster_view(self) -> dict[str, object]:
         """For the teacher's page: every joined name with the machine (address) it joined from and its games
