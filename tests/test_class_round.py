@@ -103,3 +103,20 @@ def test_the_projector_counts_a_round_down_and_shows_its_winners(tmp_path, monke
         with pytest.raises(urllib.error.HTTPError) as refused:
             teacher(opened, "/api/teacher/round", {"minutes": 99})
         assert refused.value.code == 400 and time.perf_counter() - started < 5
+
+
+def test_the_guide_says_the_projectors_rules_as_the_page_has_them():
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    guide = " ".join((root / "docs" / "teaching.md").read_text(encoding="utf-8").split())
+    script = (root / "armgame" / "classroom" / "static" / "standings.js").read_text(encoding="utf-8")
+
+    def constant(name: str) -> int:
+        return int(re.search(rf"const {name} = (\d+);", script).group(1))
+
+    assert constant("WINNERS_SECONDS") == 90 and "for a minute and a half" in guide
+    assert f"turn by themselves every {constant('PAGE_SECONDS')} s" in guide
+    assert f"even {constant('MIN_TEXT')} px text" in guide
+    assert f"and {GRACE_SECONDS} s more for the last games" in guide
