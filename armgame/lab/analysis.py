@@ -40,16 +40,20 @@ def channel_of(session: LabSession, outcome: TrialOutcome) -> ChannelMeasures:
     tx, ty = outcome.plan.position
     length = math.hypot(tx - hx, ty - hy)
     reference = session.protocol.reference_field(outcome.plan.block)
-    return channel_measures(np.asarray(outcome.channel_force), np.column_stack([outcome.vxs, outcome.vys]),
+    n = outcome.reach_samples  # the channel's samples are the path's: none after the hand was sent home
+    return channel_measures(np.asarray(outcome.channel_force[:n]),
+                            np.column_stack([outcome.vxs[:n], outcome.vys[:n]]).reshape(-1, 2),
                             (-(ty - hy) / length, (tx - hx) / length),
                             None if reference is None else reference.matrix)
 
 
 def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
+    """The reach a trial's measures are taken on: the shown hand from the go cue to the trial's end, or to the
+    moment space sent the hand home if it did (``TrialOutcome.home_at``): the jump home is no movement."""
     dt = session.config.dt
-    n = len(outcome.xs)
+    n = outcome.reach_samples
     t = (outcome.go_step + np.arange(n)) * dt
-    return Reach(t=t, hand=np.column_stack([outcome.xs, outcome.ys]), start=session.home,
+    return Reach(t=t, hand=np.column_stack([outcome.xs[:n], outcome.ys[:n]]).reshape(-1, 2), start=session.home,
                  target=outcome.plan.position, go_time=outcome.go_step * dt, hit=outcome.hit)
 
 
@@ -74,6 +78,7 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
         "path_length_ratio": m.path_length_ratio,
         "hit": o.hit,
         **channel_of(session, o).as_dict(),
+        "hand_sent_home": o.home_at is not None,
     }
 
 
@@ -92,7 +97,7 @@ def path_groups(session: LabSession, per_group: int | None = None) -> dict[str, 
             continue
         chosen = trials[:per_group] if which == "early" else trials[-per_group:]
         if chosen:
-            groups[label] = [np.column_stack([o.xs, o.ys]) for o in chosen]
+            groups[label] = [np.column_stack([o.xs[:o.reach_samples], o.ys[:o.reach_samples]]) for o in chosen]
     return groups
 
 
@@ -365,7 +370,7 @@ def channel_traces(session: LabSession) -> list[tuple[object, ...]]:
         cancel = -(v @ np.asarray(reference.matrix).T) @ normal if reference is not None \
             else np.full(len(v), math.nan)
         speed = np.hypot(v[:, 0], v[:, 1])
-        for k, force in enumerate(o.channel_force):
+        for k, force in enumerate(o.channel_force[:o.reach_samples]):  # not past the hand sent home
             out.append((o.plan.index + 1, o.plan.block_name, o.plan.target_deg, k * dt, force, float(cancel[k]),
                         float(speed[k])))
     return out

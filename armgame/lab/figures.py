@@ -110,7 +110,8 @@ def class_curve(students: Sequence[Sequence[Mapping[str, Any]]],
     ``students``: one sequence of trial rows (``TRIAL_COLUMNS``) per student. Trials are matched by
     their ``trial`` number, so students who ran different numbers of trials (a run stopped early, a
     longer protocol) each count where they have data: ``n`` is the number of students with a defined
-    (finite) ``metric`` on that trial. ``mean`` is NaN where ``n`` = 0; ``sem`` is the sample
+    (finite) ``metric`` on that trial, a reach whose hand was sent home (``hand_sent_home``) not counted.
+    ``mean`` is NaN where ``n`` = 0; ``sem`` is the sample
     standard deviation over the square root of ``n`` and NaN where ``n`` < 2. ``block`` and
     ``perturbation`` are those most students had on that trial. Returns one dict per trial number
     seen, in order: ``trial, block, perturbation, mean, sem, n``.
@@ -127,7 +128,8 @@ def class_curve(students: Sequence[Sequence[Mapping[str, Any]]],
                 raise UserError(f"student {s} has trial {trial} twice")
             seen.add(trial)
             labels.setdefault(trial, Counter())[(str(row["block"]), str(row["perturbation"]))] += 1
-            value = float(row[metric])
+            # A reach abandoned with space (the hand sent home) is not one of the experiment's: no value here.
+            value = math.nan if row.get("hand_sent_home") else float(row[metric])
             values.setdefault(trial, [])
             if math.isfinite(value):
                 values[trial].append(value)

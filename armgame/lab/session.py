@@ -77,6 +77,16 @@ class TrialOutcome:
     #: On a channel trial: the hand's true velocity (m/s) at those steps, for the adaptation index.
     vxs: list[float] = field(default_factory=list, repr=False)
     vys: list[float] = field(default_factory=list, repr=False)
+    #: Where space ("hand home") sent the hand home during the reach: the number of samples of ``xs`` taken before
+    #: the jump (None: it never was). The samples from there on are not the reach: a jump of tens of centimetres in
+    #: one physics step is no movement, and measured as one it reads as a reach of tens of metres a second.
+    home_at: int | None = None
+
+    @property
+    def reach_samples(self) -> int:
+        """How many samples of ``xs`` (and of the channel's) are the reach: all, or those before the hand was sent
+        home."""
+        return len(self.xs) if self.home_at is None else self.home_at
 
 
 def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]) -> tuple[TrialPlan, ...]:
@@ -224,6 +234,7 @@ class LabSession(GameSession):
         self._go_step = 0
         self._xs: list[float] = []
         self._ys: list[float] = []
+        self._home_at: int | None = None
         self.rules.target = self.home_target
         self._enter_trial()
 
@@ -430,6 +441,7 @@ class LabSession(GameSession):
                 self._go_step = self.steps
                 self._counter = 0
                 self._xs, self._ys = [x], [y]
+                self._home_at = None
                 self.rules.target = Target(*plan.position, self.protocol.target_radius)
                 if plan.channel:
                     self._step, self._channel = self.channel_for(plan.target)
@@ -445,7 +457,7 @@ class LabSession(GameSession):
         hit = self._counter >= self.hold_steps
         if not hit and self.steps - self._go_step < self.timeout_steps:
             return 0
-        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys)
+        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys, home_at=self._home_at)
         if plan.channel:
             outcome.channel_force, outcome.vxs, outcome.vys = self._fs, self._vxs, self._vys
         self.outcomes.append(outcome)
@@ -459,3 +471,7 @@ class LabSession(GameSession):
     def _reset_arm(self) -> None:
         super()._reset_arm()  # the reset key: home, at rest, counted; the trial's clock runs on
         self.cursor = self.shown_hand()
+        if self.phase == REACH and self._home_at is None and not self.over:
+            # The reach ends here for its measures: every sample so far was taken before the jump (keys act
+            # between physics steps), every later one after it.
+            self._home_at = len(self._xs)
