@@ -391,3 +391,81 @@ def write_channel_traces(path: Path, session: LabSession) -> None:
         writer.writerow([trial, block, repr(deg), repr(t), repr(force), "" if math.isnan(cancel) else repr(cancel),
                          repr(speed)])
     _write_text(Path(path), buffer.getvalue())
+
+
+# ------------------------------------------------------------------ the class curve (issue 39)
+@dataclass(frozen=True)
+class ClassRun:
+    """A lab run offered to a class curve: the name its replay carries (None: none), whether a program played it
+    (a bot's run: its replay is not ``driven`` by the keyboard), its protocol and its trial rows (``trial_rows``)."""
+
+    player: str | None
+    program: bool
+    protocol: object
+    rows: Sequence[Mapping[str, object]]
+
+
+@dataclass(frozen=True)
+class ClassCurve:
+    """A class curve and how it was made: the protocol and measure, which runs are in it (their places in the
+    runs given), the programs' runs kept apart, every other run left out with why, and the curve's rows
+    (``figures.class_curve``: ``trial, block, perturbation, mean, sem, n``, in the measure's SI unit)."""
+
+    protocol: object
+    metric: str | None
+    members: tuple[int, ...]
+    programs: int
+    left_out: tuple[tuple[int, str], ...]
+    trials: tuple[dict[str, object], ...]
+
+    @property
+    def students(self) -> int:
+        return len(self.members)
+
+
+def curve_protocol(choice: object):
+    """The class curve's protocol from the teacher's choice as a class keeps it (``Roster.lab`` in ``class.json``):
+    a preset's name, a protocol as plain data, or None (no protocol chosen)."""
+    from .protocol import preset, protocol_from_dict
+
+    if isinstance(choice, dict):
+        return protocol_from_dict(choice, "lab")
+    return preset(choice) if isinstance(choice, str) and choice else None
+
+
+def class_curve_of(runs: Sequence[ClassRun], protocol, metric: str | None = None, *,
+                   people_only: bool = True) -> ClassCurve:
+    """The class curve of ``protocol`` over ``runs``: what the live class's ``/lab`` page draws
+    (``classroom.intake.Clerk.lab_curve``) and ``armgame analyze --class`` writes, built here once so that the
+    two agree by construction.
+
+    ``people_only`` (a class's rule): programs' runs are counted apart and never in the curve, and each person
+    (by ``records.standings.player_key`` of their name) counts once, with their first run of the protocol in the
+    order given. Without it (a folder of replays that is no class's, where bots may stand in for volunteers in
+    a rehearsal) every run of the protocol counts. Runs of another protocol are left out. ``metric``: the
+    curve's measure (default: the one the learning figure plots, ``figure_metric``).
+    """
+    from ..records.standings import player_key
+    from .figures import class_curve
+
+    members: list[int] = []
+    left_out: list[tuple[int, str]] = []
+    seen: dict[str, str] = {}
+    programs = 0
+    for i, run in enumerate(runs):
+        if people_only and run.program:
+            programs += 1
+            left_out.append((i, "a program's run: counted apart, never in the class curve"))
+        elif protocol is None or run.protocol != protocol:
+            left_out.append((i, "another protocol than the class curve's"))
+        elif people_only and run.player and player_key(run.player) in seen:
+            left_out.append((i, f"not {run.player}'s first run of the protocol (that one is in the curve)"))
+        else:
+            if people_only and run.player:
+                seen[player_key(run.player)] = run.player
+            members.append(i)
+    if protocol is None or not members:
+        return ClassCurve(protocol, None, (), programs, tuple(left_out), ())
+    metric = metric or figure_metric(protocol)
+    curve = class_curve([runs[i].rows for i in members], metric)
+    return ClassCurve(protocol, metric, tuple(members), programs, tuple(left_out), tuple(curve))
