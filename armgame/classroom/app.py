@@ -403,17 +403,18 @@ def _check_code(state: ClassState, request: Request, typed: object) -> None:
 
 
 def _check_secret(state: ClassState, request: Request) -> None:
-    """The teacher's secret, from the Authorization header. The teacher's own machine is never made to wait:
-    a guesser elsewhere cannot lock the teacher out."""
+    """The teacher's routes: the teacher's own machine is the teacher (no secret to type, so none is ever shown
+    where the room can read it; never made to wait); any other machine needs the secret, from the Authorization
+    header, its wrong guesses counted apart."""
     address = _address(request)
-    own = state.guard.is_own(address)
-    if not own:
-        _waiting(state.secrets, address, "secrets")
+    if state.guard.is_own(address):
+        return
+    _waiting(state.secrets, address, "secrets")
     secret = _bearer(request)
     if secret is None or not state.clerk.roster.secret_matches(secret):
-        if not own:
-            state.secrets.failed(address)
-        raise RefusedError(403, "the teacher's secret is needed for this (it is printed in the teacher's terminal)")
+        state.secrets.failed(address)
+        raise RefusedError(403, "the teacher's secret is needed for this on another machine than the teacher's (it "
+                                "is in the file teacher.secret in the class's folder)")
     state.secrets.succeeded(address)
 
 

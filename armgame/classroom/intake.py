@@ -152,6 +152,9 @@ class Clerk:
                 return player, None
             raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
                                f"name (or join from the machine that took it)")
+        if name.strip().upper() == "NAME":
+            raise RefusedError(400, "type your own name in place of NAME (in quotes if it has a space: "
+                                    "--name \"Ann B\")")
         problem = name_problem(name)
         if problem is not None:
             raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "

@@ -7,7 +7,8 @@ let secret = sessionStorage.getItem("armgame-secret") || "";
 function say(text) { $("status").textContent = text; }
 
 async function call(path, body) {
-  const options = {headers: {Authorization: "Bearer " + secret}};
+  // On the teacher's own laptop no secret is needed (the class knows its own machine); elsewhere it is typed.
+  const options = {headers: secret ? {Authorization: "Bearer " + secret} : {}};
   if (body !== undefined) {
     options.method = "POST";
     options.headers["Content-Type"] = "application/json";
@@ -118,6 +119,7 @@ async function refresh() {
     say(s.closed ? "The class is closed to new games." : "The class takes games.");
   } catch (e) {
     $("controls").hidden = true;
+    $("ask-secret").hidden = false;
     say(e.message);
   }
 }
@@ -154,7 +156,7 @@ $("lab-protocol").addEventListener("change", async () => {
 });
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
-if (secret) refresh();
+refresh();
 
 // The browser game's address (public: the projector shows it too), for students who cannot install Python.
 fetch("/api/standings").then((r) => r.json()).then((s) => {
