@@ -95,3 +95,41 @@ def test_a_folder_that_is_no_class_keeps_its_rules(tmp_path, runs, capsys):
     said = capsys.readouterr()
     assert "class curve of 2 students (1 left out)" in said.out and "programs" not in said.out
     assert [n for *_, n in curve_csv(tmp_path / "c")] == [2, 2, 2, 2]
+
+
+def test_the_teachers_page_downloads_the_class_curve_as_a_png(tmp_path, runs, monkeypatch):
+    import json
+    import urllib.error
+    import urllib.request
+
+    from class_server import running_class
+
+    from armgame.classroom import client
+
+    def get(opened, path):
+        request = urllib.request.Request(f"http://127.0.0.1:{opened.port}{path}",
+                                         headers={"Authorization": f"Bearer {opened.clerk.roster.secret}"})
+        try:
+            with urllib.request.urlopen(request, timeout=20) as r:
+                return r.status, r.headers.get("Content-Type"), r.read()
+        except urllib.error.HTTPError as exc:
+            return exc.code, exc.headers.get("Content-Type"), exc.read()
+
+    with running_class(tmp_path / "class", lab=str(runs / "short.toml")) as opened:
+        status, _, body = get(opened, "/api/teacher/lab.png")
+        assert status == 404 and "no class curve yet" in json.loads(body)["error"]
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        for i, name in enumerate(("Ann", "Bo"), 1):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            client.hand_in(client.join(address, opened.clerk.roster.code, name),
+                           as_person(runs / f"short{i}.json", name))
+        status, kind, png = get(opened, "/api/teacher/lab.png")
+        assert (status, kind) == (200, "image/png") and png.startswith(b"\x89PNG\r\n\x1a\n")
+        import io
+
+        import matplotlib.image
+        assert matplotlib.image.imread(io.BytesIO(png)).shape[:2] == (1080, 1920)  # the lab's figure, projector-sized
+        monkeypatch.setitem(sys.modules, "matplotlib", None)  # the README's install: no [plot] extra
+        status, _, body = get(opened, "/api/teacher/lab.png")
+        message = json.loads(body)["error"]
+        assert status == 503 and "pip install 'armgame[plot]'" in message and "\n" not in message

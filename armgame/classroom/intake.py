@@ -368,15 +368,23 @@ class Clerk:
 
         return curve_protocol(self.roster.lab)
 
+    def class_curve(self) -> Any:
+        """``lab.analysis.class_curve_of`` the teacher's protocol over the class's runs (in SI units): hidden
+        names left out, programs' runs counted apart."""
+        from ..lab.analysis import ClassRun, class_curve_of
+
+        runs = [run for run in self.lab_runs if run.program or (run.first and not self.roster.is_hidden(run.player))]
+        return class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                              self._curve_protocol())
+
     def lab_curve(self) -> dict[str, object]:
         """The class curve of the protocol the teacher chose: each person's first run of it (programs' runs
         and hidden names never in it; the programs counted apart). Built by ``lab.analysis.class_curve_of``,
         as ``armgame analyze --class`` builds it from the folder afterwards."""
-        from ..lab.analysis import ClassRun, class_curve_of, display_unit
+        from ..lab.analysis import display_unit
 
         protocol = self._curve_protocol()
-        runs = [run for run in self.lab_runs if run.program or (run.first and not self.roster.is_hidden(run.player))]
-        curve = class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs], protocol)
+        curve = self.class_curve()
         if not curve.students:
             return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
                     "metric": None, "trials": []}

@@ -270,6 +270,27 @@ def paths_figure(groups: Mapping[str, Sequence[np.ndarray]], home: Sequence[floa
 def class_figure(curve: Sequence[Mapping[str, Any]], path: Path, *,
                  metric: str = "initial_direction_error_deg") -> None:
     """The class curve from ``class_curve``: the mean with its s.e.m. band, blocks shaded, n below."""
+    _draw_class(curve, metric, lambda fig: _save(fig, path))
+
+
+def class_figure_png(curve: Sequence[Mapping[str, Any]], *, metric: str = "initial_direction_error_deg") -> bytes:
+    """``class_figure``'s picture as PNG bytes (the class's teacher page downloads it); UserError without
+    matplotlib."""
+    drawn: list[bytes] = []
+    _class_png(curve, drawn, metric=metric)
+    return drawn[0]
+
+
+@_lab_style
+def _class_png(curve: Sequence[Mapping[str, Any]], drawn: list[bytes], *, metric: str) -> None:
+    def keep(fig: Any) -> None:
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png")
+        drawn.append(buffer.getvalue())
+    _draw_class(curve, metric, keep)
+
+
+def _draw_class(curve: Sequence[Mapping[str, Any]], metric: str, finish: Callable[[Any], None]) -> None:
     label, scale = _measure(metric)
     if not curve:
         raise UserError("no trials to draw")
@@ -313,7 +334,7 @@ def class_figure(curve: Sequence[Mapping[str, Any]], path: Path, *,
     else:
         ax.set_xlabel("trial")
     _legend_below(fig, n_ax if n_ax is not None else ax, handles_from=ax)
-    _save(fig, path)
+    finish(fig)
 
 
 # ------------------------------------------------------------------------------------- internals
