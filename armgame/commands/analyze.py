@@ -58,8 +58,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "the learning figure plots), or the adaptation index of the channel trials")
     p.add_argument("--subtract-baseline", action="store_true",
                    help="each channel trial's adaptation_index less its direction's baseline: the mean index of the "
-                   "channel trials to that direction before the run's first perturbed block (empty for a direction "
-                   "with none); in the tables and with --fit-on index")
+                   "channel trials to that direction before the run's first perturbed block (for a direction with "
+                   "none, the nearest probed direction's, the mean of two as near); in the tables and with --fit-on "
+                   "index")
     p.add_argument("--channel-traces", action="store_true",
                    help="also write each run's channel trials' force over time, one row per physics step: "
                    "REPLAY.channel_traces.csv beside the tables (trial, block, target_deg, time_s, channel_force_n, "
@@ -216,6 +217,14 @@ def _replays(args: argparse.Namespace) -> int:
                 continue
             print("  adaptation index less each direction's baseline, which was: "
                   + ", ".join(f"{deg:g} deg {value:+.2f}" for deg, value in offsets.items()))
+            from ..lab.analysis import baseline_for
+
+            borrowed = sorted({float(r["target_deg"]) for r in rows if r["perturbation"] == "channel"}  # type: ignore[arg-type]
+                              - set(offsets))
+            if borrowed:  # directions the baseline never probed: the nearest probed direction's stands in
+                print("  no baseline channel trial to " + "; ".join(
+                    f"{deg:g} deg: the nearest probed ({' and '.join(f'{d:g}' for d in baseline_for(offsets, deg)[1])}"
+                    " deg) stands in" for deg in borrowed))
         if args.channel_traces:
             from ..lab.analysis import write_channel_traces
 

@@ -302,9 +302,24 @@ def baseline_offsets(session: LabSession, rows: Sequence[Mapping[str, object]]) 
     return {deg: float(np.mean(v)) for deg, v in sorted(seen.items())}
 
 
+def baseline_for(offsets: Mapping[float, float], deg: float) -> tuple[float, tuple[float, ...]]:
+    """The baseline subtracted from a channel trial to ``deg``, and the probed directions it came from: the
+    direction's own (``baseline_offsets``), or for a direction the baseline never probed (the ``spontaneous``
+    preset's baseline probes 4 of its 8), the nearest probed direction's, the mean of the two when two are as
+    near. NaN with no offsets at all."""
+    if deg in offsets:
+        return offsets[deg], (deg,)
+    if not offsets:
+        return math.nan, ()
+    away = {d: abs(signed_angle(d - deg)) for d in offsets}
+    nearest = min(away.values())
+    chosen = tuple(sorted(d for d in offsets if away[d] == nearest))
+    return float(np.mean([offsets[d] for d in chosen])), chosen
+
+
 def subtract_baseline(session: LabSession, rows: Sequence[Mapping[str, object]]) -> list[dict[str, object]]:
-    """The rows with each channel trial's adaptation index less its direction's ``baseline_offsets`` (NaN for a
-    direction with no baseline channel trial). Raises ValueError for a run with no baseline channel trial."""
+    """The rows with each channel trial's adaptation index less its direction's baseline (``baseline_for``: its
+    own, else the nearest probed direction's). Raises ValueError for a run with no baseline channel trial."""
     offsets = baseline_offsets(session, rows)
     if not offsets:
         raise ValueError("the run has no channel trial before its first perturbed block: no baseline to subtract")
@@ -312,7 +327,8 @@ def subtract_baseline(session: LabSession, rows: Sequence[Mapping[str, object]])
     for r in rows:
         r = dict(r)
         if r["perturbation"] == "channel":
-            r["adaptation_index"] = float(r["adaptation_index"]) - offsets.get(float(r["target_deg"]), math.nan)  # type: ignore[arg-type]
+            base = baseline_for(offsets, float(r["target_deg"]))[0]  # type: ignore[arg-type]
+            r["adaptation_index"] = float(r["adaptation_index"]) - base  # type: ignore[arg-type]
         out.append(r)
     return out
 
