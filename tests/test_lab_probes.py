@@ -166,7 +166,7 @@ def test_the_local_learner_generalizes_by_its_tuning_and_the_global_one_everywhe
     with pytest.raises(UserError, match="tuning width must be a number of degrees from 5 to 180, got 1"):
         DirectionalLearner(TwoRateLearner(), 1)
     bot, flat = make_lab_bot("adaptive", representation="local"), make_lab_bot("adaptive")
-    assert "local learner: Gaussian tuning over movement direction, 30 deg wide" in bot.describe()
+    assert "local learner: Gaussian tuning over movement direction, bases of s.d. 30 deg" in bot.describe()
     assert flat.describe().startswith("global learner") and make_lab_bot("model").describe() == ""
     with pytest.raises(UserError, match="learner representation"):
         make_lab_bot("adaptive", representation="wide")
@@ -293,3 +293,22 @@ def test_subtract_baseline_never_blanks_a_direction_the_baseline_did_not_probe(t
            task=LabTask.of(session)).save(path)
     assert main(["analyze", str(path), "--out", str(tmp_path / "t"), "--subtract-baseline"]) == 0
     assert "no baseline channel trial to " in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("argv", "representation"), [
+    (["generalization"], "local"),  # the preset's point, without a flag (issue 39)
+    (["generalization", "--representation", "global"], "global"),  # its control, by name
+    (["curl"], "global"),
+])
+def test_the_generalization_preset_runs_the_local_learner_by_default(argv, representation, monkeypatch):
+    import armgame.lab.bots
+
+    made = []
+
+    def capture(name, rates=None, representation="global", *rest, **options):
+        made.append(representation)
+        raise SystemExit(0)  # the learner chosen is all this test needs: no run
+    monkeypatch.setattr(armgame.lab.bots, "make_lab_bot", capture)
+    with pytest.raises(SystemExit):
+        main(["lab", *argv, "--bot", "adaptive", "--headless"])
+    assert made == [representation]
