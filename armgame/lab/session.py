@@ -183,8 +183,8 @@ def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = 
     ``person``: a person at the keys gets three times the time every trial could take, and two minutes
     more (``lesson``: 408 s, 6.8 minutes, of reaching, cards and paths not counted; a program 204 s), where
     a program gets one and a half times and one minute: a volunteer slow to bring the hand home, or talking to
-    the class, must not lose the run on the clock. Only a run that idles costs more to replay; a finished one ends at its last
-    trial."""
+    the class, must not lose the run on the clock. Only a run that idles costs more to replay; a finished one
+    ends at its last trial."""
     worst = protocol.trials * (protocol.delay[1] + protocol.timeout)
     program = math.ceil(1.5 * worst + 60.0)
     time_limit = float(min(86400, max(program, min(math.ceil(3.0 * worst + 120.0), MAX_GAME_SECONDS)) if person
