@@ -165,6 +165,64 @@ function showPlay(url) {
     .replace(/\/play$/, "\u200b/play");  // if the column is narrow, the line breaks there and nowhere else
 }
 
+// A round: its clock counted down on the projector, its own standings while it runs, and its winners, large,
+// for WINNERS_SECONDS once it is over. The clock is the class's (the round's end, as the server set it).
+const WINNERS_SECONDS = 90;
+let roundTimer = null;
+
+function mmss(seconds) {
+  const s = Math.max(0, Math.ceil(seconds));
+  return Math.floor(s / 60) + ":" + String(s % 60).padStart(2, "0");
+}
+
+function roundShown(r) {
+  return r && !(r.over && (Date.now() - Date.parse(r.end)) / 1000 > WINNERS_SECONDS);
+}
+
+function showRound(r) {
+  const banner = document.getElementById("round");
+  const winners = document.getElementById("winners");
+  clearInterval(roundTimer);
+  document.body.dataset.round = r && roundShown(r) ? (r.over ? "over" : "on") : "";
+  banner.hidden = !(r && roundShown(r) && !r.over);
+  winners.hidden = !(r && roundShown(r) && r.over);
+  if (!r || !roundShown(r)) return;
+  if (!r.over) {
+    document.getElementById("round-title").textContent = "Round " + r.number + ": play now!";
+    const tick = () => {
+      const left = (Date.parse(r.end) - Date.now()) / 1000;
+      document.getElementById("round-clock").textContent = left > 0 ? mmss(left) + " left"
+        : "time! the last games are coming in";
+    };
+    tick();
+    roundTimer = setInterval(tick, 250);
+    return;
+  }
+  document.getElementById("winners-title").textContent = "Round " + r.number + ": " +
+    (r.winners.length ? "the winners" : "no games handed in");
+  document.getElementById("winners-players").textContent =
+    r.players === 1 ? "1 student played in the round" : r.players + " students played in the round";
+  const list = document.getElementById("winners-list");
+  list.replaceChildren();
+  for (const w of r.winners) {
+    const li = document.createElement("li");
+    li.dataset.rank = String(w.rank);
+    const place = document.createElement("span");
+    place.className = "place";
+    place.textContent = ["", "1st", "2nd", "3rd"][w.rank] || w.rank + "th";
+    const name = document.createElement("span");
+    name.className = "name";
+    name.textContent = w.name;
+    const score = document.createElement("span");
+    score.className = "score";
+    score.textContent = String(w.score);
+    li.append(place, name, score);
+    list.appendChild(li);
+  }
+  // Back to the class's standings once the moment has passed.
+  roundTimer = setTimeout(() => { if (latest) render(latest); }, WINNERS_SECONDS * 1000);
+}
+
 function render(s) {
   // The join line comes only to the projector's own link (its key) and the teacher's machine: a page
   // anyone on the network opens shows the standings without the code.
@@ -177,7 +235,12 @@ function render(s) {
   const a = s.arrival;
   const isNew = a && lastArrival !== null && a.seq > lastArrival;
   if (a) lastArrival = Math.max(lastArrival || 0, a.seq); else if (lastArrival === null) lastArrival = 0;
-  fillStudents(document.getElementById("students"), s.students, isNew && !a.program ? a.name : null);
+  showRound(s.round);
+  const during = s.round && roundShown(s.round) && !s.round.over;
+  document.getElementById("students-title").textContent = during
+    ? "Round " + s.round.number + ": best game each, handed in during the round" : "Students: best game each";
+  fillStudents(document.getElementById("students"), during ? s.round.students : s.students,
+    isNew && !a.program ? a.name : null);
   fillPrograms(document.getElementById("programs"), s.programs, isNew && a.program ? a.name : null);
   if (isNew) announce(a);
   document.body.dataset.version = String(s.version);
