@@ -664,6 +664,26 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
                             media_type="text/csv; charset=utf-8")
         return route
 
+    async def teacher_lab_png(request: Request) -> Response:
+        """The class curve as the lab's figure draws it (a PNG for a report), where matplotlib is installed."""
+        _check_secret(state, request)
+        from ..lab.figures import class_figure_png, require_matplotlib
+
+        try:
+            require_matplotlib()
+        except UserError:
+            raise RefusedError(503, "the lab curve's picture needs matplotlib on the teacher's machine: pip install "
+                                    "'armgame[plot]' (the lab's CSV needs nothing)") from None
+
+        def draw() -> bytes | None:  # on the clerk's thread: the curve as it is now, and one drawing at a time
+            curve = clerk.class_curve()
+            return class_figure_png(curve.trials, metric=curve.metric) if curve.students else None
+        png = await state.run(draw)
+        if png is None:
+            raise RefusedError(404, "no class curve yet: no volunteer's run of the class's protocol")
+        return Response(png, 200, {**SECURITY_HEADERS, "Content-Disposition":
+                                   'attachment; filename="class-lab-curve.png"'}, media_type="image/png")
+
     routes = [
         Route("/", _refusals(home)),
         Route("/lab", _refusals(lab_page)),
@@ -687,6 +707,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/teacher/roster", _refusals(teacher_roster)),
         Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),
         Route("/api/teacher/lab.csv", _refusals(csv_route(clerk.lab_csv, "class-lab-reaches.csv"))),
+        Route("/api/teacher/lab.png", _refusals(teacher_lab_png)),
     ]
     app = Starlette(routes=routes, lifespan=lifespan)
     app.state.armgame = state

@@ -367,34 +367,36 @@ class Clerk:
 
     def _curve_protocol(self) -> Any:
         """The protocol the teacher chose for the class curve (``Roster.lab``), or None."""
-        from ..lab.protocol import preset, protocol_from_dict
+        from ..lab.analysis import curve_protocol
 
-        lab = self.roster.lab
-        if isinstance(lab, dict):
-            return protocol_from_dict(lab, "lab")
-        return preset(lab) if lab else None
+        return curve_protocol(self.roster.lab)
+
+    def class_curve(self) -> Any:
+        """``lab.analysis.class_curve_of`` the teacher's protocol over the class's runs (in SI units): hidden
+        names left out, programs' runs counted apart."""
+        from ..lab.analysis import ClassRun, class_curve_of
+
+        runs = [run for run in self.lab_runs if run.program or (run.first and not self.roster.is_hidden(run.player))]
+        return class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                              self._curve_protocol())
 
     def lab_curve(self) -> dict[str, object]:
         """The class curve of the protocol the teacher chose: each person's first run of it (programs' runs
-        and hidden names never in it; the programs counted apart)."""
-        from ..lab.analysis import display_unit, figure_metric
-        from ..lab.figures import class_curve
+        and hidden names never in it; the programs counted apart). Built by ``lab.analysis.class_curve_of``,
+        as ``armgame analyze --class`` builds it from the folder afterwards."""
+        from ..lab.analysis import display_unit
 
         protocol = self._curve_protocol()
-        runs = [run for run in self.lab_runs if run.first and not run.program and run.protocol == protocol
-                and not self.roster.is_hidden(run.player)]
-        programs = sum(run.program for run in self.lab_runs)
-        if protocol is None or not runs:
-            return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": programs,
+        curve = self.class_curve()
+        if not curve.students:
+            return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
                     "metric": None, "trials": []}
-        metric = figure_metric(protocol)
-        curve = class_curve([run.rows for run in runs], metric)
-        scale, unit = display_unit(metric)
+        scale, unit = display_unit(curve.metric)  # type: ignore[arg-type]
         trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
                    "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
-                  for row in curve]
-        return {"protocol": protocol.name, "students": len(runs), "programs": programs,
-                "metric": metric, "unit": unit, "trials": trials}
+                  for row in curve.trials]
+        return {"protocol": protocol.name, "students": curve.students, "programs": curve.programs,
+                "metric": curve.metric, "unit": unit, "trials": trials}
 
     # ------------------------------------------------------------------ the teacher
     def hide(self, name: object, hidden: bool) -> str:

@@ -75,8 +75,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="adaptive bot: the learner's learning rates B_f B_s (default: 0.21 0.02; 0 0 learns nothing)")
     p.add_argument("--representation", choices=("global", "local"), default=None,
                    help="adaptive bot: its internal model of the field, one estimate for every direction (global, "
-                   "the default) or Gaussian tuning over movement direction (local: what it learns falls off with "
-                   "the angle from where it learned it)")
+                   "the default but on the generalization preset) or Gaussian tuning over movement direction (local, "
+                   "the generalization preset's default: what it learns falls off with the angle from where it "
+                   "learned it)")
     p.add_argument("--tuning-width", type=float, default=None, metavar="DEG",
                    help="with --representation local: the tuning's width, s.d. in degrees (5 to 180; default 30)")
     p.add_argument("--motor-noise", type=_noise_level, default=None, metavar="LEVEL",
@@ -198,6 +199,10 @@ def run(args: argparse.Namespace) -> int:
     if (args.retention or args.learning or args.representation) and args.bot != "adaptive":
         raise UserError("--retention, --learning and --representation set the adaptive bot's learner: add --bot "
                         "adaptive")
+    from ..lab.protocol import PRESET_REPRESENTATION
+
+    if args.bot == "adaptive" and args.representation is None:  # the preset's own learner (generalization: local)
+        args.representation = PRESET_REPRESENTATION.get(args.protocol, "global")
     if args.tuning_width is not None and args.representation != "local":
         raise UserError("--tuning-width sets the local learner's tuning: add --representation local")
     if args.no_figures and not args.out and args.headless:

@@ -111,7 +111,7 @@ class LabBot(ReachingBot):
         if self.rates is None:
             return ""
         if self.representation == "local":
-            return (f"local learner: Gaussian tuning over movement direction, {self.width_deg:g} deg wide "
+            return (f"local learner: Gaussian tuning over movement direction, bases of s.d. {self.width_deg:g} deg "
                     "(learning falls off with the angle from the trained direction)")
         return "global learner: one estimate for every direction (it generalizes fully)"
 

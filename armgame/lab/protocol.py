@@ -386,6 +386,12 @@ HUMAN_NOISE = 0.3
 #: the run's seed, so a noisy run is as reproducible as a quiet one; a protocol file's bot has none unless asked.
 PRESET_MOTOR_NOISE = {name: 0.0 if name == "lesson" else HUMAN_NOISE for name in PRESETS}
 
+#: The adapting bot's learner on each preset when ``--representation`` does not say: ``generalization``'s point is
+#: local generalization, so its bot learns locally (the global learner, a control, is asked for by name); every
+#: other preset's learns one estimate for every direction. A bot's replay records its keys, not its learner, so
+#: an old run of the preset replays as it was recorded.
+PRESET_REPRESENTATION = {name: "local" if name == "generalization" else "global" for name in PRESETS}
+
 
 def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
     """Exposure to the curl field, de-adaptation, re-exposure: re-learning is faster (savings).
@@ -425,7 +431,7 @@ def spontaneous() -> Protocol:
 
 
 def generalization() -> Protocol:
-    """Train on one direction, probe them all (Shadmehr & Mussa-Ivaldi 1994; Krakauer et al. 2000;
+    """Train on one direction, probe them all (Shadmehr & Mussa-Ivaldi 1994; Gandolfo, Mussa-Ivaldi & Bizzi 1996;
     Donchin et al. 2003): a baseline to the 8 targets with a channel trial to each (the per-direction
     baseline), training in the curl field to ``GENERALIZATION_TRAINED_DEG`` only, then a test block that
     keeps training there while its channel trials probe every direction twice, spread evenly. The adaptation

@@ -77,6 +77,16 @@ class TrialOutcome:
     #: On a channel trial: the hand's true velocity (m/s) at those steps, for the adaptation index.
     vxs: list[float] = field(default_factory=list, repr=False)
     vys: list[float] = field(default_factory=list, repr=False)
+    #: Where space ("hand home") sent the hand home during the reach: the number of samples of ``xs`` taken before
+    #: the jump (None: it never was). The samples from there on are not the reach: a jump of tens of centimetres in
+    #: one physics step is no movement, and measured as one it reads as a reach of tens of metres a second.
+    home_at: int | None = None
+
+    @property
+    def reach_samples(self) -> int:
+        """How many samples of ``xs`` (and of the channel's) are the reach: all, or those before the hand was sent
+        home."""
+        return len(self.xs) if self.home_at is None else self.home_at
 
 
 def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]) -> tuple[TrialPlan, ...]:
@@ -171,10 +181,10 @@ def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = 
     and a clock long enough for every trial (a run that fidgets at home past it ends there).
 
     ``person``: a person at the keys gets three times the time every trial could take, and two minutes
-    more (``lesson``: 5 minutes of reaching, cards and paths not counted), where a program gets one and a
-    half times and one minute: a volunteer slow to bring the hand home, or talking to the class, must not
-    lose the run on the clock. Only a run that idles costs more to replay; a finished one ends at its last
-    trial."""
+    more (``lesson``: 408 s, 6.8 minutes, of reaching, cards and paths not counted; a program 204 s), where
+    a program gets one and a half times and one minute: a volunteer slow to bring the hand home, or talking to
+    the class, must not lose the run on the clock. Only a run that idles costs more to replay; a finished one
+    ends at its last trial."""
     worst = protocol.trials * (protocol.delay[1] + protocol.timeout)
     program = math.ceil(1.5 * worst + 60.0)
     time_limit = float(min(86400, max(program, min(math.ceil(3.0 * worst + 120.0), MAX_GAME_SECONDS)) if person
@@ -224,6 +234,7 @@ class LabSession(GameSession):
         self._go_step = 0
         self._xs: list[float] = []
         self._ys: list[float] = []
+        self._home_at: int | None = None
         self.rules.target = self.home_target
         self._enter_trial()
 
@@ -430,6 +441,7 @@ class LabSession(GameSession):
                 self._go_step = self.steps
                 self._counter = 0
                 self._xs, self._ys = [x], [y]
+                self._home_at = None
                 self.rules.target = Target(*plan.position, self.protocol.target_radius)
                 if plan.channel:
                     self._step, self._channel = self.channel_for(plan.target)
@@ -445,7 +457,7 @@ class LabSession(GameSession):
         hit = self._counter >= self.hold_steps
         if not hit and self.steps - self._go_step < self.timeout_steps:
             return 0
-        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys)
+        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys, home_at=self._home_at)
         if plan.channel:
             outcome.channel_force, outcome.vxs, outcome.vys = self._fs, self._vxs, self._vys
         self.outcomes.append(outcome)
@@ -459,3 +471,7 @@ class LabSession(GameSession):
     def _reset_arm(self) -> None:
         super()._reset_arm()  # the reset key: home, at rest, counted; the trial's clock runs on
         self.cursor = self.shown_hand()
+        if self.phase == REACH and self._home_at is None and not self.over:
+            # The reach ends here for its measures: every sample so far was taken before the jump (keys act
+            # between physics steps), every later one after it.
+            self._home_at = len(self._xs)

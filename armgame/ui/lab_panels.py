@@ -87,7 +87,8 @@ def draw_feedback(renderer: GameRenderer, screen: pygame.Surface, view: Viewport
     target = view.to_screen(*outcome.plan.position)
     pygame.draw.line(screen, p.edge, home, target, width)
     pygame.draw.circle(screen, p.target, target, view.length(session.protocol.target_radius), width)
-    points = [view.to_screen(x, y) for x, y in zip(outcome.xs[::4], outcome.ys[::4], strict=True)]
+    n = outcome.reach_samples  # the reach, not the jump home after space
+    points = [view.to_screen(x, y) for x, y in zip(outcome.xs[:n:4], outcome.ys[:n:4], strict=True)]
     if len(points) > 1:
         pygame.draw.lines(screen, p.trail, False, points, width)
         for end in (points[0], points[-1]):

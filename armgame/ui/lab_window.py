@@ -76,6 +76,7 @@ class LabHud(Hud):
     curve: LearningCurve | None = None
     summary: str = ""
     saved: Sequence[str] = field(default_factory=tuple)
+    away: bool = False  # paused because the window lost the focus
 
 
 class LabRenderer(GameRenderer):
@@ -117,7 +118,8 @@ class LabRenderer(GameRenderer):
         elif lab is not None and lab.card is not None:
             draw_card(self, screen, lab.card.title, lab.card.lines, lab.card.prompt)
         elif hud.paused and not hud.ended:
-            self._panel(screen, "Paused", "p to play on")
+            self._panel(screen, "Paused", "click here or press a key to play on" if lab is not None and lab.away
+                        else "p to play on")
         elif session.over or hud.ended:
             done = len(session.outcomes)
             self._panel(screen, "Done" if session.finished else "Time is up",
@@ -274,6 +276,8 @@ class LabWindow(GameWindow):
         self.summary = ""
         self.feedback: Feedback | None = None
         self.seen = len(session.outcomes)
+        #: Paused because the window lost the focus (not by p): focus back, or any key, plays on.
+        self.away = False
         show_cards = not self.watching if cards is None else cards
         self.card: Card | None = self._intro_card() if show_cards and session.steps == 0 else None
         self.block_cards = show_cards
@@ -337,6 +341,26 @@ class LabWindow(GameWindow):
         return tuple(items)
 
     def handle(self, event: pygame.event.Event) -> None:
+        if event.type == pygame.WINDOWFOCUSLOST:
+            self._track(event)
+            # The game pauses until p; a lab volunteer knows no p (issue 39: a run stood 1.5 minutes at trial 3
+            # after the pointer left the window). A person's keys are let go (the releases would go elsewhere)
+            # and the run waits only while the window is away; a bot's or a replay's runs on.
+            if self.keyboard and not self.finished and not self.paused:
+                self.set_paused(True)
+                self.away = True
+            return
+        if event.type == pygame.WINDOWFOCUSGAINED:
+            if self.away:
+                self.away = False
+                self.set_paused(False)
+            return
+        if event.type == pygame.KEYDOWN and self.away:
+            # Keys reach the window again: the focus is back, whatever the window manager said.
+            self.away = False
+            self.set_paused(False)
+            if key_name(event) == "p":
+                return  # the key a volunteer was told for the pause: it resumes, it does not pause again
         if event.type == pygame.KEYDOWN:
             name = key_name(event)
             if self.card is not None and name in START_KEYS:
@@ -463,7 +487,7 @@ class LabWindow(GameWindow):
             hud.speed = self.speed
         saved = ("saving the run ...",) if saving else self.saved
         return LabHud(**{f: getattr(hud, f) for f in Hud.__dataclass_fields__}, card=self.card,
-                      feedback=self.feedback, curve=self.curve, summary=self.summary, saved=saved)
+                      feedback=self.feedback, curve=self.curve, summary=self.summary, saved=saved, away=self.away)
 
     def frame(self, elapsed: float) -> None:
         """Handle pending events; advance physics by ``elapsed`` real seconds unless a card, a path or the

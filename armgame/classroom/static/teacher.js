@@ -167,6 +167,7 @@ $("round-stop").addEventListener("click", async () => {
 });
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
+$("lab-png").addEventListener("click", () => download("/api/teacher/lab.png", "class-lab-curve.png"));
 refresh();
 
 // The browser game's address (public: the projector shows it too), for students who cannot install Python.
