@@ -166,7 +166,7 @@ def games(n: int, seconds: float, switching: bool) -> tuple[BatchGameSession, Mu
     batch.target_x[:] = batch.target_y[:] = 100.0
     rng = np.random.default_rng(0)
     dt, total = batch.config.dt, int(batch.total_steps[0])
-    rise, decay = batch._rise, batch._decay
+    rise, decay = batch.kernel_inputs.rise, batch.kernel_inputs.decay
     steps, flat, goal, rate = [], [], [], []
     for i in range(n):
         held = rng.random(4) < 0.5
@@ -191,7 +191,7 @@ def games(n: int, seconds: float, switching: bool) -> tuple[BatchGameSession, Mu
 def batch_runner(n: int, seconds: float, switching: bool, fast: bool, lanes: bool) -> Callable[[], float]:
     """Seconds for ``_ckernel.run`` to play the games from their start (a fresh copy each time)."""
     batch, events, halt = games(n, seconds, switching)
-    kernel = compiled.CompiledKernel(batch, fast=fast)
+    kernel = compiled.CompiledKernel(batch.kernel_inputs, batch.arrays, batch._hit_test)
     start = [a.copy() for a in (batch._xs, batch._act, batch._goal, batch._rate, batch._slack)]
 
     def run() -> float:

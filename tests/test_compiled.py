@@ -28,7 +28,7 @@ needs_build = pytest.mark.skipif(not (compiled.AVAILABLE or os.environ.get("ARMG
 def arrays(n: int = 3) -> dict:
     """A valid argument set for ``_ckernel.run``, as ``CompiledKernel`` passes it."""
     batch = BatchGameSession([GameConfig(seed=s, time_limit=1.0) for s in range(n)], kernel="numpy")
-    kernel = compiled.CompiledKernel(batch)
+    kernel = compiled.CompiledKernel(batch.kernel_inputs, batch.arrays, batch._hit_test)
     events = compiled.MuscleEvents.by_game(n, np.array([0, 5]), np.array([0, n + 1]), np.array([1.0, 1.0]),
                                            np.array([0.1, 0.1]))
     return {"params": kernel.params, "mode": kernel.mode, "fast": False, "n": n, "x": batch._xs,
@@ -393,3 +393,17 @@ def test_rk4_run_refuses_bad_arguments_before_any_step(change, message):
             "limit": 1e4} | change
     with pytest.raises(ValueError, match=message):
         session_module._ckernel.rk4_run(*args.values())
+
+
+def test_every_compiled_module_is_loaded_by_one_helper_that_refuses_another_convention():
+    """``armgame._native.load``: a module not built, or built from another version of its ``.c`` file, is
+    None (the Python twin runs); one that speaks the convention asked is handed over."""
+    from armgame import _native
+
+    assert _native.load("armgame.game._no_such_module", 1) is None
+    assert _native.load("armgame.game._ckernel", compiled.KERNEL_VERSION + 1, PARAMS=26) is None
+    assert not _native.speaks(types.SimpleNamespace(VERSION=1), 1, PARAMS=26)
+    assert _native.speaks(types.SimpleNamespace(VERSION=1, PARAMS=26), 1, PARAMS=26)
+    assert _native.speaks(types.SimpleNamespace(), None)
+    if compiled.AVAILABLE:
+        assert _native.load("armgame.game._ckernel", compiled.KERNEL_VERSION, PARAMS=26) is compiled._ckernel

@@ -20,6 +20,11 @@ from armgame.game.session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, InputEvent
 KEYS = ("d", "f", "j", "k", RESET_KEY, TOGGLE_ARM_KEY, "x")
 
 
+def scheduled(batch: BatchGameSession, timelines, now: int, limit: list[int]) -> Schedule:
+    """``schedule`` of the batch's timelines, handed what the batch hands it."""
+    return schedule(batch.kernel_inputs, batch._held, batch.total_steps, timelines, now, limit)
+
+
 def reference_schedule(batch: BatchGameSession, timelines, now: int, limit: list[int]) -> Schedule:
     index = {key: m for m, key in enumerate(batch.muscle_keys)}
     rise, decay = batch._rise.tolist(), batch._decay.tolist()
@@ -78,7 +83,7 @@ def test_the_schedule_is_the_loop_it_replaced(timelines, now, data):
     batch = BatchGameSession([GameConfig(seed=i, time_limit=t) for i, t in enumerate(seconds)], kernel="numpy")
     batch._held[...] = np.array(data.draw(st.lists(st.booleans(), min_size=4 * n, max_size=4 * n))).reshape(4, n)
     limit = [min(int(t), data.draw(st.integers(-3, 90))) for t in batch.total_steps]
-    assert_same(schedule(batch, timelines, now, limit), reference_schedule(batch, timelines, now, limit))
+    assert_same(scheduled(batch, timelines, now, limit), reference_schedule(batch, timelines, now, limit))
 
 
 def test_a_class_of_scripts_and_steps_no_game_reaches():
@@ -94,6 +99,6 @@ def test_a_class_of_scripts_and_steps_no_game_reaches():
     batch = BatchGameSession([GameConfig(seed=i) for i in range(40)], kernel="numpy")
     limit = [int(t) for t in batch.total_steps]
     limit[7] = 9_000
-    got, want = schedule(batch, timelines, 0, limit), reference_schedule(batch, timelines, 0, limit)
+    got, want = scheduled(batch, timelines, 0, limit), reference_schedule(batch, timelines, 0, limit)
     assert_same(got, want)
     assert len(got.steps) > 3_000 and len(got.specials) > 1_000

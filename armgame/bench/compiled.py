@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..game.session import _ckernel, kernel_mode, kernel_params
+from ..game.session import compiled_kernel, kernel_mode, kernel_params
 from ..physics.params import TwoJointParams
 from ..physics.twojoint import TwoJointArm
 from .measure import (
@@ -33,6 +33,9 @@ from .measure import (
     step_label,
     step_torques,
 )
+
+#: The game's C module (None: not built here), loaded as the game loads it.
+_ckernel = compiled_kernel()
 
 #: The compiled schemes (the scheme each runs, as the table names it).
 METHODS = {"rk4": "rk4 (compiled)"}

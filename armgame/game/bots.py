@@ -43,18 +43,17 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Protocol
 
+from .._native import load
 from ..errors import UserError
 from ..physics.twojoint import TwoJointArm
 from ..words import unknown_name
 from .rules import GameConfig, Target
 from .session import DOWN, UP, GameResult, GameSession
 
-try:  # the compiled forward model (setup.py builds it where a C compiler is found)
-    from . import _cbots
-except ImportError:
-    _cbots = None
-#: A build of another version of _cbots.c is not used: its calling convention may differ.
-_c_predict = _cbots.predict if getattr(_cbots, "VERSION", None) == 1 else None
+#: The compiled forward model (setup.py builds it where a C compiler is found); a build of another
+#: version of _cbots.c is not used: its calling convention may differ.
+_cbots = load("armgame.game._cbots", 1)
+_c_predict = None if _cbots is None else _cbots.predict
 
 CONTROL_PERIOD = 0.004
 #: The cost of keys down in a decision, per key (``ReachingBot.act``).

@@ -15,8 +15,10 @@ import math
 import struct
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import asdict, dataclass
+from types import ModuleType
 
 from .. import __version__
+from .._native import load, speaks
 from ..errors import UserError
 from ..limits import MAX_EVENTS
 from ..physics.integrators import _SIXTH, Integrator
@@ -25,11 +27,6 @@ from ..physics.trig import sin_cos
 from ..physics.twojoint import TwoJointArm
 from .muscles import MuscleLevelError, MuscleSet
 from .rules import GameConfig, GameRules
-
-try:  # the compiled loops (setup.py builds them where a C compiler is found)
-    from . import _ckernel
-except ImportError:
-    _ckernel = None
 
 #: The calling convention of ``_ckernel.c`` this package speaks: this module's one game and
 #: ``batch/compiled.py``'s batches. A build of another (a stale ``.so``) is not used.
@@ -40,11 +37,17 @@ KERNEL_PARAMS = 26
 
 def speaks_our_convention(module: object) -> bool:
     """Whether a built ``_ckernel`` is the one this package calls (not a stale build of another)."""
-    return getattr(module, "VERSION", None) == KERNEL_VERSION and getattr(module, "PARAMS", None) == KERNEL_PARAMS
+    return speaks(module, KERNEL_VERSION, PARAMS=KERNEL_PARAMS)
 
 
-if _ckernel is not None and not speaks_our_convention(_ckernel):
-    _ckernel = None
+def compiled_kernel() -> ModuleType | None:
+    """``armgame.game._ckernel`` where built and speaking ``KERNEL_VERSION`` (else None): the one way this
+    game, the batch's wrapper (``batch/compiled.py``) and the benchmark load it."""
+    return load("armgame.game._ckernel", KERNEL_VERSION, PARAMS=KERNEL_PARAMS)
+
+
+#: The compiled loops (setup.py builds them where a C compiler is found), or None: the Python loop runs.
+_ckernel = compiled_kernel()
 _c_game_steps = None if _ckernel is None else _ckernel.game_steps
 _c_rk4_step = None if _ckernel is None else _ckernel.rk4_step
 

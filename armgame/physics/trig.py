@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .._native import load
+
 FloatArray = NDArray[np.float64]
 
 #: Past this |angle| (rad) the result is NaN: the quadrant is read from the low bits of
@@ -84,10 +86,13 @@ def cos_python(x: float) -> float:
     return sin_cos_python(x)[1]
 
 
-try:  # the same operations in C (_trig.h, _ctrig.c): some 0.05 us a call against 0.5 (benchmarks/trig_change.py)
-    from ._ctrig import cos, sin, sin_cos
-except ImportError:
+# The same operations in C (_trig.h, _ctrig.c): some 0.05 us a call against 0.5 (benchmarks/trig_change.py).
+# Its interface (a float in, floats out) has no convention a stale build could misread: no version asked.
+_ctrig = load("armgame.physics._ctrig", None)
+if _ctrig is None:
     sin_cos, sin, cos = sin_cos_python, sin_python, cos_python
+else:
+    sin_cos, sin, cos = _ctrig.sin_cos, _ctrig.sin, _ctrig.cos
 
 
 def sin_array(x: FloatArray, out: FloatArray | None = None) -> FloatArray:

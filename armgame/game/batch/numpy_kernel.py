@@ -33,14 +33,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...physics.trig import cos_array, sin_cos_array
-
-if TYPE_CHECKING:
-    from .session import BatchGameSession
+from .kernel_inputs import KernelInputs
 
 #: A hand this close to a target's edge (relative to radius^2) goes to the exact scalar test.
 NEAR = 1.0 + 1e-6
@@ -65,8 +62,8 @@ class NumpyKernel:
     closures (which allocate).
     """
 
-    def __init__(self, batch: BatchGameSession, m: int) -> None:
-        self.batch, self.m = batch, m
+    def __init__(self, inputs: KernelInputs, m: int) -> None:
+        self.inputs, self.m = inputs, m
         self._bound: tuple[tuple[int, ...], Callable[[], bool]] | None = None
 
     def stepper(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray,
@@ -83,8 +80,8 @@ class NumpyKernel:
 
     def _build(self, x: np.ndarray, act: np.ndarray, goal: np.ndarray, rate: np.ndarray,
                slack: np.ndarray) -> Callable[[], bool]:
-        batch, m = self.batch, self.m
-        model, config = batch.model, batch.config
+        inputs, m = self.inputs, self.m
+        model, config = inputs.model, inputs.config
         p = model.params
         gravity, damping = p.has_gravity, p.has_gravity or p.has_damping
         const = np.array
@@ -116,11 +113,11 @@ class NumpyKernel:
         stages = [(x, (*x, x[2:4], x[4:6]))] + [(s, (*s, s[2:4], s[4:6])) for s in (s2, s3, s4)]
         # Torque rows: (activation row, moment) pairs; a zero moment adds a +0.0 term, kept as one "+ 0.0".
         rows = []
-        for out, moments in ((t1, batch._shoulder), (t2, batch._elbow)):
+        for out, moments in ((t1, inputs.shoulder), (t2, inputs.elbow)):
             terms = [(act[i], const(c)) for i, c in enumerate(moments) if c != 0.0]
             rows.append((out, terms, len(terms) < len(moments)))
-        generic = None if config.integrator == "rk4" else batch._physics_step
-        exact = generic is not None or not batch._rounds or m < batch._series_from
+        generic = None if config.integrator == "rk4" else inputs.physics_step
+        exact = generic is not None or not inputs.fast or m < inputs.series_from
 
         def elbow(q2):
             sin_cos_array(q2, hs, bc)
@@ -138,7 +135,7 @@ class NumpyKernel:
         K4, K3, K2, K1 = (const([[a], [b]]) for a, b in ((1.0 / 40320.0, 1.0 / 362880.0),
                                                           (-1.0 / 720.0, -1.0 / 5040.0),
                                                           (1.0 / 24.0, 1.0 / 120.0), (-0.5, -1.0 / 6.0)))
-        LIMIT2 = batch._series_limit * batch._series_limit
+        LIMIT2 = inputs.series_limit * inputs.series_limit
         REANCHOR = 32
 
         def accel(q1, q2, w1, w2, o1, o2, velocity, out):
@@ -283,7 +280,7 @@ class NumpyKernel:
         """
         step = self.stepper(x, act, goal, rate, slack)
         self.anchor[0] = 0  # the states may have changed since the last run: the fast kernel's trig anew
-        config = self.batch.config
+        config = self.inputs.config
         l1, l2, radius = config.arm.l1, config.arm.l2, config.target_radius
         near = NEAR * radius * radius
         cos, sin, sqrt = math.cos, math.sin, math.sqrt

@@ -18,14 +18,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import chain, repeat
 from operator import attrgetter, eq
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 
 from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, InputEvent
-
-if TYPE_CHECKING:
-    from .session import BatchGameSession
+from .kernel_inputs import KernelInputs
 
 
 class Schedule(NamedTuple):
@@ -65,9 +63,12 @@ def _event_columns(timelines: Sequence[Sequence[InputEvent]], codes: dict[str, i
     return steps, code, down
 
 
-def schedule(batch: BatchGameSession, timelines: Sequence[Sequence[InputEvent]], now: int,
-             limit: list[int]) -> Schedule:
-    """What each timeline does to ``batch`` and when, from step ``now`` to game i's stop ``limit[i]``.
+def schedule(inputs: KernelInputs, held: np.ndarray, total_steps: np.ndarray,
+             timelines: Sequence[Sequence[InputEvent]], now: int, limit: list[int]) -> Schedule:
+    """What each timeline does to a batch and when, from step ``now`` to game i's stop ``limit[i]``.
+
+    The batch: its muscles (``inputs``), the keys each game holds now (``held``, (4, n), muscle by
+    muscle as the batch keeps them) and each game's end (``total_steps``).
 
     The single session's rules (``TimelineInput``, ``GameSession.key_event``), in numpy over all the
     events at once rather than in a loop per event (0.23 s of a class's 1,000 games before):
@@ -80,13 +81,13 @@ def schedule(batch: BatchGameSession, timelines: Sequence[Sequence[InputEvent]],
     * of one muscle's changes at one step the last wins, in the first's place; a reset or tab counts
       when pressed.
     """
-    n = batch.n
-    codes = {RESET_KEY: _RESET, TOGGLE_ARM_KEY: _TOGGLE} | {key: m for m, key in enumerate(batch.muscle_keys)}
+    n = held.shape[1]
+    codes = {RESET_KEY: _RESET, TOGGLE_ARM_KEY: _TOGGLE} | {key: m for m, key in enumerate(inputs.muscle_keys)}
     counts = np.fromiter(map(len, timelines), dtype=np.int64, count=n)
     steps, code, down = _event_columns(timelines, codes)
     game = np.repeat(np.arange(n, dtype=np.int64), counts)
     stop = np.asarray(limit, dtype=np.int64)
-    end = batch.total_steps.astype(np.int64)
+    end = total_steps.astype(np.int64)
     # Past a game's stop: its first such event and all after it (a running count within the game).
     past = np.cumsum(steps > stop[game])
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
@@ -111,7 +112,7 @@ def schedule(batch: BatchGameSession, timelines: Sequence[Sequence[InputEvent]],
     now_down = down[index]
     first = np.ones(len(index), dtype=bool)
     first[1:] = key[1:] != key[:-1]
-    held = batch._held.T.reshape(-1)  # by game * 4 + muscle
+    held = held.T.reshape(-1)  # by game * 4 + muscle
     was_down = np.empty_like(now_down)
     was_down[1:] = now_down[:-1]
     was_down[first] = held[key[first]]
@@ -132,7 +133,7 @@ def schedule(batch: BatchGameSession, timelines: Sequence[Sequence[InputEvent]],
     muscle, games = key[run_start] % 4, key[run_start] // 4
     pressed = now_down[run_end]
     return Schedule(run_clock[run_start], (muscle * n + games).astype(np.intp), pressed.astype(np.float64),
-                    np.where(pressed, batch._rise[muscle], batch._decay[muscle]), specials,
+                    np.where(pressed, inputs.rise[muscle], inputs.decay[muscle]), specials,
                     held_at_end.reshape(n, 4).T.copy())
 
 

@@ -4,7 +4,8 @@ Owns the batch's state (one array per quantity: joint state, activations, target
 input (keys, levels, resets, restarts), the choice of kernel and of when the fast arithmetic may
 run, the hit test and scoring, ``play`` (timelines) and ``replay_many`` (recorded games, in
 batches). The physics steps run in a kernel (``numpy_kernel`` or ``compiled``); timelines become
-commands in ``schedule``.
+commands in ``schedule``. Those read the batch through two values made here once (``kernel_inputs``:
+its fixed numbers and its state arrays), never through this class.
 
 Invariant: each game of a batch equals the single ``GameSession`` fed the same inputs: hits,
 score, resets and steps exactly, and its joint state bit for bit (both kernels: the same operations,
@@ -54,6 +55,7 @@ from ..rules import GameConfig, GameRules, hand_position
 from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
 from .compiled import CompiledKernel
 from .compiled import available as compiled_available
+from .kernel_inputs import BatchArrays, KernelInputs
 from .numpy_kernel import NumpyKernel
 from .schedule import MuscleEvents, schedule
 
@@ -133,14 +135,11 @@ class BatchGameSession:
         self.config = c = configs[0]
         self.n = n = len(configs)
         self.model = TwoJointArm(c.arm)
-        self._physics_step = Integrator(c.integrator, self.model, "numpy").step_components
         muscles = MuscleSet(c.muscles, c.dt)
         self.muscle_keys = muscles.keys
         self.keys = (*muscles.keys, RESET_KEY, TOGGLE_ARM_KEY)
         self._rise = np.array(muscles._rise)
         self._decay = np.array(muscles._decay)
-        self._shoulder = tuple(m[0] for m in muscles.moments)
-        self._elbow = tuple(m[1] for m in muscles.moments)
         self.target_radius = c.target_radius
         self.total_steps = np.array([g.total_steps for g in configs], dtype=np.int64)
         # Rows of the state: q1, q2, w1, w2; rows of the muscle arrays: the four muscles. Rows
@@ -171,18 +170,24 @@ class BatchGameSession:
         self.knife_edge = np.zeros(n, dtype=bool)
         use_compiled = kernel != "numpy" and compiled_available() and c.integrator == "rk4"
         # Whether the kernel may round differently from the single session: the fast stages, which
-        # compiled pay at any batch size, in numpy only from ``_series_from`` games (call overhead).
-        self._series_from = SERIES_MIN_GAMES
-        self._series_limit = SERIES_LIMIT  # the largest elbow increment numpy's fast stages take by series
+        # compiled pay at any batch size, in numpy only from SERIES_MIN_GAMES games (call overhead).
         self._rounds = (not self.exact and c.integrator == "rk4"
                         and int(self.total_steps.max()) * c.dt <= FAST_MAX_SECONDS
-                        and (use_compiled or n >= self._series_from))
+                        and (use_compiled or n >= SERIES_MIN_GAMES))
+        #: What the kernels and the schedule read of this batch (they are handed these, never the batch).
+        self.kernel_inputs = KernelInputs(
+            model=self.model, config=c, shoulder=tuple(m[0] for m in muscles.moments),
+            elbow=tuple(m[1] for m in muscles.moments), muscle_keys=muscles.keys, rise=self._rise,
+            decay=self._decay, physics_step=Integrator(c.integrator, self.model, "numpy").step_components,
+            fast=self._rounds, series_from=SERIES_MIN_GAMES, series_limit=SERIES_LIMIT)
+        self.arrays = BatchArrays(self._xs, self._act, self._goal, self._rate, self._slack, self.target_x,
+                                  self.target_y, self.steps, self._trig)
         self.rules: list[GameRules] = [None] * n  # type: ignore[list-item]
         self._kernels: dict[int, NumpyKernel] = {}
         for i in range(n):
             self._start(i, configs[i])
         #: The compiled kernel where built (and asked for) and the integrator is RK4; else None: numpy.
-        self.compiled = CompiledKernel(self, fast=self._rounds) if use_compiled else None
+        self.compiled = CompiledKernel(self.kernel_inputs, self.arrays, self._hit_test) if use_compiled else None
 
     def _start(self, i: int, config: GameConfig) -> None:
         self.configs[i] = config
@@ -427,7 +432,7 @@ class BatchGameSession:
         if kernel is None:
             if len(self._kernels) > 2:  # keep the full batch's and a few others, not one per size ever seen
                 self._kernels = {k: v for k, v in self._kernels.items() if k == self.n}
-            kernel = self._kernels[m] = NumpyKernel(self, m)
+            kernel = self._kernels[m] = NumpyKernel(self.kernel_inputs, m)
         for k, near in kernel.run(x, act, goal, rate, tx, ty, slack, count):
             for j in near.tolist():
                 i = j if games is None else int(games[j])
@@ -490,10 +495,12 @@ class BatchGameSession:
             raise ValueError("play needs every game of the batch at the same step")
         now = int(self.steps[0])
         limit = [t if s is None else min(int(s), t) for s, t in zip(stops, self.total_steps.tolist(), strict=True)]
-        muscle_steps, flat, goal, rate, specials, held = schedule(self, timelines, now, limit)
+        muscle_steps, flat, goal, rate, specials, held = schedule(self.kernel_inputs, self._held, self.total_steps,
+                                                                  timelines, now, limit)
         limits = np.array(limit, dtype=np.int64)
         if self.compiled is not None:
-            self.compiled.play(MuscleEvents.by_game(self.n, muscle_steps, flat, goal, rate), specials, limits)
+            self.compiled.play(MuscleEvents.by_game(self.n, muscle_steps, flat, goal, rate), specials, limits,
+                               self.key_event)
             self._held[...] = held
             return [self.result(i) for i in range(self.n)]
         # Lockstep: every game's commands by step (stable: a game's order within a step is kept).
