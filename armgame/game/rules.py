@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 from ..errors import UserError
 from ..physics.defaults import GAME_DT, GAME_INTEGRATOR
+from ..physics.hand import hand_xy_arm_sine
 from ..physics.params import GAME_ARM, TwoJointParams
-from ..physics.trig import sin_cos
 from .muscles import DEFAULT_MUSCLES, MuscleSpec
 
 #: The 2012 game's screen (800 x 800 px, shoulder at (400, 600), 500 px/m) in metres.
@@ -72,13 +72,11 @@ class Target:
         return dx * dx + dy * dy <= self.radius * self.radius
 
 
-def hand_position(l1: float, l2: float, q1: float, q2: float) -> tuple[float, float]:
-    """Where the rules see the hand of joint angles (q1, q2): the arm's own sine (``physics.trig``), + and *
-    only, so the browser's engine (``classroom/static/engine.js``) and every loop of this one find the same
-    bits on any machine (the C library's ``math.cos`` differs between systems and from JavaScript's)."""
-    s1, c1 = sin_cos(q1)
-    s12, c12 = sin_cos(q1 + q2)
-    return l1 * c1 + l2 * c12, l1 * s1 + l2 * s12
+#: Where the rules see the hand of joint angles (q1, q2): ``physics.hand.hand_xy_arm_sine``, the arm's own
+#: sine (``physics.trig``), + and * only, so the browser's engine (``classroom/static/engine.js``) and every
+#: loop of this one find the same bits on any machine (the C library's ``math.cos`` differs between systems
+#: and from JavaScript's).
+hand_position = hand_xy_arm_sine
 
 
 @dataclass

@@ -21,6 +21,7 @@ from .. import __version__
 from .._native import load, speaks
 from ..errors import UserError
 from ..limits import MAX_EVENTS
+from ..physics.hand import hand_xy
 from ..physics.integrators import _SIXTH, Integrator
 from ..physics.params import TwoJointParams
 from ..physics.trig import sin_cos
@@ -148,8 +149,7 @@ class GameSession:
 
     def hand(self) -> tuple[float, float]:
         p = self.config.arm
-        q1, q2 = self.state[0], self.state[1]
-        return p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2)
+        return hand_xy(p.l1, p.l2, self.state[0], self.state[1])
 
     def result(self) -> GameResult:
         b, c = self.rules.board, self.config

@@ -30,6 +30,7 @@ from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
 from ..game.rules import GameConfig, Target
 from ..game.session import GameResult, GameSession
 from ..limits import MAX_GAME_SECONDS
+from ..physics.hand import hand_from_trig, hand_xy
 from ..physics.integrators import Integrator
 from ..physics.loads import ChannelField, Loads, loaded_arm
 from .perturbations import Display, display_for, loads_for
@@ -347,7 +348,7 @@ class LabSession(GameSession):
         assert channel is not None
         l1, l2 = self.config.arm.l1, self.config.arm.l2
         s1, c1, s12, c12 = math.sin(q1), math.cos(q1), math.sin(q1 + q2), math.cos(q1 + q2)
-        x, y = l1 * c1 + l2 * c12, l1 * s1 + l2 * s12
+        x, y = hand_from_trig(l1, l2, c1, s1, c12, s12)
         vx = (-l1 * s1 - l2 * s12) * w1 - l2 * s12 * w2
         vy = (l1 * c1 + l2 * c12) * w1 + l2 * c12 * w2
         self._fs.append(-channel.lateral(x, y, vx, vy))
@@ -379,7 +380,6 @@ class LabSession(GameSession):
         dt = self.config.dt
         arm = self.config.arm
         l1, l2 = arm.l1, arm.l2
-        cos, sin = math.cos, math.sin
         muscles = self.muscles
         a0, a1, a2, a3 = muscles.activation
         g0, g1, g2, g3 = muscles.goal
@@ -401,9 +401,7 @@ class LabSession(GameSession):
             q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
             self.steps += 1
             ran += 1
-            s12 = q1 + q2
-            hx = l1 * cos(q1) + l2 * cos(s12)
-            hy = l1 * sin(q1) + l2 * sin(s12)
+            hx, hy = hand_xy(l1, l2, q1, q2)
             if show is not None:
                 hx, hy = show(hx, hy, q1, q2)
             if channel is not None:

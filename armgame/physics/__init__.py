@@ -1,5 +1,6 @@
 """Arm dynamics: pure numpy and math, nothing that draws."""
 
+from .hand import hand_from_trig, hand_xy, hand_xy_arm_sine, hand_xy_arrays
 from .integrators import INTEGRATOR_NAMES, SCHEMES, Integrator, UnknownIntegratorError
 from .onejoint import OneJointArm
 from .params import (
@@ -26,4 +27,8 @@ __all__ = [
     "TwoJointParams",
     "UnknownIntegratorError",
     "UnreachableError",
+    "hand_from_trig",
+    "hand_xy",
+    "hand_xy_arm_sine",
+    "hand_xy_arrays",
 ]

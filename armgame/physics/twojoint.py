@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import UserError
+from .hand import hand_xy_arrays
 from .params import TwoJointParams
 from .trig import cos as trig_cos
 from .trig import cos_array, sin_array, sin_cos, sin_cos_array
@@ -99,10 +100,7 @@ class TwoJointArm:
     def hand(self, q: ArrayLike) -> FloatArray:
         q = np.asarray(q, dtype=float)
         l1, l2 = self.params.l1, self.params.l2
-        q12 = q[..., 0] + q[..., 1]
-        x = l1 * np.cos(q[..., 0]) + l2 * np.cos(q12)
-        y = l1 * np.sin(q[..., 0]) + l2 * np.sin(q12)
-        return np.stack([x, y], axis=-1)
+        return np.stack(hand_xy_arrays(l1, l2, q[..., 0], q[..., 1]), axis=-1)
 
     def jacobian(self, q: ArrayLike) -> FloatArray:
         """d(hand)/dq, shape (..., 2, 2): rows x, y; columns shoulder, elbow."""

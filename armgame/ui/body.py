@@ -23,6 +23,7 @@ from collections.abc import Sequence
 
 import pygame
 
+from ..physics.hand import hand_xy
 from .palette import RGB, Palette
 
 Point = tuple[float, float]
@@ -52,8 +53,7 @@ def _along(origin: Point, direction: Point, normal: Point, a: float, n: float) -
 
 def joints(q1: float, q2: float, l1: float, l2: float) -> tuple[Point, Point, Point]:
     """Shoulder, elbow and hand (m)."""
-    elbow = (l1 * math.cos(q1), l1 * math.sin(q1))
-    return (0.0, 0.0), elbow, (elbow[0] + l2 * math.cos(q1 + q2), elbow[1] + l2 * math.sin(q1 + q2))
+    return (0.0, 0.0), (l1 * math.cos(q1), l1 * math.sin(q1)), hand_xy(l1, l2, q1, q2)
 
 
 def muscle_ends(i: int, q1: float, q2: float, l1: float, l2: float) -> tuple[Point, Point]:

@@ -25,6 +25,7 @@ import pygame
 from ..game.rules import GameConfig
 from ..game.session import DOWN, UP, GameSession, InputEvent, RealTimeDriver
 from ..game.timeline import TimelineDriver
+from ..physics.hand import hand_xy
 from .display import open_window as _open_window
 from .display import toggle_fullscreen
 from .names import TextRenderer
@@ -408,8 +409,7 @@ class GameWindow:
         arm = self.session.config.arm
         q1, q2 = self.session.interpolated_angles(self.alpha)
         now = (self.session.steps - 1 + self.alpha) * self.session.config.dt
-        x = arm.l1 * math.cos(q1) + arm.l2 * math.cos(q1 + q2)
-        y = arm.l1 * math.sin(q1) + arm.l2 * math.sin(q1 + q2)
+        x, y = hand_xy(arm.l1, arm.l2, q1, q2)
         if not self.trail or self.trail[-1][0] < now:
             self.trail.append((now, x, y))
         while self.trail and self.trail[0][0] < now - TRAIL_SECONDS:

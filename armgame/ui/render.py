@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import pygame
 
 from ..game.session import GameSession
+from ..physics.hand import hand_xy
 from ..words import plural
 from .body import blend, draw_arm, draw_torso
 from .palette import PALETTES, RGB, Palette  # PALETTES read from here too: its home until it moved down
@@ -607,8 +608,7 @@ class GameRenderer:
         dirty: list[pygame.Rect] = []
         arm = session.config.arm
         q1, q2 = session.interpolated_angles(alpha)
-        elbow = (arm.l1 * math.cos(q1), arm.l1 * math.sin(q1))
-        hand = (elbow[0] + arm.l2 * math.cos(q1 + q2), elbow[1] + arm.l2 * math.sin(q1 + q2))
+        hand = hand_xy(arm.l1, arm.l2, q1, q2)
         clip = screen.get_clip()
         screen.set_clip(lay.scene)
         if len(hud.trail) > 1:

@@ -36,6 +36,7 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
+from ...physics.hand import hand_xy, hand_xy_arrays
 from ...physics.trig import cos_array, sin_cos_array
 from .kernel_inputs import KernelInputs
 
@@ -283,7 +284,7 @@ class NumpyKernel:
         config = self.inputs.config
         l1, l2, radius = config.arm.l1, config.arm.l2, config.target_radius
         near = NEAR * radius * radius
-        cos, sin, sqrt = math.cos, math.sin, math.sqrt
+        sqrt = math.sqrt
         for k in range(count):
             if step():
                 where = np.flatnonzero(self.near_mask)
@@ -292,8 +293,8 @@ class NumpyKernel:
                     gaps, close_list = [], []
                     for j, a, b, x0, y0 in zip(where.tolist(), angles[0], angles[1], tx[where].tolist(),
                                                ty[where].tolist(), strict=True):
-                        dx = l1 * cos(a) + l2 * cos(a + b) - x0
-                        dy = l1 * sin(a) + l2 * sin(a + b) - y0
+                        hx, hy = hand_xy(l1, l2, a, b)
+                        dx, dy = hx - x0, hy - y0
                         d2 = dx * dx + dy * dy
                         gaps.append(sqrt(d2) - radius - 1e-9)
                         if d2 <= near:
@@ -302,8 +303,8 @@ class NumpyKernel:
                     close = np.array(close_list, dtype=np.intp)
                 else:
                     a, b = x[0, where], x[1, where]
-                    dx = l1 * np.cos(a) + l2 * np.cos(a + b) - tx[where]
-                    dy = l1 * np.sin(a) + l2 * np.sin(a + b) - ty[where]
+                    hx, hy = hand_xy_arrays(l1, l2, a, b)
+                    dx, dy = hx - tx[where], hy - ty[where]
                     d2 = dx * dx + dy * dy
                     slack[where] = np.sqrt(d2) - radius - 1e-9
                     close = where[d2 <= near]

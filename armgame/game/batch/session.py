@@ -48,6 +48,7 @@ import numpy as np
 from ... import __version__
 from ...errors import UserError
 from ...physics.batch import SERIES_LIMIT
+from ...physics.hand import hand_from_trig
 from ...physics.integrators import Integrator
 from ...physics.twojoint import TwoJointArm
 from ..muscles import MuscleLevelError, MuscleSet
@@ -231,7 +232,7 @@ class BatchGameSession:
         """Hand positions (m), x and y, one per game."""
         p = self.config.arm
         c1, s1, c12, s12 = self.hand_trig()
-        return p.l1 * c1 + p.l2 * c12, p.l1 * s1 + p.l2 * s12
+        return hand_from_trig(p.l1, p.l2, c1, s1, c12, s12)
 
     def hand_trig(self) -> np.ndarray:
         """cos q1, sin q1, cos(q1 + q2), sin(q1 + q2) of every game, rows of a (4, n) array (do not write).
