@@ -83,7 +83,7 @@ for i in range({frames}):
     session.advance(4)
     trail = (trail + [session.hand()])[-60:]
     target = session.rules.target
-    hud = Hud(mode='PLAY   seed 10', help=help_, hits=[(target.x, target.y, (i % 60) / 60)], trail=trail)
+    hud = Hud(details=('seed 10',), help=help_, hits=[(target.x, target.y, (i % 60) / 60)], trail=trail)
     t0 = time.perf_counter()
     renderer.draw(screen, session, 0.5, hud)
     t1 = time.perf_counter()

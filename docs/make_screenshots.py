@@ -58,7 +58,7 @@ def game_frame(out: Path) -> Path:
             trail = [*trail[-49:], session.hand()]
     renderer = GameRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles))
     surface = pygame.Surface(DRAW_SIZE)
-    hud = Hud(mode="PLAY", help=("d f j k muscles", "space reset (-1)", "tab hide arm", "p pause", "Esc quit"),
+    hud = Hud(help=("d f j k muscles", "space reset (-1)", "tab hide arm", "p pause", "Esc quit"),
               trail=trail)
     renderer.draw(surface, session, hud=hud)
     return _save(surface, out / "game.png")
@@ -118,7 +118,7 @@ def game_end_frame(out: Path) -> Path:
     standing = Standing(3, 24, top, "the class", note=note,
                         saved="Saved as ann-b-game3.json")
     surface = pygame.Surface(PROJECTOR)
-    renderer.draw(surface, session, hud=Hud(mode="PLAY", ended=True, standing=standing,
+    renderer.draw(surface, session, hud=Hud(ended=True, standing=standing,
                                             end_hint="Enter plays again    Esc quits"))
     path = out / "game_end.png"
     pygame.image.save(surface, str(path))

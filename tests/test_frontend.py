@@ -174,7 +174,7 @@ def test_feedback_sounds_and_trail_leave_the_result_alone():
         sounds = FakeSounds()
         driver = RealTimeDriver(Autopilot(session, make_bot("model")))  # type: ignore[arg-type]
         win = GameWindow(session, screen, clock=FakeClock(), fps=0, driver=driver, sounds=sounds, trail=True,
-                         mode="AUTOPILOT: model", standing=lambda name: None)
+                         driven_by="AUTOPILOT: model", standing=lambda name: None)
         frames = 0
         while not win.ended:
             win.frame(1 / 37)  # an odd frame rate: the physics must not care
@@ -342,7 +342,7 @@ def test_replay_speed_and_skips_match_a_fresh_replay(window):
     Autopilot(played, make_bot("model")).play()
     source = ReplaySource(config, tuple(played.timeline), played.steps, "Ann")
     screen = open_window((1280, 720))
-    win = GameWindow(GameSession(config), screen, clock=FakeClock(), fps=0, replay=source, mode="REPLAY")
+    win = GameWindow(GameSession(config), screen, clock=FakeClock(), fps=0, replay=source, driven_by="REPLAY")
     # The help line names the player and lists exactly the keys that work.
     assert win.help_items() == ("watching Ann's game", "p pause", "-/+ speed", "1 real speed", "left/right 5 s",
                                 "F11 fullscreen", "Esc quit")
@@ -407,20 +407,21 @@ def screens(session, renderer):
                  "p pause", "m mute", "F11 fullscreen", "Esc quit")
     table = Standing(3, 40, tuple((i, "W" * 24, 999) for i in range(1, 11)))
     return {
-        "play": Hud(mode="PLAY   seed 10", help=play_help),
-        "countdown": Hud(mode="PLAY   seed 10", help=play_help, countdown=3),
-        "paused": Hud(mode="PLAY   seed 10", help=play_help, paused=True),
-        "hit": Hud(mode="PLAY   seed 10", help=play_help, hits=[(0.1, 0.6, 0.1)]),
-        "bot": Hud(mode="AUTOPILOT: model", help=("p pause", "m mute", "F11 fullscreen", "Esc quit")),
-        "replay": Hud(mode="REPLAY   Wolfgang Amadeus   2026-11-22 23:59", progress=(12.3, 60.0), speed=0.25,
+        "play": Hud(details=("seed 10",), help=play_help),
+        "countdown": Hud(details=("seed 10",), help=play_help, countdown=3),
+        "paused": Hud(details=("seed 10",), help=play_help, paused=True),
+        "hit": Hud(details=("seed 10",), help=play_help, hits=[(0.1, 0.6, 0.1)]),
+        "bot": Hud(driver="AUTOPILOT: model", help=("p pause", "m mute", "F11 fullscreen", "Esc quit")),
+        "replay": Hud(driver="REPLAY", details=("Wolfgang Amadeus", "2026-11-22 23:59"), progress=(12.3, 60.0),
+                      speed=0.25,
                       help=("p pause", "-/+ speed", "left/right 5 s", "m mute", "F11 fullscreen", "Esc quit")),
-        "name": Hud(mode="PLAY", ended=True, name_entry="W" * 24),
-        "name and table": Hud(mode="PLAY", ended=True, name_entry="W" * 24, end_hint="Enter saves    Esc quits (the "
+        "name": Hud(ended=True, name_entry="W" * 24),
+        "name and table": Hud(ended=True, name_entry="W" * 24, end_hint="Enter saves    Esc quits (the "
                               "game's replay is kept)", standing=Standing(3, 40, table.top, "custom games", True)),
-        "end": Hud(mode="PLAY", ended=True, standing=table),
-        "end, ranked low": Hud(mode="PLAY", ended=True, standing=Standing(
+        "end": Hud(ended=True, standing=table),
+        "end, ranked low": Hud(ended=True, standing=Standing(
             38, 40, (*table.top, (38, "W" * 24, 0)), "the ranked table")),
-        "end, no table": Hud(mode="REPLAY", ended=True),
+        "end, no table": Hud(driver="REPLAY", ended=True),
     }
 
 
@@ -508,7 +509,7 @@ def test_a_view_still_maps_the_world_as_before():
 def test_each_mode_says_what_it_is_and_offers_only_its_keys(window):
     screen = open_window((1280, 720))
     session = GameSession(GameConfig())
-    bot = GameWindow(session, screen, clock=FakeClock(), fps=0, mode="AUTOPILOT: naive",
+    bot = GameWindow(session, screen, clock=FakeClock(), fps=0, driven_by="AUTOPILOT: naive",
                      driver=RealTimeDriver(Autopilot(session, make_bot("naive"))), sounds=FakeSounds())
     assert bot.help_items() == ("p pause", "m mute", "F11 fullscreen", "Esc quit")
     bot.frame(0.0)

@@ -36,7 +36,7 @@ def renderer(palette="okabe-ito", text_scale=1.0):
 def test_the_smallest_text_is_a_fortieth_of_the_window_height(fonts):
     assert min_text(PROJECTOR) == 19 and text_heights(PROJECTOR)[2] >= 19
     session, r = renderer()
-    hud = Hud(mode="PLAY", help=("d/f shoulder", "j/k elbow", "p pause", "Esc quit"))
+    hud = Hud(help=("d/f shoulder", "j/k elbow", "p pause", "Esc quit"))
     lay = r.layout(PROJECTOR, session, hud)
     assert min(lab.height for lab in lay.labels) >= 19
     assert min(lab.rect.height for lab in lay.labels) >= 19
@@ -135,7 +135,7 @@ def test_the_end_screens_long_lines_wrap_whole_inside_the_panel(fonts):
             "game is kept and will be handed in the next time you join")
     session, r = renderer("high-contrast")
     session.play([])
-    hud = Hud(mode="PLAY", ended=True, standing=Standing(None, 0, (), note=note))
+    hud = Hud(ended=True, standing=Standing(None, 0, (), note=note))
     for size in (PROJECTOR, (800, 600)):
         lay = r.layout(size, session, hud)
         lines = sorted((lab for lab in lay.labels if lab.role == "end"), key=lambda lab: lab.rect.top)

@@ -514,7 +514,8 @@ def _play_in_window(session, args: argparse.Namespace, window):
                          driver=_bot_driver(session, args), ask_name=named is None, trail=args.trail,
                          standing=_standing(session, args), next_game=next_game,
                          preview=None if getattr(args, "membership", None) else _preview(session, args),
-                         mode=f"AUTOPILOT: {args.bot}" if args.bot else f"PLAY   seed {args.seed}")
+                         driven_by=f"AUTOPILOT: {args.bot}" if args.bot else None,
+                         details=() if args.bot else (f"seed {args.seed}",))
     args.name = args.name or played.player_name  # the name typed on the end screen
     return played.session
 

@@ -88,7 +88,8 @@ def _watch(replay, args: argparse.Namespace):
     source = ReplaySource(replay.config, replay.timeline, replay.steps, replay.player)
     session, _ = source.start()
     window = play_window(session, settings, path, fullscreen=args.fullscreen, fps=args.fps, replay=source,
-                         trail=args.trail, mode=f"REPLAY   {replay.player or 'no name'}   {when}",
+                         trail=args.trail, driven_by="REPLAY",
+                         details=(replay.player or "no name", when),
                          caption=f"armgame replay - {replay.player or 'a game'}, seed {replay.config.seed}")
     return window.session
 

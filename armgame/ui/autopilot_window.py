@@ -147,7 +147,7 @@ class AutopilotWindow:
             game.driver.clock = game.session.steps * dt
 
     def hud(self, game: Game) -> Hud:
-        return Hud(mode=WHO[game.name], paused=self.paused, ended=game.session.over)
+        return Hud(driver=WHO[game.name], paused=self.paused, ended=game.session.over)
 
     # ----------------------------------------------------------------- frames
     def handle(self, event: pygame.event.Event) -> None:

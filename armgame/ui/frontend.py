@@ -106,10 +106,10 @@ class GameWindow:
     name, returns where the score would stand without entering it, so that rank and table show at
     once (the command passes both in: the window knows nothing of score files). On the end screen,
     Enter saves the name, then Enter again sets ``play_again`` and closes (a replay: watches again).
-    ``mode`` is the label that says what is on screen ("PLAY   seed 10", "AUTOPILOT: model",
-    "REPLAY   Ann   2026-11-22 14:03"); ``countdown`` puts 3-2-1 before the clock (never for a
-    replay); ``sounds`` plays hit, reset, tick, go and end; ``on_mute`` hears the m key (to persist it);
-    ``trail`` keeps the hand's last second for drawing.
+    ``driven_by`` and ``details`` say what is on screen (``Hud``'s ``driver`` and ``details``: None and
+    ("seed 10",) for the player's game, "AUTOPILOT: model", "REPLAY" and ("Ann", "2026-11-22 14:03"));
+    ``countdown`` puts 3-2-1 before the clock (never for a replay); ``sounds`` plays hit, reset, tick, go
+    and end; ``on_mute`` hears the m key (to persist it); ``trail`` keeps the hand's last second for drawing.
     """
 
     def __init__(
@@ -121,7 +121,8 @@ class GameWindow:
         driver: RealTimeDriver | None = None,
         ask_name: bool = False,
         *,
-        mode: str = "PLAY",
+        driven_by: str | None = None,
+        details: Sequence[str] = (),
         countdown: bool = True,
         sounds: SoundPlayer | None = None,
         trail: bool = False,
@@ -146,7 +147,7 @@ class GameWindow:
         self.name_entry: str | None = None
         self.player_name: str | None = None
         self.ask_name = ask_name
-        self.mode = mode
+        self.driven_by, self.details = driven_by, tuple(details)
         self.sounds = sounds
         self.trail_on = trail
         self.standing_of = standing
@@ -383,7 +384,7 @@ class GameWindow:
             self.standing = self.standing.later() or self.standing
         now = self.session.time
         self.hits = [h for h in self.hits if 0.0 <= now - h[2] < PLUS_ONE_TIME]
-        hud = Hud(mode=self.mode, help=self.help_items(), paused=self.paused,
+        hud = Hud(driver=self.driven_by, details=self.details, help=self.help_items(), paused=self.paused,
                   countdown=None if self.countdown_left is None else math.ceil(self.countdown_left),
                   name_entry=self.name_entry, name_limit=NAME_LENGTH, standing=self.standing, ended=self.ended,
                   end_hint=self._end_hint(),
@@ -458,8 +459,9 @@ class NextGame:
 
 def play_window(session: GameSession, settings: Settings, settings_path: Path, *, fullscreen: bool = False,
                 fps: int = 60, driver: RealTimeDriver | None = None, ask_name: bool = False, trail: bool = False,
-                standing: Callable[[str | None], Standing | None] | None = None, mode: str = "PLAY",
-                replay: ReplaySource | None = None, caption: str = CAPTION,
+                standing: Callable[[str | None], Standing | None] | None = None,
+                driven_by: str | None = None, details: Sequence[str] = (), replay: ReplaySource | None = None,
+                caption: str = CAPTION,
                 preview: Callable[[], Standing | None] | None = None,
                 next_game: Callable[[GameWindow], NextGame | None] | None = None) -> GameWindow:
     """Open the window, play until the player quits, close it; returns the last game's window.
@@ -487,7 +489,8 @@ def play_window(session: GameSession, settings: Settings, settings_path: Path, *
         game: NextGame | None = NextGame(session, driver, standing, preview)
         resized = False
         while game is not None:
-            window = GameWindow(game.session, screen, fps=fps, driver=game.driver, ask_name=ask_name, mode=mode,
+            window = GameWindow(game.session, screen, fps=fps, driver=game.driver, ask_name=ask_name,
+                                driven_by=driven_by, details=details,
                                 sounds=sounds, trail=trail, palette=settings.palette, standing=game.standing,
                                 preview=game.preview, on_mute=lambda muted: remember(mute=muted), replay=replay)
             window.renderer.text_scale = settings.text_scale

@@ -257,8 +257,9 @@ class LabWindow(GameWindow):
                  cards: bool | None = None, palette: str = "okabe-ito", text_scale: float = 1.0) -> None:
         if replay is not None and driver is None:
             session, driver = replay.start()
-        super().__init__(session, screen, clock, fps, driver, ask_name=False, mode=mode, countdown=False,
-                         palette=palette)
+        super().__init__(session, screen, clock, fps, driver, ask_name=False, countdown=False, palette=palette)
+        #: What drives the run, as the help line and the cards say it ("LAB": the person at the keys).
+        self.mode = mode
         pygame.display.set_caption(CAPTION)
         self.renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles), palette,
                                     text_scale=text_scale)

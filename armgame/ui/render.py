@@ -128,7 +128,12 @@ class Standing:
 class Hud:
     """What the window wants shown beyond the game itself."""
 
-    mode: str = "PLAY"
+    #: Whose game is shown when it is not the player's at the keys ("AUTOPILOT: model", "REPLAY"): the mode
+    #: line starts with it, and the end screen names it and says "Score", not "Your score". None: the player's
+    #: own game, whose mode line starts "PLAY".
+    driver: str | None = None
+    #: The rest of the mode line ("seed 10"; a replay's player and date), each part kept whole on a line.
+    details: tuple[str, ...] = ()
     help: tuple[str, ...] = ()
     paused: bool = False
     countdown: int | None = None  # 3, 2, 1 before the clock starts
@@ -141,6 +146,11 @@ class Hud:
     speed: float | None = None
     hits: Sequence[tuple[float, float, float]] = ()  # recent hits: x, y (m) and age (s of game time)
     trail: Sequence[tuple[float, float]] = ()  # hand positions (m), oldest first
+
+    @property
+    def mode(self) -> tuple[str, ...]:
+        """The mode line's parts, as shown: "PLAY" or whose game it is, then the details."""
+        return (self.driver or "PLAY", *self.details)
 
 
 @dataclass(frozen=True)
@@ -313,7 +323,7 @@ class GameRenderer:
         if landscape:
             # Wide enough for the mode's words and the clock where the window allows (text sized for a
             # larger window than this one: a half of the autopilot's).
-            needed = max([self.text_size(part, normal)[0] for part in hud.mode.split("   ")] +
+            needed = max([self.text_size(part, normal)[0] for part in hud.mode] +
                          [self.text_size("Time 00.0", big)[0]]) + 2 * pad
             side = min(max(round(w * 0.27), 200, needed), max(480, needed), w - round(h * 0.55))
             hud_area = pygame.Rect(pad, pad, side - 2 * pad, h - 2 * pad)
@@ -327,7 +337,7 @@ class GameRenderer:
         x0, y = hud_area.left, hud_area.top
         # The mode, score and clock.
         # The mode's parts ("REPLAY", the player, the date) share a line where they fit.
-        for line in self.wrap_items(hud.mode.split("   "), normal, hud_area.width, gap):
+        for line in self.wrap_items(hud.mode, normal, hud_area.width, gap):
             labels.append(self.label(line, normal, p.ink, "mode", topleft=(x0, y)))
             y = labels[-1].rect.bottom + gap // 2
         y += gap // 2
@@ -447,10 +457,10 @@ class GameRenderer:
         lay.bars = []
         lay.progress = None
         board = session.rules.board
-        playing = hud.mode.startswith("PLAY")
+        playing = hud.driver is None
         lines: list[tuple[str, int, RGB]] = []
-        if not playing:  # whose game it was: a bot's, a replay's
-            lines.append((hud.mode.split("   ")[0], normal, p.ink))
+        if hud.driver is not None:  # whose game it was: a bot's, a replay's
+            lines.append((hud.driver, normal, p.ink))
         lines += [(f"Your score: {board.score}" if playing else f"Score: {board.score}", big, p.ink),
                   (f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}", normal, p.ink)]
         standing = hud.standing
