@@ -20,6 +20,7 @@ from ..game.bots import BOT_NAMES, Autopilot, make_bot
 from ..game.rules import GameConfig
 from ..game.session import GameSession, RealTimeDriver
 from .display import open_window, toggle_fullscreen
+from .loop import run_loop
 from .playback import MAX_FRAME, PLAYBACK_HELP, REPLAY_SPEEDS, SKIP_SECONDS, skip_sign, speed_after
 from .render import PALETTES, GameRenderer, Hud, Label, text_heights
 
@@ -201,19 +202,16 @@ def run_window(seed: int, duration: float = 60.0, size: tuple[int, int] | None =
     # No size asked: the desktop's own shape (a 4:3 projector gets a 4:3 window, not a 16:9 strip in it).
     screen = open_window(size, fullscreen, "armgame demo: autopilot, model against naive", None)
     window = AutopilotWindow(seed, duration, screen, palette=palette, text_scale=text_scale)
-    limiter = pygame.time.Clock()
-    last = window.clock()
-    frames = 0
+    wanted = [screenshot]
+
+    def shoot() -> None:  # the first frame 20 s into the race
+        if wanted[0] is not None and window.games[0].session.time >= 20.0:
+            pygame.image.save(window.screen, str(wanted[0]))
+            wanted[0] = None
+
     try:
-        while window.running and (max_frames is None or frames < max_frames):
-            now = window.clock()
-            window.frame(now - last)
-            last = now
-            frames += 1
-            if screenshot is not None and window.games[0].session.time >= 20.0:
-                pygame.image.save(window.screen, str(screenshot))
-                screenshot = None
-            limiter.tick(60)
+        run_loop(window.frame, lambda: window.running, fps=60, max_frames=max_frames, clock=window.clock,
+                 after_frame=shoot)
     finally:
         result = window.hits()
         pygame.display.quit()

@@ -33,6 +33,7 @@ import pygame
 
 from ..words import plural
 from .display import open_window, toggle_fullscreen
+from .loop import run_loop
 from .names import TextRenderer
 from .render import PALETTES, RGB, Label, text_heights
 
@@ -583,18 +584,18 @@ def show_class(address: ClassAddress, settings: Settings, fullscreen: bool = Fal
     try:
         screen = open_window(settings.size, fullscreen, f"armgame: the class at {address.label}", DEFAULT_SIZE)
         window = ClassWindow(address.label, screen, poller, settings.palette, settings.text_scale)
-        limiter = pygame.time.Clock()
-        frames = 0
+        wanted = [screenshot]
+
+        def shoot() -> None:  # the first frame with standings on it
+            if wanted[0] is not None and window.standings is not None:
+                pygame.image.save(window.screen, str(wanted[0]))
+                wanted[0] = None
+
         try:
-            while window.running and (max_frames is None or frames < max_frames):
-                window.frame()
-                frames += 1
-                if screenshot is not None and window.standings is not None:
-                    pygame.image.save(window.screen, str(screenshot))
-                    screenshot = None
-                limiter.tick(FPS)
-            if screenshot is not None and window.screen is not None:
-                pygame.image.save(window.screen, str(screenshot))
+            run_loop(lambda _seconds: window.frame(), lambda: window.running, fps=FPS, max_frames=max_frames,
+                     after_frame=shoot)
+            if wanted[0] is not None and window.screen is not None:
+                pygame.image.save(window.screen, str(wanted[0]))
         finally:
             pygame.display.quit()
     finally:

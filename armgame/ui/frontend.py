@@ -28,6 +28,7 @@ from ..game.timeline import TimelineDriver
 from ..physics.hand import hand_xy
 from .display import open_window as _open_window
 from .display import toggle_fullscreen
+from .loop import run_loop
 from .names import TextRenderer
 from .playback import MAX_FRAME, PLAYBACK_HELP, REPLAY_SPEEDS, SKIP_SECONDS, skip_sign, speed_after
 from .render import PLUS_ONE_TIME, Hud, Standing
@@ -434,16 +435,7 @@ class GameWindow:
         pygame.display.flip()
 
     def run(self, max_frames: int | None = None) -> GameSession:
-        limiter = pygame.time.Clock()
-        last = self.clock()
-        frames = 0
-        while self.running and (max_frames is None or frames < max_frames):
-            now = self.clock()
-            self.frame(now - last)
-            last = now
-            frames += 1
-            if self.fps:
-                limiter.tick(self.fps)
+        run_loop(self.frame, lambda: self.running, fps=self.fps, max_frames=max_frames, clock=self.clock)
         return self.session
 
 

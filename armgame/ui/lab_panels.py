@@ -25,16 +25,6 @@ if TYPE_CHECKING:
 Placed = list[tuple[str, pygame.Rect]]
 
 
-def _wrap(renderer: GameRenderer, text: str, height: int, width: int) -> list[str]:
-    lines: list[str] = []
-    for word in text.split():
-        if lines and renderer.text_size(lines[-1] + " " + word, height)[0] <= width:
-            lines[-1] += " " + word
-        else:
-            lines.append(renderer.fit_text(word, height, width))
-    return lines
-
-
 def _blit(renderer: GameRenderer, screen: pygame.Surface, placed: Placed, text: str, height: int, colour: RGB,
           **anchor: tuple[int, int]) -> pygame.Rect:
     surface = renderer.text(text, height, colour)
@@ -59,7 +49,7 @@ def draw_card(renderer: GameRenderer, screen: pygame.Surface, title: str, lines:
     pad = normal
     width = min(w - 2 * small, max(round(w * 0.7), 40 * small))
     inner = width - 2 * pad
-    wrapped = [_wrap(renderer, line, normal, inner) for line in lines]
+    wrapped = [renderer.wrap_text(line, normal, inner, max_lines=None) for line in lines]
     line_h = renderer.font(normal).get_height()
     height = renderer.font(big).get_height() + pad + sum(len(x) * line_h + pad // 3 for x in wrapped) + \
         pad + renderer.font(normal).get_height() + 2 * pad
@@ -195,7 +185,7 @@ def draw_end(renderer: GameRenderer, screen: pygame.Surface, summary: str, curve
               midtop=(w // 2, pad)).bottom + pad // 2
     means = ",   ".join(f"{b.name} {b.mean:+.1f} {curve.unit}" if math.isfinite(b.mean) else f"{b.name} -"
                        for b in curve.blocks)
-    mean_lines = _wrap(renderer, f"Block means: {means}", normal, w - 2 * pad)
+    mean_lines = renderer.wrap_text(f"Block means: {means}", normal, w - 2 * pad, max_lines=None)
     line_h = renderer.font(small).get_height()
     bottom_lines = len(saved) + 1
     bottom = h - pad - bottom_lines * (line_h + pad // 4) - len(mean_lines) * (renderer.font(normal).get_height())

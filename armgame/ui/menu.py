@@ -23,6 +23,7 @@ import pygame
 
 from ..errors import UserError
 from .display import open_window, toggle_fullscreen
+from .loop import run_loop
 from .names import TextRenderer
 from .render import PALETTES, Label, min_text
 
@@ -381,16 +382,12 @@ def run_menu(root: Callable[[], Page], *, palette: str = "okabe-ito", size: tupl
     """Show the menu until it is quit; each started item runs with the menu's window closed, then the
     menu opens again on the same page, saying what the item returned."""
     menu = MenuWindow(root, palette, fullscreen, size, text_scale, looks)
-    limiter = pygame.time.Clock()
     frames = 0
     while menu.running and (max_frames is None or frames < max_frames):
         menu.screen = open_window(menu.windowed_size or size, menu.fullscreen, CAPTION, DEFAULT_SIZE)
         try:
-            while menu.running and menu.pending is None and (max_frames is None or frames < max_frames):
-                menu.frame()
-                frames += 1
-                if fps:
-                    limiter.tick(fps)
+            frames += run_loop(lambda _seconds: menu.frame(), lambda: menu.running and menu.pending is None,
+                               fps=fps, max_frames=None if max_frames is None else max_frames - frames)
         finally:
             if not menu.fullscreen:
                 menu.windowed_size = menu.screen.get_size()

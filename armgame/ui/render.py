@@ -26,6 +26,7 @@ from ..physics.hand import hand_xy
 from ..words import plural
 from .body import blend, draw_arm, draw_torso
 from .palette import PALETTES, RGB, Palette  # PALETTES read from here too: its home until it moved down
+from .text import Label, TextKit  # Label read from here too: its home until the text kit came
 
 #: Smallest text height at 720 lines, in pixels (a projector at the back of a classroom).
 MIN_TEXT_AT_720 = 14
@@ -62,11 +63,6 @@ def text_heights(size: tuple[int, int], text_scale: float = 1.0) -> tuple[int, i
     """Text heights (big, normal, small) for a window of ``size``, times the ``text_scale`` setting."""
     small = round(max(min_text(size), round(18 * min(size) / 720)) * text_scale)
     return round(small * 1.6), round(small * 1.2), small
-
-
-def font_size_for(height: int) -> int:
-    """pygame's default font renders lines about 0.68 times its nominal size high."""
-    return max(1, round(height / 0.68))
 
 
 @dataclass(frozen=True)
@@ -153,15 +149,6 @@ class Hud:
         return (self.driver or "PLAY", *self.details)
 
 
-@dataclass(frozen=True)
-class Label:
-    text: str
-    height: int  # the line height asked for (px); the rect has the font's real one
-    colour: RGB
-    rect: pygame.Rect
-    role: str
-
-
 @dataclass
 class Layout:
     size: tuple[int, int]
@@ -203,8 +190,11 @@ def clock_text(seconds: float) -> str:
     return f"{whole // 60}:{whole % 60:02d}"
 
 
-class GameRenderer:
-    """Lays out and draws frames; fonts, text and the static background are made once and cached."""
+class GameRenderer(TextKit):
+    """Lays out and draws frames; fonts, text and the static background are made once and cached.
+
+    Its text is the windows' text kit (``ui.text.TextKit``, the line-height rule), so the lab's, the
+    autopilot's and the class's windows, which draw through a renderer, measure and wrap as the game does."""
 
     def __init__(self, key_labels: tuple[str, ...], muscle_names: tuple[str, ...],
                  palette: str | Palette = "okabe-ito", text_scale: float = 1.0) -> None:
@@ -213,9 +203,7 @@ class GameRenderer:
         self.text_scale = text_scale
         self.muscle_names = muscle_names
         self.palette = PALETTES[palette] if isinstance(palette, str) else palette
-        self._fonts: dict[int, pygame.font.Font] = {}
-        self._text: dict[tuple[str, int, RGB], pygame.Surface] = {}
-        self._sizes: dict[tuple[str, int], tuple[int, int]] = {}
+        super().__init__()
         self._backgrounds: dict[tuple, pygame.Surface] = {}
         self._veils: dict[tuple[int, int], pygame.Surface] = {}
         #: Where the last frame drew over its background (None: draw the next frame whole).
@@ -227,83 +215,14 @@ class GameRenderer:
         self.text_basis: tuple[int, int] | None = None
 
     # ------------------------------------------------------------------ text
-    def font(self, height: int) -> pygame.font.Font:
-        """pygame's default font at a line height of about ``height`` px (created once per size)."""
-        font = self._fonts.get(height)
-        if font is None:
-            size = font_size_for(height)
-            font = pygame.font.Font(None, size)
-            while font.get_height() < height and size < 4 * height:  # never shorter than asked: the size rules
-                size += 1
-                font = pygame.font.Font(None, size)
-            self._fonts[height] = font
-        return font
-
-    def text(self, string: str, height: int, colour: RGB | None = None) -> pygame.Surface:
-        colour = self.palette.ink if colour is None else colour
-        key = (string, height, colour)
-        surface = self._text.get(key)
-        if surface is None:
-            if len(self._text) > 512:  # the clock makes new strings every frame
-                self._text.clear()
-            surface = self._text[key] = self.font(height).render(string, True, colour)
-        return surface
+    def default_colour(self) -> RGB:
+        return self.palette.ink
 
     def draw_label(self, screen: pygame.Surface, label: Label) -> pygame.Rect:
         """One label, in the default font (``names.TextRenderer`` draws any script)."""
         if label.role == "name":  # changes with every key: not worth caching
             return screen.blit(self.font(label.height).render(label.text, True, label.colour), label.rect)
         return screen.blit(self.text(label.text, label.height, label.colour), label.rect)
-
-    def text_size(self, text: str, height: int) -> tuple[int, int]:
-        """``Font.size``, remembered: a layout measures the same strings frame after frame."""
-        key = (text, height)
-        size = self._sizes.get(key)
-        if size is None:
-            if len(self._sizes) > 2048:
-                self._sizes.clear()
-            size = self._sizes[key] = self.font(height).size(text)
-        return size
-
-    def label(self, text: str, height: int, colour: RGB, role: str, **anchor: object) -> Label:
-        w, h = self.text_size(text, height)
-        rect = pygame.Rect(0, 0, w, h)
-        for name, value in anchor.items():
-            setattr(rect, name, value)
-        return Label(text, height, colour, rect, role)
-
-    def fit_text(self, text: str, height: int, width: int) -> str:
-        """``text`` cut with an ellipsis to ``width`` px (a long name in the table)."""
-        if self.text_size(text, height)[0] <= width:
-            return text
-        while text and self.text_size(text + "...", height)[0] > width:
-            text = text[:-1]
-        return text + "..."
-
-    def wrap_text(self, text: str, height: int, width: int, max_lines: int = 3) -> list[str]:
-        """``text`` on as many lines of ``width`` px as it needs, broken between words, at most ``max_lines`` (the
-        last cut with an ellipsis only if even those do not hold it): a message is read whole, not cut off."""
-        lines: list[str] = []
-        for word in text.split():
-            if lines and self.text_size(lines[-1] + " " + word, height)[0] <= width:
-                lines[-1] += " " + word
-            else:
-                lines.append(word)
-        if len(lines) > max_lines:
-            lines = [*lines[:max_lines - 1], " ".join(lines[max_lines - 1:])]
-        return [self.fit_text(line, height, width) for line in lines]
-
-    def wrap_items(self, items: Sequence[str], height: int, width: int, gap: int) -> list[str]:
-        """Help items on as few lines as fit ``width``; an item is never split."""
-        sep = " " * 4
-        lines: list[str] = []
-        for item in items:
-            item = self.fit_text(item, height, width)
-            if lines and self.text_size(lines[-1] + sep + item, height)[0] <= width:
-                lines[-1] += sep + item
-            else:
-                lines.append(item)
-        return lines
 
     # ---------------------------------------------------------------- layout
     def layout(self, size: tuple[int, int], session: GameSession, hud: Hud | None = None) -> Layout:
