@@ -267,11 +267,21 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
 #: The error-clamp columns, empty on other trials; a table without them (written before they existed)
 #: still reads, with them empty.
 CHANNEL_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ChannelMeasures))
+#: Issue 41's columns: what the player saw of the hand (``feedback``: full, endpoint or none), the trial's
+#: ``disturbance`` in units of the run's first perturbation (+1 it, -1 its opposite, 0 none, a catch or a channel
+#: trial; empty when a run's perturbations share no unit), and a channel trial's index against the reference field
+#: held at the hand and at the joints (``armgame.lab.designs``). A table without them still reads (``feedback`` as
+#: full, the rest empty).
+DESIGN_COLUMNS: tuple[str, ...] = ("feedback", "disturbance", "adaptation_index_hand", "adaptation_index_joint")
 TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time_s",
                                   "movement_time_s", "peak_speed_m_per_s", "initial_direction_error_deg",
-                                  "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS)
+                                  "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS,
+                                  *DESIGN_COLUMNS)
+#: The columns a table may lack (written before they existed), and what each then reads as.
+OPTIONAL_COLUMNS: dict[str, str] = {**dict.fromkeys(CHANNEL_COLUMNS, ""), **dict.fromkeys(DESIGN_COLUMNS, ""),
+                                    "feedback": "full"}
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
-_TEXT_COLUMNS = ("block", "perturbation")
+_TEXT_COLUMNS = ("block", "perturbation", "feedback")
 #: Whose run a row is, in a table of several runs (``armgame analyze A.json B.json --out all.csv``).
 LABEL_COLUMNS: tuple[str, ...] = ("player", "replay")
 _NONNEGATIVE = ("movement_time_s", "peak_speed_m_per_s", "path_length_ratio")
@@ -319,7 +329,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
 
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
     with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``CHANNEL_COLUMNS``
-    may be absent, as in tables written before error-clamp trials existed, and read as NaN;
+    and ``DESIGN_COLUMNS`` may be absent, as in tables written before they existed, and read as NaN (``feedback`` as full);
     ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned; the old names of
     ``RENAMED_COLUMNS``, before each column named its unit, read as the new ones). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a
@@ -344,7 +354,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
         header = [RENAMED_COLUMNS.get(name.strip(), name.strip()) for name in header]
         if len(set(header)) != len(header):
             raise TrialsFileError(f"{path}: line 1: a column is named twice")
-        missing = [name for name in TRIAL_COLUMNS if name not in header and name not in CHANNEL_COLUMNS]
+        missing = [name for name in TRIAL_COLUMNS if name not in header and name not in OPTIONAL_COLUMNS]
         unknown = [name for name in header if name not in TRIAL_COLUMNS and name not in LABEL_COLUMNS]
         if missing or unknown:
             what = f"lacks column(s) {', '.join(missing)}" if missing else f"has unknown column(s) {_show(unknown)}"
@@ -359,7 +369,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
             row: dict[str, object] = {}
             for name in TRIAL_COLUMNS:
                 try:
-                    row[name] = _parse(name, values.get(name, ""))
+                    row[name] = _parse(name, values.get(name, OPTIONAL_COLUMNS.get(name, "")))
                 except ValueError as exc:
                     raise TrialsFileError(f"{path}: line {line}, column {name}: {exc}") from None
             rows.append(row)
