@@ -329,7 +329,8 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
 
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
     with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``CHANNEL_COLUMNS``
-    and ``DESIGN_COLUMNS`` may be absent, as in tables written before they existed, and read as NaN (``feedback`` as full);
+    and ``DESIGN_COLUMNS`` may be absent, as in tables written before they existed, and read as NaN,
+    ``feedback`` as full;
     ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned; the old names of
     ``RENAMED_COLUMNS``, before each column named its unit, read as the new ones). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a
