@@ -344,7 +344,7 @@ class RunKeeper:
 
 
 #: What a run writes in --out (adaptation.png only with channel trials): refused before the run if there.
-OUT_FILES = ("trials.csv", "learning.png", "paths.png", "adaptation.png")
+OUT_FILES = ("trials.csv", "learning.png", "paths.png", "adaptation.png", "frames.png", "generalization.png")
 
 
 def _numbered(path: Path | None, run: int) -> Path | None:

@@ -226,6 +226,9 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
 
             adaptation_figure(rows, out / "adaptation.png")
             written.append(out / "adaptation.png")
+        from .figures_designs import design_figures
+
+        written += design_figures(session, rows, out)
     return written
 
 

@@ -88,14 +88,13 @@ def frame_indices(session: LabSession, outcome: TrialOutcome) -> tuple[float, fl
     return _slope(f, -(v @ b.T) @ n), _slope(f, -hand_force @ n)
 
 
-def frames_summary(session: LabSession, rows: Sequence[Mapping[str, object]], first: int | None = None,
-                   ) -> list[dict[str, object]]:
-    """For each block of channel trials at a posture other than where its reference field was learned (a frames
-    test): the mean hand-frame and joint-frame index over its first ``first`` channel trials (default: a cycle of
-    targets), each less that direction's baseline at that posture (the mean index of the channel trials to that
-    direction at that posture before the field first came on; none: raw), and which frame it reads as."""
+def frames_table(session: LabSession, rows: Sequence[Mapping[str, object]]) -> list[dict[str, object]]:
+    """Every channel trial of a frames test (a block of channel trials at a posture other than where its reference
+    field was learned, after that field first came on): its block, trial number, direction and the hand-frame and
+    joint-frame indices, each less that direction's baseline at that posture (the mean index of the channel trials
+    to that direction at that posture before the field first came on), with ``less_baseline`` saying whether there
+    was one."""
     protocol = session.protocol
-    first = first or protocol.targets
     onset = next((i for i, b in enumerate(protocol.blocks) if not b.perturbation.is_null), len(protocol.blocks))
     base: dict[tuple[tuple[float, float], float], list[tuple[float, float]]] = {}
     for o, r in zip(session.outcomes, rows, strict=True):
@@ -104,32 +103,41 @@ def frames_summary(session: LabSession, rows: Sequence[Mapping[str, object]], fi
             base.setdefault(key, []).append((float(r["adaptation_index_hand"]),  # type: ignore[arg-type]
                                              float(r["adaptation_index_joint"])))  # type: ignore[arg-type]
     offsets = {k: tuple(float(np.mean(c)) for c in zip(*v, strict=True)) for k, v in base.items()}
-    out: list[dict[str, object]] = []
+    tests = set()
     for b, block in enumerate(protocol.blocks):
         reference = protocol.reference_field(b)
-        if not block.channel_trials or reference is None or b < onset:
+        if block.channel_trials and reference is not None and b >= onset \
+                and block.posture_of(protocol) != protocol.field_posture_deg(reference):
+            tests.add(b)
+    out: list[dict[str, object]] = []
+    for o, r in zip(session.outcomes, rows, strict=True):
+        if o.plan.block not in tests or not o.plan.channel:
             continue
-        posture = block.posture_of(protocol)
-        if posture == protocol.field_posture_deg(reference):
-            continue
-        values: list[tuple[float, float]] = []
-        subtracted = True
-        for o, r in zip(session.outcomes, rows, strict=True):
-            if o.plan.block != b or not o.plan.channel:
-                continue
-            hand, joint = float(r["adaptation_index_hand"]), float(r["adaptation_index_joint"])  # type: ignore[arg-type]
-            offset = offsets.get((posture, o.plan.target_deg))
-            if offset is None:
-                subtracted = False
-            else:
-                hand, joint = hand - offset[0], joint - offset[1]
-            values.append((hand, joint))
-        values = [v for v in values[:first] if all(math.isfinite(x) for x in v)]
-        if not values:
-            continue
-        hand, joint = (float(np.mean(c)) for c in zip(*values, strict=True))
-        out.append({"block": block.name, "posture_deg": posture, "trials": len(values), "hand": hand, "joint": joint,
-                    "less_baseline": subtracted, "reads_as": "joint" if joint > hand else "hand"})
+        posture = protocol.blocks[o.plan.block].posture_of(protocol)
+        hand, joint = float(r["adaptation_index_hand"]), float(r["adaptation_index_joint"])  # type: ignore[arg-type]
+        offset = offsets.get((posture, o.plan.target_deg))
+        if offset is not None:
+            hand, joint = hand - offset[0], joint - offset[1]
+        if math.isfinite(hand) and math.isfinite(joint):
+            out.append({"block": o.plan.block_name, "trial": o.plan.index + 1, "target_deg": o.plan.target_deg,
+                        "posture_deg": posture, "hand": hand, "joint": joint, "less_baseline": offset is not None})
+    return out
+
+
+def frames_summary(session: LabSession, rows: Sequence[Mapping[str, object]], first: int | None = None,
+                   ) -> list[dict[str, object]]:
+    """Per frames test block (``frames_table``): the mean hand-frame and joint-frame index over its first ``first``
+    channel trials (default: a cycle of targets), and which frame the run reads as learned in."""
+    first = first or session.protocol.targets
+    table = frames_table(session, rows)
+    out: list[dict[str, object]] = []
+    for name in dict.fromkeys(str(r["block"]) for r in table):
+        mine = [r for r in table if r["block"] == name][:first]
+        hand = float(np.mean([r["hand"] for r in mine]))
+        joint = float(np.mean([r["joint"] for r in mine]))
+        out.append({"block": name, "posture_deg": mine[0]["posture_deg"], "trials": len(mine), "hand": hand,
+                    "joint": joint, "less_baseline": all(r["less_baseline"] for r in mine),
+                    "reads_as": "joint" if joint > hand else "hand"})
     return out
 
 

@@ -308,8 +308,8 @@ def fit_state_space(disturbance: Sequence[float] | np.ndarray, clamped: Sequence
         t2 = np.sum(lf * ex1 - lm * exx1)
         a, b = np.linalg.solve(np.array([[s11, s12], [s12, s22]]), np.array([t1, t2]))
         a, b = float(np.clip(a, 1e-6, 1.0 - 1e-6)), float(np.clip(b, 1e-6, 1.0 - 1e-6))
-        resid = ex1x1 - 2.0 * (a * exx1 + b * (lf * ex1 - lm * exx1)) + a * a * exx + 2.0 * a * b * (lf * ex - lm * exx) \
-            + b * b * (lf * lf - 2.0 * lf * ex + lm * exx)
+        resid = (ex1x1 - 2.0 * (a * exx1 + b * (lf * ex1 - lm * exx1)) + a * a * exx
+                 + 2.0 * a * b * (lf * ex - lm * exx) + b * b * (lf * lf - 2.0 * lf * ex + lm * exx))
         q = max(float(np.mean(resid)), 1e-12)
         fo, mo, vo = f[seen], ex[seen], exx[seen]
         if errors:
