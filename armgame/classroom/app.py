@@ -403,17 +403,18 @@ def _check_code(state: ClassState, request: Request, typed: object) -> None:
 
 
 def _check_secret(state: ClassState, request: Request) -> None:
-    """The teacher's secret, from the Authorization header. The teacher's own machine is never made to wait:
-    a guesser elsewhere cannot lock the teacher out."""
+    """The teacher's routes: the teacher's own machine is the teacher (no secret to type, so none is ever shown
+    where the room can read it; never made to wait); any other machine needs the secret, from the Authorization
+    header, its wrong guesses counted apart."""
     address = _address(request)
-    own = state.guard.is_own(address)
-    if not own:
-        _waiting(state.secrets, address, "secrets")
+    if state.guard.is_own(address):
+        return
+    _waiting(state.secrets, address, "secrets")
     secret = _bearer(request)
     if secret is None or not state.clerk.roster.secret_matches(secret):
-        if not own:
-            state.secrets.failed(address)
-        raise RefusedError(403, "the teacher's secret is needed for this (it is printed in the teacher's terminal)")
+        state.secrets.failed(address)
+        raise RefusedError(403, "the teacher's secret is needed for this on another machine than the teacher's (it "
+                                "is in the file teacher.secret in the class's folder)")
     state.secrets.succeeded(address)
 
 
@@ -476,6 +477,15 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         for problem in await state.run(clerk.load_lab):
             say(f"left out of the class curve: {problem}")
 
+    async def round_clock() -> None:
+        """A round's end is a change no request makes: looked for every second while a round is on, so the
+        projector shows its winners as its clock runs out."""
+        while not state.stopping.is_set():
+            await asyncio.sleep(1.0)
+            if clerk.roster.round is not None and not clerk.round_over:
+                with contextlib.suppress(RefusedError):
+                    await state.run(clerk.round_ended)
+
     @asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
         state.worker = ClerkThread(clerk, state.publish)
@@ -484,12 +494,14 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
             on_ready()
         # The lab runs already in the folder are checked again in the background: the page is up at once.
         loading = asyncio.ensure_future(load_lab())
+        ticking = asyncio.ensure_future(round_clock())
         try:
             yield
         finally:
             state.stopping.set()
             state.changed.set()
             loading.cancel()
+            ticking.cancel()
             state.worker.stop()  # a hand-in being written is finished, never cut
 
     async def home(request: Request) -> Response:
@@ -626,6 +638,15 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         message = await state.run(lambda: clerk.choose_lab(body.get("protocol")))
         return _json({"ok": True, "message": message})
 
+    async def teacher_round(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        if body.get("stop") is True:
+            message = await state.run(clerk.stop_round)
+        else:
+            message = await state.run(lambda: clerk.start_round(body.get("minutes")))
+        return _json({"ok": True, "message": message})
+
     async def teacher_standings(request: Request) -> Response:
         _check_secret(state, request)
         return _json(await state.run(lambda: clerk.standings(teacher=True)))
@@ -661,6 +682,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/teacher/close", _refusals(teacher_close), methods=["POST"]),
         Route("/api/teacher/lock", _refusals(teacher_lock), methods=["POST"]),
         Route("/api/teacher/lab", _refusals(teacher_lab), methods=["POST"]),
+        Route("/api/teacher/round", _refusals(teacher_round), methods=["POST"]),
         Route("/api/teacher/standings", _refusals(teacher_standings)),
         Route("/api/teacher/roster", _refusals(teacher_roster)),
         Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),
