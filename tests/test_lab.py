@@ -63,6 +63,8 @@ def test_presets_round_trip_through_plain_data(name):
     if name in ("savings", "spontaneous", "generalization"):
         assert p.blocks[1].perturbation == Perturbation.make("curl", b=CURL_B)
         return
+    if name in ("frames", "rotation-generalization", "random-fields"):  # issue 41's: tests/test_lab_designs.py
+        return
     assert [b.name for b in p.blocks] == ["baseline", "exposure", "washout"]
     assert p.blocks[1].perturbation.kind == {"null": "none", "lesson": "curl"}.get(name, name)
 

@@ -307,7 +307,7 @@ def _json(data: object, status: int = 200, headers: dict[str, str] | None = None
 
 def _refusal(exc: RefusedError) -> Response:
     headers = {"Retry-After": str(getattr(exc, "retry_after", 2))} if exc.status in (429, 503) else {}
-    if exc.status in (400, 401, 403, 408, 413, 415, 429):  # a body may be left unread: the connection is not used again
+    if exc.status in (400, 401, 403, 408, 413, 415, 429, 503):  # a body may be left unread: the connection ends
         headers["Connection"] = "close"
     return _json({"ok": False, "error": exc.message}, exc.status, headers)
 

@@ -48,11 +48,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-figures", action="store_true",
                    help="with --class or --fit: no figures (--class draws its figure only where matplotlib is "
                    "installed, and says so otherwise)")
-    p.add_argument("--fit", choices=("two-rate", "one-rate", "both"),
+    p.add_argument("--fit", choices=("two-rate", "one-rate", "both", "trial-by-trial", "state-space"),
                    help="fit a learner to each replay's per-trial errors by maximum likelihood (Gaussian noise): "
                    "two-rate (A_f, A_s, B_f, B_s), one-rate (A, B), or both, compared by AIC, BIC and the likelihood "
                    "ratio; the values with 95%% profile-likelihood intervals, the residual, the log-likelihood, and "
-                   "NAME.fit.json and NAME.fit.png (the fit over the data) next to --out, if given")
+                   "NAME.fit.json and NAME.fit.png (the fit over the data) next to --out, if given; trial-by-trial: "
+                   "the generalization function over direction from trial-to-trial changes (Donchin et al. 2003); "
+                   "state-space: one state with process and output noise, by EM (Cheng & Sabes 2006)")
     p.add_argument("--fit-on", choices=("error", "index"), default="error",
                    help="with --fit: the errors of the reaches that are not channel trials (default; the measure "
                    "the learning figure plots), or the adaptation index of the channel trials")
@@ -266,6 +268,8 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
     from ..lab.fit import compare, fit_learner
 
     metric = figure_metric(session.protocol) if on == "error" else "adaptation_index"
+    if model in ("trial-by-trial", "state-space"):
+        return _design_fit(session, rows, on, beside, path, player, figures, model, metric)
     comparison = None
     try:
         disturbance, clamped = fit_schedule(session)
@@ -331,6 +335,63 @@ def class_of(folder: Path):
     if folder.name == LAB_DIR and (folder.parent / ROSTER_NAME).is_file():
         return folder.parent, folder
     return None, folder
+
+
+def _design_fit(session, rows, on: str, beside: Path | None, path: Path, player: str | None, figures: bool,
+                model: str, metric: str) -> list[Path]:
+    """Issue 41's fits (``armgame.lab.trialfit``) of one verified run, printed and, with ``beside``, kept as
+    ``NAME.fit.json`` (and ``NAME.fit.png``: the generalization function, or the fit over the data)."""
+    from ..lab.analysis import fit_schedule
+    from ..lab.trialfit import fit_generalization, fit_state_space
+
+    if model == "trial-by-trial" and on != "error":
+        raise UserError("--fit trial-by-trial fits the reaches' errors (--fit-on error)")
+    try:
+        disturbance, clamped = fit_schedule(session)
+        observed = [float(r[metric]) for r in rows]
+        if model == "trial-by-trial":
+            fit = fit_generalization([o.plan.target for o in session.outcomes], session.protocol.targets,
+                                     disturbance, observed, clamped)
+        else:
+            fit = fit_state_space(disturbance, clamped, observed, on)
+    except ValueError as exc:
+        raise UserError(f"cannot fit the {model} model to its {metric}: {exc}") from None
+    unit = metric.rsplit("_", 1)[1] if metric != "adaptation_index" else ""
+    shown, scale = ("cm", 100.0) if unit == "m" else (unit, 1.0)
+    how = "profile likelihood" if model == "trial-by-trial" else "Wald, observed information"
+    print(f"  {model} fit to {metric} ({fit.n} trials), 95% intervals by {how}:")
+    for line in fit.lines(shown, scale):
+        print(line)
+    if beside is None:
+        return []
+    import json
+
+    from ..lab.metrics import check_regular_target
+    from ..records.storage import atomic_write_bytes
+
+    try:
+        beside.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the output folder {beside}: {exc.strerror or exc}") from None
+    kept = beside / f"{path.stem}.fit.json"
+    check_regular_target(kept)
+    record = {"replay": str(path), "player": player or "", "protocol": session.protocol.name,
+              "seed": session.config.seed, "measure": metric, **fit.as_dict(unit)}
+    try:
+        atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
+    except (OSError, ValueError) as exc:
+        raise UserError(f"cannot write {kept}: {exc}") from None
+    written = [kept]
+    if figures:
+        from ..lab.figures_designs import generalization_fit_figure, state_space_figure
+
+        figure = beside / f"{path.stem}.fit.png"
+        if model == "trial-by-trial":
+            generalization_fit_figure(fit, figure, shown, scale)
+        else:
+            state_space_figure(rows, fit, figure, metric)
+        written.append(figure)
+    return written
 
 
 def _class(args: argparse.Namespace) -> int:

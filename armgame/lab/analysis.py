@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -36,15 +36,20 @@ def channel_of(session: LabSession, outcome: TrialOutcome) -> ChannelMeasures:
     ``Protocol.reference_field`` names for its block."""
     if not outcome.plan.channel:
         return NO_CHANNEL
-    hx, hy = session.home
+    hx, hy = outcome.plan.home
     tx, ty = outcome.plan.position
     length = math.hypot(tx - hx, ty - hy)
     reference = session.protocol.reference_field(outcome.plan.block)
     n = outcome.reach_samples  # the channel's samples are the path's: none after the hand was sent home
-    return channel_measures(np.asarray(outcome.channel_force[:n]),
-                            np.column_stack([outcome.vxs[:n], outcome.vys[:n]]).reshape(-1, 2),
-                            (-(ty - hy) / length, (tx - hx) / length),
-                            None if reference is None else reference.matrix)
+    measures = channel_measures(np.asarray(outcome.channel_force[:n]),
+                                np.column_stack([outcome.vxs[:n], outcome.vys[:n]]).reshape(-1, 2),
+                                (-(ty - hy) / length, (tx - hx) / length),
+                                None if reference is None else reference.matrix)
+    if reference is not None and reference.kind == "joint_viscous":  # its index: against the field at the joints
+        from .designs import frame_indices
+
+        measures = replace(measures, adaptation_index=frame_indices(session, outcome)[1])
+    return measures
 
 
 def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
@@ -53,18 +58,26 @@ def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
     dt = session.config.dt
     n = outcome.reach_samples
     t = (outcome.go_step + np.arange(n)) * dt
-    return Reach(t=t, hand=np.column_stack([outcome.xs[:n], outcome.ys[:n]]).reshape(-1, 2), start=session.home,
+    return Reach(t=t, hand=np.column_stack([outcome.xs[:n], outcome.ys[:n]]).reshape(-1, 2), start=outcome.plan.home,
                  target=outcome.plan.position, go_time=outcome.go_step * dt, hit=outcome.hit)
 
 
 def trial_rows(session: LabSession) -> list[dict[str, object]]:
     """One row per finished trial, with the columns of ``metrics.TRIAL_COLUMNS``."""
-    return [trial_row(session, o) for o in session.outcomes]
+    try:
+        disturbance = fit_schedule(session)[0].tolist()
+    except ValueError:  # no perturbation, or ones that are not multiples of one another: no one unit
+        disturbance = [math.nan] * len(session.outcomes)
+    return [trial_row(session, o, d) for o, d in zip(session.outcomes, disturbance, strict=True)]
 
 
-def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
-    """One finished trial's row, with the columns of ``metrics.TRIAL_COLUMNS``."""
+def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.nan) -> dict[str, object]:
+    """One finished trial's row, with the columns of ``metrics.TRIAL_COLUMNS`` (``disturbance``: the trial's, in
+    units of the run's first perturbation, ``disturbance_schedule``; NaN when not given)."""
+    from .designs import frame_indices
+
     m = reach_metrics(reach_of(session, o))
+    hand, joint = frame_indices(session, o)
     return {
         "block": o.plan.block_name,
         "trial": o.plan.index + 1,
@@ -79,6 +92,10 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
         "hit": o.hit,
         **channel_of(session, o).as_dict(),
         "hand_sent_home": o.home_at is not None,
+        "feedback": o.plan.feedback,
+        "disturbance": disturbance,
+        "adaptation_index_hand": hand,
+        "adaptation_index_joint": joint,
     }
 
 
@@ -165,6 +182,11 @@ def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndar
             along = float(np.sum(b * r)) / float(np.sum(r * r))
             if np.allclose(b, along * r):
                 return along
+        elif p.kind == reference.kind == "joint_viscous":
+            w, r = np.asarray(p.joint_matrix), np.asarray(reference.joint_matrix)
+            along = float(np.sum(w * r)) / float(np.sum(r * r))
+            if np.allclose(w, along * r):
+                return along
         elif p.kind == reference.kind == "rotation":
             return p["angle"] / reference["angle"]
         elif p == reference:
@@ -209,6 +231,9 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
 
             adaptation_figure(rows, out / "adaptation.png")
             written.append(out / "adaptation.png")
+        from .figures_designs import design_figures
+
+        written += design_figures(session, rows, out)
     return written
 
 
@@ -374,17 +399,26 @@ def channel_traces(session: LabSession) -> list[tuple[object, ...]]:
     regressor; NaN with no reference field) and the hand's speed."""
     out: list[tuple[object, ...]] = []
     dt = session.config.dt
-    hx, hy = session.home
     for o in session.outcomes:
         if not o.plan.channel:
             continue
+        hx, hy = o.plan.home
         tx, ty = o.plan.position
         length = math.hypot(tx - hx, ty - hy)
         normal = np.array([-(ty - hy) / length, (tx - hx) / length])
         v = np.column_stack([o.vxs, o.vys]) if o.vxs else np.zeros((0, 2))
         reference = session.protocol.reference_field(o.plan.block)
-        cancel = -(v @ np.asarray(reference.matrix).T) @ normal if reference is not None \
-            else np.full(len(v), math.nan)
+        if reference is not None and reference.kind == "joint_viscous":  # held at the joints: at each sample's q
+            from .designs import candidate_fields, jacobian
+
+            arm = session.config.arm
+            w = candidate_fields(session.protocol, reference, arm.l1, arm.l2)[1]
+            jac = jacobian(arm.l1, arm.l2, np.asarray(o.q1s), np.asarray(o.q2s))
+            torque = np.linalg.solve(jac, v[..., None])[..., 0] @ w.T
+            cancel = -np.linalg.solve(np.swapaxes(jac, -1, -2), torque[..., None])[..., 0] @ normal
+        else:
+            cancel = -(v @ np.asarray(reference.matrix).T) @ normal if reference is not None \
+                else np.full(len(v), math.nan)
         speed = np.hypot(v[:, 0], v[:, 1])
         for k, force in enumerate(o.channel_force[:o.reach_samples]):  # not past the hand sent home
             out.append((o.plan.index + 1, o.plan.block_name, o.plan.target_deg, k * dt, force, float(cancel[k]),

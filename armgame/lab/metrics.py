@@ -271,15 +271,22 @@ CHANNEL_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ChannelMeasures)
 #: only, and the class curve leaves the trial out (an abandoned reach is not one of the experiment's). A table
 #: written before the column existed still reads, with it 0.
 HAND_SENT_HOME = "hand_sent_home"
+#: Issue 41's columns: what the player saw of the hand (``feedback``: full, endpoint or none), the trial's
+#: ``disturbance`` in units of the run's first perturbation (+1 it, -1 its opposite, 0 none, a catch or a channel
+#: trial; empty when a run's perturbations share no unit), and a channel trial's index against the reference field
+#: held at the hand and at the joints (``armgame.lab.designs``). A table without them still reads (``feedback`` as
+#: full, the rest empty).
+DESIGN_COLUMNS: tuple[str, ...] = ("feedback", "disturbance", "adaptation_index_hand", "adaptation_index_joint")
 TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time_s",
                                   "movement_time_s", "peak_speed_m_per_s", "initial_direction_error_deg",
                                   "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS,
-                                  HAND_SENT_HOME)
+                                  HAND_SENT_HOME, *DESIGN_COLUMNS)
 #: Columns a table may lack (written before they existed), and what each then reads as.
-LATER_COLUMNS: dict[str, object] = {**dict.fromkeys(CHANNEL_COLUMNS, NAN), HAND_SENT_HOME: False}
+LATER_COLUMNS: dict[str, object] = {**dict.fromkeys(CHANNEL_COLUMNS, NAN), HAND_SENT_HOME: False,
+                                    **dict.fromkeys(DESIGN_COLUMNS, NAN), "feedback": "full"}
 _FLAGS = ("hit", HAND_SENT_HOME)
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
-_TEXT_COLUMNS = ("block", "perturbation")
+_TEXT_COLUMNS = ("block", "perturbation", "feedback")
 #: Whose run a row is, in a table of several runs (``armgame analyze A.json B.json --out all.csv``).
 LABEL_COLUMNS: tuple[str, ...] = ("player", "replay")
 _NONNEGATIVE = ("movement_time_s", "peak_speed_m_per_s", "path_length_ratio")
@@ -328,8 +335,8 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
 
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
     with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``LATER_COLUMNS``
-    may be absent, as in tables written before they existed: the ``CHANNEL_COLUMNS`` read as NaN,
-    ``hand_sent_home`` as False;
+    may be absent, as in tables written before they existed: the ``CHANNEL_COLUMNS`` and the
+    ``DESIGN_COLUMNS`` read as NaN, ``feedback`` as full, ``hand_sent_home`` as False;
     ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned; the old names of
     ``RENAMED_COLUMNS``, before each column named its unit, read as the new ones). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a

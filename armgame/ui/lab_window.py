@@ -85,8 +85,8 @@ class LabRenderer(GameRenderer):
     #: What drives the run: "LAB" (a person at the keys), "AUTOPILOT: NAME", "REPLAY", or "" (a program).
     mode = "LAB"
 
-    def view(self, size: tuple[int, int], session: LabSession) -> Viewport:
-        hx, hy = session.home
+    def view(self, size: tuple[int, int], session: LabSession, home: tuple[float, float] | None = None) -> Viewport:
+        hx, hy = session.home if home is None else home
         span = max(0.08, 1.45 * session.protocol.distance)
         return Viewport.fit(size, (hx - span, hx + span, hy - span, hy + 1.35 * span))
 
@@ -95,10 +95,12 @@ class LabRenderer(GameRenderer):
         hud = hud or Hud()
         lab = hud if isinstance(hud, LabHud) else None
         p = self.palette
-        view = self.view(screen.get_size(), session)
+        # A reach's path is shown in its own workspace, though the next trial's block may start at another posture.
+        shown = lab.feedback.outcome.plan.home if lab is not None and lab.feedback is not None else session.home
+        view = self.view(screen.get_size(), session, shown)
         line = max(3, round(min(screen.get_size()) / 240))
         screen.fill(p.scene)
-        for x, y in target_positions(session.protocol, session.home):
+        for x, y in target_positions(session.protocol, shown):
             pygame.draw.circle(screen, p.edge, view.to_screen(x, y), view.length(session.protocol.target_radius), line)
         home = session.home_target
         holding = session.phase == HOLD and not session.over
@@ -110,7 +112,7 @@ class LabRenderer(GameRenderer):
         elif not holding and not session.over:
             target = session.rules.target
             pygame.draw.circle(screen, p.target, view.to_screen(target.x, target.y), view.length(target.radius))
-        if feedback is None:
+        if feedback is None and session.cursor_visible:  # a trial without vision hides it from the go cue on
             pygame.draw.circle(screen, CURSOR, view.to_screen(*session.cursor), view.length(0.006))
         self._hud(screen, session, hud)
         if lab is not None and lab.curve is not None:
@@ -172,7 +174,10 @@ class LabRenderer(GameRenderer):
             screen.blit(self.text(self.fit_text(block.instruction, normal, screen.get_width() - 2 * margin), normal),
                         (margin, y))
             y += normal + small // 3
-        if feedback is not None:
+        if feedback is not None and feedback.outcome.plan.feedback == "none":
+            screen.blit(self.text(self.fit_text(feedback.words, big, screen.get_width() - 2 * margin), big,
+                                  p.faint), (margin, y))
+        elif feedback is not None:
             verdict = "hit" if feedback.outcome.hit else "time out"
             screen.blit(self.text(self.fit_text(f"{verdict}: {feedback.words}", big, screen.get_width() - 2 * margin),
                                   big, HIT if feedback.outcome.hit else p.warn), (margin, y))
@@ -444,7 +449,9 @@ class LabWindow(GameWindow):
             return
         self.seen = len(s.outcomes)
         last = s.outcomes[-1]
-        self.feedback = Feedback(last, result_words(s, last), at_time=last.end_step * s.config.dt)
+        # Knowledge of results only as the trial gives it: none on a trial without vision (issue 41).
+        words = "reach done" if last.plan.feedback == "none" else result_words(s, last)
+        self.feedback = Feedback(last, words, at_time=last.end_step * s.config.dt)
         if not self.watching:
             self._stop_the_clock()
 
