@@ -300,8 +300,7 @@ class LabSession(GameSession):
         if (q1, q2) == tuple(self.home_q):
             return self.home, self.home_q
         p = self.config.arm
-        return (p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2)), \
-            (q1, q2)
+        return hand_xy(p.l1, p.l2, q1, q2), (q1, q2)
 
     # ------------------------------------------------------------------ queries
     @property
