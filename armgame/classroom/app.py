@@ -29,9 +29,9 @@ import sys
 import threading
 import time
 from collections import OrderedDict, deque
-from collections.abc import AsyncIterator, Callable
+from collections.abc import AsyncIterator, Callable, Iterator
 from concurrent.futures import Future
-from contextlib import asynccontextmanager
+from contextlib import asynccontextmanager, contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,11 +42,25 @@ from starlette.routing import Route
 
 from ..errors import UserError
 from . import page
-from .intake import MAX_HANDIN_BYTES, Clerk, RefusedError
+from .intake import CLOSED, MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
+from .roster import token_digest
 
-QUEUE_LIMIT = 64
-#: Hand-ins entered with one table write at the most.
-BATCH = 32
+#: Jobs and hand-ins waiting for the clerk at once. A hand-in verified in a batch costs about 1.5 ms of the
+#: clerk's time, so a full queue is a second and a half of work: room for a lecture hall's round's end
+#: (``benchmarks/class_server.py``) where 64 sent nine in ten students away for 2 s, again and again.
+QUEUE_LIMIT = 1024
+#: The bodies those waiting hand-ins hold, in bytes at the most (a bot's game is 0.5 MB, a student's 9 KB).
+QUEUE_BYTES = 64 * 1024 * 1024
+#: Hand-ins of one player (one token) waiting at once: a client that floods the class has one in the queue,
+#: and its next is told the class is busy before its body is read, so a flooder's backlog never sits in
+#: front of an honest student's game.
+TOKEN_SHARE = 1
+#: Hand-ins checked, re-simulated (one batch) and entered (one table write) together at the most.
+BATCH = 64
+#: Seconds a hand-in waits for one of the ``UPLOADS`` slots before it is told the class is busy.
+UPLOAD_WAIT = 5.0
+#: What a student is told when the class cannot take their game yet (their client hands it in again).
+BUSY = "the class is busy: your game is kept and will be handed in in a moment"
 UPLOADS = 8
 BODY_SECONDS = 30.0
 MAX_JSON_BYTES = 4096
@@ -96,6 +110,9 @@ class ClerkThread:
 
     def __init__(self, clerk: Clerk, after: Callable[[], None]) -> None:
         self.clerk, self.after = clerk, after
+        #: The joined players' token digests, rebuilt on this thread after every job (a join, a name released)
+        #: and read by the event loop: a hand-in from a token that is no player's is refused before its body.
+        self.tokens: frozenset[str] = self._tokens()
         self.jobs: queue.SimpleQueue[tuple[str, Any, Future | None]] = queue.SimpleQueue()
         self.thread = threading.Thread(target=self._serve, name="armgame-clerk", daemon=True)
         self.thread.start()
@@ -120,6 +137,7 @@ class ClerkThread:
                 return
             if job[0] == "job":
                 outcomes = [(job[2], _outcome(job[1]))]
+                self.tokens = self._tokens()  # before the answer: a machine that just joined hands in next
             else:
                 batch = [job]
                 while len(batch) < BATCH:  # what arrived meanwhile goes in the same write
@@ -142,12 +160,18 @@ class ClerkThread:
                 else:
                     future.set_result(outcome)
 
+    def _tokens(self) -> frozenset[str]:
+        return frozenset(p.token_sha256 for p in self.clerk.roster.players.values())
+
     def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
-        """Each hand-in's answer (or the exception to raise in its request), in the batch's order."""
+        """Each hand-in's answer (or the exception to raise in its request), in the batch's order: the batch
+        checked together (``Clerk.check_many``: its games re-simulated in one batch), then entered together."""
         outcomes: list[tuple[Future, Any]] = []
         checked = []
-        for _, (token, body), future in batch:
-            found = _outcome(lambda token=token, body=body: self.clerk.check(token, body))
+        found_all = _outcome(lambda: self.clerk.check_many([work for _, work, _ in batch]))
+        if isinstance(found_all, BaseException):
+            found_all = [found_all] * len(batch)
+        for (_, _, future), found in zip(batch, found_all, strict=True):
             if isinstance(found, BaseException | dict):
                 outcomes.append((future, found))
             else:
@@ -179,6 +203,9 @@ class ClassState:
     join_line: str
     worker: ClerkThread | None = None
     waiting: int = 0
+    #: Hand-ins waiting (their bodies being read or queued) by token digest, and the bytes queued.
+    shares: dict[str, int] = field(default_factory=dict)
+    queued_bytes: int = 0
     failures: Failures = field(default_factory=Failures)
     uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(UPLOADS))
     streams: int = 0
@@ -202,17 +229,43 @@ class ClassState:
 
     async def run(self, job: Callable[[], Any], kind: str = "job") -> Any:
         """``job`` on the clerk's thread (or, for "hand-in", ``job`` is (token, body)), if the queue has
-        room; the pages are told of any change."""
-        if self.waiting >= QUEUE_LIMIT:
-            raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
+        room (``QUEUE_LIMIT`` jobs, ``QUEUE_BYTES`` of bodies); the pages are told of any change."""
+        size = len(job[1]) if kind == "hand-in" else 0  # type: ignore[index]
+        if self.waiting >= QUEUE_LIMIT or (size and self.queued_bytes + size > QUEUE_BYTES):
+            raise RefusedError(503, BUSY)
         assert self.worker is not None, "the class is not serving"
         self.waiting += 1
+        self.queued_bytes += size
         try:
             return await asyncio.wrap_future(self.worker.submit(kind, job))
         finally:
             self.waiting -= 1
+            self.queued_bytes -= size
             self.changed.set()
             self.changed = asyncio.Event()
+
+    @contextmanager
+    def hand_in_share(self, token: str | None) -> Iterator[None]:
+        """A hand-in's place, taken before its body is read, with the refusals that cost nothing: a token that
+        is no player's (401), a closed class (403), a player who already has ``TOKEN_SHARE`` hand-ins waiting
+        (503: the client hands it in again in a moment). The clerk checks the token and the class again: a
+        name may be released meanwhile."""
+        assert self.worker is not None, "the class is not serving"
+        digest = token_digest(token) if token else None
+        if digest is None or digest not in self.worker.tokens:
+            raise RefusedError(401, NOT_JOINED)
+        if self.clerk.roster.closed:
+            raise RefusedError(403, CLOSED)
+        if self.shares.get(digest, 0) >= TOKEN_SHARE:
+            raise RefusedError(503, BUSY)
+        self.shares[digest] = self.shares.get(digest, 0) + 1
+        try:
+            yield
+        finally:
+            if self.shares[digest] <= 1:
+                del self.shares[digest]
+            else:
+                self.shares[digest] -= 1
 
 
 def _json(data: object, status: int = 200, headers: dict[str, str] | None = None) -> Response:
@@ -387,11 +440,17 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
     async def hand_in(request: Request) -> Response:
         _check_code(state, request, request.headers.get("x-armgame-code"))
         token = _bearer(request)
-        if state.uploads.locked():
-            raise RefusedError(503, "the class is busy: your machine will hand the game in again in a moment")
-        async with state.uploads:
-            data = await _body(request, MAX_HANDIN_BYTES)
-        return _json(await state.run((token, data), "hand-in"))
+        with state.hand_in_share(token):  # before the body is read: a flooder's next hand-in costs nothing
+            try:
+                async with asyncio.timeout(UPLOAD_WAIT):
+                    await state.uploads.acquire()
+            except TimeoutError:
+                raise RefusedError(503, BUSY) from None
+            try:
+                data = await _body(request, MAX_HANDIN_BYTES)
+            finally:
+                state.uploads.release()
+            return _json(await state.run((token, data), "hand-in"))
 
     async def teacher_hide(request: Request) -> Response:
         _check_secret(state, request)

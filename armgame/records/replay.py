@@ -19,6 +19,7 @@ this layer stays below the lab. The commands that read replays import the lab fi
 
 from __future__ import annotations
 
+import json
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields, replace
@@ -413,7 +414,26 @@ class Replay:
         } | ({} if self.task is None else {"task": self.task.as_dict()})
 
     def to_bytes(self) -> bytes:
-        return dump_json(self.as_dict())
+        """The replay's file: ``dump_json(self.as_dict())``, byte for byte. The timeline (nearly all of a game's
+        bytes) is written here rather than by ``json``'s indenting encoder, which is pure Python and took 1.7 ms
+        of a class server's 4 ms a hand-in: every other field goes through ``dump_json`` as before, with the
+        timeline, the last key in sorted order, left empty and then filled in."""
+        data = self.as_dict()
+        if not self.timeline:
+            return dump_json(data)
+        data["timeline"] = []
+        head = dump_json(data)
+        tail = b'"timeline": []\n}\n'
+        if not head.endswith(tail):  # a key after "timeline" (none today): the general encoder, never a guess
+            return dump_json(self.as_dict())
+        keys: dict[str, str] = {}
+        for e in self.timeline:
+            if e.key not in keys:
+                keys[e.key] = json.dumps(e.key, ensure_ascii=False)
+        # json.dumps(indent=1) at the timeline's depth: the list at 1 space, its events at 2, their fields at 3.
+        events = ",\n  ".join(f'[\n   {e.step},\n   {keys[e.key]},\n   {json.dumps(e.action)}\n  ]'
+                              for e in self.timeline)
+        return head[:-len(tail)] + f'"timeline": [\n  {events}\n ]\n}}\n'.encode()
 
     def save(self, path: Path) -> None:
         data = self.to_bytes()
