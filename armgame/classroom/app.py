@@ -127,6 +127,10 @@ class ClerkThread:
         """The jobs already queued are finished (a hand-in being written is never cut), then the thread ends."""
         self.jobs.put(_STOP)
         self.thread.join()
+        try:  # the journal of the games taken, into the table's one file (read either way if this fails)
+            self.clerk.table.compact()
+        except Exception as exc:
+            print(f"armgame class: the table's journal stays beside it: {exc}", file=sys.stderr)
 
     def _serve(self) -> None:
         held = None

@@ -168,6 +168,8 @@ class Clerk:
             raise DataFileError(f"{self.table.path} ranks seed {self.table.seed}, the class seed {roster.seed}: "
                                 f"this folder's table is not the class's (nothing was changed)")
         self._sweep()
+        with contextlib.suppress(DataFileError):  # a journal a killed server left, taken into the table (or read)
+            self.table.compact()
         self.entries: list[ScoreEntry] = self.table.all_entries()
         # The two lists' rows, one a player, kept as games are entered: an answer's rank and the standings
         # cost a lookup, not a pass over the whole table (which grew with every hand-in).
@@ -358,7 +360,7 @@ class Clerk:
         """Enter checked games together (one table write for all: a burst of a class costs one write, not
         thirty); each game's answer, or why it was not entered. Durable on disk before this returns."""
         try:
-            results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked])
+            results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked], journal=True)
         except (ValueError, UserError) as exc:  # the table could not be written: none was entered
             refusal = RefusedError(503, f"the class's table could not take the game: {exc}")
             return [refusal for _ in checked]
