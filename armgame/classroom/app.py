@@ -42,7 +42,7 @@ from starlette.routing import Route
 
 from ..errors import UserError
 from . import page
-from .intake import CLOSED, MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
+from .intake import AGAIN, CLOSED, MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
 from .roster import token_digest
 
 #: Jobs and hand-ins waiting for the clerk at once. A hand-in verified in a batch costs about 1.5 ms of the
@@ -168,23 +168,29 @@ class ClerkThread:
         return frozenset(p.token_sha256 for p in self.clerk.roster.players.values())
 
     def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
-        """Each hand-in's answer (or the exception to raise in its request), in the batch's order: the batch
-        checked together (``Clerk.check_many``: its games re-simulated in one batch), then entered together."""
+        """Each hand-in's answer (or the exception to raise in its request): the batch checked together
+        (``Clerk.check_many``: its games re-simulated in one batch), then entered together; a game the batch
+        held twice is checked again after that, as the next batch would (``AGAIN``)."""
         outcomes: list[tuple[Future, Any]] = []
-        checked = []
-        found_all = _outcome(lambda: self.clerk.check_many([work for _, work, _ in batch]))
-        if isinstance(found_all, BaseException):
-            found_all = [found_all] * len(batch)
-        for (_, _, future), found in zip(batch, found_all, strict=True):
-            if isinstance(found, BaseException | dict):
-                outcomes.append((future, found))
-            else:
-                checked.append((found, future))
-        if checked:
-            answers = _outcome(lambda: self.clerk.enter([c for c, _ in checked]))
-            if isinstance(answers, BaseException):
-                answers = [answers] * len(checked)
-            outcomes += [(future, answer) for (_, future), answer in zip(checked, answers, strict=True)]
+        while batch:
+            again = []
+            checked = []
+            found_all = _outcome(lambda batch=batch: self.clerk.check_many([work for _, work, _ in batch]))
+            if isinstance(found_all, BaseException):
+                found_all = [found_all] * len(batch)
+            for job, found in zip(batch, found_all, strict=True):
+                if found is AGAIN:
+                    again.append(job)
+                elif isinstance(found, BaseException | dict):
+                    outcomes.append((job[2], found))
+                else:
+                    checked.append((found, job[2]))
+            if checked:
+                answers = _outcome(lambda checked=checked: self.clerk.enter([c for c, _ in checked]))
+                if isinstance(answers, BaseException):
+                    answers = [answers] * len(checked)
+                outcomes += [(future, answer) for (_, future), answer in zip(checked, answers, strict=True)]
+            batch = again
         return outcomes
 
 

@@ -94,6 +94,13 @@ class Checked:
     digests: tuple[str, ...]
 
 
+class _Again:
+    """``Clerk.check_many``'s answer for a game that came twice in one batch: check it again after the batch."""
+
+
+AGAIN = _Again()
+
+
 @dataclass(frozen=True)
 class _Pending:
     """A game through every check but its re-simulation (``Clerk.check_many`` verifies them together)."""
@@ -246,19 +253,29 @@ class Clerk:
         found = self.check_many([(token, data)])[0]
         if isinstance(found, BaseException):
             raise found
+        assert not isinstance(found, _Again), "one hand-in cannot come twice"
         return found
 
     def check_many(self, hand_ins: Sequence[tuple[str | None, bytes]]
-                   ) -> list[dict[str, object] | Checked | BaseException]:
+                   ) -> list[dict[str, object] | Checked | BaseException | _Again]:
         """``check`` of hand-ins that arrived together, each outcome (the exception ``check`` would raise,
         returned) in order: the cheap refusals first, then the games still to verify re-simulated together
-        (``records.batch_verify``'s lanes, each verdict the single session's, bit for bit)."""
-        outcomes: list[dict[str, object] | Checked | BaseException | _Pending] = []
+        (``records.batch_verify``'s lanes, each verdict the single session's, bit for bit). ``AGAIN``: a game the
+        batch holds earlier, to check again once the batch is entered (``check`` never returns it)."""
+        outcomes: list[dict[str, object] | Checked | BaseException | _Pending | _Again] = []
         for token, data in hand_ins:
             try:
                 outcomes.append(self._read(token, data))
             except Exception as exc:  # one hand-in's failure is its own answer, never the batch's
                 outcomes.append(exc)
+        # A game a batch holds twice (whatever each claims) is answered as one after the other: the later one
+        # once the first is entered or refused, as if it had come in the next batch (``AGAIN``).
+        seen: set[str] = set()
+        for i, p in enumerate(outcomes):
+            if isinstance(p, _Pending):
+                if seen.intersection(p.digests):
+                    outcomes[i] = AGAIN
+                seen.update(p.digests)
         pending = [p for p in outcomes if isinstance(p, _Pending)]
         verdicts = self._verify_games([(p.replay, p.digests[0]) for p in pending])
         judged: dict[int, dict[str, object] | Checked | BaseException] = {}
