@@ -243,3 +243,21 @@ def test_the_client_says_busy_never_the_wi_fi_hint(monkeypatch):
     with pytest.raises(client.RefusalError) as refused:
         client._request(address, "/api/handin", b"{}", {}, sleep=lambda s: None)
     assert "busy" in str(refused.value) and "Wi-Fi" not in str(refused.value)
+
+
+def test_a_refused_forgery_makes_its_players_next_hand_in_wait(tmp_path, monkeypatch):
+    with running_class(tmp_path / "class") as opened:
+        code = opened.clerk.roster.code
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "m1"))
+        forger = client.join(address, code, "Flo")
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "m2"))
+        honest = client.join(address, code, "Ann")
+        forged = _forged(tapped_game(4, player="Flo"), score=50)
+        assert _post(opened.port, forger.token, code, forged.to_bytes())[0] == 422
+        status, answer, _ = _post(opened.port, forger.token, code, tapped_game(5, player="Flo").to_bytes())
+        assert status == 503 and answer["error"] == class_app.BUSY  # its next game waits COOL_DOWN seconds
+        assert _post(opened.port, honest.token, code, tapped_game(6, player="Ann").to_bytes())[0] == 200
+        state = opened.server.config.app.state.armgame
+        state.cooling[token_digest(forger.token)] = time.monotonic()  # the cool-down over
+        assert _post(opened.port, forger.token, code, tapped_game(5, player="Flo").to_bytes())[0] == 200

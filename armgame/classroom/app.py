@@ -55,6 +55,11 @@ QUEUE_BYTES = 64 * 1024 * 1024
 #: and its next is told the class is busy before its body is read, so a flooder's backlog never sits in
 #: front of an honest student's game.
 TOKEN_SHARE = 1
+#: Seconds a player's next hand-in is told the class is busy after one of theirs did not reproduce its score
+#: (422, found only by re-simulating it): a forger's next game waits its turn behind the honest students'
+#: instead of taking the clerk's time at once. An honest student's game is never refused so. A body that is
+#: not a class's game (400, 413) is refused before any re-simulation, cheaply, and does not count.
+COOL_DOWN = 2.0
 #: Hand-ins checked, re-simulated (one batch) and entered (one table write) together at the most.
 BATCH = 64
 #: Seconds a hand-in waits for one of the ``UPLOADS`` slots before it is told the class is busy.
@@ -216,6 +221,8 @@ class ClassState:
     #: Hand-ins waiting (their bodies being read or queued) by token digest, and the bytes queued.
     shares: dict[str, int] = field(default_factory=dict)
     queued_bytes: int = 0
+    #: Token digests whose hand-in was refused, and until when (``time.monotonic``) their next one is busy.
+    cooling: dict[str, float] = field(default_factory=dict)
     failures: Failures = field(default_factory=Failures)
     uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(UPLOADS))
     streams: int = 0
@@ -258,8 +265,8 @@ class ClassState:
     def hand_in_share(self, token: str | None) -> Iterator[None]:
         """A hand-in's place, taken before its body is read, with the refusals that cost nothing: a token that
         is no player's (401), a closed class (403), a player who already has ``TOKEN_SHARE`` hand-ins waiting
-        (503: the client hands it in again in a moment). The clerk checks the token and the class again: a
-        name may be released meanwhile."""
+        or whose last one did not reproduce less than ``COOL_DOWN`` s ago (503: the client hands it in again in a
+        moment). The clerk checks the token and the class again: a name may be released meanwhile."""
         assert self.worker is not None, "the class is not serving"
         digest = token_digest(token) if token else None
         if digest is None or digest not in self.worker.tokens:
@@ -268,9 +275,17 @@ class ClassState:
             raise RefusedError(403, CLOSED)
         if self.shares.get(digest, 0) >= TOKEN_SHARE:
             raise RefusedError(503, BUSY)
+        if digest in self.cooling:
+            if self.cooling[digest] > time.monotonic():
+                raise RefusedError(503, BUSY)
+            del self.cooling[digest]
         self.shares[digest] = self.shares.get(digest, 0) + 1
         try:
             yield
+        except RefusedError as exc:
+            if exc.status == 422:
+                self.cooling[digest] = time.monotonic() + COOL_DOWN
+            raise
         finally:
             if self.shares[digest] <= 1:
                 del self.shares[digest]
