@@ -426,12 +426,15 @@ class Replay:
         tail = b'"timeline": []\n}\n'
         if not head.endswith(tail):  # a key after "timeline" (none today): the general encoder, never a guess
             return dump_json(self.as_dict())
-        keys: dict[str, str] = {}
+        keys: dict[str, str] = {}  # each key's and action's JSON, made once
         for e in self.timeline:
             if e.key not in keys:
                 keys[e.key] = json.dumps(e.key, ensure_ascii=False)
         # json.dumps(indent=1) at the timeline's depth: the list at 1 space, its events at 2, their fields at 3.
-        events = ",\n  ".join(f'[\n   {e.step},\n   {keys[e.key]},\n   {json.dumps(e.action)}\n  ]'
+        for e in self.timeline:
+            if e.action not in keys:
+                keys[e.action] = json.dumps(e.action, ensure_ascii=False)
+        events = ",\n  ".join(f'[\n   {e.step},\n   {keys[e.key]},\n   {keys[e.action]}\n  ]'
                               for e in self.timeline)
         return head[:-len(tail)] + f'"timeline": [\n  {events}\n ]\n}}\n'.encode()
 
@@ -495,9 +498,21 @@ def _timeline_from_list(data: object, config: GameConfig, last_step: int) -> tup
     if len(data) > MAX_EVENTS:
         raise ValueError(f"timeline has {len(data)} events, more than {MAX_EVENTS}")
     keys = (*(m.key for m in config.muscles), "space", "tab")
+    known = frozenset(keys)
+    actions = (DOWN, UP)
     events: list[InputEvent] = []
     previous = 0
     for i, item in enumerate(data):
+        # The fast test first (a bot's game has tens of thousands of events, and checking each field by the
+        # general checks was most of a class server's time for it); any event it does not pass, the checks
+        # below refuse with their own message.
+        if type(item) is list and len(item) == 3:
+            step, key, action = item
+            if (type(step) is int and previous <= step <= last_step and type(key) is str and key in known
+                    and type(action) is str and action in actions):
+                events.append(InputEvent(step, key, action))
+                previous = step
+                continue
         where = f"timeline[{i}]"
         if not isinstance(item, list) or len(item) != 3:
             raise ValueError(f"{where} must be [step, key, action]")
