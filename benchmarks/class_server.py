@@ -752,6 +752,8 @@ def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> di
         for kind, paths in (("honest", [g["path"] for g in games[:count]]),
                             ("forged", forged[:count])):
             bodies = [Path(p).read_bytes() for p in paths]
+            if not bodies:
+                continue
             wall0, cpu0 = time.perf_counter(), time.process_time()
             answered: dict[str, int] = {}
             for lo in range(0, len(bodies), app.BATCH):

@@ -23,6 +23,7 @@ data that its script sets as text.
 from __future__ import annotations
 
 import asyncio
+import gc
 import json
 import queue
 import sys
@@ -176,6 +177,19 @@ class ClerkThread:
         """Each hand-in's answer (or the exception to raise in its request): the batch checked together
         (``Clerk.check_many``: its games re-simulated in one batch), then entered together; a game the batch
         held twice is checked again after that, as the next batch would (``AGAIN``)."""
+        # The cyclic garbage collector paused for the batch: reading a bot's game makes 15,000 events and their
+        # lists, no cycle among them, and the collections they set off (each also walking every object the
+        # server holds) were a third of such a hand-in's cost (104 ms against 65 ms, measured in-process).
+        # Reference counting still frees them; what cycles there are wait for the next collection.
+        collecting = gc.isenabled()
+        gc.disable()
+        try:
+            return self._hand_in_batch(batch)
+        finally:
+            if collecting:
+                gc.enable()
+
+    def _hand_in_batch(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
         outcomes: list[tuple[Future, Any]] = []
         while batch:
             again = []
