@@ -748,7 +748,7 @@ def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> di
             roster.players[f"s{i}"] = Player(f"s{i}", token_digest(tokens[-1]), GAME_DATE)
         roster.save()
         clerk = Clerk(Path(tmp), roster)
-        worker = type("Worker", (), {"clerk": clerk})()
+        worker = app.ClerkThread(clerk, lambda: None)  # its batches run here, in this thread, as its own would
         for kind, paths in (("honest", [g["path"] for g in games[:count]]),
                             ("forged", forged[:count])):
             bodies = [Path(p).read_bytes() for p in paths]
@@ -759,12 +759,13 @@ def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> di
             for lo in range(0, len(bodies), app.BATCH):
                 batch = [("hand-in", (tokens[i], bodies[i]), Future()) for i in range(lo, min(len(bodies),
                                                                                                 lo + app.BATCH))]
-                for _, outcome in app.ClerkThread._hand_in(worker, batch):
+                for _, outcome in worker._hand_in(batch):
                     key = "ok" if isinstance(outcome, dict) else str(getattr(outcome, "status", type(outcome)))
                     answered[key] = answered.get(key, 0) + 1
             wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
             out[kind] = {"handins": len(bodies), "answers": answered, "wall_s": wall, "cpu_s": cpu,
                          "per_s": len(bodies) / wall, "cpu_ms_per_handin": 1000 * cpu / len(bodies)}
+        worker.stop()
         del os.environ["ARMGAME_CACHE"]
     out["load_average_1min"] = _load()
     return out
@@ -811,7 +812,8 @@ def table_costs(games: list[dict[str, Any]], sizes: list[int], batches: int = 5,
                                 "max_ms": 1000 * max(times)}
                 out["sizes"][str(size)] = row
         finally:
-            del os.environ["ARMGAME_CACHE"]
+            worker.stop()
+        del os.environ["ARMGAME_CACHE"]
     out["load_average_1min"] = _load()
     return out
 

@@ -71,10 +71,13 @@ def _mix() -> list[tuple[str, bytes]]:
 
 def _batch(clerk: Clerk, hand_ins: list[tuple[str, bytes]]) -> list[object]:
     """The clerk thread's one batch of ``hand_ins``: each outcome, in their order."""
-    worker = type("Worker", (), {"clerk": clerk})()
-    futures = [Future() for _ in hand_ins]
-    jobs = [("hand-in", h, f) for h, f in zip(hand_ins, futures, strict=True)]
-    outcomes = dict(class_app.ClerkThread._hand_in(worker, jobs))
+    worker = class_app.ClerkThread(clerk, lambda: None)
+    try:
+        futures = [Future() for _ in hand_ins]
+        jobs = [("hand-in", h, f) for h, f in zip(hand_ins, futures, strict=True)]
+        outcomes = dict(worker._hand_in(jobs))  # here, as the clerk's thread runs a batch
+    finally:
+        worker.stop()
     return [outcomes[f] for f in futures]
 
 
