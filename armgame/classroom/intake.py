@@ -157,6 +157,11 @@ class _Board:
     def row(self, rank: int) -> PlayerRow:
         return self._rows[self._order[rank - 1][1]]
 
+    def each(self) -> Iterator[PlayerRow]:
+        """The rows best first, one at a time: the projector's standings stop at their 60th."""
+        for _, key in self._order:
+            yield self._rows[key]
+
     def rows(self, first: int | None = None) -> list[PlayerRow]:
         """The rows best first (the ``first`` ones only, if given)."""
         return [self._rows[key] for _, key in self._order[:first]]
@@ -427,7 +432,7 @@ class Clerk:
                 "note": note, "top": top, "message": ("already handed in: " if already else "handed in: ") + line}
 
     def _rows(self, programs: bool) -> Iterator[PlayerRow]:
-        return iter(self.boards[programs].rows())
+        return self.boards[programs].each()
 
     # ------------------------------------------------------------------ the lab
     def _lab_run(self, player: Player, replay: Replay) -> dict[str, object]:
