@@ -57,7 +57,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ..errors import UserError
-from ..files import _CLOEXEC, _NOFOLLOW
+from ..files import _BINARY, _CLOEXEC, _NOFOLLOW
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from ..words import plural
 from .entry import _COUNT_MAX, _OPTIONAL, _SEED_MAX, ScoreEntry, entry_order, sort_key
@@ -468,32 +468,36 @@ class TableFile:
         journal_size = (index.signature[1] or (0, 0))[1]
         if table_size + journal_size + sum(map(len, lines)) > MAX_TABLE_BYTES:
             raise TableError("the table would grow past its size limit: not entered (nothing was dropped)")
-        self._write_journal(b"".join(lines), journal_size)
+        self._write_journal(b"".join(lines))
         self._index = _Index(self._signature(), shas, games, place, count)
         return results
 
-    def _write_journal(self, data: bytes, size: int) -> None:
+    def _write_journal(self, data: bytes) -> None:
         """Append ``data`` (whole lines) to the journal and fsync it, and its folder if the journal is new. A cut
         last line (a writer killed mid-append, never acknowledged) is cut off first, so no line is ever joined
         to it."""
-        flags = os.O_RDWR | os.O_CREAT | _NOFOLLOW | _CLOEXEC  # read too: its last byte
+        flags = os.O_RDWR | os.O_CREAT | _NOFOLLOW | _CLOEXEC | _BINARY  # read too: its last byte
         new = not os.path.lexists(self.journal_path)
         try:
             fd = os.open(self.journal_path, flags, 0o666)
         except OSError as exc:
             raise TableError(f"{self.journal_path}: cannot write: {exc.strerror or exc}") from None
+        end = 0
         try:
-            st = os.fstat(fd)
-            if not stat.S_ISREG(st.st_mode):
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
                 raise TableError(f"{self.journal_path}: is not a regular file")
-            end = st.st_size
-            if end and os.pread(fd, 1, end - 1) != b"\n":
-                tail = os.pread(fd, min(end, MAX_TABLE_BYTES), 0)
-                end = tail.rfind(b"\n") + 1
-                os.ftruncate(fd, end)
-            written = 0
-            while written < len(data):
-                written += os.pwrite(fd, data[written:], end + written)
+            # lseek and read rather than pread: Windows has no pread.
+            end = os.lseek(fd, 0, os.SEEK_END)
+            if end:
+                os.lseek(fd, end - 1, os.SEEK_SET)
+                if os.read(fd, 1) != b"\n":
+                    os.lseek(fd, 0, os.SEEK_SET)
+                    end = _read_all(fd).rfind(b"\n") + 1
+                    os.ftruncate(fd, end)
+            os.lseek(fd, end, os.SEEK_SET)
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
             os.fsync(fd)
         except OSError as exc:
             with contextlib.suppress(OSError):
