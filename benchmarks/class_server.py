@@ -2,11 +2,12 @@
 
     python benchmarks/class_server.py                           # classes of 30, 100 and 1,000; 3 repeats
     python benchmarks/class_server.py --sizes 30,100 --repeats 5 --json
-    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60   # a quick look, about 4 s
+    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60 --flood 0 --clerk 0 --table-sizes ''
+                                                                # a quick look, about 4 s
 
-The default run takes about 7 minutes on the 2-core machine of docs/performance.md (8 under other
-jobs' load): making the 3,000 games about 25 s, a class of 30 or 100 about 15 s a repeat, a class
-of 1,000 about 100 s.
+The default run takes about 12 minutes on the 2-core machine of docs/performance.md (more under other
+jobs' load): making the 4,000 games about 30 s, a class of 30 or 100 about 15 s a repeat, a class
+of 1,000 about 60 s, the flood 35 s, the clerk alone 15 s and the table's costs 20 s.
 
 The server is ``python -m armgame class serve --folder TMP --host 127.0.0.1 --port P`` in its own
 process, a new class in a new temporary folder for every class and repeat. The students are
@@ -37,6 +38,21 @@ the same on every run: keyboard games whose keys switch every 0.1-0.5 s as in
 bot's game (about 0.5 MB), each let go of at another step near the end so that each is its
 own game. The projector's figures and the clients share the machine with the server: on a
 2-core machine the clients take a share of it (printed: the clients' CPU seconds).
+
+Then, each ``--repeats`` times:
+
+4. **the flood** (``--flood 100``): a new class where 100 clients, each joined under its own name (valid
+   tokens), post forged games (a real game's claimed score raised: it does not reproduce; ten distinct
+   ones each, then again) and, one post in four, a replay cut off, as fast as the server answers (no
+   wait after a 503, a new connection each), for ``--flood-seconds``; meanwhile ``--flood-honest``
+   students hand in their own games one after another, 0.5 s apart, through the students' client. The
+   honest hand-ins' latencies (p50, p99, max) are the figure: honest students first;
+5. **the clerk alone** (``--clerk 1000``), in this process, no HTTP: that many distinct honest hand-ins,
+   then as many forged ones, in the server's batches (``ClerkThread._hand_in``): hand-ins a second and
+   the CPU time of each;
+6. **the table's cost per hand-in** (``--table-sizes 10,1000,10000``): a batch of 32 games entered
+   (``ScoreTable.add_many``, the clerk's write, the replays' files included) into a table already
+   holding that many entries, appended to its journal and, for comparison, the whole table rewritten.
 
 Figures are medians over ``--repeats`` with [min-max]; the machine and its load average are printed
 beside them.

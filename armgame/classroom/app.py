@@ -7,10 +7,12 @@ Every request is hostile until checked, and what it can cost is bounded before a
   window passes, so a four-letter code cannot be guessed by trying;
 * a body over its limit is refused from its declared length, or cut off as it arrives (413);
   a body slower than ``BODY_SECONDS`` is cut off (408); at most ``UPLOADS`` bodies are read at
-  once, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES`` whatever arrives;
+  once, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES`` (and the queued bodies under
+  ``QUEUE_BYTES``) whatever arrives;
 * changes go to one worker thread (the ``Clerk``), never the event loop; at most ``QUEUE_LIMIT``
-  wait for it, and past that a client is told to come back (503 with Retry-After): its replay
-  stays on its machine, and the client hands it in again;
+  jobs and ``HANDIN_QUEUE`` hand-ins wait for it, one hand-in a player (``TOKEN_SHARE``, checked
+  before the body is read, with the token and a closed class), and past that a client is told to
+  come back (503 with Retry-After): its replay stays on its machine, and the client hands it in again;
 * a hand-in is answered only after the clerk has written it durably (fsynced file and folder);
 * the projector's event stream sends the latest standings, never a backlog, to at most
   ``MAX_STREAMS`` pages.
@@ -46,10 +48,13 @@ from . import page
 from .intake import AGAIN, CLOSED, MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
 from .roster import token_digest
 
-#: Jobs and hand-ins waiting for the clerk at once. A hand-in verified in a batch costs about 1.5 ms of the
-#: clerk's time, so a full queue is a second and a half of work: room for a lecture hall's round's end
-#: (``benchmarks/class_server.py``) where 64 sent nine in ten students away for 2 s, again and again.
-QUEUE_LIMIT = 1024
+#: Jobs (a join, the teacher's requests) waiting for the clerk at once; past it, 503 and the client comes back.
+#: A join rewrites the roster, so a lecture hall's joins are let in a few at a time.
+QUEUE_LIMIT = 64
+#: Hand-ins waiting for the clerk at once. One checked and entered in a batch costs the clerk 2.5 ms (a bot's
+#: game 60 ms): room for a lecture hall's round's end (``benchmarks/class_server.py``), where a queue of 64
+#: sent nine students in ten away for 2 s, again and again.
+HANDIN_QUEUE = 1024
 #: The bodies those waiting hand-ins hold, in bytes at the most (a bot's game is 0.5 MB, a student's 9 KB).
 QUEUE_BYTES = 64 * 1024 * 1024
 #: Hand-ins of one player (one token) waiting at once: a client that floods the class has one in the queue,
@@ -231,7 +236,8 @@ class ClassState:
     clerk: Clerk
     join_line: str
     worker: ClerkThread | None = None
-    waiting: int = 0
+    waiting: int = 0  # jobs
+    handins: int = 0
     #: Hand-ins waiting (their bodies being read or queued) by token digest, and the bytes queued.
     shares: dict[str, int] = field(default_factory=dict)
     queued_bytes: int = 0
@@ -260,17 +266,22 @@ class ClassState:
 
     async def run(self, job: Callable[[], Any], kind: str = "job") -> Any:
         """``job`` on the clerk's thread (or, for "hand-in", ``job`` is (token, body)), if the queue has
-        room (``QUEUE_LIMIT`` jobs, ``QUEUE_BYTES`` of bodies); the pages are told of any change."""
-        size = len(job[1]) if kind == "hand-in" else 0  # type: ignore[index]
-        if self.waiting >= QUEUE_LIMIT or (size and self.queued_bytes + size > QUEUE_BYTES):
+        room (``QUEUE_LIMIT`` jobs; ``HANDIN_QUEUE`` hand-ins and ``QUEUE_BYTES`` of their bodies); the pages
+        are told of any change."""
+        handin = kind == "hand-in"
+        size = len(job[1]) if handin else 0  # type: ignore[index]
+        if (self.handins >= HANDIN_QUEUE or self.queued_bytes + size > QUEUE_BYTES) if handin \
+                else self.waiting >= QUEUE_LIMIT:
             raise RefusedError(503, BUSY)
         assert self.worker is not None, "the class is not serving"
-        self.waiting += 1
+        self.waiting += not handin
+        self.handins += handin
         self.queued_bytes += size
         try:
             return await asyncio.wrap_future(self.worker.submit(kind, job))
         finally:
-            self.waiting -= 1
+            self.waiting -= not handin
+            self.handins -= handin
             self.queued_bytes -= size
             self.changed.set()
             self.changed = asyncio.Event()
