@@ -32,6 +32,11 @@ GRACE_SECONDS = 3
 #: queue, bounded in bytes and one hand-in a player, is what keeps memory bounded). The process's limit of
 #: open files is raised to fit where the system allows (``_more_files``).
 CONCURRENCY = 2500
+#: Connections the system holds for the server to accept (capped by the system's own, 4,096 on Linux, 128 on
+#: macOS unless raised). Past it a new connection's first packet is dropped and its client sends it again a
+#: second later, then three: at 128, a round's end of 1,000 students at once, or a flood of clients, cost an
+#: honest student seconds before the server even saw their game.
+BACKLOG = 2048
 
 
 def lan_address() -> str:
@@ -218,7 +223,7 @@ def _bind(host: str, port: int) -> socket.socket:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     try:
         sock.bind(where)
-        sock.listen(128)
+        sock.listen(BACKLOG)
     except OSError as exc:
         sock.close()
         if exc.errno == errno.EADDRINUSE:
