@@ -1,6 +1,7 @@
 """The suite's reference scores: random, the naive bot, the model bot and PPO on every v1 id.
 
     python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
+    python benchmarks/reference_scores.py bots --out refs --ids armgame/CenterOutHold-v1 --policies naive model
     python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
     python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
@@ -41,9 +42,10 @@ def slug(env_id: str) -> str:
     return env_id.split("/")[-1]
 
 
-def run_bots(out: Path, ids: tuple[str, ...], games: int) -> None:
+def run_bots(out: Path, ids: tuple[str, ...], games: int,
+             policies: tuple[str, ...] = ("random", "naive", "model")) -> None:
     for env_id in ids:
-        for policy in ("random", "naive", "model"):
+        for policy in policies:
             start = time.perf_counter()
             result = evaluate(policy, env_id, games=games)
             write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start)
@@ -137,6 +139,8 @@ def main(argv: list[str] | None = None) -> int:
     bots.add_argument("--out", type=Path, required=True)
     bots.add_argument("--games", type=int, default=GAMES)
     bots.add_argument("--ids", nargs="*", default=list(IDS))
+    bots.add_argument("--policies", nargs="*", default=["random", "naive", "model"],
+                      help="some of random, naive and model (a row's bots rerun alone)")
     ppo = sub.add_parser("ppo")
     ppo.add_argument("env_id")
     ppo.add_argument("--seed", type=int, default=0)
@@ -149,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
     refs.add_argument("folder", type=Path)
     args = parser.parse_args(argv)
     if args.command == "bots":
-        run_bots(args.out, tuple(args.ids), args.games)
+        run_bots(args.out, tuple(args.ids), args.games, tuple(args.policies))
     elif args.command == "ppo":
         run_ppo(args.out, args.env_id, args.seed, args.steps, args.games)
     elif args.command == "references":

@@ -37,3 +37,12 @@ def read_lab_replays() -> None:
     from ..lab.record import register
 
     register()
+
+
+def read_env_games() -> None:
+    """Make a Gymnasium env's game readable here (``armgame.records.env_game``: its variant and muscle levels);
+    the commands that verify or replay games call it. The class and the table never do: a replay with a task
+    section is never a ranked game, and an unregistered kind is refused in one line."""
+    from ..records.env_game import register
+
+    register()
