@@ -24,8 +24,6 @@ from armgame.env.variants import MAX_FIELD_STRENGTH, MAX_VISCOUS_STRENGTH, Reach
 from armgame.env.vector import REWARD_TOLERANCE
 from armgame.records.replay import Replay
 
-REACH_IDS = tuple(i for i in gym.registry if i.startswith("armgame/Reach"))
-
 
 # ------------------------------------------------------------------ item 6: evaluate exported
 def test_evaluate_is_exported_where_the_docs_name_it():
@@ -146,31 +144,70 @@ def test_aggregate_runs_normalises_by_the_references_and_refuses_uneven_runs():
 
 
 # ------------------------------------------------------------------ item 3: every game verifiable
-def play(env, policy, seed: int):
+def play(env, policy, seed: int, most: int = 10**6):
     observation, info = env.reset(seed=seed)
     env.action_space.seed(seed)
-    done = False
-    while not done:
+    done, steps = False, 0
+    while not done and steps < most:
         action = env.action_space.sample() if policy is None else policy(observation)
         observation, _, terminated, truncated, info = env.step(action)
-        done = terminated or truncated
+        done, steps = terminated or truncated, steps + 1
     return info
 
 
-@pytest.mark.parametrize("env_id", REACH_IDS)
-def test_every_reach_game_is_recorded_and_verifies(env_id, tmp_path):
-    env = gym.make(env_id, time_limit=4.0)
-    policies = [None] if env_id.endswith("Continuous-v0") else [None, bot_policy("naive", env)]
-    for k, policy in enumerate(policies):
-        info = play(env, policy, 7 + k)
-        replay = replay_of(env, driver="random" if policy is None else "naive bot")
-        assert replay.result.hits == info["hits"] and replay.result.score == info["score"]
+ALL_IDS = tuple(i for i in gym.registry if i.startswith("armgame/"))
+
+
+def short(env_id: str):
+    """The id's env with short episodes: 4 s games, 2-trial CenterOut-v1 episodes (v0: a run, cut short)."""
+    if env_id.startswith("armgame/Reach"):
+        return gym.make(env_id, time_limit=4.0)
+    return gym.make(env_id, episode_trials=2) if env_id.endswith("-v1") else gym.make(env_id)
+
+
+def a_bot(env_id: str, env):
+    if env_id.endswith("Continuous-v0"):
+        return None  # v0's levels are not centred: no bot plays them (random play is recorded)
+    if env_id.startswith("armgame/CenterOut") and env_id.endswith("-v0"):
+        from armgame.env.center_out import CenterOutBotPolicy
+
+        return CenterOutBotPolicy("model", env)
+    return bot_policy("model", env)
+
+
+def test_every_id_is_covered():
+    assert len(ALL_IDS) == 20
+
+
+@pytest.mark.parametrize("env_id", ALL_IDS)
+def test_every_game_an_env_plays_is_recorded_and_verifies(env_id):
+    env = short(env_id)
+    bot = a_bot(env_id, env)
+    for k, policy in enumerate([None] if bot is None else [None, bot]):
+        info = play(env, policy, 7 + k, most=400)  # a CenterOut-v0 run is recorded as far as it went
+        replay = replay_of(env, driver="random" if policy is None else "model bot")
+        assert replay.result.hits == info["hits"]
         read = Replay.from_bytes(replay.to_bytes())
         ok, got = read.verify()
         assert ok, (env_id, k, got)
-        plain = env.unwrapped.game_variant.plain if env.unwrapped.version else True
-        levels = "Continuous" in env_id
-        assert (read.task is None) == (plain and not levels), env_id
+        if env_id.startswith("armgame/Reach"):
+            plain = env.unwrapped.game_variant.plain if env.unwrapped.version else True
+            assert (read.task is None) == (plain and "Continuous" not in env_id), env_id
+        else:
+            assert read.task.hold_at_home == env.unwrapped.session.hold_at_home
+
+
+def test_a_centre_out_episode_s_go_cue_rule_is_part_of_its_replay(tmp_path, capsys):
+    env = gym.make("armgame/CenterOutHold-v1", episode_trials=2)
+    play(env, None, 3, most=400)  # random keys never hold still at home: no go cue in 8 s
+    path = tmp_path / "episode.json"
+    replay_of(env, driver="random").save(path)
+    assert main(["verify", str(path)]) == 0
+    assert "go cue after a hold at home" in capsys.readouterr().out
+    data = json.loads(path.read_text())
+    data["task"]["hold_at_home"] = False  # the other rule: go cues, and trials, come anyway
+    path.write_text(json.dumps(data))
+    assert main(["verify", str(path)]) == 1
 
 
 def test_a_variant_game_recorded_without_its_section_differs_and_with_it_matches(tmp_path, capsys):

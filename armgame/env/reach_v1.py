@@ -118,7 +118,8 @@ class ReachV1Env(ReachEnv):
       ``motor_noise`` (0 to 1: signal-dependent noise, each muscle's force times ``1 + n``,
       ``n`` of that s.d., correlated over 50 ms), ``observation_delay`` (env steps, 0 to 100),
       ``field`` (``"curl"`` or ``"viscous"``) with ``field_strength`` (curl: ``b`` in N s/m, -50 to
-      50; viscous: the lab's matrix times it; default 1), ``target_radius`` (m, 0.001 to 0.2;
+      50; viscous: the lab's matrix times it, -2 to 2; default 1; a field game whose joint speed passes
+      the declared bound stops, terminated, ``info["stopped"]`` saying why), ``target_radius`` (m, 0.001 to 0.2;
       default the game's 0.05). The suite's ids fix them: ``ReachHold-v1``, ``ReachNoisy-v1``,
       ``ReachDelay-v1``, ``ReachField-v1``, ``ReachHard-v1`` and their ``Continuous`` twins
       (``armgame.env.suite``).

@@ -44,6 +44,11 @@ CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
     "CenterOutHold": {"trial_start": "hold"},
 }
 
+#: The protocol these seeds, ``evaluate`` and ``aggregate_runs`` make (docs/programs.md, "The protocol"): name it
+#: in a paper. 1: three seed ranges, a fresh policy each game, normalised by random play (0) and the model bot
+#: (1). A score normalised by a ceiling controller instead will be protocol 2, once every id has one.
+PROTOCOL_VERSION = 1
+
 #: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
 EVALUATION_SEED_START = 10**9
 EVALUATION_SEED_COUNT = 10**6

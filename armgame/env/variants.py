@@ -20,12 +20,12 @@ and ``ReachHard-v1``, all four at once. What each does to the game:
   ``b = field_strength`` N s/m (-50 to 50: it does no work, so the speed bound holds whatever ``b``), or
   the lab's viscous matrix scaled by ``field_strength`` (-2 to 2, ``MAX_VISCOUS_STRENGTH``). The viscous
   matrix's symmetric part feeds the arm energy (at some postures more than the joints' damping takes out
-  even at strength 1), so no bound is proven under it: beyond about 3 the arm runs away (at 4, random
-  keys spun it to 314 rad/s; at 20 one game in three overflowed). The range is what was measured stable
-  with margin (``benchmarks/field_range.py``: a policy that feeds the arm all the energy its muscles can
-  reaches 21 rad/s at strength 2, under the game's bound of 34.4), and a guard keeps the declared speed
-  bounds true beyond it: a game whose joint speed passes them stops, terminated, ``info["stopped"]``
-  saying why in one line (``armgame.game.variant.RunawayError``).
+  even at strength 1), so no bound is proven under it: from about 4 the arm runs away (issue 40 found
+  one game in three overflowing at 20, within the old range of 50). The range is what was measured
+  stable with margin (``benchmarks/field_range.py``: a policy that feeds the arm all the energy its
+  muscles can reaches 21.1 rad/s at strength 2 and 29.1 at 3, under the game's bound of 34.4), and a
+  guard keeps the declared speed bounds true beyond it: a game whose joint speed passes them stops,
+  terminated, ``info["stopped"]`` saying why in one line (``armgame.game.variant.RunawayError``).
 * ``target_radius`` (m): the game's targets smaller or larger (the game's 0.05 by default).
 
 A variant's game is not the game of ``armgame play``, and its score is not comparable with a player's,

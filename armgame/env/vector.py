@@ -16,8 +16,7 @@ differently from the single session: the compiled kernel's at any size, numpy's 
 otherwise bit for bit), truncations, infos and v0's rewards (whole hits) exactly (a hit decided within
 1e-11 m of a target's edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``). v1's dense
 reward is a difference of distances computed from those states, so it agrees to the same round-off, not
-bit for bit: within ``REWARD_TOLERANCE`` at the default progress weight (tests/test_env_protocol.py; 1.1e-14
-at most in 16 games of 20 s of random keys).
+bit for bit: within ``REWARD_TOLERANCE`` at the default progress weight (tests/test_env_protocol.py).
 """
 
 from __future__ import annotations

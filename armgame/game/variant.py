@@ -185,3 +185,25 @@ class VariantPlay:
             if now >= steps or session.over:  # a claimed runaway that did not come plays on: the steps differ
                 break
         return session
+
+
+def play_inputs(session: GameSession, timeline: Sequence, levels: Sequence[LevelEvent], steps: int) -> GameSession:
+    """Play ``session`` (any ``GameSession``: a lab run too) to ``steps`` from its key timeline and level events, each
+    applied before its physics step, levels first (an env's order within a step)."""
+    keys = list(timeline)
+    k = i = 0
+    while session.steps < steps and not session.over:
+        now = session.steps
+        while i < len(levels) and levels[i].step <= now:
+            session.set_muscle_levels(levels[i].levels)
+            i += 1
+        while k < len(keys) and keys[k].step <= now:
+            session.key_event(keys[k].key, keys[k].action)
+            k += 1
+        stop = steps
+        if k < len(keys):
+            stop = min(stop, max(keys[k].step, now + 1))
+        if i < len(levels):
+            stop = min(stop, max(levels[i].step, now + 1))
+        session.advance(stop - now)
+    return session

@@ -101,7 +101,7 @@ class EnvGameTask:
         delay = check_int("task.observation_delay", d["observation_delay"], 0, 10**6)
         if not isinstance(d["stopped"], bool):
             raise ValueError(f"task.stopped must be true or false, got {d['stopped']!r}")
-        levels = _levels(d["levels"], last_step)
+        levels = levels_from_list(d["levels"], last_step)
         try:
             variant = GameVariant(hold_steps, noise, decision_steps, field, parameter, limit)
         except UserError as exc:
@@ -146,7 +146,8 @@ def _field(data: object) -> tuple[str | None, object]:
                                   for j, v in enumerate(row)) for i, row in enumerate(rows))
 
 
-def _levels(data: object, last_step: int) -> tuple[LevelEvent, ...]:
+def levels_from_list(data: object, last_step: int) -> tuple[LevelEvent, ...]:
+    """A section's ``"levels"``, checked: [step, four levels from 0 to 1], steps in order, within the game."""
     if not isinstance(data, list):
         raise ValueError("task.levels must be a list of [step, level, level, level, level]")
     if len(data) > MAX_EVENTS:
