@@ -57,6 +57,18 @@ def _dash_value_hint(message: str, arg_strings: Sequence[str]) -> str:
     return ""
 
 
+def _spaced_name_hint(argv: Sequence[str] | None, extra: Sequence[str]) -> str:
+    """For ``--name Ann B``: the shell split the name at its space; say how to keep it whole."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    if "--name" not in words[:-2] or not extra:
+        return ""
+    at = words.index("--name")
+    rest = list(itertools.takewhile(lambda w: not w.startswith("-"), words[at + 2:]))
+    if not rest or rest[0] != extra[0]:  # the word left over is not the name's second half
+        return ""
+    return f' (a name with a space goes in quotes: --name "{" ".join([words[at + 1], *rest])}")'
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="armgame",
@@ -98,7 +110,7 @@ def _main(argv: Sequence[str] | None) -> int:
     args, extra = parser.parse_known_args(argv)
     if extra:  # left over by the command's parser: its error, under its name
         parser_of_command = args._commands.get(getattr(args, "command", None), parser)
-        parser_of_command.error(f"unrecognized arguments: {' '.join(extra)}")
+        parser_of_command.error(f"unrecognized arguments: {' '.join(extra)}{_spaced_name_hint(argv, extra)}")
     command = getattr(args, "command", None)
     if command is None:  # `armgame` alone: the menu, or the commands without a display
         from .commands import menu

@@ -1,5 +1,6 @@
-"""Draw the live class's pages as a projector shows them: docs/img/class_page.png and class_lab.png; and the
-browser game (/play) as a student's laptop shows it, mid-game and at its end: class_play.png, class_play_end.png.
+"""Draw the live class's pages as a projector shows them: docs/img/class_page.png (thirty students) and
+class_lab.png, and a round's end, class_round.png; and the browser game (/play) as a student's laptop shows
+it, mid-game and at its end: class_play.png, class_play_end.png.
 
     python docs/make_class_screenshots.py             # writes docs/img/class_*.png
     python docs/make_class_screenshots.py --out DIR   # somewhere else, at 1024x768 and 1920x1080 both
@@ -31,14 +32,18 @@ from armgame.records.replay import Replay  # noqa: E402
 
 STUDENTS = [("Amira", 42), ("Ben", 30), ("Chloé", 55), ("Dmitri", 18), ("Eun-ji", 48), ("Farah", 25),
             ("Gabriel", 36), ("Hana", 12), ("Ife", 58), ("Jonas", 22), ("Kai", 40), ("Lucía", 33), ("Mateo", 8),
-            ("Nour", 45), ("Oskar", 28)]
+            ("Nour", 45), ("Oskar", 28), ("Priya", 51), ("Quentin", 15), ("Rosa", 38), ("Sami", 21), ("Tariq", 44),
+            ("Uma", 31), ("Viktor", 50), ("Wen", 27), ("Xavier", 10), ("Yara", 35), ("Zoë F", 47),
+            ("Aleksandra Nowakowska", 39), ("Bruno", 24), ("Carmen", 53), ("Diego", 16)]
+#: The games handed in during the round the pictures show: (student, seconds of the model bot's keys).
+ROUND = [("Ben", 57), ("Hana", 49), ("Dmitri", 46), ("Amira", 26)]
 #: The volunteers run the guide's own protocol (docs/teaching.md): the lesson preset.
 LAB = "lesson"
 #: The washout one trial long: the after-effect's label at the curve's right edge, where it must stay inside.
 QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
              'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')
 #: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
-PICTURES = ("class_page.png", "class_lab.png", "class_play.png", "class_play_end.png")
+PICTURES = ("class_page.png", "class_lab.png", "class_round.png", "class_play.png", "class_play_end.png")
 
 
 def curve_protocol(work: Path, quick: bool) -> str:
@@ -92,6 +97,42 @@ def play(browser, opened, size: tuple[int, int], out: Path, suffix: str) -> None
         raise SystemExit(f"the browser game at {size[0]}x{size[1]} logged {errors}")
 
 
+def teacher(opened, path: str, body: dict) -> None:
+    """A teacher's action, from the teacher's machine (which needs no secret)."""
+    import json
+    import urllib.request
+
+    req = urllib.request.Request(f"http://127.0.0.1:{opened.port}{path}", method="POST",
+                                 data=json.dumps(body).encode(), headers={"Content-Type": "application/json"})
+    urllib.request.urlopen(req, timeout=10).close()
+
+
+def round_end(browser, opened, work: Path, size: tuple[int, int], out: Path, suffix: str) -> None:
+    """A three-minute round with a few games handed in during it, and the projector at its end (the round's record
+    moved back, as a restart would read it, so the picture need not wait three minutes)."""
+    from datetime import datetime, timedelta
+
+    from armgame.classroom.rounds import GRACE_SECONDS
+
+    teacher(opened, "/api/teacher/round", {"minutes": 3})
+    address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+    machines = {name: f"m{i}" for i, (name, _) in enumerate(STUDENTS)}  # each student on their own machine
+    for name, seconds in ROUND:
+        os.environ[client.CLIENT_ENV] = str(work / machines[name])
+        client.hand_in(client.join(address, opened.clerk.roster.code, name),
+                       keyboard_game(seconds * 0.7 + size[0] / 10_000, player=name).to_bytes())  # each size its game
+    last = max(datetime.fromisoformat(e.entered_at) for e in opened.clerk.entries if e.entered_at)
+    moved = {**opened.clerk.roster.round, "minutes": 1,
+             "start": (last - timedelta(minutes=1, seconds=GRACE_SECONDS - 1)).isoformat(timespec="seconds")}
+    opened.clerk.roster.changed(round=moved)
+    page = browser.new_page(viewport={"width": size[0], "height": size[1]})
+    page.goto(f"http://127.0.0.1:{opened.port}/")
+    page.wait_for_selector("body[data-round='over']", state="attached", timeout=15_000)
+    page.screenshot(path=str(out / f"class_round{suffix}.png"))
+    page.close()
+    teacher(opened, "/api/teacher/round", {"stop": True})
+
+
 def main_(argv: list[str] | None = None) -> int:
     from playwright.sync_api import sync_playwright
 
@@ -111,6 +152,7 @@ def main_(argv: list[str] | None = None) -> int:
                 suffix = "" if args.out is None or args.quick else f"-{width}x{height}"
                 page.goto(f"http://127.0.0.1:{opened.port}/")
                 page.wait_for_selector("#students tr:nth-child(4)")
+                page.wait_for_timeout(300)  # the columns measured at the page's final size
                 page.screenshot(path=str(out / f"class_page{suffix}.png"))
                 page.goto(f"http://127.0.0.1:{opened.port}/lab")
                 page.wait_for_selector(f"body[data-students='{2 if args.quick else 4}']", state="attached")
@@ -122,6 +164,7 @@ def main_(argv: list[str] | None = None) -> int:
                     raise SystemExit(f"the class curve at {width}x{height} cuts {clipped}")
                 page.screenshot(path=str(out / f"class_lab{suffix}.png"))
                 page.close()
+                round_end(browser, opened, Path(tmp), (width, height), out, suffix)
                 play(browser, opened, (width, height), out, suffix)
                 print(f"wrote {out / f'class_page{suffix}.png'}, class_lab{suffix}.png and class_play*{suffix}.png")
             browser.close()

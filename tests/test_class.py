@@ -247,7 +247,6 @@ def test_the_guide_shows_the_lines_the_class_prints(tmp_path):
     with running_class(tmp_path / "class", lines=printed):
         pass
     variable = {re.escape("FROG"): "[A-Z]{4}", re.escape("192.168.1.20:8765"): r"127\.0\.0\.1:\d+",
-                re.escape("x3H..."): r"\S+",
                 re.escape("3f0a8d30240315451b05"): "[0-9a-f]{20}",
                 re.escape("/home/teacher/.local/share/armgame/classes/2026-11-25"): r"\S+"}
     patterns = []
@@ -259,3 +258,47 @@ def test_the_guide_shows_the_lines_the_class_prints(tmp_path):
     assert len(printed) == len(patterns), printed
     for pattern, line in zip(patterns, printed, strict=True):
         assert re.fullmatch(pattern, line), (pattern, line)
+
+
+def test_a_closed_class_refuses_a_game_before_it_is_played(tmp_path, students, capsys):
+    import time
+
+    with running_class(tmp_path / "class") as opened:
+        students("ann")
+        client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Ann")
+        req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/close", method="POST",
+                                     data=b'{"closed": true}', headers={"Content-Type": "application/json"})
+        urllib.request.urlopen(req, timeout=10).close()
+        started = time.perf_counter()
+        assert main(["play", "--headless", "--bot", "model", "--join", f"127.0.0.1:{opened.port}", "--code",
+                     opened.clerk.roster.code, "--name", "Ann"]) == 2
+        err = capsys.readouterr().err
+        assert "is closed: it takes no more games" in err and len(err.strip().splitlines()) == 1
+        assert time.perf_counter() - started < 5  # refused at the join, not after a 60 s game
+
+
+def test_after_class_the_names_the_teacher_hid_stay_hidden_and_the_add_loop_runs_again_quietly(tmp_path, students,
+                                                                                               capsys):
+    folder = tmp_path / "class"
+    with running_class(folder) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        for name, seconds in (("Ann", 20), ("Bo", 30)):
+            students(name)
+            client.hand_in(client.join(address, opened.clerk.roster.code, name),
+                           keyboard_game(seconds, player=name).to_bytes())
+        req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/hide", method="POST",
+                                     data=b'{"name": "Bo"}', headers={"Content-Type": "application/json"})
+        urllib.request.urlopen(req, timeout=10).close()
+    capsys.readouterr()
+    assert main(["scores", "--scores", str(folder)]) == 0
+    out = capsys.readouterr().out
+    assert "Ann" in out and "Bo" not in out and "1 name hidden by the class's teacher" in out
+    game = tmp_path / "ann.json"
+    keyboard_game(20, player="Ann").save(game)
+    table = tmp_path / "offline"
+    assert main(["scores", "--scores", str(table), "--new"]) == 0
+    assert main(["scores", "--scores", str(table), "--add", str(game)]) == 0
+    capsys.readouterr()
+    assert main(["scores", "--scores", str(table), "--add", str(game)]) == 0  # the loop run a second time
+    captured = capsys.readouterr()
+    assert captured.out.startswith("already in: Ann's game") and captured.err == ""

@@ -138,7 +138,9 @@ def test_hostile_names_are_data_everywhere(opened):
     assert {r["name"] for r in standings["students"]} == set(names)  # as typed, for the page to set as text
     status, text = call(opened, "GET", "/api/teacher/games.csv", headers={
         "Authorization": f"Bearer {opened.clerk.roster.secret}"})
-    rows = {r["name"] for r in csv.DictReader(io.StringIO(text))}
+    assert text.startswith("\ufeffentered,")  # a spreadsheet reads it as UTF-8: an accented name stays whole
+    rows = {r["name"] for r in csv.DictReader(io.StringIO(text.removeprefix("\ufeff")))}
+    assert all(len(r["entered_local"]) == 19 for r in csv.DictReader(io.StringIO(text.removeprefix("\ufeff"))))
     assert "'=HYPERLINK(\"http://x\")" in rows and "'+1 \"quoted\" 'name'" in rows  # never a formula
     assert '<script>alert("x")</script>' in rows
     status, page = call(opened, "GET", "/")
@@ -147,21 +149,22 @@ def test_hostile_names_are_data_everywhere(opened):
     assert "<script>alert" not in page  # the page holds no data: its script fetches it and sets it as text
 
 
-def test_the_teachers_actions_need_the_secret(opened):
+def test_the_teachers_actions_need_the_secret_on_another_machine(opened):
     status, answer = join(opened, "Ann")
     code, token = opened.clerk.roster.code, answer["token"]
     call(opened, "POST", "/api/handin", tapped_game(3, player="Ann").to_bytes(),
          {"Authorization": f"Bearer {token}", "X-Armgame-Code": code})
+    other = "127.0.0.2"  # a classmate's laptop; 127.0.0.1 is the teacher's own, which needs no secret
     for path, body in (("/api/teacher/hide", b'{"name": "Ann"}'), ("/api/teacher/close", b'{"closed": true}')):
-        for headers in ({}, {"Authorization": "Bearer guessed"}, {"Authorization": f"Bearer {code}"}):
-            status, answer = call(opened, "POST", path, body, headers)
+        for headers in ({}, {"Authorization": "Bearer guessed"}):
+            status, answer = call(opened, "POST", path, body, headers, other)
             assert status == 403 and "teacher's secret" in answer["error"]
     for path in ("/api/teacher/games.csv", "/api/teacher/lab.csv", "/api/teacher/standings"):
-        assert call(opened, "GET", path)[0] == 403
+        assert call(opened, "GET", path, source=other)[0] in (403, 429)
     assert call(opened, "GET", "/api/standings")[1]["students"][0]["name"] == "Ann"
     assert opened.clerk.roster.secret not in call(opened, "GET", "/teacher")[1]
     secret = {"Authorization": f"Bearer {opened.clerk.roster.secret}"}
-    assert call(opened, "POST", "/api/teacher/hide", b'{"name": "Ann"}', secret)[0] == 200
+    assert call(opened, "POST", "/api/teacher/hide", b'{"name": "Ann"}', secret, "127.0.0.3")[0] == 200
     assert call(opened, "GET", "/api/standings")[1]["students"] == []  # hidden from the projector
     assert len(opened.clerk.entries) == 1  # and still in the table
     assert call(opened, "POST", "/api/teacher/close", b'{"closed": true}', secret)[0] == 200
@@ -259,8 +262,8 @@ def test_the_teacher_frees_a_name_for_a_students_new_machine(opened):
     status, answer = join(opened, "ann")  # the new laptop, the name typed in another case
     assert status == 409 and "taken" in answer["error"]
     student = {"Authorization": f"Bearer {old}"}
-    status, answer = call(opened, "POST", "/api/teacher/release", b'{"name": "Ann"}', student)
-    assert status == 403 and "teacher's secret" in answer["error"]  # a student cannot free names
+    status, answer = call(opened, "POST", "/api/teacher/release", b'{"name": "Ann"}', student, "127.0.0.2")
+    assert status == 403 and "teacher's secret" in answer["error"]  # a student's machine cannot free names
     status, answer = call(opened, "POST", "/api/teacher/release", b'{"name": "Bob"}', secret)
     assert status == 404 and "no machine" in answer["error"]
     assert call(opened, "POST", "/api/teacher/release", b'{"name": 7}', secret)[0] == 400

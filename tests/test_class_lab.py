@@ -60,8 +60,9 @@ def test_volunteers_runs_fill_the_class_curve_one_run_each(tmp_path, runs, monke
                      f"127.0.0.1:{opened.port}", "--code", code, "--name", "Bot"]) == 0
         assert "a program's run" in capsys.readouterr().out
         lab = json.loads(get(opened, "/api/lab"))
-        rows = list(csv.DictReader(io.StringIO(get(opened, "/api/teacher/lab.csv", opened.clerk.roster.secret)
-                                               .decode())))
+        data = get(opened, "/api/teacher/lab.csv", opened.clerk.roster.secret)
+        assert data.startswith("\ufeff".encode())  # a spreadsheet reads it as UTF-8
+        rows = list(csv.DictReader(io.StringIO(data.decode("utf-8-sig"))))
     assert lab["protocol"] == "short" and lab["students"] == 2 and lab["programs"] == 1
     assert lab["metric"] == "max_perpendicular_error_m" and lab["unit"] == "cm"
     assert [t["trial"] for t in lab["trials"]] == [1, 2, 3, 4] and all(t["n"] == 2 for t in lab["trials"])

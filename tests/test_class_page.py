@@ -42,19 +42,19 @@ def test_the_page_shows_games_as_they_arrive_and_names_as_text_and_the_teacher_a
 
 
 def _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch) -> None:
-    """The teacher's page, in the same browser (one chromium for both pages): nothing without the secret; with
-    it, every student listed (names as text), Hide takes one off the projector, and a name is freed for a
-    student's new machine."""
+    """The teacher's page, in the same browser (one chromium for both pages), on the teacher's own machine: open at
+    once with no secret typed (none is ever shown), every student listed (names as text) and every joined name by
+    the machine it joined from, Hide takes one off the projector, and a name is freed for a student's new
+    machine."""
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann's machine"))
     client.hand_in(client.join(address, code, "Ann"), tapped_game(7, player="Ann").to_bytes())
+    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "cy's machine"))
+    client.join(address, code, "Cy")  # joined, no game yet
     page.goto(f"http://127.0.0.1:{opened.port}/teacher")
-    page.fill("#secret", "a guess")
-    page.click("#unlock")
-    page.wait_for_selector("#status:has-text('secret')")
-    assert not page.is_visible("#controls")
-    page.fill("#secret", opened.clerk.roster.secret)
-    page.click("#unlock")
     page.wait_for_selector(f"#everyone tr:nth-child({len(HOSTILE) + 1})")
+    assert not page.is_visible("#ask-secret") and opened.clerk.roster.secret not in page.content()
+    page.wait_for_selector("#machines tr:has-text('Cy'):has-text('joined, no game yet')")
+    assert "have not handed a game in yet" in page.inner_text("#waiting")
     names = page.eval_on_selector_all("#everyone td:nth-child(2)", "cells => cells.map(c => c.textContent)")
     assert sorted(names) == sorted(["Ann", *HOSTILE]) and page.dialogs == []
     page.click("#everyone tr:has-text('Ann') button")
@@ -63,7 +63,7 @@ def _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch) -> No
     page.fill("#release-name", "ann")
     page.click("#release")
     page.wait_for_selector("#status:has-text('Ann is free')")
-    assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == len(HOSTILE)
+    assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == len(HOSTILE) + 1
 
 
 def test_the_class_screenshot_script_draws_every_class_picture(tmp_path, monkeypatch):

@@ -130,3 +130,37 @@ def test_on_a_phone_several_fingers_hold_several_muscles(tmp_path):
         page.click("#not-me")  # another student on this phone: the name is asked again
         page.wait_for_selector("#join", state="visible")
         assert errors == []
+
+
+def close(opened, closed: bool) -> None:
+    """The teacher's page's button, from the teacher's machine (which needs no secret)."""
+    import urllib.request
+
+    req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/close", method="POST",
+                                 data=json.dumps({"closed": closed}).encode(),
+                                 headers={"Content-Type": "application/json"})
+    with urllib.request.urlopen(req, timeout=10) as r:
+        assert json.loads(r.read())["ok"]
+
+
+def test_a_closed_class_starts_no_game_until_the_teacher_opens_it(tmp_path):
+    with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
+        errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+        join(page, opened.clerk.roster.code, "Nia")
+        close(opened, True)  # the teacher closes the class; Nia comes back to the page
+        page.reload()
+        page.wait_for_selector("#status:has-text('the class is closed')")
+        run_for(page, 6000)  # asked again: still closed, still no game
+        assert page.inner_text("#status").startswith("the class is closed") and not page.is_visible("#end")
+        close(opened, False)
+        for _ in range(50):  # the page's next question finds it open and the countdown starts
+            run_for(page, 1000)
+            if "closed" not in page.inner_text("#status"):
+                break
+        assert "closed" not in page.inner_text("#status")
+        page.keyboard.press("x")  # the countdown's key: the game is on, and its keys are taken
+        page.keyboard.down("d")
+        run_for(page, 500)
+        page.keyboard.up("d")
+        assert "not Nia?" not in page.inner_text("#status")  # offered only between games
+        assert errors == []

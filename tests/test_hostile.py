@@ -516,7 +516,9 @@ def test_scores_add_enters_a_recorded_game_once_and_checks_it(tmp_path, capsys):
     assert "--name" in capsys.readouterr().err
     assert main(["scores", "--scores", str(folder), "--add", str(record), "--name", "Kim"]) == 0
     assert "ranked" in capsys.readouterr().out
-    assert main(["scores", "--scores", str(folder), "--add", str(record), "--name", "Kim"]) == 2
+    assert main(["scores", "--scores", str(folder), "--add", str(record), "--name", "Kim"]) == 0  # a loop run again
+    assert capsys.readouterr().out.startswith("already in: Kim's game")
+    assert main(["scores", "--scores", str(folder), "--add", str(record), "--name", "Lee"]) == 2  # another's copy
     assert "already in the table" in capsys.readouterr().err
     data = json.loads(record.read_text())
     data["result"]["score"] = data["result"]["hits"] = 30

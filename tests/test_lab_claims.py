@@ -10,6 +10,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from armgame.lab.learner import TwoRateLearner, simulate
 from armgame.lab.protocol import CHANNEL_DAMPING, CHANNEL_STIFFNESS, SAVINGS_WASHOUT, preset, target_positions
@@ -247,3 +248,37 @@ def test_the_physics_docs_remaining_numbers():
     # "memory stays a few thousand rows": the writer's chunk.
     assert 2000 <= simulation._CHUNK_ROWS < 10_000 and "memory stays a few thousand rows" in PHYSICS
     # derive's "`--seed`, 0 to 2^63 - 1" is held by tests/test_derive.py, where SymPy is imported anyway.
+
+
+def test_issue_39s_corrected_numbers():
+    """The numbers an independent re-analysis found wrong in the lab's docs (issue 39), as now stated: the
+    person's clock on ``lesson`` (lab_config's docstring said 5 minutes), the worst window times with the mean
+    and the longest wait at home, the generalization's width against its bases', and the citations."""
+    import importlib.util
+
+    from armgame.lab.learner import TUNING_WIDTH_DEG, DirectionalLearner
+
+    lesson = preset("lesson")
+    person, program = lab_config(lesson, 10, person=True).time_limit, lab_config(lesson, 10).time_limit
+    assert f"``lesson``: {person:.0f} s, {person / 60:.1f} minutes, of reaching" in re.sub(r"\s+", " ",
+                                                                                            lab_config.__doc__)
+    assert f"a program {program:.0f} s" in re.sub(r"\s+", " ", lab_config.__doc__)
+    _says(LAB, f"(`lesson`: {program:.0f} s and {person:.0f} s)")
+    spec = importlib.util.spec_from_file_location("lab_slot", DOCS.parent / "benchmarks" / "lab_slot.py")
+    slot = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(slot)
+    _, worst, longest = slot.person_estimate(lesson)
+    _says(_text("teaching.md"), f"at most {worst / 60:.1f} minutes even if every reach times out (with the mean wait "
+                                f"at home; {longest / 60:.2f} with the longest)")
+    local = DirectionalLearner(TwoRateLearner())
+    widths = [d / math.sqrt(-2.0 * math.log(local.generalization(d))) for d in (22.5, 45.0, 67.5, 90.0)]
+    assert max(widths) - min(widths) < 0.01  # the overlap of two tunings is a Gaussian: one s.d. at every angle
+    assert widths[0] == pytest.approx(TUNING_WIDTH_DEG * math.sqrt(2.0), abs=0.01)
+    _says(LAB, f"The {TUNING_WIDTH_DEG:g} deg is each basis function's width (s.d.); the generalization they make is "
+               f"wider, a Gaussian of s.d. {widths[1]:.1f} deg")
+    # Krakauer et al. (2000) is a visuomotor-rotation study: cited for rotation, never for a force field's design.
+    _says(LAB, "Gandolfo, Mussa-Ivaldi & Bizzi (1996) trained a force field", "(Krakauer et al. 2000 asked the same of "
+               "a visuomotor rotation)", "Generalization of a visuomotor rotation across directions.")
+    from armgame.lab import protocol as protocols
+
+    assert "Krakauer" not in protocols.generalization.__doc__

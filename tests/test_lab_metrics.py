@@ -20,6 +20,7 @@ from armgame.lab.metrics import (
     read_trials_csv,
     write_trials_csv,
 )
+from armgame.lab.protocol import FEEDBACK
 
 DT = 0.001
 D = 0.10        # reach distance (m)
@@ -235,16 +236,19 @@ def row(number, **changes):
             "reaction_time_s": 0.3141592653589793, "movement_time_s": 0.45, "peak_speed_m_per_s": 0.375,
             "initial_direction_error_deg": -12.5, "max_perpendicular_error_m": 0.0123,
             "path_length_ratio": 1.1, "hit": True, "channel_force_peak_n": float("nan"),
-            "channel_force_at_peak_speed_n": float("nan"), "adaptation_index": float("nan")}
+            "channel_force_at_peak_speed_n": float("nan"), "adaptation_index": float("nan"),
+            "hand_sent_home": False,
+            "feedback": "full", "disturbance": 1.0, "adaptation_index_hand": float("nan"),
+            "adaptation_index_joint": float("nan")}
     base.update(changes)
     return base
 
 
 def test_trials_round_trip_exactly_with_nan_as_empty(tmp_path):
     rows = [row(1, perturbation="channel", channel_force_peak_n=1.5, channel_force_at_peak_speed_n=-0.25,
-                adaptation_index=0.75),
+                adaptation_index=0.75, adaptation_index_hand=0.75, adaptation_index_joint=-0.5),
             row(2, hit=False, reaction_time_s=float("nan"), path_length_ratio=np.float64(1 / 3)),
-            row(3, block="washout", perturbation="none", trial=np.int64(3), hit=np.bool_(True))]
+            row(3, block="washout", perturbation="none", trial=np.int64(3), hit=np.bool_(True), hand_sent_home=True)]
     path = tmp_path / "trials.csv"
     write_trials_csv(path, rows)
     text = path.read_text()
@@ -254,6 +258,7 @@ def test_trials_round_trip_exactly_with_nan_as_empty(tmp_path):
     assert [list(r) for r in back] == [list(TRIAL_COLUMNS)] * 3
     assert back[1]["path_length_ratio"] == 1 / 3 and math.isnan(back[1]["reaction_time_s"])
     assert back[0] == rows[0] and back[2]["trial"] == 3 and back[2]["hit"] is True and back[1]["hit"] is False
+    assert back[2]["hand_sent_home"] is True and back[1]["hand_sent_home"] is False
 
 
 def test_write_refuses_bad_rows_and_non_regular_targets(tmp_path):
@@ -318,6 +323,7 @@ def test_reader_accepts_a_spreadsheets_table(tmp_path):
     (rows,) = read_trials_csv(write_text(tmp_path, text))
     assert rows["hit"] is True and math.isnan(rows["reaction_time_s"]) and rows["trial"] == 1
     assert list(rows) == list(TRIAL_COLUMNS) and math.isnan(rows["adaptation_index"])  # absent: read as NaN
+    assert rows["hand_sent_home"] is False  # a table from before the column: no reach was sent home
 
 
 def test_a_table_from_before_each_column_named_its_unit_still_reads(tmp_path):
@@ -333,7 +339,8 @@ def test_a_table_from_before_each_column_named_its_unit_still_reads(tmp_path):
 def test_every_measure_names_its_unit():
     """SI in every table: a measure's column ends in its unit, or is a ratio or an index."""
     for name in TRIAL_COLUMNS:
-        if name not in ("block", "trial", "perturbation", "hit", "path_length_ratio", "adaptation_index"):
+        if name not in ("block", "trial", "perturbation", "hit", "path_length_ratio", "adaptation_index", "feedback",
+                        "disturbance", "adaptation_index_hand", "adaptation_index_joint", "hand_sent_home"):
             assert name.endswith(("_s", "_m", "_m_per_s", "_deg", "_n")), name
 
 
@@ -392,7 +399,9 @@ text = st.text(st.characters(codec="utf-8", categories=("L", "N", "P", "S", "Zs"
     "peak_speed_m_per_s": measure.map(abs), "initial_direction_error_deg": measure,
     "max_perpendicular_error_m": measure,
     "path_length_ratio": measure.map(abs), "hit": st.booleans(), "channel_force_peak_n": measure,
-    "channel_force_at_peak_speed_n": measure, "adaptation_index": measure}), max_size=5))
+    "channel_force_at_peak_speed_n": measure, "adaptation_index": measure, "hand_sent_home": st.booleans(),
+    "feedback": st.sampled_from(FEEDBACK), "disturbance": measure, "adaptation_index_hand": measure,
+    "adaptation_index_joint": measure}), max_size=5))
 def test_any_table_round_trips_exactly(tmp_path_factory, rows):
     path = tmp_path_factory.mktemp("round") / "trials.csv"
     write_trials_csv(path, rows)

@@ -166,7 +166,7 @@ def test_the_local_learner_generalizes_by_its_tuning_and_the_global_one_everywhe
     with pytest.raises(UserError, match="tuning width must be a number of degrees from 5 to 180, got 1"):
         DirectionalLearner(TwoRateLearner(), 1)
     bot, flat = make_lab_bot("adaptive", representation="local"), make_lab_bot("adaptive")
-    assert "local learner: Gaussian tuning over movement direction, 30 deg wide" in bot.describe()
+    assert "local learner: Gaussian tuning over movement direction, bases of s.d. 30 deg" in bot.describe()
     assert flat.describe().startswith("global learner") and make_lab_bot("model").describe() == ""
     with pytest.raises(UserError, match="learner representation"):
         make_lab_bot("adaptive", representation="wide")
@@ -253,3 +253,62 @@ def test_probe_and_learner_options_errors_are_one_line(argv, message, capsys, tm
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_subtract_baseline_never_blanks_a_direction_the_baseline_did_not_probe(tmp_path, capsys):
+    """Issue 39: ``spontaneous``'s baseline probes 4 of its 8 directions, and --subtract-baseline blanked every
+    channel trial to the other 4 (32 of 68). A direction without its own baseline takes the nearest probed
+    direction's (the mean of the two when two are as near), and the output names them."""
+    from armgame.lab.analysis import baseline_for, baseline_offsets, subtract_baseline, trial_rows
+
+    assert baseline_for({0.0: 0.25, 90.0: -0.25, 180.0: 0.5}, 45.0) == (0.0, (0.0, 90.0))
+    assert baseline_for({0.0: 0.25, 90.0: -0.25, 180.0: 0.5}, 135.0) == (0.125, (90.0, 180.0))
+    assert baseline_for({0.0: 0.25, 180.0: 0.5}, 315.0) == (0.25, (0.0,))
+    assert baseline_for({0.0: 0.25}, 0.0) == (0.25, (0.0,))
+    spontaneous = preset("spontaneous")
+    plans = schedule(spontaneous, 10, 0.004, (0.0, 0.5))
+    probed = {p.target_deg for p in plans if p.channel and p.block == 0}
+    assert len(probed) == 4 < len({p.target_deg for p in plans if p.channel})  # the case the issue found
+    curl = Perturbation.make("curl", b=2.0)
+    protocol = Protocol("probes", (Block("baseline", 8, channel_trials=2),
+                                   Block("exposure", 12, curl, channel_trials=4)), targets=4)
+    session = LabSession(lab_config(protocol, 3), protocol)
+    from armgame.game.bots import Autopilot
+
+    Autopilot(session, make_lab_bot("model")).play()
+    rows = trial_rows(session)
+    offsets = baseline_offsets(session, rows)
+    assert len(offsets) == 2
+    less = subtract_baseline(session, rows)
+    exposed = [r for r in less if r["perturbation"] == "channel" and r["block"] == "exposure"]
+    assert len({r["target_deg"] for r in exposed}) == 4 and all(math.isfinite(r["adaptation_index"]) for r in exposed)
+    for before, after in zip(rows, less, strict=True):
+        if after in exposed:
+            base, _ = baseline_for(offsets, before["target_deg"])
+            assert after["adaptation_index"] == before["adaptation_index"] - base
+    from armgame.records.replay import Replay, now_iso
+
+    path = tmp_path / "p.json"
+    Replay(session.config, tuple(session.timeline), session.result(), "bot", "model", None, now_iso(),
+           task=LabTask.of(session)).save(path)
+    assert main(["analyze", str(path), "--out", str(tmp_path / "t"), "--subtract-baseline"]) == 0
+    assert "no baseline channel trial to " in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("argv", "representation"), [
+    (["generalization"], "local"),  # the preset's point, without a flag (issue 39)
+    (["generalization", "--representation", "global"], "global"),  # its control, by name
+    (["curl"], "global"),
+])
+def test_the_generalization_preset_runs_the_local_learner_by_default(argv, representation, monkeypatch):
+    import armgame.lab.bots
+
+    made = []
+
+    def capture(name, rates=None, representation="global", *rest, **options):
+        made.append(representation)
+        raise SystemExit(0)  # the learner chosen is all this test needs: no run
+    monkeypatch.setattr(armgame.lab.bots, "make_lab_bot", capture)
+    with pytest.raises(SystemExit):
+        main(["lab", *argv, "--bot", "adaptive", "--headless"])
+    assert made == [representation]

@@ -467,3 +467,56 @@ def test_r_runs_again_in_the_same_window_and_each_file_is_listed_where_it_is(tmp
     assert _numbered(tmp_path / "run", 1) == tmp_path / "run" and _numbered(tmp_path / "run", 2) == tmp_path / "run-3"
     home = Path.home()
     assert kept_lines([home / "a" / "r.json", home / "a" / "t.csv"]) == ["Kept in ~/a:", "   r.json   t.csv"]
+
+
+def test_losing_the_focus_never_stalls_the_run(screen):
+    """Issue 39: a volunteer's pointer left the window, the window lost the focus and paused until p, which no
+    volunteer is told: the run stood still for 1.5 minutes at trial 3. Now it waits only while the window is away:
+    the focus back, or any key, plays on; a key held as it left is let go, in the timeline."""
+    session = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0)
+    start(win)
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_d))
+    win.frame(0.05)
+    assert session.held[0]
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSLOST))
+    win.frame(0.05)
+    assert win.paused and win.away and not session.held[0] and session.timeline[-1].action == "up"
+    steps = session.steps
+    win.frame(0.5)
+    assert session.steps == steps  # away: the run waits (the volunteer may be gone)
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSGAINED))
+    win.frame(0.05)
+    assert not win.paused and session.steps > steps
+    # A window manager that never says the focus came back: the first key plays on, and acts.
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSLOST))
+    win.frame(0.05)
+    steps = session.steps
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_j))
+    win.frame(0.05)
+    assert not win.paused and session.held[2] and session.steps > steps
+    # p, the key the pause panel names, resumes too rather than pausing again.
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSLOST))
+    win.frame(0.05)
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_p))
+    win.frame(0.05)
+    assert not win.paused and not win.away
+    # A pause asked for with p is the volunteer's: the focus coming back does not lift it.
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_p))
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSLOST))
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSGAINED))
+    win.frame(0.05)
+    assert win.paused
+
+
+def test_a_bots_run_goes_on_without_the_focus(screen):
+    session = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0, driver=RealTimeDriver(Autopilot(session,
+                                                                                               make_lab_bot("model"))),
+                    mode="AUTOPILOT: model")
+    win.card = None
+    pygame.event.post(pygame.event.Event(pygame.WINDOWFOCUSLOST))
+    win.frame(0.0)
+    steps = session.steps
+    win.frame(0.2)
+    assert not win.paused and session.steps > steps

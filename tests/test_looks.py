@@ -126,3 +126,19 @@ def test_text_scale_and_the_high_contrast_palette_are_settings():
     for bad in ("text_scale = 9", "text_scale = \"big\"", "text_scale = true", "text_scale = nan"):
         with pytest.raises(SettingsError, match=r"text_scale must be a number from 0\.75 to 2\.5"):
             from_toml(bad.encode(), "s.toml")
+
+
+def test_the_end_screens_long_lines_wrap_whole_inside_the_panel(fonts):
+    from armgame.ui.render import Standing
+
+    note = ("Not handed in yet: the class at 192.168.1.20:8765 did not answer (busy, or stopped for a moment); your "
+            "game is kept and will be handed in the next time you join")
+    session, r = renderer("high-contrast")
+    session.play([])
+    hud = Hud(mode="PLAY", ended=True, standing=Standing(None, 0, (), note=note))
+    for size in (PROJECTOR, (800, 600)):
+        lay = r.layout(size, session, hud)
+        lines = sorted((lab for lab in lay.labels if lab.role == "end"), key=lambda lab: lab.rect.top)
+        shown = " ".join(lab.text for lab in lines)
+        assert note in shown and "..." not in shown, size
+        assert all(lay.panels[0].contains(lab.rect) for lab in lines), size

@@ -74,8 +74,30 @@ def test_each_entry_starts_its_window_and_the_menu_comes_back(monkeypatch):
 def test_a_failed_entry_says_so_on_the_menu():
     menu = MenuWindow(lambda: menu_command.main_page(lambda argv: 2))
     menu.choose(0)
-    assert menu.pending is not None and menu.pending.start() == \
-        "armgame play stopped (status 2): the terminal says why"
+    assert menu.pending is not None and menu.pending.start() == "armgame play stopped (status 2)"
+
+
+def test_a_failed_join_shows_its_whole_reason_on_the_menu(capsys):
+    """The command's own line, as the terminal has it, on the menu, wrapped, never cut off."""
+    import sys
+
+    why = ("cannot reach the class at 10.0.0.9:8765 (Connection refused): is the class started, and is this machine "
+           "on the teacher's network? (school Wi-Fi often keeps laptops apart: docs/teaching.md)")
+
+    def failing(argv):
+        print(f"armgame play: {why}", file=sys.stderr)
+        return 2
+
+    menu = MenuWindow(lambda: menu_command.main_page(failing))
+    menu.choose(0)
+    menu.status = menu.pending.start()
+    assert menu.status == why and why in capsys.readouterr().err  # the terminal has it too
+    pygame.display.init()
+    pygame.font.init()
+    menu.screen = pygame.display.set_mode((1024, 768))
+    shown = [label.text for label in sorted(menu.layout((1024, 768)).labels, key=lambda label: label.rect.top)
+             if label.role == "status"]
+    assert len(shown) > 1 and " ".join(shown) == why
 
 
 def test_the_mouse_chooses_and_clicks():

@@ -9,7 +9,10 @@ which the projector's page shows live, one row per student. What each module own
 * ``intake``: one hand-in from arrival to answer: checked, verified, entered once by its content,
   durably on disk before it is acknowledged; the class's standings built from what was entered.
 * ``app``: the ASGI application (Starlette): the routes, the bounded queue in front of the clerk
-  thread, rate limits and body limits, the projector's event stream.
+  thread, rate limits and body limits per machine, the projector's event stream.
+* ``guard``: what a connection may cost before it is a request (deadlines, a share per address),
+  under uvicorn's own HTTP parsing.
+* ``rounds``: a round ("everyone play now"): which games count, its clock, its winners.
 * ``page``: the projector's, the lab's and the teacher's pages (static HTML; the data arrives as JSON
   and is only ever set as text).
 * ``serve``: starting the server (uvicorn) on the address the students can reach, and stopping it.

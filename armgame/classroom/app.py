@@ -307,7 +307,7 @@ def _json(data: object, status: int = 200, headers: dict[str, str] | None = None
 
 def _refusal(exc: RefusedError) -> Response:
     headers = {"Retry-After": str(getattr(exc, "retry_after", 2))} if exc.status in (429, 503) else {}
-    if exc.status in (400, 401, 403, 408, 413, 415, 429):  # a body may be left unread: the connection is not used again
+    if exc.status in (400, 401, 403, 408, 413, 415, 429, 503):  # a body may be left unread: the connection ends
         headers["Connection"] = "close"
     return _json({"ok": False, "error": exc.message}, exc.status, headers)
 
@@ -403,17 +403,18 @@ def _check_code(state: ClassState, request: Request, typed: object) -> None:
 
 
 def _check_secret(state: ClassState, request: Request) -> None:
-    """The teacher's secret, from the Authorization header. The teacher's own machine is never made to wait:
-    a guesser elsewhere cannot lock the teacher out."""
+    """The teacher's routes: the teacher's own machine is the teacher (no secret to type, so none is ever shown
+    where the room can read it; never made to wait); any other machine needs the secret, from the Authorization
+    header, its wrong guesses counted apart."""
     address = _address(request)
-    own = state.guard.is_own(address)
-    if not own:
-        _waiting(state.secrets, address, "secrets")
+    if state.guard.is_own(address):
+        return
+    _waiting(state.secrets, address, "secrets")
     secret = _bearer(request)
     if secret is None or not state.clerk.roster.secret_matches(secret):
-        if not own:
-            state.secrets.failed(address)
-        raise RefusedError(403, "the teacher's secret is needed for this (it is printed in the teacher's terminal)")
+        state.secrets.failed(address)
+        raise RefusedError(403, "the teacher's secret is needed for this on another machine than the teacher's (it "
+                                "is in the file teacher.secret in the class's folder)")
     state.secrets.succeeded(address)
 
 
@@ -476,6 +477,15 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         for problem in await state.run(clerk.load_lab):
             say(f"left out of the class curve: {problem}")
 
+    async def round_clock() -> None:
+        """A round's end is a change no request makes: looked for every second while a round is on, so the
+        projector shows its winners as its clock runs out."""
+        while not state.stopping.is_set():
+            await asyncio.sleep(1.0)
+            if clerk.roster.round is not None and not clerk.round_over:
+                with contextlib.suppress(RefusedError):
+                    await state.run(clerk.round_ended)
+
     @asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
         state.worker = ClerkThread(clerk, state.publish)
@@ -484,12 +494,14 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
             on_ready()
         # The lab runs already in the folder are checked again in the background: the page is up at once.
         loading = asyncio.ensure_future(load_lab())
+        ticking = asyncio.ensure_future(round_clock())
         try:
             yield
         finally:
             state.stopping.set()
             state.changed.set()
             loading.cancel()
+            ticking.cancel()
             state.worker.stop()  # a hand-in being written is finished, never cut
 
     async def home(request: Request) -> Response:
@@ -626,6 +638,15 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         message = await state.run(lambda: clerk.choose_lab(body.get("protocol")))
         return _json({"ok": True, "message": message})
 
+    async def teacher_round(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        if body.get("stop") is True:
+            message = await state.run(clerk.stop_round)
+        else:
+            message = await state.run(lambda: clerk.start_round(body.get("minutes")))
+        return _json({"ok": True, "message": message})
+
     async def teacher_standings(request: Request) -> Response:
         _check_secret(state, request)
         return _json(await state.run(lambda: clerk.standings(teacher=True)))
@@ -642,6 +663,26 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
                                                         f'attachment; filename="{filename}"'},
                             media_type="text/csv; charset=utf-8")
         return route
+
+    async def teacher_lab_png(request: Request) -> Response:
+        """The class curve as the lab's figure draws it (a PNG for a report), where matplotlib is installed."""
+        _check_secret(state, request)
+        from ..lab.figures import class_figure_png, require_matplotlib
+
+        try:
+            require_matplotlib()
+        except UserError:
+            raise RefusedError(503, "the lab curve's picture needs matplotlib on the teacher's machine: pip install "
+                                    "'armgame[plot]' (the lab's CSV needs nothing)") from None
+
+        def draw() -> bytes | None:  # on the clerk's thread: the curve as it is now, and one drawing at a time
+            curve = clerk.class_curve()
+            return class_figure_png(curve.trials, metric=curve.metric) if curve.students else None
+        png = await state.run(draw)
+        if png is None:
+            raise RefusedError(404, "no class curve yet: no volunteer's run of the class's protocol")
+        return Response(png, 200, {**SECURITY_HEADERS, "Content-Disposition":
+                                   'attachment; filename="class-lab-curve.png"'}, media_type="image/png")
 
     routes = [
         Route("/", _refusals(home)),
@@ -661,10 +702,12 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/teacher/close", _refusals(teacher_close), methods=["POST"]),
         Route("/api/teacher/lock", _refusals(teacher_lock), methods=["POST"]),
         Route("/api/teacher/lab", _refusals(teacher_lab), methods=["POST"]),
+        Route("/api/teacher/round", _refusals(teacher_round), methods=["POST"]),
         Route("/api/teacher/standings", _refusals(teacher_standings)),
         Route("/api/teacher/roster", _refusals(teacher_roster)),
         Route("/api/teacher/games.csv", _refusals(csv_route(clerk.games_csv, "class-games.csv"))),
         Route("/api/teacher/lab.csv", _refusals(csv_route(clerk.lab_csv, "class-lab-reaches.csv"))),
+        Route("/api/teacher/lab.png", _refusals(teacher_lab_png)),
     ]
     app = Starlette(routes=routes, lifespan=lifespan)
     app.state.armgame = state

@@ -101,8 +101,12 @@ class ClassAddress:
 
 def check_code(text: str, what: str = "--code") -> str:
     code = normal_code(text)
-    if len(code) != CODE_LENGTH or any(c not in CODE_ALPHABET for c in code):
+    if len(code) != CODE_LENGTH:
         raise UserError(f"{what} {text!r}: a class code is {CODE_LENGTH} letters, as the projector shows it")
+    never = sorted({c for c in code if c not in CODE_ALPHABET})
+    if never:  # "BBBB": a letter no code holds, because a projector's font would make it another
+        raise UserError(f"{what} {text!r}: no class code holds {', '.join(never)} (codes leave out letters and digits "
+                        f"a projector's font confuses, such as B and 8, O and 0): check the code on the projector")
     return code
 
 
@@ -180,6 +184,8 @@ class Membership:
     name: str
     token: str
     seed: int
+    #: The class took no more games when this machine joined (the teacher closed it).
+    closed: bool = False
 
     @property
     def key(self) -> str:
@@ -243,7 +249,8 @@ def join(address: ClassAddress, code: str, name: str | None) -> Membership:
     body = json.dumps({"code": code, "name": name, **({"token": token} if token else {})}).encode()
     answer = _request(address, "/api/join", body, {"Content-Type": "application/json"})
     try:
-        membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]))
+        membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]),
+                                answer.get("closed") is True)
     except (KeyError, TypeError, ValueError):
         raise BadAnswerError("the class's answer is not armgame's (is that address an armgame class?)") from None
     _remember(membership)

@@ -29,6 +29,7 @@ import secrets
 import stat
 from collections.abc import Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +43,7 @@ from ..records.standings import one_row_per_player, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
 from ..records.tablefile import name_slug
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
+from .rounds import Round, new_round, round_view
 
 #: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
 #: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
@@ -123,6 +125,7 @@ class Clerk:
         self.lab_runs: list[LabRun] = []
         self.lab_digests: set[str] = set()
         self.arrival: Arrival | None = None
+        self.round_over = False  # the current round's winners have been shown
         self.version = 0  # bumped at every change the projector should see
         self.lab_version = 0  # and at every change of the class curve (a lab run, a name hidden)
 
@@ -152,6 +155,9 @@ class Clerk:
                 return player, None
             raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
                                f"name (or join from the machine that took it)")
+        if name.strip().upper() == "NAME":
+            raise RefusedError(400, "type your own name in place of NAME (in quotes if it has a space: "
+                                    "--name \"Ann B\")")
         problem = name_problem(name)
         if problem is not None:
             raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "
@@ -361,34 +367,36 @@ class Clerk:
 
     def _curve_protocol(self) -> Any:
         """The protocol the teacher chose for the class curve (``Roster.lab``), or None."""
-        from ..lab.protocol import preset, protocol_from_dict
+        from ..lab.analysis import curve_protocol
 
-        lab = self.roster.lab
-        if isinstance(lab, dict):
-            return protocol_from_dict(lab, "lab")
-        return preset(lab) if lab else None
+        return curve_protocol(self.roster.lab)
+
+    def class_curve(self) -> Any:
+        """``lab.analysis.class_curve_of`` the teacher's protocol over the class's runs (in SI units): hidden
+        names left out, programs' runs counted apart."""
+        from ..lab.analysis import ClassRun, class_curve_of
+
+        runs = [run for run in self.lab_runs if run.program or (run.first and not self.roster.is_hidden(run.player))]
+        return class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                              self._curve_protocol())
 
     def lab_curve(self) -> dict[str, object]:
         """The class curve of the protocol the teacher chose: each person's first run of it (programs' runs
-        and hidden names never in it; the programs counted apart)."""
-        from ..lab.analysis import display_unit, figure_metric
-        from ..lab.figures import class_curve
+        and hidden names never in it; the programs counted apart). Built by ``lab.analysis.class_curve_of``,
+        as ``armgame analyze --class`` builds it from the folder afterwards."""
+        from ..lab.analysis import display_unit
 
         protocol = self._curve_protocol()
-        runs = [run for run in self.lab_runs if run.first and not run.program and run.protocol == protocol
-                and not self.roster.is_hidden(run.player)]
-        programs = sum(run.program for run in self.lab_runs)
-        if protocol is None or not runs:
-            return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": programs,
+        curve = self.class_curve()
+        if not curve.students:
+            return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
                     "metric": None, "trials": []}
-        metric = figure_metric(protocol)
-        curve = class_curve([run.rows for run in runs], metric)
-        scale, unit = display_unit(metric)
+        scale, unit = display_unit(curve.metric)  # type: ignore[arg-type]
         trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
                    "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
-                  for row in curve]
-        return {"protocol": protocol.name, "students": len(runs), "programs": programs,
-                "metric": metric, "unit": unit, "trials": trials}
+                  for row in curve.trials]
+        return {"protocol": protocol.name, "students": curve.students, "programs": curve.programs,
+                "metric": curve.metric, "unit": unit, "trials": trials}
 
     # ------------------------------------------------------------------ the teacher
     def hide(self, name: object, hidden: bool) -> str:
@@ -477,10 +485,48 @@ class Clerk:
         shown = arrival is not None and not self.roster.is_hidden(arrival.name)
         return {"version": self.version, "seed": self.roster.seed, "closed": self.roster.closed,
                 "joined": len(self.roster.players), "games": len(self.entries),
+                "round": None if teacher else self.round_view(),
                 "students": rows(False), "programs": rows(True),
                 "arrival": None if not shown else {"seq": arrival.seq, "name": arrival.name,  # type: ignore[union-attr]
                                                    "score": arrival.score, "note": arrival.note,  # type: ignore[union-attr]
                                                    "program": arrival.program}}  # type: ignore[union-attr]
+
+    # ------------------------------------------------------------------ rounds
+    def current_round(self) -> Round | None:
+        return None if self.roster.round is None else Round.from_dict(self.roster.round)
+
+    def start_round(self, minutes: object) -> str:
+        """A new round of ``minutes``, from now (the last one ends here if it was still on)."""
+        try:
+            rnd = new_round(self.current_round(), minutes, max((e.entered or 0 for e in self.entries), default=0))
+        except ValueError as exc:
+            raise RefusedError(400, str(exc)) from None
+        self.roster.changed(round=rnd.as_dict())
+        self.version += 1
+        self.round_over = False
+        return f"round {rnd.number}: {rnd.minutes} min, from now"
+
+    def stop_round(self) -> str:
+        rnd = self.current_round()
+        if rnd is None:
+            raise RefusedError(404, "no round has been started")
+        self.roster.changed(round=None)
+        self.version += 1
+        return f"round {rnd.number} is off the projector"
+
+    def round_ended(self, now: datetime | None = None) -> bool:
+        """Whether the round's results just became final (its clock and grace run out): the projector is told
+        once, and shows its winners."""
+        rnd = self.current_round()
+        if rnd is None or self.round_over or not rnd.over(now or datetime.now(UTC)):
+            return False
+        self.round_over = True
+        self.version += 1
+        return True
+
+    def round_view(self, now: datetime | None = None) -> dict[str, object] | None:
+        return round_view(self.current_round(), self.entries, self.roster.hidden, now or datetime.now(UTC),
+                          STANDINGS_ROWS)
 
     def roster_view(self) -> dict[str, object]:
         """For the teacher's page: every joined name with the machine (address) it joined from and its games
@@ -507,11 +553,13 @@ class Clerk:
                 "lab": lab.get("name") if isinstance(lab, dict) else lab, "presets": list(PRESETS)}
 
     def games_csv(self) -> str:
-        columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_at",
-                   "hidden", "replay")
+        """Every game entered, in order; ``entered_local`` is the teacher's clock (what a teacher compares with
+        the lesson), ``entered_at`` the same moment in UTC as the table keeps it."""
+        columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_local",
+                   "entered_at", "hidden", "replay")
         ordered = sorted(self.entries, key=lambda e: e.entered or 0)
         return _csv(columns, ([e.entered, e.name, "programs" if e.program else "students", e.driven, e.driver or "",
-                               e.score, e.hits, e.resets, e.seed, e.entered_at or "",
+                               e.score, e.hits, e.resets, e.seed, local_time(e.entered_at), e.entered_at or "",
                                self.roster.is_hidden(e.name), e.replay] for e in ordered))
 
     def lab_csv(self) -> str:
@@ -572,8 +620,21 @@ def csv_cell(value: object) -> str:
     return "'" + text if text.startswith(_FORMULA) else text
 
 
+def local_time(utc: str | None) -> str:
+    """An ISO time with its zone as this machine's local time, to the second (the teacher's clock)."""
+    if not utc:
+        return ""
+    try:
+        return datetime.fromisoformat(utc).astimezone().strftime("%Y-%m-%d %H:%M:%S")
+    except (ValueError, OverflowError, OSError):
+        return ""
+
+
 def _csv(columns: Sequence[str], rows) -> str:
+    """The CSV text, with a byte-order mark first: the one sign a spreadsheet (Excel) reads to take the file as
+    UTF-8, so an accented name is not garbled."""
     out = io.StringIO()
+    out.write("\ufeff")
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(columns)
     for row in rows:

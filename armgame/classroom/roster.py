@@ -5,6 +5,7 @@ thread), atomically and fsynced before a join is acknowledged::
 
     class.json        {"format": "armgame-class", "format_version": 2, "code": "FROG", "seed": 10,
                        "closed": false, "locked": false, "lab": "lesson", a protocol or null,
+                       "round": {"number", "start", "minutes", "after"} or null,
                        "players": {key: {"name", "token_sha256", "joined", "address"}},
                        "hidden": [key, ...]}
     teacher.secret    the teacher's secret, created once with owner-only permissions
@@ -100,6 +101,8 @@ class Roster:
     locked: bool = False
     #: The class curve's protocol: a preset's name, a protocol file's ``as_dict`` (the teacher's own), or None.
     lab: str | dict | None = None
+    #: The last round the teacher started (``rounds.Round.as_dict``), or None.
+    round: dict | None = None
 
     def __post_init__(self) -> None:
         self._index()
@@ -183,7 +186,7 @@ class Roster:
             version = check_int("format_version", d.get("format_version"), 1, 10**6)
             if version > FORMAT_VERSION:
                 raise ValueError(f"class record format {version} is newer than this armgame reads: update armgame")
-            later = {"locked", "lab"} if version >= 2 else set()
+            later = {"locked", "lab", "round"} if version >= 2 else set()
             d = check_keys("class record", d, {"format", "format_version", "code", "seed", "closed", "players",
                                                "hidden", "created", *later})
             code = check_str("code", d["code"], CODE_LENGTH)
@@ -222,15 +225,21 @@ class Roster:
                 protocol_from_dict(lab, "lab")  # a class record's own protocol is checked like any other
             elif lab is not None:
                 lab = check_str("lab", lab, 80)
+            rnd = d.get("round")
+            if rnd is not None:
+                from .rounds import Round
+
+                rnd = Round.from_dict(rnd).as_dict()
         except ValueError as exc:
             raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
         hidden = {player_key(k) for k in d["hidden"]}  # player_key of an older key is today's key
-        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab)
+        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab, rnd)
 
     def save(self) -> None:
         data = dump_json({
             "format": FORMAT, "format_version": FORMAT_VERSION, "code": self.code, "seed": self.seed,
-            "closed": self.closed, "locked": self.locked, "lab": self.lab, "created": self.created,
+            "closed": self.closed, "locked": self.locked, "lab": self.lab, "round": self.round,
+            "created": self.created,
             "hidden": sorted(self.hidden),
             "players": {k: {"name": p.name, "token_sha256": p.token_sha256, "joined": p.joined, "address": p.address}
                         for k, p in self.players.items()},

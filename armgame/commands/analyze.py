@@ -23,13 +23,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "trials, and measure every reach: one row per reach (block, trial, target_deg, perturbation, "
         "reaction_time_s, movement_time_s, peak_speed_m_per_s, initial_direction_error_deg, max_perpendicular_error_m, "
         "path_length_ratio, hit, and on error-clamp trials channel_force_peak_n, channel_force_at_peak_speed_n, "
-        "adaptation_index). --fit two-rate (or one-rate) fits a learner's rates to each run by maximum likelihood, "
+        "adaptation_index; hand_sent_home is 1 on a reach that space ended, measured only up to then). --fit "
+        "two-rate (or one-rate) fits a learner's rates to each run by maximum likelihood, "
         "with profile-likelihood intervals, AIC and BIC; --fit both fits the two and says which the data support. A "
         "replay that does not verify is reported and left out. With --class DIR: "
         "every lab replay in DIR (one per student, the same protocol) into one class curve, the mean and s.e.m. "
-        "per trial of --metric: class_curve.csv and class_curve.png in --out. The class's protocol is the one most "
-        "replays share (or the one --protocol names); each game counts once, however many copies of it there are; "
-        "what is left out is named, with why. Exit status: 0 if every replay "
+        "per trial of --metric: class_curve.csv and, where matplotlib is installed, class_curve.png in --out. The "
+        "class's protocol is the one most replays share (or the one --protocol names); each game counts once, "
+        "however many copies of it there are; what is left out is named, with why. A live class's folder (with its "
+        "class.json), or its lab/, gives the class's own curve, the one its /lab page drew: the teacher's protocol, "
+        "each person's first run of it, programs' runs and hidden names apart. Exit status: 0 if every replay "
         "was analysed, 1 if some were left out, 2 on bad arguments or when nothing could be analysed.",
     )
     p.add_argument("replays", nargs="*", metavar="REPLAY", help="lab replays (armgame lab --record FILE)")
@@ -43,19 +46,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="the class curve's measure (default: max_perpendicular_error_m for force fields, "
                    "initial_direction_error_deg for visual transforms)")
     p.add_argument("--no-figures", action="store_true",
-                   help="with --class or --fit: no figures (no matplotlib needed)")
-    p.add_argument("--fit", choices=("two-rate", "one-rate", "both"),
+                   help="with --class or --fit: no figures (--class draws its figure only where matplotlib is "
+                   "installed, and says so otherwise)")
+    p.add_argument("--fit", choices=("two-rate", "one-rate", "both", "trial-by-trial", "state-space"),
                    help="fit a learner to each replay's per-trial errors by maximum likelihood (Gaussian noise): "
                    "two-rate (A_f, A_s, B_f, B_s), one-rate (A, B), or both, compared by AIC, BIC and the likelihood "
                    "ratio; the values with 95%% profile-likelihood intervals, the residual, the log-likelihood, and "
-                   "NAME.fit.json and NAME.fit.png (the fit over the data) next to --out, if given")
+                   "NAME.fit.json and NAME.fit.png (the fit over the data) next to --out, if given; trial-by-trial: "
+                   "the generalization function over direction from trial-to-trial changes (Donchin et al. 2003); "
+                   "state-space: one state with process and output noise, by EM (Cheng & Sabes 2006)")
     p.add_argument("--fit-on", choices=("error", "index"), default="error",
                    help="with --fit: the errors of the reaches that are not channel trials (default; the measure "
                    "the learning figure plots), or the adaptation index of the channel trials")
     p.add_argument("--subtract-baseline", action="store_true",
                    help="each channel trial's adaptation_index less its direction's baseline: the mean index of the "
-                   "channel trials to that direction before the run's first perturbed block (empty for a direction "
-                   "with none); in the tables and with --fit-on index")
+                   "channel trials to that direction before the run's first perturbed block (for a direction with "
+                   "none, the nearest probed direction's, the mean of two as near); in the tables and with --fit-on "
+                   "index")
     p.add_argument("--channel-traces", action="store_true",
                    help="also write each run's channel trials' force over time, one row per physics step: "
                    "REPLAY.channel_traces.csv beside the tables (trial, block, target_deg, time_s, channel_force_n, "
@@ -212,6 +219,14 @@ def _replays(args: argparse.Namespace) -> int:
                 continue
             print("  adaptation index less each direction's baseline, which was: "
                   + ", ".join(f"{deg:g} deg {value:+.2f}" for deg, value in offsets.items()))
+            from ..lab.analysis import baseline_for
+
+            borrowed = sorted({float(r["target_deg"]) for r in rows if r["perturbation"] == "channel"}  # type: ignore[arg-type]
+                              - set(offsets))
+            if borrowed:  # directions the baseline never probed: the nearest probed direction's stands in
+                print("  no baseline channel trial to " + "; ".join(
+                    f"{deg:g} deg: the nearest probed ({' and '.join(f'{d:g}' for d in baseline_for(offsets, deg)[1])}"
+                    " deg) stands in" for deg in borrowed))
         if args.channel_traces:
             from ..lab.analysis import write_channel_traces
 
@@ -253,6 +268,8 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
     from ..lab.fit import compare, fit_learner
 
     metric = figure_metric(session.protocol) if on == "error" else "adaptation_index"
+    if model in ("trial-by-trial", "state-space"):
+        return _design_fit(session, rows, on, beside, path, player, figures, model, metric)
     comparison = None
     try:
         disturbance, clamped = fit_schedule(session)
@@ -307,9 +324,78 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
     return written
 
 
+def class_of(folder: Path):
+    """(the class's folder, its lab runs' folder) when ``folder`` is a live class's folder (``class.json`` in it)
+    or its ``lab/``; else (None, ``folder``)."""
+    from ..classroom.intake import LAB_DIR
+    from ..classroom.roster import ROSTER_NAME
+
+    if (folder / ROSTER_NAME).is_file():
+        return folder, folder / LAB_DIR
+    if folder.name == LAB_DIR and (folder.parent / ROSTER_NAME).is_file():
+        return folder.parent, folder
+    return None, folder
+
+
+def _design_fit(session, rows, on: str, beside: Path | None, path: Path, player: str | None, figures: bool,
+                model: str, metric: str) -> list[Path]:
+    """Issue 41's fits (``armgame.lab.trialfit``) of one verified run, printed and, with ``beside``, kept as
+    ``NAME.fit.json`` (and ``NAME.fit.png``: the generalization function, or the fit over the data)."""
+    from ..lab.analysis import fit_schedule
+    from ..lab.trialfit import fit_generalization, fit_state_space
+
+    if model == "trial-by-trial" and on != "error":
+        raise UserError("--fit trial-by-trial fits the reaches' errors (--fit-on error)")
+    try:
+        disturbance, clamped = fit_schedule(session)
+        observed = [float(r[metric]) for r in rows]
+        if model == "trial-by-trial":
+            fit = fit_generalization([o.plan.target for o in session.outcomes], session.protocol.targets,
+                                     disturbance, observed, clamped)
+        else:
+            fit = fit_state_space(disturbance, clamped, observed, on)
+    except ValueError as exc:
+        raise UserError(f"cannot fit the {model} model to its {metric}: {exc}") from None
+    unit = metric.rsplit("_", 1)[1] if metric != "adaptation_index" else ""
+    shown, scale = ("cm", 100.0) if unit == "m" else (unit, 1.0)
+    how = "profile likelihood" if model == "trial-by-trial" else "Wald, observed information"
+    print(f"  {model} fit to {metric} ({fit.n} trials), 95% intervals by {how}:")
+    for line in fit.lines(shown, scale):
+        print(line)
+    if beside is None:
+        return []
+    import json
+
+    from ..lab.metrics import check_regular_target
+    from ..records.storage import atomic_write_bytes
+
+    try:
+        beside.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the output folder {beside}: {exc.strerror or exc}") from None
+    kept = beside / f"{path.stem}.fit.json"
+    check_regular_target(kept)
+    record = {"replay": str(path), "player": player or "", "protocol": session.protocol.name,
+              "seed": session.config.seed, "measure": metric, **fit.as_dict(unit)}
+    try:
+        atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
+    except (OSError, ValueError) as exc:
+        raise UserError(f"cannot write {kept}: {exc}") from None
+    written = [kept]
+    if figures:
+        from ..lab.figures_designs import generalization_fit_figure, state_space_figure
+
+        figure = beside / f"{path.stem}.fit.png"
+        if model == "trial-by-trial":
+            generalization_fit_figure(fit, figure, shown, scale)
+        else:
+            state_space_figure(rows, fit, figure, metric)
+        written.append(figure)
+    return written
+
+
 def _class(args: argparse.Namespace) -> int:
-    from ..lab.analysis import figure_metric
-    from ..lab.figures import class_curve
+    from ..lab.analysis import ClassRun, class_curve_of, curve_protocol
     from ..lab.metrics import write_class_csv
 
     folder = user_path(args.class_dir, "--class")
@@ -318,10 +404,26 @@ def _class(args: argparse.Namespace) -> int:
     out = user_path(args.out, "--out")
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {args.out}: not a folder")
-    if not args.no_figures:
+    figures = not args.no_figures
+    if figures:  # the curve's CSV needs no matplotlib: the figure is drawn only where it is installed
         from ..lab.figures import require_matplotlib
 
-        require_matplotlib()
+        try:
+            require_matplotlib()
+        except UserError:
+            figures = False
+    classroom, folder = class_of(folder)
+    roster = None
+    if classroom is not None:  # a live class's folder: its own rules, as its /lab page drew the curve
+        from ..classroom.roster import Roster
+        from ..records.storage import DataFileError
+
+        try:
+            roster = Roster.open(classroom, None)[0]
+        except DataFileError as exc:
+            raise UserError(str(exc)) from None
+        if not folder.is_dir():
+            raise UserError(f"{classroom}: a class with no lab runs ({folder.name}/ is missing)")
     files = sorted(p for p in folder.iterdir() if p.suffix.lower() == ".json")
     if not files:
         raise UserError(f"{folder}: no replays (*.json) there")
@@ -329,7 +431,7 @@ def _class(args: argparse.Namespace) -> int:
         raise UserError(f"{folder}: {len(files)} replays, more than a class curve reads ({MAX_CLASS_FILES})")
     from ..records.identity import FirstEntries, game_digest
 
-    runs, skipped, copies = [], 0, []
+    runs, skipped, copies, replays = [], 0, [], []
     first: FirstEntries[Path] = FirstEntries()  # in file order: the first verified run of a game counts
     for path in files:
         try:
@@ -346,34 +448,65 @@ def _class(args: argparse.Namespace) -> int:
             continue
         first.copy_of(path, None, digest, ok=True)  # verified: it counts from now on
         runs.append((path, rows, session, digest))
-    students, protocol, left_out = class_members(runs, args.protocol)
+        replays.append(replay)
+    left_out: list[tuple[Path, str]] = []
+    if roster is not None:
+        # Hidden names are never in the class's curve; a program's run is counted apart (class_curve_of).
+        keep = [i for i, r in enumerate(replays) if not (r.player and roster.is_hidden(r.player))
+                or r.driven != "keyboard"]
+        left_out += [(runs[i][0], "a name the teacher hid") for i in range(len(runs)) if i not in keep]
+        runs, replays = [runs[i] for i in keep], [replays[i] for i in keep]
+    people = [run for run, r in zip(runs, replays, strict=True) if roster is None or r.driven == "keyboard"]
+    if args.protocol is None and roster is not None and roster.lab:
+        protocol = curve_protocol(roster.lab)  # the teacher's choice, as the class's /lab page showed it
+        print(f"the class's protocol: {protocol.name} (the teacher's choice, {classroom / 'class.json'})")
+    else:
+        protocol = class_members(people, args.protocol)[1]
+    curve = class_curve_of([ClassRun(r.player, r.driven != "keyboard", run[2].protocol, run[1])
+                            for run, r in zip(runs, replays, strict=True)], protocol, args.metric,
+                           people_only=roster is not None)
+    shared = None if protocol is None else \
+        f"{protocol.name!r}, shared by {sum(run[2].protocol == protocol for run in runs)} replays"
+    for i, why in curve.left_out:
+        other = runs[i][2].protocol
+        if why.startswith("another protocol") and protocol is not None:
+            why = (f"its protocol is also named {other.name!r} but differs from the class's ({shared})"
+                   if other.name == protocol.name
+                   else f"its protocol {other.name!r} differs from the class's ({shared})")
+        left_out.append((runs[i][0], why))
     left_out = sorted(left_out + copies, key=lambda item: str(item[0]))
     for path, reason in left_out:
         print(f"armgame analyze: {path}: {reason}: not in the curve", file=sys.stderr)
     skipped += len(left_out)
-    for path, rows in students:
-        print(f"{path.name}: verified: {len(rows)} reaches")
-    students = [rows for _, rows in students]
-    if not students:
+    for i in curve.members:
+        print(f"{runs[i][0].name}: verified: {len(runs[i][1])} reaches")
+    if not curve.students:
+        if protocol is not None and roster is not None and roster.lab:
+            raise UserError(f"{folder}: no person's verified run of the class's protocol {protocol.name!r}")
         raise UserError(f"{folder}: no replay could be analysed")
-    metric = args.metric or figure_metric(protocol)
-    curve = class_curve(students, metric)
+    metric = curve.metric
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise UserError(f"cannot create the output folder {out}: {exc.strerror or exc}") from None
     csv_path = out / "class_curve.csv"
-    write_class_csv(csv_path, curve, metric)
+    write_class_csv(csv_path, curve.trials, metric)  # type: ignore[arg-type]
     written = [csv_path]
-    if not args.no_figures:
+    if figures:
         from ..lab.figures import class_figure
 
-        class_figure(curve, out / "class_curve.png", metric=metric)
+        class_figure(curve.trials, out / "class_curve.png", metric=metric)  # type: ignore[arg-type]
         written.append(out / "class_curve.png")
-    print(f"class curve of {plural(len(students), 'student')} ({skipped} left out), {plural(len(curve), 'trial')}, "
-          f"{metric}")
+    print(f"class curve of {plural(curve.students, 'student')} ({skipped} left out), "
+          f"{plural(len(curve.trials), 'trial')}, {metric}")
+    if curve.programs:
+        print(f"  {plural(curve.programs, 'run')} of programs kept apart (never in a class's curve, as on its /lab "
+              "page)")
     for path in written:
         print(f"wrote {path}")
+    if not figures and not args.no_figures:
+        print("class_curve.png not drawn: the figure needs matplotlib (pip install 'armgame[plot]'); the CSV is "
+              "complete")
     return 1 if skipped else 0
 
 

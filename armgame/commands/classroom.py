@@ -153,6 +153,9 @@ def join_class(args: argparse.Namespace):
         print(f"armgame: {exc}; playing on: your games are kept and handed in the next time you join",
               file=sys.stderr)
     else:
+        if membership.closed:  # before a game that could not be handed in, not after it
+            raise UserError(f"the class at {address.label} is closed: it takes no more games (the teacher can open "
+                            f"it again)")
         print(f"joined the class at {address.label} as {membership.name} (seed {membership.seed})", file=sys.stderr)
         for line in client.send_outbox(membership):
             print(line, file=sys.stderr)

@@ -75,8 +75,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="adaptive bot: the learner's learning rates B_f B_s (default: 0.21 0.02; 0 0 learns nothing)")
     p.add_argument("--representation", choices=("global", "local"), default=None,
                    help="adaptive bot: its internal model of the field, one estimate for every direction (global, "
-                   "the default) or Gaussian tuning over movement direction (local: what it learns falls off with "
-                   "the angle from where it learned it)")
+                   "the default but on the generalization preset) or Gaussian tuning over movement direction (local, "
+                   "the generalization preset's default: what it learns falls off with the angle from where it "
+                   "learned it)")
+    p.add_argument("--frame", choices=("hand", "joint"), default=None,
+                   help="adaptive bot: the coordinates its internal model holds a force field in: at the hand (force "
+                   "B^ v, the default) or at the joints (torque W^ qdot); they differ at a posture other than the one "
+                   "it was learned at (the frames preset)")
     p.add_argument("--tuning-width", type=float, default=None, metavar="DEG",
                    help="with --representation local: the tuning's width, s.d. in degrees (5 to 180; default 30)")
     p.add_argument("--motor-noise", type=_noise_level, default=None, metavar="LEVEL",
@@ -195,9 +200,13 @@ def run(args: argparse.Namespace) -> int:
     if args.motor_noise and not args.bot:
         raise UserError("--motor-noise sets a bot's motor noise: add --bot (a person brings their own)")
     _resolve_motor_noise(args)
-    if (args.retention or args.learning or args.representation) and args.bot != "adaptive":
-        raise UserError("--retention, --learning and --representation set the adaptive bot's learner: add --bot "
-                        "adaptive")
+    if (args.retention or args.learning or args.representation or args.frame) and args.bot != "adaptive":
+        raise UserError("--retention, --learning, --representation and --frame set the adaptive bot's learner: add "
+                        "--bot adaptive")
+    from ..lab.protocol import PRESET_REPRESENTATION
+
+    if args.bot == "adaptive" and args.representation is None:  # the preset's own learner (generalization: local)
+        args.representation = PRESET_REPRESENTATION.get(args.protocol, "global")
     if args.tuning_width is not None and args.representation != "local":
         raise UserError("--tuning-width sets the local learner's tuning: add --representation local")
     if args.no_figures and not args.out and args.headless:
@@ -219,6 +228,7 @@ def run(args: argparse.Namespace) -> int:
                               *(args.learning or (defaults.rate_fast, defaults.rate_slow)))
         bot = _bot(args, rates)
         args.learner_words = bot.describe()
+        args.frame_words = bot.frame_words()
     if args.headless:
         from ..game.bots import Autopilot
 
@@ -261,7 +271,8 @@ def _bot(args: argparse.Namespace, rates):
     if args.bot != "adaptive":
         return make_lab_bot(args.bot, noise=_motor_noise(args))
     width = TUNING_WIDTH_DEG if args.tuning_width is None else args.tuning_width
-    return make_lab_bot(args.bot, rates, args.representation or "global", width, noise=_motor_noise(args))
+    return make_lab_bot(args.bot, rates, args.representation or "global", width, noise=_motor_noise(args),
+                        frame=args.frame or "hand")
 
 
 def default_runs_dir() -> Path:
@@ -338,7 +349,7 @@ class RunKeeper:
 
 
 #: What a run writes in --out (adaptation.png only with channel trials): refused before the run if there.
-OUT_FILES = ("trials.csv", "learning.png", "paths.png", "adaptation.png")
+OUT_FILES = ("trials.csv", "learning.png", "paths.png", "adaptation.png", "frames.png", "generalization.png")
 
 
 def _numbered(path: Path | None, run: int) -> Path | None:
@@ -404,6 +415,8 @@ def _report(session, args: argparse.Namespace) -> None:
           f"{session.config.seed}{session.ending}")
     if getattr(args, "learner_words", ""):
         print(f"  the adaptive bot's {args.learner_words}")
+    if getattr(args, "frame_words", ""):
+        print(f"  its {args.frame_words}")
     if getattr(args, "bot", None):
         print(f"  {_noise_line(args)}")
     if session.outcomes:
@@ -426,6 +439,24 @@ def _report(session, args: argparse.Namespace) -> None:
             key, how = ("index_less_baseline", "less each direction's baseline") if subtracted else ("index", "raw")
             print(f"  {name}: adaptation index by angle from the trained {mine[0]['trained_deg']:g} deg ({how}): "
                   + ", ".join(f"{g['angle_deg']:+g} {g[key]:+.2f}" for g in mine))
+        _report_designs(session, rows)
+
+
+def _report_designs(session, rows) -> None:
+    """Issue 41's designs in the run's output: the frames test and generalization probed without vision."""
+    from ..lab.designs import frames_summary, probe_generalization
+
+    for f in frames_summary(session, rows):
+        how = "less each direction's baseline there" if f["less_baseline"] else "raw"
+        print(f"  {f['block']} (posture {f['posture_deg'][0]:g}, {f['posture_deg'][1]:g} deg): mean adaptation index "
+              f"of its first {f['trials']} channel trials ({how}): the field held at the hand {f['hand']:+.2f}, held "
+              f"at the joints {f['joint']:+.2f}: it reads as learned in {f['reads_as']} coordinates")
+    table = probe_generalization(session, rows)
+    for name in dict.fromkeys(str(g["block"]) for g in table):
+        mine = [g for g in table if g["block"] == name]
+        print(f"  {name}: generalization of the rotation by angle from the trained {mine[0]['trained_deg']:g} deg "
+              f"(probes with feedback {mine[0]['feedback']}, fraction of the rotation, less each direction's "
+              "baseline): " + ", ".join(f"{g['angle_deg']:+g} {g['generalization']:+.2f}" for g in mine))
 
 
 def _home(path: Path) -> str:

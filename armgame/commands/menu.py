@@ -10,7 +10,10 @@ ssh, a CI job), or pygame is missing, the commands are printed instead and the e
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
+import re
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -85,11 +88,40 @@ def looks(palette: str, text_scale: float) -> tuple[str, float]:
 
 
 def _start(launch: Callable[[Sequence[str]], int], *argv: str) -> Callable[[], str | None]:
+    """``launch(argv)`` from the menu; what the menu says after it: nothing, or the command's own last line of
+    error (the whole reason, as the terminal has it: a student in the menu may have no terminal in view)."""
     def start() -> str | None:
-        code = launch(list(argv))
-        return None if code == 0 else f"armgame {' '.join(argv)} stopped (status {code}): the terminal says why"
+        said = _LastLine(sys.stderr)
+        with contextlib.redirect_stderr(said):
+            code = launch(list(argv))
+        if code == 0:
+            return None
+        return said.last or f"armgame {' '.join(argv)} stopped (status {code})"
 
     return start
+
+
+class _LastLine(io.TextIOBase):
+    """A stream that passes everything on to ``out`` and keeps the last non-empty line written, without the
+    ``armgame COMMAND:`` that starts a command's error."""
+
+    def __init__(self, out) -> None:
+        self.out, self.last, self._partial = out, "", ""
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, text: str) -> int:
+        self.out.write(text)
+        lines = (self._partial + text).split("\n")
+        self._partial = lines.pop()
+        for line in lines:
+            if line.strip():
+                self.last = re.sub(r"^armgame( [a-z]+)*: (error: )?", "", line.strip())
+        return len(text)
+
+    def flush(self) -> None:
+        self.out.flush()
 
 
 def main_page(launch: Callable[[Sequence[str]], int]):

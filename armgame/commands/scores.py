@@ -123,6 +123,12 @@ def run(args: argparse.Namespace) -> int:
     if not entries:
         print(f"no scores yet in {table.path}")
         return 0
+    hidden = _hidden_by_the_teacher(table.folder, warn)
+    if hidden:  # a live class's folder: the names its teacher hid stay off every list of it
+        from ..records.standings import player_key
+
+        entries = [e for e in entries if player_key(e.name) not in hidden]
+        print(f"{plural(len(hidden), 'name')} hidden by the class's teacher (armgame class serve): not listed")
     limit = None if args.all else args.top
     per_player = not args.all_games
     lists, flagged = listing(table, entries, limit, check=not args.no_check, per_player=per_player)
@@ -130,6 +136,22 @@ def run(args: argparse.Namespace) -> int:
         cache.save()
     _print_listing(table, len(entries), lists, flagged, args.no_check, _games_note(per_player, limit, args.no_check))
     return 0
+
+
+def _hidden_by_the_teacher(folder, warn) -> set[str]:
+    """The names the teacher hid in the live class kept in ``folder`` (its ``class.json``), by player key; none
+    where the folder is not a class's. A class record that cannot be read is said once, and hides nothing."""
+    from ..classroom.roster import ROSTER_NAME, Roster
+    from ..errors import UserError
+
+    if not (folder / ROSTER_NAME).exists():
+        return set()
+    try:
+        roster, _ = Roster.open(folder, None)
+    except UserError as exc:
+        warn(f"{exc} (the names its teacher hid are listed)")
+        return set()
+    return set(roster.hidden)
 
 
 def listing(table, entries, limit: int | None, check: bool, per_player: bool = True):
@@ -314,6 +336,10 @@ def _add(table, args: argparse.Namespace) -> int:
         raise UserError(f"{path}: the replay has no player's name: give --name")
     if not replay.complete:
         raise UserError(f"{path}: the game was stopped before its end: only a whole game enters the table")
+    twin = _already_in(table, replay)
+    if twin is not None:  # the collecting loop run again: nothing to do, and nothing wrong
+        print(f"already in: {twin.name}'s game (score {twin.score}, entry #{twin.entered})")
+        return 0
     from ..records.replay import VerifyCostError
 
     try:
@@ -330,6 +356,19 @@ def _add(table, args: argparse.Namespace) -> int:
         raise UserError(str(exc)) from None
     print(f"entered {entry.name}'s game (score {entry.score}): {where_it_went(table, entry)}")
     return 0
+
+
+def _already_in(table, replay):
+    """The entry that holds ``replay``'s game, as it claims it, under its own player's name; or None (another
+    name's copy, or other claims for the same game, go on to the checks that refuse them)."""
+    from ..records.identity import game_digests
+    from ..records.standings import player_key
+
+    digests = set(game_digests(replay))
+    r = replay.result
+    return next((e for e in table.all_entries() if e.game_sha256 in digests
+                 and player_key(e.name) == player_key(replay.player)
+                 and (e.score, e.hits, e.resets) == (r.score, r.hits, r.resets)), None)
 
 
 def where_it_went(table, entry) -> str:

@@ -207,7 +207,8 @@ class CenterOutEnv(SessionEnv):
     At each step in which trials ended, ``info["reaches"]`` lists their rows of the lab's trials table
     (``armgame.lab.metrics.TRIAL_COLUMNS``: block, trial, target_deg, perturbation, reaction_time_s,
     movement_time_s, peak_speed_m_per_s, initial_direction_error_deg, max_perpendicular_error_m,
-    path_length_ratio, hit, channel_force_peak_n, channel_force_at_peak_speed_n, adaptation_index;
+    path_length_ratio, hit, channel_force_peak_n, channel_force_at_peak_speed_n, adaptation_index,
+    hand_sent_home;
     docs/lab.md "Measures"), measured on the cursor's path by
     ``armgame.lab.metrics.reach_metrics``. Every step's ``info`` has ``trials_done``, ``hits`` and
     ``block`` (the current block's name).

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -36,31 +36,48 @@ def channel_of(session: LabSession, outcome: TrialOutcome) -> ChannelMeasures:
     ``Protocol.reference_field`` names for its block."""
     if not outcome.plan.channel:
         return NO_CHANNEL
-    hx, hy = session.home
+    hx, hy = outcome.plan.home
     tx, ty = outcome.plan.position
     length = math.hypot(tx - hx, ty - hy)
     reference = session.protocol.reference_field(outcome.plan.block)
-    return channel_measures(np.asarray(outcome.channel_force), np.column_stack([outcome.vxs, outcome.vys]),
-                            (-(ty - hy) / length, (tx - hx) / length),
-                            None if reference is None else reference.matrix)
+    n = outcome.reach_samples  # the channel's samples are the path's: none after the hand was sent home
+    measures = channel_measures(np.asarray(outcome.channel_force[:n]),
+                                np.column_stack([outcome.vxs[:n], outcome.vys[:n]]).reshape(-1, 2),
+                                (-(ty - hy) / length, (tx - hx) / length),
+                                None if reference is None else reference.matrix)
+    if reference is not None and reference.kind == "joint_viscous":  # its index: against the field at the joints
+        from .designs import frame_indices
+
+        measures = replace(measures, adaptation_index=frame_indices(session, outcome)[1])
+    return measures
 
 
 def reach_of(session: LabSession, outcome: TrialOutcome) -> Reach:
+    """The reach a trial's measures are taken on: the shown hand from the go cue to the trial's end, or to the
+    moment space sent the hand home if it did (``TrialOutcome.home_at``): the jump home is no movement."""
     dt = session.config.dt
-    n = len(outcome.xs)
+    n = outcome.reach_samples
     t = (outcome.go_step + np.arange(n)) * dt
-    return Reach(t=t, hand=np.column_stack([outcome.xs, outcome.ys]), start=session.home,
+    return Reach(t=t, hand=np.column_stack([outcome.xs[:n], outcome.ys[:n]]).reshape(-1, 2), start=outcome.plan.home,
                  target=outcome.plan.position, go_time=outcome.go_step * dt, hit=outcome.hit)
 
 
 def trial_rows(session: LabSession) -> list[dict[str, object]]:
     """One row per finished trial, with the columns of ``metrics.TRIAL_COLUMNS``."""
-    return [trial_row(session, o) for o in session.outcomes]
+    try:
+        disturbance = fit_schedule(session)[0].tolist()
+    except ValueError:  # no perturbation, or ones that are not multiples of one another: no one unit
+        disturbance = [math.nan] * len(session.outcomes)
+    return [trial_row(session, o, d) for o, d in zip(session.outcomes, disturbance, strict=True)]
 
 
-def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
-    """One finished trial's row, with the columns of ``metrics.TRIAL_COLUMNS``."""
+def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.nan) -> dict[str, object]:
+    """One finished trial's row, with the columns of ``metrics.TRIAL_COLUMNS`` (``disturbance``: the trial's, in
+    units of the run's first perturbation, ``disturbance_schedule``; NaN when not given)."""
+    from .designs import frame_indices
+
     m = reach_metrics(reach_of(session, o))
+    hand, joint = frame_indices(session, o)
     return {
         "block": o.plan.block_name,
         "trial": o.plan.index + 1,
@@ -74,6 +91,11 @@ def trial_row(session: LabSession, o: TrialOutcome) -> dict[str, object]:
         "path_length_ratio": m.path_length_ratio,
         "hit": o.hit,
         **channel_of(session, o).as_dict(),
+        "hand_sent_home": o.home_at is not None,
+        "feedback": o.plan.feedback,
+        "disturbance": disturbance,
+        "adaptation_index_hand": hand,
+        "adaptation_index_joint": joint,
     }
 
 
@@ -92,7 +114,7 @@ def path_groups(session: LabSession, per_group: int | None = None) -> dict[str, 
             continue
         chosen = trials[:per_group] if which == "early" else trials[-per_group:]
         if chosen:
-            groups[label] = [np.column_stack([o.xs, o.ys]) for o in chosen]
+            groups[label] = [np.column_stack([o.xs[:o.reach_samples], o.ys[:o.reach_samples]]) for o in chosen]
     return groups
 
 
@@ -160,6 +182,11 @@ def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndar
             along = float(np.sum(b * r)) / float(np.sum(r * r))
             if np.allclose(b, along * r):
                 return along
+        elif p.kind == reference.kind == "joint_viscous":
+            w, r = np.asarray(p.joint_matrix), np.asarray(reference.joint_matrix)
+            along = float(np.sum(w * r)) / float(np.sum(r * r))
+            if np.allclose(w, along * r):
+                return along
         elif p.kind == reference.kind == "rotation":
             return p["angle"] / reference["angle"]
         elif p == reference:
@@ -204,6 +231,9 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
 
             adaptation_figure(rows, out / "adaptation.png")
             written.append(out / "adaptation.png")
+        from .figures_designs import design_figures
+
+        written += design_figures(session, rows, out)
     return written
 
 
@@ -297,9 +327,24 @@ def baseline_offsets(session: LabSession, rows: Sequence[Mapping[str, object]]) 
     return {deg: float(np.mean(v)) for deg, v in sorted(seen.items())}
 
 
+def baseline_for(offsets: Mapping[float, float], deg: float) -> tuple[float, tuple[float, ...]]:
+    """The baseline subtracted from a channel trial to ``deg``, and the probed directions it came from: the
+    direction's own (``baseline_offsets``), or for a direction the baseline never probed (the ``spontaneous``
+    preset's baseline probes 4 of its 8), the nearest probed direction's, the mean of the two when two are as
+    near. NaN with no offsets at all."""
+    if deg in offsets:
+        return offsets[deg], (deg,)
+    if not offsets:
+        return math.nan, ()
+    away = {d: abs(signed_angle(d - deg)) for d in offsets}
+    nearest = min(away.values())
+    chosen = tuple(sorted(d for d in offsets if away[d] == nearest))
+    return float(np.mean([offsets[d] for d in chosen])), chosen
+
+
 def subtract_baseline(session: LabSession, rows: Sequence[Mapping[str, object]]) -> list[dict[str, object]]:
-    """The rows with each channel trial's adaptation index less its direction's ``baseline_offsets`` (NaN for a
-    direction with no baseline channel trial). Raises ValueError for a run with no baseline channel trial."""
+    """The rows with each channel trial's adaptation index less its direction's baseline (``baseline_for``: its
+    own, else the nearest probed direction's). Raises ValueError for a run with no baseline channel trial."""
     offsets = baseline_offsets(session, rows)
     if not offsets:
         raise ValueError("the run has no channel trial before its first perturbed block: no baseline to subtract")
@@ -307,7 +352,8 @@ def subtract_baseline(session: LabSession, rows: Sequence[Mapping[str, object]])
     for r in rows:
         r = dict(r)
         if r["perturbation"] == "channel":
-            r["adaptation_index"] = float(r["adaptation_index"]) - offsets.get(float(r["target_deg"]), math.nan)  # type: ignore[arg-type]
+            base = baseline_for(offsets, float(r["target_deg"]))[0]  # type: ignore[arg-type]
+            r["adaptation_index"] = float(r["adaptation_index"]) - base  # type: ignore[arg-type]
         out.append(r)
     return out
 
@@ -353,19 +399,28 @@ def channel_traces(session: LabSession) -> list[tuple[object, ...]]:
     regressor; NaN with no reference field) and the hand's speed."""
     out: list[tuple[object, ...]] = []
     dt = session.config.dt
-    hx, hy = session.home
     for o in session.outcomes:
         if not o.plan.channel:
             continue
+        hx, hy = o.plan.home
         tx, ty = o.plan.position
         length = math.hypot(tx - hx, ty - hy)
         normal = np.array([-(ty - hy) / length, (tx - hx) / length])
         v = np.column_stack([o.vxs, o.vys]) if o.vxs else np.zeros((0, 2))
         reference = session.protocol.reference_field(o.plan.block)
-        cancel = -(v @ np.asarray(reference.matrix).T) @ normal if reference is not None \
-            else np.full(len(v), math.nan)
+        if reference is not None and reference.kind == "joint_viscous":  # held at the joints: at each sample's q
+            from .designs import candidate_fields, jacobian
+
+            arm = session.config.arm
+            w = candidate_fields(session.protocol, reference, arm.l1, arm.l2)[1]
+            jac = jacobian(arm.l1, arm.l2, np.asarray(o.q1s), np.asarray(o.q2s))
+            torque = np.linalg.solve(jac, v[..., None])[..., 0] @ w.T
+            cancel = -np.linalg.solve(np.swapaxes(jac, -1, -2), torque[..., None])[..., 0] @ normal
+        else:
+            cancel = -(v @ np.asarray(reference.matrix).T) @ normal if reference is not None \
+                else np.full(len(v), math.nan)
         speed = np.hypot(v[:, 0], v[:, 1])
-        for k, force in enumerate(o.channel_force):
+        for k, force in enumerate(o.channel_force[:o.reach_samples]):  # not past the hand sent home
             out.append((o.plan.index + 1, o.plan.block_name, o.plan.target_deg, k * dt, force, float(cancel[k]),
                         float(speed[k])))
     return out
@@ -386,3 +441,81 @@ def write_channel_traces(path: Path, session: LabSession) -> None:
         writer.writerow([trial, block, repr(deg), repr(t), repr(force), "" if math.isnan(cancel) else repr(cancel),
                          repr(speed)])
     _write_text(Path(path), buffer.getvalue())
+
+
+# ------------------------------------------------------------------ the class curve (issue 39)
+@dataclass(frozen=True)
+class ClassRun:
+    """A lab run offered to a class curve: the name its replay carries (None: none), whether a program played it
+    (a bot's run: its replay is not ``driven`` by the keyboard), its protocol and its trial rows (``trial_rows``)."""
+
+    player: str | None
+    program: bool
+    protocol: object
+    rows: Sequence[Mapping[str, object]]
+
+
+@dataclass(frozen=True)
+class ClassCurve:
+    """A class curve and how it was made: the protocol and measure, which runs are in it (their places in the
+    runs given), the programs' runs kept apart, every other run left out with why, and the curve's rows
+    (``figures.class_curve``: ``trial, block, perturbation, mean, sem, n``, in the measure's SI unit)."""
+
+    protocol: object
+    metric: str | None
+    members: tuple[int, ...]
+    programs: int
+    left_out: tuple[tuple[int, str], ...]
+    trials: tuple[dict[str, object], ...]
+
+    @property
+    def students(self) -> int:
+        return len(self.members)
+
+
+def curve_protocol(choice: object):
+    """The class curve's protocol from the teacher's choice as a class keeps it (``Roster.lab`` in ``class.json``):
+    a preset's name, a protocol as plain data, or None (no protocol chosen)."""
+    from .protocol import preset, protocol_from_dict
+
+    if isinstance(choice, dict):
+        return protocol_from_dict(choice, "lab")
+    return preset(choice) if isinstance(choice, str) and choice else None
+
+
+def class_curve_of(runs: Sequence[ClassRun], protocol, metric: str | None = None, *,
+                   people_only: bool = True) -> ClassCurve:
+    """The class curve of ``protocol`` over ``runs``: what the live class's ``/lab`` page draws
+    (``classroom.intake.Clerk.lab_curve``) and ``armgame analyze --class`` writes, built here once so that the
+    two agree by construction.
+
+    ``people_only`` (a class's rule): programs' runs are counted apart and never in the curve, and each person
+    (by ``records.standings.player_key`` of their name) counts once, with their first run of the protocol in the
+    order given. Without it (a folder of replays that is no class's, where bots may stand in for volunteers in
+    a rehearsal) every run of the protocol counts. Runs of another protocol are left out. ``metric``: the
+    curve's measure (default: the one the learning figure plots, ``figure_metric``).
+    """
+    from ..records.standings import player_key
+    from .figures import class_curve
+
+    members: list[int] = []
+    left_out: list[tuple[int, str]] = []
+    seen: dict[str, str] = {}
+    programs = 0
+    for i, run in enumerate(runs):
+        if people_only and run.program:
+            programs += 1
+            left_out.append((i, "a program's run: counted apart, never in the class curve"))
+        elif protocol is None or run.protocol != protocol:
+            left_out.append((i, "another protocol than the class curve's"))
+        elif people_only and run.player and player_key(run.player) in seen:
+            left_out.append((i, f"not {run.player}'s first run of the protocol (that one is in the curve)"))
+        else:
+            if people_only and run.player:
+                seen[player_key(run.player)] = run.player
+            members.append(i)
+    if protocol is None or not members:
+        return ClassCurve(protocol, None, (), programs, tuple(left_out), ())
+    metric = metric or figure_metric(protocol)
+    curve = class_curve([runs[i].rows for i in members], metric)
+    return ClassCurve(protocol, metric, tuple(members), programs, tuple(left_out), tuple(curve))

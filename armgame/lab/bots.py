@@ -33,6 +33,16 @@ the straight line, so there is no movement error to learn from: the learner's er
 its retentions act (Smith et al. 2006 model channel trials so), which is what lets spontaneous
 recovery show. Mirror and joint-space displays are not learned by this bot (it
 plays them as the model bot does): they need more than one parameter.
+
+Issue 41. **The frame its field is held in** (``frame``, ``FRAMES``): ``hand`` (the default, as above: a
+curl's ``b^`` or a matrix ``B^`` at the hand, whose torque ``J(q)^T B^ v`` follows the arm to any posture
+as the same hand field) or ``joint`` (a matrix ``W^`` at the joints, the torque ``W^ qdot`` whatever the
+posture: learned by the same least squares on the external torque, with the design ``qdot``). At the
+posture it is learned at the two predict the same forces; at another they differ, which is what the
+``frames`` preset tests. **What it sees**: a trial that hides the cursor (``TrialPlan.feedback``) gives it
+no cursor to log; with ``endpoint`` feedback it measures the rotation from where the cursor was shown at
+the end, with ``none`` it sees no visual error at all, and its rotation learner is taught 0 (its
+retentions act, as on a channel trial). What it feels (the field's torque) it learns from on every trial.
 """
 
 from __future__ import annotations
@@ -53,6 +63,8 @@ LAB_BOT_NAMES = ("model", "naive", "adaptive")
 #: direction: it generalizes fully, by construction) or ``local`` (``DirectionalLearner``: Gaussian tuning over
 #: movement direction, so what it learns in one direction falls off with the angle from it).
 REPRESENTATIONS = ("global", "local")
+#: The coordinates its internal model holds a force field in (issue 41): at the hand, or at the joints.
+FRAMES = ("hand", "joint")
 #: The viscous field's fit: the ridge toward no correction, as a fraction of the fit's mean curvature.
 RIDGE = 0.01
 
@@ -73,10 +85,13 @@ class LabBot(ReachingBot):
     """A reaching bot for the lab: forgets its view at each new trial; learns if given rates."""
 
     def __init__(self, name: str, interaction: bool, rates: LearningRates | None = None,
-                 representation: str = "global", width_deg: float = TUNING_WIDTH_DEG) -> None:
+                 representation: str = "global", width_deg: float = TUNING_WIDTH_DEG, frame: str = "hand") -> None:
         super().__init__(name, interaction)
         if representation not in REPRESENTATIONS:
             raise UserError(unknown_name("learner representation", representation, REPRESENTATIONS))
+        if frame not in FRAMES:
+            raise UserError(unknown_name("learner frame", frame, FRAMES))
+        self.frame = frame
         self.rates = rates
         self.representation = representation
         self.width_deg = float(width_deg)
@@ -111,9 +126,20 @@ class LabBot(ReachingBot):
         if self.rates is None:
             return ""
         if self.representation == "local":
-            return (f"local learner: Gaussian tuning over movement direction, {self.width_deg:g} deg wide "
+            return (f"local learner: Gaussian tuning over movement direction, bases of s.d. {self.width_deg:g} deg "
                     "(learning falls off with the angle from the trained direction)")
         return "global learner: one estimate for every direction (it generalizes fully)"
+
+    def frame_words(self) -> str:
+        """The frame its field is held in, in words, for every adaptive run's output (empty for a bot that does
+        not learn)."""
+        if self.rates is None:
+            return ""
+        if self.frame == "joint":
+            return ("force fields held in joint coordinates: torque W^ qdot at the joints, the same torque at any "
+                    "posture (--frame hand holds them at the hand)")
+        return ("force fields held in hand coordinates: force B^ v at the hand, the same force at any posture "
+                "(--frame joint holds them at the joints)")
 
     def _estimate_of(self, learner: TwoRateLearner | DirectionalLearner | None) -> float:
         if learner is None:
@@ -140,7 +166,8 @@ class LabBot(ReachingBot):
 
     @property
     def matrix_estimate(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
-        """``B^`` (N s/m) of a viscous field, or None when the bot learns ``b^`` (the curl) instead."""
+        """``B^`` (N s/m) of a viscous field (with ``frame = "joint"``: ``W^``, N m s/rad), or None when the bot
+        learns ``b^`` (the curl) instead."""
         if self.matrix_learner is None:
             return None
         b11, b12, b21, b22 = (float(v) for v in self.matrix_learner.estimate)  # type: ignore[union-attr]
@@ -148,7 +175,7 @@ class LabBot(ReachingBot):
 
     def _expected_field(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
         """The matrix its internal model adds beyond the learned curl: the known field plus the learned ``B^``."""
-        learned = self.matrix_estimate
+        learned = self.matrix_estimate if self.frame == "hand" else None
         if learned is None:
             return self.known_field
         known = self.known_field or ((0.0, 0.0), (0.0, 0.0))
@@ -159,13 +186,18 @@ class LabBot(ReachingBot):
         p = session.config.arm
         l1, l2 = p.l1, p.l2
         b = self.curl_estimate
+        kinds = {block.perturbation.kind for block in session.protocol.blocks}
         if self.rates is not None and self.matrix_learner is None \
-                and any(block.perturbation.kind == "viscous" for block in session.protocol.blocks):
+                and ("viscous" in kinds or "joint_viscous" in kinds or (self.frame == "joint" and "curl" in kinds)):
             r = self.rates
             self.matrix_learner = TwoRateLearner(r.retention_fast, r.retention_slow, r.rate_fast, r.rate_slow,
                                                  fast=np.zeros(4), slow=np.zeros(4))
         expected = self._expected_field()
-        if expected is not None:
+        if self.frame == "joint" and self.matrix_learner is not None:
+            (w11, w12), (w21, w22) = self.matrix_estimate  # type: ignore[misc]
+            self.load_estimate = JointMatrixLoad(w11, w12, w21, w22, None if self.known_field is None else
+                                                 MatrixLoad(l1, l2, *self.known_field[0], *self.known_field[1]))
+        elif expected is not None:
             (k11, k12), (k21, k22) = expected
             # plus the learned curl b^ [[0, 1], [-1, 0]]
             self.load_estimate = MatrixLoad(l1, l2, k11, k12 + b, k21 - b, k22)
@@ -204,7 +236,8 @@ class LabBot(ReachingBot):
             q1, q2, w1, w2 = session.state
             t1, t2 = session.muscles.torque()
             x, y = session.hand()
-            cx, cy = session.cursor
+            # It logs the cursor only when it is shown: a trial without vision gives it none to learn from.
+            cx, cy = session.cursor if getattr(session, "cursor_visible", True) else (math.nan, math.nan)
             self._log.append((q1, q2, w1, w2, t1, t2, x, y, cx, cy))
         return super().act(session)
 
@@ -215,7 +248,14 @@ class LabBot(ReachingBot):
         assert self.curl_learner is not None and self.rotation_learner is not None
         b_hat, theta_hat = self.curl_estimate, self.rotation_estimate
         b_seen = self._measure_curl(session, log)
-        theta_seen = self._measure_rotation(session, log)
+        feedback = getattr(outcome.plan, "feedback", "full")
+        if feedback == "full":
+            theta_seen = self._measure_rotation(session, log)
+        elif feedback == "endpoint" and log and outcome.xs:  # the cursor shown where the reach ended
+            theta_seen = self._measure_rotation(session, [(*log[-1][:8], outcome.xs[-1], outcome.ys[-1])],
+                                                outcome.plan.home)
+        else:
+            theta_seen = theta_hat  # nothing seen: no visual error (the retentions act, as in a channel)
         self.history.append((outcome.plan.index, b_seen, b_hat, theta_seen, theta_hat))
         if self.matrix_learner is not None:
             correction = self._measure_matrix(session, log)
@@ -272,9 +312,17 @@ class LabBot(ReachingBot):
         # What it expected is what it predicted with this trial: _install's load (the matrix learner,
         # when there is one, always gives it one), unchanged until this trial is learned from.
         expected = self.load_estimate
-        assert isinstance(expected, MatrixLoad)
+        assert isinstance(expected, (MatrixLoad, JointMatrixLoad))
         g = np.zeros((4, 4))
         h = np.zeros(4)
+        if self.frame == "joint":  # tau = W qdot: d tau / d (w11, w12, w21, w22) = [[w1, w2, 0, 0], [0, 0, w1, w2]]
+            for q1, q2, w1, w2, r1, r2 in self._external_torques(session, log):
+                t1, t2 = expected(q1, q2, w1, w2)
+                design = np.array([[w1, w2, 0.0, 0.0], [0.0, 0.0, w1, w2]])
+                g += design.T @ design
+                h += design.T @ np.array([r1 - t1, r2 - t2])
+            scale = np.trace(g) / 4.0
+            return np.zeros(4) if scale < 1e-12 else np.linalg.solve(g + RIDGE * scale * np.eye(4), h)
         for q1, q2, w1, w2, r1, r2 in self._external_torques(session, log):
             vy, mvx = curl_unit_force(l1, l2, q1, q2, w1, w2)
             vx = -mvx
@@ -290,16 +338,35 @@ class LabBot(ReachingBot):
         return np.linalg.solve(g + RIDGE * scale * np.eye(4), h)
 
     @staticmethod
-    def _measure_rotation(session: LabSession, log: list) -> float:
+    def _measure_rotation(session: LabSession, log: list, home: tuple[float, float] | None = None) -> float:
         """The angle from the felt displacement to the seen one at the trial's end (0 if the hand stayed home)."""
         if not log:
             return 0.0
-        hx, hy = session.home
+        hx, hy = session.home if home is None else home
         _q1, _q2, _w1, _w2, _t1, _t2, x, y, cx, cy = log[-1]
         dx, dy, sx, sy = x - hx, y - hy, cx - hx, cy - hy
         if math.hypot(dx, dy) < 0.2 * session.protocol.distance:
             return 0.0
         return math.atan2(dx * sy - dy * sx, dx * sx + dy * sy)
+
+
+@dataclass(frozen=True)
+class JointMatrixLoad:
+    """A viscous field at the joints as a bot believes it: ``W qdot`` N m (``frame = "joint"``), plus a known hand
+    field if it holds one."""
+
+    w11: float
+    w12: float
+    w21: float
+    w22: float
+    hand: MatrixLoad | None = None
+
+    def __call__(self, q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
+        t1, t2 = self.w11 * w1 + self.w12 * w2, self.w21 * w1 + self.w22 * w2
+        if self.hand is not None:
+            e1, e2 = self.hand(q1, q2, w1, w2)
+            t1, t2 = t1 + e1, t2 + e2
+        return t1, t2
 
 
 def curl_unit_force(l1: float, l2: float, q1: float, q2: float, w1: float, w2: float) -> tuple[float, float]:
@@ -319,7 +386,7 @@ def curl_unit_torque(l1: float, l2: float, q1: float, q2: float, fx: float, fy: 
 
 
 def make_lab_bot(name: str, rates: LearningRates | None = None, representation: str = "global",
-                 width_deg: float = TUNING_WIDTH_DEG, noise: MotorNoise | None = None) -> LabBot:
+                 width_deg: float = TUNING_WIDTH_DEG, noise: MotorNoise | None = None, frame: str = "hand") -> LabBot:
     """``model``, ``naive`` (the game's bots) or ``adaptive`` (the model bot learning the perturbation, with a
     ``global`` or ``local`` representation of it: ``REPRESENTATIONS``), with ``noise`` on its motor command if
     given (``MotorNoise``: the keys it presses carry it)."""
@@ -329,7 +396,7 @@ def make_lab_bot(name: str, rates: LearningRates | None = None, representation: 
         bot = LabBot("naive", interaction=False)
     elif name == "adaptive":
         bot = LabBot("adaptive", interaction=True, rates=rates or LearningRates(), representation=representation,
-                     width_deg=width_deg)
+                     width_deg=width_deg, frame=frame)
     else:
         raise UserError(unknown_name("lab bot", name, LAB_BOT_NAMES))
     bot.noise = noise

@@ -110,7 +110,8 @@ def class_curve(students: Sequence[Sequence[Mapping[str, Any]]],
     ``students``: one sequence of trial rows (``TRIAL_COLUMNS``) per student. Trials are matched by
     their ``trial`` number, so students who ran different numbers of trials (a run stopped early, a
     longer protocol) each count where they have data: ``n`` is the number of students with a defined
-    (finite) ``metric`` on that trial. ``mean`` is NaN where ``n`` = 0; ``sem`` is the sample
+    (finite) ``metric`` on that trial, a reach whose hand was sent home (``hand_sent_home``) not counted.
+    ``mean`` is NaN where ``n`` = 0; ``sem`` is the sample
     standard deviation over the square root of ``n`` and NaN where ``n`` < 2. ``block`` and
     ``perturbation`` are those most students had on that trial. Returns one dict per trial number
     seen, in order: ``trial, block, perturbation, mean, sem, n``.
@@ -127,7 +128,8 @@ def class_curve(students: Sequence[Sequence[Mapping[str, Any]]],
                 raise UserError(f"student {s} has trial {trial} twice")
             seen.add(trial)
             labels.setdefault(trial, Counter())[(str(row["block"]), str(row["perturbation"]))] += 1
-            value = float(row[metric])
+            # A reach abandoned with space (the hand sent home) is not one of the experiment's: no value here.
+            value = math.nan if row.get("hand_sent_home") else float(row[metric])
             values.setdefault(trial, [])
             if math.isfinite(value):
                 values[trial].append(value)
@@ -268,6 +270,27 @@ def paths_figure(groups: Mapping[str, Sequence[np.ndarray]], home: Sequence[floa
 def class_figure(curve: Sequence[Mapping[str, Any]], path: Path, *,
                  metric: str = "initial_direction_error_deg") -> None:
     """The class curve from ``class_curve``: the mean with its s.e.m. band, blocks shaded, n below."""
+    _draw_class(curve, metric, lambda fig: _save(fig, path))
+
+
+def class_figure_png(curve: Sequence[Mapping[str, Any]], *, metric: str = "initial_direction_error_deg") -> bytes:
+    """``class_figure``'s picture as PNG bytes (the class's teacher page downloads it); UserError without
+    matplotlib."""
+    drawn: list[bytes] = []
+    _class_png(curve, drawn, metric=metric)
+    return drawn[0]
+
+
+@_lab_style
+def _class_png(curve: Sequence[Mapping[str, Any]], drawn: list[bytes], *, metric: str) -> None:
+    def keep(fig: Any) -> None:
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png")
+        drawn.append(buffer.getvalue())
+    _draw_class(curve, metric, keep)
+
+
+def _draw_class(curve: Sequence[Mapping[str, Any]], metric: str, finish: Callable[[Any], None]) -> None:
     label, scale = _measure(metric)
     if not curve:
         raise UserError("no trials to draw")
@@ -311,7 +334,7 @@ def class_figure(curve: Sequence[Mapping[str, Any]], path: Path, *,
     else:
         ax.set_xlabel("trial")
     _legend_below(fig, n_ax if n_ax is not None else ax, handles_from=ax)
-    _save(fig, path)
+    finish(fig)
 
 
 # ------------------------------------------------------------------------------------- internals

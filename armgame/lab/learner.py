@@ -135,10 +135,11 @@ def simulate(learner: TwoRateLearner, disturbance: Sequence[float] | np.ndarray,
 
 
 #: The local learner's tuning (docs/lab.md, "Generalization"): Gaussian bases over movement direction, this wide
-#: (s.d., degrees), centred every 360 / ``TUNING_CENTRES`` degrees. A choice, not a fit: with bases 30 deg wide,
+#: (s.d., degrees), centred every 360 / ``TUNING_CENTRES`` degrees. A choice, not a fit: with bases of s.d. 30 deg,
 #: what is learned in one direction carries over to 0.57 of it at 45 deg and 0.105 at 90 deg (``generalization``), the
 #: local fall-off force-field studies report (Thoroughman & Shadmehr 2000; Donchin et al. 2003), without the
-#: partial bimodal generalization to the opposite direction some of them found.
+#: partial bimodal generalization to the opposite direction some of them found. The generalization is wider than
+#: a basis: a Gaussian of s.d. 30 x sqrt 2 = 42.4 deg, the overlap of two tunings.
 TUNING_WIDTH_DEG = 30.0
 TUNING_CENTRES = 16
 MIN_TUNING_WIDTH_DEG = 5.0

@@ -267,11 +267,26 @@ def reach_metrics(reach: Reach, *, threshold: float = 0.05, direction_at: str = 
 #: The error-clamp columns, empty on other trials; a table without them (written before they existed)
 #: still reads, with them empty.
 CHANNEL_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ChannelMeasures))
+#: 1 when space ("hand home") sent the hand home during the reach: the row measures the path before the jump
+#: only, and the class curve leaves the trial out (an abandoned reach is not one of the experiment's). A table
+#: written before the column existed still reads, with it 0.
+HAND_SENT_HOME = "hand_sent_home"
+#: Issue 41's columns: what the player saw of the hand (``feedback``: full, endpoint or none), the trial's
+#: ``disturbance`` in units of the run's first perturbation (+1 it, -1 its opposite, 0 none, a catch or a channel
+#: trial; empty when a run's perturbations share no unit), and a channel trial's index against the reference field
+#: held at the hand and at the joints (``armgame.lab.designs``). A table without them still reads (``feedback`` as
+#: full, the rest empty).
+DESIGN_COLUMNS: tuple[str, ...] = ("feedback", "disturbance", "adaptation_index_hand", "adaptation_index_joint")
 TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time_s",
                                   "movement_time_s", "peak_speed_m_per_s", "initial_direction_error_deg",
-                                  "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS)
+                                  "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS,
+                                  HAND_SENT_HOME, *DESIGN_COLUMNS)
+#: Columns a table may lack (written before they existed), and what each then reads as.
+LATER_COLUMNS: dict[str, object] = {**dict.fromkeys(CHANNEL_COLUMNS, NAN), HAND_SENT_HOME: False,
+                                    **dict.fromkeys(DESIGN_COLUMNS, NAN), "feedback": "full"}
+_FLAGS = ("hit", HAND_SENT_HOME)
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
-_TEXT_COLUMNS = ("block", "perturbation")
+_TEXT_COLUMNS = ("block", "perturbation", "feedback")
 #: Whose run a row is, in a table of several runs (``armgame analyze A.json B.json --out all.csv``).
 LABEL_COLUMNS: tuple[str, ...] = ("player", "replay")
 _NONNEGATIVE = ("movement_time_s", "peak_speed_m_per_s", "path_length_ratio")
@@ -294,7 +309,8 @@ def write_trials_csv(path: Path, rows: Iterable[Mapping[str, object]], labels: S
     several runs in one table stay attributable); each row then has them too, as text.
 
     Numbers are written exactly (the shortest text that reads back to the same float); an
-    undefined measure (NaN) is an empty field; ``hit`` is 1 or 0. Only a regular file is written:
+    undefined measure (NaN) is an empty field; ``hit`` and ``hand_sent_home`` are 1 or 0. Only a regular file is
+    written:
     an existing folder, device or symbolic link at ``path`` is refused (``UserError``). A row with a
     missing or unknown column, or a value of the wrong kind, is a ``ValueError`` (a caller's bug).
     """
@@ -318,15 +334,16 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
     """Read a trials table written by ``write_trials_csv`` (or a spreadsheet), trusting nothing.
 
     The file must be a regular file of at most 16 MiB, UTF-8 (a leading byte-order mark is allowed),
-    with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``CHANNEL_COLUMNS``
-    may be absent, as in tables written before error-clamp trials existed, and read as NaN;
+    with a header naming exactly the columns of ``TRIAL_COLUMNS`` (in any order; the ``LATER_COLUMNS``
+    may be absent, as in tables written before they existed: the ``CHANNEL_COLUMNS`` and the
+    ``DESIGN_COLUMNS`` read as NaN, ``feedback`` as full, ``hand_sent_home`` as False;
     ``LABEL_COLUMNS``, which ``analyze`` writes first, are allowed and not returned; the old names of
     ``RENAMED_COLUMNS``, before each column named its unit, read as the new ones). Each row is
     checked: ``block`` and ``perturbation`` printable text of at most 64 characters, ``trial`` a
     whole number from 0 to 1,000,000, ``target_deg`` a finite number, each measure a finite number
     or empty (read as NaN; times may be negative, speed, movement time and ratio may not), ``hit``
-    one of 1, 0, true, false. The first problem raises ``TrialsFileError`` (a ``UserError``) in one
-    line naming the file, the line and the column. Rows come back in file order, typed, keyed in
+    and ``hand_sent_home`` one of 1, 0, true, false. The first problem raises ``TrialsFileError`` (a
+    ``UserError``) in one line naming the file, the line and the column. Rows come back in file order, typed, keyed in
     ``TRIAL_COLUMNS`` order.
     """
     path = Path(path)
@@ -344,7 +361,7 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
         header = [RENAMED_COLUMNS.get(name.strip(), name.strip()) for name in header]
         if len(set(header)) != len(header):
             raise TrialsFileError(f"{path}: line 1: a column is named twice")
-        missing = [name for name in TRIAL_COLUMNS if name not in header and name not in CHANNEL_COLUMNS]
+        missing = [name for name in TRIAL_COLUMNS if name not in header and name not in LATER_COLUMNS]
         unknown = [name for name in header if name not in TRIAL_COLUMNS and name not in LABEL_COLUMNS]
         if missing or unknown:
             what = f"lacks column(s) {', '.join(missing)}" if missing else f"has unknown column(s) {_show(unknown)}"
@@ -358,8 +375,11 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
             values = dict(zip(header, fields_, strict=True))
             row: dict[str, object] = {}
             for name in TRIAL_COLUMNS:
+                if name not in values:  # a column the table was written before
+                    row[name] = LATER_COLUMNS[name]
+                    continue
                 try:
-                    row[name] = _parse(name, values.get(name, ""))
+                    row[name] = _parse(name, values[name])
                 except ValueError as exc:
                     raise TrialsFileError(f"{path}: line {line}, column {name}: {exc}") from None
             rows.append(row)
@@ -425,7 +445,7 @@ def _format(name: str, value: object, n: int) -> str:
                 or not 0 <= value <= MAX_TRIAL:
             raise ValueError(f"{where}: must be a whole number from 0 to {MAX_TRIAL}, got {value!r}")
         return str(int(value))
-    if name == "hit":
+    if name in _FLAGS:
         if not isinstance(value, (bool, np.bool_)):
             raise ValueError(f"{where}: must be True or False, got {value!r}")
         return "1" if value else "0"
@@ -449,7 +469,7 @@ def _parse(name: str, text: str) -> object:
         if not text.isascii() or not text.isdigit() or len(text) > 7 or int(text) > MAX_TRIAL:
             raise ValueError(f"must be a whole number from 0 to {MAX_TRIAL}, got {_show(text)}")
         return int(text)
-    if name == "hit":
+    if name in _FLAGS:
         flag = text.lower()
         if flag not in ("1", "0", "true", "false"):
             raise ValueError(f"must be 1, 0, true or false, got {_show(text)}")

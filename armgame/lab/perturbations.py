@@ -10,14 +10,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from ..physics.loads import ConstantForce, CurlField, Loads, SpringField, ViscousField
+from ..physics.loads import ConstantForce, CurlField, JointLoad, Loads, SpringField, ViscousField
 from .protocol import Perturbation
 
 Display = Callable[[float, float, float, float], tuple[float, float]]
 
 
 def loads_for(p: Perturbation, home: tuple[float, float]) -> Loads | None:
-    """The hand force of a force perturbation; None for the others (the arm's own dynamics run)."""
+    """The hand force (or, for ``joint_viscous``, the joint torque) of a force perturbation; None for the others
+    (the arm's own dynamics run)."""
     if p.kind == "curl":
         return Loads(hand=CurlField(p["b"])) if p["b"] != 0.0 else None
     if p.kind == "constant":
@@ -25,6 +26,9 @@ def loads_for(p: Perturbation, home: tuple[float, float]) -> Loads | None:
     if p.kind == "viscous":
         matrix = p.matrix
         return Loads(hand=ViscousField(matrix)) if any(v != 0.0 for row in matrix for v in row) else None  # type: ignore[union-attr]
+    if p.kind == "joint_viscous":  # torque W qdot at the joints (issue 41), whatever the posture
+        matrix = p.joint_matrix
+        return Loads(joint=JointLoad(viscosity=matrix)) if any(v != 0.0 for row in matrix for v in row) else None  # type: ignore[union-attr]
     if p.kind == "spring":
         return Loads(hand=SpringField(p["stiffness"], home)) if p["stiffness"] != 0.0 else None
     return None

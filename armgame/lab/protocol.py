@@ -18,7 +18,17 @@ Perturbation kinds (parameters in brackets, with their TOML names):
 * ``mirror`` (``axis``, degrees): the hand is shown mirrored in the line through home at that
   angle from +x (90: left and right swap);
 * ``jointspace`` (``gain``, m/rad): Flanagan & Rao's display: the hand is shown at
-  ``home + gain (q1 - q1_home, q2 - q2_home)``, shoulder angle across, elbow angle up.
+  ``home + gain (q1 - q1_home, q2 - q2_home)``, shoulder angle across, elbow angle up;
+* ``joint_viscous`` (``matrix = [[w11, w12], [w21, w22]]``, N m s/rad): a viscous field in joint
+  coordinates, the torque ``tau = W qdot`` at the joints (issue 41: Shadmehr & Mussa-Ivaldi's
+  test of the frame a field is learned in). Seen at the hand it is ``J^-T W J^-1``, which changes
+  with the posture, where a hand field ``B`` stays ``B``.
+
+Issue 41's block settings (each defaults to today's behaviour and is written only when set): a
+block's own home posture (``home_shoulder_deg``, ``home_elbow_deg``: a second workspace), what the
+player sees of the hand (``feedback`` on its ordinary trials, ``probe_feedback`` on its catch and
+channel trials: ``full``, ``endpoint`` or ``none``, see ``FEEDBACK``) and fields mixed at random
+trial by trial (``mix``: ``MIX_KINDS``, balanced per direction; ``session.schedule``).
 
 Error-clamp (force-channel) trials: ``channel_trials = N`` in a block makes N of its trials
 channels, drawn as catch trials are (never in the block's first cycle of targets, never a catch
@@ -40,9 +50,9 @@ from ..errors import UserError
 from ..records.storage import check_float, check_int, check_keys, check_str, read_limited
 from ..words import unknown_name
 
-FORCE_KINDS = ("curl", "constant", "spring", "viscous")
+FORCE_KINDS = ("curl", "constant", "spring", "viscous", "joint_viscous")
 #: Fields ``F = B v``: the adaptation index of a channel trial is measured against one of these.
-VELOCITY_KINDS = ("curl", "viscous")
+VELOCITY_KINDS = ("curl", "viscous", "joint_viscous")
 VISUAL_KINDS = ("rotation", "mirror", "jointspace")
 KINDS = ("none", *FORCE_KINDS, *VISUAL_KINDS)
 
@@ -57,7 +67,24 @@ PARAMETERS: dict[str, tuple[tuple[str, float, float, float, str], ...]] = {
     "rotation": (("angle", -180.0, 180.0, 0.0, "deg"),),
     "mirror": (("axis", -180.0, 180.0, 90.0, "deg"),),
     "jointspace": (("gain", 0.01, 2.0, 0.25, "m/rad"),),
+    "joint_viscous": (("w11", -5.0, 5.0, 0.0, "N m s/rad"), ("w12", -5.0, 5.0, 0.0, "N m s/rad"),
+                      ("w21", -5.0, 5.0, 0.0, "N m s/rad"), ("w22", -5.0, 5.0, 0.0, "N m s/rad")),
 }
+#: The kinds whose parameters are a 2 x 2 matrix, written ``matrix = [[.., ..], [.., ..]]`` in a file.
+MATRIX_KINDS = {"viscous": ("b11", "b12", "b21", "b22"), "joint_viscous": ("w11", "w12", "w21", "w22")}
+
+#: What the player sees of the hand on a trial (Krakauer et al. 2000's probes without vision): ``full``, the
+#: cursor throughout; ``endpoint``, no cursor from the go cue until the trial ends, then the hand's endpoint
+#: (knowledge of results, not of the path); ``none``, no cursor from the go cue on and nothing after. The cursor is
+#: always shown at home, to bring the hand there. A trial without a cursor also ends when the hand has left home
+#: and stopped (``STILL_SPEED``, for the hold time), wherever that is: a player who cannot see cannot home in.
+FEEDBACK = ("full", "endpoint", "none")
+#: Below this hand speed (m/s), held for the hold time once the hand is more than half the target distance from
+#: home, a trial without a cursor ends: the reach is over.
+STILL_SPEED = 0.02
+#: A mixed block's trial kinds (Thoroughman & Shadmehr 2000; Donchin et al. 2003): the block's perturbation
+#: (``on``), none (``off``), or its opposite (``opposite``: every parameter negated).
+MIX_KINDS = ("on", "off", "opposite")
 
 #: The curl preset's field. Chosen by measurement (docs/lab.md, ``tests/test_lab.py``): the model
 #: bot, which knows the arm but not the field, is pushed 2-3 cm off its 10 cm reaches, and a bot
@@ -125,6 +152,19 @@ class Perturbation:
     def __getitem__(self, name: str) -> float:
         return dict(self.params)[name]
 
+    def opposite(self) -> Perturbation:
+        """Every parameter negated: the opposite field or rotation (a mixed block's ``opposite`` trials)."""
+        if self.kind in ("none", "mirror", "jointspace", "spring"):
+            raise UserError(f"perturbation {self.kind} has no opposite")
+        return Perturbation(self.kind, tuple((name, -value) for name, value in self.params))
+
+    @property
+    def joint_matrix(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """``W`` of a joint-space field ``tau = W qdot`` (``joint_viscous``), else None."""
+        if self.kind != "joint_viscous":
+            return None
+        return (self["w11"], self["w12"]), (self["w21"], self["w22"])
+
     @property
     def is_force(self) -> bool:
         return self.kind in FORCE_KINDS
@@ -147,6 +187,9 @@ class Perturbation:
         if self.kind == "viscous":
             (b11, b12), (b21, b22) = self.matrix  # type: ignore[misc]
             return f"viscous B=[[{b11:g}, {b12:g}], [{b21:g}, {b22:g}]] N s/m"
+        if self.kind == "joint_viscous":
+            (w11, w12), (w21, w22) = self.joint_matrix  # type: ignore[misc]
+            return f"joint_viscous W=[[{w11:.4g}, {w12:.4g}], [{w21:.4g}, {w22:.4g}]] N m s/rad"
         units = {name: unit for name, _l, _h, _d, unit in PARAMETERS[self.kind]}
         parts = [f"{name}={value:g} {units[name]}" for name, value in self.params]
         return " ".join([self.kind, *parts])
@@ -163,6 +206,8 @@ class Perturbation:
     def as_dict(self) -> dict[str, object]:
         if self.kind == "viscous":
             return {"perturbation": self.kind, "matrix": [list(row) for row in self.matrix]}  # type: ignore[union-attr]
+        if self.kind == "joint_viscous":
+            return {"perturbation": self.kind, "matrix": [list(row) for row in self.joint_matrix]}  # type: ignore[union-attr]
         return {"perturbation": self.kind, **dict(self.params)}
 
 
@@ -184,6 +229,21 @@ class Block:
     #: The targets its catch and channel trials go to (a generalization test probes directions never trained);
     #: None: the block's own ``directions``.
     probe_directions: tuple[int, ...] | None = None
+    #: Issue 41. This block's home posture (shoulder, elbow; degrees), a second workspace; None: the protocol's.
+    home_posture_deg: tuple[float, float] | None = None
+    #: What the player sees of the hand on the block's ordinary trials (``FEEDBACK``).
+    feedback: str = "full"
+    #: ... and on its catch and channel trials (the probes); None: as on its ordinary trials.
+    probe_feedback: str | None = None
+    #: Its ordinary trials' kinds drawn at random (``MIX_KINDS``), balanced per direction; empty: all ``on``.
+    mix: tuple[str, ...] = ()
+
+    @property
+    def probes_feedback(self) -> str:
+        return self.feedback if self.probe_feedback is None else self.probe_feedback
+
+    def posture_of(self, protocol: Protocol) -> tuple[float, float]:
+        return protocol.home_posture_deg if self.home_posture_deg is None else self.home_posture_deg
 
     @property
     def channel_block(self) -> bool:
@@ -274,6 +334,20 @@ class Protocol:
             return own
         return next((b.perturbation for b in self.blocks if b.perturbation.kind in VELOCITY_KINDS), None)
 
+    @property
+    def start_posture_deg(self) -> tuple[float, float]:
+        """Where the run starts: its first block's posture (the protocol's unless that block sets its own)."""
+        return self.blocks[0].posture_of(self) if self.blocks else self.home_posture_deg
+
+    @property
+    def postures_deg(self) -> tuple[tuple[float, float], ...]:
+        """Every posture its blocks reach from, the start first."""
+        return tuple(dict.fromkeys(b.posture_of(self) for b in self.blocks)) or (self.home_posture_deg,)
+
+    def field_posture_deg(self, field: Perturbation) -> tuple[float, float]:
+        """The posture of the first block that has ``field`` on: where it is learned (for the frames' indices)."""
+        return next((b.posture_of(self) for b in self.blocks if b.perturbation == field), self.start_posture_deg)
+
     def target_angles_deg(self) -> tuple[float, ...]:
         return tuple(self.first_target_deg + 360.0 * i / self.targets for i in range(self.targets))
 
@@ -315,10 +389,25 @@ class Protocol:
             "blocks": [
                 {"name": b.name, "trials": b.trials, "catch_trials": b.catch_trials, "instruction": b.instruction,
                  **({"channel_trials": b.channel_trials} if b.channel_trials else {}), **directions(b),
-                 **b.perturbation.as_dict()}
+                 **_design_keys(b), **b.perturbation.as_dict()}
                 for b in self.blocks
             ],
         }
+
+
+def _design_keys(b: Block) -> dict[str, object]:
+    """A block's issue-41 settings as a file writes them: only those set, so a protocol without them is written
+    byte for byte as before."""
+    out: dict[str, object] = {}
+    if b.home_posture_deg is not None:
+        out["home_shoulder_deg"], out["home_elbow_deg"] = b.home_posture_deg
+    if b.feedback != "full":
+        out["feedback"] = b.feedback
+    if b.probe_feedback is not None:
+        out["probe_feedback"] = b.probe_feedback
+    if b.mix:
+        out["mix"] = list(b.mix)
+    return out
 
 
 def _blocks(exposure: Perturbation, baseline: int = 16, exposure_trials: int = 80, washout: int = 24,
@@ -368,11 +457,17 @@ def preset(name: str) -> Protocol:
         return spontaneous()
     if name == "generalization":
         return generalization()
+    if name == "frames":
+        return frames()
+    if name == "rotation-generalization":
+        return rotation_generalization()
+    if name == "random-fields":
+        return random_fields()
     raise UserError(unknown_name("lab preset", name, PRESETS, "or give a .toml file"))
 
 
 PRESETS = ("lesson", "null", "curl", "rotation", "mirror", "jointspace", "viscous", "savings", "spontaneous",
-           "generalization")
+           "generalization", "frames", "rotation-generalization", "random-fields")
 
 #: ``--motor-noise human``: the s.d. of a bot's motor command as a fraction of it. A choice, not a fit to a
 #: published data set (docs/lab.md, "Motor noise"): it makes the ``model`` bot's baseline reaches vary from trial
@@ -385,6 +480,12 @@ HUMAN_NOISE = 0.3
 #: demo, whose bot is shown beside the volunteers and rehearsed to the digit (docs/teaching.md): none. Seeded by
 #: the run's seed, so a noisy run is as reproducible as a quiet one; a protocol file's bot has none unless asked.
 PRESET_MOTOR_NOISE = {name: 0.0 if name == "lesson" else HUMAN_NOISE for name in PRESETS}
+
+#: The adapting bot's learner on each preset when ``--representation`` does not say: ``generalization``'s point is
+#: local generalization, so its bot learns locally (the global learner, a control, is asked for by name); every
+#: other preset's learns one estimate for every direction. A bot's replay records its keys, not its learner, so
+#: an old run of the preset replays as it was recorded.
+PRESET_REPRESENTATION = {name: "local" if name == "generalization" else "global" for name in PRESETS}
 
 
 def savings(counter: int = SAVINGS_COUNTER) -> Protocol:
@@ -425,7 +526,7 @@ def spontaneous() -> Protocol:
 
 
 def generalization() -> Protocol:
-    """Train on one direction, probe them all (Shadmehr & Mussa-Ivaldi 1994; Krakauer et al. 2000;
+    """Train on one direction, probe them all (Shadmehr & Mussa-Ivaldi 1994; Gandolfo, Mussa-Ivaldi & Bizzi 1996;
     Donchin et al. 2003): a baseline to the 8 targets with a channel trial to each (the per-direction
     baseline), training in the curl field to ``GENERALIZATION_TRAINED_DEG`` only, then a test block that
     keeps training there while its channel trials probe every direction twice, spread evenly. The adaptation
@@ -438,6 +539,67 @@ def generalization() -> Protocol:
         Block("exposure", train, curl, 0, DEFAULT_INSTRUCTIONS["exposure"], directions=trained),
         Block("test", test, curl, 0, DEFAULT_INSTRUCTIONS["exposure"], channel_trials=probes, directions=trained,
               probe_directions=tuple(range(8))),
+    )))
+
+
+#: The frames preset (Shadmehr & Mussa-Ivaldi 1994): training at the game's posture, testing with the shoulder
+#: rotated 90 deg (the elbow as it was). A pure shoulder rotation by phi turns the hand Jacobian by phi, so a joint
+#: field learned at the first posture is seen at the hand of the second as ``R B R^T``: for their (symmetric)
+#: matrix, at 90 deg, nearly ``-B`` (the two frames predict opposite after-effects); a curl field would be the same
+#: in both frames, which is why the test needs the viscous field. Blocks: baseline at the training posture, a
+#: baseline at the test posture with a channel trial to each target (each direction's baseline there), exposure
+#: at the training posture, then a block of channel trials at the test posture.
+FRAMES_TEST_POSTURE = (135.0, 90.0)
+FRAMES_BLOCKS = (16, 24, 160, 16)
+#: Krakauer et al.'s (2000) design on the rotation: baseline with a no-cursor probe to each target, training to one
+#: direction with the cursor rotated, a test that keeps training while no-cursor probes go to every direction twice.
+ROTATION_GENERALIZATION_BLOCKS = (24, 64, 48, 16)
+#: The random-fields preset (Thoroughman & Shadmehr 2000; Donchin et al. 2003): the curl field on or off at random
+#: trial by trial, balanced per direction, so the trial-by-trial fit can read how an error in one direction
+#: changes the next reach in another.
+RANDOM_FIELDS_BLOCKS = (16, 192)
+
+
+def frames() -> Protocol:
+    """Train at one posture, test at another (Shadmehr & Mussa-Ivaldi 1994): which frame was the field learned in?
+    The channel trials at the test posture are measured against the field held in hand coordinates and the same
+    field held in joint coordinates (``adaptation_index_hand``, ``adaptation_index_joint``; docs/lab.md)."""
+    (b11, b12), (b21, b22) = VISCOUS_B
+    field = Perturbation.make("viscous", b11=b11, b12=b12, b21=b21, b22=b22)
+    base_a, base_b, train, test = FRAMES_BLOCKS
+    return _checked(Protocol("frames", (
+        Block("baseline", base_a, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"]),
+        Block("baseline 2", base_b, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"], channel_trials=8,
+              home_posture_deg=FRAMES_TEST_POSTURE),
+        Block("exposure", train, field, 0, DEFAULT_INSTRUCTIONS["exposure"]),
+        Block("test", test, field, 0, DEFAULT_INSTRUCTIONS["clamp"], channel_trials=test,
+              home_posture_deg=FRAMES_TEST_POSTURE),
+    )))
+
+
+def rotation_generalization() -> Protocol:
+    """Krakauer, Pine, Ghilardi & Ghez (2000): a 30 deg rotation trained to one target, generalization measured with
+    probes without vision (no cursor from the go cue on, the rotation off) to every target, each direction's
+    baseline probes subtracted (docs/lab.md)."""
+    base, train, test, probes = ROTATION_GENERALIZATION_BLOCKS
+    rotation = Perturbation.make("rotation", angle=ROTATION_ANGLE)
+    trained = (GENERALIZATION_TRAINED_DEG // 45,)
+    return _checked(Protocol("rotation-generalization", (
+        Block("baseline", base, NONE, 8, DEFAULT_INSTRUCTIONS["baseline"], probe_feedback="none"),
+        Block("exposure", train, rotation, 0, DEFAULT_INSTRUCTIONS["exposure"], directions=trained),
+        Block("test", test, rotation, probes, DEFAULT_INSTRUCTIONS["exposure"], directions=trained,
+              probe_directions=tuple(range(8)), probe_feedback="none"),
+    )))
+
+
+def random_fields() -> Protocol:
+    """Thoroughman & Shadmehr (2000), Donchin, Francis & Shadmehr (2003): the curl field on or off at random, trial
+    by trial (``mix``, balanced per direction), for ``armgame analyze --fit trial-by-trial``."""
+    base, mixed = RANDOM_FIELDS_BLOCKS
+    return _checked(Protocol("random-fields", (
+        Block("baseline", base, NONE, 0, DEFAULT_INSTRUCTIONS["baseline"]),
+        Block("random", mixed, Perturbation.make("curl", b=CURL_B), 0, DEFAULT_INSTRUCTIONS["exposure"],
+              mix=("on", "off")),
     )))
 
 
@@ -473,7 +635,7 @@ _TOP = {"name", "targets", "distance", "target_radius", "home_radius", "hold_tim
         "timeout", "first_target_deg", "home_shoulder_deg", "home_elbow_deg", "channel_stiffness", "channel_damping",
         "probe_schedule", "consecutive_probes"}
 _BLOCK = {"name", "trials", "catch_trials", "channel_trials", "instruction", "perturbation", "directions_deg",
-          "probe_directions_deg"}
+          "probe_directions_deg", "home_shoulder_deg", "home_elbow_deg", "feedback", "probe_feedback", "mix"}
 
 
 def _directions(where: str, value: object, angles: tuple[float, ...]) -> tuple[int, ...]:
@@ -493,14 +655,42 @@ def _directions(where: str, value: object, angles: tuple[float, ...]) -> tuple[i
     return tuple(out)
 
 
-def viscous_matrix(where: str, value: object) -> dict[str, float]:
-    """``matrix = [[b11, b12], [b21, b22]]`` (N s/m, each within the viscous field's range) as parameters."""
+def viscous_matrix(where: str, value: object, kind: str = "viscous") -> dict[str, float]:
+    """``matrix = [[b11, b12], [b21, b22]]`` (N s/m, each within the viscous field's range; for ``joint_viscous``
+    ``[[w11, w12], [w21, w22]]`` in N m s/rad) as parameters."""
+    names = MATRIX_KINDS[kind]
+    unit = PARAMETERS[kind][0][4]
     if not (isinstance(value, list) and len(value) == 2
             and all(isinstance(row, list) and len(row) == 2 for row in value)):
-        raise ValueError(f"{where} must be [[b11, b12], [b21, b22]] (N s/m)")
-    limits = {name: (low, high) for name, low, high, _d, _u in PARAMETERS["viscous"]}
+        raise ValueError(f"{where} must be [[{names[0]}, {names[1]}], [{names[2]}, {names[3]}]] ({unit})")
+    limits = {name: (low, high) for name, low, high, _d, _u in PARAMETERS[kind]}
     return {name: check_float(f"{where}[{i}][{j}]", value[i][j], *limits[name])
-            for (i, j), name in zip(((0, 0), (0, 1), (1, 0), (1, 1)), ("b11", "b12", "b21", "b22"), strict=True)}
+            for (i, j), name in zip(((0, 0), (0, 1), (1, 0), (1, 1)), names, strict=True)}
+
+
+def _block_design(w: str, b: dict) -> dict[str, object]:
+    """A file's block's issue-41 settings, checked: its posture, feedback and mix (absent: today's behaviour)."""
+    out: dict[str, object] = {}
+    if "home_shoulder_deg" in b or "home_elbow_deg" in b:
+        if not ("home_shoulder_deg" in b and "home_elbow_deg" in b):
+            raise ValueError(f"{w}: a block's posture needs both home_shoulder_deg and home_elbow_deg")
+        out["home_posture_deg"] = (check_float(f"{w}.home_shoulder_deg", b["home_shoulder_deg"], -180.0, 180.0),
+                                   check_float(f"{w}.home_elbow_deg", b["home_elbow_deg"], 5.0, 175.0))
+    for key in ("feedback", "probe_feedback"):
+        if key in b:
+            value = check_str(f"{w}.{key}", b[key], 20)
+            if value not in FEEDBACK:
+                raise ValueError(f"{w}.{key} must be one of {', '.join(FEEDBACK)}, got {value!r}")
+            out[key] = value
+    if "mix" in b:
+        mix = b["mix"]
+        if not isinstance(mix, list) or not 2 <= len(mix) <= 12:
+            raise ValueError(f"{w}.mix must be a list of 2 to 12 of {', '.join(MIX_KINDS)}")
+        for i, item in enumerate(mix):
+            if item not in MIX_KINDS:
+                raise ValueError(f"{w}.mix[{i}] must be one of {', '.join(MIX_KINDS)}, got {item!r}")
+        out["mix"] = tuple(mix)
+    return out
 
 
 def protocol_from_dict(data: object, where: str = "protocol", recorded: bool = False) -> Protocol:
@@ -530,10 +720,10 @@ def protocol_from_dict(data: object, where: str = "protocol", recorded: bool = F
         kind = check_str(f"{w}.perturbation", b.get("perturbation", "none"), 20)
         if kind not in KINDS:
             raise ValueError(f"{w}.perturbation must be one of {', '.join(KINDS)}, got {kind!r}")
-        param_names = {"matrix"} if kind == "viscous" else {p[0] for p in PARAMETERS[kind]}
+        param_names = {"matrix"} if kind in MATRIX_KINDS else {p[0] for p in PARAMETERS[kind]}
         check_keys(w, b, {"trials"}, frozenset((_BLOCK - {"trials"}) | param_names))
-        if kind == "viscous":
-            values = viscous_matrix(f"{w}.matrix", b["matrix"]) if "matrix" in b else {}
+        if kind in MATRIX_KINDS:
+            values = viscous_matrix(f"{w}.matrix", b["matrix"], kind) if "matrix" in b else {}
         else:
             values = {p: check_float(f"{w}.{p}", b[p], low, high)
                       for p, low, high, _d, _u in PARAMETERS[kind] if p in b}
@@ -548,6 +738,7 @@ def protocol_from_dict(data: object, where: str = "protocol", recorded: bool = F
             _directions(f"{w}.directions_deg", b["directions_deg"], angles) if "directions_deg" in b else None,
             _directions(f"{w}.probe_directions_deg", b["probe_directions_deg"], angles)
             if "probe_directions_deg" in b else None,
+            **_block_design(w, b),  # type: ignore[arg-type]
         ))
     schedule = check_str("probe_schedule", d["probe_schedule"], 20) if "probe_schedule" in d \
         else "random" if recorded else "balanced"
@@ -592,8 +783,22 @@ def _checked(p: Protocol) -> Protocol:
             raise ValueError(f"blocks[{i}].probe_directions_deg: block {b.name!r} has no catch or channel trials")
         if b.probe_directions is not None and not balanced:
             raise ValueError(f"blocks[{i}].probe_directions_deg needs probe_schedule = \"balanced\"")
-        if b.catch_trials and b.perturbation.kind == "none":
-            raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} has no perturbation to switch off")
+        if b.catch_trials and b.perturbation.kind == "none" and b.probes_feedback == "full":
+            # Without a perturbation a catch trial is only a probe of what the player does without vision.
+            raise ValueError(f"blocks[{i}].catch_trials: block {b.name!r} has no perturbation to switch off "
+                             "(in a block without one, catch trials need probe_feedback = \"endpoint\" or \"none\")")
+        if b.feedback not in FEEDBACK or b.probes_feedback not in FEEDBACK:
+            raise ValueError(f"blocks[{i}].feedback must be one of {', '.join(FEEDBACK)}")
+        if b.mix:
+            if any(m not in MIX_KINDS for m in b.mix) or len(b.mix) < 2:
+                raise ValueError(f"blocks[{i}].mix must list 2 or more of {', '.join(MIX_KINDS)}")
+            if b.perturbation.kind in ("none", "mirror", "jointspace", "spring") \
+                    or ("opposite" in b.mix and b.perturbation.is_null):
+                raise ValueError(f"blocks[{i}].mix: block {b.name!r} needs a field or a rotation to mix "
+                                 f"(it has {b.perturbation.kind})")
+            if b.catch_trials:
+                raise ValueError(f"blocks[{i}].mix: a mixed block's off trials are its catch trials: give no "
+                                 "catch_trials")
         if b.channel_trials > b.trials:
             raise ValueError(f"blocks[{i}].channel_trials must be at most the block's trials ({b.trials})")
         if b.channel_block:

@@ -48,17 +48,23 @@ class LabTask:
     @classmethod
     def of(cls, session: LabSession, motor_noise: MotorNoise | None = None) -> LabTask:
         return cls(session.protocol, tuple((t, g, e, h) for t, g, e, h in session.trial_records()),  # type: ignore[misc]
-                   paths_digest(session), motor_noise)
+                   paths_digest(session), motor_noise, trial_fields(session))
+
+    #: A protocol with mixed blocks (issue 41): each finished trial's perturbation as it ran (``Perturbation.label``),
+    #: for the reader and checked by verify; None otherwise (and absent from the file).
+    fields: tuple[str, ...] | None = None
 
     def as_dict(self) -> dict[str, object]:
         noise = {} if self.motor_noise is None else {"motor_noise": self.motor_noise.as_dict()}
+        fields = {} if self.fields is None else {"fields": list(self.fields)}
         return {"kind": TASK_KIND, "protocol": self.protocol.as_dict(), "trials": [list(t) for t in self.trials],
-                "paths_sha256": self.paths_sha256, **noise}
+                "paths_sha256": self.paths_sha256, **noise, **fields}
 
     @classmethod
     def from_dict(cls, data: object, config: GameConfig, last_step: int) -> LabTask:
         """Rebuild and check a task section; raises ValueError naming the bad field."""
-        d = check_keys("task", data, {"kind", "protocol", "trials", "paths_sha256"}, frozenset({"motor_noise"}))
+        d = check_keys("task", data, {"kind", "protocol", "trials", "paths_sha256"},
+                       frozenset({"motor_noise", "fields"}))
         kind = check_str("task.kind", d["kind"], 40)
         if kind != TASK_KIND:
             raise ValueError(f"task.kind must be {TASK_KIND!r}, got {kind!r}")
@@ -83,7 +89,13 @@ class LabTask:
         digest = check_str("task.paths_sha256", d["paths_sha256"], 64)
         if not _HEX64.fullmatch(digest):
             raise ValueError("task.paths_sha256 must be 64 hexadecimal digits")
-        return cls(protocol, tuple(trials), digest, _motor_noise(d["motor_noise"]) if "motor_noise" in d else None)
+        fields = None
+        if "fields" in d:
+            if not isinstance(d["fields"], list) or len(d["fields"]) != len(trials):
+                raise ValueError("task.fields must be a list of one perturbation per trial")
+            fields = tuple(check_str(f"task.fields[{i}]", v, 120) for i, v in enumerate(d["fields"]))
+        return cls(protocol, tuple(trials), digest, _motor_noise(d["motor_noise"]) if "motor_noise" in d else None,
+                   fields)
 
     def new_session(self, config: GameConfig) -> LabSession:
         """A fresh session of this task, at its start (for a window to replay the timeline into)."""
@@ -101,7 +113,8 @@ class LabTask:
         recomputed = session.result()
         same_trials = tuple(tuple(t) for t in session.trial_records()) == self.trials
         same_paths = paths_digest(session) == self.paths_sha256
-        return same_outcome(recomputed, result) and same_trials and same_paths, recomputed, session
+        same_fields = self.fields is None or trial_fields(session) == self.fields
+        return same_outcome(recomputed, result) and same_trials and same_paths and same_fields, recomputed, session
 
 
 def _motor_noise(data: object) -> MotorNoise:
@@ -121,6 +134,13 @@ def motor_noise_words(noise: MotorNoise | None) -> str:
         return "no motor noise"
     return (f"motor noise {noise.level:g} (the s.d. of the command as a fraction of it, correlated over "
             f"{1000 * noise.correlation_time:g} ms, seed {noise.seed})")
+
+
+def trial_fields(session: LabSession) -> tuple[str, ...] | None:
+    """Each finished trial's perturbation as it ran, for a protocol with mixed blocks; None for any other."""
+    if not any(b.mix for b in session.protocol.blocks):
+        return None
+    return tuple("channel" if o.plan.channel else o.plan.active.label() for o in session.outcomes)
 
 
 def paths_digest(session: LabSession) -> str:

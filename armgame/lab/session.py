@@ -16,6 +16,12 @@ as a robot switches its field on for the movement: a force field through a ``Loa
 closures, a visual transform on the shown hand. So the hold at home is never disturbed (a steady
 force there would keep the go cue from ever coming). The shown hand is recorded every physics
 step from the go cue to the trial's end, for the per-reach metrics.
+
+Issue 41: a block may have a home posture of its own (the arm is put there at the end of the
+trial before, as a robot moves the arm to a second workspace); a trial may hide the cursor from
+its go cue on (``TrialPlan.feedback``: ``endpoint`` shows where the reach ended once it is over,
+``none`` nothing), and such a trial also ends when the hand has left home and stopped; a block may
+mix its field on, off or reversed at random, balanced per direction (``Block.mix``).
 """
 
 from __future__ import annotations
@@ -33,7 +39,7 @@ from ..limits import MAX_GAME_SECONDS
 from ..physics.integrators import Integrator
 from ..physics.loads import ChannelField, Loads, loaded_arm
 from .perturbations import Display, display_for, loads_for
-from .protocol import MAX_CHANNEL_LAMBDA_DT, NONE, Block, Perturbation, Protocol, target_positions
+from .protocol import MAX_CHANNEL_LAMBDA_DT, NONE, STILL_SPEED, Block, Perturbation, Protocol, target_positions
 
 HOLD, REACH = "hold", "reach"
 _WENT, _ENDED = 1, 2
@@ -55,6 +61,11 @@ class TrialPlan:
     catch: bool
     #: An error-clamp trial: the force channel along the home-to-target line instead of the perturbation.
     channel: bool = False
+    #: Where the trial starts: the home position (m) and posture (rad) of its block.
+    home: tuple[float, float] = (0.0, 0.0)
+    home_q: tuple[float, float] = (0.0, 0.0)
+    #: What the player sees of the hand from the go cue on (``protocol.FEEDBACK``).
+    feedback: str = "full"
 
     @property
     def active(self) -> Perturbation:
@@ -77,19 +88,43 @@ class TrialOutcome:
     #: On a channel trial: the hand's true velocity (m/s) at those steps, for the adaptation index.
     vxs: list[float] = field(default_factory=list, repr=False)
     vys: list[float] = field(default_factory=list, repr=False)
+    #: On a channel trial: the joint angles (rad) at those steps, for a field held in joint coordinates.
+    q1s: list[float] = field(default_factory=list, repr=False)
+    q2s: list[float] = field(default_factory=list, repr=False)
+    #: Where space ("hand home") sent the hand home during the reach: the number of samples of ``xs`` taken before
+    #: the jump (None: it never was). The samples from there on are not the reach: a jump of tens of centimetres in
+    #: one physics step is no movement, and measured as one it reads as a reach of tens of metres a second.
+    home_at: int | None = None
+
+    @property
+    def reach_samples(self) -> int:
+        """How many samples of ``xs`` (and of the channel's) are the reach: all, or those before the hand was sent
+        home."""
+        return len(self.xs) if self.home_at is None else self.home_at
 
 
-def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]) -> tuple[TrialPlan, ...]:
+def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float],
+             homes: dict[tuple[float, float], tuple[tuple[float, float], tuple[float, float]]] | None = None,
+             ) -> tuple[TrialPlan, ...]:
     """Every trial of the protocol: targets in shuffled cycles (each of the block's targets once a cycle),
     go-cue delays, catch trials and channel trials, all drawn from one ``random.Random(seed)`` in a fixed
     order. A block without catch or channel trials draws nothing for them, so the schedules of protocols
     without probes are those they always were; how the probes are placed is ``protocol.probe_schedule``'s
-    (``balanced_probes``, or ``random``: drawn uniformly among the trials after the block's first cycle)."""
+    (``balanced_probes``, or ``random``: drawn uniformly among the trials after the block's first cycle).
+
+    ``homes``: each posture's (home position, posture in rad), by the posture in degrees, for protocols whose blocks
+    move home (``LabSession`` works them out); by default every block starts at ``home``. A mixed block (``mix``)
+    draws its trials' kinds after its targets and probes: per target, in order, shuffled cycles of the mix."""
     rng = random.Random(seed)
-    positions = target_positions(protocol, home)
     angles = protocol.target_angles_deg()
+    start_q = tuple(math.radians(a) for a in protocol.start_posture_deg)
     plans: list[TrialPlan] = []
     for b, block in enumerate(protocol.blocks):
+        if homes is None:
+            block_home, block_q = home, start_q
+        else:
+            block_home, block_q = homes[block.posture_of(protocol)]
+        positions = target_positions(protocol, block_home)
         own = block.targets_of(protocol)
         if block.channel_block:
             order = _cycles(rng, block.probe_targets_of(protocol), block.trials)
@@ -106,12 +141,35 @@ def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]
                 channel = set(rng.sample(free, block.channel_trials))
             else:
                 channel = set()
+        kinds = _mixed(rng, block, order, catch | channel) if block.mix else {}
+        opposite = block.perturbation.opposite() if "opposite" in block.mix else None
         for i in range(block.trials):
             delay = rng.uniform(*protocol.delay)
             t = order[i]
+            kind = kinds.get(i, "on")
+            perturbation = block.perturbation if kind == "on" else NONE if kind == "off" else opposite
+            probe = i in catch or i in channel
             plans.append(TrialPlan(len(plans), b, block.name, t, angles[t] % 360.0, positions[t],
-                                   max(1, round(delay / dt)), block.perturbation, i in catch, i in channel))
+                                   max(1, round(delay / dt)), perturbation, i in catch, i in channel,  # type: ignore[arg-type]
+                                   block_home, block_q,  # type: ignore[arg-type]
+                                   block.probes_feedback if probe else block.feedback))
     return tuple(plans)
+
+
+def _mixed(rng: random.Random, block: Block, order: list[int], probes: set[int]) -> dict[int, str]:
+    """A mixed block's ordinary trials' kinds: for each target (in the order of first appearance), its trials
+    take shuffled cycles of the block's ``mix``, so each direction has each kind as often as its trials allow
+    (within one), and the sequence of kinds seen from trial to trial is random."""
+    out: dict[int, str] = {}
+    for t in dict.fromkeys(order[i] for i in range(len(order)) if i not in probes):
+        mine = [i for i in range(block.trials) if order[i] == t and i not in probes]
+        kinds: list[str] = []
+        while len(kinds) < len(mine):
+            cycle = list(block.mix)
+            rng.shuffle(cycle)
+            kinds += cycle
+        out.update(zip(mine, kinds, strict=False))
+    return out
 
 
 def _cycles(rng: random.Random, targets: tuple[int, ...], n: int) -> list[int]:
@@ -171,15 +229,15 @@ def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = 
     and a clock long enough for every trial (a run that fidgets at home past it ends there).
 
     ``person``: a person at the keys gets three times the time every trial could take, and two minutes
-    more (``lesson``: 5 minutes of reaching, cards and paths not counted), where a program gets one and a
-    half times and one minute: a volunteer slow to bring the hand home, or talking to the class, must not
-    lose the run on the clock. Only a run that idles costs more to replay; a finished one ends at its last
-    trial."""
+    more (``lesson``: 408 s, 6.8 minutes, of reaching, cards and paths not counted; a program 204 s), where
+    a program gets one and a half times and one minute: a volunteer slow to bring the hand home, or talking to
+    the class, must not lose the run on the clock. Only a run that idles costs more to replay; a finished one
+    ends at its last trial."""
     worst = protocol.trials * (protocol.delay[1] + protocol.timeout)
     program = math.ceil(1.5 * worst + 60.0)
     time_limit = float(min(86400, max(program, min(math.ceil(3.0 * worst + 120.0), MAX_GAME_SECONDS)) if person
                            else program))
-    home = tuple(math.radians(a) for a in protocol.home_posture_deg)
+    home = tuple(math.radians(a) for a in protocol.start_posture_deg)
     return GameConfig(start_posture=home, time_limit=time_limit, seed=seed, muscles=muscles,  # type: ignore[arg-type]
                       target_radius=protocol.target_radius, scene=LAB_SCENE, **options)  # type: ignore[arg-type]
 
@@ -196,25 +254,32 @@ class LabSession(GameSession):
         self.hold_at_home = bool(hold_at_home)
         if config.scene != LAB_SCENE:
             raise UserError(f"a lab run's scene is {LAB_SCENE!r}, got {config.scene!r}")
-        if tuple(config.start_posture) != tuple(math.radians(a) for a in protocol.home_posture_deg):
+        if tuple(config.start_posture) != tuple(math.radians(a) for a in protocol.start_posture_deg):
             raise UserError("the run's start posture differs from its protocol's home posture")
         self.protocol = protocol
         self.home_q = config.start_posture
         self.home = self.hand()
         self.home_target = Target(*self.home, protocol.home_radius)
-        for x, y in target_positions(protocol, self.home):
-            self.model.inverse_kinematics((x, y))  # UnreachableError (one line) for a target out of reach
-        self.plans = schedule(protocol, config.seed, config.dt, self.home)
+        #: Each posture's (home, posture in rad), by the posture in degrees (one for most protocols).
+        self.homes = {deg: self._home_at(deg) for deg in protocol.postures_deg}
+        for home, _q in self.homes.values():
+            for x, y in target_positions(protocol, home):
+                self.model.inverse_kinematics((x, y))  # UnreachableError (one line) for a target out of reach
+        self.plans = schedule(protocol, config.seed, config.dt, self.home,
+                              self.homes if len(self.homes) > 1 else None)
+        self._still = 0
         self.hold_steps = max(1, round(protocol.hold_time / config.dt))
         self.timeout_steps = max(1, round(protocol.timeout / config.dt))
         if protocol.has_channels:
             self._check_channel()
-        self._physics: dict[Perturbation, tuple[object, Display | None]] = {}
-        self._channels: dict[int, tuple[object, ChannelField]] = {}
+        self._physics: dict[tuple[Perturbation, tuple[float, float]], tuple[object, Display | None]] = {}
+        self._channels: dict[tuple[int, tuple[float, float]], tuple[object, ChannelField]] = {}
         self._channel: ChannelField | None = None
         self._fs: list[float] = []
         self._vxs: list[float] = []
         self._vys: list[float] = []
+        self._q1s: list[float] = []
+        self._q2s: list[float] = []
         self.outcomes: list[TrialOutcome] = []
         self.trial_index = 0
         self.finished = False
@@ -224,10 +289,26 @@ class LabSession(GameSession):
         self._go_step = 0
         self._xs: list[float] = []
         self._ys: list[float] = []
+        self._home_at: int | None = None
         self.rules.target = self.home_target
         self._enter_trial()
 
+    def _home_at(self, posture_deg: tuple[float, float]) -> tuple[tuple[float, float], tuple[float, float]]:
+        """(the hand at that posture, the posture in rad), as ``hand()`` computes the hand."""
+        q1, q2 = (math.radians(a) for a in posture_deg)
+        if (q1, q2) == tuple(self.home_q):
+            return self.home, self.home_q
+        p = self.config.arm
+        return (p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2)), \
+            (q1, q2)
+
     # ------------------------------------------------------------------ queries
+    @property
+    def cursor_visible(self) -> bool:
+        """Whether the player sees the cursor now: always at home, and in a reach unless the trial hides it."""
+        plan = self.plan
+        return self.phase == HOLD or plan is None or plan.feedback == "full"
+
     @property
     def over(self) -> bool:
         return self.finished or self.steps >= self.total_steps
@@ -285,24 +366,26 @@ class LabSession(GameSession):
     # ----------------------------------------------------------------- physics
     def physics_for(self, perturbation: Perturbation) -> tuple[object, Display | None]:
         """(step function, shown-hand transform) of a perturbation, built once per run."""
-        if perturbation not in self._physics:
+        key = (perturbation, self.home)
+        if key not in self._physics:
             loads = loads_for(perturbation, self.home)
             step = self.unloaded_step() if loads is None else \
                 Integrator(self.config.integrator, loaded_arm(self.model, loads)).step_components
-            self._physics[perturbation] = (step, display_for(perturbation, self.home, self.home_q))
-        return self._physics[perturbation]
+            self._physics[key] = (step, display_for(perturbation, self.home, self.home_q))
+        return self._physics[key]
 
     def channel_for(self, target: int) -> tuple[object, ChannelField]:
         """(step function, channel) of an error-clamp trial to ``target``, built once per target."""
-        if target not in self._channels:
+        key = (target, self.home)
+        if key not in self._channels:
             hx, hy = self.home
             tx, ty = target_positions(self.protocol, self.home)[target]
             length = math.hypot(tx - hx, ty - hy)
             channel = ChannelField(self.protocol.channel_stiffness, self.protocol.channel_damping, self.home,
                                    ((tx - hx) / length, (ty - hy) / length))
             step = Integrator(self.config.integrator, loaded_arm(self.model, Loads(hand=channel))).step_components
-            self._channels[target] = (step, channel)
-        return self._channels[target]
+            self._channels[key] = (step, channel)
+        return self._channels[key]
 
     def _check_channel(self) -> None:
         """Refuse a channel too stiff for the fixed physics step (as MotorNet checks delays against dt).
@@ -316,7 +399,9 @@ class LabSession(GameSession):
         import numpy as np
 
         p, dt = self.protocol, self.config.dt
-        postures = [self.home_q] + [tuple(self.model.inverse_kinematics(xy)) for xy in target_positions(p, self.home)]
+        postures = [q for home, q in self.homes.values()]
+        postures += [tuple(self.model.inverse_kinematics(xy)) for home, _q in self.homes.values()
+                     for xy in target_positions(p, home)]
         lightest = math.inf
         for q in postures:
             jac = self.model.jacobian(np.asarray(q, dtype=float))
@@ -342,6 +427,8 @@ class LabSession(GameSession):
         self._fs.append(-channel.lateral(x, y, vx, vy))
         self._vxs.append(vx)
         self._vys.append(vy)
+        self._q1s.append(q1)
+        self._q2s.append(q2)
 
     def _enter_trial(self) -> None:
         self._channel = None
@@ -349,6 +436,9 @@ class LabSession(GameSession):
         if plan is None:
             self.finished = True
             return
+        if plan.home_q != self.home_q and plan.home_q != (0.0, 0.0):  # a block at another posture: home moves
+            self.home, self.home_q = plan.home, plan.home_q
+            self.home_target = Target(*self.home, self.protocol.home_radius)
         self._step, self._show = self.physics_for(NONE)
         self.phase = HOLD
         self._counter = 0
@@ -430,11 +520,13 @@ class LabSession(GameSession):
                 self._go_step = self.steps
                 self._counter = 0
                 self._xs, self._ys = [x], [y]
+                self._home_at = None
                 self.rules.target = Target(*plan.position, self.protocol.target_radius)
+                self._still = 0
                 if plan.channel:
                     self._step, self._channel = self.channel_for(plan.target)
                     self._show = None
-                    self._fs, self._vxs, self._vys = [], [], []
+                    self._fs, self._vxs, self._vys, self._q1s, self._q2s = [], [], [], [], []
                 else:
                     self._step, self._show = self.physics_for(plan.active)
                 return _WENT
@@ -443,11 +535,14 @@ class LabSession(GameSession):
         self._ys.append(y)
         self._counter = self._counter + 1 if self.rules.target.contains(x, y) else 0
         hit = self._counter >= self.hold_steps
-        if not hit and self.steps - self._go_step < self.timeout_steps:
+        if not hit and plan.feedback != "full" and self._stopped(x, y):
+            hit = self.rules.target.contains(x, y)  # without a cursor the reach ends where the hand stopped
+        elif not hit and self.steps - self._go_step < self.timeout_steps:
             return 0
-        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys)
+        outcome = TrialOutcome(plan, self._go_step, self.steps, hit, self._xs, self._ys, home_at=self._home_at)
         if plan.channel:
             outcome.channel_force, outcome.vxs, outcome.vys = self._fs, self._vxs, self._vys
+            outcome.q1s, outcome.q2s = self._q1s, self._q2s
         self.outcomes.append(outcome)
         if hit:
             self.rules.board.hits += 1
@@ -456,6 +551,27 @@ class LabSession(GameSession):
         self._enter_trial()
         return _ENDED
 
+    def _stopped(self, x: float, y: float) -> bool:
+        """A trial without a cursor: whether the hand, more than half the target distance from home, has moved
+        slower than ``STILL_SPEED`` for the hold time (counted in ``_still``)."""
+        xs, ys = self._xs, self._ys
+        hx, hy = self.home
+        away = (x - hx) * (x - hx) + (y - hy) * (y - hy) > 0.25 * self.protocol.distance * self.protocol.distance
+        if away and len(xs) >= 2:
+            dx, dy = x - xs[-2], y - ys[-2]
+            limit = STILL_SPEED * self.config.dt
+            self._still = self._still + 1 if dx * dx + dy * dy < limit * limit else 0
+        else:
+            self._still = 0
+        return self._still >= self.hold_steps or self.steps - self._go_step >= self.timeout_steps
+
     def _reset_arm(self) -> None:
         super()._reset_arm()  # the reset key: home, at rest, counted; the trial's clock runs on
+        if tuple(self.config.start_posture) != tuple(self.home_q):  # a block at another posture: its home
+            q1, q2 = self.home_q
+            self.state = self.previous_state = (q1, q2, 0.0, 0.0)
         self.cursor = self.shown_hand()
+        if self.phase == REACH and self._home_at is None and not self.over:
+            # The reach ends here for its measures: every sample so far was taken before the jump (keys act
+            # between physics steps), every later one after it.
+            self._home_at = len(self._xs)

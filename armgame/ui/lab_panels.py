@@ -79,15 +79,24 @@ def draw_card(renderer: GameRenderer, screen: pygame.Surface, title: str, lines:
 
 def draw_feedback(renderer: GameRenderer, screen: pygame.Surface, view: Viewport, session: LabSession,
                   outcome: TrialOutcome) -> None:
-    """Knowledge of results: the straight line asked for and the path made (its measure is in the HUD)."""
+    """Knowledge of results: the straight line asked for and the path made (its measure is in the HUD). As the trial
+    gives it (issue 41): with ``endpoint`` feedback only where the reach ended, with ``none`` nothing."""
     p = renderer.palette
     w, h = screen.get_size()
     width = max(MIN_LINE, round(min(w, h) / 200))
-    home = view.to_screen(*session.home)
+    if outcome.plan.feedback == "none":
+        return
+    home = view.to_screen(*outcome.plan.home)
     target = view.to_screen(*outcome.plan.position)
     pygame.draw.line(screen, p.edge, home, target, width)
     pygame.draw.circle(screen, p.target, target, view.length(session.protocol.target_radius), width)
-    points = [view.to_screen(x, y) for x, y in zip(outcome.xs[::4], outcome.ys[::4], strict=True)]
+    n = outcome.reach_samples  # the reach, not the jump home after space
+    if outcome.plan.feedback == "endpoint":
+        if n:
+            end = view.to_screen(outcome.xs[n - 1], outcome.ys[n - 1])
+            pygame.draw.circle(screen, p.hand, end, max(width + 1, view.length(0.006)))
+        return
+    points = [view.to_screen(x, y) for x, y in zip(outcome.xs[:n:4], outcome.ys[:n:4], strict=True)]
     if len(points) > 1:
         pygame.draw.lines(screen, p.trail, False, points, width)
         for end in (points[0], points[-1]):

@@ -76,6 +76,7 @@ class LabHud(Hud):
     curve: LearningCurve | None = None
     summary: str = ""
     saved: Sequence[str] = field(default_factory=tuple)
+    away: bool = False  # paused because the window lost the focus
 
 
 class LabRenderer(GameRenderer):
@@ -84,8 +85,8 @@ class LabRenderer(GameRenderer):
     #: What drives the run: "LAB" (a person at the keys), "AUTOPILOT: NAME", "REPLAY", or "" (a program).
     mode = "LAB"
 
-    def view(self, size: tuple[int, int], session: LabSession) -> Viewport:
-        hx, hy = session.home
+    def view(self, size: tuple[int, int], session: LabSession, home: tuple[float, float] | None = None) -> Viewport:
+        hx, hy = session.home if home is None else home
         span = max(0.08, 1.45 * session.protocol.distance)
         return Viewport.fit(size, (hx - span, hx + span, hy - span, hy + 1.35 * span))
 
@@ -94,10 +95,12 @@ class LabRenderer(GameRenderer):
         hud = hud or Hud()
         lab = hud if isinstance(hud, LabHud) else None
         p = self.palette
-        view = self.view(screen.get_size(), session)
+        # A reach's path is shown in its own workspace, though the next trial's block may start at another posture.
+        shown = lab.feedback.outcome.plan.home if lab is not None and lab.feedback is not None else session.home
+        view = self.view(screen.get_size(), session, shown)
         line = max(3, round(min(screen.get_size()) / 240))
         screen.fill(p.scene)
-        for x, y in target_positions(session.protocol, session.home):
+        for x, y in target_positions(session.protocol, shown):
             pygame.draw.circle(screen, p.edge, view.to_screen(x, y), view.length(session.protocol.target_radius), line)
         home = session.home_target
         holding = session.phase == HOLD and not session.over
@@ -109,7 +112,7 @@ class LabRenderer(GameRenderer):
         elif not holding and not session.over:
             target = session.rules.target
             pygame.draw.circle(screen, p.target, view.to_screen(target.x, target.y), view.length(target.radius))
-        if feedback is None:
+        if feedback is None and session.cursor_visible:  # a trial without vision hides it from the go cue on
             pygame.draw.circle(screen, CURSOR, view.to_screen(*session.cursor), view.length(0.006))
         self._hud(screen, session, hud)
         if lab is not None and lab.curve is not None:
@@ -117,7 +120,8 @@ class LabRenderer(GameRenderer):
         elif lab is not None and lab.card is not None:
             draw_card(self, screen, lab.card.title, lab.card.lines, lab.card.prompt)
         elif hud.paused and not hud.ended:
-            self._panel(screen, "Paused", "p to play on")
+            self._panel(screen, "Paused", "click here or press a key to play on" if lab is not None and lab.away
+                        else "p to play on")
         elif session.over or hud.ended:
             done = len(session.outcomes)
             self._panel(screen, "Done" if session.finished else "Time is up",
@@ -170,7 +174,10 @@ class LabRenderer(GameRenderer):
             screen.blit(self.text(self.fit_text(block.instruction, normal, screen.get_width() - 2 * margin), normal),
                         (margin, y))
             y += normal + small // 3
-        if feedback is not None:
+        if feedback is not None and feedback.outcome.plan.feedback == "none":
+            screen.blit(self.text(self.fit_text(feedback.words, big, screen.get_width() - 2 * margin), big,
+                                  p.faint), (margin, y))
+        elif feedback is not None:
             verdict = "hit" if feedback.outcome.hit else "time out"
             screen.blit(self.text(self.fit_text(f"{verdict}: {feedback.words}", big, screen.get_width() - 2 * margin),
                                   big, HIT if feedback.outcome.hit else p.warn), (margin, y))
@@ -274,6 +281,8 @@ class LabWindow(GameWindow):
         self.summary = ""
         self.feedback: Feedback | None = None
         self.seen = len(session.outcomes)
+        #: Paused because the window lost the focus (not by p): focus back, or any key, plays on.
+        self.away = False
         show_cards = not self.watching if cards is None else cards
         self.card: Card | None = self._intro_card() if show_cards and session.steps == 0 else None
         self.block_cards = show_cards
@@ -337,6 +346,26 @@ class LabWindow(GameWindow):
         return tuple(items)
 
     def handle(self, event: pygame.event.Event) -> None:
+        if event.type == pygame.WINDOWFOCUSLOST:
+            self._track(event)
+            # The game pauses until p; a lab volunteer knows no p (issue 39: a run stood 1.5 minutes at trial 3
+            # after the pointer left the window). A person's keys are let go (the releases would go elsewhere)
+            # and the run waits only while the window is away; a bot's or a replay's runs on.
+            if self.keyboard and not self.finished and not self.paused:
+                self.set_paused(True)
+                self.away = True
+            return
+        if event.type == pygame.WINDOWFOCUSGAINED:
+            if self.away:
+                self.away = False
+                self.set_paused(False)
+            return
+        if event.type == pygame.KEYDOWN and self.away:
+            # Keys reach the window again: the focus is back, whatever the window manager said.
+            self.away = False
+            self.set_paused(False)
+            if key_name(event) == "p":
+                return  # the key a volunteer was told for the pause: it resumes, it does not pause again
         if event.type == pygame.KEYDOWN:
             name = key_name(event)
             if self.card is not None and name in START_KEYS:
@@ -419,7 +448,9 @@ class LabWindow(GameWindow):
             return
         self.seen = len(s.outcomes)
         last = s.outcomes[-1]
-        self.feedback = Feedback(last, result_words(s, last), at_time=last.end_step * s.config.dt)
+        # Knowledge of results only as the trial gives it: none on a trial without vision (issue 41).
+        words = "reach done" if last.plan.feedback == "none" else result_words(s, last)
+        self.feedback = Feedback(last, words, at_time=last.end_step * s.config.dt)
         if not self.watching:
             self._stop_the_clock()
 
@@ -463,7 +494,7 @@ class LabWindow(GameWindow):
             hud.speed = self.speed
         saved = ("saving the run ...",) if saving else self.saved
         return LabHud(**{f: getattr(hud, f) for f in Hud.__dataclass_fields__}, card=self.card,
-                      feedback=self.feedback, curve=self.curve, summary=self.summary, saved=saved)
+                      feedback=self.feedback, curve=self.curve, summary=self.summary, saved=saved, away=self.away)
 
     def frame(self, elapsed: float) -> None:
         """Handle pending events; advance physics by ``elapsed`` real seconds unless a card, a path or the

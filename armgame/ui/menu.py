@@ -290,8 +290,9 @@ class MenuWindow:
         help_lines = r.wrap_items(self.help_items(), small, width, gap)
         line_h = r.font(small).get_height()
         bottom = h - pad - len(help_lines) * (line_h + gap // 2)
-        if self.status:
-            bottom -= line_h + gap
+        status = r.wrap_text(self.status, small, width) if self.status else []
+        if status:
+            bottom -= len(status) * (line_h + gap // 2) + gap
         column = min(width, max(round(800 * u * max(k, 1.0)), 280))
         left = (w - column) // 2
         items = self.page.items
@@ -341,9 +342,10 @@ class MenuWindow:
         for line in reversed(help_lines):
             lay.labels.append(r.label(line, small, p.faint, "help", midbottom=(w // 2, y)))
             y = lay.labels[-1].rect.top - gap // 2
-        if self.status:
-            lay.labels.append(r.label(r.fit_text(self.status, small, width), small, p.warn, "status",
-                                      midbottom=(w // 2, y - gap // 2)))
+        y -= gap // 2
+        for line in reversed(status):  # the whole message, on as many lines as it needs
+            lay.labels.append(r.label(line, small, p.warn, "status", midbottom=(w // 2, y)))
+            y = lay.labels[-1].rect.top - gap // 2
         return lay
 
     def draw(self) -> MenuLayout:

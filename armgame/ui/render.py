@@ -269,6 +269,19 @@ class GameRenderer:
             text = text[:-1]
         return text + "..."
 
+    def wrap_text(self, text: str, height: int, width: int, max_lines: int = 3) -> list[str]:
+        """``text`` on as many lines of ``width`` px as it needs, broken between words, at most ``max_lines`` (the
+        last cut with an ellipsis only if even those do not hold it): a message is read whole, not cut off."""
+        lines: list[str] = []
+        for word in text.split():
+            if lines and self.text_size(lines[-1] + " " + word, height)[0] <= width:
+                lines[-1] += " " + word
+            else:
+                lines.append(word)
+        if len(lines) > max_lines:
+            lines = [*lines[:max_lines - 1], " ".join(lines[max_lines - 1:])]
+        return [self.fit_text(line, height, width) for line in lines]
+
     def wrap_items(self, items: Sequence[str], height: int, width: int, gap: int) -> list[str]:
         """Help items on as few lines as fit ``width``; an item is never split."""
         sep = " " * 4
@@ -454,6 +467,9 @@ class GameRenderer:
             rows = list(standing.top)
         margin = max(8, round(24 * lay.unit))
         panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
+        # A long line (the class's answer, "your game is kept ...") wraps in the panel rather than being cut off.
+        lines = [(part, size, colour) for text, size, colour in lines
+                 for part in self.wrap_text(text, size, panel_w - 2 * margin, max_lines=6)]
         heading = bool(rows) and standing is not None
         content_h = sum(self.font(size).get_height() + gap for _, size, _ in lines)
         if heading:

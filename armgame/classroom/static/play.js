@@ -131,6 +131,7 @@ function scheduleRetry() {
 function showOutbox() {
   const kept = load(OUTBOX, []).length;
   statusLine.replaceChildren();
+  if (phase === "closed") statusLine.append(CLOSED + " · ");
   if (member) statusLine.append("playing as " + member.name + " ");
   if (kept > 0) statusLine.append("· " + (kept === 1 ? "1 game" : kept + " games") + " kept, to hand in ");
   if (member && phase !== "playing") {
@@ -188,9 +189,35 @@ function joined(code, data) {
   member = { code, name: data.name, token: data.token, seed: data.seed };
   save(MEMBER, member);
   joinForm.hidden = true;
-  statusLine.textContent = data.closed ? "the class is closed to new games" : "";
-  newGame();
+  statusLine.textContent = "";
+  if (data.closed) waitWhileClosed(); else newGame();
   flushOutbox().then(showAnswers);
+}
+
+// A closed class takes no games: none is started that could not be handed in. The page asks again every few
+// seconds and starts one once the teacher opens the class.
+let closedTimer = null;
+const CLOSED = "the class is closed: it takes no more games (the game starts if the teacher opens it)";
+async function classClosed() {
+  try {
+    const r = await fetch("/api/standings", { cache: "no-store" });
+    return r.ok && (await r.json()).closed === true;
+  } catch (e) {
+    return false;  // not reached: the game is played, kept and handed in later
+  }
+}
+
+function waitWhileClosed() {
+  phase = "closed";
+  endCard.hidden = true;
+  showOutbox();
+  clearTimeout(closedTimer);
+  closedTimer = setTimeout(async () => { if (await classClosed()) waitWhileClosed(); else playAgain(); }, 5000);
+}
+
+async function playAgain() {
+  if (await classClosed()) { waitWhileClosed(); return; }
+  newGame();
 }
 
 // ------------------------------------------------------------------ a game
@@ -309,7 +336,7 @@ function showEnd(line, kind, data) {
 
 function plural(n, word) { return n + " " + word + (n === 1 ? "" : "s"); }
 
-document.getElementById("again").addEventListener("click", () => { if (phase === "over") newGame(); });
+document.getElementById("again").addEventListener("click", () => { if (phase === "over") playAgain(); });
 
 // ------------------------------------------------------------------ keys and fingers
 const SPECIAL = { " ": "space", "Tab": "tab" };
@@ -321,7 +348,7 @@ function gameKey(event) {
 window.addEventListener("keydown", (event) => {
   if (phase === "join") return;
   if (phase === "over") {
-    if (event.key === "Enter") { event.preventDefault(); newGame(); }
+    if (event.key === "Enter") { event.preventDefault(); playAgain(); }
     return;
   }
   const key = gameKey(event);

@@ -4,10 +4,15 @@
 const $ = (id) => document.getElementById(id);
 let secret = sessionStorage.getItem("armgame-secret") || "";
 
-function say(text) { $("status").textContent = text; }
+// What the last action did, in ink; only a refusal or a failure in red.
+function say(text, failed = false) {
+  $("status").textContent = text;
+  $("status").classList.toggle("failed", failed);
+}
 
 async function call(path, body) {
-  const options = {headers: {Authorization: "Bearer " + secret}};
+  // On the teacher's own laptop no secret is needed (the class knows its own machine); elsewhere it is typed.
+  const options = {headers: secret ? {Authorization: "Bearer " + secret} : {}};
   if (body !== undefined) {
     options.method = "POST";
     options.headers["Content-Type"] = "application/json";
@@ -35,7 +40,7 @@ function row(table, r, kind) {
   button.textContent = r.hidden ? "Show" : "Hide";
   button.addEventListener("click", async () => {
     try { say((await (await call("/api/teacher/hide", {name: r.name, hidden: !r.hidden})).json()).message); }
-    catch (e) { say(e.message); }
+    catch (e) { say(e.message, true); }
     refresh();
   });
   td.appendChild(button);
@@ -47,7 +52,7 @@ function button(text, action) {
   const b = document.createElement("button");
   b.textContent = text;
   b.addEventListener("click", async () => {
-    try { say((await (await action()).json()).message); } catch (e) { say(e.message); }
+    try { say((await (await action()).json()).message); } catch (e) { say(e.message, true); }
     refresh();
   });
   return b;
@@ -118,7 +123,8 @@ async function refresh() {
     say(s.closed ? "The class is closed to new games." : "The class takes games.");
   } catch (e) {
     $("controls").hidden = true;
-    say(e.message);
+    $("ask-secret").hidden = false;
+    say(e.message, true);
   }
 }
 
@@ -130,7 +136,7 @@ async function download(path, filename) {
     a.download = filename;
     a.click();
     URL.revokeObjectURL(a.href);
-  } catch (e) { say(e.message); }
+  } catch (e) { say(e.message, true); }
 }
 
 $("unlock").addEventListener("click", () => {
@@ -138,23 +144,31 @@ $("unlock").addEventListener("click", () => {
   sessionStorage.setItem("armgame-secret", secret);
   refresh();
 });
-$("close").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: true}); } catch (e) { say(e.message); } refresh(); });
-$("open").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: false}); } catch (e) { say(e.message); } refresh(); });
+$("close").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: true}); } catch (e) { say(e.message, true); } refresh(); });
+$("open").addEventListener("click", async () => { try { await call("/api/teacher/close", {closed: false}); } catch (e) { say(e.message, true); } refresh(); });
 $("release").addEventListener("click", async () => {
   try { say((await (await call("/api/teacher/release", {name: $("release-name").value.trim()})).json()).message); }
-  catch (e) { say(e.message); }
+  catch (e) { say(e.message, true); }
 });
-$("lock").addEventListener("click", async () => { try { say((await (await call("/api/teacher/lock", {locked: true})).json()).message); } catch (e) { say(e.message); } refresh(); });
-$("unlock-list").addEventListener("click", async () => { try { say((await (await call("/api/teacher/lock", {locked: false})).json()).message); } catch (e) { say(e.message); } refresh(); });
+$("lock").addEventListener("click", async () => { try { say((await (await call("/api/teacher/lock", {locked: true})).json()).message); } catch (e) { say(e.message, true); } refresh(); });
+$("unlock-list").addEventListener("click", async () => { try { say((await (await call("/api/teacher/lock", {locked: false})).json()).message); } catch (e) { say(e.message, true); } refresh(); });
 $("lab-protocol").addEventListener("change", async () => {
   if (!$("lab-protocol").value) return;
   try { say((await (await call("/api/teacher/lab", {protocol: $("lab-protocol").value})).json()).message); }
-  catch (e) { say(e.message); }
+  catch (e) { say(e.message, true); }
   refresh();
+});
+$("round-start").addEventListener("click", async () => {
+  try { say((await (await call("/api/teacher/round", {minutes: Number($("round-minutes").value)})).json()).message); }
+  catch (e) { say(e.message, true); }
+});
+$("round-stop").addEventListener("click", async () => {
+  try { say((await (await call("/api/teacher/round", {stop: true})).json()).message); } catch (e) { say(e.message, true); }
 });
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
-if (secret) refresh();
+$("lab-png").addEventListener("click", () => download("/api/teacher/lab.png", "class-lab-curve.png"));
+refresh();
 
 // The browser game's address (public: the projector shows it too), for students who cannot install Python.
 fetch("/api/standings").then((r) => r.json()).then((s) => {
