@@ -40,7 +40,7 @@ from ..errors import UserError
 from ..game.rules import GameConfig
 from ..game.session import GameResult, InputEvent, LevelEvent
 from ..game.variant import play_inputs
-from ..lab.record import LabTask, paths_digest
+from ..lab.record import LabTask, paths_digest, trial_fields
 from ..lab.session import LabSession
 from ..records.env_game import EnvGameTask, levels_from_list, register
 from ..records.replay import Replay, now_iso, register_task, same_outcome
@@ -148,12 +148,14 @@ class CenterOutEnvTask:
 
     def verify(self, config: GameConfig, timeline: Sequence[InputEvent],
                result: GameResult) -> tuple[bool, GameResult, LabSession]:
-        """Replay and compare the result, every trial and the hand paths' digest, as a lab run's."""
+        """Replay and compare the result, every trial, the hand paths' digest and (a protocol with mixed blocks) each
+        trial's perturbation, as ``LabTask.verify`` compares a lab run's."""
         session = self.session(config, timeline, result.steps)
         recomputed = session.result()
         same_trials = tuple(tuple(t) for t in session.trial_records()) == self.lab.trials
         same_paths = paths_digest(session) == self.lab.paths_sha256
-        return same_outcome(recomputed, result) and same_trials and same_paths, recomputed, session
+        same_fields = self.lab.fields is None or trial_fields(session) == self.lab.fields
+        return same_outcome(recomputed, result) and same_trials and same_paths and same_fields, recomputed, session
 
 
 def register_centre_out() -> None:
