@@ -2,11 +2,12 @@
 
     python benchmarks/class_server.py                           # classes of 30, 100 and 1,000; 3 repeats
     python benchmarks/class_server.py --sizes 30,100 --repeats 5 --json
-    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60   # a quick look, about 4 s
+    python benchmarks/class_server.py --sizes 30 --repeats 1 --sustained 60 --flood 0 --clerk 0 --table-sizes ''
+                                                                # a quick look, about 4 s
 
-The default run takes about 7 minutes on the 2-core machine of docs/performance.md (8 under other
-jobs' load): making the 3,000 games about 25 s, a class of 30 or 100 about 15 s a repeat, a class
-of 1,000 about 100 s.
+The default run takes about 12 minutes on the 2-core machine of docs/performance.md (more under other
+jobs' load): making the 4,000 games about 30 s, a class of 30 or 100 about 15 s a repeat, a class
+of 1,000 about 60 s, the flood 35 s, the clerk alone 15 s and the table's costs 20 s.
 
 The server is ``python -m armgame class serve --folder TMP --host 127.0.0.1 --port P`` in its own
 process, a new class in a new temporary folder for every class and repeat. The students are
@@ -38,6 +39,21 @@ bot's game (about 0.5 MB), each let go of at another step near the end so that e
 own game. The projector's figures and the clients share the machine with the server: on a
 2-core machine the clients take a share of it (printed: the clients' CPU seconds).
 
+Then, each ``--repeats`` times:
+
+4. **the flood** (``--flood 100``): a new class where 100 clients, each joined under its own name (valid
+   tokens), post forged games (a real game's claimed score raised: it does not reproduce; ten distinct
+   ones each, then again) and, one post in four, a replay cut off, as fast as the server answers (no
+   wait after a 503, a new connection each), for ``--flood-seconds``; meanwhile ``--flood-honest``
+   students hand in their own games one after another, 0.5 s apart, through the students' client. The
+   honest hand-ins' latencies (p50, p99, max) are the figure: honest students first;
+5. **the clerk alone** (``--clerk 1000``), in this process, no HTTP: that many distinct honest hand-ins,
+   then as many forged ones, in the server's batches (``ClerkThread._hand_in``): hand-ins a second and
+   the CPU time of each;
+6. **the table's cost per hand-in** (``--table-sizes 10,1000,10000``): a batch of 32 games entered
+   (``ScoreTable.add_many``, the clerk's write, the replays' files included) into a table already
+   holding that many entries, appended to its journal and, for comparison, the whole table rewritten.
+
 Figures are medians over ``--repeats`` with [min-max]; the machine and its load average are printed
 beside them.
 """
@@ -63,6 +79,7 @@ import sys
 import tempfile
 import threading
 import time
+import urllib.error
 import urllib.request
 from collections.abc import Callable
 from pathlib import Path
@@ -78,6 +95,10 @@ GO_LEAD = 0.1
 BOT_SHIFT = 10
 START_SECONDS = 60.0
 STOP_SECONDS = 30.0
+#: Seconds between an honest student's hand-ins during the flood (each one's latency is measured).
+FLOOD_HONEST_EVERY = 0.5
+#: One hand-in in four of a flooder's: a replay cut off (not JSON).
+FLOOD_MALFORMED = b'{"format": "armgame-replay", "format_version": 1, "timeline": [[1, "d", "do'
 
 
 # ------------------------------------------------------------------ the games
@@ -308,6 +329,11 @@ def student_thread(address: Any, code: str, student: dict[str, Any], phase: str,
             student["token"] = str(answer.get("token"))
         out.append(record)
         return
+    if phase == "flood":
+        flood_thread(address, code, student, start[0], games, out, request)
+        return
+    if student.get("flooder"):
+        return  # a flooder hands in nothing honest
     indices = student["games"][:1] if phase == "burst" else student["games"][1:]
     for index in indices:
         if "token" not in student:
@@ -321,6 +347,51 @@ def student_thread(address: Any, code: str, student: dict[str, Any], phase: str,
             record["error"] = json.dumps(answer)[:200]
         record.update(game=index, name=student["name"], already=bool(answer and answer.get("already")))
         out.append(record)
+
+
+def flood_thread(address: Any, code: str, student: dict[str, Any], start_at: float, games: dict[int, bytes],
+                 out: list[dict[str, Any]], request: Callable[..., dict[str, Any]]) -> None:
+    """The flood phase: a flooder posts forged and malformed games as fast as the server answers (no wait after a
+    503, a new connection each) until ``student["until"]`` s after ``start_at``, with a record of its counts; an
+    honest student hands in its games one after another, ``FLOOD_HONEST_EVERY`` s apart, through the students'
+    own client (waits after a 503 included), each with its latency."""
+    if "token" not in student:
+        return
+    headers = {"Content-Type": "application/json", "Authorization": f"Bearer {student['token']}",
+               "X-Armgame-Code": code}
+    end = start_at + student["until"]
+    if student.get("flooder"):
+        counts: dict[str, int] = {}
+        n = 0
+        while time.time() < end:
+            body = games[student["games"][n % len(student["games"])]] if n % 4 else FLOOD_MALFORMED
+            n += 1
+            req = urllib.request.Request(f"http://{address.label}/api/handin", data=body, method="POST",
+                                         headers=headers)
+            try:
+                with urllib.request.urlopen(req, timeout=30) as response:
+                    response.read()
+                    status = str(response.status)
+            except urllib.error.HTTPError as exc:
+                exc.read()
+                exc.close()
+                status = str(exc.code)
+            except OSError as exc:
+                status = type(exc).__name__
+            counts[status] = counts.get(status, 0) + 1
+        out.append({"flooder": student["name"], "counts": counts})
+        return
+    for index in student["games"]:
+        if time.time() >= end:
+            break
+        record = request("/api/handin", games[index], headers)
+        answer = record.pop("answer", None)
+        if answer is not None and not (answer.get("ok") and answer.get("name") == student["name"]):
+            record["outcome"] = "wrong answer"
+            record["error"] = json.dumps(answer)[:200]
+        record.update(game=index, name=student["name"], already=bool(answer and answer.get("already")))
+        out.append(record)
+        time.sleep(FLOOD_HONEST_EVERY)
 
 
 def client_main() -> int:
@@ -607,6 +678,162 @@ def one_class(size: int, games: list[dict[str, Any]], args: argparse.Namespace,
     return result
 
 
+def forge(paths: list[str], folder: Path) -> list[str]:
+    """Each game with its claimed score raised by 7 (a forgery: it does not reproduce), written to ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    forged = []
+    for path in paths:
+        data = json.loads(Path(path).read_bytes())
+        data["result"]["score"] += 7
+        target = folder / Path(path).name
+        target.write_bytes(json.dumps(data, indent=1, sort_keys=True).encode())
+        forged.append(str(target))
+    return forged
+
+
+def flood_class(flooders: int, honest: int, seconds: float, games: list[dict[str, Any]], forged: list[str],
+                args: argparse.Namespace, say: Callable[[str], None]) -> dict[str, Any]:
+    """``flooders`` joined clients posting forged and malformed games as fast as they can for ``seconds``, while
+    ``honest`` students hand in their games one after another; the honest hand-ins' latencies."""
+    per_flooder = max(1, len(forged) // flooders)
+    paths = [g["path"] for g in games] + forged
+    students = [{"name": f"flooder {k:03d}", "flooder": True, "until": seconds,
+                 "games": [len(games) + (k * per_flooder + j) % len(forged) for j in range(per_flooder)]}
+                for k in range(flooders)]
+    per_honest = math.ceil(seconds / FLOOD_HONEST_EVERY) + 1
+    students += [{"name": f"student {h:03d}", "until": seconds,
+                  "games": [h * per_honest + j for j in range(per_honest)]} for h in range(honest)]
+    if honest * per_honest > len(games):
+        raise SystemExit(f"class_server: the flood needs {honest * per_honest} honest games, {len(games)} were made")
+    with tempfile.TemporaryDirectory(prefix="armgame-class-flood-") as tmp:
+        folder = Path(tmp) / "class"
+        server = Server(folder)
+        clients = None
+        try:
+            clients = Clients(min(args.clients, len(students)), f"127.0.0.1:{server.port}", server.code, students,
+                              paths)
+            joined, _, _ = clients.phase("join", args.timeout)
+            if sum(r["outcome"] == "ok" for r in joined) != len(students):
+                raise RuntimeError(f"the flood's clients could not all join: {tally(joined, 0)['errors']}")
+            load = _load()
+            cpu0 = server.cpu_seconds()
+            records, start, how = clients.phase("flood", seconds + args.timeout)
+            cpu1 = server.cpu_seconds()
+            peak = server.peak_rss()
+        finally:
+            if clients is not None:
+                clients.close()
+            status = server.stop()
+        folder_check = check_folder(folder, {r["game"]: r["name"] for r in records
+                                             if "flooder" not in r and r["outcome"] == "ok"}, games)
+    posted: dict[str, int] = {}
+    for r in records:
+        for key, count in r.get("counts", {}).items():
+            posted[key] = posted.get(key, 0) + count
+    honest_records = [r for r in records if "flooder" not in r]
+    figures = tally(honest_records, start)
+    handled = sum(posted.values()) + figures["requests"] + figures["busy_503"]
+    result = {"flooders": flooders, "honest": honest, "seconds": seconds, "honest_handins": figures,
+              "flood_answers": dict(sorted(posted.items())), "flood_posts_per_s": sum(posted.values()) / seconds,
+              "server_cpu_s": None if None in (cpu0, cpu1) else cpu1 - cpu0,
+              "server_cpu_ms_per_request": None if None in (cpu0, cpu1) else 1000 * (cpu1 - cpu0) / max(1, handled),
+              "server_peak_rss_mb": None if peak is None else peak / 2**20, "server_exit": status,
+              "clients_cpu_s": how["clients_cpu_s"], "folder": folder_check, "load_average_1min": load}
+    say(f"  flood of {flooders}: honest p50 {figures['p50_s'] or 0:.2f} s, p99 {figures['p99_s'] or 0:.2f} s, "
+        f"max {figures['max_s'] or 0:.2f} s over {figures['acknowledged']} hand-ins; the flooders posted "
+        f"{result['flood_posts_per_s']:.0f} a second ({result['flood_answers']}), load {_load()}")
+    return result
+
+
+def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> dict[str, Any]:
+    """The clerk alone, in this process (no HTTP): ``count`` distinct honest hand-ins, then ``count`` forged ones,
+    in the server's batches (``ClerkThread._hand_in``, ``BATCH`` at a time); CPU and wall time per hand-in."""
+    from concurrent.futures import Future
+
+    from armgame.classroom import app
+    from armgame.classroom.intake import Clerk
+    from armgame.classroom.roster import Player, Roster, token_digest
+
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory(prefix="armgame-class-clerk-") as tmp:
+        os.environ["ARMGAME_CACHE"] = str(Path(tmp) / "cache")  # the teacher's record of the table: not the user's
+        roster, _ = Roster.open(Path(tmp), CLASS_SEED)
+        tokens = []
+        for i in range(count):
+            tokens.append(f"token-{i:06d}-{'x' * 20}")
+            roster.players[f"s{i}"] = Player(f"s{i}", token_digest(tokens[-1]), GAME_DATE)
+        roster.save()
+        roster.reindex()
+        clerk = Clerk(Path(tmp), roster)
+        worker = app.ClerkThread(clerk, lambda: None)  # its batches run here, in this thread, as its own would
+        for kind, paths in (("honest", [g["path"] for g in games[:count]]),
+                            ("forged", forged[:count])):
+            bodies = [Path(p).read_bytes() for p in paths]
+            if not bodies:
+                continue
+            wall0, cpu0 = time.perf_counter(), time.process_time()
+            answered: dict[str, int] = {}
+            for lo in range(0, len(bodies), app.BATCH):
+                batch = [("hand-in", (tokens[i], bodies[i]), Future()) for i in range(lo, min(len(bodies),
+                                                                                                lo + app.BATCH))]
+                for _, outcome in worker._hand_in(batch):
+                    key = "ok" if isinstance(outcome, dict) else str(getattr(outcome, "status", type(outcome)))
+                    answered[key] = answered.get(key, 0) + 1
+            wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+            out[kind] = {"handins": len(bodies), "answers": answered, "wall_s": wall, "cpu_s": cpu,
+                         "per_s": len(bodies) / wall, "cpu_ms_per_handin": 1000 * cpu / len(bodies)}
+        worker.stop()
+        del os.environ["ARMGAME_CACHE"]
+    out["load_average_1min"] = _load()
+    return out
+
+
+def table_costs(games: list[dict[str, Any]], sizes: list[int], batches: int = 5, batch: int = 32) -> dict[str, Any]:
+    """The cost of entering a batch of ``batch`` games (``ScoreTable.add_many``, the clerk's write) into a table that
+    already holds each of ``sizes`` entries: appended to the table's journal, and, for comparison, the whole
+    table rewritten (the write before the journal). Per hand-in, median [min-max] of ``batches`` batches."""
+    import inspect
+    import uuid
+
+    from armgame.records.replay import Replay
+    from armgame.records.scores import ScoreTable, table_bytes
+
+    journaled = "journal" in inspect.signature(ScoreTable.add_many).parameters
+    replays = [Replay.from_bytes(Path(g["path"]).read_bytes()) for g in games[:2 * batches * batch + 1]]
+    out: dict[str, Any] = {"batch": batch, "batches": batches, "sizes": {}}
+    with tempfile.TemporaryDirectory(prefix="armgame-class-table-") as tmp:
+        os.environ["ARMGAME_CACHE"] = str(Path(tmp) / "cache")
+        try:
+            for size in sizes:
+                row = {}
+                for how in ("journal", "rewrite") if journaled else ("rewrite",):
+                    folder = Path(tmp) / f"{how}-{size}"
+                    table = ScoreTable(folder, warn=lambda line: None)
+                    table.new(CLASS_SEED)
+                    (first,) = table.add_many([dataclasses.replace(replays[0], player="seed")])
+                    # The table of ``size`` entries: the first one's line repeated, each its own id, replay and game.
+                    entries = [dataclasses.replace(first, id=uuid.uuid4().hex, name=f"p{i % 997}",
+                                                   replay_sha256=f"{i:064x}", game_sha256=f"{i + 1:064x}",
+                                                   entered=i + 1) for i in range(size)]
+                    (folder / "scores.json").write_bytes(table_bytes(entries, CLASS_SEED, size + 1))
+                    table = ScoreTable(folder, warn=lambda line: None)
+                    times = []
+                    for b in range(batches):
+                        part = [dataclasses.replace(r, player=f"q{j}") for j, r in
+                                enumerate(replays[1 + b * batch:1 + (b + 1) * batch])]
+                        began = time.perf_counter()
+                        got = table.add_many(part, journal=True) if how == "journal" else table.add_many(part)
+                        times.append((time.perf_counter() - began) / len(part))
+                        assert all(not isinstance(g, Exception) for g in got), got
+                    row[how] = {"ms_per_handin": 1000 * statistics.median(times), "min_ms": 1000 * min(times),
+                                "max_ms": 1000 * max(times)}
+                out["sizes"][str(size)] = row
+        finally:
+            del os.environ["ARMGAME_CACHE"]
+    out["load_average_1min"] = _load()
+    return out
+
+
 def _ms(seconds: float | None) -> float | None:
     return None if seconds is None else 1000 * seconds
 
@@ -665,31 +892,59 @@ def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def measure(sizes: list[int], repeats: int = 3, sustained: int = 600, clients: int = 4, bot_share: float = 0.05,
-            seed: int = 0, timeout: float = 300.0, say: Callable[[str], None] = lambda line: None) -> dict[str, Any]:
-    """The figures for each class size (see the module docstring); ``say`` gets progress lines."""
+            seed: int = 0, timeout: float = 300.0, say: Callable[[str], None] = lambda line: None,
+            flooders: int = 0, flood_honest: int = 10, flood_seconds: float = 20.0, clerk: int = 0,
+            table_sizes: list[int] | None = None) -> dict[str, Any]:
+    """The figures for each class size (see the module docstring), then the flood (``flooders`` > 0), the clerk
+    alone (``clerk`` hand-ins) and the table's cost per hand-in at ``table_sizes``; ``say`` gets progress lines."""
     args = argparse.Namespace(sustained=sustained, clients=clients, timeout=timeout)
-    needed = max(size + size * max(2, math.ceil(sustained / size)) for size in sizes)
+    needed = max([size + size * max(2, math.ceil(sustained / size)) for size in sizes]
+                 + [flood_honest * (math.ceil(flood_seconds / FLOOD_HONEST_EVERY) + 1) if flooders else 0,
+                    clerk, 2 * 5 * 32 + 1 if table_sizes else 0])
+    forgeries = max(10 * flooders, clerk)
     report: dict[str, Any] = {"machine": machine(), "repeats": repeats, "sustained": sustained, "clients": clients,
                               "bot_share": bot_share, "seed": seed, "classes": {}}
     with tempfile.TemporaryDirectory(prefix="armgame-class-games-") as tmp:
         began = time.perf_counter()
-        games = make_games(Path(tmp), needed, bot_share, seed)
+        games = make_games(Path(tmp), needed + forgeries, bot_share, seed)
+        games, forged = games[:needed], forge([g["path"] for g in games[needed:]], Path(tmp) / "forged")
         keyboard = [g["bytes"] for g in games if not g["bot"]]
         bots = [g["bytes"] for g in games if g["bot"]]
         report["games"] = {"made": len(games), "seconds_to_make": time.perf_counter() - began, "bots": len(bots),
+                           "forged": len(forged),
                            "keyboard_bytes_mean": statistics.fmean(keyboard) if keyboard else None,
                            "bot_bytes_mean": statistics.fmean(bots) if bots else None,
                            "keyboard_score_mean": statistics.fmean(g["score"] for g in games if not g["bot"])
                            if keyboard else None}
-        say(f"made {len(games)} games ({len(bots)} bots') in {report['games']['seconds_to_make']:.0f} s")
+        say(f"made {len(games)} games ({len(bots)} bots') and {len(forged)} forgeries in "
+            f"{report['games']['seconds_to_make']:.0f} s")
         for size in sizes:
             runs = []
             for repeat in range(repeats):
                 say(f"class of {size}, repeat {repeat + 1} of {repeats}")
                 runs.append(one_class(size, games, args, say))
             report["classes"][str(size)] = {**summary(runs), "runs": runs}
+        if flooders:
+            runs = []
+            for repeat in range(repeats):
+                say(f"flood of {flooders} clients, {flood_honest} honest students, repeat {repeat + 1} of {repeats}")
+                runs.append(flood_class(flooders, flood_honest, flood_seconds, games, forged, args, say))
+            report["flood"] = {"p50_s": _spread([r["honest_handins"]["p50_s"] for r in runs]),
+                               "p99_s": _spread([r["honest_handins"]["p99_s"] for r in runs]),
+                               "max_s": _spread([r["honest_handins"]["max_s"] for r in runs]), "runs": runs}
+        if clerk:
+            say(f"the clerk alone: {clerk} honest hand-ins, then {clerk} forged")
+            report["clerk"] = [clerk_rate(games, forged, clerk) for _ in range(repeats)]
+        if table_sizes:
+            say(f"the table's cost per hand-in at {', '.join(map(str, table_sizes))} entries")
+            report["table"] = [table_costs(games, table_sizes) for _ in range(repeats)]
     report["machine"]["load_average_1min_end"] = _load()
     return report
+
+
+def _spread(values: list[float | None]) -> dict[str, float] | None:
+    known = [v for v in values if v is not None]
+    return {"median": statistics.median(known), "min": min(known), "max": max(known)} if known else None
 
 
 def _fmt(figure: dict[str, float] | None, scale: float = 1.0, digits: int = 2) -> str:
@@ -732,6 +987,29 @@ def print_report(report: dict[str, Any]) -> None:
     for label, key, scale, digits in rows:
         print(f"{label:<{width}}  " + "  ".join(f"{_fmt(report['classes'][s][key], scale, digits):>24}"
                                                 for s in sizes))
+    if "flood" in report:
+        f = report["flood"]
+        run = f["runs"][0]
+        print(f"flood: {run['flooders']} clients posting forged and malformed games as fast as they can for "
+              f"{run['seconds']:g} s, {run['honest']} honest students handing in a game every "
+              f"{FLOOD_HONEST_EVERY:g} s: an honest hand-in's latency p50 {_fmt(f['p50_s'])} s, p99 "
+              f"{_fmt(f['p99_s'])} s, max {_fmt(f['max_s'])} s")
+        for r in f["runs"]:
+            h = r["honest_handins"]
+            print(f"  {h['acknowledged']} of {h['requests']} honest hand-ins acknowledged ({h['busy_503']} x 503); "
+                  f"the flood posted {r['flood_posts_per_s']:.0f} a second, answered {r['flood_answers']}; server CPU "
+                  f"{r['server_cpu_ms_per_request'] or float('nan'):.2f} ms a request, peak "
+                  f"{r['server_peak_rss_mb'] or float('nan'):.0f} MB; clients' CPU {r['clients_cpu_s']:.0f} s; load "
+                  f"{r['load_average_1min']}")
+    for c in report.get("clerk", []):
+        print("the clerk alone (no HTTP): " + "; ".join(
+            f"{kind} {c[kind]['per_s']:.0f} hand-ins a second, {c[kind]['cpu_ms_per_handin']:.2f} ms of CPU each "
+            f"({c[kind]['answers']})" for kind in ("honest", "forged")) + f"; load {c['load_average_1min']}")
+    for t in report.get("table", []):
+        print(f"entering a batch of {t['batch']}, ms per hand-in (median [min-max] of {t['batches']} batches): " +
+              "; ".join(f"{size} entries: " + ", ".join(
+                  f"{how} {v['ms_per_handin']:.2f} [{v['min_ms']:.2f}-{v['max_ms']:.2f}]" for how, v in row.items())
+                  for size, row in t["sizes"].items()) + f"; load {t['load_average_1min']}")
     for s in sizes:
         c = report["classes"][s]
         run = c["runs"][0]
@@ -754,6 +1032,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--bot-share", type=float, default=0.05, help="share of bot games (default: 0.05)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the students' keys (default: 0)")
     parser.add_argument("--timeout", type=float, default=300.0, help="the most a phase may take, s (default: 300)")
+    parser.add_argument("--flood", type=int, default=100,
+                        help="clients flooding forged games, all joined (default: 100; 0: no flood)")
+    parser.add_argument("--flood-honest", type=int, default=10,
+                        help="honest students handing in during the flood (default: 10)")
+    parser.add_argument("--flood-seconds", type=float, default=20.0, help="the flood's length, s (default: 20)")
+    parser.add_argument("--clerk", type=int, default=1000,
+                        help="hand-ins of the clerk alone, in this process (default: 1000; 0: none)")
+    parser.add_argument("--table-sizes", default="10,1000,10000",
+                        help="table sizes the cost of entering is measured at ('': none; default: 10,1000,10000)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     args = parser.parse_args(argv)
     try:
@@ -766,8 +1053,18 @@ def main(argv: list[str] | None = None) -> int:
                      "0 <= --sustained <= 100000, 0 <= --bot-share <= 1, 1 <= --timeout <= 3600")
     # SIGTERM ends the run as Ctrl-C does, so every server and client process is stopped on the way out.
     signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        table_sizes = [int(t) for t in args.table_sizes.split(",") if t.strip()]
+    except ValueError:
+        parser.error("--table-sizes: whole numbers separated by commas")
+    if not (0 <= args.flood <= 500 and 0 <= args.flood_honest <= 100 and 1 <= args.flood_seconds <= 600
+            and 0 <= args.clerk <= 10_000 and all(1 <= t <= 100_000 for t in table_sizes)):
+        parser.error("need 0 <= --flood <= 500, 0 <= --flood-honest <= 100, 1 <= --flood-seconds <= 600, "
+                     "0 <= --clerk <= 10000, table sizes 1 to 100000")
     report = measure(sizes, args.repeats, args.sustained, args.clients, args.bot_share, args.seed, args.timeout,
-                     say=lambda line: print(line, file=sys.stderr, flush=True))
+                     say=lambda line: print(line, file=sys.stderr, flush=True), flooders=args.flood,
+                     flood_honest=args.flood_honest, flood_seconds=args.flood_seconds, clerk=args.clerk,
+                     table_sizes=table_sizes)
     if args.json:
         print(json.dumps(report, indent=1))
     else:

@@ -1,9 +1,11 @@
 """The suite's reference scores: random, the naive bot, the model bot and PPO on every v1 id.
 
     python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
+    python benchmarks/reference_scores.py bots --out refs --ids armgame/CenterOutHold-v1 --policies naive model
     python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
     python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
+    python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
 
 Every score is ``armgame.env.evaluate`` on the evaluation seeds (the first 100 of
 ``EVALUATION_SEEDS``), so the numbers here and a paper's are hits on the same games. PPO is
@@ -29,7 +31,7 @@ import numpy as np
 
 import armgame.env  # noqa: F401  (registers the ids)
 from armgame.env.evaluation import evaluate
-from armgame.env.suite import suite_ids
+from armgame.env.suite import PROTOCOL_VERSION, suite_ids
 
 GAMES = 100
 PPO_STEPS = 500_000
@@ -41,9 +43,10 @@ def slug(env_id: str) -> str:
     return env_id.split("/")[-1]
 
 
-def run_bots(out: Path, ids: tuple[str, ...], games: int) -> None:
+def run_bots(out: Path, ids: tuple[str, ...], games: int,
+             policies: tuple[str, ...] = ("random", "naive", "model")) -> None:
     for env_id in ids:
-        for policy in ("random", "naive", "model"):
+        for policy in policies:
             start = time.perf_counter()
             result = evaluate(policy, env_id, games=games)
             write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start)
@@ -130,6 +133,32 @@ def references(folder: Path) -> str:
     return "\n".join(lines)
 
 
+def aggregate(folder: Path) -> str:
+    """The IQM, mean and median normalised score, with stratified bootstrap intervals, of the ``result.json`` files
+    (``examples/train_ppo.py --out``) anywhere under ``folder``: one run a training seed and id."""
+    from armgame.env.evaluation import aggregate_runs
+
+    runs: dict[str, dict[int, float]] = {}
+    budgets = set()
+    for path in sorted(folder.rglob("result.json")):
+        r = json.loads(path.read_text(encoding="utf-8"))
+        runs.setdefault(r["env_id"], {})[int(r["training_seed"])] = float(r["mean_hits"])
+        budgets.add(int(r["budget_steps"]))
+    if not runs:
+        raise SystemExit(f"{folder}: no result.json under it")
+    seeds = {tuple(sorted(by_seed)) for by_seed in runs.values()}
+    if len(seeds) != 1:
+        raise SystemExit(f"{folder}: the ids were not trained with the same seeds: {sorted(seeds)}")
+    order = sorted(next(iter(seeds)))
+    result = aggregate_runs({env_id: [by_seed[s] for s in order] for env_id, by_seed in runs.items()})
+    lines = [result.summary(), f"budget: {', '.join(f'{b:,}' for b in sorted(budgets))} env steps; "
+                               f"training seeds {order}; protocol {PROTOCOL_VERSION}"]
+    for name in ("iqm", "mean", "median"):
+        point, low, high = getattr(result, name)
+        lines.append(f"  {name:6} {point:.3f} [{low:.3f}, {high:.3f}]")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -137,6 +166,8 @@ def main(argv: list[str] | None = None) -> int:
     bots.add_argument("--out", type=Path, required=True)
     bots.add_argument("--games", type=int, default=GAMES)
     bots.add_argument("--ids", nargs="*", default=list(IDS))
+    bots.add_argument("--policies", nargs="*", default=["random", "naive", "model"],
+                      help="some of random, naive and model (a row's bots rerun alone)")
     ppo = sub.add_parser("ppo")
     ppo.add_argument("env_id")
     ppo.add_argument("--seed", type=int, default=0)
@@ -147,13 +178,17 @@ def main(argv: list[str] | None = None) -> int:
     tab.add_argument("folder", type=Path)
     refs = sub.add_parser("references")
     refs.add_argument("folder", type=Path)
+    agg = sub.add_parser("aggregate")
+    agg.add_argument("folder", type=Path)
     args = parser.parse_args(argv)
     if args.command == "bots":
-        run_bots(args.out, tuple(args.ids), args.games)
+        run_bots(args.out, tuple(args.ids), args.games, tuple(args.policies))
     elif args.command == "ppo":
         run_ppo(args.out, args.env_id, args.seed, args.steps, args.games)
     elif args.command == "references":
         print(references(args.folder))
+    elif args.command == "aggregate":
+        print(aggregate(args.folder))
     else:
         print(table(args.folder))
     return 0

@@ -1,23 +1,30 @@
 """Train PPO (Stable-Baselines3) to play armgame: ``armgame/Reach-v1``, SB3's defaults but the batch.
 
     pip install -e '.[rl]'
-    python examples/train_ppo.py                  # 10 minutes, then the policy's hits per game
-    python examples/train_ppo.py --minutes 2 --out ppo-run
+    python examples/train_ppo.py                            # 1,500,000 env steps, then the test games
+    python examples/train_ppo.py --steps 300000 --out ppo-run --env armgame/ReachHold-v1
 
 The heart of it is five lines: make the native vector env through the SB3 adapter, hand it to
-PPO, learn, and play deterministic games. Every ``--eval-every`` steps it plays 10 whole games (the
-first 10 of the suite's evaluation seeds, which training never plays; the deterministic policy) and
-prints their mean hits, the number to compare with the
-game's bots (``armgame play --bot naive``: about 22 a game) and with players. ``--out`` keeps the
-curve (``curve.csv``: env steps, wall seconds, mean/min/max hits), the model (``model.zip``) and, for
-the keys env, the policy's game of seed 0 as a replay anyone can watch (``armgame replay
-ppo-run/game.json``) or check (``armgame verify``): the game's own rules recount its hits.
+PPO, learn, and play deterministic games. It follows the suite's protocol (docs/programs.md, "The
+protocol"): the budget is env steps (``--steps``), not wall time, so runs on different machines train
+alike; training plays game seeds below ``TRAINING_SEED_LIMIT``; every ``--eval-every`` steps it plays 10
+**validation** games (``VALIDATION_SEEDS``, the deterministic policy) and prints their mean hits, which
+is what a run may look at; only at the end it plays the 100 **test** games (``armgame.env.evaluate`` on
+the evaluation seeds) once. ``--out`` keeps the curve (``curve.csv``: env steps, wall seconds,
+mean/min/max hits on the validation games), ``result.json`` (the id, training seed, budget and the test
+games' hits, what ``benchmarks/reference_scores.py aggregate`` summarises over training seeds), the
+model (``model.zip``) and the policy's game of seed 0 as a replay anyone can watch (``armgame replay
+ppo-run/game.json``) or check (``armgame verify``): the game's own rules, and the id's dwell, noise and
+field, recount its hits. ``--minutes`` caps the wall time as well, for a laptop (then say so: the budget
+reached is in ``result.json``).
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -30,38 +37,45 @@ from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.vec_env import VecMonitor
 
 import armgame.env  # noqa: F401  (registers the ids)
+from armgame.env.evaluation import evaluate
+from armgame.env.record import replay_of
 from armgame.env.sb3 import make_sb3_vec_env
-from armgame.env.suite import EVALUATION_SEEDS
-from armgame.records.replay import Replay
+from armgame.env.suite import VALIDATION_SEEDS
 
-# Held-out games: the suite's evaluation seeds, which training never plays (armgame.env.suite).
-EVAL_SEEDS = list(EVALUATION_SEEDS[:10])
+# What a run watches: validation games, never the test games evaluate() plays at the end (armgame.env.suite).
+VALIDATION = list(VALIDATION_SEEDS[:10])
 
 
-def evaluate(model: PPO, env_id: str) -> np.ndarray:
-    """Hits in each of 10 whole games (the first 10 evaluation seeds) played by the deterministic policy."""
-    envs = gym.make_vec(env_id, num_envs=len(EVAL_SEEDS), vectorization_mode="vector_entry_point")
-    obs, info = envs.reset(seed=EVAL_SEEDS)
-    while True:
+def validate(model: PPO, env_id: str) -> np.ndarray:
+    """Hits in each of 10 whole validation games played by the deterministic policy."""
+    envs = gym.make_vec(env_id, num_envs=len(VALIDATION), vectorization_mode="vector_entry_point")
+    obs, info = envs.reset(seed=VALIDATION)
+    done = np.zeros(len(VALIDATION), dtype=bool)
+    hits = np.zeros(len(VALIDATION), dtype=np.int64)
+    while not done.all():  # an episode of CenterOut ends when its trials do, each at its own step
         actions, _ = model.predict(obs, deterministic=True)
         obs, _, terminated, truncated, info = envs.step(actions)
-        if (terminated | truncated).all():
-            return info["hits"].copy()
+        ended = (terminated | truncated) & ~done
+        hits[ended] = info["hits"][ended]
+        done |= ended
+    envs.close()
+    return hits
 
 
 def keep_a_game(model: PPO, env_id: str, path: Path) -> int:
     """Plays game seed 0 with the deterministic policy in a single env and saves its replay; its hits."""
     env = gym.make(env_id)
     obs, _ = env.reset(seed=0)
-    truncated = False
-    while not truncated:
-        obs, _, _, truncated, info = env.step(model.predict(obs, deterministic=True)[0])
-    Replay.from_session(env.unwrapped.session, "script", driver="ppo").save(path)
+    done = False
+    while not done:
+        obs, _, terminated, truncated, info = env.step(model.predict(obs, deterministic=True)[0])
+        done = terminated or truncated
+    replay_of(env, driver="ppo").save(path)
     return int(info["hits"])
 
 
 class Curve(BaseCallback):
-    """Evaluates every ``every`` env steps and stops training at the wall-clock budget."""
+    """Validates every ``every`` env steps; stops training at the optional wall-clock cap."""
 
     def __init__(self, env_id: str, every: int, seconds: float, out: Path | None) -> None:
         super().__init__()
@@ -78,9 +92,9 @@ class Curve(BaseCallback):
 
     def record(self) -> None:
         wall = time.perf_counter() - self.start
-        hits = evaluate(self.model, self.env_id)
+        hits = validate(self.model, self.env_id)
         self.rows.append((self.num_timesteps, round(wall, 1), float(hits.mean()), int(hits.min()), int(hits.max())))
-        print(f"{self.num_timesteps:>9,} steps  {wall:7.0f} s  hits per game: mean {hits.mean():5.1f} "
+        print(f"{self.num_timesteps:>9,} steps  {wall:7.0f} s  validation hits per game: mean {hits.mean():5.1f} "
               f"(min {hits.min()}, max {hits.max()})", flush=True)
         if self.out is not None:
             with (self.out / "curve.csv").open("w", newline="") as f:
@@ -92,30 +106,37 @@ class Curve(BaseCallback):
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--env", default="armgame/Reach-v1", help="an armgame id with a vector entry point")
-    parser.add_argument("--minutes", type=float, default=10.0, help="wall-clock budget (default 10)")
-    parser.add_argument("--steps", type=int, default=50_000_000, help="env steps at most")
+    parser.add_argument("--steps", type=int, default=1_500_000, help="the budget in env steps (default 1,500,000)")
+    parser.add_argument("--minutes", type=float, default=math.inf, help="a wall-clock cap as well (default none)")
     parser.add_argument("--envs", type=int, default=32, help="games stepped together (default 32)")
     parser.add_argument("--seed", type=int, default=0, help="training seed")
-    parser.add_argument("--eval-every", type=int, default=100_000, help="env steps between evaluations")
-    parser.add_argument("--out", type=Path, help="folder for curve.csv and model.zip")
+    parser.add_argument("--eval-every", type=int, default=100_000, help="env steps between validations")
+    parser.add_argument("--test-games", type=int, default=100, help="test games played at the end (default 100)")
+    parser.add_argument("--out", type=Path, help="folder for curve.csv, result.json, model.zip and game.json")
     args = parser.parse_args(argv)
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
 
     # A 64-unit MLP gains nothing from a second thread and loses much when another process shares the cores.
     torch.set_num_threads(1)
-    envs = VecMonitor(make_sb3_vec_env(args.env, args.envs, seed=args.seed))
+    # Game seeds from seed * 1000 up: below the validation and test ranges, and apart for each training seed.
+    envs = VecMonitor(make_sb3_vec_env(args.env, args.envs, seed=args.seed * 1000), info_keywords=("hits",))
     model = PPO("MlpPolicy", envs, n_steps=128, batch_size=256, seed=args.seed, device="cpu", verbose=0)
     curve = Curve(args.env, args.eval_every, args.minutes * 60.0, args.out)
     model.learn(args.steps, callback=curve)
     curve.record()
+    test = evaluate(model, args.env, games=args.test_games)  # once, at the end: the test games
+    print(test.summary())
     if args.out is not None:
         model.save(args.out / "model.zip")
-        if isinstance(envs.action_space, gym.spaces.MultiBinary):  # a levels game has no key timeline
-            hits = keep_a_game(model, args.env, args.out / "game.json")
-            print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")
+        result = {"env_id": args.env, "algorithm": "PPO", "training_seed": args.seed, "env_steps": model.num_timesteps,
+                  "budget_steps": args.steps, "test_seeds": [test.seeds[0], test.seeds[-1]],
+                  "test_hits": list(test.hits), "mean_hits": test.mean_hits, "normalised": test.normalised}
+        (args.out / "result.json").write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
+        hits = keep_a_game(model, args.env, args.out / "game.json")
+        print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")
     best = max(row[2] for row in curve.rows)
-    print(f"best mean hits per game: {best:.1f} (the naive bot: about 22)")
+    print(f"best validation mean hits per game: {best:.1f} (the naive bot: about 22)")
     return 0
 
 

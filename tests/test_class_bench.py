@@ -19,3 +19,18 @@ def test_the_class_server_benchmark_runs():
     assert run["folder"] == {"entries": 6, "acknowledged_kept": 6, "not_acknowledged_but_kept": 0}
     assert figures["whole_class_s"]["median"] > 0 and figures["sustained_per_s"]["median"] > 0
     assert run["server_exit"] == 0 and run["server_notices"] == {}
+
+
+def test_the_flood_the_clerk_and_the_table_costs_run():
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "class_server.py"
+    spec = importlib.util.spec_from_file_location("class_server_benchmark", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    report = bench.measure([1], repeats=1, sustained=1, clients=1, bot_share=0.0, flooders=2, flood_honest=1,
+                           flood_seconds=1.0, clerk=4, table_sizes=[3])
+    run = report["flood"]["runs"][0]
+    assert run["honest_handins"]["acknowledged"] >= 1 and run["honest_handins"]["not_acknowledged"] == {}
+    assert set(run["flood_answers"]) <= {"400", "422", "503"} and run["flood_answers"]
+    clerk = report["clerk"][0]
+    assert clerk["honest"]["answers"] == {"ok": 4} and clerk["forged"]["answers"] == {"422": 4}
+    assert set(report["table"][0]["sizes"]["3"]) == {"journal", "rewrite"}

@@ -199,6 +199,7 @@ def test_a_flood_is_queued_and_refused_politely_and_nothing_is_lost(tmp_path, mo
     """50 machines hand in at once into a queue of 4 and 2 upload slots: some are asked to come back
     (503), their clients ask again, and every game is entered once."""
     monkeypatch.setattr(class_app, "QUEUE_LIMIT", 4)
+    monkeypatch.setattr(class_app, "HANDIN_QUEUE", 4)
     monkeypatch.setattr(class_app, "UPLOADS", 2)
     monkeypatch.setattr(client, "_retry_after", lambda value: 0.05)
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))

@@ -20,6 +20,7 @@ SELECTION = [
     "tests/test_portable.py",
     "tests/test_scores.py::test_add_saves_the_replay_beside_the_table_and_checks_out",
     "tests/test_scores.py::test_concurrent_writers_all_keep_their_entries",
+    "tests/test_class_flood.py::test_the_journal_is_durable_without_rewriting_the_table",
     "tests/test_scores.py::test_a_truncated_table_is_kept_aside_and_its_valid_entries_recovered",
     "tests/test_hostile.py::test_symlinked_replays_folder_or_lock_is_refused",
     "tests/test_hostile.py::test_a_replay_planted_as_a_symlink_is_not_followed",

@@ -20,10 +20,11 @@ Every request is hostile until checked, and what it can cost is bounded before a
   a body slower than ``BODY_SECONDS`` is cut off (408); at most ``UPLOADS`` bodies are read at
   once, ``UPLOADS_PER_ADDRESS`` from one address, and a hand-in's code and token are checked
   from its headers before its body is read, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES``
-  whatever arrives;
+  (and the queued bodies under ``QUEUE_BYTES``) whatever arrives;
 * changes go to one worker thread (the ``Clerk``), never the event loop; at most ``QUEUE_LIMIT``
-  wait for it, and past that a client is told to come back (503 with Retry-After): its replay
-  stays on its machine, and the client hands it in again;
+  jobs and ``HANDIN_QUEUE`` hand-ins wait for it, one hand-in a player (``TOKEN_SHARE``, checked
+  before the body is read, with the token and a closed class), and past that a client is told to
+  come back (503 with Retry-After): its replay stays on its machine, and the client hands it in again;
 * a hand-in is answered only after the clerk has written it durably (fsynced file and folder);
 * the projector's event stream sends the latest standings, never a backlog, to at most
   ``MAX_STREAMS`` pages, ``STREAMS_PER_ADDRESS`` from one address; the projector's own page
@@ -40,6 +41,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import gc
 import hmac
 import ipaddress
 import json
@@ -52,7 +54,7 @@ import time
 from collections import Counter, OrderedDict, deque
 from collections.abc import AsyncIterator, Callable, Iterator
 from concurrent.futures import Future
-from contextlib import asynccontextmanager
+from contextlib import asynccontextmanager, contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -64,11 +66,33 @@ from starlette.routing import Route
 from ..errors import UserError
 from . import page
 from .guard import Guard
-from .intake import MAX_HANDIN_BYTES, Clerk, RefusedError
+from .intake import AGAIN, CLOSED, MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
+from .roster import token_digest
 
+#: Jobs (a join, the teacher's requests) waiting for the clerk at once; past it, 503 and the client comes back.
+#: A join rewrites the roster, so a lecture hall's joins are let in a few at a time.
 QUEUE_LIMIT = 64
-#: Hand-ins entered with one table write at the most.
-BATCH = 32
+#: Hand-ins waiting for the clerk at once. One checked and entered in a batch costs the clerk 2.5 ms (a bot's
+#: game 60 ms): room for a lecture hall's round's end (``benchmarks/class_server.py``), where a queue of 64
+#: sent nine students in ten away for 2 s, again and again.
+HANDIN_QUEUE = 1024
+#: The bodies those waiting hand-ins hold, in bytes at the most (a bot's game is 0.5 MB, a student's 9 KB).
+QUEUE_BYTES = 64 * 1024 * 1024
+#: Hand-ins of one player (one token) waiting at once: a client that floods the class has one in the queue,
+#: and its next is told the class is busy before its body is read, so a flooder's backlog never sits in
+#: front of an honest student's game.
+TOKEN_SHARE = 1
+#: Seconds a player's next hand-in is told the class is busy after one of theirs did not reproduce its score
+#: (422, found only by re-simulating it): a forger's next game waits its turn behind the honest students'
+#: instead of taking the clerk's time at once. An honest student's game is never refused so. A body that is
+#: not a class's game (400, 413) is refused before any re-simulation, cheaply, and does not count.
+COOL_DOWN = 2.0
+#: Hand-ins checked, re-simulated (one batch) and entered (one table write) together at the most.
+BATCH = 64
+#: Seconds a hand-in waits for one of the ``UPLOADS`` slots before it is told the class is busy.
+UPLOAD_WAIT = 5.0
+#: What a student is told when the class cannot take their game yet (their client hands it in again).
+BUSY = "the class is busy: your game is kept and will be handed in in a moment"
 UPLOADS = 16
 UPLOADS_PER_ADDRESS = 2
 #: Within the connection's own deadline (``guard.REQUEST_SECONDS``), so the app answers 408 first.
@@ -85,7 +109,6 @@ MAX_GUESS_WAIT = 3600.0
 MAX_TRACKED_ADDRESSES = 10_000
 JOINS_PER_MINUTE = 3
 CLASS_JOINS_PER_MINUTE = 120
-BUSY = "the class is busy: your game is kept and will be handed in in a moment"
 SECURITY_HEADERS = {
     "Content-Security-Policy": "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
                                "img-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'",
@@ -158,6 +181,9 @@ class ClerkThread:
 
     def __init__(self, clerk: Clerk, after: Callable[[], None]) -> None:
         self.clerk, self.after = clerk, after
+        #: The joined players' token digests, rebuilt on this thread after every job (a join, a name released)
+        #: and read by the event loop: a hand-in from a token that is no player's is refused before its body.
+        self.tokens: frozenset[str] = self._tokens()
         self.jobs: queue.SimpleQueue[tuple[str, Any, Future | None]] = queue.SimpleQueue()
         self.thread = threading.Thread(target=self._serve, name="armgame-clerk", daemon=True)
         self.thread.start()
@@ -172,6 +198,10 @@ class ClerkThread:
         """The jobs already queued are finished (a hand-in being written is never cut), then the thread ends."""
         self.jobs.put(_STOP)
         self.thread.join()
+        try:  # the journal of the games taken, into the table's one file (read either way if this fails)
+            self.clerk.table.compact()
+        except Exception as exc:
+            print(f"armgame class: the table's journal stays beside it: {exc}", file=sys.stderr)
 
     def _serve(self) -> None:
         held = None
@@ -182,6 +212,7 @@ class ClerkThread:
                 return
             if job[0] == "job":
                 outcomes = [(job[2], _outcome(job[1]))]
+                self.tokens = self._tokens()  # before the answer: a machine that just joined hands in next
             else:
                 batch = [job]
                 while len(batch) < BATCH:  # what arrived meanwhile goes in the same write
@@ -204,21 +235,46 @@ class ClerkThread:
                 else:
                     future.set_result(outcome)
 
+    def _tokens(self) -> frozenset[str]:
+        return frozenset(p.token_sha256 for p in self.clerk.roster.players.values())
+
     def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
-        """Each hand-in's answer (or the exception to raise in its request), in the batch's order."""
+        """Each hand-in's answer (or the exception to raise in its request): the batch checked together
+        (``Clerk.check_many``: its games re-simulated in one batch), then entered together; a game the batch
+        held twice is checked again after that, as the next batch would (``AGAIN``)."""
+        # The cyclic garbage collector paused for the batch: reading a bot's game makes 15,000 events and their
+        # lists, no cycle among them, and the collections they set off (each also walking every object the
+        # server holds) were a third of such a hand-in's cost (104 ms against 65 ms, measured in-process).
+        # Reference counting still frees them; what cycles there are wait for the next collection.
+        collecting = gc.isenabled()
+        gc.disable()
+        try:
+            return self._hand_in_batch(batch)
+        finally:
+            if collecting:
+                gc.enable()
+
+    def _hand_in_batch(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
         outcomes: list[tuple[Future, Any]] = []
-        checked = []
-        for _, (token, body), future in batch:
-            found = _outcome(lambda token=token, body=body: self.clerk.check(token, body))
-            if isinstance(found, BaseException | dict):
-                outcomes.append((future, found))
-            else:
-                checked.append((found, future))
-        if checked:
-            answers = _outcome(lambda: self.clerk.enter([c for c, _ in checked]))
-            if isinstance(answers, BaseException):
-                answers = [answers] * len(checked)
-            outcomes += [(future, answer) for (_, future), answer in zip(checked, answers, strict=True)]
+        while batch:
+            again = []
+            checked = []
+            found_all = _outcome(lambda batch=batch: self.clerk.check_many([work for _, work, _ in batch]))
+            if isinstance(found_all, BaseException):
+                found_all = [found_all] * len(batch)
+            for job, found in zip(batch, found_all, strict=True):
+                if found is AGAIN:
+                    again.append(job)
+                elif isinstance(found, BaseException | dict):
+                    outcomes.append((job[2], found))
+                else:
+                    checked.append((found, job[2]))
+            if checked:
+                answers = _outcome(lambda checked=checked: self.clerk.enter([c for c, _ in checked]))
+                if isinstance(answers, BaseException):
+                    answers = [answers] * len(checked)
+                outcomes += [(future, answer) for (_, future), answer in zip(checked, answers, strict=True)]
+            batch = again
         return outcomes
 
 
@@ -242,7 +298,13 @@ class ClassState:
     guard: Guard = field(default_factory=Guard)
     play_url: str = ""
     worker: ClerkThread | None = None
-    waiting: int = 0
+    waiting: int = 0  # jobs
+    handins: int = 0
+    #: Hand-ins waiting (their bodies being read or queued) by token digest, and the bytes queued.
+    shares: dict[str, int] = field(default_factory=dict)
+    queued_bytes: int = 0
+    #: Token digests whose hand-in was refused, and until when (``time.monotonic``) their next one is busy.
+    cooling: dict[str, float] = field(default_factory=dict)
     codes: Guesses = field(default_factory=Guesses)
     secrets: Guesses = field(default_factory=Guesses)
     tokens: Guesses = field(default_factory=Guesses)
@@ -287,17 +349,56 @@ class ClassState:
 
     async def run(self, job: Callable[[], Any], kind: str = "job") -> Any:
         """``job`` on the clerk's thread (or, for "hand-in", ``job`` is (token, body)), if the queue has
-        room; the pages are told of any change."""
-        if self.waiting >= QUEUE_LIMIT:
+        room (``QUEUE_LIMIT`` jobs; ``HANDIN_QUEUE`` hand-ins and ``QUEUE_BYTES`` of their bodies); the pages
+        are told of any change."""
+        handin = kind == "hand-in"
+        size = len(job[1]) if handin else 0  # type: ignore[index]
+        if (self.handins >= HANDIN_QUEUE or self.queued_bytes + size > QUEUE_BYTES) if handin \
+                else self.waiting >= QUEUE_LIMIT:
             raise RefusedError(503, BUSY)
         assert self.worker is not None, "the class is not serving"
-        self.waiting += 1
+        self.waiting += not handin
+        self.handins += handin
+        self.queued_bytes += size
         try:
             return await asyncio.wrap_future(self.worker.submit(kind, job))
         finally:
-            self.waiting -= 1
+            self.waiting -= not handin
+            self.handins -= handin
+            self.queued_bytes -= size
             self.changed.set()
             self.changed = asyncio.Event()
+
+    @contextmanager
+    def hand_in_share(self, token: str | None) -> Iterator[None]:
+        """A hand-in's place, taken before its body is read, with the refusals that cost nothing: a token that
+        is no player's (401), a closed class (403), a player who already has ``TOKEN_SHARE`` hand-ins waiting
+        or whose last one did not reproduce less than ``COOL_DOWN`` s ago (503: the client hands it in again in a
+        moment). The clerk checks the token and the class again: a name may be released meanwhile."""
+        assert self.worker is not None, "the class is not serving"
+        digest = token_digest(token) if token else None
+        if digest is None or digest not in self.worker.tokens:
+            raise RefusedError(401, NOT_JOINED)
+        if self.clerk.roster.closed:
+            raise RefusedError(403, CLOSED)
+        if self.shares.get(digest, 0) >= TOKEN_SHARE:
+            raise RefusedError(503, BUSY)
+        if digest in self.cooling:
+            if self.cooling[digest] > time.monotonic():
+                raise RefusedError(503, BUSY)
+            del self.cooling[digest]
+        self.shares[digest] = self.shares.get(digest, 0) + 1
+        try:
+            yield
+        except RefusedError as exc:
+            if exc.status == 422:
+                self.cooling[digest] = time.monotonic() + COOL_DOWN
+            raise
+        finally:
+            if self.shares[digest] <= 1:
+                del self.shares[digest]
+            else:
+                self.shares[digest] -= 1
 
 
 def _json(data: object, status: int = 200, headers: dict[str, str] | None = None) -> Response:
@@ -593,14 +694,19 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         address = _address(request)
         _check_code(state, request, request.headers.get("x-armgame-code"))
         token = _check_token(state, request)
-        if clerk.roster.closed:
-            raise RefusedError(403, "the class is closed: no more games are taken (your replay stays on your machine)")
-        if state.uploads.locked():
-            raise RefusedError(503, BUSY)
-        with _share(state.uploading, address, UPLOADS_PER_ADDRESS, state.guard.is_own(address), BUSY):
-            async with state.uploads:
+        with state.hand_in_share(token), _share(state.uploading, address, UPLOADS_PER_ADDRESS,
+                                                 state.guard.is_own(address), BUSY):
+            # the token's and the machine's places taken before the body is read: a flooder's next costs nothing
+            try:
+                async with asyncio.timeout(UPLOAD_WAIT):
+                    await state.uploads.acquire()
+            except TimeoutError:
+                raise RefusedError(503, BUSY) from None
+            try:
                 data = await _body(request, MAX_HANDIN_BYTES)
-        return _json(await state.run((token, data), "hand-in"))
+            finally:
+                state.uploads.release()
+            return _json(await state.run((token, data), "hand-in"))
 
     async def teacher_hide(request: Request) -> Response:
         _check_secret(state, request)

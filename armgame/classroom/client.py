@@ -42,6 +42,12 @@ DEFAULT_PORT = 8765
 TIMEOUT = 15.0
 #: How long a hand-in keeps asking a busy class, in all.
 BUSY_PATIENCE = 60.0
+#: The requests asked again when the class took them but their answer never came: a game counts once.
+_ASKED_AGAIN_SAFELY = frozenset({"/api/handin"})
+#: Seconds before asking again when the class took a request but its answer never came.
+LOST_ANSWER_PAUSE = 1.0
+#: What a busy class means to a student (a 503 without the class's own line: the server's connection limit).
+BUSY = "the class is busy: your game is kept and will be handed in in a moment"
 MAX_OUTBOX = 200
 _HOST = re.compile(r"[A-Za-z0-9]([A-Za-z0-9.-]{0,252})")
 
@@ -129,7 +135,13 @@ class RefusalError(UserError):
 
 def _request(address: ClassAddress, path: str, body: bytes, headers: dict[str, str],
              sleep: Callable[[float], None] = time.sleep) -> dict:
-    """POST ``body``; the JSON answer. Asks a busy class again (bounded); raises UnreachableError or RefusalError."""
+    """POST ``body``; the JSON answer. Asks a busy class again (bounded); raises UnreachableError or RefusalError.
+
+    Busy is a 503, and for a hand-in also a class that took the connection but whose answer did not come (cut
+    off, or later than ``TIMEOUT`` under a lecture hall's load): that is not a network problem, and asking
+    again is safe (a game handed in twice counts once; a join asked again would find its name taken, so a
+    join is not). Only a connection that could not be made is unreachable, with the hint about school
+    networks."""
     waited = 0.0
     while True:
         req = urllib.request.Request(address.url(path), data=body, method="POST", headers=headers)
@@ -138,19 +150,28 @@ def _request(address: ClassAddress, path: str, body: bytes, headers: dict[str, s
                 return _answer(response.read(1 << 20))
         except urllib.error.HTTPError as exc:
             answer = _answer(exc.read(1 << 20), quiet=True)
-            message = str(answer.get("error") or f"the class answered {exc.code} {exc.reason}")
+            message = str(answer.get("error") or (BUSY if exc.code == 503
+                                                  else f"the class answered {exc.code} {exc.reason}"))
             if exc.code == 503 and waited < BUSY_PATIENCE:
                 pause = _retry_after(exc.headers.get("Retry-After"))
                 sleep(pause)
                 waited += pause
                 continue
             raise RefusalError(exc.code, message) from None
-        except (urllib.error.URLError, OSError, http.client.HTTPException) as exc:
+        except urllib.error.URLError as exc:  # the connection (or the request's sending) failed
             reason = getattr(exc, "reason", exc) or type(exc).__name__
             raise UnreachableError(
                 f"cannot reach the class at {address.label} ({getattr(reason, 'strerror', None) or reason}): is the "
                 f"class started, and is this machine on the teacher's network? (school Wi-Fi often keeps laptops "
                 f"apart: docs/teaching.md, 'When students cannot join')") from None
+        except (OSError, http.client.HTTPException) as exc:  # connected, but no answer: the class is busy
+            if path not in _ASKED_AGAIN_SAFELY:
+                raise UnreachableError(f"the class at {address.label} took the request but its answer did not "
+                                       f"come ({type(exc).__name__}): it may be busy; try again in a moment") from None
+            if waited >= BUSY_PATIENCE:
+                raise RefusalError(503, BUSY) from exc
+            sleep(LOST_ANSWER_PAUSE)
+            waited += LOST_ANSWER_PAUSE
 
 
 def _retry_after(value: str | None) -> float:

@@ -18,6 +18,7 @@ The class's folder::
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import csv
 import hashlib
@@ -27,19 +28,23 @@ import math
 import os
 import secrets
 import stat
-from collections.abc import Sequence
+from collections import OrderedDict
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
+from ..game.batch import replay_many
+from ..game.session import GameResult
+from ..records.batch_verify import batchable
 from ..records.identity import game_digest, game_digests
 from ..records.lookalikes import name_problem
-from ..records.replay import Replay, check_name, now_iso
+from ..records.replay import Replay, check_name, now_iso, same_outcome
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
-from ..records.standings import one_row_per_player, player_key
+from ..records.standings import PlayerRow, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
 from ..records.tablefile import name_slug
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
@@ -55,6 +60,12 @@ MAX_HANDIN_WORK = 1_500_000
 #: Rows of each list the standings carry: the projector shows the top, the CSV has everything.
 STANDINGS_ROWS = 60
 LAB_DIR, LAB_MORE_DIR = "lab", "lab-more"
+NOT_JOINED = ("this machine has not joined the class under that name: join first "
+              "(armgame play --join HOST:PORT --code CODE --name NAME)")
+CLOSED = "the class is closed: no more games are taken (your replay stays on your machine)"
+#: Forged games whose re-simulated result is kept (by identity), so one sent again is not played again:
+#: a result is about 200 bytes.
+REMEMBERED_FORGERIES = 4096
 
 
 class RefusedError(Exception):
@@ -87,6 +98,22 @@ class Checked:
     digests: tuple[str, ...]
 
 
+class _Again:
+    """``Clerk.check_many``'s answer for a game that came twice in one batch: check it again after the batch."""
+
+
+AGAIN = _Again()
+
+
+@dataclass(frozen=True)
+class _Pending:
+    """A game through every check but its re-simulation (``Clerk.check_many`` verifies them together)."""
+
+    player: Player
+    replay: Replay
+    digests: tuple[str, ...]
+
+
 @dataclass
 class LabRun:
     player: str
@@ -101,6 +128,49 @@ class LabRun:
 def ordinal(n: int) -> str:
     suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
     return f"{n}{suffix}"
+
+
+class _Board:
+    """One list's rows, one a player, best first (``standings.one_row_per_player`` of the list), kept up to
+    date as entries arrive: a player's rank is a binary search, not a pass over every entry."""
+
+    def __init__(self, best_first: Iterable[ScoreEntry] = ()) -> None:
+        self._rows: dict[str, PlayerRow] = {}
+        self._order: list[tuple[tuple, str]] = []  # (sort_key of the row's best, its player's key), sorted
+        for entry in best_first:
+            self.add(entry)
+
+    def __len__(self) -> int:
+        return len(self._order)
+
+    def add(self, entry: ScoreEntry) -> None:
+        key = player_key(entry.name)
+        row = self._rows.get(key)
+        if row is None:
+            self._rows[key] = PlayerRow(entry.name, entry, 1)
+            bisect.insort(self._order, (sort_key(entry), key))
+        elif sort_key(entry) < sort_key(row.best):  # a new best: the row moves, under the best game's name
+            del self._order[bisect.bisect_left(self._order, (sort_key(row.best), key))]
+            self._rows[key] = PlayerRow(entry.name, entry, row.games + 1)
+            bisect.insort(self._order, (sort_key(entry), key))
+        else:
+            self._rows[key] = PlayerRow(row.name, row.best, row.games + 1)
+
+    def rank(self, key: str) -> int:
+        """The 1-based place of the player whose ``player_key`` is ``key`` (who has a row)."""
+        return bisect.bisect_left(self._order, (sort_key(self._rows[key].best), key)) + 1
+
+    def row(self, rank: int) -> PlayerRow:
+        return self._rows[self._order[rank - 1][1]]
+
+    def each(self) -> Iterator[PlayerRow]:
+        """The rows best first, one at a time: the projector's standings stop at their 60th."""
+        for _, key in self._order:
+            yield self._rows[key]
+
+    def rows(self, first: int | None = None) -> list[PlayerRow]:
+        """The rows best first (the ``first`` ones only, if given)."""
+        return [self._rows[key] for _, key in self._order[:first]]
 
 
 class Clerk:
@@ -120,7 +190,12 @@ class Clerk:
             raise DataFileError(f"{self.table.path} ranks seed {self.table.seed}, the class seed {roster.seed}: "
                                 f"this folder's table is not the class's (nothing was changed)")
         self._sweep()
+        with contextlib.suppress(DataFileError):  # a journal a killed server left, taken into the table (or read)
+            self.table.compact()
         self.entries: list[ScoreEntry] = self.table.all_entries()
+        # The two lists' rows, one a player, kept as games are entered: an answer's rank and the standings
+        # cost a lookup, not a pass over the whole table (which grew with every hand-in).
+        self.boards = {programs: _Board(e for e in self.entries if e.program == programs) for programs in (False, True)}
         self.games: dict[str, ScoreEntry] = {e.game_sha256: e for e in self.entries if e.game_sha256}
         self.lab_runs: list[LabRun] = []
         self.lab_digests: set[str] = set()
@@ -128,6 +203,7 @@ class Clerk:
         self.round_over = False  # the current round's winners have been shown
         self.version = 0  # bumped at every change the projector should see
         self.lab_version = 0  # and at every change of the class curve (a lab run, a name hidden)
+        self._recomputed: OrderedDict[str, GameResult] = OrderedDict()  # forged games' results, by identity
 
     def _sweep(self) -> None:
         """Temporary files a server killed mid-write left (never renamed: nothing refers to them). Only
@@ -181,8 +257,7 @@ class Clerk:
     def player(self, token: str | None) -> Player:
         player = self.roster.player_of(token) if token else None
         if player is None:
-            raise RefusedError(401, "this machine has not joined the class under that name: join first "
-                               "(armgame play --join HOST:PORT --code CODE --name NAME)")
+            raise RefusedError(401, NOT_JOINED)
         return player
 
     # ------------------------------------------------------------------ handing in
@@ -200,9 +275,53 @@ class Clerk:
         """A hand-in checked and verified, ready to ``enter``; or the answer already (a game handed in
         before by the same player; a lab run, which is kept here at once). Raises RefusedError; writes
         nothing but a lab run."""
+        found = self.check_many([(token, data)])[0]
+        if isinstance(found, BaseException):
+            raise found
+        assert not isinstance(found, _Again), "one hand-in cannot come twice"
+        return found
+
+    def check_many(self, hand_ins: Sequence[tuple[str | None, bytes]]
+                   ) -> list[dict[str, object] | Checked | BaseException | _Again]:
+        """``check`` of hand-ins that arrived together, each outcome (the exception ``check`` would raise,
+        returned) in order: the cheap refusals first, then the games still to verify re-simulated together
+        (``records.batch_verify``'s lanes, each verdict the single session's, bit for bit). ``AGAIN``: a game the
+        batch holds earlier, to check again once the batch is entered (``check`` never returns it)."""
+        outcomes: list[dict[str, object] | Checked | BaseException | _Pending | _Again] = []
+        for token, data in hand_ins:
+            try:
+                outcomes.append(self._read(token, data))
+            except Exception as exc:  # one hand-in's failure is its own answer, never the batch's
+                outcomes.append(exc)
+        # A game a batch holds twice (whatever each claims) is answered as one after the other: the later one
+        # once the first is entered or refused, as if it had come in the next batch (``AGAIN``).
+        seen: set[str] = set()
+        for i, p in enumerate(outcomes):
+            if isinstance(p, _Pending):
+                if seen.intersection(p.digests):
+                    outcomes[i] = AGAIN
+                seen.update(p.digests)
+        pending = [p for p in outcomes if isinstance(p, _Pending)]
+        verdicts = self._verify_games([(p.replay, p.digests[0]) for p in pending])
+        judged: dict[int, dict[str, object] | Checked | BaseException] = {}
+        for p, verdict in zip(pending, verdicts, strict=True):
+            if isinstance(verdict, BaseException):
+                judged[id(p)] = verdict
+                continue
+            ok, recomputed = verdict
+            r = p.replay.result
+            judged[id(p)] = Checked(p.player, p.replay.with_player(p.player.name), p.digests) if ok else \
+                RefusedError(422, f"the replay does not reproduce its score (recorded {r.score}, it replays to "
+                                  f"{recomputed.score}): not entered")
+        return [judged[id(o)] if isinstance(o, _Pending) else o for o in outcomes]
+
+    def _read(self, token: str | None, data: bytes) -> dict[str, object] | _Pending:
+        """One hand-in up to its verification: the checks that cost nothing first (the token, a closed
+        class), then the replay read once, its work bounded, its rules and seed, its identity computed once
+        and looked up; a lab run is kept here (its own verification). Raises RefusedError."""
         player = self.player(token)
         if self.roster.closed:
-            raise RefusedError(403, "the class is closed: no more games are taken (your replay stays on your machine)")
+            raise RefusedError(403, CLOSED)
         try:
             replay = Replay.from_bytes(data, "the replay")
         except DataFileError as exc:
@@ -215,7 +334,7 @@ class Clerk:
             return self._lab_run(player, replay)
         return self._game(player, replay)
 
-    def _game(self, player: Player, replay: Replay) -> dict[str, object] | Checked:
+    def _game(self, player: Player, replay: Replay) -> dict[str, object] | _Pending:
         r = replay.result
         if not replay.complete:
             raise RefusedError(400, "the game stopped before its clock ran out: only a whole game is handed in")
@@ -224,31 +343,74 @@ class Clerk:
             raise RefusedError(400, f"this class plays the standard game of seed {self.roster.seed}; this game is "
                                f"{rules} rules, seed {r.seed} (play it with --join to get the class's game)")
         # An entry keeps the digest of the identity version that entered it: the game is looked up by each.
+        # Computed here once and carried to the table's entry (``Checked.digests``).
         digests = game_digests(replay)
         twin = next((self.games[d] for d in digests if d in self.games), None)
-        if twin is not None:
+        if twin is not None:  # known: answered without re-simulating it
             if player_key(twin.name) == player_key(player.name):
                 return self._answer(twin, already=True)
             raise RefusedError(409, f"this game was already handed in by {twin.name}: a game counts once, whoever "
                                f"hands it in")
-        ok, recomputed = replay.verify()
-        if not ok:
-            raise RefusedError(422, f"the replay does not reproduce its score (recorded {r.score}, it replays to "
-                               f"{recomputed.score}): not entered")
-        return Checked(player, replay.with_player(player.name), digests)
+        return _Pending(player, replay, digests)
+
+    def _verify_games(self, games: Sequence[tuple[Replay, str]]) -> list[tuple[bool, GameResult] | BaseException]:
+        """``replay.verify()`` of each game, or the exception it raised: the games together in the batch's
+        lanes where they can share them, the rest (and any game whose batch failed) one at a time.
+
+        The batch plays every game to its end; ``verify`` stops once the game has scored more hits or resets
+        than claimed, and its refusal names the score there. A game the batch finds past its claim is
+        therefore verified again alone (rare: a forgery that hides hits or resets), so every verdict and
+        every message is the single session's. A forged game seen before is not played again: its result
+        is remembered by its identity (``_recomputed``, bounded)."""
+        replays = [replay for replay, _ in games]
+        results: list[GameResult | None] = [None] * len(replays)
+        todo: list[int] = []
+        for i, (replay, digest) in enumerate(games):
+            known = self._recomputed.get(digest)
+            if known is not None:
+                results[i] = known
+            elif batchable(replay):
+                todo.append(i)
+        if todo:
+            with contextlib.suppress(Exception):  # e.g. one game's blow-up stopped the batch: each alone below
+                got = replay_many([replays[i].config for i in todo], [replays[i].timeline for i in todo],
+                                  [replays[i].result.steps for i in todo], exact=True)
+                for i, result in zip(todo, got, strict=True):
+                    results[i] = result
+        verdicts: list[tuple[bool, GameResult] | BaseException] = []
+        for (replay, digest), result in zip(games, results, strict=True):
+            claimed = result is not None and same_outcome(result, replay.result)
+            if result is None or (not claimed and (result.hits > replay.result.hits
+                                                   or result.resets > replay.result.resets)):
+                try:
+                    verdicts.append(replay.verify())
+                except Exception as exc:  # the single session's exception is this game's answer
+                    verdicts.append(exc)
+                continue
+            if not claimed:
+                self._remember(digest, result)
+            verdicts.append((claimed, result))
+        return verdicts
+
+    def _remember(self, digest: str, result: GameResult) -> None:
+        self._recomputed[digest] = result
+        self._recomputed.move_to_end(digest)
+        while len(self._recomputed) > REMEMBERED_FORGERIES:
+            self._recomputed.popitem(last=False)
 
     def enter(self, checked: Sequence[Checked]) -> list[dict[str, object] | RefusedError]:
         """Enter checked games together (one table write for all: a burst of a class costs one write, not
         thirty); each game's answer, or why it was not entered. Durable on disk before this returns."""
         try:
-            results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked])
+            results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked], journal=True)
         except (ValueError, UserError) as exc:  # the table could not be written: none was entered
             refusal = RefusedError(503, f"the class's table could not take the game: {exc}")
             return [refusal for _ in checked]
         answers: list[dict[str, object] | RefusedError] = []
         fresh = [r for r in results if isinstance(r, ScoreEntry)]
-        self.entries.extend(fresh)
-        self.entries.sort(key=sort_key)
+        for entry in fresh:
+            bisect.insort(self.entries, entry, key=sort_key)
+            self.boards[entry.program].add(entry)
         for c, result in zip(checked, results, strict=True):
             if isinstance(result, ScoreEntry):
                 self.games[c.digests[0]] = result
@@ -270,25 +432,27 @@ class Clerk:
 
     def _answer(self, entry: ScoreEntry, already: bool = False) -> dict[str, object]:
         """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""
-        rows = self._rows(entry.program)
-        key = player_key(entry.name)
-        rank = next(i for i, row in enumerate(rows, 1) if player_key(row.name) == key)
-        best = rows[rank - 1].best
+        board = self.boards[entry.program]
+        rank = board.rank(player_key(entry.name))
+        row = board.row(rank)
+        best = row.best
         where = "in the class" if not entry.program else "among the programs"
         if best.id == entry.id:
-            note = "first game" if rows[rank - 1].games == 1 else "new personal best"
-            line = f"{ordinal(rank)} of {len(rows)} {where} (your best so far)"
+            note = "first game" if row.games == 1 else "new personal best"
+            line = f"{ordinal(rank)} of {len(board)} {where} (your best so far)"
         else:
             note = f"best {best.score}"
-            line = f"score {entry.score}; your best, {best.score}, is {ordinal(rank)} of {len(rows)} {where}"
-        top = [[i, row.name, row.best.score] for i, row in enumerate(rows, 1)
-               if (i <= 10 and not self.roster.is_hidden(row.name)) or i == rank]
+            line = f"score {entry.score}; your best, {best.score}, is {ordinal(rank)} of {len(board)} {where}"
+        top = [[i, r.name, r.best.score] for i, r in enumerate(board.rows(10), 1)
+               if not self.roster.is_hidden(r.name) or i == rank]
+        if rank > 10:
+            top.append([rank, row.name, best.score])
         return {"ok": True, "already": already, "name": entry.name, "score": entry.score, "rank": rank,
-                "of": len(rows), "best": best.score, "list": "programs" if entry.program else "students",
+                "of": len(board), "best": best.score, "list": "programs" if entry.program else "students",
                 "note": note, "top": top, "message": ("already handed in: " if already else "handed in: ") + line}
 
-    def _rows(self, programs: bool) -> list:
-        return one_row_per_player(e for e in self.entries if e.program == programs)
+    def _rows(self, programs: bool) -> Iterator[PlayerRow]:
+        return self.boards[programs].each()
 
     # ------------------------------------------------------------------ the lab
     def _lab_run(self, player: Player, replay: Replay) -> dict[str, object]:

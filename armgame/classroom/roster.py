@@ -105,11 +105,12 @@ class Roster:
     round: dict | None = None
 
     def __post_init__(self) -> None:
-        self._index()
+        self.reindex()
 
-    def _index(self) -> None:
+    def reindex(self) -> None:
         """The lookups the server's event loop makes while the clerk's thread changes the roster: rebuilt
-        whole and swapped in, so a reader on another thread sees the old index or the new, never half."""
+        whole and swapped in, so a reader on another thread sees the old index or the new, never half. Every
+        change through ``add``, ``remove`` and ``changed`` does it; call it after filling ``players`` directly."""
         self.by_token = {p.token_sha256: key for key, p in self.players.items()}
         self.by_skeleton = {s: key for key, p in self.players.items() for s in skeletons(p.name)}
 
@@ -122,7 +123,7 @@ class Roster:
             del self.players[key]
             raise
         finally:
-            self._index()
+            self.reindex()
 
     def remove(self, key: str) -> Player:
         """The player under ``key`` taken out, saved; nothing changed if the save fails."""
@@ -133,7 +134,7 @@ class Roster:
             self.players[key] = player
             raise
         finally:
-            self._index()
+            self.reindex()
         return player
 
     def changed(self, **values: object) -> None:
@@ -150,7 +151,7 @@ class Roster:
             self.hidden = before_hidden
             raise
         finally:
-            self._index()
+            self.reindex()
 
     @property
     def path(self) -> Path:

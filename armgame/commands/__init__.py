@@ -9,6 +9,7 @@ that does the same without one, which the CLI prints when no display can be open
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shlex
 from collections.abc import Sequence
 
@@ -37,3 +38,25 @@ def read_lab_replays() -> None:
     from ..lab.record import register
 
     register()
+
+
+def read_env_games() -> None:
+    """Make a Gymnasium env's game readable here (``armgame.records.env_game``: its variant and muscle levels);
+    the commands that verify or replay games call it. The class and the table never do: a replay with a task
+    section is never a ranked game, and an unregistered kind is refused in one line."""
+    from ..records.env_game import register
+    from ..records.replay import register_task
+
+    register()
+    with contextlib.suppress(ValueError):  # armgame.env.record registered its own, which reads the same class
+        register_task("centre-out-env", _read_centre_out)
+
+
+def _read_centre_out(section: object, config: object, last_step: int) -> object:
+    """A CenterOut env's section, read by ``armgame.env.record`` (above the lab): it needs Gymnasium's extra."""
+    try:
+        from ..env.record import CenterOutEnvTask
+    except ImportError as exc:
+        raise ValueError(f"a CenterOut env's episode: verifying it needs Gymnasium (pip install 'armgame[gym]'): "
+                         f"{exc}") from None
+    return CenterOutEnvTask.from_dict(section, config, last_step)  # type: ignore[arg-type]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
-from . import read_lab_replays
+from . import read_env_games, read_lab_replays
 from .verify import work_arg
 
 
@@ -40,6 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from ..records.storage import user_path
 
     read_lab_replays()
+    read_env_games()
     replay = Replay.load(user_path(args.file, "FILE"))
     if args.headless:
         from .. import limits  # read now: the budget is the one verify spends
@@ -82,6 +83,9 @@ def _watch(replay, args: argparse.Namespace):
     except ImportError as exc:
         raise UserError(f"the window needs pygame-ce: {exc}") from None
     settings, path = window_settings(args)
+    if replay.task is not None and hasattr(replay.task, "about"):
+        raise UserError(f"{args.file}: a Gymnasium env's game ({replay.task.about()}): the window plays the game "
+                        f"itself, not its variant; --headless replays it, armgame verify checks it")
     if replay.task is not None:  # a lab run is watched on its own task's session and window
         return _watch_lab(replay, args, settings)
     when = replay.date[:16].replace("T", " ") if replay.date else "date unknown"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..words import plural
-from . import read_lab_replays
+from . import read_env_games, read_lab_replays
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -43,6 +43,7 @@ def run(args: argparse.Namespace) -> int:
     from ..records.storage import user_path
 
     read_lab_replays()
+    read_env_games()
     path = user_path(args.file, "FILE")
     limit = getattr(args, "max_work", None)
     if path.is_dir() and not (path / TABLE_NAME).exists() and not (path / TABLE_NAME).is_symlink():
@@ -144,7 +145,9 @@ def _report(path, replay, ok: bool, got) -> int:
     r = replay.result
     who = f"{replay.player}'s game" if replay.player else "game"
     about = f"{who} ({ruleset_name(replay.config)} rules, {replay.driven}, seed {r.seed}, {r.duration:g} s)"
-    if replay.task is not None:  # a lab run: its trials were compared too
+    if replay.task is not None and hasattr(replay.task, "about"):  # a Gymnasium env's game: its variant replayed
+        about = f"{who} ({replay.task.about()}, {replay.driven}, seed {r.seed}, {r.duration:g} s)"
+    elif replay.task is not None:  # a lab run: its trials were compared too
         who = f"{replay.player}'s lab run" if replay.player else "lab run"
         about = (f"{who} ({replay.task.protocol.name}, {replay.driven}, seed {r.seed}, "
                  f"{plural(len(replay.task.trials), 'trial')})")

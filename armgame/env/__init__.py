@@ -15,8 +15,10 @@ Importing this package registers, with ``gymnasium.register``:
 * the suite (``suite``): ``armgame/ReachHold-v1``, ``ReachNoisy-v1``, ``ReachDelay-v1``,
   ``ReachField-v1``, ``ReachHard-v1`` (Reach-v1 with a dwell, motor noise, a feedback delay, a force
   field, and all four on smaller targets: ``variants``) and ``armgame/CenterOutHold-v1`` (the go cue
-  waits for a stop at home), each with a ``Continuous`` twin; ``evaluation.evaluate`` scores a policy
-  on the held-out evaluation seeds against the reference scores (``references``);
+  waits for a stop at home), each with a ``Continuous`` twin; ``evaluate`` (``evaluation.evaluate``,
+  exported here) scores a policy on the held-out evaluation seeds against the reference scores
+  (``references``), ``aggregate_runs`` summarises training seeds (IQM, stratified bootstrap:
+  ``statistics``), and ``record.replay_of`` writes any env's game as a replay ``armgame verify`` checks;
 * ``armgame/Reach-v0``, ``armgame/ReachContinuous-v0``, ``armgame/CenterOut-v0``,
   ``armgame/CenterOutContinuous-v0``: the first versions, unchanged (``reach``, ``center_out``).
 
@@ -40,7 +42,11 @@ from __future__ import annotations
 
 import gymnasium
 
+from .evaluation import Evaluation, aggregate_runs, evaluate
 from .suite import CENTER_OUT_SUITE, SUITE
+
+__all__ = ["CENTER_OUT_IDS", "CENTER_OUT_SUITE", "CENTER_OUT_V1_IDS", "ENV_IDS", "SUITE", "V1_IDS", "Evaluation",
+           "aggregate_runs", "evaluate"]
 
 ENV_IDS = ("armgame/Reach-v0", "armgame/ReachContinuous-v0")
 CENTER_OUT_IDS = ("armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0")

@@ -10,6 +10,17 @@ normalised score: 0 for the random policy, 1 for the model bot.
 The same policy, id, seeds and arguments give the same result, bit for bit: every game is reset
 with its seed and a policy that samples (``"random"``) samples from a generator seeded by it.
 
+**Every game starts with a fresh policy.** A game's result must not depend on the games played before
+it, or the score of a seed would depend on where it stands in the list. The game's bots are made anew for
+each game (their plans, their memory of the last target and their own clocks are a game's, not a
+policy's); a policy of your own that keeps state between steps gets its ``reset()`` called before each
+game, if it has one (``armgame.env.policies``' bots have one), or pass ``policy_factory``, called once a
+game. (Until this was so, CenterOutHold-v1's naive bot scored 0 on seed 7,000,002 after another game and
+1 hit alone: its clock ran on from one game into the next.)
+
+Several training seeds of one algorithm are summarised with ``aggregate_runs``: the interquartile mean
+of their scores over the ids, with a stratified bootstrap interval (``armgame.env.statistics``).
+
 >>> from armgame.env.evaluation import evaluate
 >>> result = evaluate("model", "armgame/Reach-v1", games=2, time_limit=5.0)
 >>> result.games, result.seeds
@@ -20,7 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -95,7 +106,8 @@ def mean_interval(values: Sequence[float]) -> tuple[float, float]:
 
 
 def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | None = None,
-             games: int = DEFAULT_GAMES, deterministic: bool = True, **env_kwargs: Any) -> Evaluation:
+             games: int = DEFAULT_GAMES, deterministic: bool = True,
+             policy_factory: Callable[[gym.Env], Policy] | None = None, **env_kwargs: Any) -> Evaluation:
     """Play ``games`` whole games of ``env_id`` with ``policy`` and measure its hits.
 
     ``policy``: ``"random"`` (the action space sampled, seeded by each game's seed), ``"naive"`` or
@@ -104,6 +116,10 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     game seeds (default: the first ``games`` evaluation seeds). ``env_kwargs`` go to
     ``gymnasium.make`` (e.g. ``time_limit``); the normalised score is given only for the id's own
     arguments, those its reference scores were measured with.
+
+    Every game gets a fresh policy: the bots are made anew, a policy with a ``reset()`` method has it
+    called before each game, and ``policy_factory(env)`` (then ``policy`` only names it) makes a new
+    policy for each game.
     """
     if seeds is None:
         if isinstance(games, bool) or not isinstance(games, int) or not 1 <= games <= min(MAX_GAMES,
@@ -113,25 +129,39 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     seeds = tuple(int(s) for s in seeds)
     if not 1 <= len(seeds) <= MAX_GAMES:
         raise EnvArgumentError(f"seeds must hold 1 to {MAX_GAMES} game seeds, got {len(seeds)}")
-    import armgame.env  # noqa: F401  (registers the ids)
-
-    if not isinstance(policy, str) and hasattr(policy, "predict"):
+    if policy_factory is not None and not callable(policy_factory):
+        raise EnvArgumentError(f"policy_factory must be a callable env -> policy, got {policy_factory!r}")
+    if policy_factory is None and not isinstance(policy, str) and hasattr(policy, "predict"):
         name = type(policy).__name__
         hits, scores, minutes = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
     else:
-        name, hits, scores, minutes = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs)
+        name, hits, scores, minutes = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs,
+                                                       policy_factory)
     normalised = None if env_kwargs else normalised_score(env_id, float(np.mean(hits)))
     return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised)
 
 
 def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
-                     env_kwargs: dict[str, Any]) -> tuple[str, tuple[int, ...], tuple[int, ...], float]:
-    """The games one after another in one single env: (the policy's name, hits, scores, minutes a game)."""
+                     env_kwargs: dict[str, Any], policy_factory: Callable[[gym.Env], Policy] | None = None,
+                     ) -> tuple[str, tuple[int, ...], tuple[int, ...], float]:
+    """The games one after another in one single env: (the policy's name, hits, scores, minutes a game).
+
+    The policy is fresh for each game (``evaluate``): made anew by ``policy_factory`` or, for a bot's name,
+    by ``bot_policy``; else its ``reset()``, where it has one, is called before the game."""
     env = gym.make(env_id, **env_kwargs)
     try:
-        act, name = _policy(policy, env, deterministic)
+        if policy_factory is not None:
+            name = policy if isinstance(policy, str) else getattr(policy_factory, "__name__", "policy")
+        else:
+            act, name = _policy(policy, env, deterministic)
         hits, scores, durations = [], [], []
         for seed in seeds:
+            if policy_factory is not None:
+                act = _policy(policy_factory(env), env, deterministic)[0]
+            elif isinstance(policy, str) and policy in ("naive", "model"):
+                act = _policy(policy, env, deterministic)[0]  # a new bot: nothing of the last game in it
+            elif callable(getattr(policy, "reset", None)):
+                policy.reset()
             observation, info = env.reset(seed=seed)
             if name == "random":
                 env.action_space.seed(seed)
@@ -232,3 +262,65 @@ def normalised_score(env_id: str, mean_hits: float) -> float | None:
         return None
     low, high = reference["random"], reference["model"]
     return (mean_hits - low) / (high - low) if high != low else None
+
+
+@dataclasses.dataclass(frozen=True)
+class Aggregate:
+    """Several training seeds' scores over several ids, summarised (``aggregate_runs``).
+
+    ``scores``: one row a training seed, one column an id (``env_ids``' order); each entry that run's
+    normalised score on the id (``normalised``) or its mean hits. ``iqm``, ``mean`` and ``median`` are
+    (point, 95 % low, 95 % high), the intervals stratified bootstrap ones (``armgame.env.statistics``)."""
+
+    env_ids: tuple[str, ...]
+    scores: np.ndarray
+    normalised: bool
+    iqm: tuple[float, float, float]
+    mean: tuple[float, float, float]
+    median: tuple[float, float, float]
+
+    @property
+    def runs(self) -> int:
+        return int(self.scores.shape[0])
+
+    def summary(self) -> str:
+        what = "normalised score" if self.normalised else "hits a game"
+        point, low, high = self.iqm
+        return (f"IQM {what} {point:.2f} (95% stratified bootstrap CI {low:.2f} to {high:.2f}) over {self.runs} "
+                f"training seeds x {len(self.env_ids)} ids")
+
+
+def aggregate_runs(runs: Mapping[str, Sequence[Evaluation | float]], *, normalise: bool = True,
+                   reps: int = 50_000, seed: int = 0) -> Aggregate:
+    """Summarise an algorithm's training seeds over ids: IQM, mean and median with stratified bootstrap intervals.
+
+    ``runs`` maps each id to one score per training seed, in the same seeds' order for every id: an
+    ``Evaluation`` (its mean hits) or a number of mean hits. ``normalise``: score each by ``normalised_score``
+    (every id needs reference scores), else by hits. Report the IQM and its interval, the number of
+    training seeds and the budget in env steps (Agarwal et al. 2021)."""
+    if not runs:
+        raise EnvArgumentError("aggregate_runs needs at least one id's runs")
+    counts = {len(values) for values in runs.values()}
+    if len(counts) != 1 or 0 in counts:
+        raise EnvArgumentError(f"every id needs the same number of runs, at least 1, got {sorted(counts)}")
+    env_ids = tuple(runs)
+    columns = []
+    for env_id in env_ids:
+        column = []
+        for value in runs[env_id]:
+            hits = value.mean_hits if isinstance(value, Evaluation) else float(value)
+            if normalise:
+                score = normalised_score(env_id, hits)
+                if score is None:
+                    raise EnvArgumentError(f"{env_id} has no reference scores to normalise by: normalise=False")
+                hits = score
+            column.append(hits)
+        columns.append(column)
+    from .statistics import iqm, mean_of_tasks, median_of_tasks, stratified_bootstrap_ci
+
+    table = np.array(columns, dtype=np.float64).T
+    summaries = []
+    for statistic in (iqm, mean_of_tasks, median_of_tasks):
+        low, high = stratified_bootstrap_ci(table, statistic, reps=reps, seed=seed)
+        summaries.append((float(statistic(table)), low, high))  # type: ignore[arg-type]
+    return Aggregate(env_ids, table, normalise, *summaries)

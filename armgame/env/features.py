@@ -38,7 +38,9 @@ from ..physics.params import TwoJointParams
 from .errors import EnvArgumentError
 
 try:
-    from . import _cvector  # armgame/env/_cvector.c, built by pip install where a C compiler exists
+    # armgame/env/_cvector.c, built by pip install where a C compiler exists. Imported by its module's name, not
+    # ``from . import``, which imports the package first: the package imports evaluate, which imports this.
+    import armgame.env._cvector as _cvector
 except ImportError:
     _cvector = None
 if getattr(_cvector, "VERSION", None) != 1:  # not built, or built from another _cvector.c: its calling convention

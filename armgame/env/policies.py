@@ -109,6 +109,12 @@ class BotPolicy:
         self._seen: _SeenGame | None = None
         self._time_left = -1.0
 
+    def reset(self) -> None:
+        """Forget the game under way: the next observation starts a new game whatever its clock says
+        (``armgame.env.evaluate`` calls it before every game)."""
+        self._seen = None
+        self._time_left = -1.0
+
     def _read(self, observation: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...], float, float, float]:
         """(joint state, activations, target x, target y, time left in s) from an observation of the env's version."""
         values = np.asarray(observation, dtype=np.float64).tolist()
@@ -169,10 +175,17 @@ class CenterOutV1BotPolicy:
         self.protocol = base.protocol
         self.config: GameConfig = lab_config(self.protocol, 0)
         self.decision_time = base.decision_steps * self.config.dt
-        self.bot = ReachingBot(bot, interaction=bot == "model", control_period=self.decision_time)
+        self.name = bot
         self.home = hand_and_velocity(self.config.arm, *self.config.start_posture, 0.0, 0.0)[:2]
+        self.reset()
+
+    def reset(self) -> None:
+        """A new episode: a new bot, its own clock from zero (``armgame.env.evaluate`` calls it before every
+        game; a bot whose clock ran on from the last episode held home too long or too short)."""
+        self.bot = ReachingBot(self.name, interaction=self.name == "model", control_period=self.decision_time)
         self._muscles = MuscleSet(self.config.muscles, self.config.dt)
-        self._seen = _SeenGame(self.config, self._muscles, Target(*self.home, self.protocol.home_radius))
+        self._seen = _SeenGame(dataclasses.replace(self.config), self._muscles,
+                               Target(*self.home, self.protocol.home_radius))
         self._decisions = 0
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:

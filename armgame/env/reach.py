@@ -89,6 +89,12 @@ class ReachSettings:
                    hit_bonus, check_dtype(observation_dtype), variant or ReachVariant())
 
     @property
+    def joint_speed_bound(self) -> float:
+        """Either joint's speed bound (rad/s) for these settings: the arm's energy bound with the muscles as
+        strong as the variant's noise can make them (a field's game is held to it by the variant's guard)."""
+        return speed_bound(self.variant.bound_config(self.config))
+
+    @property
     def decision_time(self) -> float:
         """Seconds of game time per env step."""
         return self.decision_steps * self.config.dt
@@ -114,10 +120,9 @@ class ReachSettings:
 
     def observation_space(self) -> spaces.Box:
         if self.version:
-            variant = self.variant
-            # A viscous field's symmetric part does work on the arm: no energy bound holds under it.
-            joint_speed = math.inf if variant.field == "viscous" else speed_bound(variant.bound_config(self.config))
-            low, high = reach_bounds_v1(self.config, joint_speed)
+            # A viscous field's symmetric part does work on the arm, so no energy bound holds under it: its game
+            # stops at this bound instead (armgame.game.variant's guard), so the bound is declared all the same.
+            low, high = reach_bounds_v1(self.config, self.joint_speed_bound)
             dtype = np.dtype(self.observation_dtype)
             return spaces.Box(low.astype(dtype), high.astype(dtype), dtype=dtype)
         low, high = observation_bounds(self.config)
@@ -331,15 +336,22 @@ class ReachEnv(SessionEnv):
         else:
             self._press_keys(action, self.action_space.n)
         self._before_advance(session)
-        session.advance(self.decision_steps)
+        stopped = self._advance(session)
         reward = self._reward(board.hits - hits, board.resets - resets)
         if self.render_mode == "human":
             self.render()
+        if stopped:  # the game ended before its clock: terminated, with the reason in one line
+            return self._observation(), reward, True, False, self._info() | stopped
         return self._observation(), reward, False, session.over, self._info()
 
     # --------------------------------------------------------------- internals
     def _new_session(self, config: GameConfig) -> GameSession:
         return GameSession(config)
+
+    def _advance(self, session: GameSession) -> dict[str, Any]:
+        """Run the decision's physics steps; what stopped the game early, for ``info`` (v0: nothing does)."""
+        session.advance(self.decision_steps)
+        return {}
 
     def _before_advance(self, session: GameSession) -> None:
         """What a variant does to the game before each decision's physics steps (v0: nothing)."""

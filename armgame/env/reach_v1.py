@@ -16,10 +16,11 @@ import numpy as np
 
 from ..game.rules import GameConfig
 from ..game.session import GameSession
+from ..game.variant import GameVariant, MuscleNoise, RunawayError
 from .errors import EnvArgumentError
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, hand_and_velocity
 from .reach import DEFAULT_DECISION_STEPS, ReachEnv, ReachSettings, wrap_angle
-from .variants import DelayedObservations, MuscleNoise, ReachVariant
+from .variants import DelayedObservations, ReachVariant
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
                         "to_target_x", "to_target_y", "time_left_fraction")
@@ -117,7 +118,8 @@ class ReachV1Env(ReachEnv):
       ``motor_noise`` (0 to 1: signal-dependent noise, each muscle's force times ``1 + n``,
       ``n`` of that s.d., correlated over 50 ms), ``observation_delay`` (env steps, 0 to 100),
       ``field`` (``"curl"`` or ``"viscous"``) with ``field_strength`` (curl: ``b`` in N s/m, -50 to
-      50; viscous: the lab's matrix times it; default 1), ``target_radius`` (m, 0.001 to 0.2;
+      50; viscous: the lab's matrix times it, -2 to 2; default 1; a field game whose joint speed passes
+      the declared bound stops, terminated, ``info["stopped"]`` saying why), ``target_radius`` (m, 0.001 to 0.2;
       default the game's 0.05). The suite's ids fix them: ``ReachHold-v1``, ``ReachNoisy-v1``,
       ``ReachDelay-v1``, ``ReachField-v1``, ``ReachHard-v1`` and their ``Continuous`` twins
       (``armgame.env.suite``).
@@ -150,6 +152,8 @@ class ReachV1Env(ReachEnv):
         self._edge = 0.0
         self._score = 0
         self._noise: MuscleNoise | None = None
+        #: Why the game stopped before its clock ran out (a field's runaway), or None.
+        self._stopped: str | None = None
         self._delayed = DelayedObservations(variant.observation_delay) if variant.observation_delay else None
 
     @property
@@ -172,13 +176,29 @@ class ReachV1Env(ReachEnv):
         return observation, reward, terminated, truncated, info
 
     def _new_session(self, config: GameConfig) -> GameSession:
-        variant = self.variant
-        if variant.plain:
+        self._stopped = None
+        game = self.game_variant
+        if game.plain:
+            self._noise = None
             return GameSession(config)
-        session = variant.session(config)
-        self._noise = MuscleNoise(variant.motor_noise, config.seed, self.decision_time, session) \
-            if variant.motor_noise else None
+        session = game.session(config)
+        self._noise = game.noise(config, session)
         return session
+
+    @property
+    def game_variant(self) -> GameVariant:
+        """The game's rules and physics of this env's variant, as its replay carries them (``armgame.env.record``)."""
+        s = self.settings
+        return self.variant.game_variant(s.config, s.decision_steps, s.joint_speed_bound)
+
+    def _advance(self, session: GameSession) -> dict[str, Any]:
+        """The decision's physics steps; a field's runaway ends the game where it began (``GameVariant``'s guard)."""
+        try:
+            session.advance(self.decision_steps)
+        except RunawayError as exc:
+            session.total_steps = session.steps  # the game is over here: its replay says so ("stopped")
+            self._stopped = str(exc)
+        return {} if self._stopped is None else {"stopped": self._stopped}
 
     def _before_advance(self, session: GameSession) -> None:
         if self._noise is not None:

@@ -7,9 +7,13 @@
 ``SyncVectorEnv`` of single envs for the harder tasks: the batch kernel steps only the game itself), so
 ``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they take ``Reach-v1``.
 
-``EVALUATION_SEEDS`` are game seeds no training example uses (``examples/`` train on seeds below
-``TRAINING_SEED_LIMIT``): ``armgame.env.evaluate`` plays them, so scores in different papers are
-scores on the same games.
+Three disjoint ranges of game seeds make the protocol (docs/programs.md, "The protocol"):
+
+* **training**: below ``TRAINING_SEED_LIMIT`` (10^9); the examples seed their games there;
+* **validation**: ``VALIDATION_SEEDS`` (10^9 + 10^6 to 10^9 + 2 10^6 - 1): what a training run watches
+  to choose a checkpoint, stop early or tune, so the test games never steer a choice;
+* **test**: ``EVALUATION_SEEDS`` (10^9 to 10^9 + 10^6 - 1): ``armgame.env.evaluate`` plays them, once a
+  run is over, so scores in different papers are scores on the same games.
 """
 
 from __future__ import annotations
@@ -40,12 +44,21 @@ CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
     "CenterOutHold": {"trial_start": "hold"},
 }
 
+#: The protocol these seeds, ``evaluate`` and ``aggregate_runs`` make (docs/programs.md, "The protocol"): name it
+#: in a paper. 1: three seed ranges, a fresh policy each game, normalised by random play (0) and the model bot
+#: (1). A score normalised by a ceiling controller instead will be protocol 2, once every id has one.
+PROTOCOL_VERSION = 1
+
 #: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
 EVALUATION_SEED_START = 10**9
 EVALUATION_SEED_COUNT = 10**6
 EVALUATION_SEEDS = range(EVALUATION_SEED_START, EVALUATION_SEED_START + EVALUATION_SEED_COUNT)
 #: Training examples (``examples/train_ppo.py``) seed their games below this.
 TRAINING_SEED_LIMIT = EVALUATION_SEED_START
+#: Game seeds for validation (a run's curve, early stopping, tuning): neither trained on nor the test games.
+VALIDATION_SEED_START = EVALUATION_SEED_START + EVALUATION_SEED_COUNT
+VALIDATION_SEED_COUNT = 10**6
+VALIDATION_SEEDS = range(VALIDATION_SEED_START, VALIDATION_SEED_START + VALIDATION_SEED_COUNT)
 
 
 def suite_ids() -> tuple[str, ...]:

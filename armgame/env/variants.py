@@ -17,12 +17,22 @@ and ``ReachHard-v1``, all four at once. What each does to the game:
   task's bookkeeping, not what the agent senses).
 * ``field`` (``"curl"`` or ``"viscous"``) and ``field_strength``: a force at the hand all game long,
   the lab's fields (``armgame.physics.loads``): the curl field ``F = b [[0, 1], [-1, 0]] v`` with
-  ``b = field_strength`` N s/m, or the lab's viscous matrix scaled by ``field_strength``.
+  ``b = field_strength`` N s/m (-50 to 50: it does no work, so the speed bound holds whatever ``b``), or
+  the lab's viscous matrix scaled by ``field_strength`` (-2 to 2, ``MAX_VISCOUS_STRENGTH``). The viscous
+  matrix's symmetric part feeds the arm energy (at some postures more than the joints' damping takes out
+  even at strength 1), so no bound is proven under it: from about 4 the arm runs away (issue 40 found
+  one game in three overflowing at 20, within the old range of 50). The range is what was measured
+  stable with margin (``benchmarks/field_range.py``: a policy that feeds the arm all the energy its
+  muscles can reaches 21.1 rad/s at strength 2 and 29.1 at 3, under the game's bound of 34.4), and a
+  guard keeps the declared speed bounds true beyond it: a game whose joint speed passes them stops,
+  terminated, ``info["stopped"]`` saying why in one line (``armgame.game.variant.RunawayError``).
 * ``target_radius`` (m): the game's targets smaller or larger (the game's 0.05 by default).
 
-A variant's game is not the game of ``armgame play``: with any of these on, the episode has no
-replay and its score is not comparable with a player's. The noise and the field run the physics
-in Python (about five times slower a step than the compiled loop); the others cost nothing.
+A variant's game is not the game of ``armgame play``, and its score is not comparable with a player's,
+but it is recorded all the same: ``armgame.env.record.replay_of(env)`` writes a replay whose task
+section carries the variant (``armgame.game.variant.GameVariant``), which ``armgame verify`` replays.
+The noise and the field run the physics in Python (about five times slower a step than the compiled
+loop); the others cost nothing.
 """
 
 from __future__ import annotations
@@ -35,20 +45,21 @@ from typing import Any
 import numpy as np
 
 from ..game.muscles import MuscleSpec
-from ..game.rules import DwellRules, GameConfig, GameRules
+from ..game.rules import GameConfig
 from ..game.session import GameSession
-from ..physics.integrators import Integrator
-from ..physics.loads import CurlField, Loads, ViscousField, loaded_arm
+from ..game.variant import NOISE_CORRELATION_TIME, NOISE_FACTOR_MAX, GameVariant, MuscleNoise
 from .errors import EnvArgumentError
 
+__all__ = ["FIELDS", "MAX_FIELD_STRENGTH", "MAX_VISCOUS_STRENGTH", "NOISE_CORRELATION_TIME", "NOISE_FACTOR_MAX",
+           "DelayedObservations", "MuscleNoise", "ReachVariant"]
+
 FIELDS = ("curl", "viscous")
-#: The motor noise's correlation time (s): a force held between decisions drifts rather than jitters.
-NOISE_CORRELATION_TIME = 0.05
-#: The largest factor noise puts on a muscle's force: the speed bounds are computed for it.
-NOISE_FACTOR_MAX = 2.0
 MAX_HOLD_TIME = 5.0
 MAX_OBSERVATION_DELAY = 100
+#: The curl field's ``b`` (N s/m) at most, either sign: it does no work, so any ``b`` keeps the speed bound.
 MAX_FIELD_STRENGTH = 50.0
+#: The viscous field's scale at most, either sign: what was measured stable, with margin (module docstring).
+MAX_VISCOUS_STRENGTH = 2.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -78,8 +89,10 @@ class ReachVariant:
             strength = 0.0
         else:
             default = DEFAULT_FIELD_STRENGTH[field]  # type: ignore[index]
-            strength = default if field_strength is None else _number(
-                "field_strength", field_strength, -MAX_FIELD_STRENGTH, MAX_FIELD_STRENGTH, "")
+            most = MAX_FIELD_STRENGTH if field == "curl" else MAX_VISCOUS_STRENGTH
+            unit = "N s/m" if field == "curl" else "(times the lab's viscous matrix; stronger runs away)"
+            strength = default if field_strength is None else _number("field_strength", field_strength, -most, most,
+                                                                       unit)
         return cls(hold, noise, int(observation_delay), field if strength != 0.0 else None, strength)  # type: ignore[arg-type]
 
     @property
@@ -90,15 +103,20 @@ class ReachVariant:
     def hold_steps(self, dt: float) -> int:
         return max(1, round(self.hold_time / dt))
 
-    def loads(self) -> Loads | None:
+    def game_variant(self, config: GameConfig, decision_steps: int, speed_limit: float = math.inf) -> GameVariant:
+        """The game's rules and physics of this variant for decisions of ``decision_steps`` physics steps: what
+        its replay carries (the field as its parameter, the viscous matrix itself). ``speed_limit``: the joint
+        speed bound the env declares (``reach.speed_bound``), which a game with a field stops at rather than
+        pass (``armgame.game.variant.RunawayError``)."""
+        parameter: Any = None
         if self.field == "curl":
-            return Loads(hand=CurlField(self.field_strength))
-        if self.field == "viscous":
+            parameter = self.field_strength
+        elif self.field == "viscous":
             from ..lab.protocol import VISCOUS_B  # the lab's matrix, once
 
-            return Loads(hand=ViscousField(tuple(tuple(self.field_strength * v for v in row)  # type: ignore[arg-type]
-                                                 for row in VISCOUS_B)))
-        return None
+            parameter = tuple(tuple(self.field_strength * v for v in row) for row in VISCOUS_B)
+        return GameVariant(self.hold_steps(config.dt) if self.hold_time else 0, self.motor_noise, decision_steps,
+                           self.field, parameter, speed_limit if self.field is not None else math.inf)
 
     def bound_config(self, config: GameConfig) -> GameConfig:
         """A config whose speed bound holds for this variant: the muscles as strong as noise can make them."""
@@ -108,16 +126,9 @@ class ReachVariant:
                                    m.rise_time, m.decay_time) for m in config.muscles)
         return dataclasses.replace(config, muscles=muscles)
 
-    def session(self, config: GameConfig) -> GameSession:
-        """The game of ``config`` with this variant's rules and physics."""
-        rules: GameRules | None = DwellRules(config, self.hold_steps(config.dt)) if self.hold_time else None
-        # Noise rescales the muscles' moments between decisions, which only the Python loop reads afresh.
-        session = GameSession(config, compiled=not self.motor_noise, rules=rules)
-        loads = self.loads()
-        if loads is not None:
-            # The session runs a step swapped in through its Python loop (the compiled one has no loads).
-            session._physics_step = Integrator(config.integrator, loaded_arm(session.model, loads)).step_components
-        return session
+    def session(self, config: GameConfig, decision_steps: int = 1, speed_limit: float = math.inf) -> GameSession:
+        """The game of ``config`` with this variant's rules and physics (its noise: ``game_variant().noise``)."""
+        return self.game_variant(config, decision_steps, speed_limit).session(config)
 
     def as_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -133,28 +144,6 @@ def _number(name: str, value: object, low: float, high: float, unit: str) -> flo
         raise EnvArgumentError(f"{name} must be a number from {low:g} to {high:g} {unit}".rstrip()
                                + f", got {value!r}")
     return float(value)
-
-
-class MuscleNoise:
-    """``ReachVariant.motor_noise`` on a session's muscles: ``apply`` before each decision's steps.
-
-    The factors scale each muscle's moments (its force at full activation), so the force noise is
-    proportional to the activation; ``ReachVariant.session`` gives a noisy game the Python loop, which reads
-    the moments afresh each call (the compiled loop packs them once)."""
-
-    def __init__(self, level: float, seed: int, decision_time: float, session: GameSession) -> None:
-        self.level = level
-        self._rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([seed, 0x5EED_0015E])))
-        self._keep = math.exp(-decision_time / NOISE_CORRELATION_TIME)
-        self._fresh = level * math.sqrt(1.0 - self._keep * self._keep)
-        # Started from its stationary spread, so the first decision is as noisy as the last.
-        self.state = self._rng.standard_normal(4) * level
-        self._moments = session.muscles.moments
-
-    def apply(self, session: GameSession) -> None:
-        self.state = self._keep * self.state + self._fresh * self._rng.standard_normal(4)
-        factors = np.clip(1.0 + self.state, 0.0, NOISE_FACTOR_MAX).tolist()
-        session.muscles.moments = tuple((f * s, f * e) for f, (s, e) in zip(factors, self._moments, strict=True))
 
 
 class DelayedObservations:

@@ -13,8 +13,10 @@ seed from a generator seeded ``s + i``, as the single env's ``reset()`` does). S
 equals N single envs: observations to the batch's round-off (``STATE_TOLERANCE``; the batches
 run the fast kernel, ``BatchGameSession(exact=False)``, which for games up to 60 s rounds
 differently from the single session: the compiled kernel's at any size, numpy's from 2,048 games;
-otherwise bit for bit), rewards, truncations and infos exactly (a hit decided within 1e-11 m of a
-target's edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``).
+otherwise bit for bit), truncations, infos and v0's rewards (whole hits) exactly (a hit decided within
+1e-11 m of a target's edge could differ: about 3e-8 a crossing, see ``armgame.game.batch``). v1's dense
+reward is a difference of distances computed from those states, so it agrees to the same round-off, not
+bit for bit: within ``REWARD_TOLERANCE`` at the default progress weight (tests/test_env_protocol.py).
 """
 
 from __future__ import annotations
@@ -411,6 +413,11 @@ class ReachV1VectorEnv(ReachVectorEnv):
             self._measure(part, batch, obs, None)
         return obs
 
+
+#: How far Reach-v1's batched dense reward may lie from the single env's at the default progress weight
+#: (10 per metre): the weight times the hands' round-off, which the states' (``STATE_TOLERANCE``, 1e-10)
+#: bounds, with room to spare.
+REWARD_TOLERANCE = 1e-9
 
 #: Below this many games, ``gymnasium.make_vec`` of a Reach id steps single envs (``SingleEnvsVectorEnv``):
 #: a game's compiled loop costs less than a batch's fixed numpy work a step (benchmarks/env_speed.py: the

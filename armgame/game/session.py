@@ -84,6 +84,15 @@ class InputEvent:
     action: str
 
 
+@dataclass(frozen=True)
+class LevelEvent:
+    """Muscle levels (0 to 1, one a muscle) commanded before physics step ``step``: a program's continuous action,
+    kept in ``GameSession.level_events`` so that its game can be replayed (``armgame.game.variant``)."""
+
+    step: int
+    levels: tuple[float, ...]
+
+
 class NonFiniteStateError(UserError):
     """The arm's state overflowed: the configuration's physics blows up at this step."""
 
@@ -132,6 +141,10 @@ class GameSession:
         self.previous_state = self.state
         self.held = [False] * len(self.muscles.keys)
         self.timeline: list[InputEvent] = []
+        #: The continuous actions that changed a muscle's command (``set_muscle_levels``), in order; at most
+        #: ``MAX_EVENTS`` (``level_events_overflow`` tells when more came: that game cannot be replayed).
+        self.level_events: list[LevelEvent] = []
+        self.level_events_overflow = False
         self.event_limit_reached = False
 
     # ------------------------------------------------------------------ queries
@@ -194,6 +207,7 @@ class GameSession:
         The continuous counterpart of the muscle keys, for programs (Gymnasium's continuous
         reach): not recorded in the key timeline, ignored after the end, and it leaves the
         keys' held state alone. Levels 0 and 1 act exactly as releasing and pressing a key.
+        A call that changes a muscle's command (its goal or rate) is kept in ``level_events``.
         """
         if self.over:
             return
@@ -203,8 +217,17 @@ class GameSession:
         for i, level in enumerate(values):  # check all before changing any
             if not 0.0 <= level <= 1.0:
                 raise MuscleLevelError(f"muscle level {i} must be from 0 to 1, got {level!r}")
+        muscles = self.muscles
+        before = (list(muscles.goal), list(muscles.rate))
         for i, level in enumerate(values):
-            self.muscles.set_level(i, level)
+            muscles.set_level(i, level)
+        # A call that changes nothing (the same levels again, the activation on the same side) is not kept:
+        # goal and rate are all set_level changes, so replaying the kept calls gives the same commands.
+        if (muscles.goal, muscles.rate) != before:
+            if len(self.level_events) < MAX_EVENTS:
+                self.level_events.append(LevelEvent(self.steps, tuple(values)))
+            else:
+                self.level_events_overflow = True
 
     def _compiled_loop(self) -> tuple[bytes, int, object] | None:
         """(params, mode, the step it replaces) for ``_ckernel.game_steps``, or None where it cannot run."""

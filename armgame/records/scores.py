@@ -143,6 +143,7 @@ class ScoreTable(TableFile, TableChecks):
         if data is None:
             return [], None
         entries, damage, head = _parse(data, self._replay_backs())
+        entries, _, damage = self._with_journal(entries, damage)
         entries, self._seed, self.notes = self._as_recorded(entries, head)
         return entries, damage
 
@@ -250,14 +251,16 @@ class ScoreTable(TableFile, TableChecks):
             later = shlex.join(["armgame", "scores", "--scores", str(self.folder), "--add", str(path)])
             raise TableBusyError(f"{exc}; your game's replay is kept as {path}: enter it later with {later}") from None
 
-    def add_many(self, replays: Sequence[Replay], digests: Sequence[Sequence[str]] | None = None
-                 ) -> list[ScoreEntry | ValueError]:
+    def add_many(self, replays: Sequence[Replay], digests: Sequence[Sequence[str]] | None = None,
+                 journal: bool = False) -> list[ScoreEntry | ValueError]:
         """``add`` for many games at once, for a server taking a class's games: their replays written with
         one folder fsync, the table read and written once under the lock. Returns, for each game, its
         entry or the ValueError (a ``TableError`` for a game already in) that kept it out; raises
         ``TableError`` (busy, over a limit, not a safe place) with none entered. ``digests``: each game's
         ``identity.game_digests``, where the caller computed them already (a quarter of a class server's
-        work was computing them again)."""
+        work was computing them again). ``journal``: the entries are appended to the table's journal, not
+        written into a whole new table (``tablefile``: what a server taking many games a second does; durable
+        alike, and its cost does not grow with the table)."""
         results: list[tuple[ScoreEntry, frozenset[str]] | ValueError] = []
         files: dict[str, bytes] = {}
         for i, replay in enumerate(replays):
@@ -274,7 +277,7 @@ class ScoreTable(TableFile, TableChecks):
         atomic_write_many([(self.replays / name, data) for name, data in files.items()], "replay")
         entries = [r for r in results if not isinstance(r, ValueError)]
         with self._locked():
-            entered = iter(self._enter_many(entries))
+            entered = iter(self._append(entries) if journal else self._enter_many(entries))
         return [r if isinstance(r, ValueError) else next(entered) for r in results]
 
     def new(self, seed: int) -> None:

@@ -18,6 +18,18 @@ temporary file in the same folder, fsynced and renamed over the old one
 (``armgame.records.storage``): readers need no lock, since they always see a whole table,
 old or new.
 
+The journal: a server that takes a class's games (``ScoreTable.add_many(..., journal=True)``) does not
+rewrite the whole table for each game, which cost it more with every entry. Under the same lock it appends
+each new entry as one line to ``scores.journal`` beside the table and fsyncs it (and the folder, when the
+journal is new) before it answers, so what it acknowledged survives a kill as the table's own write does.
+Every reader reads the table and then the journal's lines; a last line without its newline is a write that
+a kill cut off (never acknowledged: left out, and cut off by the next append). The next whole write of the
+table (another ``add``, or ``compact``, which the class server runs at its start and its stop) takes the
+journal's entries into ``scores.json``, and only then removes the journal: a kill in between leaves entries
+in both, which are one entry (one id) to every reader. The journal is only appended to a clean table
+(no damage, no planted counter or seed, every entry numbered); otherwise the whole table is written, which
+repairs or sets aside what it must, as before.
+
 Trust: the table is parsed as data with a schema check of every field. A damaged table
 (truncated, not JSON, an entry failing its checks) is never overwritten silently: the next
 write first copies its bytes to ``scores.json.corrupt-<UTC time>``, then writes the new
@@ -45,6 +57,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ..errors import UserError
+from ..files import _BINARY, _CLOEXEC, _NOFOLLOW
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
 from ..words import plural
 from .entry import _COUNT_MAX, _OPTIONAL, _SEED_MAX, ScoreEntry, entry_order, sort_key
@@ -58,6 +71,7 @@ from .storage import (
     check_keys,
     check_path_length,
     copy_aside,
+    fsync_folder,
     open_regular,
     parse_json,
     read_limited,
@@ -65,6 +79,7 @@ from .storage import (
 from .teacher import TeacherRecord
 
 TABLE_NAME = "scores.json"
+JOURNAL_NAME = "scores.journal"
 LOCK_NAME = "scores.lock"
 REPLAYS_DIR = "replays"
 FORMAT = "armgame-scores"
@@ -108,6 +123,7 @@ class TableFile:
     def __init__(self, folder: Path, warn: Callable[[str], None], records: Path | None = None) -> None:
         self.folder = Path(folder)
         self.path = self.folder / TABLE_NAME
+        self.journal_path = self.folder / JOURNAL_NAME
         self.lock_path = self.folder / LOCK_NAME
         #: The lock file's permissions: everyone's for a table classmates share, the owner's for a live class's.
         self.lock_mode = 0o666
@@ -115,6 +131,7 @@ class TableFile:
         self.warn = warn
         self.record = TeacherRecord(self.folder, records, warn)
         self._seed: int | None = None
+        self._index: _Index | None = None  # what the journal's appender knows of the table (``_append``)
 
     def _replay_backs(self) -> Callable[[ScoreEntry], bool]:
         """Whether an entry's replay file in ``replays/`` is the one it names (its SHA-256) and was played
@@ -242,6 +259,8 @@ class TableFile:
             else:
                 data = _read_all(fd)
                 entries, damage, head = _parse(data, self._replay_backs())
+            entries, journaled, damage = self._with_journal(entries, damage)
+            self._index = None  # the appender reads the table again after a whole write
             record = self.record.load(fresh=True)  # under the lock: what this account's last write left
             if seed is not None:
                 if entries:
@@ -292,10 +311,24 @@ class TableFile:
                     with contextlib.suppress(OSError):
                         kept.unlink()
                 raise
+            journal = os.path.lexists(self.journal_path)
+            if journal:  # its entries are in the table now: a kill before this leaves them in both, one entry
+                if damage is not None:  # its bytes kept, as a damaged table's are
+                    with contextlib.suppress(OSError, DataFileError):
+                        journal_fd = open_regular(self.journal_path, "table journal", follow=False)
+                        try:
+                            copy_aside(journal_fd, self.folder / f"{JOURNAL_NAME}.corrupt-"
+                                       f"{datetime.now(UTC).strftime('%Y%m%dT%H%M%SZ')}")
+                        finally:
+                            os.close(journal_fd)
+                self.journal_path.unlink()
+                fsync_folder(self.folder)
             if seed is not None:
                 self.record.start(seed)
             elif record is not None:
-                self.record.entered([e for e in results if isinstance(e, ScoreEntry)])
+                unknown = [e for e in journaled if record.knows(e) is None]  # appended: recorded now, in order
+                self.record.entered(sorted(unknown, key=lambda e: e.entered or 0)
+                                    + [e for e in results if isinstance(e, ScoreEntry)])
             if damage is not None:
                 where = f"; the damaged file is kept as {kept.name}" if kept else ""
                 self.warn(f"{damage.describe(self.path)}{where}")
@@ -318,6 +351,164 @@ class TableFile:
                              f"(entry #{twin.entered}); a game enters once, whoever's name it carries")
         return ScoreEntry(**{**entry.as_dict(), "entered": place,
                              "entered_at": datetime.now(UTC).isoformat(timespec="seconds")})
+
+    # ------------------------------------------------------------------ the journal
+    def _journal_data(self) -> bytes:
+        """The journal's bytes (b"" if there is none). Never follows a symlink; over the table's size limit it
+        is refused like the table."""
+        try:
+            mode = os.lstat(self.journal_path).st_mode
+        except FileNotFoundError:
+            return b""
+        except OSError as exc:
+            raise TableError(f"{self.journal_path}: cannot read: {exc.strerror or exc}") from None
+        if not stat.S_ISREG(mode):
+            raise TableError(f"{self.journal_path}: is not a regular file (a symbolic link is not followed)")
+        try:
+            return read_limited(self.journal_path, MAX_TABLE_BYTES, "table journal", follow=False)
+        except DataFileError as exc:
+            raise TableError(str(exc)) from None
+
+    def _with_journal(self, entries: list[ScoreEntry], damage: Damage | None
+                      ) -> tuple[list[ScoreEntry], list[ScoreEntry], Damage | None]:
+        """The table's entries and the journal's after them (an entry already in the table by its id is one
+        entry: a kill between a compaction's write and the journal's removal); the journal's own entries; and
+        the damage, the journal's bad lines counted in it."""
+        journal, problem, found = _journal_entries(self._journal_data())
+        ids = {e.id for e in entries}
+        fresh = [e for e in journal if e.id not in ids]
+        if problem is not None:
+            reason = f"{JOURNAL_NAME}: {problem}"
+            damage = Damage(reason if damage is None else f"{damage.reason}; {reason}",
+                            len(entries) + len(fresh), (damage.found if damage else len(entries)) + found)
+        return entries + fresh, fresh, damage
+
+    def compact(self) -> None:
+        """Take the journal's entries into ``scores.json`` (one whole write under the lock) and remove it; nothing
+        to do without a journal. A class's server runs it at its start and its stop."""
+        if not os.path.lexists(self.journal_path):
+            return
+        with self._locked():
+            self._enter_many([])
+
+    def _signature(self) -> tuple:
+        """What tells the appender the table and the journal are as it left them (another writer's whole write
+        makes a new file; another append, a longer journal)."""
+        def of(path: Path) -> tuple | None:
+            try:
+                st = os.lstat(path)
+            except FileNotFoundError:
+                return None
+            return st.st_ino, st.st_size, st.st_mtime_ns, st.st_mode
+        return of(self.path), of(self.journal_path)
+
+    def _load_index(self) -> _Index | None:
+        """Under the lock: the table and its journal read whole, once; None if the journal may not be appended
+        to (damage, a planted counter or seed, an entry without its place, this account's record of another
+        seed): the whole table is written then, as ``_enter_many`` does."""
+        fd = self._open_table()
+        if fd is None:
+            return None
+        try:
+            data = _read_all(fd)
+        finally:
+            os.close(fd)
+        entries, damage, head = _parse(data, self._replay_backs())
+        entries, _, damage = self._with_journal(entries, damage)
+        record = self.record.load(fresh=True)
+        if (damage is not None or head.seed is None or head.counter_problem is not None
+                or any(e.entered is None for e in entries) or (record is not None and record.seed != head.seed)):
+            return None
+        last = max([0, *(e.entered or 0 for e in entries)])
+        next_entry = max(head.next_entry, last + 1)
+        if next_entry + MAX_TABLE_ENTRIES > _COUNT_MAX:  # near the counter's end: the whole write renumbers
+            return None
+        self._seed = head.seed
+        return _Index(self._signature(), {e.replay_sha256 for e in entries},
+                      {e.game_sha256: e for e in entries if e.game_sha256 is not None}, next_entry, len(entries))
+
+    def _append(self, new_entries: Sequence[tuple[ScoreEntry, frozenset[str]]]) -> list[ScoreEntry | TableError]:
+        """Under the lock: ``_enter_many``'s entries appended to the journal, fsynced, without rewriting the
+        table; the whole write where the journal may not be used (``_load_index``)."""
+        index = self._index if self._index is not None and self._index.signature == self._signature() else None
+        if index is None:
+            index = self._index = self._load_index()
+        if index is None:
+            return self._enter_many(new_entries)
+        results: list[ScoreEntry | TableError] = []
+        lines: list[bytes] = []
+        shas, games, place = set(index.replays), dict(index.games), index.next_entry
+        for entry, digests in new_entries:
+            twin = next((games[d] for d in digests if d in games), None)
+            if entry.replay_sha256 in shas or twin is not None:
+                twin = twin or next(e for e in games.values() if e.replay_sha256 == entry.replay_sha256)
+                when = (twin.entered_at or twin.date)[:16].replace("T", " ")
+                results.append(TableError(f"this game is already in the table: entered by {twin.name} on {when} "
+                                          f"UTC (entry #{twin.entered}); a game enters once, whoever's name it "
+                                          f"carries"))
+                continue
+            entry = ScoreEntry(**{**entry.as_dict(), "entered": place,
+                                  "entered_at": datetime.now(UTC).isoformat(timespec="seconds")})
+            line = _entry_line(entry).encode("utf-8") + b"\n"
+            back, problem, _ = _journal_entries(line)
+            if problem is not None or back != [entry]:
+                raise TableError(f"the table's journal line would not read back ({problem or 'another entry'}): "
+                                 f"not entered, nothing was changed")
+            shas.add(entry.replay_sha256)
+            if entry.game_sha256 is not None:
+                games[entry.game_sha256] = entry
+            lines.append(line)
+            results.append(entry)
+            place += 1
+        if not lines:
+            return results
+        count = index.count + len(lines)
+        if count > MAX_TABLE_ENTRIES:
+            raise TableError(f"the table holds {index.count} entries, its limit: not entered (nothing was "
+                             f"dropped; start a new table with --scores)")
+        table_size = (index.signature[0] or (0, 0))[1]
+        journal_size = (index.signature[1] or (0, 0))[1]
+        if table_size + journal_size + sum(map(len, lines)) > MAX_TABLE_BYTES:
+            raise TableError("the table would grow past its size limit: not entered (nothing was dropped)")
+        self._write_journal(b"".join(lines))
+        self._index = _Index(self._signature(), shas, games, place, count)
+        return results
+
+    def _write_journal(self, data: bytes) -> None:
+        """Append ``data`` (whole lines) to the journal and fsync it, and its folder if the journal is new. A cut
+        last line (a writer killed mid-append, never acknowledged) is cut off first, so no line is ever joined
+        to it."""
+        flags = os.O_RDWR | os.O_CREAT | _NOFOLLOW | _CLOEXEC | _BINARY  # read too: its last byte
+        new = not os.path.lexists(self.journal_path)
+        try:
+            fd = os.open(self.journal_path, flags, 0o666)
+        except OSError as exc:
+            raise TableError(f"{self.journal_path}: cannot write: {exc.strerror or exc}") from None
+        end = 0
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise TableError(f"{self.journal_path}: is not a regular file")
+            # lseek and read rather than pread: Windows has no pread.
+            end = os.lseek(fd, 0, os.SEEK_END)
+            if end:
+                os.lseek(fd, end - 1, os.SEEK_SET)
+                if os.read(fd, 1) != b"\n":
+                    os.lseek(fd, 0, os.SEEK_SET)
+                    end = _read_all(fd).rfind(b"\n") + 1
+                    os.ftruncate(fd, end)
+            os.lseek(fd, end, os.SEEK_SET)
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
+            os.fsync(fd)
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                os.ftruncate(fd, end)  # nothing of this write is left to be read as entered
+            raise TableError(f"{self.journal_path}: cannot write: {exc.strerror or exc}") from None
+        finally:
+            os.close(fd)
+        if new:
+            fsync_folder(self.folder)
 
     def _copy_aside(self, fd: int) -> Path:
         stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
@@ -548,9 +739,7 @@ def table_bytes(entries: list[ScoreEntry], seed: int | None = DEFAULT_SEED, next
     Fields an entry lacks (it came from an older table) are left out rather than written as null. A
     ``seed`` of None writes ``kept_seed`` (the JSON of a seed that is not valid, kept as found), or no
     seed at all."""
-    lines = [json.dumps({k: v for k, v in e.as_dict().items() if v is not None or k not in _OPTIONAL},
-                        sort_keys=True, ensure_ascii=False, allow_nan=False)
-             for e in sorted(entries, key=sort_key)]
+    lines = [_entry_line(e) for e in sorted(entries, key=sort_key)]
     if next_entry is None:
         next_entry = max([0, *(e.entered or 0 for e in entries)]) + 1
     head = json.dumps({"format": FORMAT, "format_version": FORMAT_VERSION})[:-1]
@@ -560,6 +749,38 @@ def table_bytes(entries: list[ScoreEntry], seed: int | None = DEFAULT_SEED, next
         head += f', "seed": {kept_seed}'
     head += f', "next_entry": {next_entry}'
     return (head + ', "entries": [\n' + ",\n".join(lines) + "\n]}\n").encode("utf-8")
+
+
+def _entry_line(e: ScoreEntry) -> str:
+    """An entry as one line of JSON: the table's lines and the journal's are the same."""
+    return json.dumps({k: v for k, v in e.as_dict().items() if v is not None or k not in _OPTIONAL},
+                      sort_keys=True, ensure_ascii=False, allow_nan=False)
+
+
+def _journal_entries(data: bytes) -> tuple[list[ScoreEntry], str | None, int]:
+    """The journal's entries, the first problem with a line (None: none), and the lines found. The part after
+    the last newline is a write cut off by a kill: never acknowledged, not read, no problem."""
+    entries: list[ScoreEntry] = []
+    problem = None
+    lines = data.split(b"\n")[:-1]
+    for i, line in enumerate(lines):
+        try:
+            entries.append(ScoreEntry.from_dict(parse_json(line)))
+        except (ValueError, RecursionError) as exc:
+            problem = problem or f"line {i + 1}: {str(exc)[:200]}"
+    return entries, problem, len(lines)
+
+
+@dataclass(frozen=True)
+class _Index:
+    """What the journal's appender knows of the table at ``signature`` (``TableFile._signature``): its replays'
+    digests, its games by digest, the next place in the order of entry and how many entries it holds."""
+
+    signature: tuple
+    replays: set[str]
+    games: dict[str, ScoreEntry]
+    next_entry: int
+    count: int
 
 
 def name_slug(name: str) -> str:

@@ -1,0 +1,297 @@
+"""Issue 40: the suite's protocol (seeds, fresh policies, IQM and stratified bootstrap), every Reach game
+verifiable, fields that stay physical, and the small items (evaluate exported, the batched reward's round-off)."""
+
+from __future__ import annotations
+
+import doctest
+import itertools
+import json
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from scipy.stats import trim_mean
+
+import armgame.env
+import armgame.env.statistics
+from armgame.cli import main
+from armgame.env import evaluation, suite
+from armgame.env.errors import EnvArgumentError
+from armgame.env.policies import BotPolicy, bot_policy
+from armgame.env.record import replay_of
+from armgame.env.statistics import iqm, mean_of_tasks, median_of_tasks, stratified_bootstrap_ci
+from armgame.env.variants import MAX_FIELD_STRENGTH, MAX_VISCOUS_STRENGTH, ReachVariant
+from armgame.env.vector import REWARD_TOLERANCE
+from armgame.records.replay import Replay
+
+
+# ------------------------------------------------------------------ item 6: evaluate exported
+def test_evaluate_is_exported_where_the_docs_name_it():
+    assert armgame.env.evaluate is evaluation.evaluate
+    assert armgame.env.aggregate_runs is evaluation.aggregate_runs
+
+
+# ------------------------------------------------------------------ item 2: the protocol
+def test_the_three_seed_ranges_are_disjoint():
+    training = range(0, suite.TRAINING_SEED_LIMIT)
+    ranges = (training, suite.VALIDATION_SEEDS, suite.EVALUATION_SEEDS)
+    for a, b in itertools.combinations(ranges, 2):
+        assert a.stop <= b.start or b.stop <= a.start, (a, b)
+    assert len(suite.VALIDATION_SEEDS) == len(suite.EVALUATION_SEEDS) == 10**6
+
+
+def test_a_seed_scores_the_same_alone_and_after_another_game():
+    # The issue's case: the naive bot hit once on this seed alone and never after another game, because one
+    # bot's clock ran on between games. evaluate gives every game a fresh bot.
+    result = armgame.env.evaluate("naive", "armgame/CenterOutHold-v1", seeds=[7_000_001, 7_000_002])
+    assert result.hits[1] == 1
+
+
+class Counting:
+    """A policy with state: the number of steps it has seen, reset by ``reset``."""
+
+    def __init__(self) -> None:
+        self.resets = 0
+        self.steps = 0
+
+    def reset(self) -> None:
+        self.resets += 1
+        self.steps = 0
+
+    def __call__(self, observation):
+        self.steps += 1
+        assert self.steps <= 10  # a game of 0.2 s is 10 decisions: more means the last game leaked in
+        return np.zeros(4, dtype=np.int8)
+
+
+def test_evaluate_resets_a_policy_with_state_before_every_game_or_makes_one_a_game():
+    policy = Counting()
+    armgame.env.evaluate(policy, "armgame/Reach-v1", games=3, time_limit=0.2)
+    assert policy.resets == 3
+    made = []
+
+    def factory(env):
+        made.append(BotPolicy("naive", env))
+        return made[-1]
+
+    result = armgame.env.evaluate("naive", "armgame/Reach-v1", games=3, time_limit=0.5, policy_factory=factory)
+    assert len(made) == 3 and len({id(p) for p in made}) == 3
+    assert result.hits == armgame.env.evaluate("naive", "armgame/Reach-v1", games=3, time_limit=0.5).hits
+    with pytest.raises(EnvArgumentError, match="policy_factory"):
+        armgame.env.evaluate("naive", "armgame/Reach-v1", games=1, policy_factory=3)
+
+
+def test_the_statistics_docstring_runs():
+    failed, attempted = doctest.testmod(armgame.env.statistics)
+    assert attempted >= 3 and failed == 0
+
+
+def test_the_iqm_is_the_quarter_trimmed_mean():
+    rng = np.random.default_rng(0)
+    for shape in ((5, 7), (3, 4), (1, 1), (10, 2)):
+        x = rng.normal(size=shape)
+        assert iqm(x) == pytest.approx(trim_mean(x, 0.25, axis=None), rel=1e-12, abs=1e-15)
+    assert iqm(np.array([[0.0, 100.0], [1.0, 2.0]])) == 1.5  # one run far off moves it not at all
+
+
+def exact_bootstrap(scores: np.ndarray, statistic) -> np.ndarray:
+    """The statistic on every stratified resample of ``scores`` (runs x tasks), each equally likely."""
+    runs, tasks = scores.shape
+    per_task = [list(itertools.product(range(runs), repeat=runs)) for _ in range(tasks)]
+    values = []
+    for choice in itertools.product(*per_task):
+        sample = np.stack([scores[list(rows), t] for t, rows in enumerate(choice)], axis=1)
+        values.append(float(statistic(sample[None])[0]))
+    return np.sort(values)
+
+
+@pytest.mark.parametrize("statistic", [iqm, mean_of_tasks, median_of_tasks])
+def test_the_stratified_bootstrap_matches_every_resample_enumerated(statistic):
+    scores = np.array([[0.1, 2.0], [0.7, 3.5], [0.3, 9.0]])  # 3 runs of 2 tasks: 27 x 27 resamples
+    exact = exact_bootstrap(scores, statistic)
+    low, high = stratified_bootstrap_ci(scores, statistic, reps=50_000, seed=1)
+    # The percentile interval's ends lie between the exact distribution's 2nd and 3rd, 97th and 98th percentiles.
+    assert np.quantile(exact, 0.02) <= low <= np.quantile(exact, 0.03)
+    assert np.quantile(exact, 0.97) <= high <= np.quantile(exact, 0.98)
+    assert stratified_bootstrap_ci(scores, statistic, reps=2_000, seed=1) == \
+        stratified_bootstrap_ci(scores, statistic, reps=2_000, seed=1)
+
+
+def test_each_task_is_resampled_from_its_own_runs_only():
+    scores = np.array([[1.0, 10.0], [2.0, 20.0]])
+    seen = []
+
+    def record(samples):
+        seen.append(samples.copy())
+        return samples.mean(axis=(1, 2))
+
+    stratified_bootstrap_ci(scores, record, reps=200, seed=0)
+    samples = np.concatenate(seen)
+    assert set(np.unique(samples[:, :, 0])) <= {1.0, 2.0} and set(np.unique(samples[:, :, 1])) <= {10.0, 20.0}
+
+
+def test_aggregate_runs_normalises_by_the_references_and_refuses_uneven_runs():
+    runs = {"armgame/Reach-v1": [53.21, 53.21, 0.53], "armgame/ReachHold-v1": [45.87, 0.46, 45.87]}
+    result = armgame.env.aggregate_runs(runs, reps=1_000)
+    assert result.scores.shape == (3, 2) and result.scores.max() == pytest.approx(1.0)
+    # The six scores 1, 1, 0, 1, 0, 1 (normalised): their middle four 0, 1, 1, 1.
+    assert result.iqm[0] == pytest.approx(0.75) and result.iqm[1] <= result.iqm[0] <= result.iqm[2]
+    assert "IQM normalised score 0.75" in result.summary()
+    with pytest.raises(EnvArgumentError, match="same number"):
+        armgame.env.aggregate_runs({"armgame/Reach-v1": [1.0], "armgame/ReachHold-v1": [1.0, 2.0]})
+    with pytest.raises(EnvArgumentError, match="reference"):
+        armgame.env.aggregate_runs({"armgame/Reach-v0": [1.0]})
+
+
+# ------------------------------------------------------------------ item 3: every game verifiable
+def play(env, policy, seed: int, most: int = 10**6):
+    observation, info = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    done, steps = False, 0
+    while not done and steps < most:
+        action = env.action_space.sample() if policy is None else policy(observation)
+        observation, _, terminated, truncated, info = env.step(action)
+        done, steps = terminated or truncated, steps + 1
+    return info
+
+
+ALL_IDS = tuple(i for i in gym.registry if i.startswith("armgame/"))
+
+
+def short(env_id: str):
+    """The id's env with short episodes: 4 s games, 2-trial CenterOut-v1 episodes (v0: a run, cut short)."""
+    if env_id.startswith("armgame/Reach"):
+        return gym.make(env_id, time_limit=4.0)
+    return gym.make(env_id, episode_trials=2) if env_id.endswith("-v1") else gym.make(env_id)
+
+
+def a_bot(env_id: str, env):
+    if env_id.endswith("Continuous-v0"):
+        return None  # v0's levels are not centred: no bot plays them (random play is recorded)
+    if env_id.startswith("armgame/CenterOut") and env_id.endswith("-v0"):
+        from armgame.env.center_out import CenterOutBotPolicy
+
+        return CenterOutBotPolicy("model", env)
+    return bot_policy("model", env)
+
+
+def test_every_id_is_covered():
+    assert len(ALL_IDS) == 20
+
+
+@pytest.mark.parametrize("env_id", ALL_IDS)
+def test_every_game_an_env_plays_is_recorded_and_verifies(env_id):
+    env = short(env_id)
+    bot = a_bot(env_id, env)
+    for k, policy in enumerate([None] if bot is None else [None, bot]):
+        info = play(env, policy, 7 + k, most=400)  # a CenterOut-v0 run is recorded as far as it went
+        replay = replay_of(env, driver="random" if policy is None else "model bot")
+        assert replay.result.hits == info["hits"]
+        read = Replay.from_bytes(replay.to_bytes())
+        ok, got = read.verify()
+        assert ok, (env_id, k, got)
+        if env_id.startswith("armgame/Reach"):
+            plain = env.unwrapped.game_variant.plain if env.unwrapped.version else True
+            assert (read.task is None) == (plain and "Continuous" not in env_id), env_id
+        else:
+            assert read.task.hold_at_home == env.unwrapped.session.hold_at_home
+
+
+def test_a_centre_out_episode_s_go_cue_rule_is_part_of_its_replay(tmp_path, capsys):
+    env = gym.make("armgame/CenterOutHold-v1", episode_trials=2)
+    play(env, None, 3, most=400)  # random keys never hold still at home: no go cue in 8 s
+    path = tmp_path / "episode.json"
+    replay_of(env, driver="random").save(path)
+    assert main(["verify", str(path)]) == 0
+    assert "go cue after a hold at home" in capsys.readouterr().out
+    data = json.loads(path.read_text())
+    data["task"]["hold_at_home"] = False  # the other rule: go cues, and trials, come anyway
+    path.write_text(json.dumps(data))
+    assert main(["verify", str(path)]) == 1
+
+
+def test_a_variant_game_recorded_without_its_section_differs_and_with_it_matches(tmp_path, capsys):
+    # What train_ppo.py wrote before: the key timeline alone, which replays the plain game.
+    env = gym.make("armgame/ReachField-v1", time_limit=6.0)
+    info = play(env, bot_policy("model", env), 3)
+    assert info["hits"] >= 3
+    bare = Replay.from_session(env.unwrapped.session, "script", driver="bot")
+    assert not bare.verify()[0]
+    path = tmp_path / "game.json"
+    replay_of(env, driver="model bot").save(path)
+    assert main(["verify", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "matches" in out and "armgame/ReachField-v1" in out and "curl field" in out
+    # The section is what the result depends on: a changed field is another game.
+    data = json.loads(path.read_text())
+    data["task"]["field"]["b"] = -2.0
+    path.write_text(json.dumps(data))
+    assert main(["verify", str(path)]) == 1
+    assert "DIFFERS" in capsys.readouterr().out
+
+
+# ------------------------------------------------------------------ item 4: fields that stay physical
+def pump(observation):
+    """The keys that push each joint the way it turns: all the energy the muscles can feed the arm."""
+    w1, w2 = observation[2], observation[3]
+    return np.array([w1 > 0, w1 <= 0, w2 > 0, w2 <= 0], dtype=np.int8)
+
+
+@pytest.mark.parametrize(("field", "strength"), [("curl", MAX_FIELD_STRENGTH), ("curl", -MAX_FIELD_STRENGTH),
+                                                 ("viscous", MAX_VISCOUS_STRENGTH), ("viscous", -MAX_VISCOUS_STRENGTH)])
+def test_every_field_at_its_extremes_plays_whole_games_within_the_declared_bounds(field, strength):
+    env = gym.make("armgame/Reach-v1", field=field, field_strength=strength, time_limit=5.0,
+                   observation_dtype="float64")
+    space = env.observation_space
+    assert np.isfinite(space.low).all() and np.isfinite(space.high).all()
+    for policy in (None, pump):
+        observation, _ = env.reset(seed=2)
+        env.action_space.seed(2)
+        done = False
+        while not done:
+            observation, _, terminated, truncated, info = env.step(
+                env.action_space.sample() if policy is None else policy(observation))
+            assert space.contains(observation)
+            done = terminated or truncated
+        assert truncated and not terminated and "stopped" not in info  # the whole game, no runaway
+
+
+def test_a_field_beyond_its_range_is_refused_in_one_line():
+    for field, strength in (("viscous", 3.0), ("viscous", -2.5), ("curl", 51.0)):
+        with pytest.raises(EnvArgumentError, match="field_strength") as caught:
+            gym.make("armgame/Reach-v1", field=field, field_strength=strength)
+        assert "\n" not in str(caught.value)
+
+
+def test_a_runaway_stops_the_game_cleanly_and_its_replay_verifies():
+    env = gym.make("armgame/Reach-v1", time_limit=10.0, observation_dtype="float64")
+    env.unwrapped.variant = ReachVariant(field="viscous", field_strength=10.0)  # beyond the range, set directly
+    observation, _ = env.reset(seed=3)
+    done = False
+    while not done:
+        observation, _, terminated, truncated, info = env.step(pump(observation))
+        assert env.observation_space.contains(observation)
+        done = terminated or truncated
+    assert terminated and not truncated and "past 34.4 rad/s" in info["stopped"] and "\n" not in info["stopped"]
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(pump(observation))
+    replay = Replay.from_bytes(replay_of(env).to_bytes())
+    assert replay.task.stopped and replay.verify()[0]
+
+
+# ------------------------------------------------------------------ item 6: the batched reward's round-off
+def test_the_batched_dense_reward_is_the_single_envs_to_round_off():
+    batched = gym.make_vec("armgame/Reach-v1", num_envs=8, time_limit=4.0)
+    single = gym.make_vec("armgame/Reach-v1", num_envs=8, time_limit=4.0, vectorization_mode="sync")
+    assert type(batched).__name__ == "ReachV1VectorEnv"
+    batched.reset(seed=0)
+    single.reset(seed=0)
+    batched.action_space.seed(1)
+    largest, returns = 0.0, np.zeros((2, 8))
+    for _ in range(200):
+        action = batched.action_space.sample()
+        rb, rs = batched.step(action)[1], single.step(action)[1]
+        largest = max(largest, float(np.abs(rb - rs).max()))
+        returns += rb, rs
+    assert largest <= REWARD_TOLERANCE and np.abs(returns[0] - returns[1]).max() <= 200 * REWARD_TOLERANCE
+    assert returns.std() > 0  # the rewards were not all zero
