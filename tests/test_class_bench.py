@@ -5,6 +5,8 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
+import pytest
+
 
 def test_the_class_server_benchmark_runs():
     path = Path(__file__).resolve().parent.parent / "benchmarks" / "class_server.py"
@@ -21,6 +23,7 @@ def test_the_class_server_benchmark_runs():
     assert run["server_exit"] == 0 and run["server_notices"] == {}
 
 
+@pytest.mark.slow
 def test_the_flood_the_clerk_and_the_table_costs_run():
     path = Path(__file__).resolve().parent.parent / "benchmarks" / "class_server.py"
     spec = importlib.util.spec_from_file_location("class_server_benchmark", path)

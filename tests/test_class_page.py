@@ -3,6 +3,7 @@ shown as text, and the text reads from the back row at 1024x768; then the teache
 
 from __future__ import annotations
 
+import pytest
 from browser import browser_page
 from class_server import running_class, tapped_game
 
@@ -66,6 +67,7 @@ def _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch) -> No
     assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == len(HOSTILE) + 1
 
 
+@pytest.mark.slow
 def test_the_class_screenshot_script_draws_every_class_picture(tmp_path, monkeypatch):
     """docs/make_class_screenshots.py cannot rot: it runs here, on a smaller class, into a temporary folder."""
     import importlib.util

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from browser import browser_page
 from class_server import running_class
 from play_page import join, open_page, play_keys, run_for, to_the_end
@@ -22,6 +23,7 @@ def _scores(opened, name: str) -> list[int]:
     return sorted(e.score for e in entries)
 
 
+@pytest.mark.slow
 def test_a_game_with_keys_is_handed_in_shown_on_the_projector_and_kept_when_the_class_is_away(tmp_path):
     with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
         base = f"http://127.0.0.1:{opened.port}"
@@ -96,6 +98,7 @@ def test_a_game_with_keys_is_handed_in_shown_on_the_projector_and_kept_when_the_
         assert page.dialogs == []
 
 
+@pytest.mark.slow
 def test_on_a_phone_several_fingers_hold_several_muscles(tmp_path):
     with running_class(tmp_path / "class") as opened, \
             browser_page(390, 844, has_touch=True, is_mobile=True, device_scale_factor=2) as page:
