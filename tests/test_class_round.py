@@ -120,3 +120,19 @@ def test_the_guide_says_the_projectors_rules_as_the_page_has_them():
     assert f"turn by themselves every {constant('PAGE_SECONDS')} s" in guide
     assert f"even {constant('MIN_TEXT')} px text" in guide
     assert f"and {GRACE_SECONDS} s more for the last games" in guide
+
+
+def test_equal_scores_share_a_place_on_the_projector_and_in_the_answer(tmp_path, monkeypatch):
+    with running_class(tmp_path / "class") as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        answers = {}
+        for name, seconds in (("Ann", 20.0), ("Bo", 20.1), ("Cy", 30.0), ("Di", 5.0)):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            member = client.join(address, opened.clerk.roster.code, name)
+            answers[name] = client.hand_in(member, keyboard_game(seconds, player=name).to_bytes()).answer
+        assert answers["Ann"]["score"] == answers["Bo"]["score"]  # two games, one score
+        with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}/api/standings", timeout=10) as r:
+            students = json.loads(r.read())["students"]
+    assert [(s["rank"], s["name"]) for s in students] == [(1, "Cy"), (2, "Ann"), (2, "Bo"), (4, "Di")]
+    assert answers["Bo"]["rank"] == 1 and answers["Bo"]["message"].startswith("handed in: 1st of 2")  # level with Ann
+    assert [row[0] for row in answers["Di"]["top"]] == [1, 2, 2, 4]

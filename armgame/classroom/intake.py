@@ -48,7 +48,7 @@ from ..records.standings import PlayerRow, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
 from ..records.tablefile import name_slug
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
-from .rounds import Round, new_round, round_view
+from .rounds import Round, new_round, round_view, shared_rank
 
 #: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
 #: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
@@ -436,6 +436,9 @@ class Clerk:
         rank = board.rank(player_key(entry.name))
         row = board.row(rank)
         best = row.best
+        position = rank  # the row's position; its place is shared with every row of an equal score above it
+        while rank > 1 and board.row(rank - 1).best.score == best.score:
+            rank -= 1
         where = "in the class" if not entry.program else "among the programs"
         if best.id == entry.id:
             note = "first game" if row.games == 1 else "new personal best"
@@ -443,9 +446,12 @@ class Clerk:
         else:
             note = f"best {best.score}"
             line = f"score {entry.score}; your best, {best.score}, is {ordinal(rank)} of {len(board)} {where}"
-        top = [[i, r.name, r.best.score] for i, r in enumerate(board.rows(10), 1)
-               if not self.roster.is_hidden(r.name) or i == rank]
-        if rank > 10:
+        placed: list[dict[str, object]] = []
+        for r in board.rows(10):
+            placed.append({"rank": shared_rank(placed, r.best.score), "score": r.best.score, "name": r.name})
+        top = [[p["rank"], p["name"], p["score"]] for i, p in enumerate(placed, 1)
+               if not self.roster.is_hidden(str(p["name"])) or i == position]
+        if position > 10:
             top.append([rank, row.name, best.score])
         return {"ok": True, "already": already, "name": entry.name, "score": entry.score, "rank": rank,
                 "of": len(board), "best": best.score, "list": "programs" if entry.program else "students",
@@ -638,7 +644,7 @@ class Clerk:
                 if hidden and not teacher:
                     continue
                 e = row.best
-                out.append({"rank": len(out) + 1, "name": row.name, "score": e.score, "hits": e.hits,
+                out.append({"rank": shared_rank(out, e.score), "name": row.name, "score": e.score, "hits": e.hits,
                             "games": row.games, "driver": e.how if programs else None,
                             **({"hidden": hidden} if teacher else {})})
                 if len(out) >= STANDINGS_ROWS and not teacher:
