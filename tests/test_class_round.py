@@ -136,3 +136,27 @@ def test_equal_scores_share_a_place_on_the_projector_and_in_the_answer(tmp_path,
     assert [(s["rank"], s["name"]) for s in students] == [(1, "Cy"), (2, "Ann"), (2, "Bo"), (4, "Di")]
     assert answers["Bo"]["rank"] == 1 and answers["Bo"]["message"].startswith("handed in: 1st of 2")  # level with Ann
     assert [row[0] for row in answers["Di"]["top"]] == [1, 2, 2, 4]
+
+
+def test_the_teacher_renames_a_student_and_their_games_stay_one_row(tmp_path, monkeypatch):
+    with running_class(tmp_path / "class") as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann"))
+        ann = client.join(address, opened.clerk.roster.code, "Ann Bx")
+        client.hand_in(ann, keyboard_game(20, player="Ann Bx").to_bytes())
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "bo"))
+        client.join(address, opened.clerk.roster.code, "Bo")
+        for to, status in (("Bo", 409), ("BO", 409), ("B\u043e", 400), ("Ann\u200b B", 400), ("", 400)):
+            with pytest.raises(urllib.error.HTTPError) as refused:
+                teacher(opened, "/api/teacher/rename", {"name": "Ann Bx", "to": to})
+            assert refused.value.code == status, to
+        assert teacher(opened, "/api/teacher/rename", {"name": "ann bx", "to": "Ann B"})["message"] == \
+            "Ann Bx is shown as Ann B (the same machine, the same games)"
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann"))
+        again = client.hand_in(ann, keyboard_game(30, player="Ann Bx").to_bytes()).answer  # the same machine
+        assert again["name"] == "Ann B" and again["message"].startswith("handed in: 1st of 1 in the class")
+        with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}/api/standings", timeout=10) as r:
+            students = json.loads(r.read())["students"]
+        assert [(s["name"], s["games"]) for s in students] == [("Ann B", 2)]
+    with running_class(tmp_path / "class") as opened:  # a restart keeps the new name
+        assert [row.name for row in opened.clerk.boards[False].rows()] == ["Ann B"]

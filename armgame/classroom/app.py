@@ -720,6 +720,12 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         message = await state.run(lambda: clerk.release(body.get("name")))
         return _json({"ok": True, "message": message})
 
+    async def teacher_rename(request: Request) -> Response:
+        _check_secret(state, request)
+        body = await _json_body(request)
+        message = await state.run(lambda: clerk.rename(body.get("name"), body.get("to")))
+        return _json({"ok": True, "message": message})
+
     async def teacher_remove(request: Request) -> Response:
         _check_secret(state, request)
         body = await _json_body(request)
@@ -805,6 +811,7 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
         Route("/api/teacher/hide", _refusals(teacher_hide), methods=["POST"]),
         Route("/api/teacher/release", _refusals(teacher_release), methods=["POST"]),
         Route("/api/teacher/remove", _refusals(teacher_remove), methods=["POST"]),
+        Route("/api/teacher/rename", _refusals(teacher_rename), methods=["POST"]),
         Route("/api/teacher/close", _refusals(teacher_close), methods=["POST"]),
         Route("/api/teacher/lock", _refusals(teacher_lock), methods=["POST"]),
         Route("/api/teacher/lab", _refusals(teacher_lab), methods=["POST"]),

@@ -134,9 +134,12 @@ class _Board:
     """One list's rows, one a player, best first (``standings.one_row_per_player`` of the list), kept up to
     date as entries arrive: a player's rank is a binary search, not a pass over every entry."""
 
-    def __init__(self, best_first: Iterable[ScoreEntry] = ()) -> None:
+    def __init__(self, best_first: Iterable[ScoreEntry] = (), renamed: dict[str, str] | None = None) -> None:
         self._rows: dict[str, PlayerRow] = {}
         self._order: list[tuple[tuple, str]] = []  # (sort_key of the row's best, its player's key), sorted
+        #: Names the teacher changed (``Roster.renamed``: the old name's key to the name now shown): a renamed
+        #: student's games from before and after are one row, under the new name.
+        self.renamed = renamed or {}
         for entry in best_first:
             self.add(entry)
 
@@ -144,14 +147,15 @@ class _Board:
         return len(self._order)
 
     def add(self, entry: ScoreEntry) -> None:
-        key = player_key(entry.name)
+        name = self.renamed.get(player_key(entry.name), entry.name)
+        key = player_key(name)
         row = self._rows.get(key)
         if row is None:
-            self._rows[key] = PlayerRow(entry.name, entry, 1)
+            self._rows[key] = PlayerRow(name, entry, 1)
             bisect.insort(self._order, (sort_key(entry), key))
         elif sort_key(entry) < sort_key(row.best):  # a new best: the row moves, under the best game's name
             del self._order[bisect.bisect_left(self._order, (sort_key(row.best), key))]
-            self._rows[key] = PlayerRow(entry.name, entry, row.games + 1)
+            self._rows[key] = PlayerRow(name, entry, row.games + 1)
             bisect.insort(self._order, (sort_key(entry), key))
         else:
             self._rows[key] = PlayerRow(row.name, row.best, row.games + 1)
@@ -195,7 +199,7 @@ class Clerk:
         self.entries: list[ScoreEntry] = self.table.all_entries()
         # The two lists' rows, one a player, kept as games are entered: an answer's rank and the standings
         # cost a lookup, not a pass over the whole table (which grew with every hand-in).
-        self.boards = {programs: _Board(e for e in self.entries if e.program == programs) for programs in (False, True)}
+        self._build_boards()
         self.games: dict[str, ScoreEntry] = {e.game_sha256: e for e in self.entries if e.game_sha256}
         self.lab_runs: list[LabRun] = []
         self.lab_digests: set[str] = set()
@@ -347,7 +351,7 @@ class Clerk:
         digests = game_digests(replay)
         twin = next((self.games[d] for d in digests if d in self.games), None)
         if twin is not None:  # known: answered without re-simulating it
-            if player_key(twin.name) == player_key(player.name):
+            if player_key(self.shown_name(twin.name)) == player_key(player.name):
                 return self._answer(twin, already=True)
             raise RefusedError(409, f"this game was already handed in by {twin.name}: a game counts once, whoever "
                                f"hands it in")
@@ -419,9 +423,10 @@ class Clerk:
             if isinstance(result, ScoreEntry):
                 answer = self._answer(result)
                 self.version += 1
-                self.arrival = Arrival(self.version, result.name, result.score, str(answer["note"]), result.program)
+                self.arrival = Arrival(self.version, self.shown_name(result.name), result.score, str(answer["note"]),
+                                       result.program)
                 answers.append(answer)
-            elif twin is not None and player_key(twin.name) == player_key(c.player.name):
+            elif twin is not None and player_key(self.shown_name(twin.name)) == player_key(c.player.name):
                 answers.append(self._answer(twin, already=True))  # the same game twice in one burst
             elif twin is not None:
                 answers.append(RefusedError(409, f"this game was already handed in by {twin.name}: a game counts "
@@ -433,7 +438,7 @@ class Clerk:
     def _answer(self, entry: ScoreEntry, already: bool = False) -> dict[str, object]:
         """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""
         board = self.boards[entry.program]
-        rank = board.rank(player_key(entry.name))
+        rank = board.rank(player_key(self.shown_name(entry.name)))
         row = board.row(rank)
         best = row.best
         position = rank  # the row's position; its place is shared with every row of an equal score above it
@@ -456,6 +461,14 @@ class Clerk:
         return {"ok": True, "already": already, "name": entry.name, "score": entry.score, "rank": rank,
                 "of": len(board), "best": best.score, "list": "programs" if entry.program else "students",
                 "note": note, "top": top, "message": ("already handed in: " if already else "handed in: ") + line}
+
+    def _build_boards(self) -> None:
+        self.boards = {programs: _Board((e for e in self.entries if e.program == programs), self.roster.renamed)
+                       for programs in (False, True)}
+
+    def shown_name(self, name: str) -> str:
+        """The name the class shows for a game entered under ``name`` (the teacher may have changed it)."""
+        return self.roster.renamed.get(player_key(name), name)
 
     def _rows(self, programs: bool) -> Iterator[PlayerRow]:
         return self.boards[programs].each()
@@ -593,6 +606,37 @@ class Clerk:
         return (f"{player.name} is free: the next machine to join under it takes it (the old one can no longer "
                 f"hand in); their games stay theirs")
 
+    def rename(self, name: object, to: object) -> str:
+        """The teacher changes a student's name (a typo, a nickname): the machine that joined under it keeps it
+        under the new one, the games handed in before and after are one row under the new name, and the table's
+        file keeps each game as it was entered (the CSV shows both). Refused like a join: a new name that hides
+        part of itself, or that a reader would take for another student's."""
+        if not isinstance(name, str) or player_key(name) not in self.roster.players:
+            raise RefusedError(404, "no machine has joined under that name")
+        try:
+            new = check_name(to, "the new name")
+        except ValueError as exc:
+            raise RefusedError(400, str(exc)) from None
+        old_key, new_key = player_key(name), player_key(new)
+        player = self.roster.players[old_key]
+        problem = name_problem(new)
+        if problem is not None:
+            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem})")
+        taken = self.roster.players.get(new_key) or self.roster.lookalike_of(new)
+        if new_key != old_key and taken is not None and taken is not player:
+            raise RefusedError(409, f"that name is taken or reads like {taken.name}: choose another")
+        players = {k: p for k, p in self.roster.players.items() if k != old_key}
+        players[new_key] = Player(new, player.token_sha256, player.joined, player.address)
+        renamed = {k: (new if player_key(v) == old_key else v) for k, v in self.roster.renamed.items()}
+        renamed[old_key] = new
+        renamed.pop(new_key, None)
+        hidden = (self.roster.hidden - {old_key}) | ({new_key} if old_key in self.roster.hidden else set())
+        self.roster.changed(players=players, renamed=renamed, hidden=hidden)
+        self._build_boards()
+        self.version += 1
+        self.lab_version += 1
+        return f"{player.name} is shown as {new} (the same machine, the same games)"
+
     def remove(self, names: object) -> str:
         """Names taken off the class at once (a flood of names from one machine): each one's machine can no
         longer hand in, the names are hidden from the projector, and their games stay in the table (the
@@ -696,7 +740,7 @@ class Clerk:
 
     def round_view(self, now: datetime | None = None) -> dict[str, object] | None:
         return round_view(self.current_round(), self.entries, self.roster.hidden, now or datetime.now(UTC),
-                          STANDINGS_ROWS)
+                          STANDINGS_ROWS, name_of=self.shown_name)
 
     def roster_view(self) -> dict[str, object]:
         """For the teacher's page: every joined name with the machine (address) it joined from and its games
@@ -706,7 +750,7 @@ class Clerk:
 
         played: dict[str, int] = {}
         for entry in self.entries:
-            key = player_key(entry.name)
+            key = player_key(self.shown_name(entry.name))
             played[key] = played.get(key, 0) + 1
         machines: dict[str, list[dict[str, object]]] = {}
         for key, p in self.roster.players.items():

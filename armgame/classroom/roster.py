@@ -6,6 +6,7 @@ thread), atomically and fsynced before a join is acknowledged::
     class.json        {"format": "armgame-class", "format_version": 2, "code": "FROG", "seed": 10,
                        "closed": false, "locked": false, "lab": "lesson", a protocol or null,
                        "round": {"number", "start", "minutes", "after"} or null,
+                       "renamed": {old name's key: the name shown now},
                        "players": {key: {"name", "token_sha256", "joined", "address"}},
                        "hidden": [key, ...]}
     teacher.secret    the teacher's secret, created once with owner-only permissions
@@ -103,6 +104,8 @@ class Roster:
     lab: str | dict | None = None
     #: The last round the teacher started (``rounds.Round.as_dict``), or None.
     round: dict | None = None
+    #: Names the teacher changed: the old name's ``player_key`` to the name the class shows now.
+    renamed: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.reindex()
@@ -187,7 +190,7 @@ class Roster:
             version = check_int("format_version", d.get("format_version"), 1, 10**6)
             if version > FORMAT_VERSION:
                 raise ValueError(f"class record format {version} is newer than this armgame reads: update armgame")
-            later = {"locked", "lab", "round"} if version >= 2 else set()
+            later = {"locked", "lab", "round", "renamed"} if version >= 2 else set()
             d = check_keys("class record", d, {"format", "format_version", "code", "seed", "closed", "players",
                                                "hidden", "created", *later})
             code = check_str("code", d["code"], CODE_LENGTH)
@@ -226,6 +229,10 @@ class Roster:
                 protocol_from_dict(lab, "lab")  # a class record's own protocol is checked like any other
             elif lab is not None:
                 lab = check_str("lab", lab, 80)
+            renamed = d.get("renamed", {})
+            if not isinstance(renamed, dict) or len(renamed) > MAX_PLAYERS:
+                raise ValueError(f"renamed must be an object of at most {MAX_PLAYERS} names")
+            renamed = {check_str("a renamed key", k, 200): check_name(v) for k, v in renamed.items()}
             rnd = d.get("round")
             if rnd is not None:
                 from .rounds import Round
@@ -234,12 +241,14 @@ class Roster:
         except ValueError as exc:
             raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
         hidden = {player_key(k) for k in d["hidden"]}  # player_key of an older key is today's key
-        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab, rnd)
+        return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab, rnd,
+                   renamed)
 
     def save(self) -> None:
         data = dump_json({
             "format": FORMAT, "format_version": FORMAT_VERSION, "code": self.code, "seed": self.seed,
             "closed": self.closed, "locked": self.locked, "lab": self.lab, "round": self.round,
+            "renamed": dict(sorted(self.renamed.items())),
             "created": self.created,
             "hidden": sorted(self.hidden),
             "players": {k: {"name": p.name, "token_sha256": p.token_sha256, "joined": p.joined, "address": p.address}

@@ -14,7 +14,7 @@ round goes on with it. Pure: no I/O, no clock of its own (``now`` is given).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 
@@ -84,17 +84,18 @@ def new_round(previous: Round | None, minutes: object, entered: int, now: dateti
 
 
 def round_view(rnd: Round | None, best_first: Sequence, hidden: Iterable[str], now: datetime,
-               rows: int) -> dict[str, object] | None:
+               rows: int, name_of: Callable[[str], str] = lambda name: name) -> dict[str, object] | None:
     """What the projector shows of ``rnd``: its clock (start and end, ISO: the page counts down), whether it is
     over, its standings (each student's best game handed in during it; programs and hidden names never), and
-    once over, its winners. ``best_first``: the class's entries in rank order."""
+    once over, its winners. ``best_first``: the class's entries in rank order; ``name_of``: the name the class
+    shows for a game's (the teacher may have changed it)."""
     if rnd is None:
         return None
     hidden = set(hidden)
     games = [e for e in best_first
-             if not e.program and rnd.counts(e.entered, e.entered_at) and player_key(e.name) not in hidden]
+             if not e.program and rnd.counts(e.entered, e.entered_at) and player_key(name_of(e.name)) not in hidden]
     table = []
-    for row in one_row_per_player(games):
+    for row in one_row_per_player(games, lambda e: name_of(e.name)):
         table.append({"rank": shared_rank(table, row.best.score), "name": row.name, "score": row.best.score,
                       "games": row.games})
         if len(table) >= rows:
@@ -102,7 +103,7 @@ def round_view(rnd: Round | None, best_first: Sequence, hidden: Iterable[str], n
     over = rnd.over(now)
     return {"number": rnd.number, "start": rnd.start.isoformat(timespec="seconds"),
             "end": rnd.end.isoformat(timespec="seconds"), "minutes": rnd.minutes, "over": over,
-            "players": len({player_key(e.name) for e in games}), "students": table,
+            "players": len({player_key(name_of(e.name)) for e in games}), "students": table,
             "winners": [r for r in table if r["rank"] <= WINNERS] if over else []}
 
 

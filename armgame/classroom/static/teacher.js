@@ -165,6 +165,13 @@ $("round-start").addEventListener("click", async () => {
 $("round-stop").addEventListener("click", async () => {
   try { say((await (await call("/api/teacher/round", {stop: true})).json()).message); } catch (e) { say(e.message, true); }
 });
+$("rename").addEventListener("click", async () => {
+  try {
+    say((await (await call("/api/teacher/rename", {name: $("rename-name").value.trim(),
+      to: $("rename-to").value.trim()})).json()).message);
+  } catch (e) { say(e.message, true); }
+  refresh();
+});
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
 $("lab-png").addEventListener("click", () => download("/api/teacher/lab.png", "class-lab-curve.png"));
