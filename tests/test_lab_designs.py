@@ -219,3 +219,19 @@ def test_the_state_space_fit_separates_process_from_output_noise():
         low, high = fit.intervals[name]
         assert low <= value <= high, (name, value, fit.intervals[name])
     assert 0.5 < fit.values["Q"] / truth["Q"] < 2.0
+
+
+def test_the_docs_account_of_the_bots_random_fields_run_is_its_learners_and_protocols():
+    """docs/lab.md says why the bot's random-fields run shows no generalization function: its fast process
+    forgets 41% a trial, a direction comes back about 8 trials later, its slow process learns 2% an error."""
+    from pathlib import Path
+
+    from armgame.lab.learner import TwoRateLearner
+    from armgame.lab.protocol import preset
+
+    text = " ".join((Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8").split())
+    learner = TwoRateLearner()
+    forgets, learns = round(100 * (1 - learner.retention_fast)), round(100 * learner.rate_slow)
+    directions = preset("random-fields").targets  # each direction once a cycle: back after about that many
+    assert f"fast process forgets {forgets}% a trial" in text and f"learns {learns}% of an error" in text
+    assert f"comes about {directions} trials later" in text
