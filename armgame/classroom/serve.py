@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
+from ..words import plural
 
 GRACE_SECONDS = 3
 SERVER_LOCK = "server.lock"
@@ -156,7 +157,7 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
     def ready() -> None:
         others = other_addresses(host) if host not in ("127.0.0.1", "localhost", "::1") else []
         say(f"armgame class {'started' if new else 'goes on'}: code {roster.code}, seed {roster.seed}, "
-            f"{len(clerk.entries)} games so far, kept in {folder}")
+            f"{plural(len(clerk.entries), 'game')} so far, kept in {folder}")
         say(f"  students type:  {join_line} --name NAME")
         say(f"  browser:        {play_url}   (Chromebooks, tablets: nothing to install)")
         say(f"  projector:      http://{_label(host)}:{port}/?key={roster.projector_key()}   (shows the code; "
@@ -263,7 +264,7 @@ def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[s
     opened = open_class(folder, host, port, seed, say, lab=lab, proxy=proxy)
     opened.run()
     where = shell_path(folder)
-    say(f"armgame class stopped: {len(opened.clerk.entries)} games kept in {folder}")
+    say(f"armgame class stopped: {plural(len(opened.clerk.entries), 'game')} kept in {folder}")
     say(f"  the standings, one row a student:  armgame scores --scores {where}")
     if opened.clerk.lab_runs:
         lab = shell_path(folder / "lab")
