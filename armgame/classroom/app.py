@@ -708,56 +708,26 @@ def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None 
                 state.uploads.release()
             return _json(await state.run((token, data), "hand-in"))
 
-    async def teacher_hide(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.hide(body.get("name"), bool(body.get("hidden", True))))
-        return _json({"ok": True, "message": message})
+    def teacher_action(act: Callable[[dict[str, Any]], str]) -> Callable[[Request], Any]:
+        """A teacher's change: the secret (or the teacher's machine), the JSON body, ``act(body)`` on the clerk's
+        thread, its one line back."""
+        async def route(request: Request) -> Response:
+            _check_secret(state, request)
+            body = await _json_body(request)
+            return _json({"ok": True, "message": await state.run(lambda: act(body))})
+        return route
 
-    async def teacher_release(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.release(body.get("name")))
-        return _json({"ok": True, "message": message})
+    def start_or_stop_round(body: dict[str, Any]) -> str:
+        return clerk.stop_round() if body.get("stop") is True else clerk.start_round(body.get("minutes"))
 
-    async def teacher_rename(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.rename(body.get("name"), body.get("to")))
-        return _json({"ok": True, "message": message})
-
-    async def teacher_remove(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.remove(body.get("names")))
-        return _json({"ok": True, "message": message})
-
-    async def teacher_close(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.close(bool(body.get("closed", True))))
-        return _json({"ok": True, "message": message})
-
-    async def teacher_lock(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.lock(bool(body.get("locked", True))))
-        return _json({"ok": True, "message": message})
-
-    async def teacher_lab(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        message = await state.run(lambda: clerk.choose_lab(body.get("protocol")))
-        return _json({"ok": True, "message": message})
-
-    async def teacher_round(request: Request) -> Response:
-        _check_secret(state, request)
-        body = await _json_body(request)
-        if body.get("stop") is True:
-            message = await state.run(clerk.stop_round)
-        else:
-            message = await state.run(lambda: clerk.start_round(body.get("minutes")))
-        return _json({"ok": True, "message": message})
+    teacher_hide = teacher_action(lambda b: clerk.hide(b.get("name"), bool(b.get("hidden", True))))
+    teacher_release = teacher_action(lambda b: clerk.release(b.get("name")))
+    teacher_rename = teacher_action(lambda b: clerk.rename(b.get("name"), b.get("to")))
+    teacher_remove = teacher_action(lambda b: clerk.remove(b.get("names")))
+    teacher_close = teacher_action(lambda b: clerk.close(bool(b.get("closed", True))))
+    teacher_lock = teacher_action(lambda b: clerk.lock(bool(b.get("locked", True))))
+    teacher_lab = teacher_action(lambda b: clerk.choose_lab(b.get("protocol")))
+    teacher_round = teacher_action(start_or_stop_round)
 
     async def teacher_standings(request: Request) -> Response:
         _check_secret(state, request)
