@@ -26,18 +26,44 @@ def chromium_path() -> str:
     return found
 
 
+#: This process's chromium, launched by the first page and kept for the rest of the run (closed by
+#: ``close_shared``, from ``tests/conftest.py`` at the session's end): each page gets a context of its own
+#: (its own cookies, storage and cache, as a fresh browser has), so a launch (about 0.8 s) is paid once a
+#: worker instead of once a page.
+_shared: dict[str, object] = {}
+
+
+def _shared_browser() -> object:
+    sync_api = pytest.importorskip("playwright.sync_api")
+    executable = chromium_path()
+    if "browser" not in _shared or not _shared["browser"].is_connected():
+        close_shared()
+        _shared["playwright"] = sync_api.sync_playwright().start()
+        _shared["browser"] = _shared["playwright"].chromium.launch(executable_path=executable, args=FLAGS)
+    return _shared["browser"]
+
+
+def close_shared() -> None:
+    """Close this process's chromium and Playwright, if a page started them."""
+    browser, playwright = _shared.pop("browser", None), _shared.pop("playwright", None)
+    try:
+        if browser is not None:
+            browser.close()
+    finally:
+        if playwright is not None:
+            playwright.stop()
+
+
 @contextlib.contextmanager
 def browser_page(width: int, height: int, **options: object) -> Iterator[object]:
-    """A page of a fresh headless chromium at ``width`` x ``height`` (``options``: Playwright's ``new_page``
-    ones, e.g. ``has_touch=True``); its dialogs are counted in ``page.dialogs`` (and dismissed), so a test
-    sees any script a name could have smuggled in."""
-    sync_api = pytest.importorskip("playwright.sync_api")
-    with sync_api.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=chromium_path(), args=FLAGS)
-        try:
-            page = browser.new_page(viewport={"width": width, "height": height}, **options)
-            page.dialogs = []
-            page.on("dialog", lambda dialog: (page.dialogs.append(dialog.message), dialog.dismiss()))
-            yield page
-        finally:
-            browser.close()
+    """A page of headless chromium at ``width`` x ``height`` in a fresh browser context (``options``:
+    Playwright's ``new_context`` ones, e.g. ``has_touch=True``); its dialogs are counted in ``page.dialogs``
+    (and dismissed), so a test sees any script a name could have smuggled in."""
+    context = _shared_browser().new_context(viewport={"width": width, "height": height}, **options)
+    try:
+        page = context.new_page()
+        page.dialogs = []
+        page.on("dialog", lambda dialog: (page.dialogs.append(dialog.message), dialog.dismiss()))
+        yield page
+    finally:
+        context.close()

@@ -29,9 +29,17 @@ def pytest_configure(config) -> None:
     os.chmod(folder, 0o700)
     os.environ["ARMGAME_CACHE"] = folder
     config.add_cleanup(lambda: shutil.rmtree(folder, ignore_errors=True))
+    config.add_cleanup(_close_browser)
     if sys.dont_write_bytecode:
         sys.dont_write_bytecode = False
         os.environ.pop("PYTHONDONTWRITEBYTECODE", None)  # the armgame subprocesses the tests start too
+
+
+def _close_browser() -> None:
+    """The chromium the browser tests share in this process (tests/browser.py), if one was started."""
+    browser = sys.modules.get("browser")
+    if browser is not None and hasattr(browser, "close_shared"):
+        browser.close_shared()
 
 
 def pytest_xdist_auto_num_workers(config) -> int:

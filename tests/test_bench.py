@@ -126,6 +126,7 @@ def test_game_scene_is_deterministic_and_switches_on_the_bench_grid():
     assert game_torque_script() == game.torque_segments
 
 
+@pytest.mark.slow  # the benchmark's smoke run (about 5 s): CI runs it after the suite; figures read on a slide below
 def test_bench_quick_json_runs_end_to_end(tmp_path, monkeypatch, capsys, bench_slides):
     """In-process (the subprocess proved only that Python starts): the real command, parser to JSON,
     and its one-case figures (the smallest grid, two cells) read on a slide."""

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 
+@pytest.mark.slow  # the benchmark's smoke run (about 2 s of a server): CI runs it after the suite, as the flood's
 def test_the_class_server_benchmark_runs():
     path = Path(__file__).resolve().parent.parent / "benchmarks" / "class_server.py"
     spec = importlib.util.spec_from_file_location("class_server_benchmark", path)

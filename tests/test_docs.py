@@ -289,6 +289,7 @@ def test_every_relative_link_and_anchor_resolves(path):
             assert anchor in _anchors(linked), f"{path.name}: link to {target}: no such heading"
 
 
+@pytest.mark.slow  # every picture drawn at full size in a subprocess (about 2.5 s): CI, as the class's script
 def test_the_screenshot_script_draws_every_picture(tmp_path):
     """docs/make_screenshots.py cannot rot: it runs here (dummy video driver) into a temporary folder."""
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}

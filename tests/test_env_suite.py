@@ -338,6 +338,7 @@ def test_the_registry_lists_every_id_the_docs_name():
     assert armgame.env.SUITE is SUITE
 
 
+@pytest.mark.slow  # about 1.6 s: test_env_v1 trains the same method on the plain game in the suite; CI runs this
 def test_the_small_learner_still_beats_random_play_on_a_harder_task():
     """examples/train_es.py's cross-entropy method, smaller than tests/test_env_v1.py runs it, on the delayed game."""
     spec = importlib.util.spec_from_file_location("train_es", EXAMPLES / "train_es.py")
