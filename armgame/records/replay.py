@@ -513,9 +513,10 @@ class Replay:
         except (ValueError, TypeError, UserError, RecursionError) as exc:  # UserError: GameConfig's own checks
             raise DataFileError(f"{source}: {exc}") from None
         if len(replay.timeline) >= _KEEP_TEXT_EVENTS and data.endswith(_TIMELINE_CLOSE):
-            # The last "timeline" key's value, running to the file's end: the top-level one (the object closes
-            # there), the one the parse kept (JSON's last of a key). A text of plain events is its only writing.
-            start = data.rfind(_TIMELINE_OPEN)
+            # A "timeline" key's value running to the file's end, nothing but plain events: the top-level one (the
+            # object closes there), the one the parse kept (JSON's last of a key: no other key follows), and its only
+            # writing. The first such key is found from the start (the head is short; the events hold none).
+            start = data.find(_TIMELINE_OPEN)
             end = len(data) - len(_TIMELINE_CLOSE)
             if start >= 0 and _TIMELINE_TEXT.fullmatch(data, start + len(_TIMELINE_OPEN), end):
                 object.__setattr__(replay, "timeline_text",
