@@ -329,3 +329,19 @@ def test_both_forms_in_one_pass_are_the_two_passes():
         assert applied == applied_input(replay)
         assert events == identity._form_v1(replay)["timeline"]
         assert identity.game_digests(replay) == (game_digest(replay), identity._digest(identity._form_v1(replay)))
+
+
+def test_config_digest_remembers_the_object_not_an_equal_one():
+    """``config_digest`` remembers a configuration's digest by the object: an equal configuration whose JSON
+    differs (-0.0 for 0.0) keeps its own digest, asked in either order, as many times as asked."""
+    from armgame.records.rulesets import canonical_config, config_digest
+
+    plain = GameConfig(start_posture=(0.0, 1.0))
+    signed = GameConfig(start_posture=(-0.0, 1.0))
+    assert plain == signed and canonical_config(plain) != canonical_config(signed)
+    for _ in range(3):
+        for config in (plain, signed, GameConfig(start_posture=(-0.0, 1.0))):
+            assert config_digest(config) == hashlib.sha256(canonical_config(config)).hexdigest()
+    for seed in range(200):  # more than it keeps: the oldest go, the answers stay the same
+        assert config_digest(replace(plain, seed=seed)) == config_digest(plain)
+    assert config_digest(signed) != config_digest(plain)
