@@ -512,7 +512,8 @@ class Replay:
             raise DataFileError(f"{source}: not a text file (UTF-8 JSON expected)") from None
         except (ValueError, TypeError, UserError, RecursionError) as exc:  # UserError: GameConfig's own checks
             raise DataFileError(f"{source}: {exc}") from None
-        if len(replay.timeline) >= _KEEP_TEXT_EVENTS and data.endswith(_TIMELINE_CLOSE):
+        if (len(replay.timeline) >= _KEEP_TEXT_EVENTS and isinstance(data, bytes)
+                and data.endswith(_TIMELINE_CLOSE)):
             # A "timeline" key's value running to the file's end, nothing but plain events: the top-level one (the
             # object closes there), the one the parse kept (JSON's last of a key: no other key follows), and its only
             # writing. The first such key is found from the start (the head is short; the events hold none).
