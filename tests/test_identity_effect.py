@@ -307,3 +307,41 @@ def test_a_live_class_knows_a_game_entered_before_the_bump(tmp_path):
     with pytest.raises(RefusedError, match="already handed in by Old"):
         clerk.hand_in(other_token, data)
     assert old.name == "Old" and other.name == "Bo"
+
+
+def test_both_forms_in_one_pass_are_the_two_passes():
+    """``game_digests`` of a game that ran to its end takes ``applied_input`` and version 1's events in one pass
+    (``_both_forms``): the same values as the two passes, on timelines of every shape (no-ops, repeats, events at
+    and past the end, a key no muscle has, an action neither down nor up, even out of order)."""
+    from armgame.records import identity
+
+    base, _ = played([])
+    rng = random.Random(5)
+    keys = (*KEYS, "x")
+    for _ in range(3_000):
+        lo = rng.choice((0, STEPS - 20))
+        steps = sorted(rng.randint(lo, rng.choice((lo + 4, STEPS + 3))) for _ in range(rng.randint(0, 30)))
+        if rng.random() < 0.1:
+            rng.shuffle(steps)
+        actions = (DOWN, UP, "x") if rng.random() < 0.05 else (DOWN, UP)
+        replay = replace(base, timeline=tuple(InputEvent(s, rng.choice(keys), rng.choice(actions)) for s in steps))
+        applied, events = identity._both_forms(replay)
+        assert applied == applied_input(replay)
+        assert events == identity._form_v1(replay)["timeline"]
+        assert identity.game_digests(replay) == (game_digest(replay), identity._digest(identity._form_v1(replay)))
+
+
+def test_config_digest_remembers_the_object_not_an_equal_one():
+    """``config_digest`` remembers a configuration's digest by the object: an equal configuration whose JSON
+    differs (-0.0 for 0.0) keeps its own digest, asked in either order, as many times as asked."""
+    from armgame.records.rulesets import canonical_config, config_digest
+
+    plain = GameConfig(start_posture=(0.0, 1.0))
+    signed = GameConfig(start_posture=(-0.0, 1.0))
+    assert plain == signed and canonical_config(plain) != canonical_config(signed)
+    for _ in range(3):
+        for config in (plain, signed, GameConfig(start_posture=(-0.0, 1.0))):
+            assert config_digest(config) == hashlib.sha256(canonical_config(config)).hexdigest()
+    for seed in range(200):  # more than it keeps: the oldest go, the answers stay the same
+        assert config_digest(replace(plain, seed=seed)) == config_digest(plain)
+    assert config_digest(signed) != config_digest(plain)

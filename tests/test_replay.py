@@ -220,3 +220,54 @@ def test_the_window_plays_a_replay_from_its_timeline_only(tmp_path):
         pygame.display.quit()
     assert session.timeline == recorded.timeline
     assert session.state == recorded.state and session.result() == recorded.result()
+
+
+def _long_game(events: int = 1_500, seed: int = 3) -> Replay:
+    """A game with a bot's many events (enough that a read keeps its timeline's text)."""
+    config = GameConfig(seed=seed)
+    keys = [m.key for m in config.muscles]
+    timeline = []
+    for i in range(events):
+        step = i * (config.total_steps - 1) // events
+        timeline.append(InputEvent(step, keys[i % 4], "down" if (i // 4) % 2 == 0 else "up"))
+    timeline.append(InputEvent(config.total_steps - 1, "space", "down"))
+    session = GameSession(config)
+    session.play(timeline)
+    return Replay.from_session(session, "bot", "model")
+
+
+def test_a_long_replay_read_keeps_its_timeline_text_and_writes_the_same_bytes():
+    """``Replay.timeline_text``: a file read whose timeline is written as ``to_bytes`` writes it is written again
+    from its own text, byte for byte what encoding the events gives (as read, under another player's name, with
+    another date); a replay rebuilt with another timeline writes its own."""
+    import dataclasses
+
+    original = _long_game()
+    data = original.to_bytes()
+    read = Replay.from_bytes(data)
+    assert read.timeline_text is not None and read.timeline_text[0] is read.timeline
+    assert read == original and read.timeline == original.timeline
+    assert all(type(e) is InputEvent and e == f for e, f in zip(read.timeline, original.timeline, strict=True))
+    bare = dataclasses.replace(read, timeline_text=None)
+    assert read.to_bytes() == data == bare.to_bytes()
+    assert read.with_player("Ann").to_bytes() == bare.with_player("Ann").to_bytes()
+    assert dataclasses.replace(read, date="2020-01-01T00:00:00+00:00").to_bytes() == \
+        dataclasses.replace(bare, date="2020-01-01T00:00:00+00:00").to_bytes()
+    as_text = Replay.from_bytes(data.decode())  # type: ignore[arg-type]  # text is read as well; nothing kept
+    assert as_text == original and as_text.timeline_text is None and as_text.to_bytes() == data
+    shorter = dataclasses.replace(read, timeline=read.timeline[:-1])
+    assert shorter.to_bytes() == dataclasses.replace(bare, timeline=bare.timeline[:-1]).to_bytes() != data
+
+
+def test_a_timeline_written_otherwise_is_not_kept():
+    """A file whose timeline is written another way (compact JSON, a step with a space, a key escaped) keeps no
+    text: it is written again as ``to_bytes`` writes it."""
+    original = _long_game()
+    canonical = original.to_bytes()
+    spaced = canonical.replace(b'[\n   0,\n', b'[\n   0 ,\n', 1)
+    escaped = canonical.replace(b'"down"\n  ]', b'"\\u0064own"\n  ]', 1)
+    for data in (json.dumps(json.loads(canonical), separators=(",", ":")).encode(), spaced, escaped):
+        assert data != canonical
+        read = Replay.from_bytes(data)
+        assert read.timeline_text is None
+        assert read == original and read.to_bytes() == canonical

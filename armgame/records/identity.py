@@ -94,15 +94,67 @@ def applied_input(replay: Replay) -> AppliedInput:
     return AppliedInput(tuple(runs), tuple(sorted(resets.items())))
 
 
-def _form(replay: Replay) -> dict[str, object]:
-    applied = applied_input(replay)
+def _both_forms(replay: Replay) -> tuple[AppliedInput, list[tuple[int, str, str]]]:
+    """``applied_input(replay)`` and version 1's events (``_form_v1``'s ``"timeline"``) in one pass, for a game
+    that ran to its end (where the two stop at the same event: ``applied_input``'s stop is the end, and
+    ``_form_v1``'s the steps played). The same values as the two, in half their time (a bot's game: 15,000
+    events). A step's set is taken when the next event's step differs (``applied_input``'s look-ahead: the step's
+    last event); while both run, the muscles held are the same, as each event changes them alike."""
+    steps = replay.result.steps
+    assert steps == replay.config.total_steps, "a game that ran to its end"
+    index = {m.key: i for i, m in enumerate(replay.config.muscles)}
+    names = [f"m{i}" for i in range(len(index))]
+    held = mask = 0
+    runs: list[tuple[int, int]] = []
+    resets: dict[int, int] = {}
+    events: list[tuple[int, str, str]] = []
+    add = events.append
+    pending: int | None = None  # the step of the event before: its step's last once the step changes
+    for e in replay.timeline:
+        step = e.step
+        if step != pending:
+            if pending is not None and held != mask and pending < steps:
+                runs.append((pending, held))
+                mask = held
+            pending = step
+        if step >= steps:
+            pending = None  # taken above, as the event before's look-ahead would
+            break
+        key = e.key
+        m = index.get(key)
+        if m is not None:
+            action = e.action
+            down = action == DOWN
+            bit = 1 << m
+            if bool(held & bit) != down:
+                add((step, names[m], action))
+            held = held | bit if down else held & ~bit
+        elif key == RESET_KEY:
+            action = e.action
+            if action == DOWN:
+                resets[step] = resets.get(step, 0) + 1
+                add((step, key, action))
+        elif key == TOGGLE_ARM_KEY:
+            action = e.action
+            if action == DOWN:
+                add((step, key, action))
+    if pending is not None and held != mask and pending < steps:
+        runs.append((pending, held))
+    return AppliedInput(tuple(runs), tuple(sorted(resets.items()))), events
+
+
+def _form(replay: Replay, applied: AppliedInput | None = None) -> dict[str, object]:
+    applied = applied_input(replay) if applied is None else applied
     return {"identity": IDENTITY_VERSION, "rules": config_digest(replay.config), "seed": replay.config.seed,
             "steps": replay.result.steps, "held": applied.held, "resets": applied.resets}
 
 
-def _form_v1(replay: Replay) -> dict[str, object]:
+def _form_v1(replay: Replay, events: list[tuple[int, str, str]] | None = None) -> dict[str, object]:
     """Version 1's form (events, those that change nothing dropped), kept only to recognise the digests
-    tables took before version 2: exactly as it was computed then."""
+    tables took before version 2: exactly as it was computed then (``events``: its timeline, by ``_both_forms``)."""
+    if events is not None:
+        return {"identity": 1, "rules": config_digest(replay.config), "seed": replay.config.seed,
+                "steps": replay.result.steps, "timeline": events}
     index = {m.key: f"m{i}" for i, m in enumerate(replay.config.muscles)}
     held: set[str] = set()
     last = replay.result.steps
@@ -127,7 +179,9 @@ def _form_v1(replay: Replay) -> dict[str, object]:
 
 
 def _digest(form: dict[str, object]) -> str:
-    return hashlib.sha256(json.dumps(form, separators=(",", ":")).encode()).hexdigest()
+    # check_circular=False: the same text without the encoder's note of every list it enters (a form is built here,
+    # with no cycle), a fifth of the time of a bot's 15,000 events.
+    return hashlib.sha256(json.dumps(form, separators=(",", ":"), check_circular=False).encode()).hexdigest()
 
 
 def game_digest(replay: Replay) -> str:
@@ -138,7 +192,10 @@ def game_digest(replay: Replay) -> str:
 def game_digests(replay: Replay) -> tuple[str, ...]:
     """The game's digest by every identity version this armgame knows, the current one first: a table
     entered before a bump holds the older one."""
-    return game_digest(replay), _digest(_form_v1(replay))
+    if replay.result.steps != replay.config.total_steps:  # stopped early: the two forms stop apart
+        return game_digest(replay), _digest(_form_v1(replay))
+    applied, events = _both_forms(replay)
+    return _digest(_form(replay, applied)), _digest(_form_v1(replay, events))
 
 
 def identity_claims(replay: Replay, digests: Sequence[str] | None = None) -> dict[str, object]:

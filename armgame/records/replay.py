@@ -22,7 +22,7 @@ from __future__ import annotations
 import json
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any, Protocol
@@ -59,6 +59,16 @@ MAX_NAME = 40
 _WORD = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]*")
 #: A key or action that JSON writes as itself in quotes, with no comma or bracket a replacement could touch.
 _PLAIN = re.compile(r"[A-Za-z0-9_]+")
+#: A replay file's timeline as ``Replay.to_bytes`` writes it, every key and action a plain word (``_PLAIN``): the
+#: text between ``_TIMELINE_OPEN`` and ``_TIMELINE_CLOSE``, the file's last key. A file read whose timeline is
+#: this text (and it is the top-level one: the object closes right after it) keeps it, so that the replay
+#: written again (a class's table: the same game under the player's name) takes it as it is rather than
+#: encoding 15,000 events again: the same bytes, as every event is written the one way ``to_bytes`` writes it
+#: (a step's digits with no sign or leading zero, JSON's only way; a plain word in quotes).
+_EVENT_TEXT = rb'\[\n   [0-9]+,\n   "[A-Za-z0-9_]+",\n   "[A-Za-z0-9_]+"\n  \]'
+_TIMELINE_TEXT = re.compile(_EVENT_TEXT + rb'(?:,\n  ' + _EVENT_TEXT + rb')*')
+_TIMELINE_OPEN = b'"timeline": [\n  '
+_TIMELINE_CLOSE = b'\n ]\n}\n'
 
 
 def check_name(name: object, what: str = "player name") -> str:
@@ -324,6 +334,10 @@ class Replay:
     #: The task section of a run that is more than a game (see ``register_task``; the lab's: its protocol
     #: and trials); None for a game.
     task: ReplayTask | None = None
+    #: The timeline as the file read wrote it, if that is as ``to_bytes`` writes it (``_TIMELINE_TEXT``), with the
+    #: timeline it is the text of: ``to_bytes`` takes it only for that very timeline (a replay rebuilt with another,
+    #: by ``dataclasses.replace``, writes its own). Not part of what the replay is (equality, repr).
+    timeline_text: tuple[tuple[InputEvent, ...], bytes] | None = field(default=None, compare=False, repr=False)
 
     @property
     def steps(self) -> int:
@@ -343,7 +357,7 @@ class Replay:
 
     def with_player(self, player: str) -> Replay:
         return Replay(self.config, self.timeline, self.result, self.driven, self.driver, check_name(player),
-                      self.date, self.version, self.task)
+                      self.date, self.version, self.task, self.timeline_text)
 
     def replay(self, max_work: int | None = None) -> GameResult:
         """Recompute the result: the timeline replayed on a fresh session, no clock. With ``max_work``, a game
@@ -404,6 +418,9 @@ class Replay:
 
     # ------------------------------------------------------------------ files
     def as_dict(self) -> dict[str, object]:
+        return self._as_dict([[e.step, e.key, e.action] for e in self.timeline])
+
+    def _as_dict(self, timeline: list[list[object]]) -> dict[str, object]:
         return {
             "format": FORMAT,
             "format_version": FORMAT_VERSION,
@@ -414,7 +431,7 @@ class Replay:
             "driver": self.driver,
             "scene": self.config.scene,
             "config": config_to_dict(self.config),
-            "timeline": [[e.step, e.key, e.action] for e in self.timeline],
+            "timeline": timeline,
             "result": self.result.as_dict(),
         } | ({} if self.task is None else {"task": self.task.as_dict()})
 
@@ -425,15 +442,16 @@ class Replay:
         field goes through ``dump_json`` as before, with the timeline, the last key in sorted order, left empty
         and then filled in: by ``json``'s compact C encoder and three replacements where every key is a plain
         word (so no comma or bracket is inside a string), else an event at a time."""
-        data = self.as_dict()
-        timeline = data["timeline"]
-        if not timeline:
-            return dump_json(data)
-        data["timeline"] = []
-        head = dump_json(data)
+        if not self.timeline:
+            return dump_json(self.as_dict())
+        head = dump_json(self._as_dict([]))
         tail = b'"timeline": []\n}\n'
         if not head.endswith(tail):  # a key after "timeline" (none today): the general encoder, never a guess
             return dump_json(self.as_dict())
+        read = self.timeline_text
+        if read is not None and read[0] is self.timeline:  # the file read's own text of this timeline
+            return head[:-len(tail)] + _TIMELINE_OPEN + read[1] + _TIMELINE_CLOSE
+        timeline = [[e.step, e.key, e.action] for e in self.timeline]
         # json.dumps(indent=1) at the timeline's depth: the list at 1 space, its events at 2, their fields at 3.
         words = {e.key for e in self.timeline} | {e.action for e in self.timeline}
         if all(_PLAIN.fullmatch(word) for word in words):
@@ -487,17 +505,33 @@ class Replay:
     @classmethod
     def from_bytes(cls, data: bytes, source: str = "replay") -> Replay:
         try:
-            return cls.from_dict(parse_json(data))
+            replay = cls.from_dict(parse_json(data))
         except DataFileError:
             raise
         except UnicodeDecodeError:
             raise DataFileError(f"{source}: not a text file (UTF-8 JSON expected)") from None
         except (ValueError, TypeError, UserError, RecursionError) as exc:  # UserError: GameConfig's own checks
             raise DataFileError(f"{source}: {exc}") from None
+        if (len(replay.timeline) >= _KEEP_TEXT_EVENTS and isinstance(data, bytes)
+                and data.endswith(_TIMELINE_CLOSE)):
+            # A "timeline" key's value running to the file's end, nothing but plain events: the top-level one (the
+            # object closes there), the one the parse kept (JSON's last of a key: no other key follows), and its only
+            # writing. The first such key is found from the start (the head is short; the events hold none).
+            start = data.find(_TIMELINE_OPEN)
+            end = len(data) - len(_TIMELINE_CLOSE)
+            if start >= 0 and _TIMELINE_TEXT.fullmatch(data, start + len(_TIMELINE_OPEN), end):
+                object.__setattr__(replay, "timeline_text",
+                                   (replay.timeline, bytes(data[start + len(_TIMELINE_OPEN):end])))
+        return replay
 
     @classmethod
     def load(cls, path: Path, follow: bool = True) -> Replay:
         return cls.from_bytes(read_limited(Path(path), MAX_REPLAY_BYTES, "replay file", follow), str(path))
+
+
+#: From how many events a replay read keeps its timeline's text (``Replay.timeline_text``): a bot's game (15,000
+#: events, 0.5 MB) is written again in a tenth of the time; a student's few hundred cost little either way.
+_KEEP_TEXT_EVENTS = 1_000
 
 
 def _timeline_from_list(data: object, config: GameConfig, last_step: int) -> tuple[InputEvent, ...]:
@@ -509,6 +543,10 @@ def _timeline_from_list(data: object, config: GameConfig, last_step: int) -> tup
     known = frozenset(keys)
     actions = (DOWN, UP)
     events: list[InputEvent] = []
+    add = events.append
+    # An event made as ``InputEvent(step, key, action)`` makes it (the same fields, in order), without the frozen
+    # dataclass's __init__ and its three object.__setattr__ calls: half the time of a bot's 15,000 events.
+    new = object.__new__
     previous = 0
     for i, item in enumerate(data):
         # The fast test first (a bot's game has tens of thousands of events, and checking each field by the
@@ -518,7 +556,12 @@ def _timeline_from_list(data: object, config: GameConfig, last_step: int) -> tup
             step, key, action = item
             if (type(step) is int and previous <= step <= last_step and type(key) is str and key in known
                     and type(action) is str and action in actions):
-                events.append(InputEvent(step, key, action))
+                event = new(InputEvent)
+                fields_ = event.__dict__
+                fields_["step"] = step
+                fields_["key"] = key
+                fields_["action"] = action
+                add(event)
                 previous = step
                 continue
         where = f"timeline[{i}]"

@@ -15,6 +15,7 @@ timeline names muscles by their key, and the physics and the targets are the sam
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 from dataclasses import dataclass
@@ -33,9 +34,24 @@ def canonical_config(config: GameConfig) -> bytes:
     return json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False).encode("utf-8")
 
 
+#: ``config_digest`` of the configurations seen last, by the object (kept, so its id is not reused): a class's
+#: hand-in asks for its replay's six times (its ruleset, its two identities, its entry). By the object, not by
+#: equality: two equal configurations may still differ in their JSON (0.0 and -0.0 are equal).
+_DIGESTS: dict[int, tuple[GameConfig, str]] = {}
+_DIGESTS_KEPT = 64
+
+
 def config_digest(config: GameConfig) -> str:
     """SHA-256 (hex) of the canonical configuration: equal digests, equal games but for the seed."""
-    return hashlib.sha256(canonical_config(config)).hexdigest()
+    known = _DIGESTS.get(id(config))
+    if known is not None and known[0] is config:
+        return known[1]
+    digest = hashlib.sha256(canonical_config(config)).hexdigest()
+    if len(_DIGESTS) >= _DIGESTS_KEPT:
+        with contextlib.suppress(KeyError, StopIteration, RuntimeError):  # another thread's change: kept or not
+            del _DIGESTS[next(iter(_DIGESTS))]
+    _DIGESTS[id(config)] = (config, digest)
+    return digest
 
 
 @dataclass(frozen=True)
