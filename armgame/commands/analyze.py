@@ -294,27 +294,11 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
     fit = fits[-1]  # the file's and the figure's: the two-rate model when both were fitted
     if beside is None:
         return []
-    import json
-
-    from ..lab.metrics import check_regular_target
-    from ..records.storage import atomic_write_bytes
-
-    try:
-        beside.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UserError(f"cannot create the output folder {beside}: {exc.strerror or exc}") from None
-    kept = beside / f"{path.stem}.fit.json"
-    check_regular_target(kept)
-    record = {"replay": str(path), "player": player or "", "protocol": session.protocol.name,
-              "seed": session.config.seed, "measure": metric, **fit.as_dict(unit)}
-    if comparison is not None:
-        record["compared_with"] = comparison.simple.as_dict(unit)
-        record["comparison"] = comparison.as_dict()
-    try:
-        atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
-    except (OSError, ValueError) as exc:
-        raise UserError(f"cannot write {kept}: {exc}") from None
-    written = [kept]
+    extra = {} if comparison is None else {"compared_with": comparison.simple.as_dict(unit),
+                                           "comparison": comparison.as_dict()}
+    written = [_keep_fit(beside, path, {"replay": str(path), "player": player or "",
+                                        "protocol": session.protocol.name, "seed": session.config.seed,
+                                        "measure": metric, **fit.as_dict(unit), **extra})]
     if figures:
         from ..lab.figures import fit_figure
 
@@ -335,6 +319,27 @@ def class_of(folder: Path):
     if folder.name == LAB_DIR and (folder.parent / ROSTER_NAME).is_file():
         return folder.parent, folder
     return None, folder
+
+
+def _keep_fit(beside: Path, path: Path, record: dict[str, object]) -> Path:
+    """A fit's record kept beside its replay as ``NAME.fit.json`` (the folder made if need be); UserError in one
+    line if it cannot be."""
+    import json
+
+    from ..lab.metrics import check_regular_target
+    from ..records.storage import atomic_write_bytes
+
+    try:
+        beside.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"cannot create the output folder {beside}: {exc.strerror or exc}") from None
+    kept = beside / f"{path.stem}.fit.json"
+    check_regular_target(kept)
+    try:
+        atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
+    except (OSError, ValueError) as exc:
+        raise UserError(f"cannot write {kept}: {exc}") from None
+    return kept
 
 
 def _design_fit(session, rows, on: str, beside: Path | None, path: Path, player: str | None, figures: bool,
@@ -364,24 +369,9 @@ def _design_fit(session, rows, on: str, beside: Path | None, path: Path, player:
         print(line)
     if beside is None:
         return []
-    import json
-
-    from ..lab.metrics import check_regular_target
-    from ..records.storage import atomic_write_bytes
-
-    try:
-        beside.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UserError(f"cannot create the output folder {beside}: {exc.strerror or exc}") from None
-    kept = beside / f"{path.stem}.fit.json"
-    check_regular_target(kept)
-    record = {"replay": str(path), "player": player or "", "protocol": session.protocol.name,
-              "seed": session.config.seed, "measure": metric, **fit.as_dict(unit)}
-    try:
-        atomic_write_bytes(kept, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
-    except (OSError, ValueError) as exc:
-        raise UserError(f"cannot write {kept}: {exc}") from None
-    written = [kept]
+    written = [_keep_fit(beside, path, {"replay": str(path), "player": player or "",
+                                        "protocol": session.protocol.name, "seed": session.config.seed,
+                                        "measure": metric, **fit.as_dict(unit)})]
     if figures:
         from ..lab.figures_designs import generalization_fit_figure, state_space_figure
 
