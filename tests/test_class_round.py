@@ -15,7 +15,8 @@ from browser import browser_page
 from class_server import keyboard_game, running_class
 
 from armgame.classroom import client
-from armgame.classroom.rounds import GRACE_SECONDS, Round, new_round, round_view, shared_rank
+from armgame.classroom.rounds import GRACE_SECONDS, Round, new_round, round_view
+from armgame.records.standings import shared_rank
 
 START = datetime(2026, 11, 27, 10, 0, tzinfo=UTC)
 

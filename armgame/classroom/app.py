@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import gc
 import hmac
 import ipaddress
@@ -181,9 +182,6 @@ class ClerkThread:
 
     def __init__(self, clerk: Clerk, after: Callable[[], None]) -> None:
         self.clerk, self.after = clerk, after
-        #: The joined players' token digests, rebuilt on this thread after every job (a join, a name released)
-        #: and read by the event loop: a hand-in from a token that is no player's is refused before its body.
-        self.tokens: frozenset[str] = self._tokens()
         self.jobs: queue.SimpleQueue[tuple[str, Any, Future | None]] = queue.SimpleQueue()
         self.thread = threading.Thread(target=self._serve, name="armgame-clerk", daemon=True)
         self.thread.start()
@@ -212,7 +210,6 @@ class ClerkThread:
                 return
             if job[0] == "job":
                 outcomes = [(job[2], _outcome(job[1]))]
-                self.tokens = self._tokens()  # before the answer: a machine that just joined hands in next
             else:
                 batch = [job]
                 while len(batch) < BATCH:  # what arrived meanwhile goes in the same write
@@ -234,9 +231,6 @@ class ClerkThread:
                     future.set_exception(outcome)
                 else:
                     future.set_result(outcome)
-
-    def _tokens(self) -> frozenset[str]:
-        return frozenset(p.token_sha256 for p in self.clerk.roster.players.values())
 
     def _hand_in(self, batch: list[tuple[str, Any, Future]]) -> list[tuple[Future, Any]]:
         """Each hand-in's answer (or the exception to raise in its request): the batch checked together
@@ -370,15 +364,13 @@ class ClassState:
             self.changed = asyncio.Event()
 
     @contextmanager
-    def hand_in_share(self, token: str | None) -> Iterator[None]:
-        """A hand-in's place, taken before its body is read, with the refusals that cost nothing: a token that
-        is no player's (401), a closed class (403), a player who already has ``TOKEN_SHARE`` hand-ins waiting
-        or whose last one did not reproduce less than ``COOL_DOWN`` s ago (503: the client hands it in again in a
-        moment). The clerk checks the token and the class again: a name may be released meanwhile."""
-        assert self.worker is not None, "the class is not serving"
-        digest = token_digest(token) if token else None
-        if digest is None or digest not in self.worker.tokens:
-            raise RefusedError(401, NOT_JOINED)
+    def hand_in_share(self, token: str) -> Iterator[None]:
+        """A joined player's hand-in's place (``_check_token`` found the token a player's), taken before its
+        body is read, with the refusals that cost nothing: a closed class (403), a player who already has
+        ``TOKEN_SHARE`` hand-ins waiting or whose last one did not reproduce less than ``COOL_DOWN`` s ago (503:
+        the client hands it in again in a moment). The clerk checks the token and the class again: a name may
+        be released meanwhile."""
+        digest = token_digest(token)
         if self.clerk.roster.closed:
             raise RefusedError(403, CLOSED)
         if self.shares.get(digest, 0) >= TOKEN_SHARE:
@@ -432,12 +424,19 @@ def _waiting(guesses: Guesses, address: str, what: str) -> None:
         raise refusal
 
 
+@functools.cache
+def _own_names() -> frozenset[str]:
+    """The names this machine answers to besides its addresses (asked once, not at every request)."""
+    host = socket.gethostname().lower()
+    return frozenset({"localhost", host, host + ".local"})
+
+
 def _named_by_address(host: str) -> bool:
     """Whether a ``Host`` header names this server by an address (or localhost), never by a domain name a
     hostile page could point at the class (DNS rebinding)."""
     name = host.rsplit(":", 1)[0] if not host.endswith("]") else host
     name = name.strip("[]").lower()
-    if name in ("localhost", socket.gethostname().lower(), socket.gethostname().lower() + ".local"):
+    if name in _own_names():
         return True
     try:
         ipaddress.ip_address(name)
@@ -526,8 +525,7 @@ def _check_token(state: ClassState, request: Request) -> str:
     token = _bearer(request)
     if token is None or state.clerk.roster.player_of(token) is None:
         state.tokens.failed(address)
-        raise RefusedError(401, "this machine has not joined the class under that name: join first "
-                                "(armgame play --join HOST:PORT --code CODE --name NAME)")
+        raise RefusedError(401, NOT_JOINED)
     state.tokens.succeeded(address)
     return token
 

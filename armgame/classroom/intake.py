@@ -44,11 +44,11 @@ from ..records.lookalikes import name_problem
 from ..records.replay import Replay, check_name, now_iso, same_outcome
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
-from ..records.standings import PlayerRow, player_key
+from ..records.standings import PlayerRow, player_key, shared_rank
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
 from ..records.tablefile import name_slug
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
-from .rounds import Round, new_round, round_view, shared_rank
+from .rounds import Round, new_round, round_view
 
 #: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
 #: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.

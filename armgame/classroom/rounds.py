@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 
-from ..records.standings import one_row_per_player, player_key
+from ..records.standings import one_row_per_player, player_key, shared_rank
 
 #: Seconds after a round's clock runs out during which a game still counts (it was finished in time).
 GRACE_SECONDS = 10
@@ -105,11 +105,3 @@ def round_view(rnd: Round | None, best_first: Sequence, hidden: Iterable[str], n
             "end": rnd.end.isoformat(timespec="seconds"), "minutes": rnd.minutes, "over": over,
             "players": len({player_key(name_of(e.name)) for e in games}), "students": table,
             "winners": [r for r in table if r["rank"] <= WINNERS] if over else []}
-
-
-def shared_rank(above: Sequence[dict[str, object]], score: int) -> int:
-    """The place of a row scoring ``score`` below the rows ``above`` (best first): equal scores share a place
-    (1, 2, 2, 4), as a class reads a table."""
-    if above and above[-1]["score"] == score:
-        return int(above[-1]["rank"])  # type: ignore[call-overload]
-    return len(above) + 1

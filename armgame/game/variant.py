@@ -161,22 +161,13 @@ class VariantPlay:
         k = i = 0
         while session.steps < steps or (stopped and session.steps == steps):
             now = session.steps
-            while i < len(levels) and levels[i].step <= now:
-                session.set_muscle_levels(levels[i].levels)
-                i += 1
-            while k < len(keys) and keys[k].step <= now:
-                session.key_event(keys[k].key, keys[k].action)
-                k += 1
+            k, i = _apply_due(session, keys, k, levels, i)
             if now % d == 0:
                 if budget is not None and not budget(session):
                     break
                 if noise is not None:
                     noise.apply(session)
-            stop = min(now - now % d + d, steps if now < steps else now + d)
-            if k < len(keys):
-                stop = min(stop, max(keys[k].step, now + 1))
-            if i < len(levels):
-                stop = min(stop, max(levels[i].step, now + 1))
+            stop = _next_input(keys, k, levels, i, now, min(now - now % d + d, steps if now < steps else now + d))
             try:
                 session.advance(stop - now)
             except RunawayError:
@@ -194,16 +185,28 @@ def play_inputs(session: GameSession, timeline: Sequence, levels: Sequence[Level
     k = i = 0
     while session.steps < steps and not session.over:
         now = session.steps
-        while i < len(levels) and levels[i].step <= now:
-            session.set_muscle_levels(levels[i].levels)
-            i += 1
-        while k < len(keys) and keys[k].step <= now:
-            session.key_event(keys[k].key, keys[k].action)
-            k += 1
-        stop = steps
-        if k < len(keys):
-            stop = min(stop, max(keys[k].step, now + 1))
-        if i < len(levels):
-            stop = min(stop, max(levels[i].step, now + 1))
-        session.advance(stop - now)
+        k, i = _apply_due(session, keys, k, levels, i)
+        session.advance(_next_input(keys, k, levels, i, now, steps) - now)
     return session
+
+
+def _apply_due(session: GameSession, keys: Sequence, k: int, levels: Sequence[LevelEvent], i: int) -> tuple[int, int]:
+    """The level events and key events due before the session's next step applied, levels first (an env's order
+    within a step); the indices of the first of each still to come."""
+    now = session.steps
+    while i < len(levels) and levels[i].step <= now:
+        session.set_muscle_levels(levels[i].levels)
+        i += 1
+    while k < len(keys) and keys[k].step <= now:
+        session.key_event(keys[k].key, keys[k].action)
+        k += 1
+    return k, i
+
+
+def _next_input(keys: Sequence, k: int, levels: Sequence[LevelEvent], i: int, now: int, stop: int) -> int:
+    """``stop``, or the step of the next key or level event if one comes sooner (at least one step on)."""
+    if k < len(keys):
+        stop = min(stop, max(keys[k].step, now + 1))
+    if i < len(levels):
+        stop = min(stop, max(levels[i].step, now + 1))
+    return stop

@@ -18,7 +18,7 @@ the one typed.
 from __future__ import annotations
 
 import unicodedata
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Generic, TypeVar
 
@@ -84,3 +84,11 @@ def place_of_new(rows: list[PlayerRow[T]], score: int, score_of: Callable[[T], i
     """The place (1-based) a new player whose game scores ``score`` would take: after every row whose
     best scores as much (an equal score already in is the earlier game)."""
     return 1 + sum(1 for row in rows if score_of(row.best) >= score)
+
+
+def shared_rank(above: Sequence[Mapping[str, object]], score: int) -> int:
+    """The place of a row scoring ``score`` below the rows ``above`` (best first, each with its "rank" and
+    "score"): equal scores share a place (1, 2, 2, 4), as a class reads a table."""
+    if above and above[-1]["score"] == score:
+        return int(above[-1]["rank"])  # type: ignore[call-overload]
+    return len(above) + 1
