@@ -32,6 +32,7 @@ setup(
                  Extension("armgame.physics._ctrig", ["armgame/physics/_ctrig.c"],
                            depends=["armgame/physics/_trig.h"], optional=True),
                  Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True),
-                 Extension("armgame.env._cvector", ["armgame/env/_cvector.c"], optional=True)],
+                 Extension("armgame.env._cvector", ["armgame/env/_cvector.c"], optional=True),
+                 Extension("armgame.records._ctimeline", ["armgame/records/_ctimeline.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},
 )

@@ -138,6 +138,23 @@ def test_an_idle_or_trickling_connection_is_closed_at_its_deadline(opened):
     trickle.close()
 
 
+def test_a_kept_alive_or_pipelined_connection_has_the_same_deadline_for_its_next_request(opened):
+    """Two requests in one packet get two answers; a third begun behind them and never finished, or none at all
+    after an answer, is cut off at the header deadline counted from the answer (or from its first byte)."""
+    state(opened).guard.header_seconds = 0.6
+    get = b"GET /api/standings HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"
+    pipelined = sock_from(opened, LAPTOP)
+    pipelined.sendall(get + get + b"GET /api/standings HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
+    kept = sock_from(opened, LAPTOP)
+    kept.sendall(get)
+    started = time.perf_counter()
+    replies = reply_of(pipelined, 4), reply_of(kept, 4)
+    assert time.perf_counter() - started < 3
+    assert replies[0].count(b"HTTP/1.1 200") == 2 and replies[1].count(b"HTTP/1.1 200") == 1
+    pipelined.close()
+    kept.close()
+
+
 def test_a_body_trickled_after_its_headers_is_cut_off(opened):
     state(opened).guard.request_seconds = 0.8
     s = sock_from(opened, LAPTOP)

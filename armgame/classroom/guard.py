@@ -3,8 +3,9 @@
 A connection that sends nothing, or trickles its headers a byte at a time, costs its sender nothing
 and the server a socket: uvicorn counts it against ``limit_concurrency`` and has no deadline for a
 request to arrive (its issue #157), and ASGI middleware runs only once headers are parsed. So the
-class wraps uvicorn's own h11 protocol (``guarded_protocol``), keeping every byte of HTTP parsing
-uvicorn's and h11's, and adds three rules at the socket:
+class wraps uvicorn's own httptools protocol (``guarded_protocol``), keeping every byte of HTTP parsing
+uvicorn's and httptools' (llhttp, in C: uvicorn's h11 protocol, pure Python, was a third of the
+server's time at a round's end), and adds three rules at the socket:
 
 * **a deadline for the request**: its headers within ``HEADER_SECONDS`` of the connection (or of the
   previous response, on a kept-alive connection), and the whole request, body included, within
@@ -27,8 +28,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
-import h11
-from uvicorn.protocols.http.h11_impl import H11Protocol
+from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol
 
 #: Seconds for a request's headers to arrive (a browser or the client sends them in one packet).
 HEADER_SECONDS = 5.0
@@ -52,74 +52,90 @@ class Guard:
     def is_own(self, address: str) -> bool:
         return address in self.own
 
+    def admit(self, address: str) -> bool:
+        """Count a new connection from ``address``, or refuse it (False) when the address has its share."""
+        if not self.is_own(address) and self.open[address] >= self.per_address:
+            self.refused += 1
+            return False
+        self.open[address] += 1
+        return True
+
+    def release(self, address: str) -> None:
+        self.open[address] -= 1
+        if self.open[address] <= 0:
+            del self.open[address]
+
+
+def _peer_address(transport: asyncio.BaseTransport) -> str:
+    peer: Any = transport.get_extra_info("peername")
+    return str(peer[0]) if isinstance(peer, tuple) and peer else ""
+
+
 
 def guarded_protocol(guard: Guard) -> type[asyncio.Protocol]:
-    """uvicorn's h11 protocol with ``guard``'s deadlines and shares (see the module)."""
+    """uvicorn's httptools protocol with ``guard``'s deadlines and shares (see the module)."""
 
-    class GuardedH11Protocol(H11Protocol):
+    class GuardedHttpToolsProtocol(HttpToolsProtocol):
         _address = ""
         _counted = False
         _deadline: asyncio.TimerHandle | None = None
+        # What the client owes: "headers" (a request to begin or finish its headers), "body", or "nothing".
+        _owes = "headers"
 
         def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
-            peer: Any = transport.get_extra_info("peername")
-            address = str(peer[0]) if isinstance(peer, tuple) and peer else ""
-            if not guard.is_own(address) and guard.open[address] >= guard.per_address:
-                guard.refused += 1
+            address = _peer_address(transport)
+            if not guard.admit(address):
                 transport.abort()  # before uvicorn counts it: the share is the whole cost
                 return
             self._address, self._counted = address, True
-            guard.open[address] += 1
             super().connection_made(transport)
-            self._await_headers()
+            self._arm(guard.header_seconds)
 
         def connection_lost(self, exc: Exception | None) -> None:
             if not self._counted:
                 return
             self._counted = False
-            guard.open[self._address] -= 1
-            if guard.open[self._address] <= 0:
-                del guard.open[self._address]
-            self._cancel_deadline()
+            guard.release(self._address)
+            self._arm(None)
             super().connection_lost(exc)
 
-        def data_received(self, data: bytes) -> None:
-            before = self.conn.their_state
-            super().data_received(data)
-            after = self.conn.their_state
-            if before is h11.IDLE and after is not h11.IDLE and not self.transport.is_closing():
-                self._arm(guard.request_seconds if after is not h11.DONE else None)
-            elif after is h11.DONE and before is not h11.DONE:
-                self._cancel_deadline()
+        def on_message_begin(self) -> None:
+            super().on_message_begin()
+            self._owes = "headers"
+            if self._deadline is None:  # a request pipelined behind an answer still being written
+                self._arm(guard.header_seconds)
+
+        def on_headers_complete(self) -> None:
+            super().on_headers_complete()
+            self._owes = "body"
+            self._arm(guard.request_seconds)
+
+        def on_message_complete(self) -> None:
+            super().on_message_complete()
+            self._owes = "nothing"
+            self._arm(None)
 
         def on_response_complete(self) -> None:
             super().on_response_complete()
-            # A new request may begin: its headers have their deadline. A body still arriving after the answer
-            # (a route that never read it) keeps the request's deadline, armed when its headers came.
-            if not self.transport.is_closing() and self.conn.their_state is h11.IDLE:
-                self._await_headers()
-
-        def _await_headers(self) -> None:
-            self._arm(guard.header_seconds)
+            # The next request's headers have their deadline from now; a body still arriving after the answer
+            # (a route that never read it) keeps the deadline armed when its headers came.
+            if not self.transport.is_closing() and self._owes == "nothing" and not self.pipeline:
+                self._owes = "headers"
+                self._arm(guard.header_seconds)
 
         def _arm(self, seconds: float | None) -> None:
-            self._cancel_deadline()
-            if seconds is not None:
-                self._deadline = self.loop.call_later(seconds, self._too_slow)
-
-        def _cancel_deadline(self) -> None:
             if self._deadline is not None:
                 self._deadline.cancel()
                 self._deadline = None
+            if seconds is not None:
+                self._deadline = self.loop.call_later(seconds, self._too_slow)
 
         def _too_slow(self) -> None:
             self._deadline = None
-            state = self.conn.their_state
-            waiting = state is h11.IDLE or state is h11.SEND_BODY
-            if waiting and not self.transport.is_closing():
+            if self._owes != "nothing" and not self.transport.is_closing():
                 if self.cycle is not None and not self.cycle.response_complete:
                     self.cycle.disconnected = True  # the app reading its body hears of it at once
                     self.cycle.message_event.set()
                 self.transport.abort()
 
-    return GuardedH11Protocol
+    return GuardedHttpToolsProtocol

@@ -38,7 +38,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Generic, TypeVar
 
-from ..game.session import DOWN, RESET_KEY, TOGGLE_ARM_KEY
+from .._native import load
+from ..game.session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, UP
 from .replay import Replay
 from .rulesets import config_digest
 
@@ -178,6 +179,31 @@ def _form_v1(replay: Replay, events: list[tuple[int, str, str]] | None = None) -
             "steps": replay.result.steps, "timeline": events}
 
 
+#: ``_ctimeline.c``: ``_both_forms`` in C, giving the forms' JSON text, where built (``armgame._native``).
+_CTIMELINE = load("armgame.records._ctimeline", 1)
+
+
+def _native_digests(replay: Replay) -> tuple[str, str] | None:
+    """``game_digests`` of a game that ran to its end from ``_both_forms``'s C twin, or None where it cannot take
+    the game (its opening comment): the same text as ``_digest`` of the two forms, so the same digests."""
+    steps = replay.result.steps
+    if _CTIMELINE is None or not 0 <= steps < 2**63 or type(replay.timeline) is not tuple:
+        return None
+    texts = _CTIMELINE.forms_text(replay.timeline, tuple(m.key for m in replay.config.muscles), steps, RESET_KEY,
+                                  TOGGLE_ARM_KEY, DOWN, UP)
+    if texts is None:
+        return None
+    held, resets, events = texts
+
+    def head(version: int) -> str:  # the form's dict up to its lists, as json.dumps writes it, without its "}"
+        return json.dumps({"identity": version, "rules": config_digest(replay.config), "seed": replay.config.seed,
+                           "steps": steps}, separators=(",", ":"))[:-1]
+
+    current = f'{head(IDENTITY_VERSION)},"held":{held},"resets":{resets}}}'
+    first = f'{head(1)},"timeline":{events}}}'
+    return (hashlib.sha256(current.encode()).hexdigest(), hashlib.sha256(first.encode()).hexdigest())
+
+
 def _digest(form: dict[str, object]) -> str:
     # check_circular=False: the same text without the encoder's note of every list it enters (a form is built here,
     # with no cycle), a fifth of the time of a bot's 15,000 events.
@@ -186,7 +212,8 @@ def _digest(form: dict[str, object]) -> str:
 
 def game_digest(replay: Replay) -> str:
     """SHA-256 (hex) of the game's canonical form: equal digests, the same game."""
-    return _digest(_form(replay))
+    native = _native_digests(replay) if replay.result.steps == replay.config.total_steps else None
+    return native[0] if native is not None else _digest(_form(replay))
 
 
 def game_digests(replay: Replay) -> tuple[str, ...]:
@@ -194,6 +221,9 @@ def game_digests(replay: Replay) -> tuple[str, ...]:
     entered before a bump holds the older one."""
     if replay.result.steps != replay.config.total_steps:  # stopped early: the two forms stop apart
         return game_digest(replay), _digest(_form_v1(replay))
+    native = _native_digests(replay)
+    if native is not None:
+        return native
     applied, events = _both_forms(replay)
     return _digest(_form(replay, applied)), _digest(_form_v1(replay, events))
 

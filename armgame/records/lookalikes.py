@@ -120,6 +120,7 @@ def _small_capital(ch: str) -> str:
     return ch
 
 
+@functools.lru_cache(maxsize=4096)  # a roster's index asks again at each change: a class of 1,000 joined in 30 s
 def skeletons(name: str) -> frozenset[str]:
     """The name as a reader sees it (see the module): two names that share a skeleton are drawn alike.
 
