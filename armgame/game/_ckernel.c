@@ -374,6 +374,7 @@ done:
 
 static PyMethodDef methods[] = {
     {"run", armgame_run, METH_VARARGS, armgame_run_doc},
+    {"event_columns", armgame_event_columns, METH_VARARGS, armgame_event_columns_doc},
     {"game_steps", (PyCFunction)(void (*)(void))game_steps, METH_FASTCALL, game_steps_doc},
     {"rk4_step", (PyCFunction)(void (*)(void))rk4_step, METH_FASTCALL, rk4_step_doc},
     {"rk4_run", rk4_run, METH_VARARGS, rk4_run_doc},
@@ -392,7 +393,7 @@ PyMODINIT_FUNC PyInit__ckernel(void)
     PyObject *m = PyModule_Create(&module);
     /* VERSION changes with the calling convention, so a stale build is refused, not misread. */
     if (m != NULL && (PyModule_AddIntConstant(m, "PARAMS", P_COUNT) < 0
-                      || PyModule_AddIntConstant(m, "VERSION", 5) < 0
+                      || PyModule_AddIntConstant(m, "VERSION", 6) < 0
                       || PyModule_AddIntConstant(m, "SINCOS", armgame_use_sincos) < 0)) {
         Py_DECREF(m);
         return NULL;

@@ -212,6 +212,9 @@ static inline void write_trig(const Batch *B, Py_ssize_t i, double q1, double q2
 
 PyObject *armgame_run(PyObject *self, PyObject *args);
 extern const char armgame_run_doc[];
+/* The events of a batch's timelines as columns (_cevents.c). */
+PyObject *armgame_event_columns(PyObject *self, PyObject *args);
+extern const char armgame_event_columns_doc[];
 /* The games of a checked call, LANES at a time: returns the games flagged (_clanes.c). */
 Py_ssize_t armgame_run_lanes(const Batch *B);
 

@@ -22,7 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, InputEvent
+from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, InputEvent, compiled_kernel
 from .kernel_inputs import KernelInputs
 
 
@@ -49,8 +49,19 @@ _RESET, _TOGGLE = 4, 5
 _FAR = 2**62
 
 
+#: ``_ckernel``'s ``event_columns`` (``_cevents.c``), where built: this pass in C, its result read in place.
+_C_EVENT_COLUMNS = getattr(compiled_kernel(), "event_columns", None)
+
+
 def _event_columns(timelines: Sequence[Sequence[InputEvent]], codes: dict[str, int]) -> tuple[np.ndarray, ...]:
-    """Every event of every timeline as columns (step, code, down), in order: the only per-event Python."""
+    """Every event of every timeline as columns (step, code, down), in order: the only per-event Python (in C
+    where built: a bot's 15,000 events in 0.3 ms rather than 3)."""
+    if _C_EVENT_COLUMNS is not None:
+        columns = _C_EVENT_COLUMNS(timelines, codes, DOWN)
+        if columns is not None:
+            steps, code, down = columns
+            return (np.frombuffer(steps, dtype=np.int64), np.frombuffer(code, dtype=np.int64),
+                    np.frombuffer(down, dtype=bool))
     events = list(chain.from_iterable(timelines))
     count = len(events)
     steps_list = list(map(attrgetter("step"), events))
