@@ -48,7 +48,7 @@ Then, each ``--repeats`` times:
    students hand in their own games one after another, 0.5 s apart, through the students' client. The
    honest hand-ins' latencies (p50, p99, max) are the figure: honest students first;
 5. **the clerk alone** (``--clerk 1000``), in this process, no HTTP: that many distinct honest hand-ins,
-   then as many forged ones, in the server's batches (``ClerkThread._hand_in``): hand-ins a second and
+   then as many forged ones, in the server's batches (``ClerkThread.hand_in_batch``): hand-ins a second and
    the CPU time of each;
 6. **the table's cost per hand-in** (``--table-sizes 10,1000,10000``): a batch of 32 games entered
    (``ScoreTable.add_many``, the clerk's write, the replays' files included) into a table already
@@ -747,12 +747,10 @@ def flood_class(flooders: int, honest: int, seconds: float, games: list[dict[str
 
 def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> dict[str, Any]:
     """The clerk alone, in this process (no HTTP): ``count`` distinct honest hand-ins, then ``count`` forged ones,
-    in the server's batches (``ClerkThread._hand_in``, ``BATCH`` at a time); CPU and wall time per hand-in."""
-    from concurrent.futures import Future
-
-    from armgame.classroom import app
+    in the server's batches (``ClerkThread.hand_in_batch``, ``BATCH`` at a time); CPU and wall time per hand-in."""
     from armgame.classroom.intake import Clerk
     from armgame.classroom.roster import Player, Roster, token_digest
+    from armgame.classroom.worker import BATCH, ClerkThread, HandIn
 
     out: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="armgame-class-clerk-") as tmp:
@@ -765,7 +763,7 @@ def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> di
         roster.save()
         roster.reindex()
         clerk = Clerk(Path(tmp), roster)
-        worker = app.ClerkThread(clerk, lambda: None)  # its batches run here, in this thread, as its own would
+        worker = ClerkThread(clerk, lambda: None)  # its batches run here, in this thread, as its own would
         for kind, paths in (("honest", [g["path"] for g in games[:count]]),
                             ("forged", forged[:count])):
             bodies = [Path(p).read_bytes() for p in paths]
@@ -773,10 +771,9 @@ def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> di
                 continue
             wall0, cpu0 = time.perf_counter(), time.process_time()
             answered: dict[str, int] = {}
-            for lo in range(0, len(bodies), app.BATCH):
-                batch = [("hand-in", (tokens[i], bodies[i]), Future()) for i in range(lo, min(len(bodies),
-                                                                                                lo + app.BATCH))]
-                for _, outcome in worker._hand_in(batch):
+            for lo in range(0, len(bodies), BATCH):
+                batch = [HandIn(tokens[i], bodies[i]) for i in range(lo, min(len(bodies), lo + BATCH))]
+                for _, outcome in worker.hand_in_batch(batch):
                     key = "ok" if isinstance(outcome, dict) else str(getattr(outcome, "status", type(outcome)))
                     answered[key] = answered.get(key, 0) + 1
             wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0

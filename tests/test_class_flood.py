@@ -12,15 +12,15 @@ import threading
 import time
 import urllib.error
 import urllib.request
-from concurrent.futures import Future
 
 import pytest
 from class_server import keyboard_game, running_class, tapped_game
 
-from armgame.classroom import app as class_app
 from armgame.classroom import client
+from armgame.classroom import state as class_state
 from armgame.classroom.intake import Clerk, RefusedError
 from armgame.classroom.roster import Roster, token_digest
+from armgame.classroom.worker import ClerkThread, HandIn
 from armgame.game.session import DOWN, InputEvent
 from armgame.records import entry as entry_module
 from armgame.records import identity
@@ -71,14 +71,13 @@ def _mix() -> list[tuple[str, bytes]]:
 
 def _batch(clerk: Clerk, hand_ins: list[tuple[str, bytes]]) -> list[object]:
     """The clerk thread's one batch of ``hand_ins``: each outcome, in their order."""
-    worker = class_app.ClerkThread(clerk, lambda: None)
+    worker = ClerkThread(clerk, lambda: None)
     try:
-        futures = [Future() for _ in hand_ins]
-        jobs = [("hand-in", h, f) for h, f in zip(hand_ins, futures, strict=True)]
-        outcomes = dict(worker._hand_in(jobs))  # here, as the clerk's thread runs a batch
+        batch = [HandIn(token, body) for token, body in hand_ins]
+        outcomes = dict(worker.hand_in_batch(batch))  # here, as the clerk's thread runs a batch
     finally:
         worker.stop()
-    return [outcomes[f] for f in futures]
+    return [outcomes[h.future] for h in batch]
 
 
 def _verdict(outcome: object) -> tuple:
@@ -198,7 +197,7 @@ def test_a_flooders_second_hand_in_while_one_waits_is_told_busy_at_once(tmp_path
         monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "m2"))
         honest = client.join(address, code, "Ann")
         gate = threading.Event()
-        state.worker.submit("job", lambda: gate.wait(30))  # the clerk busy: hand-ins wait in its queue
+        state.worker.submit(lambda: gate.wait(30))  # the clerk busy: hand-ins wait in its queue
         waiting: list = []
         first = threading.Thread(target=lambda: waiting.append(
             _post(opened.port, flooder.token, code, tapped_game(1, player="Flo").to_bytes())))
@@ -209,7 +208,7 @@ def test_a_flooders_second_hand_in_while_one_waits_is_told_busy_at_once(tmp_path
             while token_digest(flooder.token) not in state.shares and time.monotonic() < deadline:
                 time.sleep(0.01)
             status, answer, headers = _post(opened.port, flooder.token, code, tapped_game(2, player="Flo").to_bytes())
-            assert status == 503 and answer["error"] == class_app.BUSY and headers.get("retry-after")
+            assert status == 503 and answer["error"] == class_state.BUSY and headers.get("retry-after")
             other = threading.Thread(target=lambda: waiting.append(
                 _post(opened.port, honest.token, code, tapped_game(3, player="Ann").to_bytes())))
             other.start()
@@ -259,7 +258,7 @@ def test_a_refused_forgery_makes_its_players_next_hand_in_wait(tmp_path, monkeyp
         forged = _forged(tapped_game(4, player="Flo"), score=50)
         assert _post(opened.port, forger.token, code, forged.to_bytes())[0] == 422
         status, answer, _ = _post(opened.port, forger.token, code, tapped_game(5, player="Flo").to_bytes())
-        assert status == 503 and answer["error"] == class_app.BUSY  # its next game waits COOL_DOWN seconds
+        assert status == 503 and answer["error"] == class_state.BUSY  # its next game waits COOL_DOWN seconds
         assert _post(opened.port, honest.token, code, tapped_game(6, player="Ann").to_bytes())[0] == 200
         state = opened.server.config.app.state.armgame
         state.cooling[token_digest(forger.token)] = time.monotonic()  # the cool-down over

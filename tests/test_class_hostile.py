@@ -18,7 +18,8 @@ import pytest
 from class_server import keyboard_game, running_class, tapped_game, tapped_games
 
 from armgame.classroom import app as class_app
-from armgame.classroom import client
+from armgame.classroom import client, views
+from armgame.classroom import state as class_state
 from armgame.classroom.roster import Roster
 
 
@@ -56,7 +57,7 @@ def join(opened, name: str, code: str | None = None, source: str | None = None):
 def test_a_wrong_code_is_refused_and_guessing_stops_the_guesser_only(opened):
     status, answer = join(opened, "Ann", "QQQQ", source="127.0.0.2")
     assert status == 403 and answer == {"ok": False, "error": "wrong class code: check the code on the projector"}
-    for _ in range(class_app.FREE_GUESSES - 1):
+    for _ in range(class_state.FREE_GUESSES - 1):
         join(opened, "Ann", "QQQQ", source="127.0.0.2")
     status, answer = join(opened, "Ann", source="127.0.0.2")  # while it waits, no answer of its is looked at
     assert status == 429 and "too many wrong codes" in answer["error"] and "wait 60 s" in answer["error"]
@@ -198,9 +199,9 @@ def test_a_hit_storm_is_refused_before_it_is_replayed(opened):
 def test_a_flood_is_queued_and_refused_politely_and_nothing_is_lost(tmp_path, monkeypatch):
     """50 machines hand in at once into a queue of 4 and 2 upload slots: some are asked to come back
     (503), their clients ask again, and every game is entered once."""
-    monkeypatch.setattr(class_app, "QUEUE_LIMIT", 4)
-    monkeypatch.setattr(class_app, "HANDIN_QUEUE", 4)
-    monkeypatch.setattr(class_app, "UPLOADS", 2)
+    monkeypatch.setattr(class_state, "QUEUE_LIMIT", 4)
+    monkeypatch.setattr(class_state, "HANDIN_QUEUE", 4)
+    monkeypatch.setattr(class_state, "UPLOADS", 2)
     monkeypatch.setattr(client, "_retry_after", lambda value: 0.05)
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))
     busy = []
@@ -229,10 +230,10 @@ def test_a_flood_is_queued_and_refused_politely_and_nothing_is_lost(tmp_path, mo
 
 
 def test_a_failure_inside_the_class_is_one_line_and_the_class_goes_on(opened, monkeypatch, capsys):
-    def broken(teacher: bool = False):
+    def broken(clerk, teacher: bool = False):
         raise RuntimeError("a bug")
 
-    monkeypatch.setattr(opened.clerk, "standings", broken)
+    monkeypatch.setattr(views, "standings", broken)
     status, answer = call(opened, "GET", "/api/teacher/standings",
                           headers={"Authorization": f"Bearer {opened.clerk.roster.secret}"})
     assert status == 500 and "nothing was entered" in answer["error"]

@@ -23,7 +23,8 @@ from class_server import running_class, tapped_game
 
 from armgame.classroom import app as class_app
 from armgame.classroom import client
-from armgame.classroom.intake import _real_folder
+from armgame.classroom import state as class_state
+from armgame.classroom.labruns import real_folder
 from armgame.classroom.serve import open_class
 from armgame.errors import UserError
 from armgame.records.lookalikes import name_problem, skeletons
@@ -40,7 +41,7 @@ def opened(tmp_path, monkeypatch):
         yield served
 
 
-def state(opened) -> class_app.ClassState:
+def state(opened) -> class_state.ClassState:
     return opened.server.config.app.state.armgame
 
 
@@ -207,7 +208,7 @@ def test_slow_bodies_take_one_machines_share_of_uploads_not_the_class(opened):
             slow.append(s)
         for s in slow[class_app.UPLOADS_PER_ADDRESS:]:  # past the machine's share: busy at once, body unread
             replies.append(reply_of(s))
-        assert all(r.startswith(b"HTTP/1.1 503") and class_app.BUSY.encode() in r for r in replies), replies
+        assert all(r.startswith(b"HTTP/1.1 503") and class_state.BUSY.encode() in r for r in replies), replies
         started = time.perf_counter()
         status, answer = hand_in(opened, ann["token"], tapped_game(5, player="Ann").to_bytes())
         assert status == 200 and answer["ok"] and time.perf_counter() - started < 5
@@ -295,7 +296,7 @@ def test_a_page_on_another_site_cannot_join_guess_or_lock_anyone_out(opened, tmp
 
 
 def test_x_forwarded_for_is_not_believed(opened):
-    for i in range(class_app.FREE_GUESSES):
+    for i in range(class_state.FREE_GUESSES):
         call(opened, "POST", "/api/join", json.dumps({"code": "QQQQ", "name": "x"}).encode(),
              {"X-Forwarded-For": f"10.0.0.{i}"}, source=LAPTOP)
     status, _ = call(opened, "POST", "/api/join", json.dumps({"code": "QQQQ", "name": "x"}).encode(),
@@ -305,18 +306,18 @@ def test_x_forwarded_for_is_not_believed(opened):
 
 # ---------------------------------------------------------------------- lock-outs hit the guesser
 def test_codes_secrets_and_tokens_are_counted_apart_and_the_teacher_is_never_locked_out(opened):
-    for _ in range(class_app.FREE_GUESSES):
+    for _ in range(class_state.FREE_GUESSES):
         call(opened, "GET", "/api/teacher/standings", headers={"Authorization": "Bearer wrong"}, source=LAPTOP)
     assert call(opened, "GET", "/api/teacher/standings", headers={"Authorization": "Bearer wrong"},
                 source=LAPTOP)[0] == 429
     assert join(opened, "Mallory", LAPTOP)[0] == 200  # wrong secrets are not wrong codes
-    for _ in range(3 * class_app.FREE_GUESSES):  # the teacher's machine is the teacher, whatever it sends
+    for _ in range(3 * class_state.FREE_GUESSES):  # the teacher's machine is the teacher, whatever it sends
         assert call(opened, "GET", "/api/teacher/standings", headers={"Authorization": "Bearer wrong"},
                     source="127.0.0.1")[0] == 200
     secret = opened.clerk.roster.secret
     assert call(opened, "GET", "/api/teacher/standings", headers={"Authorization": f"Bearer {secret}"},
                 source=OTHER)[0] == 200  # a colleague's machine with the secret
-    for _ in range(class_app.FREE_GUESSES):
+    for _ in range(class_state.FREE_GUESSES):
         hand_in(opened, "forged-token", b"{}", LAPTOP)
     assert hand_in(opened, "forged-token", b"{}", LAPTOP)[0] == 429
     assert join(opened, "Ann")[0] == 200  # a neighbour is not refused for the laptop's guesses
@@ -324,7 +325,7 @@ def test_codes_secrets_and_tokens_are_counted_apart_and_the_teacher_is_never_loc
 
 def test_the_wait_doubles_and_a_right_code_clears_it():
     now = [0.0]
-    guesses = class_app.Guesses(free=3, wait=60.0, clock=lambda: now[0])
+    guesses = class_state.Guesses(free=3, wait=60.0, clock=lambda: now[0])
     for _ in range(3):
         guesses.failed("a")
     assert guesses.blocked_for("a") == 60.0 and not guesses.blocked("b")
@@ -334,7 +335,7 @@ def test_the_wait_doubles_and_a_right_code_clears_it():
     guesses.succeeded("a")
     assert not guesses.blocked("a")
     # The docs' figure: from one address, the wrong codes an hour can try (5 free, then 1, 2, 4, 8... minutes).
-    guesses, now[0], tries = class_app.Guesses(clock=lambda: now[0]), 0.0, 0
+    guesses, now[0], tries = class_state.Guesses(clock=lambda: now[0]), 0.0, 0
     while now[0] < 3600:
         now[0] += guesses.blocked_for("a") or 1.0
         if now[0] < 3600:
@@ -380,7 +381,7 @@ def test_the_name_rules_in_words():
 
 def test_a_join_flood_from_one_machine_is_limited_seen_removed_and_the_list_locked(opened):
     answers = [join(opened, f"Bot {letter}", LAPTOP) for letter in "ABCDEFGH"]
-    assert [s for s, _ in answers] == [200] * class_app.JOINS_PER_MINUTE + [429] * (8 - class_app.JOINS_PER_MINUTE)
+    assert [s for s, _ in answers] == [200] * class_state.JOINS_PER_MINUTE + [429] * (8 - class_state.JOINS_PER_MINUTE)
     assert "one name a student" in answers[-1][1]["error"]
     _, ann = join(opened, "Ann")
     secret = {"Authorization": f"Bearer {opened.clerk.roster.secret}"}
@@ -405,11 +406,11 @@ def test_a_lab_folder_planted_as_a_link_is_refused(tmp_path):
     outside.mkdir()
     (tmp_path / "lab").symlink_to(outside, target_is_directory=True)
     with pytest.raises(UserError, match="not a folder"):
-        _real_folder(tmp_path / "lab")
+        real_folder(tmp_path / "lab")
     (tmp_path / "lab-more").write_text("x")
     with pytest.raises(UserError, match="not a folder"):
-        _real_folder(tmp_path / "lab-more")
-    _real_folder(tmp_path / "fresh")
+        real_folder(tmp_path / "lab-more")
+    real_folder(tmp_path / "fresh")
     assert stat.S_ISDIR(os.lstat(tmp_path / "fresh").st_mode) and list(outside.iterdir()) == []
 
 
@@ -486,8 +487,8 @@ def test_the_guide_states_the_class_limits_as_they_are():
                   f"one machine holds at most {guard.PER_ADDRESS}",
                   f"{class_app.STREAMS_PER_ADDRESS} of the projector's live pages",
                   f"{class_app.UPLOADS_PER_ADDRESS} hand-ins being uploaded",
-                  f"{class_app.FREE_GUESSES} free, then a wait of {class_app.GUESS_WAIT / 60:g} minute",
+                  f"{class_state.FREE_GUESSES} free, then a wait of {class_state.GUESS_WAIT / 60:g} minute",
                   "10 tries an hour",  # test_the_wait_doubles_and_a_right_code_clears_it counts them
-                  f"at most {class_app.JOINS_PER_MINUTE} new names a minute (the class",
-                  f"{class_app.CLASS_JOINS_PER_MINUTE})"):
+                  f"at most {class_state.JOINS_PER_MINUTE} new names a minute (the class",
+                  f"{class_state.CLASS_JOINS_PER_MINUTE})"):
         assert claim in " ".join(section.split()), claim

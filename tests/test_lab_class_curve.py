@@ -1,7 +1,7 @@
 """The class curve after class is the projector's (issue 39): ``armgame analyze --class`` on a class's folder
-and the class's ``/lab`` (``Clerk.lab_curve``) are built by one function, ``lab.analysis.class_curve_of``, from
-the teacher's protocol (``class.json``), people's first runs only, programs counted apart, hidden names left
-out; and ``analyze --class`` needs no matplotlib."""
+and the class's ``/lab`` (``classroom.views.lab_curve``) are built by one function,
+``lab.analysis.class_curve_of``, from the teacher's protocol (``class.json``), people's first runs only,
+programs counted apart, hidden names left out; and ``analyze --class`` needs no matplotlib."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import pytest
 
 from armgame.classroom.intake import Clerk
 from armgame.classroom.roster import Roster
+from armgame.classroom.views import lab_curve
 from armgame.cli import main
 from armgame.lab.protocol import load_protocol
 from armgame.records.replay import Replay
@@ -59,7 +60,7 @@ def test_analyze_class_is_the_projectors_curve(tmp_path, runs, monkeypatch, caps
     program = dataclasses.replace(Replay.load(runs / "short6.json"), player="Bot").to_bytes()
     assert "a program's run" in clerk.hand_in(tokens["Bot"], program)["message"]
     clerk.hide("Dee", True)
-    projector = clerk.lab_curve()
+    projector = lab_curve(clerk)
     assert (projector["protocol"], projector["students"], projector["programs"]) == ("short", 2, 1)
     # A class from before programs went to lab-more/: the bot's run in lab/ beside the people's. The projector's
     # curve never had it; analyze once counted it as a third student.
@@ -81,7 +82,7 @@ def test_analyze_class_is_the_projectors_curve(tmp_path, runs, monkeypatch, caps
     # The same class read again by its server (a restart) draws the same curve.
     again = Clerk(folder, Roster.open(folder, None)[0])
     again.load_lab()
-    assert again.lab_curve() == projector
+    assert lab_curve(again) == projector
 
 
 def test_a_folder_that_is_no_class_keeps_its_rules(tmp_path, runs, capsys):

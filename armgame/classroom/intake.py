@@ -1,35 +1,35 @@
-"""One hand-in, from arrival to answer, and the class's standings built from what was entered.
+"""The class's one writer, the ``Clerk``: a join, one hand-in from arrival to answer, the teacher's changes.
 
-The ``Clerk`` is the class's one writer: the server runs every change (a join, a hand-in, the
-teacher's hide and close) through it on a single worker thread, so the table, the roster and the
-lab folder never see two writers, and a hand-in is answered only once it is durably on disk (the
-table's own atomic, fsynced write). Everything a request carries is checked here before it costs
-anything: the replay is parsed with the replay reader's schema, its work bounded before it is
-re-simulated, its player taken from the token (never from the file), its game identified by its
-content (``records.identity``), so the same game from two machines is one game.
+The server runs every change (a join, a hand-in, the teacher's hide and close) through the clerk on
+a single worker thread (``worker.ClerkThread``), so the table, the roster and the lab folder never
+see two writers, and a hand-in is answered only once it is durably on disk (the table's own atomic,
+fsynced write). Everything a request carries is checked here before it costs anything: the replay
+is parsed with the replay reader's schema, its work bounded before it is re-simulated, its player
+taken from the token (never from the file), its game identified by its content
+(``records.identity``), so the same game from two machines is one game.
+
+The clerk keeps the class's state and answers each hand-in (its rank, from ``board``); what the
+pages show (the standings, the class curve, the teacher's roster and CSVs) is built from that state
+by ``views``, on the same thread.
 
 The class's folder::
 
     class.json, teacher.secret   the roster (``roster``)
     scores.json, replays/        an ordinary armgame table: ``armgame scores --scores DIR`` reads it
     lab/                         each student's first lab run of each protocol (``analyze --class``)
-    lab-more/                    their later runs, kept, not in the class curve
+    lab-more/                    their later runs, kept, not in the class curve (``labruns``)
 """
 
 from __future__ import annotations
 
 import bisect
 import contextlib
-import csv
-import hashlib
 import hmac
-import io
-import math
 import os
 import secrets
 import stat
 from collections import OrderedDict
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -39,16 +39,17 @@ from ..errors import UserError
 from ..game.batch import replay_many
 from ..game.session import GameResult
 from ..records.batch_verify import batchable
-from ..records.identity import game_digest, game_digests
+from ..records.identity import game_digests
 from ..records.lookalikes import name_problem
 from ..records.replay import Replay, check_name, now_iso, same_outcome
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
-from ..records.standings import PlayerRow, player_key, shared_rank
-from ..records.storage import DataFileError, atomic_write_bytes, read_limited
-from ..records.tablefile import name_slug
+from ..records.standings import player_key, shared_rank
+from ..records.storage import DataFileError
+from .board import Board
+from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
-from .rounds import Round, new_round, round_view
+from .rounds import Round, new_round
 
 #: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
 #: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
@@ -57,9 +58,6 @@ MAX_HANDIN_BYTES = 4 * 1024 * 1024
 #: A standard game costs 15,000 steps and its hits and events; a lab run, its protocol's steps.
 #: A game claiming more (a "hit storm") is refused before anything is replayed.
 MAX_HANDIN_WORK = 1_500_000
-#: Rows of each list the standings carry: the projector shows the top, the CSV has everything.
-STANDINGS_ROWS = 60
-LAB_DIR, LAB_MORE_DIR = "lab", "lab-more"
 NOT_JOINED = ("this machine has not joined the class under that name: join first "
               "(armgame play --join HOST:PORT --code CODE --name NAME)")
 CLOSED = "the class is closed: no more games are taken (your replay stays on your machine)"
@@ -69,12 +67,14 @@ REMEMBERED_FORGERIES = 4096
 
 
 class RefusedError(Exception):
-    """A request the class turns down: an HTTP status and one line saying why (sent as it is)."""
+    """A request the class turns down: an HTTP status and one line saying why (sent as it is); for 429 and 503,
+    the seconds after which to ask again (``Retry-After``)."""
 
-    def __init__(self, status: int, message: str) -> None:
+    def __init__(self, status: int, message: str, retry_after: int = 2) -> None:
         super().__init__(message)
         self.status = status
         self.message = message
+        self.retry_after = retry_after
 
 
 @dataclass(frozen=True)
@@ -88,14 +88,22 @@ class Arrival:
     program: bool
 
 
+#: What the student's machine is told of a hand-in taken: a JSON object (``ok``, ``already``, ``message``; for a
+#: game, its rank and the top of its list).
+Answer = dict[str, object]
+
+
 @dataclass(frozen=True)
 class Checked:
-    """A game checked and verified, not yet entered: its player, its replay under their name, its identity
-    (``identity.game_digests``: the current version's first)."""
+    """A hand-in through every check, nothing of it entered yet: a game verified for ``enter`` (its player,
+    its replay under their name, its identity: ``identity.game_digests``, the current version's first), or,
+    when ``answer`` is set, a hand-in answered already (the player's own game handed in before; a lab run,
+    kept at once), which ``enter`` never sees."""
 
     player: Player
     replay: Replay
-    digests: tuple[str, ...]
+    digests: tuple[str, ...] = ()
+    answer: Answer | None = None
 
 
 class _Again:
@@ -114,67 +122,9 @@ class _Pending:
     digests: tuple[str, ...]
 
 
-@dataclass
-class LabRun:
-    player: str
-    program: bool
-    protocol: Any
-    rows: list[dict[str, object]]
-    path: Path
-    #: A person's first run of its protocol (in ``lab/``): the only kind the class curve reads.
-    first: bool = True
-
-
 def ordinal(n: int) -> str:
     suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
     return f"{n}{suffix}"
-
-
-class _Board:
-    """One list's rows, one a player, best first (``standings.one_row_per_player`` of the list), kept up to
-    date as entries arrive: a player's rank is a binary search, not a pass over every entry."""
-
-    def __init__(self, best_first: Iterable[ScoreEntry] = (), renamed: dict[str, str] | None = None) -> None:
-        self._rows: dict[str, PlayerRow] = {}
-        self._order: list[tuple[tuple, str]] = []  # (sort_key of the row's best, its player's key), sorted
-        #: Names the teacher changed (``Roster.renamed``: the old name's key to the name now shown): a renamed
-        #: student's games from before and after are one row, under the new name.
-        self.renamed = renamed or {}
-        for entry in best_first:
-            self.add(entry)
-
-    def __len__(self) -> int:
-        return len(self._order)
-
-    def add(self, entry: ScoreEntry) -> None:
-        name = self.renamed.get(player_key(entry.name), entry.name)
-        key = player_key(name)
-        row = self._rows.get(key)
-        if row is None:
-            self._rows[key] = PlayerRow(name, entry, 1)
-            bisect.insort(self._order, (sort_key(entry), key))
-        elif sort_key(entry) < sort_key(row.best):  # a new best: the row moves, under the best game's name
-            del self._order[bisect.bisect_left(self._order, (sort_key(row.best), key))]
-            self._rows[key] = PlayerRow(name, entry, row.games + 1)
-            bisect.insort(self._order, (sort_key(entry), key))
-        else:
-            self._rows[key] = PlayerRow(row.name, row.best, row.games + 1)
-
-    def rank(self, key: str) -> int:
-        """The 1-based place of the player whose ``player_key`` is ``key`` (who has a row)."""
-        return bisect.bisect_left(self._order, (sort_key(self._rows[key].best), key)) + 1
-
-    def row(self, rank: int) -> PlayerRow:
-        return self._rows[self._order[rank - 1][1]]
-
-    def each(self) -> Iterator[PlayerRow]:
-        """The rows best first, one at a time: the projector's standings stop at their 60th."""
-        for _, key in self._order:
-            yield self._rows[key]
-
-    def rows(self, first: int | None = None) -> list[PlayerRow]:
-        """The rows best first (the ``first`` ones only, if given)."""
-        return [self._rows[key] for _, key in self._order[:first]]
 
 
 class Clerk:
@@ -265,20 +215,20 @@ class Clerk:
         return player
 
     # ------------------------------------------------------------------ handing in
-    def hand_in(self, token: str | None, data: bytes) -> dict[str, object]:
+    def hand_in(self, token: str | None, data: bytes) -> Answer:
         """Check, verify and enter one replay; the answer the student's machine shows. Raises RefusedError."""
         found = self.check(token, data)
-        if isinstance(found, dict):
-            return found
+        if found.answer is not None:
+            return found.answer
         answer = self.enter([found])[0]
         if isinstance(answer, RefusedError):
             raise answer
         return answer
 
-    def check(self, token: str | None, data: bytes) -> dict[str, object] | Checked:
-        """A hand-in checked and verified, ready to ``enter``; or the answer already (a game handed in
-        before by the same player; a lab run, which is kept here at once). Raises RefusedError; writes
-        nothing but a lab run."""
+    def check(self, token: str | None, data: bytes) -> Checked:
+        """A hand-in checked and verified, ready to ``enter``, or answered already (``Checked.answer``: a game
+        handed in before by the same player; a lab run, which is kept here at once). Raises RefusedError;
+        writes nothing but a lab run."""
         found = self.check_many([(token, data)])[0]
         if isinstance(found, BaseException):
             raise found
@@ -286,12 +236,12 @@ class Clerk:
         return found
 
     def check_many(self, hand_ins: Sequence[tuple[str | None, bytes]]
-                   ) -> list[dict[str, object] | Checked | BaseException | _Again]:
+                   ) -> list[Checked | BaseException | _Again]:
         """``check`` of hand-ins that arrived together, each outcome (the exception ``check`` would raise,
         returned) in order: the cheap refusals first, then the games still to verify re-simulated together
         (``records.batch_verify``'s lanes, each verdict the single session's, bit for bit). ``AGAIN``: a game the
         batch holds earlier, to check again once the batch is entered (``check`` never returns it)."""
-        outcomes: list[dict[str, object] | Checked | BaseException | _Pending | _Again] = []
+        outcomes: list[Checked | BaseException | _Pending | _Again] = []
         for token, data in hand_ins:
             try:
                 outcomes.append(self._read(token, data))
@@ -307,7 +257,7 @@ class Clerk:
                 seen.update(p.digests)
         pending = [p for p in outcomes if isinstance(p, _Pending)]
         verdicts = self._verify_games([(p.replay, p.digests[0]) for p in pending])
-        judged: dict[int, dict[str, object] | Checked | BaseException] = {}
+        judged: dict[int, Checked | BaseException] = {}
         for p, verdict in zip(pending, verdicts, strict=True):
             if isinstance(verdict, BaseException):
                 judged[id(p)] = verdict
@@ -319,7 +269,7 @@ class Clerk:
                                   f"{recomputed.score}): not entered")
         return [judged[id(o)] if isinstance(o, _Pending) else o for o in outcomes]
 
-    def _read(self, token: str | None, data: bytes) -> dict[str, object] | _Pending:
+    def _read(self, token: str | None, data: bytes) -> Checked | _Pending:
         """One hand-in up to its verification: the checks that cost nothing first (the token, a closed
         class), then the replay read once, its work bounded, its rules and seed, its identity computed once
         and looked up; a lab run is kept here (its own verification). Raises RefusedError."""
@@ -335,10 +285,10 @@ class Clerk:
             raise RefusedError(413, f"the replay claims {replay.result.hits} hits in {replay.result.steps} steps, more "
                                f"to check ({work:,}) than a class checks for one hand-in ({MAX_HANDIN_WORK:,})")
         if replay.task is not None:
-            return self._lab_run(player, replay)
+            return Checked(player, replay, answer=self._lab_run(player, replay))
         return self._game(player, replay)
 
-    def _game(self, player: Player, replay: Replay) -> dict[str, object] | _Pending:
+    def _game(self, player: Player, replay: Replay) -> Checked | _Pending:
         r = replay.result
         if not replay.complete:
             raise RefusedError(400, "the game stopped before its clock ran out: only a whole game is handed in")
@@ -352,7 +302,7 @@ class Clerk:
         twin = next((self.games[d] for d in digests if d in self.games), None)
         if twin is not None:  # known: answered without re-simulating it
             if player_key(self.shown_name(twin.name)) == player_key(player.name):
-                return self._answer(twin, already=True)
+                return Checked(player, replay, digests, answer=self._answer(twin, already=True))
             raise RefusedError(409, f"this game was already handed in by {twin.name}: a game counts once, whoever "
                                f"hands it in")
         return _Pending(player, replay, digests)
@@ -402,7 +352,7 @@ class Clerk:
         while len(self._recomputed) > REMEMBERED_FORGERIES:
             self._recomputed.popitem(last=False)
 
-    def enter(self, checked: Sequence[Checked]) -> list[dict[str, object] | RefusedError]:
+    def enter(self, checked: Sequence[Checked]) -> list[Answer | RefusedError]:
         """Enter checked games together (one table write for all: a burst of a class costs one write, not
         thirty); each game's answer, or why it was not entered. Durable on disk before this returns."""
         try:
@@ -410,7 +360,7 @@ class Clerk:
         except (ValueError, UserError) as exc:  # the table could not be written: none was entered
             refusal = RefusedError(503, f"the class's table could not take the game: {exc}")
             return [refusal for _ in checked]
-        answers: list[dict[str, object] | RefusedError] = []
+        answers: list[Answer | RefusedError] = []
         fresh = [r for r in results if isinstance(r, ScoreEntry)]
         for entry in fresh:
             bisect.insort(self.entries, entry, key=sort_key)
@@ -435,7 +385,7 @@ class Clerk:
                 answers.append(RefusedError(400, f"not entered: {result}"))
         return answers
 
-    def _answer(self, entry: ScoreEntry, already: bool = False) -> dict[str, object]:
+    def _answer(self, entry: ScoreEntry, already: bool = False) -> Answer:
         """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""
         board = self.boards[entry.program]
         rank = board.rank(player_key(self.shown_name(entry.name)))
@@ -463,21 +413,18 @@ class Clerk:
                 "note": note, "top": top, "message": ("already handed in: " if already else "handed in: ") + line}
 
     def _build_boards(self) -> None:
-        self.boards = {programs: _Board((e for e in self.entries if e.program == programs), self.roster.renamed)
+        self.boards = {programs: Board((e for e in self.entries if e.program == programs), self.roster.renamed)
                        for programs in (False, True)}
 
     def shown_name(self, name: str) -> str:
         """The name the class shows for a game entered under ``name`` (the teacher may have changed it)."""
         return self.roster.renamed.get(player_key(name), name)
 
-    def _rows(self, programs: bool) -> Iterator[PlayerRow]:
-        return self.boards[programs].each()
-
     # ------------------------------------------------------------------ the lab
-    def _lab_run(self, player: Player, replay: Replay) -> dict[str, object]:
+    def _lab_run(self, player: Player, replay: Replay) -> Answer:
         from ..lab.analysis import trial_rows
 
-        game = _lab_identity(replay)
+        game = lab_identity(replay)
         if game in self.lab_digests:  # known before its replay (the costly part) is run again
             return {"ok": True, "already": True, "message": "already handed in: this lab run is in the class"}
         replay = replay.with_player(player.name)
@@ -489,10 +436,7 @@ class Clerk:
         # A person's first run of a protocol is the one in the curve; a program's run never takes that place.
         first = person and not any(run.protocol == protocol and not run.program and
                                    player_key(run.player) == player_key(player.name) for run in self.lab_runs)
-        folder = self.folder / (LAB_DIR if first else LAB_MORE_DIR)
-        _real_folder(folder)
-        path = folder / f"{name_slug(player.name)}-{game[:12]}.json"
-        atomic_write_bytes(path, replay.to_bytes(), "lab run")
+        path = write_run(self.folder, player.name, replay, game, first)
         self.lab_digests.add(game)
         self.lab_runs.append(LabRun(player.name, not person, protocol, trial_rows(session) if first or not person
                                     else [], path, first))
@@ -500,7 +444,7 @@ class Clerk:
         self.lab_version += 1
         if not person:
             counted = "a program's run: kept apart, never in the class curve"
-        elif first and self._curve_protocol() == protocol:
+        elif first and self.curve_protocol() == protocol:
             counted = "in the class curve"
         elif first:
             counted = "kept (the class curve shows the protocol the teacher chose)"
@@ -510,76 +454,19 @@ class Clerk:
 
     def load_lab(self) -> list[str]:
         """Re-verify the lab runs already in the folder (at a restart); returns a line per run left out."""
-        from ..lab.analysis import trial_rows
-
-        problems = []
-        for path in _runs_in(self.folder / LAB_DIR):
-            try:
-                replay = _read_run(path)
-                if replay.task is None or replay.player is None:
-                    raise UserError(f"{path}: not a lab run with a player's name")
-                if replay.driven != "keyboard":
-                    raise UserError(f"{path}: a program's run (kept, never in the class curve)")
-                ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)
-                if not ok:
-                    raise UserError(f"{path}: does not reproduce its trials")
-            except UserError as exc:
-                problems.append(str(exc))
-                continue
-            self.lab_digests.add(_lab_identity(replay))
-            self.lab_runs.append(LabRun(replay.player, replay.driven != "keyboard", replay.task.protocol,
-                                        trial_rows(session), path))
-        for path in _runs_in(self.folder / LAB_MORE_DIR):
-            with contextlib.suppress(UserError):
-                replay = _read_run(path)
-                self.lab_digests.add(_lab_identity(replay))
-                if replay.task is None or replay.player is None:
-                    continue
-                rows: list[dict[str, object]] = []
-                if replay.driven != "keyboard":  # a program's run: its reaches are in the teacher's CSV
-                    ok, _, session = replay.task.verify(replay.config, replay.timeline, replay.result)
-                    if not ok:
-                        continue
-                    rows = trial_rows(session)
-                self.lab_runs.append(LabRun(replay.player, replay.driven != "keyboard", replay.task.protocol, rows,
-                                            path, first=False))
+        runs, identities, problems = read_runs(self.folder, MAX_HANDIN_BYTES)
+        self.lab_runs += runs
+        self.lab_digests |= identities
         if self.lab_runs:
             self.version += 1
             self.lab_version += 1
         return problems
 
-    def _curve_protocol(self) -> Any:
+    def curve_protocol(self) -> Any:
         """The protocol the teacher chose for the class curve (``Roster.lab``), or None."""
         from ..lab.analysis import curve_protocol
 
         return curve_protocol(self.roster.lab)
-
-    def class_curve(self) -> Any:
-        """``lab.analysis.class_curve_of`` the teacher's protocol over the class's runs (in SI units): hidden
-        names left out, programs' runs counted apart."""
-        from ..lab.analysis import ClassRun, class_curve_of
-
-        runs = [run for run in self.lab_runs if run.program or (run.first and not self.roster.is_hidden(run.player))]
-        return class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
-                              self._curve_protocol())
-
-    def lab_curve(self) -> dict[str, object]:
-        """The class curve of the protocol the teacher chose: each person's first run of it (programs' runs
-        and hidden names never in it; the programs counted apart). Built by ``lab.analysis.class_curve_of``,
-        as ``armgame analyze --class`` builds it from the folder afterwards."""
-        from ..lab.analysis import display_unit
-
-        protocol = self._curve_protocol()
-        curve = self.class_curve()
-        if not curve.students:
-            return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
-                    "metric": None, "trials": []}
-        scale, unit = display_unit(curve.metric)  # type: ignore[arg-type]
-        trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
-                   "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
-                  for row in curve.trials]
-        return {"protocol": protocol.name, "students": curve.students, "programs": curve.programs,
-                "metric": curve.metric, "unit": unit, "trials": trials}
 
     # ------------------------------------------------------------------ the teacher
     def hide(self, name: object, hidden: bool) -> str:
@@ -677,34 +564,6 @@ class Clerk:
         self.lab_version += 1
         return f"the class curve shows {protocol}" if protocol else "the class curve shows no protocol"
 
-    # ------------------------------------------------------------------ what the page shows
-    def standings(self, teacher: bool = False) -> dict[str, object]:
-        """The class as the projector shows it (hidden names left out), or as the teacher sees it."""
-
-        def rows(programs: bool) -> list[dict[str, object]]:
-            out = []
-            for row in self._rows(programs):
-                hidden = self.roster.is_hidden(row.name)
-                if hidden and not teacher:
-                    continue
-                e = row.best
-                out.append({"rank": shared_rank(out, e.score), "name": row.name, "score": e.score, "hits": e.hits,
-                            "games": row.games, "driver": e.how if programs else None,
-                            **({"hidden": hidden} if teacher else {})})
-                if len(out) >= STANDINGS_ROWS and not teacher:
-                    break
-            return out
-
-        arrival = self.arrival
-        shown = arrival is not None and not self.roster.is_hidden(arrival.name)
-        return {"version": self.version, "seed": self.roster.seed, "closed": self.roster.closed,
-                "joined": len(self.roster.players), "games": len(self.entries),
-                "round": None if teacher else self.round_view(),
-                "students": rows(False), "programs": rows(True),
-                "arrival": None if not shown else {"seq": arrival.seq, "name": arrival.name,  # type: ignore[union-attr]
-                                                   "score": arrival.score, "note": arrival.note,  # type: ignore[union-attr]
-                                                   "program": arrival.program}}  # type: ignore[union-attr]
-
     # ------------------------------------------------------------------ rounds
     def current_round(self) -> Round | None:
         return None if self.roster.round is None else Round.from_dict(self.roster.round)
@@ -738,119 +597,4 @@ class Clerk:
         self.version += 1
         return True
 
-    def round_view(self, now: datetime | None = None) -> dict[str, object] | None:
-        return round_view(self.current_round(), self.entries, self.roster.hidden, now or datetime.now(UTC),
-                          STANDINGS_ROWS, name_of=self.shown_name)
 
-    def roster_view(self) -> dict[str, object]:
-        """For the teacher's page: every joined name with the machine (address) it joined from and its games
-        (0: joined, not played yet), grouped by address, most names first; whether the list is locked, and the
-        class curve's protocol."""
-        from ..lab.protocol import PRESETS
-
-        played: dict[str, int] = {}
-        for entry in self.entries:
-            key = player_key(self.shown_name(entry.name))
-            played[key] = played.get(key, 0) + 1
-        machines: dict[str, list[dict[str, object]]] = {}
-        for key, p in self.roster.players.items():
-            machines.setdefault(p.address or "unknown", []).append(
-                {"name": p.name, "joined": p.joined, "games": played.get(key, 0),
-                 "hidden": key in self.roster.hidden})
-        groups = [{"address": address, "names": sorted(names, key=lambda n: str(n["joined"]))}
-                  for address, names in machines.items()]
-        groups.sort(key=lambda g: (-len(g["names"]), g["address"]))  # type: ignore[arg-type]
-        lab = self.roster.lab
-        return {"machines": groups, "joined": len(self.roster.players),
-                "waiting": sum(1 for k in self.roster.players if not played.get(k)),
-                "locked": self.roster.locked, "closed": self.roster.closed,
-                "lab": lab.get("name") if isinstance(lab, dict) else lab, "presets": list(PRESETS)}
-
-    def games_csv(self) -> str:
-        """Every game entered, in order; ``entered_local`` is the teacher's clock (what a teacher compares with
-        the lesson), ``entered_at`` the same moment in UTC as the table keeps it."""
-        columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_local",
-                   "entered_at", "hidden", "replay")
-        ordered = sorted(self.entries, key=lambda e: e.entered or 0)
-        return _csv(columns, ([e.entered, e.name, "programs" if e.program else "students", e.driven, e.driver or "",
-                               e.score, e.hits, e.resets, e.seed, local_time(e.entered_at), e.entered_at or "",
-                               self.roster.is_hidden(e.name), e.replay] for e in ordered))
-
-    def lab_csv(self) -> str:
-        from ..lab.metrics import TRIAL_COLUMNS
-
-        columns = ("player", "program", "protocol", "replay", *TRIAL_COLUMNS)
-        return _csv(columns, ([run.player, run.program, run.protocol.name, run.path.name,
-                               *(row[c] for c in TRIAL_COLUMNS)] for run in self.lab_runs for row in run.rows
-                              if run.first or run.program))
-
-
-def _real_folder(folder: Path) -> None:
-    """``folder`` made if missing; refused if anything but a real folder is there (a planted link would
-    carry the class's writes out of its folder)."""
-    try:
-        os.mkdir(folder, 0o700)
-    except FileExistsError:
-        pass
-    except OSError as exc:
-        raise UserError(f"cannot make the class's {folder.name}/ folder: {exc.strerror or exc}") from None
-    if not stat.S_ISDIR(os.lstat(folder).st_mode):
-        raise UserError(f"the class's {folder.name}/ is not a folder (a link or a file was put there): nothing was "
-                        f"written")
-
-
-def _runs_in(folder: Path) -> list[Path]:
-    """The lab runs kept in ``folder`` (regular files only: a planted link is not followed)."""
-    if not folder.is_dir() or folder.is_symlink():
-        return []
-    return sorted(p for p in folder.glob("*.json") if p.is_file() and not p.is_symlink())
-
-
-def _read_run(path: Path) -> Replay:
-    return Replay.from_bytes(read_limited(path, MAX_HANDIN_BYTES, "lab run", follow=False), str(path))
-
-
-def _lab_identity(replay: Replay) -> str:
-    """A lab run's identity: its game's (``records.identity``) and its protocol, whoever's name it carries."""
-    return hashlib.sha256((game_digest(replay) + repr(replay.task.as_dict())).encode()).hexdigest()  # type: ignore[union-attr]
-
-
-def _finite(value: object, scale: float) -> float | None:
-    value = float(value)  # type: ignore[arg-type]
-    return round(value * scale, 6) if math.isfinite(value) else None
-
-
-_FORMULA = ("=", "+", "-", "@", "\t", "\r")
-
-
-def csv_cell(value: object) -> str:
-    """A cell a spreadsheet shows as text: a leading = + - @ would make it a formula (OWASP's advice:
-    prefix a quote). Numbers are written as they are, so they stay numbers."""
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, int | float) and not isinstance(value, bool):
-        return "" if isinstance(value, float) and not math.isfinite(value) else repr(value)
-    text = str(value)
-    return "'" + text if text.startswith(_FORMULA) else text
-
-
-def local_time(utc: str | None) -> str:
-    """An ISO time with its zone as this machine's local time, to the second (the teacher's clock)."""
-    if not utc:
-        return ""
-    try:
-        return datetime.fromisoformat(utc).astimezone().strftime("%Y-%m-%d %H:%M:%S")
-    except (ValueError, OverflowError, OSError):
-        return ""
-
-
-def _csv(columns: Sequence[str], rows) -> str:
-    """The CSV text, with a byte-order mark first: the one sign a spreadsheet (Excel) reads to take the file as
-    UTF-8, so an accented name is not garbled."""
-    out = io.StringIO()
-    out.write("\ufeff")
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(columns)
-    for row in rows:
-        writer.writerow([csv_cell(v) for v in row])
-    return out.getvalue()

@@ -39,12 +39,13 @@ def _read(name: str) -> bytes:
     return resources.files(__package__).joinpath("static", name).read_bytes()
 
 
-def response(name: str, headers: dict[str, str]) -> Response:
-    """The static file ``name`` if it is one of ``PAGES``; else 404 (the name is never used as a path)."""
+def response(name: str) -> Response:
+    """The static file ``name`` if it is one of ``PAGES``; else 404 (the name is never used as a path). The
+    security headers (no inline script) are the app's middleware's, as on every answer."""
     media = PAGES.get(name)
     if media is None:
         raise RefusedError(404, "no such page")
-    return Response(_read(name), 200, headers, media_type=media)
+    return Response(_read(name), 200, media_type=media)
 
 
 @cache

@@ -1,0 +1,188 @@
+"""What every request and every answer of the class passes through, said once.
+
+* ``SecurityHeaders`` (around the whole app): every answer carries ``SECURITY_HEADERS`` (a content
+  security policy that allows no inline script, no sniffing, no referrer, nothing cached), the
+  router's own 404 and 405 included;
+* ``SameSite`` (on each of the class's routes, ``app.ROUTES``): a request the class's own pages or the
+  student's client could have sent, else refused (see ``same_site``); a path or a method the class
+  does not serve stays the router's own 404 or 405, as it always was;
+* ``EXCEPTION_HANDLERS`` (Starlette's ``exception_handlers``): a ``RefusedError`` from any endpoint,
+  check or job is its JSON answer (``refusal``); a ``UserError`` (a file the clerk could not write) is
+  a 503 in one line with no path of the teacher's machine, and one line in the teacher's terminal;
+* ``OneLineErrors`` (inside ``SecurityHeaders``): any other exception is a bug, answered 500 in one
+  line, with one line in the teacher's terminal, and the class goes on. Starlette's own handler for
+  ``Exception`` (``ServerErrorMiddleware``) would raise it again for the server to print a traceback
+  into the terminal the teacher reads the class's code from.
+
+Answers are JSON (``json_answer``): ``{"ok": false, "error": "one line"}`` when refused.
+"""
+
+from __future__ import annotations
+
+import functools
+import ipaddress
+import json
+import socket
+import sys
+from collections.abc import Mapping
+from typing import Any
+
+from starlette.datastructures import Headers
+from starlette.requests import Request
+from starlette.responses import Response
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from ..errors import UserError
+from .intake import RefusedError
+
+SECURITY_HEADERS = {
+    "Content-Security-Policy": "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
+                               "img-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'",
+    "Cross-Origin-Resource-Policy": "same-origin",
+    "X-Content-Type-Options": "nosniff",
+    "Referrer-Policy": "no-referrer",
+    "Cache-Control": "no-store",
+}
+_RAW_SECURITY_HEADERS = [(name.lower().encode("latin-1"), value.encode("latin-1"))
+                         for name, value in SECURITY_HEADERS.items()]
+#: Statuses after which a request's body may be left unread: the connection is closed after the answer.
+_BODY_LEFT = (400, 401, 403, 408, 413, 415, 429, 503)
+
+
+def json_answer(data: object, status: int = 200, headers: Mapping[str, str] | None = None) -> Response:
+    """``data`` as the class's JSON (ASCII only, no NaN)."""
+    body = json.dumps(data, ensure_ascii=True, allow_nan=False).encode()
+    return Response(body, status, headers, media_type="application/json")
+
+
+def refusal(exc: RefusedError) -> Response:
+    """A refusal's answer: its status and its one line; when to come back (429, 503), and the connection closed
+    where a body may be left unread."""
+    headers = {"Retry-After": str(exc.retry_after)} if exc.status in (429, 503) else {}
+    if exc.status in _BODY_LEFT:
+        headers["Connection"] = "close"
+    return json_answer({"ok": False, "error": exc.message}, exc.status, headers)
+
+
+async def _refused(request: Request, exc: Exception) -> Response:
+    assert isinstance(exc, RefusedError)
+    return refusal(exc)
+
+
+async def _not_written(request: Request, exc: Exception) -> Response:
+    """A file the clerk could not write: one line, nothing entered; no path for the room."""
+    print(f"armgame class: {request.method} {request.url.path}: {exc}"[:300], file=sys.stderr)
+    return refusal(RefusedError(503, "the class could not write this down (the teacher's terminal says why); "
+                                     "nothing was entered, and your machine keeps what it sent"))
+
+
+EXCEPTION_HANDLERS: dict[Any, Any] = {RefusedError: _refused, UserError: _not_written}
+
+
+class SecurityHeaders:
+    """Pure ASGI middleware: ``SECURITY_HEADERS`` first in every answer's headers (a header an answer sets itself
+    is kept as it is)."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def send_with_headers(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                headers = list(message.get("headers", ()))
+                own = {name.lower() for name, _ in headers}
+                message["headers"] = [*(h for h in _RAW_SECURITY_HEADERS if h[0] not in own), *headers]
+            await send(message)
+
+        await self.app(scope, receive, send_with_headers)
+
+
+class OneLineErrors:
+    """Pure ASGI middleware: an exception no handler answered (a bug) is a 500 in one line, and one line in
+    the teacher's terminal; nothing is raised further (the class goes on). After an answer has begun (the
+    event stream) there is nothing to answer: the exception goes on to the server."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        started = False
+
+        async def sending(message: Message) -> None:
+            nonlocal started
+            started = started or message["type"] == "http.response.start"
+            await send(message)
+
+        try:
+            await self.app(scope, receive, sending)
+        except Exception as exc:
+            if started:
+                raise
+            request = Request(scope)
+            print(f"armgame class: {request.method} {request.url.path}: {type(exc).__name__}: {exc}"[:300],
+                  file=sys.stderr)
+            await refusal(RefusedError(500, "the class could not take this request (the teacher's terminal says "
+                                            "why); nothing was entered"))(scope, receive, send)
+
+
+class SameSite:
+    """Pure ASGI middleware on each of the class's routes: ``same_site`` before the endpoint (a refusal goes to
+    ``EXCEPTION_HANDLERS`` like any other)."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http":
+            same_site(scope["method"], Headers(scope=scope))
+        await self.app(scope, receive, send)
+
+
+def same_site(method: str, headers: Headers) -> None:
+    """A request the class's own pages or the student's client could have sent; else RefusedError.
+
+    Every request names the class by an address (``Host``), never by a domain name a hostile page could
+    point at the class (DNS rebinding); a change (anything but GET) is JSON, which a page on another site
+    cannot send without a preflight the class never grants, and its ``Origin`` and ``Sec-Fetch-Site``, where
+    sent, are the class's own."""
+    if not _named_by_address(headers.get("host", "")):
+        raise RefusedError(421, "this class answers at its address only (as printed in the teacher's terminal)")
+    if method == "GET":
+        return
+    media = headers.get("content-type", "").split(";", 1)[0].strip().lower()
+    if media != "application/json":
+        raise RefusedError(415, "the class takes JSON only (Content-Type: application/json)")
+    if headers.get("sec-fetch-site", "same-origin") not in ("same-origin", "none"):
+        raise RefusedError(403, "the class takes changes from its own pages only")
+    origin = headers.get("origin")
+    if origin is not None and origin not in (f"http://{headers.get('host', '')}",
+                                             f"https://{headers.get('host', '')}"):
+        raise RefusedError(403, "the class takes changes from its own pages only")
+
+
+@functools.cache
+def _own_names() -> frozenset[str]:
+    """The names this machine answers to besides its addresses (asked once, not at every request)."""
+    host = socket.gethostname().lower()
+    return frozenset({"localhost", host, host + ".local"})
+
+
+def _named_by_address(host: str) -> bool:
+    """Whether a ``Host`` header names this server by an address (or localhost), never by a domain name a
+    hostile page could point at the class (DNS rebinding)."""
+    name = host.rsplit(":", 1)[0] if not host.endswith("]") else host
+    name = name.strip("[]").lower()
+    if name in _own_names():
+        return True
+    try:
+        ipaddress.ip_address(name)
+    except ValueError:
+        return False
+    return True

@@ -1,0 +1,181 @@
+"""What the class's pages show, built from the clerk's state: read-only, it never changes the class.
+
+* ``standings``: the projector's lists (hidden names left out, the top ``STANDINGS_ROWS`` of each), its
+  round and the game just entered; or every row, hidden ones marked, for the teacher;
+* ``lab_curve`` and ``class_curve``: the class curve of the protocol the teacher chose, as ``/lab``
+  draws it and as the teacher's PNG (``lab.analysis.class_curve_of``, the function ``armgame analyze
+  --class`` builds it with afterwards);
+* ``roster_view``: the teacher's list of names, grouped by the machine each joined from;
+* ``games_csv`` and ``lab_csv``: the teacher's exports, every cell a spreadsheet shows as text
+  (``csv_cell``).
+
+Each reads the state the clerk (``intake.Clerk``) changes, so each runs where the clerk runs: on its
+thread (``worker.ClerkThread``), as the app's ``ClassState.publish`` and the teacher's routes call them.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable, Sequence
+from datetime import UTC, datetime
+from typing import Any
+
+from ..records.standings import player_key, shared_rank
+from .intake import Clerk
+from .rounds import round_view
+
+#: Rows of each list the standings carry: the projector shows the top, the CSV has everything.
+STANDINGS_ROWS = 60
+
+
+def standings(clerk: Clerk, teacher: bool = False) -> dict[str, object]:
+    """The class as the projector shows it (hidden names left out), or as the teacher sees it."""
+    roster = clerk.roster
+
+    def rows(programs: bool) -> list[dict[str, object]]:
+        out: list[dict[str, object]] = []
+        for row in clerk.boards[programs].each():
+            hidden = roster.is_hidden(row.name)
+            if hidden and not teacher:
+                continue
+            e = row.best
+            out.append({"rank": shared_rank(out, e.score), "name": row.name, "score": e.score, "hits": e.hits,
+                        "games": row.games, "driver": e.how if programs else None,
+                        **({"hidden": hidden} if teacher else {})})
+            if len(out) >= STANDINGS_ROWS and not teacher:
+                break
+        return out
+
+    arrival = clerk.arrival
+    if arrival is not None and roster.is_hidden(arrival.name):
+        arrival = None
+    return {"version": clerk.version, "seed": roster.seed, "closed": roster.closed,
+            "joined": len(roster.players), "games": len(clerk.entries),
+            "round": None if teacher else round_shown(clerk),
+            "students": rows(False), "programs": rows(True),
+            "arrival": None if arrival is None else {"seq": arrival.seq, "name": arrival.name, "score": arrival.score,
+                                                     "note": arrival.note, "program": arrival.program}}
+
+
+def round_shown(clerk: Clerk, now: datetime | None = None) -> dict[str, object] | None:
+    """The round on the projector (``rounds.round_view``): its clock, and its winners once it is over."""
+    return round_view(clerk.current_round(), clerk.entries, clerk.roster.hidden, now or datetime.now(UTC),
+                      STANDINGS_ROWS, name_of=clerk.shown_name)
+
+
+def class_curve(clerk: Clerk) -> Any:
+    """``lab.analysis.class_curve_of`` the teacher's protocol over the class's runs (in SI units): hidden
+    names left out, programs' runs counted apart."""
+    from ..lab.analysis import ClassRun, class_curve_of
+
+    runs = [run for run in clerk.lab_runs if run.program or (run.first and not clerk.roster.is_hidden(run.player))]
+    return class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                          clerk.curve_protocol())
+
+
+def lab_curve(clerk: Clerk) -> dict[str, object]:
+    """The class curve of the protocol the teacher chose: each person's first run of it (programs' runs
+    and hidden names never in it; the programs counted apart). Built by ``lab.analysis.class_curve_of``,
+    as ``armgame analyze --class`` builds it from the folder afterwards."""
+    from ..lab.analysis import display_unit
+
+    protocol = clerk.curve_protocol()
+    curve = class_curve(clerk)
+    if not curve.students:
+        return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
+                "metric": None, "trials": []}
+    scale, unit = display_unit(curve.metric)  # type: ignore[arg-type]
+    trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
+               "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
+              for row in curve.trials]
+    return {"protocol": protocol.name, "students": curve.students, "programs": curve.programs,
+            "metric": curve.metric, "unit": unit, "trials": trials}
+
+
+def roster_view(clerk: Clerk) -> dict[str, object]:
+    """For the teacher's page: every joined name with the machine (address) it joined from and its games
+    (0: joined, not played yet), grouped by address, most names first; whether the list is locked, and the
+    class curve's protocol."""
+    from ..lab.protocol import PRESETS
+
+    roster = clerk.roster
+    played: dict[str, int] = {}
+    for entry in clerk.entries:
+        key = player_key(clerk.shown_name(entry.name))
+        played[key] = played.get(key, 0) + 1
+    machines: dict[str, list[dict[str, object]]] = {}
+    for key, p in roster.players.items():
+        machines.setdefault(p.address or "unknown", []).append(
+            {"name": p.name, "joined": p.joined, "games": played.get(key, 0), "hidden": key in roster.hidden})
+    groups = [{"address": address, "names": sorted(names, key=lambda n: str(n["joined"]))}
+              for address, names in machines.items()]
+    groups.sort(key=lambda g: (-len(g["names"]), g["address"]))  # type: ignore[arg-type]
+    lab = roster.lab
+    return {"machines": groups, "joined": len(roster.players),
+            "waiting": sum(1 for k in roster.players if not played.get(k)),
+            "locked": roster.locked, "closed": roster.closed,
+            "lab": lab.get("name") if isinstance(lab, dict) else lab, "presets": list(PRESETS)}
+
+
+def games_csv(clerk: Clerk) -> str:
+    """Every game entered, in order; ``entered_local`` is the teacher's clock (what a teacher compares with
+    the lesson), ``entered_at`` the same moment in UTC as the table keeps it."""
+    columns = ("entered", "name", "list", "driven", "driver", "score", "hits", "resets", "seed", "entered_local",
+               "entered_at", "hidden", "replay")
+    ordered = sorted(clerk.entries, key=lambda e: e.entered or 0)
+    return _csv(columns, ([e.entered, e.name, "programs" if e.program else "students", e.driven, e.driver or "",
+                           e.score, e.hits, e.resets, e.seed, local_time(e.entered_at), e.entered_at or "",
+                           clerk.roster.is_hidden(e.name), e.replay] for e in ordered))
+
+
+def lab_csv(clerk: Clerk) -> str:
+    """Every reach of the runs the class curve could read (people's first runs, programs' runs), a row each."""
+    from ..lab.metrics import TRIAL_COLUMNS
+
+    columns = ("player", "program", "protocol", "replay", *TRIAL_COLUMNS)
+    return _csv(columns, ([run.player, run.program, run.protocol.name, run.path.name,
+                           *(row[c] for c in TRIAL_COLUMNS)] for run in clerk.lab_runs for row in run.rows
+                          if run.first or run.program))
+
+
+def _finite(value: object, scale: float) -> float | None:
+    value = float(value)  # type: ignore[arg-type]
+    return round(value * scale, 6) if math.isfinite(value) else None
+
+
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_cell(value: object) -> str:
+    """A cell a spreadsheet shows as text: a leading = + - @ would make it a formula (OWASP's advice:
+    prefix a quote). Numbers are written as they are, so they stay numbers."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return "" if isinstance(value, float) and not math.isfinite(value) else repr(value)
+    text = str(value)
+    return "'" + text if text.startswith(_FORMULA) else text
+
+
+def local_time(utc: str | None) -> str:
+    """An ISO time with its zone as this machine's local time, to the second (the teacher's clock)."""
+    if not utc:
+        return ""
+    try:
+        return datetime.fromisoformat(utc).astimezone().strftime("%Y-%m-%d %H:%M:%S")
+    except (ValueError, OverflowError, OSError):
+        return ""
+
+
+def _csv(columns: Sequence[str], rows: Iterable[Sequence[object]]) -> str:
+    """The CSV text, with a byte-order mark first: the one sign a spreadsheet (Excel) reads to take the file as
+    UTF-8, so an accented name is not garbled."""
+    out = io.StringIO()
+    out.write("\ufeff")
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([csv_cell(v) for v in row])
+    return out.getvalue()
