@@ -6,10 +6,19 @@ which the projector's page shows live, one row per student. What each module own
 
 * ``roster``: the class's own record (``class.json``): its join code, the teacher's secret, the seed
   it ranks, each student's name and the hash of the token that proves it, what the teacher hid.
-* ``intake``: one hand-in from arrival to answer: checked, verified, entered once by its content,
-  durably on disk before it is acknowledged; the class's standings built from what was entered.
-* ``app``: the ASGI application (Starlette): the routes, the bounded queue in front of the clerk
-  thread, rate limits and body limits per machine, the projector's event stream.
+* ``intake``: the ``Clerk``, the class's one writer: a join, one hand-in from arrival to answer
+  (checked, verified, entered once by its content, durably on disk before it is acknowledged), the
+  teacher's changes. ``board``: the two lists' rows, kept as games are entered; ``labruns``: the lab
+  runs' files, written and read again.
+* ``views``: what the pages show, read from the clerk's state: the standings, the class curve, the
+  teacher's roster and CSVs.
+* ``worker``: the clerk's one thread, its work typed (a ``Job``, a ``HandIn``), hand-ins that wait
+  together checked and entered as one batch.
+* ``app``: the ASGI application (Starlette): module-level endpoints, the routes table, the lifespan
+  that runs the clerk's thread, every bound on what a request may cost. ``state``: what the endpoints
+  share (``ClassState``: the bounded queue in front of the clerk's thread, guesses and joins counted
+  per machine, the pages' data); ``middleware``: the security headers, the same-site check, the
+  refusals' exception handlers, a bug's one line.
 * ``guard``: what a connection may cost before it is a request (deadlines, a share per address),
   under uvicorn's own HTTP parsing.
 * ``rounds``: a round ("everyone play now"): which games count, its clock, its winners.

@@ -311,7 +311,7 @@ def _fit(session, rows, on: str, beside: Path | None, path: Path, player: str | 
 def class_of(folder: Path):
     """(the class's folder, its lab runs' folder) when ``folder`` is a live class's folder (``class.json`` in it)
     or its ``lab/``; else (None, ``folder``)."""
-    from ..classroom.intake import LAB_DIR
+    from ..classroom.labruns import LAB_DIR
     from ..classroom.roster import ROSTER_NAME
 
     if (folder / ROSTER_NAME).is_file():

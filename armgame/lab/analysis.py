@@ -486,7 +486,7 @@ def curve_protocol(choice: object):
 def class_curve_of(runs: Sequence[ClassRun], protocol, metric: str | None = None, *,
                    people_only: bool = True) -> ClassCurve:
     """The class curve of ``protocol`` over ``runs``: what the live class's ``/lab`` page draws
-    (``classroom.intake.Clerk.lab_curve``) and ``armgame analyze --class`` writes, built here once so that the
+    (``classroom.views.lab_curve``) and ``armgame analyze --class`` writes, built here once so that the
     two agree by construction.
 
     ``people_only`` (a class's rule): programs' runs are counted apart and never in the curve, and each person
