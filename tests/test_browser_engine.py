@@ -347,7 +347,7 @@ def test_the_engine_is_served_and_needs_nothing_a_strict_page_refuses():
     from armgame.classroom import page
 
     source = (ROOT / "armgame" / "classroom" / "static" / "engine.js").read_text(encoding="utf-8")
-    served = page.response("engine.js", {})
+    served = page.response("engine.js")
     assert served.status_code == 200 and served.media_type.startswith("text/javascript")
     assert served.body == source.encode("utf-8")
     code = "\n".join(line.split("//")[0] for line in source.splitlines())
