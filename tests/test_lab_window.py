@@ -520,3 +520,18 @@ def test_a_bots_run_goes_on_without_the_focus(screen):
     steps = session.steps
     win.frame(0.2)
     assert not win.paused and session.steps > steps
+
+
+def test_a_bots_intro_card_names_the_bot_and_a_replays_says_so(screen):
+    """The card says who plays the run from what the window was told (``bot``), never from its help line."""
+    from armgame.game.timeline import TimelineDriver
+
+    session = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    driver = RealTimeDriver(Autopilot(session, make_lab_bot("model")))
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0, driver=driver, mode="AUTOPILOT: model", bot="model")
+    assert win.card is not None and win.card.lines[0] == "The model bot plays this run: watch its cursor."
+    recorded = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    watched = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    win = LabWindow(watched, screen, clock=FakeClock(), fps=0, driver=TimelineDriver(watched, recorded.timeline, 0),
+                    mode="REPLAY   Ann", cards=True)
+    assert win.card is not None and win.card.lines[0] == "A replay plays this run: watch its cursor."

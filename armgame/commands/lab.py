@@ -549,7 +549,8 @@ def _play_in_window(args: argparse.Namespace, new_run, end_run) -> None:
                 driver = RealTimeDriver(Autopilot(session, bot))  # type: ignore[arg-type]
             window = LabWindow(session, screen, fps=args.fps, driver=driver,
                                mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}", on_finish=keeper,
-                               palette=settings.palette, text_scale=settings.text_scale)
+                               palette=settings.palette, text_scale=settings.text_scale,
+                               bot=None if bot is None else args.bot)
             window.speed = args.speed
             window.run()
             end_run(window.session, keeper)
