@@ -7,13 +7,12 @@ fails raises a ``ValueError`` naming it (``config.seed must be from 0 to 9223372
 the caller adds the file's name. A check returns the value it passed, so a reader builds its record from
 what the checks return.
 
-Here, below every layer (beside ``errors``, ``limits`` and ``files``, and like them importing nothing of
-armgame), so that each reader finds them in one place and none reaches into another layer's module for
-them. The ranges of one kind of record stay beside its dataclass: an arm's in
-``physics.params.PARAMETER_RANGES``, a game's in ``game.rules.GAME_RANGES``. The bounds several records
-share are here: ``INT64_MAX`` (a seed, and any count a compiled loop reads as a 64-bit integer),
-``COUNT_MAX`` (a score, a count of hits or resets, a place in a table's order of entry) and the digests'
-``HEX64`` and ``HEX32``.
+Here, below every layer (beside ``errors``, ``limits`` and ``files``; it imports nothing of armgame), so
+that each reader finds them in one place and none reaches into another layer's module for them. The ranges
+of one kind of record stay beside its dataclass: an arm's in ``physics.params.PARAMETER_RANGES``, a game's
+in ``game.rules.GAME_RANGES``. The bounds several records share are here: ``INT64_MAX`` (a seed, and a step
+a compiled loop reads as a 64-bit integer), ``COUNT_MAX`` (a score, a count of hits or resets, a place in a
+table's order of entry) and the digests' ``HEX64`` and ``HEX32``.
 """
 
 from __future__ import annotations
