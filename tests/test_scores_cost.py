@@ -90,6 +90,31 @@ def test_a_costly_replay_is_counted_before_it_runs_and_not_run_by_scores(tmp_pat
     assert "flagged:" not in out and "1 not checked yet (costly replay" in out  # a cost, not a verdict
 
 
+def test_an_input_event_costs_its_verification_event_work_counted_before_and_while_it_runs():
+    """``EVENT_WORK`` bounds what an input event costs a verification: ``replay_work`` counts it before a game is
+    read again, and ``Replay.verify`` refuses, before its first step, a game whose steps and events cost more than
+    it spends, at exactly that count: one unit of work fewer is refused, the count (and the first target's
+    drawing, at most ``MAX_TRIES`` tries) is run and matches."""
+    from armgame.game.rules import MAX_TRIES
+    from armgame.records.replay import TRY_WORK, VerifyCostError
+
+    session = GameSession(GameConfig(seed=10, time_limit=0.4))
+    while session.steps < session.total_steps - 1:  # a key pressed and released at every step: 2 events a step
+        session.key_event("d", "down")
+        session.key_event("d", "up")
+        session.advance(1)
+    session.advance(session.total_steps - session.steps)
+    busy = Replay.from_session(session, "script", "masher")
+    steps, events = busy.result.steps, len(busy.timeline)
+    assert busy.result.hits == 0 and events == 2 * (steps - 1)
+    work = steps + EVENT_WORK * events
+    assert replay_work(busy) == work and EVENT_WORK * events > 10 * steps  # the events are nearly all of it
+    with pytest.raises(VerifyCostError, match=rf"^its {steps:,} steps and {events:,} input events are more work "
+                                              rf"\({work:,} steps\) than one verification spends \({work - 1:,}\)$"):
+        busy.verify(max_work=work - 1)
+    assert busy.verify(max_work=work + TRY_WORK * MAX_TRIES)[0]
+
+
 # ------------------------------------------------------------------ honest games are never flagged (issue 26, 5)
 
 def test_the_largest_honest_games_are_well_within_the_budget():

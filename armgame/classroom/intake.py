@@ -41,12 +41,13 @@ from ..game.session import GameResult
 from ..records.batch_verify import batchable
 from ..records.identity import game_digest, game_digests
 from ..records.lookalikes import name_problem
-from ..records.replay import Replay, check_name, now_iso, same_outcome
+from ..records.replay import Replay, now_iso, same_outcome
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
 from ..records.standings import PlayerRow, player_key, shared_rank
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited
 from ..records.tablefile import name_slug
+from ..valid import check_name
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
 from .rounds import Round, new_round, round_view
 

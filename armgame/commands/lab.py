@@ -381,7 +381,7 @@ def kept_lines(written: list[Path]) -> list[str]:
 def _check_outputs(args: argparse.Namespace) -> None:
     """Refuse a bad --record, --name or missing matplotlib before the run, not after it."""
     if args.name is not None:
-        from ..records.replay import check_name
+        from ..valid import check_name
 
         try:
             args.name = check_name(args.name, "--name")

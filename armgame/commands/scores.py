@@ -319,8 +319,9 @@ def _print_rows(rows_in, games: bool) -> None:
 
 def _add(table, args: argparse.Namespace) -> int:
     from ..errors import UserError
-    from ..records.replay import Replay, check_name
+    from ..records.replay import Replay
     from ..records.storage import user_path
+    from ..valid import check_name
 
     path = user_path(args.add, "--add")
     replay = Replay.load(path)

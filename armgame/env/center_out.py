@@ -20,7 +20,7 @@ from gymnasium import spaces
 
 from ..errors import UserError
 from ..game.muscles import MuscleSet
-from ..game.rules import Target
+from ..game.rules import MAX_CONFIG_SECONDS, Target
 from ..game.session import DOWN
 from ..lab.analysis import trial_row
 from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
@@ -50,8 +50,8 @@ from .reach import (
 
 OBSERVATION_NAMES = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "cursor_x", "cursor_y", "home_x", "home_y",
                      "target_x", "target_y", "phase", "time_in_phase", "trial", "time_left")
-#: The lab's clock never runs longer than a day (``lab_config``).
-MAX_RUN_SECONDS = 86400.0
+#: The lab's clock never runs longer than a game may (``lab_config``): a day.
+MAX_RUN_SECONDS = MAX_CONFIG_SECONDS
 #: Reward lost per second of the task's time.
 DEFAULT_TIME_COST = 0.1
 

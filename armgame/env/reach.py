@@ -18,8 +18,9 @@ import numpy as np
 from gymnasium import spaces
 
 from ..errors import UserError
-from ..game.rules import GameConfig
+from ..game.rules import MAX_CONFIG_SECONDS, GameConfig
 from ..game.session import GameSession
+from ..valid import INT64_MAX
 from .base import EnvArgumentError, SessionEnv
 from .features import REACH_REWARDS, check_dtype, check_reward, reach_bounds_v1
 from .variants import ReachVariant
@@ -28,9 +29,9 @@ from .variants import ReachVariant
 DEFAULT_DECISION_STEPS = 5
 MAX_DECISION_STEPS = 1000
 #: The longest game an env plays, in seconds: the game's own limit (``GameConfig``).
-MAX_TIME_LIMIT = 24 * 3600.0
+MAX_TIME_LIMIT = MAX_CONFIG_SECONDS
 #: The game's seeds (``GameConfig.seed``) are whole numbers below this.
-SEED_LIMIT = 2**63
+SEED_LIMIT = INT64_MAX + 1
 OBSERVATION_NAMES = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "target_x", "target_y", "time_left")
 
 
