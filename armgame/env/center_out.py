@@ -35,6 +35,7 @@ from ..lab.protocol import (
     with_perturbation,
 )
 from ..lab.session import HOLD, REACH, LabSession, lab_config
+from ..physics.hand import hand_xy
 from ..physics.twojoint import TwoJointArm
 from ..words import unknown_name
 from .base import EnvArgumentError, SessionEnv
@@ -437,8 +438,7 @@ class _SeenLab:
 
     def hand(self) -> tuple[float, float]:
         p = self.config.arm
-        q1, q2 = self.state[0], self.state[1]
-        return p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2)
+        return hand_xy(p.l1, p.l2, self.state[0], self.state[1])
 
 
 class CenterOutBotPolicy:
