@@ -68,6 +68,26 @@ def test_the_v1_ids_and_their_vector_entry_points_are_registered():
     assert isinstance(gym.make_vec(CENTER_OUT, num_envs=2).unwrapped, CenterOutVectorEnv)
 
 
+def test_each_version_is_a_sibling_of_the_other_not_its_subclass():
+    """Gymnasium's way: v1 derives from the versions' shared base, never from v0, so a change to v0 cannot
+    reach v1; and every registered id's class is one version's, not two."""
+    from armgame.env.center_out import CenterOutBaseEnv, CenterOutEnv
+    from armgame.env.center_out_v1 import CenterOutV1Env
+    from armgame.env.reach import ReachBaseEnv, ReachEnv
+    from armgame.env.reach_v1 import ReachV1Env
+
+    for v0, v1, base in ((ReachEnv, ReachV1Env, ReachBaseEnv), (CenterOutEnv, CenterOutV1Env, CenterOutBaseEnv)):
+        assert not issubclass(v1, v0) and not issubclass(v0, v1)
+        assert issubclass(v0, base) and issubclass(v1, base)
+        assert (v0.version, v1.version) == (0, 1)
+    for env_id in [i for i in gym.registry if i.startswith("armgame/")]:
+        env = gym.make(env_id).unwrapped
+        assert f"-v{env.version}" in env_id
+        assert isinstance(env, ReachBaseEnv | CenterOutBaseEnv)
+        assert isinstance(env, ReachEnv | CenterOutEnv) == (env.version == 0)
+        env.close()
+
+
 @pytest.mark.parametrize("module", [armgame.env.features, armgame.env.reach_v1, armgame.env.center_out_v1,
                                     armgame.env.vector])
 def test_the_docstrings_examples_run(module):
