@@ -263,7 +263,9 @@ def test_the_end_shows_the_learning_curve_and_where_the_run_was_kept(screen):
     texts = [t for t, _ in placed]
     assert "after-effect" in texts and "   trials.csv" in texts and any(t.startswith("Block means") for t in texts)
     rects = [r for _, r in placed]
-    small = win.renderer._text_heights(win.screen)[2]
+    from armgame.ui.render import text_heights
+
+    small = text_heights(win.screen.get_size(), win.renderer.text_scale)[2]
     assert small >= 0.025 * win.screen.get_height() - 0.5
     for i, a in enumerate(rects):
         assert win.screen.get_rect().contains(a), placed[i][0]

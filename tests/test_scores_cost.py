@@ -119,8 +119,8 @@ def test_an_input_event_costs_its_verification_event_work_counted_before_and_whi
 
 def test_the_largest_honest_games_are_well_within_the_budget():
     """The largest honest games ``benchmarks/honest_work.py`` found, with the margin MAX_CHECK_WORK states."""
-    from armgame.commands.scores import MAX_CHECK_WORK
     from armgame.game.bots import play_bot
+    from armgame.records.listing import MAX_CHECK_WORK
 
     model = Replay.from_session(play_bot(GameConfig(seed=18), "model"), "bot", "model")  # the model bot's worst seed
     session = GameSession(GameConfig(seed=10))
@@ -149,12 +149,12 @@ def standard_game(player: str, presses: int) -> Replay:
 
 
 def test_a_costly_game_is_listed_apart_unflagged_and_ranked_once_verify_checks_it(tmp_path, monkeypatch, capsys):
-    import armgame.commands.scores as scores_command
+    import armgame.records.listing as listing_module
 
     table = ScoreTable(tmp_path / "t")
     table.add(standard_game("cheap", 1))  # 15,000 steps and 2 events: 15,040
     table.add(standard_game("busy", 10))  # 20 events: 15,400
-    monkeypatch.setattr(scores_command, "MAX_CHECK_WORK", 15_100)
+    monkeypatch.setattr(listing_module, "MAX_CHECK_WORK", 15_100)
     assert main(["scores", "--scores", str(table.folder)]) == 0
     out = capsys.readouterr().out
     ranked, apart = out.split("not checked yet")
