@@ -3,7 +3,8 @@
 The game reads scripts, records reads replays and tables, the lab reads protocols: they all read
 through ``read_limited`` here, which lives below every layer (like ``errors`` and ``limits``, it
 imports nothing of armgame but ``errors``) so that no layer reaches up to another for it.
-``armgame.records.storage`` holds the rest (writing, JSON, schema checks) and re-exports these.
+``armgame.records.storage`` holds the rest (writing, JSON) and re-exports these; ``armgame.valid``, the
+schema checks.
 
 * Reading: the path is opened without blocking (``O_NONBLOCK``, so a FIFO cannot hang the
   reader), then ``fstat`` must show a regular file, and at most ``limit + 1`` bytes are

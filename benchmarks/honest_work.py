@@ -1,5 +1,5 @@
 """The work ``armgame scores`` counts for honest games, and what that work really costs: the measurements
-behind ``MAX_CHECK_WORK`` (``armgame.commands.scores``) and ``HIT_WORK``/``EVENT_WORK``
+behind ``MAX_CHECK_WORK`` (``armgame.records.listing``) and ``HIT_WORK``/``EVENT_WORK``
 (``armgame.records.checking``).
 
     python benchmarks/honest_work.py              # every bot on seeds 0 to 41, fast keyboard players
@@ -24,10 +24,10 @@ import math
 import random
 import time
 
-from armgame.commands.scores import MAX_CHECK_WORK
 from armgame.game.bots import BOT_NAMES, play_bot
 from armgame.game.rules import GameConfig, GameRules
 from armgame.game.session import GameSession, InputEvent
+from armgame.records.listing import MAX_CHECK_WORK
 from armgame.records.replay import Replay
 from armgame.records.scores import EVENT_WORK, HIT_WORK, RANKED_HIT_WORK, replay_work
 

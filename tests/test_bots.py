@@ -111,7 +111,7 @@ def test_the_curl_load_equals_the_lab_bots_unit_field_and_torque():
     session = LabSession(lab_config(preset("curl"), 10), preset("curl"))
     bot = make_lab_bot("adaptive")
     bot.curl_learner.fast, bot.curl_learner.slow = 0.7, 1.1  # an estimate of b = 1.8 N s/m
-    bot._install(session)
+    bot.act(session)  # a new trial (the run's first): the bot installs what it expects of the arm's load
     assert type(bot.load_estimate) is CurlLoad  # the type the compiled loop takes
     l1, l2 = session.config.arm.l1, session.config.arm.l2
     b = bot.curl_estimate

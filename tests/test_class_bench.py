@@ -38,3 +38,19 @@ def test_the_flood_the_clerk_and_the_table_costs_run():
     clerk = report["clerk"][0]
     assert clerk["honest"]["answers"] == {"ok": 4} and clerk["forged"]["answers"] == {"422": 4}
     assert set(report["table"][0]["sizes"]["3"]) == {"journal", "rewrite"}
+
+
+@pytest.mark.slow  # plays the model bot's game once (about 2 s)
+def test_the_timeline_passes_benchmark_runs_and_checks_its_twins():
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "timeline_passes.py"
+    spec = importlib.util.spec_from_file_location("timeline_passes_benchmark", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    from armgame.records import identity
+
+    if identity._CTIMELINE is None:
+        pytest.skip("built without a C compiler: nothing to compare")
+    report = bench.measure(1)
+    for figures in report["games"].values():
+        assert set(figures["passes"]) == {"reading", "its identities", "the batch's columns", "writing it again"}
+        assert all(row["with_c_ms"][0] > 0 and row["python_ms"][0] > 0 for row in figures["passes"].values())

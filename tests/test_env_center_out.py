@@ -293,3 +293,12 @@ def test_a_viscous_matrix_option_and_a_paradigm_it_cannot_stand_for():
             run_protocol(name, "curl")
     # with its probes placed as the versioned envs always placed them (issue 29: tests/test_lab_probes.py)
     assert run_protocol("spontaneous", None) == dataclasses.replace(preset("spontaneous"), probe_schedule="random")
+
+
+def test_a_lab_bot_refuses_the_v1_env_whose_observations_it_does_not_read():
+    """The lab's bots read CenterOut-v0's observation (18 numbers); v1's (16) is another's to read
+    (``policies.CenterOutV1BotPolicy``): refused when the policy is made, not at its first step."""
+    env = gym.make("armgame/CenterOut-v1")
+    with pytest.raises(ValueError, match="CenterOut-v0"):
+        CenterOutBotPolicy("model", env)
+    env.close()

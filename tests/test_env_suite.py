@@ -147,9 +147,8 @@ def test_a_dwell_hit_is_the_step_the_hand_completes_its_stay_in_both_loops():
     env = gym.make(REACH, time_limit=20.0, observation_dtype="float64")
     policy = BotPolicy("model", env)
     # The model bot's keys in the plain game: a timeline that puts the hand in many targets.
-    env.reset(seed=7)
+    obs, _ = env.reset(seed=7)
     done = False
-    obs = env.unwrapped._observation()
     while not done:
         obs, _, _, done, _ = env.step(policy(obs))
     timeline = env.unwrapped.session.timeline
@@ -203,11 +202,12 @@ def test_motor_noise_scales_each_muscles_force_by_a_seeded_factor():
     assert np.array_equal(np.array(run[0][0]), np.array(run[1][0]))  # seeded: the same game twice
     assert not np.array_equal(np.array(run[0][0]), np.array(run[2][0]))  # and not the plain game
     factors = []
-    noisy.reset(seed=12)
-    session = noisy.unwrapped.session
+    long_game = gym.make(REACH, motor_noise=0.3, time_limit=40.0)  # 2,000 decisions, each a new draw
+    long_game.reset(seed=12)
+    session = long_game.unwrapped.session
     base = np.array(GameConfig().muscles[0].moment[0])
     for _ in range(2000):
-        noisy.unwrapped._noise.apply(session)
+        long_game.step(np.zeros(4, dtype=np.int8))
         factors.append(session.muscles.moments[0][0] / base)
     factors = np.array(factors)
     assert factors.min() >= 0.0 and factors.max() <= NOISE_FACTOR_MAX
@@ -270,7 +270,8 @@ def test_the_score_reward_is_the_score_change_plus_a_potentials_difference():
     for t in range(100):
         before = base.session.rules.board.score
         _, reward, _, truncated, info = env.step(np.array([1, 0, 0, 1]) if t % 20 < 10 else np.array([0, 1, 1, 0]))
-        edge = 0.0 if truncated else base._edge_now()
+        hand, target = base.session.hand(), base.session.rules.target
+        edge = 0.0 if truncated else max(0.0, math.hypot(hand[0] - target.x, hand[1] - target.y) - target.radius)
         phi_before = 0.0 if t == 0 else -edges[-1]
         assert math.isclose(reward, (info["score"] - before) + 10.0 * (-edge - phi_before), abs_tol=1e-12)
         edges.append(edge)

@@ -40,6 +40,12 @@ def batch_at_every_size(monkeypatch):
     monkeypatch.setattr(armgame.env.vector, "BATCH_MIN_ENVS", 1)
 
 
+def edge_of(point, target) -> float:
+    """The distance from ``point`` (the hand, or the cursor) to ``target``'s edge, 0 inside: what the dense
+    reward's progress is measured in (``features.edge_distance``)."""
+    return float(armgame.env.features.edge_distance(point[0], point[1], target.x, target.y, target.radius))
+
+
 def example(name):
     spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
@@ -66,6 +72,26 @@ def test_the_v1_ids_and_their_vector_entry_points_are_registered():
     assert set(armgame.env.V1_IDS + armgame.env.CENTER_OUT_V1_IDS) <= set(gym.registry)
     assert isinstance(gym.make_vec(REACH, num_envs=2).unwrapped, ReachV1VectorEnv)
     assert isinstance(gym.make_vec(CENTER_OUT, num_envs=2).unwrapped, CenterOutVectorEnv)
+
+
+def test_each_version_is_a_sibling_of_the_other_not_its_subclass():
+    """Gymnasium's way: v1 derives from the versions' shared base, never from v0, so a change to v0 cannot
+    reach v1; and every registered id's class is one version's, not two."""
+    from armgame.env.center_out import CenterOutBaseEnv, CenterOutEnv
+    from armgame.env.center_out_v1 import CenterOutV1Env
+    from armgame.env.reach import ReachBaseEnv, ReachEnv
+    from armgame.env.reach_v1 import ReachV1Env
+
+    for v0, v1, base in ((ReachEnv, ReachV1Env, ReachBaseEnv), (CenterOutEnv, CenterOutV1Env, CenterOutBaseEnv)):
+        assert not issubclass(v1, v0) and not issubclass(v0, v1)
+        assert issubclass(v0, base) and issubclass(v1, base)
+        assert (v0.version, v1.version) == (0, 1)
+    for env_id in [i for i in gym.registry if i.startswith("armgame/")]:
+        env = gym.make(env_id).unwrapped
+        assert f"-v{env.version}" in env_id
+        assert isinstance(env, ReachBaseEnv | CenterOutBaseEnv)
+        assert isinstance(env, ReachEnv | CenterOutEnv) == (env.version == 0)
+        env.close()
 
 
 @pytest.mark.parametrize("module", [armgame.env.features, armgame.env.reach_v1, armgame.env.center_out_v1,
@@ -150,20 +176,21 @@ def test_the_dense_rewards_sum_over_a_game_is_its_formula(env_id, kwargs):
     policy, obs = BotPolicy("model", env), env.reset(seed=4)[0]
     v1 = gym.make(REACH, time_limit=6.0, **{k: v for k, v in kwargs.items() if k != "reset_key"})
     v1.reset(seed=4)
-    total, starts, session = 0.0, [v1.unwrapped._edge], v1.unwrapped.session
+    session = v1.unwrapped.session
+    total, starts = 0.0, [edge_of(session.hand(), session.rules.target)]
     while True:
         action = policy(obs)
         obs, *_ = env.step(action)
         hits = session.rules.board.hits
         _, reward, _, truncated, info = v1.step(action)
         total += reward
-        starts += [v1.unwrapped._edge] * (session.rules.board.hits - hits)
+        starts += [edge_of(session.hand(), session.rules.target)] * (session.rules.board.hits - hits)
         if truncated:
             break
     s = v1.unwrapped.settings
     assert info["hits"] >= 3
-    assert total == pytest.approx(s.progress_weight * (sum(starts) - v1.unwrapped._edge) + s.hit_bonus * info["hits"],
-                                  abs=1e-9)
+    last = edge_of(session.hand(), session.rules.target)
+    assert total == pytest.approx(s.progress_weight * (sum(starts) - last) + s.hit_bonus * info["hits"], abs=1e-9)
     total, formula, info = game_return_by_formula(env_id, seed=8, steps=300, action_seed=1, time_limit=6.0, **kwargs)
     assert total == pytest.approx(formula, abs=1e-9)
     if kwargs.get("reset_key"):
@@ -379,8 +406,9 @@ def test_an_unseeded_center_out_reset_starts_a_fresh_run_unless_asked_to_continu
     # Mid-episode (the arm on its way, the trial under way) no reset goes on with it: a new run.
     for env in (fresh, going_on):
         seed = env.unwrapped.session.config.seed
-        play_center_out(env, 60)  # past the longest delay (1 s), short of a hit's 0.2 s in the target
-        assert not env.unwrapped._episode_over() and env.unwrapped.session.phase == REACH_PHASE  # a reach under way
+        for _ in range(60):  # past the longest delay (1 s), short of a hit's 0.2 s in the target
+            *_, terminated, truncated, _ = env.step(env.action_space.sample())
+        assert not (terminated or truncated) and env.unwrapped.session.phase == REACH_PHASE  # a reach under way
         obs, info = env.reset()
         session = env.unwrapped.session
         assert session.config.seed != seed and session.steps == 0 and info["trial"] == 0
@@ -397,10 +425,11 @@ def test_center_out_dense_reward_is_progress_toward_the_shown_target():
     total, starts, action = 0.0, [], np.array([0, 0, 0, 0])
     for step in range(400):
         shown = (session.trial_index, session.phase)
-        edge = base._edge
+        edge = edge_of(session.cursor, session.rules.target)
         _, reward, *_ = env.step(np.array([1, 0, 0, 1]) if step % 50 < 10 else action)
         hits_bonus = sum(r["hit"] for r in _[-1].get("reaches", []))
-        expected = (10.0 * (edge - base._edge) if (session.trial_index, session.phase) == shown else 0.0) \
+        after = edge_of(session.cursor, session.rules.target)
+        expected = (10.0 * (edge - after) if (session.trial_index, session.phase) == shown else 0.0) \
             + hits_bonus - 0.5 * 0.02
         assert reward == pytest.approx(expected, abs=1e-12)
         total += reward

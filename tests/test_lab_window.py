@@ -263,7 +263,9 @@ def test_the_end_shows_the_learning_curve_and_where_the_run_was_kept(screen):
     texts = [t for t, _ in placed]
     assert "after-effect" in texts and "   trials.csv" in texts and any(t.startswith("Block means") for t in texts)
     rects = [r for _, r in placed]
-    small = win.renderer._text_heights(win.screen)[2]
+    from armgame.ui.render import text_heights
+
+    small = text_heights(win.screen.get_size(), win.renderer.text_scale)[2]
     assert small >= 0.025 * win.screen.get_height() - 0.5
     for i, a in enumerate(rects):
         assert win.screen.get_rect().contains(a), placed[i][0]
@@ -520,3 +522,18 @@ def test_a_bots_run_goes_on_without_the_focus(screen):
     steps = session.steps
     win.frame(0.2)
     assert not win.paused and session.steps > steps
+
+
+def test_a_bots_intro_card_names_the_bot_and_a_replays_says_so(screen):
+    """The card says who plays the run from what the window was told (``bot``), never from its help line."""
+    from armgame.game.timeline import TimelineDriver
+
+    session = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    driver = RealTimeDriver(Autopilot(session, make_lab_bot("model")))
+    win = LabWindow(session, screen, clock=FakeClock(), fps=0, driver=driver, mode="AUTOPILOT: model", bot="model")
+    assert win.card is not None and win.card.lines[0] == "The model bot plays this run: watch its cursor."
+    recorded = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    watched = LabSession(lab_config(PROTOCOL, 2), PROTOCOL)
+    win = LabWindow(watched, screen, clock=FakeClock(), fps=0, driver=TimelineDriver(watched, recorded.timeline, 0),
+                    mode="REPLAY   Ann", cards=True)
+    assert win.card is not None and win.card.lines[0] == "A replay plays this run: watch its cursor."

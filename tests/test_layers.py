@@ -4,7 +4,8 @@ Each layer's modules are imported in a fresh interpreter, and nothing above the 
 have been imported with them. Records in particular knows no lab: a lab replay's task
 section is read by the reader the lab registers, and every command that reads replays
 registers it first, whatever was imported before. The game knows no records: what both read
-files with (``armgame.files``) sits below every layer, with ``errors``, ``limits`` and ``words``.
+files with (``armgame.files``) sits below every layer, with ``errors``, ``limits`` and ``words``, and so
+does what a valid field of a file is (``armgame.valid``), which every layer's readers check with.
 
 Within a package, no modules import each other in a circle: a piece two modules share lives
 below both (``env.errors``, ``ui.palette``, ``commands.seed_argument``, ``game.batch.kernel_inputs``).
@@ -48,7 +49,7 @@ LAYERS = {
 }
 ROOT = Path(armgame.__file__).parent
 #: The modules below every layer: each may import only the others.
-BASE = ("armgame._native", "armgame.errors", "armgame.files", "armgame.limits", "armgame.words")
+BASE = ("armgame._native", "armgame.errors", "armgame.files", "armgame.limits", "armgame.valid", "armgame.words")
 
 
 def imported_names(path: Path, module: str) -> Iterator[tuple[int, str]]:
@@ -87,6 +88,17 @@ def test_the_modules_below_every_layer_import_only_each_other():
         found += [f"{path.name}:{line} imports {name}" for line, name in imported_names(path, module)
                   if name.startswith("armgame") and not reaches(name, BASE)]
     assert found == []
+
+
+def test_what_valid_means_imports_nothing_of_armgame():
+    """``armgame.valid`` is below every layer and beside the other base modules too: the standard library only, in
+    its file and when it is imported alone (nothing else of armgame loaded with it)."""
+    path = ROOT / "valid.py"
+    assert [name for _, name in imported_names(path, "armgame.valid") if name.startswith("armgame")] == []
+    code = "import json, sys\nimport armgame.valid\nprint(json.dumps(sorted(sys.modules)))\n"
+    loaded = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                       check=True).stdout)
+    assert [m for m in loaded if reaches(m, ("armgame",))] == ["armgame", "armgame.valid"]
 
 
 # ----------------------------------------------------------------- no import circles within a package

@@ -3,6 +3,7 @@
 import json
 import math
 import os
+import re
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
@@ -10,8 +11,9 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 import pytest
 
 from armgame.cli import main
+from armgame.errors import UserError
 from armgame.game.muscles import DEFAULT_MUSCLES, remap_keys
-from armgame.game.rules import GameConfig
+from armgame.game.rules import GAME_RANGES, GameConfig
 from armgame.game.session import GameSession, InputEvent
 from armgame.game.timeline import TimelineDriver
 from armgame.physics.params import GAME_ARM
@@ -73,6 +75,27 @@ def test_game_config_round_trips_exactly_through_json():
     data = config_to_dict(config)
     assert set(data) == CONFIG_FIELDS  # a new GameConfig field must be added to the replay format
     assert config_from_dict(json.loads(json.dumps(data))) == config
+
+
+@pytest.mark.parametrize("kind, field, refusal", [
+    ("dt", "dt", "the physics step must be between 0 and 0.05 s"),
+    ("time_limit", "time_limit", "the game's duration must be between 0 and 86400 s"),
+])
+def test_a_game_config_takes_more_than_a_replay_holds_as_the_one_table_says(kind, field, refusal):
+    """``GAME_RANGES`` is both readers' table: a ``GameConfig`` takes up to its ``config`` high, which a replay's
+    reader refuses past its own high, and refuses what is past it, each in its own words."""
+    setting = GAME_RANGES[kind]
+    low, high = setting.config
+    assert setting.high < high  # a replay is the stricter
+    built = GameConfig(**{field: high})
+    with pytest.raises(ValueError, match=rf"^config\.{field} must be a finite number (from|above) {setting.low:g} "
+                                         rf"(to|and at most) {setting.high:g}, got {high!r}$"):
+        config_from_dict(config_to_dict(built))
+    past = math.nextafter(high, math.inf)
+    with pytest.raises(UserError, match=f"^{re.escape(refusal)}, got {past!r}$"):
+        GameConfig(**{field: past})
+    with pytest.raises(UserError, match=f"^{re.escape(refusal)}, got {low!r}$"):
+        GameConfig(**{field: low})
 
 
 def test_replay_file_round_trip_and_verify(tmp_path):

@@ -379,15 +379,27 @@ def test_no_prompt_when_the_name_is_known(finished_window):
 def _entry_by_the_generic_checks(data: object) -> ScoreEntry:
     """What ``ScoreEntry.from_dict`` did before it was written out field by field: the reference its
     fast paths must agree with, value for value and first error for first error."""
-    from armgame.records.replay import DRIVEN, check_date, check_name, check_word
-    from armgame.records.storage import check_float, check_int, check_keys, check_str
+    from armgame.records.replay import DRIVEN
+    from armgame.valid import (
+        HEX32,
+        HEX64,
+        check_bool,
+        check_date,
+        check_float,
+        check_int,
+        check_keys,
+        check_name,
+        check_pattern,
+        check_str,
+        check_word,
+    )
 
-    m, big = entry_module._match, 10**9
+    m, big = check_pattern, 10**9
     d = check_keys("entry", data, entry_module._REQUIRED, entry_module._OPTIONAL)
     driven = check_str("driven", d["driven"], 20)
     if driven not in DRIVEN:
         raise ValueError(f"driven must be one of {', '.join(DRIVEN)}, got {driven!r}")
-    h32, h64 = entry_module._HEX32, entry_module._HEX64
+    h32, h64 = HEX32, HEX64
     ruleset, digest, game, entered, entered_at, complete = (
         d.get(k) for k in ("ruleset", "config_sha256", "game_sha256", "entered", "entered_at", "complete"))
     entry = ScoreEntry(
@@ -405,7 +417,7 @@ def _entry_by_the_generic_checks(data: object) -> ScoreEntry:
         game_sha256=None if game is None else m("game_sha256", game, h64),
         entered=None if entered is None else check_int("entered", entered, 1, big),
         entered_at=None if entered_at is None else check_date("entered_at", entered_at),
-        complete=None if complete is None else entry_module._bool("complete", complete),
+        complete=None if complete is None else check_bool("complete", complete),
     )
     if (entry.ruleset is None) != (entry.config_sha256 is None):
         raise ValueError("ruleset and config_sha256 come together")

@@ -90,12 +90,37 @@ def test_a_costly_replay_is_counted_before_it_runs_and_not_run_by_scores(tmp_pat
     assert "flagged:" not in out and "1 not checked yet (costly replay" in out  # a cost, not a verdict
 
 
+def test_an_input_event_costs_its_verification_event_work_counted_before_and_while_it_runs():
+    """``EVENT_WORK`` bounds what an input event costs a verification: ``replay_work`` counts it before a game is
+    read again, and ``Replay.verify`` refuses, before its first step, a game whose steps and events cost more than
+    it spends, at exactly that count: one unit of work fewer is refused, the count (and the first target's
+    drawing, at most ``MAX_TRIES`` tries) is run and matches."""
+    from armgame.game.rules import MAX_TRIES
+    from armgame.records.replay import TRY_WORK, VerifyCostError
+
+    session = GameSession(GameConfig(seed=10, time_limit=0.4))
+    while session.steps < session.total_steps - 1:  # a key pressed and released at every step: 2 events a step
+        session.key_event("d", "down")
+        session.key_event("d", "up")
+        session.advance(1)
+    session.advance(session.total_steps - session.steps)
+    busy = Replay.from_session(session, "script", "masher")
+    steps, events = busy.result.steps, len(busy.timeline)
+    assert busy.result.hits == 0 and events == 2 * (steps - 1)
+    work = steps + EVENT_WORK * events
+    assert replay_work(busy) == work and EVENT_WORK * events > 10 * steps  # the events are nearly all of it
+    with pytest.raises(VerifyCostError, match=rf"^its {steps:,} steps and {events:,} input events are more work "
+                                              rf"\({work:,} steps\) than one verification spends \({work - 1:,}\)$"):
+        busy.verify(max_work=work - 1)
+    assert busy.verify(max_work=work + TRY_WORK * MAX_TRIES)[0]
+
+
 # ------------------------------------------------------------------ honest games are never flagged (issue 26, 5)
 
 def test_the_largest_honest_games_are_well_within_the_budget():
     """The largest honest games ``benchmarks/honest_work.py`` found, with the margin MAX_CHECK_WORK states."""
-    from armgame.commands.scores import MAX_CHECK_WORK
     from armgame.game.bots import play_bot
+    from armgame.records.listing import MAX_CHECK_WORK
 
     model = Replay.from_session(play_bot(GameConfig(seed=18), "model"), "bot", "model")  # the model bot's worst seed
     session = GameSession(GameConfig(seed=10))
@@ -124,12 +149,12 @@ def standard_game(player: str, presses: int) -> Replay:
 
 
 def test_a_costly_game_is_listed_apart_unflagged_and_ranked_once_verify_checks_it(tmp_path, monkeypatch, capsys):
-    import armgame.commands.scores as scores_command
+    import armgame.records.listing as listing_module
 
     table = ScoreTable(tmp_path / "t")
     table.add(standard_game("cheap", 1))  # 15,000 steps and 2 events: 15,040
     table.add(standard_game("busy", 10))  # 20 events: 15,400
-    monkeypatch.setattr(scores_command, "MAX_CHECK_WORK", 15_100)
+    monkeypatch.setattr(listing_module, "MAX_CHECK_WORK", 15_100)
     assert main(["scores", "--scores", str(table.folder)]) == 0
     out = capsys.readouterr().out
     ranked, apart = out.split("not checked yet")

@@ -10,8 +10,8 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 
 import pytest
 
-import armgame.commands.scores as scores_command
 import armgame.records.batch_verify as batch_verify
+import armgame.records.listing as listing_module
 from armgame.cli import build_parser, main
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession, InputEvent
@@ -102,7 +102,7 @@ def test_a_listed_players_other_games_are_not_replayed(tmp_path, capsys, monkeyp
     table, entries = class_table(tmp_path / "t")
     path = table.replay_path(entries[5])  # Keen's last game, changed: only a replay would find it
     path.write_bytes(path.read_bytes().replace(b'"date"', b'"date" ', 1))
-    monkeypatch.setattr(scores_command, "MIN_BATCH", 2)
+    monkeypatch.setattr(listing_module, "MIN_BATCH", 2)
     replayed = []
     real = batch_verify.verify_replays
     monkeypatch.setattr(batch_verify, "verify_replays",

@@ -13,11 +13,11 @@ from hypothesis import strategies as st
 
 from armgame import __version__
 from armgame.cli import main
-from armgame.commands.scores import listing
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 from armgame.records.cache import VerificationCache
 from armgame.records.identity import game_digest
+from armgame.records.listing import listing
 from armgame.records.replay import Replay
 from armgame.records.scores import ScoreTable, replay_claims
 from armgame.records.standings import player_key

@@ -16,9 +16,9 @@ from hypothesis import strategies as st
 
 import armgame.records.tablefile as tablefile_module
 from armgame.cli import main
-from armgame.commands.scores import listing
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
+from armgame.records.listing import listing
 from armgame.records.replay import Replay
 from armgame.records.scores import ScoreTable, TableError, entry_order
 from armgame.records.teacher import TeacherRecord

@@ -253,8 +253,8 @@ def join(address: ClassAddress, code: str, name: str | None) -> Membership:
     """Join the class (or rejoin: the token kept from the last time proves the name is this machine's).
 
     ``name`` None: the name this machine joined under last time. Raises UnreachableError or RefusalError."""
-    from ..records.replay import check_name
     from ..records.standings import player_key
+    from ..valid import check_name
 
     code = check_code(code)
     known = remembered().get(code)

@@ -41,11 +41,12 @@ from ..game.session import GameResult
 from ..records.batch_verify import batchable
 from ..records.identity import game_digests
 from ..records.lookalikes import name_problem
-from ..records.replay import Replay, check_name, now_iso, same_outcome
+from ..records.replay import Replay, now_iso, same_outcome
 from ..records.rulesets import RULESETS, ruleset_name
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
 from ..records.standings import player_key, shared_rank
 from ..records.storage import DataFileError
+from ..valid import check_name
 from .board import Board
 from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
 from .roster import MAX_PLAYERS, Player, Roster, token_digest

@@ -41,18 +41,10 @@ from pathlib import Path
 
 from ..limits import DEFAULT_SEED
 from ..records.lookalikes import skeletons
-from ..records.replay import check_date, check_name, now_iso
+from ..records.replay import now_iso
 from ..records.standings import legacy_player_key, player_key
-from ..records.storage import (
-    DataFileError,
-    atomic_write_bytes,
-    check_int,
-    check_keys,
-    check_str,
-    dump_json,
-    parse_json,
-    read_limited,
-)
+from ..records.storage import DataFileError, atomic_write_bytes, dump_json, parse_json, read_limited
+from ..valid import HEX64, INT64_MAX, check_date, check_int, check_keys, check_name, check_str
 
 ROSTER_NAME = "class.json"
 SECRET_NAME = "teacher.secret"
@@ -63,7 +55,6 @@ CODE_LENGTH = 4
 #: Names one class holds: a lecture hall of students, each with a program or two, with room.
 MAX_PLAYERS = 2000
 MAX_ROSTER_BYTES = 2 * 1024 * 1024
-_HEX64 = re.compile(r"[0-9a-f]{64}")
 _SECRET = re.compile(r"[A-Za-z0-9_-]{20,100}")
 
 
@@ -208,7 +199,7 @@ class Roster:
             code = check_str("code", d["code"], CODE_LENGTH)
             if len(code) != CODE_LENGTH or any(c not in CODE_ALPHABET for c in code):
                 raise ValueError(f"code must be {CODE_LENGTH} letters of {CODE_ALPHABET}, got {code!r}")
-            seed = check_int("seed", d["seed"], 0, 2**63 - 1)
+            seed = check_int("seed", d["seed"], 0, INT64_MAX)
             if not isinstance(d["closed"], bool):
                 raise ValueError("closed must be true or false")
             if not isinstance(d["players"], dict) or len(d["players"]) > MAX_PLAYERS:
@@ -224,7 +215,7 @@ class Roster:
                 if key in players:  # two names that are now one: the machine that joined first (filed first) keeps it
                     continue
                 digest = check_str("token_sha256", p["token_sha256"], 64)
-                if not _HEX64.fullmatch(digest):
+                if not HEX64.fullmatch(digest):
                     raise ValueError(f"player {name!r}: token_sha256 is not a SHA-256")
                 address = check_str("address", p["address"], 64) if version >= 2 else ""
                 players[key] = Player(name, digest, check_date("joined", p["joined"]), address)

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
 
 from ..records.standings import one_row_per_player, player_key, shared_rank
+from ..valid import INT64_MAX
 
 #: Seconds after a round's clock runs out during which a game still counts (it was finished in time).
 GRACE_SECONDS = 10
@@ -60,7 +61,7 @@ class Round:
         if not isinstance(data, dict) or set(data) != {"number", "start", "minutes", "after"}:
             raise ValueError("round must be an object of number, start, minutes and after")
         number, minutes, start, after = data["number"], data["minutes"], data["start"], data["after"]
-        if isinstance(after, bool) or not isinstance(after, int) or not 0 <= after < 2**63:
+        if isinstance(after, bool) or not isinstance(after, int) or not 0 <= after <= INT64_MAX:
             raise ValueError("round's after must be a whole number of entries")
         if isinstance(number, bool) or not isinstance(number, int) or not 1 <= number <= 10_000:
             raise ValueError("round's number must be a whole number from 1 to 10000")

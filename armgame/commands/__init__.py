@@ -1,7 +1,8 @@
 """One module per subcommand. Each defines ``register(subparsers)``.
 
-These modules import only the standard library at the top: ``armgame --help`` and the
-parsing of every command must not pay for numpy, scipy or pygame. Heavy imports go inside
+These modules import only the standard library at the top (and armgame's modules below every
+layer, which import nothing else): ``armgame --help`` and the parsing of every command must not
+pay for numpy, scipy or pygame. Heavy imports go inside
 each command's ``run``. A command that opens a window sets ``without_window``: the command line
 that does the same without one, which the CLI prints when no display can be opened.
 """
@@ -12,6 +13,8 @@ import argparse
 import contextlib
 import shlex
 from collections.abc import Sequence
+
+from ..valid import INT64_MAX
 
 
 def command_line(typed: Sequence[str], *added: str) -> str:
@@ -26,7 +29,7 @@ def seed_argument(text: str) -> int:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 0 <= value < 2**63:
+    if not 0 <= value <= INT64_MAX:
         raise argparse.ArgumentTypeError(f"must be from 0 to 2^63 - 1, got {text!r}")
     return value
 

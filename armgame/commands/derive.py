@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import UserError
+from ..valid import INT64_MAX
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -34,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("derive needs SymPy: pip install 'armgame[derive]'") from None
     if not 1 <= args.states <= MAX_STATES:  # each state is a few evaluations: bounded before SymPy starts
         raise UserError(f"--states must be from 1 to {MAX_STATES}, got {args.states}")
-    if not 0 <= args.seed < 2**63:
+    if not 0 <= args.seed <= INT64_MAX:
         raise UserError(f"--seed must be a whole number from 0 to 2^63 - 1, got {args.seed}")
     from ..derive import MATCH_TOLERANCE, compare_with_core, derive, format_latex, format_text
 

@@ -381,7 +381,7 @@ def kept_lines(written: list[Path]) -> list[str]:
 def _check_outputs(args: argparse.Namespace) -> None:
     """Refuse a bad --record, --name or missing matplotlib before the run, not after it."""
     if args.name is not None:
-        from ..records.replay import check_name
+        from ..valid import check_name
 
         try:
             args.name = check_name(args.name, "--name")
@@ -549,7 +549,8 @@ def _play_in_window(args: argparse.Namespace, new_run, end_run) -> None:
                 driver = RealTimeDriver(Autopilot(session, bot))  # type: ignore[arg-type]
             window = LabWindow(session, screen, fps=args.fps, driver=driver,
                                mode="LAB" if bot is None else f"AUTOPILOT: {args.bot}", on_finish=keeper,
-                               palette=settings.palette, text_scale=settings.text_scale)
+                               palette=settings.palette, text_scale=settings.text_scale,
+                               bot=None if bot is None else args.bot)
             window.speed = args.speed
             window.run()
             end_run(window.session, keeper)

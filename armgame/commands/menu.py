@@ -150,8 +150,8 @@ def class_page(launch: Callable[[Sequence[str]], int], typed: dict[str, str] | N
 
     from ..classroom import client
     from ..errors import UserError
-    from ..records.replay import MAX_NAME, check_name
     from ..ui.menu import Field, Item, Page
+    from ..valid import MAX_NAME, check_name
 
     typed = {} if typed is None else typed
     if not typed:

@@ -201,8 +201,8 @@ def _check_score_options(args: argparse.Namespace) -> None:
     """Refuse a bad --name, --record, --script or --scores before the game, not after a minute of play."""
     import sys
 
-    from ..records.replay import check_name
     from ..records.storage import check_writable_folder, user_path
+    from ..valid import check_name
     from .outputs import RecordTarget
     from .scores import scores_dir
 

@@ -1,4 +1,8 @@
-"""armgame scores: the high-score table, best first, each entry checked against its replay."""
+"""armgame scores: the high-score table, best first, each entry checked against its replay.
+
+What a listing replays, counts and flags is ``records.listing``'s to decide; this command parses, prints
+and adds a replay to the table.
+"""
 
 from __future__ import annotations
 
@@ -10,22 +14,6 @@ from . import read_lab_replays
 
 SCORES_HELP = ("folder of the high-score table (default: $ARMGAME_SCORES, else scores/ in a checkout, "
                "else ~/.local/share/armgame/scores)")
-
-
-#: The most work ``scores`` spends recomputing one game, in physics steps of the compiled loop
-#: (``records.checking.replay_work``: steps, 100 a claimed hit under a ranked ruleset and 6,000 under others,
-#: 20 an input event): about 0.13 s. Three times the largest honest game measured: the model bot's standard
-#: game of seed 18, 333,900 (15,000 steps, 50 hits, 15,695 events); the naive bot's largest is 64,720 and
-#: a keyboard player pressing each of the four keys 20 times a second 214,960 (``python
-#: benchmarks/honest_work.py``: both bots on seeds 0 to 41). A game of more (a long clock, a "hit storm"
-#: claiming thousands of hits, a replay of 100,000 events) is listed apart, not checked yet and not ranked:
-#: ``armgame verify`` checks it, whatever it costs, and the next listing has its verdict.
-MAX_CHECK_WORK = 1_000_000
-#: The rows of ``listing`` left unchecked for their cost (one a game): listed apart, neither flagged nor ranked.
-COSTLY = "costly"
-#: The fewest entries ``listing`` checks together (batches recompute many games at once): a list still
-#: wanting rows checks at least this many of the entries below, not one game at a time.
-MIN_BATCH = 256
 
 
 def add_scores_option(p: argparse.ArgumentParser) -> None:
@@ -131,6 +119,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{plural(len(hidden), 'name')} hidden by the class's teacher (armgame class serve): not listed")
     limit = None if args.all else args.top
     per_player = not args.all_games
+    from ..records.listing import listing
+
     lists, flagged = listing(table, entries, limit, check=not args.no_check, per_player=per_player)
     if cache is not None:
         cache.save()
@@ -154,108 +144,8 @@ def _hidden_by_the_teacher(folder, warn) -> set[str]:
     return set(roster.hidden)
 
 
-def listing(table, entries, limit: int | None, check: bool, per_player: bool = True):
-    """Each list's rows best first, at most ``limit`` each, and the flagged entries ``(entry, check)``.
-
-    A row is a ``standings.PlayerRow`` whose ``best`` is ``(entry, check)``: with ``per_player``, one a
-    player (``standings.one_row_per_player``), their best game that checks out and how many games they
-    played in that list; else one a game (``games`` 1), as ``--all-games`` lists them.
-
-    Cost: no replay is read without ``check``. With it, entries are checked best first, in batches
-    (``records.batch_verify``), only while a list still wants rows: at most ``limit`` rows (players) of
-    each list of standard games (each costs exactly its ruleset's steps, once per user: verdicts,
-    failures too, are cached), and at most ``limit`` custom games, flagged ones included (their cost
-    is their own). Once a player has a row, their entries below it are not replayed (but for those in
-    the batch that found it, checked together). So a row's
-    ``games`` is the player's entries in its list less those found flagged (a check failed, or a copy of
-    an earlier game): with a limit, their games below the best count as entered; with none (``--all``:
-    every entry is checked), only games that check out count. Which of two entries of one game counts,
-    and which is the copy, is ``records.identity.FirstEntries``'s to say; the entries flagged are those
-    met on the way. A game whose replay costs more than ``MAX_CHECK_WORK`` is a row of ``lists[COSTLY]``
-    (one a game): not checked yet, so neither flagged nor ranked.
-    """
-    from ..records.batch_verify import check_entries
-    from ..records.identity import FirstEntries
-    from ..records.scores import CUSTOM_GAMES, LIST_TITLES, NOT_CHECKED, sort_key
-    from ..records.standings import PlayerRow, one_row_per_player, player_key
-
-    first: FirstEntries = FirstEntries()
-    counted: dict[str, list] = {name: [] for name in LIST_TITLES}  # (entry, check) of each list's games
-    players: dict[str, set[str]] = {name: set() for name in LIST_TITLES}  # who has a row, by list
-    flagged: list = []
-    costly: list = []
-    custom_checked = 0
-
-    def who(e) -> str:
-        return player_key(e.name) if per_player else e.id
-
-    def wants(e, custom_in_batch: int) -> bool:
-        twin = first.counted_file(e.replay_sha256)
-        if twin is not None:  # a replay file already counted: the copy is flagged unread
-            flagged.append((e, _duplicate(twin)))
-            return False
-        name = table.list_of(e)
-        if limit is None:
-            return True
-        if who(e) in players[name]:  # their row is found: a game below it is counted, not replayed
-            counted[name].append((e, None))
-            return False
-        if name == CUSTOM_GAMES:  # each may cost up to MAX_GAME_STEPS: never more than --top of them
-            return custom_checked + custom_in_batch < limit
-        return len(players[name]) < limit
-
-    pending = sorted(entries, key=sort_key)
-    size = max(2 * limit, MIN_BATCH) if limit else max(1, len(pending))
-
-    def check_batch(batch: list) -> None:
-        results = check_entries(table, batch, MAX_CHECK_WORK) if check else ((e, None) for e in batch)
-        for e, c in results:
-            name = table.list_of(e, c)
-            if limit is not None and name != CUSTOM_GAMES and len(players[name]) >= limit \
-                    and who(e) not in players[name]:
-                continue
-            # Unchecked (--no-check), an entry is taken at its word: the earlier of two counts.
-            twin = first.copy_of(e, e.replay_sha256, None if c is None else c.game, c is None or c.ok)
-            if c is not None and c.label == NOT_CHECKED:
-                costly.append(PlayerRow(e.name, (e, c), 1))  # honest or not, nobody knows yet: verify checks it
-            elif c is not None and not c.ok:
-                flagged.append((e, c))
-            elif twin is not None:
-                flagged.append((e, _duplicate(twin)))
-            else:
-                players[name].add(who(e))
-                counted[name].append((e, c))
-
-    # One pass, best first: an entry its list no longer wants now is never wanted later (lists only fill).
-    batch: list = []
-    custom_in_batch = 0
-    for e in pending:
-        if not wants(e, custom_in_batch):
-            continue
-        batch.append(e)
-        custom_in_batch += table.list_of(e) == CUSTOM_GAMES
-        if len(batch) >= size:
-            custom_checked += custom_in_batch  # counted as listed before the check: an old entry's may rank it
-            check_batch(batch)
-            batch, custom_in_batch = [], 0
-    if batch:
-        check_batch(batch)
-    lists = {}
-    for name, games in counted.items():
-        games.sort(key=lambda game: sort_key(game[0]))
-        lists[name] = (one_row_per_player(games, lambda game: game[0].name) if per_player
-                       else [PlayerRow(e.name, (e, c), 1) for e, c in games])
-    lists[COSTLY] = costly
-    return lists, flagged
-
-
-def _duplicate(twin):
-    when = (twin.entered_at or twin.date)[:16].replace("T", " ")
-    return _check("DUPLICATE", f"the same game as {twin.name}'s entry of {when}, which counts")
-
-
 def _games_note(per_player: bool, limit: int | None, no_check: bool) -> str | None:
-    """What the "games" column counts (``listing``'s docstring), or None without one."""
+    """What the "games" column counts (``records.listing.listing``'s docstring), or None without one."""
     if not per_player:
         return None
     if no_check:
@@ -267,6 +157,8 @@ def _games_note(per_player: bool, limit: int | None, no_check: bool) -> str | No
 
 
 def _print_listing(table, count: int, lists, flagged, no_check: bool, note: str | None = None) -> None:
+    """Print ``records.listing.listing``'s lists and flagged entries."""
+    from ..records.listing import COSTLY
     from ..records.scores import LIST_TITLES, RANKED
 
     checked = "" if no_check else ", replays checked"
@@ -292,14 +184,9 @@ def _print_listing(table, count: int, lists, flagged, no_check: bool, note: str 
             print(f"  {e.name} ({e.score}, {e.date[:16].replace('T', ' ')}): {c.label}: {c.detail}")
 
 
-def _check(label: str, detail: str):
-    from ..records.scores import Check
-
-    return Check(False, label, detail)
-
-
 def _print_rows(rows_in, games: bool) -> None:
-    """The rows of one list (``listing``'s), ranked; ``games``: with the column of each player's games."""
+    """The rows of one list (``records.listing.listing``'s), ranked; ``games``: with the column of each
+    player's games."""
     rows = [("#", "name", "score", *(("games",) if games else ()), "hits", "resets", "driven", "seed", "length",
              "date", "version", "replay")]
     for rank, row in enumerate(rows_in, 1):
@@ -319,8 +206,9 @@ def _print_rows(rows_in, games: bool) -> None:
 
 def _add(table, args: argparse.Namespace) -> int:
     from ..errors import UserError
-    from ..records.replay import Replay, check_name
+    from ..records.replay import Replay
     from ..records.storage import user_path
+    from ..valid import check_name
 
     path = user_path(args.add, "--add")
     replay = Replay.load(path)

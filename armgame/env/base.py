@@ -1,8 +1,10 @@
 """What every armgame env shares: a session driven by key or muscle-level actions, drawn by ``armgame.ui``.
 
-``ReachEnv`` (the game) and ``CenterOutEnv`` (the lab's task) differ in their session, spaces and
+The Reach envs (the game) and the CenterOut envs (the lab's task) differ in their session, spaces and
 reward; how an action reaches the session (the same key events a player's keys make, or muscle
 levels) and how frames are made (pygame imported on the first frame only) are written once here.
+Above it, each family's versions share a base of their own (``reach.ReachBaseEnv``,
+``center_out.CenterOutBaseEnv``) and are siblings over it: no version subclasses another.
 """
 
 from __future__ import annotations

@@ -5,6 +5,9 @@ plays: an episode is one protocol run, with the same seed, trials, perturbations
 timeline. The task's rules, the perturbations and the per-reach measures stay in
 ``armgame.lab``; this module owns the spaces, the reward and the options of a reset.
 ``CenterOutBotPolicy`` lets the lab's bots play through the env from its observations.
+
+``CenterOutBaseEnv`` is what every version shares (the arguments, the run, a reset's options, the
+frames): ``CenterOutEnv`` (v0) and ``center_out_v1.CenterOutV1Env`` derive from it as siblings.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from gymnasium import spaces
 
 from ..errors import UserError
 from ..game.muscles import MuscleSet
-from ..game.rules import Target
+from ..game.rules import MAX_CONFIG_SECONDS, Target
 from ..game.session import DOWN
 from ..lab.analysis import trial_row
 from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
@@ -35,6 +38,7 @@ from ..lab.protocol import (
     with_perturbation,
 )
 from ..lab.session import HOLD, REACH, LabSession, lab_config
+from ..physics.hand import hand_xy
 from ..physics.twojoint import TwoJointArm
 from ..words import unknown_name
 from .base import EnvArgumentError, SessionEnv
@@ -50,8 +54,8 @@ from .reach import (
 
 OBSERVATION_NAMES = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "cursor_x", "cursor_y", "home_x", "home_y",
                      "target_x", "target_y", "phase", "time_in_phase", "trial", "time_left")
-#: The lab's clock never runs longer than a day (``lab_config``).
-MAX_RUN_SECONDS = 86400.0
+#: The lab's clock never runs longer than a game may (``lab_config``): a day.
+MAX_RUN_SECONDS = MAX_CONFIG_SECONDS
 #: Reward lost per second of the task's time.
 DEFAULT_TIME_COST = 0.1
 
@@ -125,7 +129,130 @@ def versioned_schedule(protocol: Protocol) -> Protocol:
     return replace(protocol, probe_schedule="random")
 
 
-class CenterOutEnv(SessionEnv):
+class CenterOutBaseEnv(SessionEnv):
+    """What the CenterOut envs' versions share: the arguments every version takes, a ``LabSession`` run of
+    the protocol made at a reset and driven a decision step at a time, a reset's options, and the frames.
+    Each version is its own sibling subclass (as Gymnasium keeps its mujoco versions), giving its spaces,
+    when an episode starts a run and ends, its reward, observation and ``info``; a change to one version
+    never reaches another.
+    """
+
+    family = "CenterOut"
+    #: The lab's rule, that a trial's go cue waits for the cursor to stay in home: each version says.
+    hold_at_home: bool
+
+    def _configure(self, render_mode: str | None, protocol: str | Protocol, perturbation: object | None,
+                   decision_steps: int, continuous: bool, time_cost: float, render_size: tuple[int, int]) -> None:
+        """The arguments every version takes, checked in this order (one line for the first bad one)."""
+        self._check_render_mode(render_mode)
+        if isinstance(decision_steps, bool) or not isinstance(decision_steps, int | np.integer) \
+                or not 1 <= decision_steps <= MAX_DECISION_STEPS:
+            raise EnvArgumentError(f"decision_steps must be a whole number of physics steps from 1 to "
+                                   f"{MAX_DECISION_STEPS}, got {decision_steps!r}")
+        if not isinstance(continuous, bool | np.bool_):
+            raise EnvArgumentError(f"continuous must be True or False, got {continuous!r}")
+        if isinstance(time_cost, bool) or not isinstance(time_cost, int | float) or not 0.0 <= time_cost <= 10.0:
+            raise EnvArgumentError(f"time_cost must be a number from 0 to 10 (reward per second), got {time_cost!r}")
+        self.protocol = run_protocol(protocol, perturbation)
+        self.decision_steps = int(decision_steps)
+        self.continuous = bool(continuous)
+        self.time_cost = float(time_cost)
+        self.render_mode = render_mode
+        self.render_size = _check_size(render_size)
+        base = lab_config(self.protocol, 0)
+        self.decision_time = self.decision_steps * base.dt
+        self.metadata = {**self.metadata, "render_fps": 1.0 / self.decision_time}
+        self.session: LabSession | None = None
+        self._view: Any = None  # armgame.ui.lab_env_view.LabEnvView, made on the first frame
+
+    # ----------------------------------------------------------------- the API
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+        self._start_episode(seed, options)
+        if self.render_mode == "human":
+            self.render()
+        return self._observation(), self._info()
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
+        session = self.session
+        if session is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        if self._episode_over():
+            raise gym.error.ResetNeeded("the episode is over: call reset() before another step()")
+        if self.continuous:
+            self._set_levels(action, 4)
+        else:
+            self._press_keys(action, 4)
+        done, hits = len(session.outcomes), session.rules.board.hits
+        ran = session.advance(self.decision_steps)
+        reward = self._reward(session.rules.board.hits - hits) - self.time_cost * ran * session.config.dt
+        info = self._info()
+        if len(session.outcomes) > done:
+            info["reaches"] = [trial_row(session, o) for o in session.outcomes[done:]]
+        if self.render_mode == "human":
+            self.render()
+        truncated = session.over and not session.finished  # the run's clock ran out
+        return self._observation(), reward, self._episode_over() and not truncated, truncated, info
+
+    # ------------------------------------------------------- each version's own
+    def _start_episode(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
+        """Start an episode: a new run (``_new_run``), or the next trials of the one under way."""
+        raise NotImplementedError
+
+    def _episode_over(self) -> bool:
+        raise NotImplementedError
+
+    def _reward(self, hits: int) -> float:
+        """The step's reward from its hits, before the time cost."""
+        raise NotImplementedError
+
+    def _bounds(self, protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
+        """The observation's bounds (float64) for runs of ``protocol``."""
+        raise NotImplementedError
+
+    def _observation(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def _info(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+    # --------------------------------------------------------------- shared
+    def _new_run(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
+        if seed is not None:
+            seed = check_seed(seed)
+        if options:
+            self._take_options(options)
+        super().reset(seed=seed)
+        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
+        try:
+            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol,
+                                      hold_at_home=self.hold_at_home)
+        except UserError as exc:  # a target out of the arm's reach, in the lab's words
+            raise EnvArgumentError(str(exc)) from None
+
+    def _take_options(self, options: Mapping[str, Any]) -> None:
+        """A reset's ``protocol`` and ``perturbation``, refused if the observation space cannot bound them."""
+        if not isinstance(options, Mapping):
+            raise EnvArgumentError(f"options must be a dict, got {type(options).__name__}")
+        unknown = set(options) - {"protocol", "perturbation"}
+        if unknown:
+            raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, unknown)))}: "
+                                   "choose protocol, perturbation")
+        protocol = run_protocol(options.get("protocol", self.protocol), options.get("perturbation"))
+        low, high = self._bounds(protocol)
+        space = self.observation_space
+        if np.any(low.astype(space.dtype) < space.low) or np.any(high.astype(space.dtype) > space.high):
+            raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
+                                   "spring force (unbounded speeds) needs an env made with it, e.g. "
+                                   "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
+        self.protocol = protocol
+
+    def _new_view(self) -> Any:
+        from ..ui.lab_env_view import LabEnvView  # pygame is imported here and only here
+
+        return LabEnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
+
+
+class CenterOutEnv(CenterOutBaseEnv):
     r"""
     ## Description
 
@@ -245,85 +372,24 @@ class CenterOutEnv(SessionEnv):
     * v0: Initial version (armgame 0.1).
     """
 
-    family = "CenterOut"
-    #: The lab's rule: a trial's go cue waits for the cursor to stay in home (v1 may start without).
+    version = 0
+    #: The lab's rule: a trial's go cue waits for the cursor to stay in home.
     hold_at_home = True
 
     def __init__(self, render_mode: str | None = None, *, protocol: str | Protocol = "null",
                  perturbation: object | None = None, decision_steps: int = DEFAULT_DECISION_STEPS,
                  continuous: bool = False, time_cost: float = DEFAULT_TIME_COST,
                  render_size: tuple[int, int] = (600, 600)) -> None:
-        self._check_render_mode(render_mode)
-        if isinstance(decision_steps, bool) or not isinstance(decision_steps, int | np.integer) \
-                or not 1 <= decision_steps <= MAX_DECISION_STEPS:
-            raise EnvArgumentError(f"decision_steps must be a whole number of physics steps from 1 to "
-                                   f"{MAX_DECISION_STEPS}, got {decision_steps!r}")
-        if not isinstance(continuous, bool | np.bool_):
-            raise EnvArgumentError(f"continuous must be True or False, got {continuous!r}")
-        if isinstance(time_cost, bool) or not isinstance(time_cost, int | float) or not 0.0 <= time_cost <= 10.0:
-            raise EnvArgumentError(f"time_cost must be a number from 0 to 10 (reward per second), got {time_cost!r}")
-        self.protocol = run_protocol(protocol, perturbation)
-        self.decision_steps = int(decision_steps)
-        self.continuous = bool(continuous)
-        self.time_cost = float(time_cost)
-        self.render_mode = render_mode
-        self.render_size = _check_size(render_size)
-        base = lab_config(self.protocol, 0)
-        self.decision_time = self.decision_steps * base.dt
-        self.metadata = {**self.metadata, "render_fps": 1.0 / self.decision_time}
+        self._configure(render_mode, protocol, perturbation, decision_steps, continuous, time_cost, render_size)
         if self.continuous:
             self.action_space = spaces.Box(0.0, 1.0, (4,), np.float32)
         else:
             self.action_space = spaces.MultiBinary(4)
         self.observation_space = spaces.Box(*observation_bounds(self.protocol), dtype=np.float64)
-        self.session: LabSession | None = None
-        self._view: Any = None  # armgame.ui.lab_env_view.LabEnvView, made on the first frame
 
-    # ----------------------------------------------------------------- the API
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
-        self._start_episode(seed, options)
-        if self.render_mode == "human":
-            self.render()
-        return self._observation(), self._info()
-
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        session = self.session
-        if session is None:
-            raise gym.error.ResetNeeded("call reset() before step()")
-        if self._episode_over():
-            raise gym.error.ResetNeeded("the episode is over: call reset() before another step()")
-        if self.continuous:
-            self._set_levels(action, 4)
-        else:
-            self._press_keys(action, 4)
-        done, hits = len(session.outcomes), session.rules.board.hits
-        ran = session.advance(self.decision_steps)
-        reward = self._reward(session.rules.board.hits - hits) - self.time_cost * ran * session.config.dt
-        info = self._info()
-        if len(session.outcomes) > done:
-            info["reaches"] = [trial_row(session, o) for o in session.outcomes[done:]]
-        if self.render_mode == "human":
-            self.render()
-        truncated = session.over and not session.finished  # the run's clock ran out
-        return self._observation(), reward, self._episode_over() and not truncated, truncated, info
-
-    # --------------------------------------------------------------- internals
     def _start_episode(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
         """v0: every episode is a new run."""
         self._new_run(seed, options)
-
-    def _new_run(self, seed: int | None, options: Mapping[str, Any] | None) -> None:
-        if seed is not None:
-            seed = check_seed(seed)
-        if options:
-            self._take_options(options)
-        super().reset(seed=seed)
-        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
-        try:
-            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol,
-                                      hold_at_home=self.hold_at_home)
-        except UserError as exc:  # a target out of the arm's reach, in the lab's words
-            raise EnvArgumentError(str(exc)) from None
 
     def _episode_over(self) -> bool:
         assert self.session is not None
@@ -332,30 +398,8 @@ class CenterOutEnv(SessionEnv):
     def _reward(self, hits: int) -> float:
         return float(hits)
 
-    def _take_options(self, options: Mapping[str, Any]) -> None:
-        """A reset's ``protocol`` and ``perturbation``, refused if the observation space cannot bound them."""
-        if not isinstance(options, Mapping):
-            raise EnvArgumentError(f"options must be a dict, got {type(options).__name__}")
-        unknown = set(options) - {"protocol", "perturbation"}
-        if unknown:
-            raise EnvArgumentError(f"unknown reset option(s) {', '.join(sorted(map(str, unknown)))}: "
-                                   "choose protocol, perturbation")
-        protocol = run_protocol(options.get("protocol", self.protocol), options.get("perturbation"))
-        low, high = self._bounds(protocol)
-        space = self.observation_space
-        if np.any(low.astype(space.dtype) < space.low) or np.any(high.astype(space.dtype) > space.high):
-            raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
-                                   "spring force (unbounded speeds) needs an env made with it, e.g. "
-                                   "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
-        self.protocol = protocol
-
     def _bounds(self, protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
         return observation_bounds(protocol)
-
-    def _new_view(self) -> Any:
-        from ..ui.lab_env_view import LabEnvView  # pygame is imported here and only here
-
-        return LabEnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
 
     def _observation(self) -> np.ndarray:
         s = self.session
@@ -437,8 +481,7 @@ class _SeenLab:
 
     def hand(self) -> tuple[float, float]:
         p = self.config.arm
-        q1, q2 = self.state[0], self.state[1]
-        return p.l1 * math.cos(q1) + p.l2 * math.cos(q1 + q2), p.l1 * math.sin(q1) + p.l2 * math.sin(q1 + q2)
+        return hand_xy(p.l1, p.l2, self.state[0], self.state[1])
 
 
 class CenterOutBotPolicy:

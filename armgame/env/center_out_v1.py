@@ -23,7 +23,7 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from ..lab.protocol import Protocol
 from ..lab.session import REACH, lab_config
 from .base import EnvArgumentError
-from .center_out import MAX_RUN_SECONDS, CenterOutEnv
+from .center_out import MAX_RUN_SECONDS, CenterOutBaseEnv
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, check_dtype, check_reward, hand_and_velocity
 from .reach import DEFAULT_DECISION_STEPS, speed_bound, wrap_angle
 from .vector_common import AutoresetBook
@@ -53,7 +53,7 @@ def observation_bounds_v1(protocol: Protocol, trial_start: str) -> tuple[np.ndar
     return low, high
 
 
-class CenterOutV1Env(CenterOutEnv):
+class CenterOutV1Env(CenterOutBaseEnv):
     r"""
     ## Description
 
@@ -172,8 +172,7 @@ class CenterOutV1Env(CenterOutEnv):
                  progress_weight: float = DEFAULT_PROGRESS_WEIGHT, hit_bonus: float = DEFAULT_HIT_BONUS,
                  time_cost: float = 0.0, observation_dtype: str = "float32",
                  render_size: tuple[int, int] = (600, 600)) -> None:
-        super().__init__(render_mode, protocol=protocol, perturbation=perturbation, decision_steps=decision_steps,
-                         continuous=continuous, time_cost=time_cost, render_size=render_size)
+        self._configure(render_mode, protocol, perturbation, decision_steps, continuous, time_cost, render_size)
         if trial_start not in TRIAL_STARTS:
             raise EnvArgumentError(f"trial_start must be 'delay' or 'hold', got {trial_start!r}")
         if episode_trials != "block" and (isinstance(episode_trials, bool)
@@ -188,8 +187,7 @@ class CenterOutV1Env(CenterOutEnv):
         self.trial_start = trial_start
         self.hold_at_home = trial_start == "hold"
         self.episode_trials = episode_trials if episode_trials == "block" else int(episode_trials)
-        if self.continuous:
-            self.action_space = spaces.Box(-1.0, 1.0, (4,), np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, (4,), np.float32) if self.continuous else spaces.MultiBinary(4)
         low, high = observation_bounds_v1(self.protocol, trial_start)
         self.observation_dtype = dtype = np.dtype(check_dtype(observation_dtype))
         self.observation_space = spaces.Box(low.astype(dtype), high.astype(dtype), dtype=dtype)

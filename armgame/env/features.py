@@ -33,18 +33,15 @@ import math
 
 import numpy as np
 
+from .._native import load
 from ..game.rules import GameConfig
+from ..physics.hand import hand_from_trig
 from ..physics.params import TwoJointParams
 from .errors import EnvArgumentError
 
-try:
-    # armgame/env/_cvector.c, built by pip install where a C compiler exists. Imported by its module's name, not
-    # ``from . import``, which imports the package first: the package imports evaluate, which imports this.
-    import armgame.env._cvector as _cvector
-except ImportError:
-    _cvector = None
-if getattr(_cvector, "VERSION", None) != 1:  # not built, or built from another _cvector.c: its calling convention
-    _cvector = None                            # may differ, so numpy's twins run
+#: armgame/env/_cvector.c where built, and only if it speaks this module's calling convention (VERSION 1;
+#: ``armgame._native``): otherwise numpy's twins run.
+_cvector = load("armgame.env._cvector", 1)
 #: ``_cvector.observe_v1`` (None: ``observe_v1`` runs numpy).
 _c_observe_v1 = None if _cvector is None else _cvector.observe_v1
 #: ``_cvector.hold_keys``: ``BatchGameSession.set_held`` in one pass, for the vector envs (None: they call it).
@@ -73,9 +70,10 @@ def hand_and_velocity(arm: TwoJointParams, q1: float, q2: float, w1: float,
     """The hand (as ``GameSession.hand``) and ``hand_velocity`` of one arm in plain floats, their trig shared:
     a single env steps 3 times as fast as through numpy's one-element arrays, and agrees with them to
     round-off (the vector tests)."""
-    c1, s1, c12, s12, w12 = math.cos(q1), math.sin(q1), math.cos(q1 + q2), math.sin(q1 + q2), w1 + w2
-    return (arm.l1 * c1 + arm.l2 * c12, arm.l1 * s1 + arm.l2 * s12,
-            -arm.l1 * s1 * w1 - arm.l2 * s12 * w12, arm.l1 * c1 * w1 + arm.l2 * c12 * w12)
+    q12, w12 = q1 + q2, w1 + w2
+    c1, s1, c12, s12 = math.cos(q1), math.sin(q1), math.cos(q12), math.sin(q12)
+    hx, hy = hand_from_trig(arm.l1, arm.l2, c1, s1, c12, s12)
+    return hx, hy, -arm.l1 * s1 * w1 - arm.l2 * s12 * w12, arm.l1 * c1 * w1 + arm.l2 * c12 * w12
 
 
 def hand_speed_bound(arm: TwoJointParams, joint_speed: float) -> float:
@@ -167,7 +165,9 @@ def observe_v1(arm: TwoJointParams, radius: float, x: np.ndarray, trig: np.ndarr
     l1, l2 = arm.l1, arm.l2
     q1, q2, w1, w2 = x[0], x[1], x[2], x[3]
     c1, s1, c12, s12 = trig[0], trig[1], trig[2], trig[3]
-    # The hand once, for both the observation and the distance; products into scratch arrays, no temporaries.
+    # The hand once, for both the observation and the distance: ``hand_from_trig``'s operations in its order
+    # (l1 c1 + l2 c12, l1 s1 + l2 s12, so the same bits), written out to build them in scratch arrays: its
+    # form makes a temporary array per product, and this pass runs at every step of every game of a batch.
     hx = l1 * c1
     scratch = np.multiply(l2, c12)
     hx += scratch

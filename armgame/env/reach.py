@@ -4,6 +4,10 @@ The env is a thin shell over ``GameSession``: an action is a set of key events (
 levels) applied before a decision step of several physics steps, exactly as a player's keys
 reach the game, so an episode is a game with the same seed, rules and score. The spaces and the
 reward are defined here once and shared with the vector env (``armgame.env.vector``).
+
+What every version of the Reach envs shares is here too: their settings (``ReachSettings``, checked
+once), the bounds and ``ReachBaseEnv``, the episode loop that ``ReachEnv`` (v0) and
+``reach_v1.ReachV1Env`` each derive from as siblings.
 """
 
 from __future__ import annotations
@@ -18,8 +22,9 @@ import numpy as np
 from gymnasium import spaces
 
 from ..errors import UserError
-from ..game.rules import GameConfig
+from ..game.rules import MAX_CONFIG_SECONDS, GameConfig
 from ..game.session import GameSession
+from ..valid import INT64_MAX
 from .base import EnvArgumentError, SessionEnv
 from .features import REACH_REWARDS, check_dtype, check_reward, reach_bounds_v1
 from .variants import ReachVariant
@@ -28,9 +33,9 @@ from .variants import ReachVariant
 DEFAULT_DECISION_STEPS = 5
 MAX_DECISION_STEPS = 1000
 #: The longest game an env plays, in seconds: the game's own limit (``GameConfig``).
-MAX_TIME_LIMIT = 24 * 3600.0
+MAX_TIME_LIMIT = MAX_CONFIG_SECONDS
 #: The game's seeds (``GameConfig.seed``) are whole numbers below this.
-SEED_LIMIT = 2**63
+SEED_LIMIT = INT64_MAX + 1
 OBSERVATION_NAMES = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "target_x", "target_y", "time_left")
 
 
@@ -180,7 +185,96 @@ def check_seed(seed: object) -> int:
     return int(seed)
 
 
-class ReachEnv(SessionEnv):
+class ReachBaseEnv(SessionEnv):
+    """What the Reach envs' versions share: a ``GameSession`` made at each reset and driven a decision step
+    at a time (``reset``, ``step``, ``info``, frames). Each version is its own sibling subclass (as
+    Gymnasium keeps its mujoco versions), giving its session, what happens before and during a decision's
+    physics steps, its reward and its observation; a change to one version never reaches another.
+    """
+
+    family = "Reach"
+
+    def _configure(self, settings: ReachSettings, render_mode: str | None, render_size: tuple[int, int]) -> None:
+        self._check_render_mode(render_mode)
+        self.settings = settings
+        self.version = settings.version
+        self.continuous = self.settings.continuous
+        self.config = self.settings.config
+        self.decision_steps = self.settings.decision_steps
+        self.decision_time = self.settings.decision_time
+        self.render_mode = render_mode
+        self.render_size = _check_size(render_size)
+        self.metadata = {**self.metadata, "render_fps": 1.0 / self.decision_time}
+        self.action_space = self.settings.action_space()
+        self.observation_space = self.settings.observation_space()
+        self.session: GameSession | None = None
+        self._view: Any = None  # armgame.ui.env_view.EnvView, made on the first frame
+
+    # ----------------------------------------------------------------- the API
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
+        if seed is not None:
+            seed = check_seed(seed)
+        super().reset(seed=seed)
+        game_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
+        self.session = self._new_session(self.settings.game(game_seed))
+        if self.render_mode == "human":
+            self.render()
+        return self._observation(), self._info()
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
+        session = self.session
+        if session is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        if session.over:
+            raise gym.error.ResetNeeded("the game is over (truncated): call reset() before another step()")
+        board = session.rules.board
+        hits, resets = board.hits, board.resets
+        if self.continuous:
+            self._set_levels(action, self.action_space.shape[0])
+        else:
+            self._press_keys(action, self.action_space.n)
+        self._before_advance(session)
+        stopped = self._advance(session)
+        reward = self._reward(board.hits - hits, board.resets - resets)
+        if self.render_mode == "human":
+            self.render()
+        if stopped:  # the game ended before its clock: terminated, with the reason in one line
+            return self._observation(), reward, True, False, self._info() | stopped
+        return self._observation(), reward, False, session.over, self._info()
+
+    # ------------------------------------------------------- each version's own
+    def _new_session(self, config: GameConfig) -> GameSession:
+        """The game of an episode, of ``config`` (the settings' game with the episode's seed)."""
+        raise NotImplementedError
+
+    def _before_advance(self, session: GameSession) -> None:
+        """What the version does to the game before each decision's physics steps."""
+        raise NotImplementedError
+
+    def _advance(self, session: GameSession) -> dict[str, Any]:
+        """Run the decision's physics steps; what stopped the game early, for ``info`` (empty: nothing did)."""
+        raise NotImplementedError
+
+    def _reward(self, hits: int, resets: int) -> float:
+        """The step's reward from its hits and reset presses."""
+        raise NotImplementedError
+
+    def _observation(self) -> np.ndarray:
+        raise NotImplementedError
+
+    # --------------------------------------------------------------- shared
+    def _new_view(self) -> Any:
+        from ..ui.env_view import EnvView  # pygame is imported here and only here
+
+        return EnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
+
+    def _info(self) -> dict[str, int]:
+        assert self.session is not None
+        board = self.session.rules.board
+        return {"score": board.score, "hits": board.hits, "resets": board.resets}
+
+
+class ReachEnv(ReachBaseEnv):
     r"""
     ## Description
 
@@ -288,7 +382,7 @@ class ReachEnv(SessionEnv):
     * v0: Initial version (armgame 0.1).
     """
 
-    family = "Reach"
+    version = 0
 
     def __init__(self, render_mode: str | None = None, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
@@ -296,74 +390,20 @@ class ReachEnv(SessionEnv):
         self._configure(ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key), render_mode,
                         render_size)
 
-    def _configure(self, settings: ReachSettings, render_mode: str | None, render_size: tuple[int, int]) -> None:
-        self._check_render_mode(render_mode)
-        self.settings = settings
-        self.version = settings.version
-        self.continuous = self.settings.continuous
-        self.config = self.settings.config
-        self.decision_steps = self.settings.decision_steps
-        self.decision_time = self.settings.decision_time
-        self.render_mode = render_mode
-        self.render_size = _check_size(render_size)
-        self.metadata = {**self.metadata, "render_fps": 1.0 / self.decision_time}
-        self.action_space = self.settings.action_space()
-        self.observation_space = self.settings.observation_space()
-        self.session: GameSession | None = None
-        self._view: Any = None  # armgame.ui.env_view.EnvView, made on the first frame
-
-    # ----------------------------------------------------------------- the API
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
-        if seed is not None:
-            seed = check_seed(seed)
-        super().reset(seed=seed)
-        game_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
-        self.session = self._new_session(self.settings.game(game_seed))
-        if self.render_mode == "human":
-            self.render()
-        return self._observation(), self._info()
-
-    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        session = self.session
-        if session is None:
-            raise gym.error.ResetNeeded("call reset() before step()")
-        if session.over:
-            raise gym.error.ResetNeeded("the game is over (truncated): call reset() before another step()")
-        board = session.rules.board
-        hits, resets = board.hits, board.resets
-        if self.continuous:
-            self._set_levels(action, self.action_space.shape[0])
-        else:
-            self._press_keys(action, self.action_space.n)
-        self._before_advance(session)
-        stopped = self._advance(session)
-        reward = self._reward(board.hits - hits, board.resets - resets)
-        if self.render_mode == "human":
-            self.render()
-        if stopped:  # the game ended before its clock: terminated, with the reason in one line
-            return self._observation(), reward, True, False, self._info() | stopped
-        return self._observation(), reward, False, session.over, self._info()
-
-    # --------------------------------------------------------------- internals
     def _new_session(self, config: GameConfig) -> GameSession:
         return GameSession(config)
 
+    def _before_advance(self, session: GameSession) -> None:
+        """v0: nothing."""
+
     def _advance(self, session: GameSession) -> dict[str, Any]:
-        """Run the decision's physics steps; what stopped the game early, for ``info`` (v0: nothing does)."""
+        """v0: the decision's physics steps, which nothing stops early."""
         session.advance(self.decision_steps)
         return {}
 
-    def _before_advance(self, session: GameSession) -> None:
-        """What a variant does to the game before each decision's physics steps (v0: nothing)."""
-
     def _reward(self, hits: int, resets: int) -> float:
-        """The step's reward from its hits and reset presses (v0: the game's score change, never floored)."""
+        """v0: the game's score change, never floored."""
         return float(hits - self.config.reset_cost * resets)
-
-    def _new_view(self) -> Any:
-        from ..ui.env_view import EnvView  # pygame is imported here and only here
-
-        return EnvView(self.render_mode, self.render_size, self.metadata["render_fps"])
 
     def _observation(self) -> np.ndarray:
         session = self.session
@@ -372,11 +412,6 @@ class ReachEnv(SessionEnv):
         target = session.rules.target
         return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2,
                          *session.muscles.activation, target.x, target.y, session.time_left))
-
-    def _info(self) -> dict[str, int]:
-        assert self.session is not None
-        board = self.session.rules.board
-        return {"score": board.score, "hits": board.hits, "resets": board.resets}
 
 
 def _check_size(size: object) -> tuple[int, int]:

@@ -19,14 +19,14 @@ from ..game.session import GameSession
 from ..game.variant import GameVariant, MuscleNoise, RunawayError
 from .errors import EnvArgumentError
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, hand_and_velocity
-from .reach import DEFAULT_DECISION_STEPS, ReachEnv, ReachSettings, wrap_angle
+from .reach import DEFAULT_DECISION_STEPS, ReachBaseEnv, ReachSettings, wrap_angle
 from .variants import DelayedObservations, ReachVariant
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
                         "to_target_x", "to_target_y", "time_left_fraction")
 
 
-class ReachV1Env(ReachEnv):
+class ReachV1Env(ReachBaseEnv):
     r"""
     ## Description
 
@@ -135,6 +135,8 @@ class ReachV1Env(ReachEnv):
     * v0: Initial version (armgame 0.1).
     """
 
+    version = 1
+
     def __init__(self, render_mode: str | None = None, *, time_limit: float | None = None,
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
@@ -213,8 +215,8 @@ class ReachV1Env(ReachEnv):
 
     def _reward(self, hits: int, resets: int) -> float:
         s = self.settings
-        if s.reward == "sparse":
-            return super()._reward(hits, resets)
+        if s.reward == "sparse":  # v0's reward: the game's score change, never floored
+            return float(hits - self.config.reset_cost * resets)
         if s.reward == "score":
             return self._score_reward()
         before, self._edge = self._edge, self._edge_now()

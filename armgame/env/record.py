@@ -44,7 +44,7 @@ from ..lab.record import LabTask, paths_digest, trial_fields
 from ..lab.session import LabSession
 from ..records.env_game import EnvGameTask, levels_from_list, register
 from ..records.replay import Replay, now_iso, register_task, same_outcome
-from ..records.storage import check_int, check_keys, check_str
+from ..valid import check_bool, check_int, check_keys, check_str
 from .errors import EnvArgumentError
 
 CENTRE_OUT_KIND = "centre-out-env"
@@ -134,10 +134,9 @@ class CenterOutEnvTask:
             raise ValueError(f"task.version {version}: this armgame reads a CenterOut env's section of version "
                              f"{CENTRE_OUT_VERSION}")
         env_id = None if d["env_id"] is None else check_str("task.env_id", d["env_id"], 100)
-        if not isinstance(d["hold_at_home"], bool):
-            raise ValueError(f"task.hold_at_home must be true or false, got {d['hold_at_home']!r}")
+        hold_at_home = check_bool("task.hold_at_home", d["hold_at_home"])
         lab = LabTask.from_dict(d["lab"], config, last_step)
-        return cls(lab, d["hold_at_home"], levels_from_list(d["levels"], last_step), env_id)
+        return cls(lab, hold_at_home, levels_from_list(d["levels"], last_step), env_id)
 
     def new_session(self, config: GameConfig) -> LabSession:
         return LabSession(config, self.lab.protocol, hold_at_home=self.hold_at_home)

@@ -9,11 +9,14 @@ from __future__ import annotations
 import math
 import random
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from ..errors import UserError
+from ..limits import MAX_GAME_SECONDS
 from ..physics.defaults import GAME_DT, GAME_INTEGRATOR
 from ..physics.hand import hand_xy_arm_sine
 from ..physics.params import GAME_ARM, TwoJointParams
+from ..valid import INT64_MAX
 from .muscles import DEFAULT_MUSCLES, MuscleSpec
 
 #: The 2012 game's screen (800 x 800 px, shoulder at (400, 600), 500 px/m) in metres.
@@ -25,6 +28,49 @@ GAME_VIEW = (-0.8, 0.8, -0.4, 1.2)
 #: arm so slow that damping, not inertia, set every torque, and a player who ignores the
 #: interaction torques did as well as one who knows them (the autopilot bots, armgame/game/bots.py).
 GAME_PLAY_ARM = GAME_ARM.replace(damping1=0.36, damping2=0.27)
+
+
+class GameRange(NamedTuple):
+    """One kind of game setting's range, in ``unit``: from ``low`` to ``high`` in a replay (``records.replay``'s
+    reader refuses a file beyond it); ``config``, where given, the range ``(low, high]`` a ``GameConfig`` takes
+    (``GameConfig.__post_init__``)."""
+
+    low: float
+    high: float
+    unit: str
+    config: tuple[float, float] | None = None
+
+
+#: The longest game a ``GameConfig`` takes, in seconds: a day (a replay holds at most ``limits.MAX_GAME_SECONDS``).
+MAX_CONFIG_SECONDS = 24 * 3600.0
+
+
+#: Every game setting's range (the arm's own are ``physics.params.PARAMETER_RANGES``). A replay's: wide enough
+#: for any custom game a class would design, narrow enough that no setting makes the physics or the target draw
+#: blow up or run for hours. A ``GameConfig`` takes more where ``config`` says, on purpose: a game a program
+#: builds for itself need not be one a replay may hold (an env's game at a coarser step, a lab run's clock for
+#: a person at the keys, up to a day); ``play`` and ``lab`` check their game against the replay's ranges before
+#: it starts (``commands.play.check_recordable``).
+GAME_RANGES: dict[str, GameRange] = {
+    "dt": GameRange(1e-4, 0.02, "s", config=(0.0, 0.05)),
+    # A replay's is above 0 (not from it), and at most MAX_GAME_STEPS steps long.
+    "time_limit": GameRange(0.0, MAX_GAME_SECONDS, "s", config=(0.0, MAX_CONFIG_SECONDS)),
+    "target_radius": GameRange(0.005, 0.5, "m", config=(0.0, math.inf)),
+    "target_range": GameRange(-360.0, 360.0, "deg"),
+    "start_posture": GameRange(-7.0, 7.0, "rad"),
+    "view": GameRange(-20.0, 20.0, "m"),
+    "moment": GameRange(-50.0, 50.0, "N m"),
+    "muscle_time": GameRange(0.001, 10.0, "s"),  # rise and decay times, also at least one physics step
+}
+
+
+def _check_setting(kind: str, value: float, refusal: str) -> None:
+    """Refuse ``value`` outside the range a ``GameConfig`` takes for ``kind`` (``GAME_RANGES``' ``config``):
+    ``refusal`` says what it must be, with the range's ``{low}``, ``{high}`` and ``{unit}`` where it names them."""
+    setting = GAME_RANGES[kind]
+    low, high = setting.config  # type: ignore[misc]
+    if not (math.isfinite(value) and low < value <= high):
+        raise UserError(refusal.format(low=low, high=high, unit=setting.unit) + f", got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -47,14 +93,11 @@ class GameConfig:
     scene: str = "game"
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.time_limit) and 0.0 < self.time_limit <= 24 * 3600):
-            raise UserError(f"the game's duration must be between 0 and 86400 s, got {self.time_limit!r}")
-        if not (math.isfinite(self.dt) and 0.0 < self.dt <= 0.05):
-            raise UserError(f"the physics step must be between 0 and 0.05 s, got {self.dt!r}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed < 2**63:
+        _check_setting("time_limit", self.time_limit, "the game's duration must be between {low:g} and {high:g} {unit}")
+        _check_setting("dt", self.dt, "the physics step must be between {low:g} and {high:g} {unit}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or not 0 <= self.seed <= INT64_MAX:
             raise UserError(f"--seed must be a whole number from 0 to 2^63 - 1, got {self.seed!r}")
-        if not (math.isfinite(self.target_radius) and self.target_radius > 0.0):
-            raise UserError(f"the target radius must be a positive number of metres, got {self.target_radius!r}")
+        _check_setting("target_radius", self.target_radius, "the target radius must be a positive number of metres")
 
     @property
     def total_steps(self) -> int:

@@ -66,6 +66,7 @@ import numpy as np
 
 from ..errors import UserError
 from ..records.storage import DataFileError, atomic_write_bytes
+from ..valid import show_value
 
 NAN = float("nan")
 
@@ -364,7 +365,8 @@ def read_trials_csv(path: Path) -> list[dict[str, object]]:
         missing = [name for name in TRIAL_COLUMNS if name not in header and name not in LATER_COLUMNS]
         unknown = [name for name in header if name not in TRIAL_COLUMNS and name not in LABEL_COLUMNS]
         if missing or unknown:
-            what = f"lacks column(s) {', '.join(missing)}" if missing else f"has unknown column(s) {_show(unknown)}"
+            what = (f"lacks column(s) {', '.join(missing)}" if missing
+                    else f"has unknown column(s) {show_value(unknown)}")
             raise TrialsFileError(f"{path}: line 1: {what}")
         for fields_ in reader:
             line = reader.line_num
@@ -463,16 +465,16 @@ def _parse(name: str, text: str) -> object:
     text = text.strip()
     if name in _TEXT_COLUMNS:
         if not text or len(text) > MAX_TEXT or not text.isprintable():
-            raise ValueError(f"must be printable text of 1 to {MAX_TEXT} characters, got {_show(text)}")
+            raise ValueError(f"must be printable text of 1 to {MAX_TEXT} characters, got {show_value(text)}")
         return text
     if name == "trial":
         if not text.isascii() or not text.isdigit() or len(text) > 7 or int(text) > MAX_TRIAL:
-            raise ValueError(f"must be a whole number from 0 to {MAX_TRIAL}, got {_show(text)}")
+            raise ValueError(f"must be a whole number from 0 to {MAX_TRIAL}, got {show_value(text)}")
         return int(text)
     if name in _FLAGS:
         flag = text.lower()
         if flag not in ("1", "0", "true", "false"):
-            raise ValueError(f"must be 1, 0, true or false, got {_show(text)}")
+            raise ValueError(f"must be 1, 0, true or false, got {show_value(text)}")
         return flag in ("1", "true")
     if text == "" and name != "target_deg":
         return NAN
@@ -481,15 +483,11 @@ def _parse(name: str, text: str) -> object:
     except ValueError:
         number = NAN
     if not math.isfinite(number):  # also refuses the words nan and inf, and 1e999
-        raise ValueError(f"must be a finite number{'' if name == 'target_deg' else ' or empty'}, got {_show(text)}")
+        empty = "" if name == "target_deg" else " or empty"
+        raise ValueError(f"must be a finite number{empty}, got {show_value(text)}")
     if name in _NONNEGATIVE and number < 0.0:
-        raise ValueError(f"must not be negative, got {_show(text)}")
+        raise ValueError(f"must not be negative, got {show_value(text)}")
     return number
-
-
-def _show(value: object) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def check_regular_target(path: Path) -> None:

@@ -47,7 +47,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import UserError
-from ..records.storage import check_float, check_int, check_keys, check_str, read_limited
+from ..records.storage import read_limited
+from ..valid import check_float, check_int, check_keys, check_str
 from ..words import unknown_name
 
 FORCE_KINDS = ("curl", "constant", "spring", "viscous", "joint_viscous")

@@ -13,7 +13,6 @@ replay that verifies is, bit for bit, the data ``armgame analyze`` measures.
 from __future__ import annotations
 
 import hashlib
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -24,14 +23,13 @@ from ..game.bots import MotorNoise
 from ..game.rules import GameConfig
 from ..game.session import GameResult, InputEvent
 from ..records.replay import register_task, same_outcome
-from ..records.storage import check_int, check_keys, check_str
+from ..valid import HEX64, INT64_MAX, check_int, check_keys, check_str
 from .protocol import Protocol, protocol_from_dict
 from .session import LAB_SCENE, LabSession
 
 TASK_KIND = "centre-out"
 
 Trial = tuple[int, int, int, bool]
-_HEX64 = re.compile(r"[0-9a-f]{64}")
 
 
 @dataclass(frozen=True)
@@ -87,7 +85,7 @@ class LabTask:
             end = check_int(f"{where} end_step", item[2], go, last_step)
             trials.append((target, go, end, item[3]))
         digest = check_str("task.paths_sha256", d["paths_sha256"], 64)
-        if not _HEX64.fullmatch(digest):
+        if not HEX64.fullmatch(digest):
             raise ValueError("task.paths_sha256 must be 64 hexadecimal digits")
         fields = None
         if "fields" in d:
@@ -123,7 +121,7 @@ def _motor_noise(data: object) -> MotorNoise:
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (level, time)):
         raise ValueError("task.motor_noise: level and correlation_time_s must be numbers")
     try:
-        return MotorNoise(float(level), check_int("task.motor_noise.seed", seed, 0, 2 ** 63 - 1), float(time))
+        return MotorNoise(float(level), check_int("task.motor_noise.seed", seed, 0, INT64_MAX), float(time))
     except UserError as exc:
         raise ValueError(f"task.motor_noise: {exc}") from None
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from .. import __version__
 from ..errors import UserError
 from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
-from ..game.rules import GameConfig, Target
+from ..game.rules import MAX_CONFIG_SECONDS, GameConfig, Target
 from ..game.session import GameResult, GameSession
 from ..limits import MAX_GAME_SECONDS
 from ..physics.hand import hand_from_trig, hand_xy
@@ -236,8 +236,8 @@ def lab_config(protocol: Protocol, seed: int, muscles: tuple[MuscleSpec, ...] = 
     ends at its last trial."""
     worst = protocol.trials * (protocol.delay[1] + protocol.timeout)
     program = math.ceil(1.5 * worst + 60.0)
-    time_limit = float(min(86400, max(program, min(math.ceil(3.0 * worst + 120.0), MAX_GAME_SECONDS)) if person
-                           else program))
+    person_limit = max(program, min(math.ceil(3.0 * worst + 120.0), MAX_GAME_SECONDS))
+    time_limit = float(min(MAX_CONFIG_SECONDS, person_limit) if person else program)
     home = tuple(math.radians(a) for a in protocol.start_posture_deg)
     return GameConfig(start_posture=home, time_limit=time_limit, seed=seed, muscles=muscles,  # type: ignore[arg-type]
                       target_radius=protocol.target_radius, scene=LAB_SCENE, **options)  # type: ignore[arg-type]

@@ -9,5 +9,6 @@ each a module: ``entry`` (``ScoreEntry``, each field checked, its orders), ``tab
 read, parsed or salvaged, written whole under its lock, its head and counters) and ``checking`` (each
 entry against its replay, within a cost counted beforehand), with ``cache`` (the per-user verdicts)
 and ``teacher`` (the account that started a table keeps its seed and order of entry where no
-classmate writes). The limits every reader and writer shares are in ``armgame.limits``.
+classmate writes); ``listing`` decides which entries a listing replays, counts and flags. The limits
+every reader and writer shares are in ``armgame.limits``, what a valid field is in ``armgame.valid``.
 """

@@ -24,7 +24,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import re
 import stat
 import sys
 from collections.abc import Callable, Sequence
@@ -32,13 +31,14 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import UserError
-from .identity import current_claims
+from ..valid import HEX64
+from .entry import CLAIM_FIELDS
+from .identity import IDENTITY_FIELDS, current_claims
 from .storage import DataFileError, atomic_write_bytes, parse_json, read_limited, user_path
 
 CACHE_ENV = "ARMGAME_CACHE"
-_HEX64 = re.compile(r"[0-9a-f]{64}")
-CLAIM_KEYS = frozenset({"name", "driven", "driver", "score", "hits", "resets", "seed", "scene", "duration", "date",
-                        "config_sha256", "ruleset", "complete", "identity", "game_sha256", "earlier_game_sha256"})
+#: The fields of a verdict's claims (``entry.replay_claims``).
+CLAIM_KEYS = frozenset((*CLAIM_FIELDS, *IDENTITY_FIELDS))
 
 
 def default_cache_dir() -> Path | None:
@@ -163,7 +163,7 @@ class VerificationCache:
                 data = parse_json(read_limited(self.path, self.MAX_BYTES, "cache file", follow=False))
                 if isinstance(data, dict) and data.get("format") == self.FORMAT \
                         and data.get("version") == __version__ and isinstance(data.get("items"), dict):
-                    self._items = {k: v for k, v in data["items"].items() if _HEX64.fullmatch(k) and _valid(v)}
+                    self._items = {k: v for k, v in data["items"].items() if HEX64.fullmatch(k) and _valid(v)}
             except (DataFileError, ValueError, UnicodeDecodeError):
                 pass  # no cache, or a damaged one: everything is verified afresh
         return self._items

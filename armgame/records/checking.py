@@ -17,13 +17,14 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..game.rules import MAX_TRIES
 from ..game.session import GameResult
 from ..limits import MAX_REPLAY_BYTES
 from ..words import plural
 from .cache import VerificationCache, file_signature
-from .entry import ScoreEntry, replay_claims
+from .entry import CLAIM_FIELDS, ScoreEntry, replay_claims
 from .identity import names_its_game
-from .replay import Replay, VerifyCostError
+from .replay import EVENT_WORK, TRY_WORK, Replay, VerifyCostError
 from .rulesets import ruleset_of
 from .storage import DataFileError, open_regular
 
@@ -160,7 +161,8 @@ class TableChecks:
         claims = cached["claims"]
         if claims is None:
             return Check(False, cached["label"], cached["detail"])
-        wanted = {key: value for key, value in claims.items() if key in _ENTRY_CLAIMS}
+        # The claims the entry's own fields must equal; its game's digest is compared by ``names_its_game`` below.
+        wanted = {key: value for key, value in claims.items() if key in CLAIM_FIELDS}
         if entry.config_sha256 is None:  # a format 1 entry makes no claim about its rules
             wanted.pop("config_sha256")
             wanted.pop("ruleset")
@@ -180,22 +182,14 @@ class TableChecks:
         return Check(cached["ok"], cached["label"], cached["detail"], claims["ruleset"], claims["game_sha256"])
 
 
-#: The claims an entry's own fields must equal (the game's digest is compared by ``names_its_game``).
-_ENTRY_CLAIMS = frozenset({"name", "driven", "driver", "score", "hits", "resets", "seed", "scene", "duration", "date",
-                           "config_sha256", "ruleset", "complete"})
-
-
-# Work is counted in physics steps of the game's compiled loop (0.12 us each on the 2-core build machine),
-# the loop every install with a C compiler runs; measured with ``python benchmarks/honest_work.py``. In the
-# Python loop a step costs 20 times more and an event or a try no more, so these overcount there.
-#: What recomputing one hit can cost under any rules: drawing the next target tries up to 1,000 postures
-#: (``GameRules._draw_target``), each measured at 5.8 to 6.1 steps (0.72 to 0.75 us) over runs: 6,000.
-HIT_WORK = 6_000
+# Work is counted in ``records.replay``'s units (``TRY_WORK``, ``EVENT_WORK``: physics steps of the game's
+# compiled loop), the ones ``Replay.verify`` counts as it runs.
+#: What recomputing one hit can cost under any rules: drawing the next target tries up to ``MAX_TRIES`` (1,000)
+#: postures (``GameRules._draw_target``), ``TRY_WORK`` each: 6,000.
+HIT_WORK = MAX_TRIES * TRY_WORK
 #: What one hit costs under a ranked ruleset, whose target ranges keep a drawn target clear of the hand:
 #: 1.36 tries on average and at most 9 in 20,000 draws from random hands, a draw measured at 14 steps.
 RANKED_HIT_WORK = 100
-#: What one input event costs: reading it, ``key_event`` and a call of the loop between steps (20.5 steps).
-EVENT_WORK = 20
 
 
 def replay_work(replay: Replay) -> int:

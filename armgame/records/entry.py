@@ -2,27 +2,39 @@
 
 An entry names its player, how the game was driven, its result, its rules (ruleset and config digest),
 its game's digest (``identity.game_digest``), its place in the table's order of entry and its replay
-file with that file's SHA-256; ``replay_claims`` is what its replay says about the same fields, which
-``checking`` compares field for field. ``sort_key`` ranks (best first, ties by the order of entry) and
-``entry_order`` is the order of entry itself.
+file with that file's SHA-256; ``replay_claims`` is what its replay says about the same fields
+(``CLAIM_FIELDS``), which ``checking`` compares field for field and the verification cache keeps.
+``sort_key`` ranks (best first, ties by the order of entry) and ``entry_order`` is the order of entry itself.
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields
 from datetime import datetime
 
+from ..game.rules import MAX_CONFIG_SECONDS
+from ..valid import (
+    COUNT_MAX,
+    HEX32,
+    HEX64,
+    INT64_MAX,
+    check_bool,
+    check_date,
+    check_float,
+    check_int,
+    check_keys,
+    check_name,
+    check_pattern,
+    check_str,
+    check_word,
+)
 from .identity import identity_claims
-from .replay import DRIVEN, KEYBOARD_DEVICES, Replay, check_date, check_name, check_word
+from .replay import DRIVEN, KEYBOARD_DEVICES, Replay
 from .rulesets import config_digest, ruleset_name
-from .storage import check_float, check_int, check_keys, check_str
 
-_COUNT_MAX = 10**9
 _REPLAY_FILE = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,150}\.json")
-_HEX64 = re.compile(r"[0-9a-f]{64}")
-_HEX32 = re.compile(r"[0-9a-f]{32}")
 
 
 @dataclass(frozen=True)
@@ -90,7 +102,7 @@ class ScoreEntry:
         driven = v
         ruleset, digest = get("ruleset"), get("config_sha256")
         v = d["id"]
-        id_ = v if type(v) is str and _HEX32.fullmatch(v) else _match("id", v, _HEX32)
+        id_ = v if type(v) is str and HEX32.fullmatch(v) else check_pattern("id", v, HEX32)
         v = raw_name = d["name"]
         name = v if type(v) is str and _NAME.fullmatch(v) else check_name(v)
         v = d["driver"]
@@ -98,41 +110,41 @@ class ScoreEntry:
             v = check_str("driver", v, 200)
         driver = v
         v = d["score"]
-        score = v if type(v) is int and 0 <= v <= _COUNT_MAX else check_int("score", v, 0, _COUNT_MAX)
+        score = v if type(v) is int and 0 <= v <= COUNT_MAX else check_int("score", v, 0, COUNT_MAX)
         v = d["hits"]
-        hits = v if type(v) is int and 0 <= v <= _COUNT_MAX else check_int("hits", v, 0, _COUNT_MAX)
+        hits = v if type(v) is int and 0 <= v <= COUNT_MAX else check_int("hits", v, 0, COUNT_MAX)
         v = d["resets"]
-        resets = v if type(v) is int and 0 <= v <= _COUNT_MAX else check_int("resets", v, 0, _COUNT_MAX)
+        resets = v if type(v) is int and 0 <= v <= COUNT_MAX else check_int("resets", v, 0, COUNT_MAX)
         v = d["seed"]
-        seed = v if type(v) is int and 0 <= v <= _SEED_MAX else check_int("seed", v, 0, _SEED_MAX)
+        seed = v if type(v) is int and 0 <= v <= INT64_MAX else check_int("seed", v, 0, INT64_MAX)
         v = d["scene"]
         scene = v if type(v) is str and _WORD40.fullmatch(v) else check_word("scene", v)
         v = d["duration"]
-        duration = (v if type(v) is float and 0.0 < v <= 86400.0
-                    else check_float("duration", v, 0.0, 86400.0, low_open=True))
+        duration = (v if type(v) is float and 0.0 < v <= MAX_CONFIG_SECONDS
+                    else check_float("duration", v, 0.0, MAX_CONFIG_SECONDS, low_open=True))
         date = check_date("date", d["date"])
         v = d["version"]
         version = v if type(v) is str and _WORD40.fullmatch(v) else check_word("version", v)
         v = d["replay"]
-        replay = v if type(v) is str and _REPLAY_FILE.fullmatch(v) else _match("replay", v, _REPLAY_FILE)
+        replay = v if type(v) is str and _REPLAY_FILE.fullmatch(v) else check_pattern("replay", v, _REPLAY_FILE)
         v = d["replay_sha256"]
-        replay_sha256 = v if type(v) is str and _HEX64.fullmatch(v) else _match("replay_sha256", v, _HEX64)
+        replay_sha256 = v if type(v) is str and HEX64.fullmatch(v) else check_pattern("replay_sha256", v, HEX64)
         if ruleset is not None and not (type(ruleset) is str and _WORD40.fullmatch(ruleset)):
             ruleset = check_word("ruleset", ruleset)
-        if digest is not None and not (type(digest) is str and _HEX64.fullmatch(digest)):
-            digest = _match("config_sha256", digest, _HEX64)
+        if digest is not None and not (type(digest) is str and HEX64.fullmatch(digest)):
+            digest = check_pattern("config_sha256", digest, HEX64)
         v = get("game_sha256")
-        if v is not None and not (type(v) is str and _HEX64.fullmatch(v)):
-            v = _match("game_sha256", v, _HEX64)
+        if v is not None and not (type(v) is str and HEX64.fullmatch(v)):
+            v = check_pattern("game_sha256", v, HEX64)
         game = v
         v = get("entered")
-        if v is not None and not (type(v) is int and 1 <= v <= _COUNT_MAX):
-            v = check_int("entered", v, 1, _COUNT_MAX)
+        if v is not None and not (type(v) is int and 1 <= v <= COUNT_MAX):
+            v = check_int("entered", v, 1, COUNT_MAX)
         entered = v
         v = get("entered_at")
         entered_at = None if v is None else check_date("entered_at", v)
         v = get("complete")
-        complete = None if v is None else _bool("complete", v)
+        complete = None if v is None else check_bool("complete", v)
         if (ruleset is None) != (digest is None):
             raise ValueError("ruleset and config_sha256 come together")
         if score > hits:
@@ -154,26 +166,12 @@ _ENTRY_FIELDS = tuple(f.name for f in fields(ScoreEntry))
 _OPTIONAL = frozenset({"ruleset", "config_sha256", "game_sha256", "entered", "entered_at", "complete"})
 _REQUIRED = set(_ENTRY_FIELDS) - _OPTIONAL
 _ALL_FIELDS = frozenset(_ENTRY_FIELDS)
-_SEED_MAX = 2**63 - 1
 _new_object = object.__new__
 #: The values check_word passes unchanged at its default length: a word of 1 to 40 characters.
 _WORD40 = re.compile(r"[A-Za-z0-9][A-Za-z0-9 ._+-]{0,39}")
 #: The names check_name passes unchanged: 1 to 40 printable characters, none of them surrounding spaces.
 #: (Only a guard for the fast path: it lets through fewer names than check_name, never more.)
 _NAME = re.compile(r"[!-~](?:[ -~]{0,38}[!-~])?")
-
-
-def _match(name: str, value: object, pattern: re.Pattern[str]) -> str:
-    value = check_str(name, value, 200)
-    if not pattern.fullmatch(value):
-        raise ValueError(f"{name} is not a valid {name.replace('_', ' ')}: {value!r}")
-    return value
-
-
-def _bool(name: str, value: object) -> bool:
-    if not isinstance(value, bool):
-        raise ValueError(f"{name} must be true or false, got {value!r}")
-    return value
 
 
 def sort_key(entry: ScoreEntry) -> tuple[int, int, datetime, str]:
@@ -190,12 +188,27 @@ def entry_order(entry: ScoreEntry) -> tuple[int, datetime, str]:
     return (entry.entered or 0, entry.when, entry.id)
 
 
+#: The fields an entry must say of its replay's game as the replay does (the entry's field of each name), with
+#: how the replay says each: ``replay_claims`` reads them, ``checking`` compares an entry's with them, and the
+#: verification cache keeps them (with the game's identity, ``identity.IDENTITY_FIELDS``) beside a verdict.
+CLAIM_FIELDS: dict[str, Callable[[Replay], object]] = {
+    "name": lambda replay: replay.player,
+    "driven": lambda replay: replay.driven,
+    "driver": lambda replay: replay.driver,
+    "score": lambda replay: replay.result.score,
+    "hits": lambda replay: replay.result.hits,
+    "resets": lambda replay: replay.result.resets,
+    "seed": lambda replay: replay.result.seed,
+    "scene": lambda replay: replay.result.scene,
+    "duration": lambda replay: replay.result.duration,
+    "date": lambda replay: replay.date,
+    "config_sha256": lambda replay: config_digest(replay.config),
+    "ruleset": lambda replay: ruleset_name(replay.config),
+    "complete": lambda replay: replay.complete,
+}
+
+
 def replay_claims(replay: Replay, digests: Sequence[str] | None = None) -> dict[str, object]:
-    """What an entry must say about its replay's game, field for field; and the game's identity
-    (``identity.identity_claims``: the digest an entry may hold, by each identity version)."""
-    r = replay.result
-    return {"name": replay.player, "driven": replay.driven, "driver": replay.driver, "score": r.score,
-            "hits": r.hits, "resets": r.resets, "seed": r.seed, "scene": r.scene, "duration": r.duration,
-            "date": replay.date, "config_sha256": config_digest(replay.config),
-            "ruleset": ruleset_name(replay.config), "complete": replay.complete,
-            **identity_claims(replay, digests)}
+    """What an entry must say about its replay's game, field for field (``CLAIM_FIELDS``); and the game's
+    identity (``identity.identity_claims``: the digest an entry may hold, by each identity version)."""
+    return {name: read(replay) for name, read in CLAIM_FIELDS.items()} | identity_claims(replay, digests)

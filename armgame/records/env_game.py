@@ -28,8 +28,8 @@ from ..game.rules import GameConfig
 from ..game.session import GameResult, GameSession, InputEvent, LevelEvent
 from ..game.variant import FIELD_KINDS, GameVariant, VariantPlay
 from ..limits import MAX_EVENTS, MAX_VERIFY_WORK
+from ..valid import check_bool, check_float, check_int, check_keys, check_str
 from .replay import TRY_WORK, register_task, same_outcome
-from .storage import check_float, check_int, check_keys, check_str
 
 TASK_KIND = "reach-env"
 SECTION_VERSION = 1
@@ -99,14 +99,13 @@ class EnvGameTask:
         limit = math.inf if d["speed_limit"] is None else check_float("task.speed_limit", d["speed_limit"], 0.0,
                                                                         MAX_SPEED_LIMIT, low_open=True)
         delay = check_int("task.observation_delay", d["observation_delay"], 0, 10**6)
-        if not isinstance(d["stopped"], bool):
-            raise ValueError(f"task.stopped must be true or false, got {d['stopped']!r}")
+        stopped = check_bool("task.stopped", d["stopped"])
         levels = levels_from_list(d["levels"], last_step)
         try:
             variant = GameVariant(hold_steps, noise, decision_steps, field, parameter, limit)
         except UserError as exc:
             raise ValueError(f"task: {exc}") from None
-        return cls(variant, levels, d["stopped"], env_id, delay)
+        return cls(variant, levels, stopped, env_id, delay)
 
     def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> GameSession:
         """The game replayed from its timeline and levels to ``steps`` (and its runaway, if it stopped at one)."""

@@ -40,6 +40,7 @@ from typing import Generic, TypeVar
 
 from .._native import load
 from ..game.session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, UP
+from ..valid import INT64_MAX
 from .replay import Replay
 from .rulesets import config_digest
 
@@ -187,7 +188,7 @@ def _native_digests(replay: Replay) -> tuple[str, str] | None:
     """``game_digests`` of a game that ran to its end from ``_both_forms``'s C twin, or None where it cannot take
     the game (its opening comment): the same text as ``_digest`` of the two forms, so the same digests."""
     steps = replay.result.steps
-    if _CTIMELINE is None or not 0 <= steps < 2**63 or type(replay.timeline) is not tuple:
+    if _CTIMELINE is None or not 0 <= steps <= INT64_MAX or type(replay.timeline) is not tuple:
         return None
     texts = _CTIMELINE.forms_text(replay.timeline, tuple(m.key for m in replay.config.muscles), steps, RESET_KEY,
                                   TOGGLE_ARM_KEY, DOWN, UP)
@@ -228,12 +229,16 @@ def game_digests(replay: Replay) -> tuple[str, ...]:
     return _digest(_form(replay, applied)), _digest(_form_v1(replay, events))
 
 
+#: The fields of ``identity_claims``, in its order.
+IDENTITY_FIELDS = ("identity", "game_sha256", "earlier_game_sha256")
+
+
 def identity_claims(replay: Replay, digests: Sequence[str] | None = None) -> dict[str, object]:
-    """What a replay says about its game's identity, for an entry's claims (``scores.replay_claims``)
+    """What a replay says about its game's identity, for an entry's claims (``entry.replay_claims``)
     and the verification cache: the version, the current digest and the older versions' digests.
     ``digests``: ``game_digests(replay)`` if the caller has them already (a class's server does)."""
     current, *earlier = game_digests(replay) if digests is None else digests
-    return {"identity": IDENTITY_VERSION, "game_sha256": current, "earlier_game_sha256": earlier}
+    return dict(zip(IDENTITY_FIELDS, (IDENTITY_VERSION, current, earlier), strict=True))
 
 
 def current_claims(claims: Mapping[str, object]) -> bool:

@@ -42,7 +42,6 @@ from pathlib import Path
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES
 from .cache import VerificationCache, default_cache_dir, file_signature  # noqa: F401 (the cache's old home)
 from .checking import (  # noqa: F401 (imported from here by the commands and tests)
-    EVENT_WORK,
     HIT_WORK,
     NOT_CHECKED,
     RANKED_HIT_WORK,
@@ -53,7 +52,7 @@ from .checking import (  # noqa: F401 (imported from here by the commands and te
 )
 from .entry import ScoreEntry, entry_order, replay_claims, sort_key
 from .identity import game_digests
-from .replay import Replay, now_iso
+from .replay import EVENT_WORK, Replay, now_iso  # noqa: F401 (EVENT_WORK: imported from here, as HIT_WORK)
 from .rulesets import CUSTOM, RULESETS, ruleset_by_digest
 from .standings import one_row_per_player, rank_of
 from .storage import DataFileError, atomic_write_many, read_limited, user_path

@@ -23,7 +23,8 @@ What it guarantees, whatever is planted at the path:
 
 The reading half (``open_regular``, ``read_limited``, ``user_path``, ``DataFileError``) lives in
 ``armgame.files``, below every layer, so the game reads its scripts without reaching up to records;
-it is re-exported here, where every other reader and writer finds it.
+it is re-exported here, where every other reader and writer finds it. What a valid field of a file
+read is (the schema checks every reader applies to what ``parse_json`` returns) is ``armgame.valid``'s.
 """
 
 from __future__ import annotations
@@ -52,10 +53,10 @@ from ..files import (
 )
 from ..files import kind_of as _kind
 
-__all__ = ["STRICT_DECODER", "DataFileError", "atomic_write_bytes", "atomic_writer", "check_float", "check_int",
-           "check_keys", "check_output_path", "check_path_length", "check_str", "check_writable_folder",
-           "copy_aside", "dump_json", "fresh_files", "fsync_folder", "is_taken", "link_new", "open_regular",
-           "parse_json", "read_limited", "save_figure", "show_path", "user_path", "write_new"]
+__all__ = ["STRICT_DECODER", "DataFileError", "atomic_write_bytes", "atomic_writer", "check_output_path",
+           "check_path_length", "check_writable_folder", "copy_aside", "dump_json", "fresh_files", "fsync_folder",
+           "is_taken", "link_new", "open_regular", "parse_json", "read_limited", "save_figure", "show_path",
+           "user_path", "write_new"]
 
 
 def _read_umask() -> int:
@@ -427,51 +428,3 @@ def parse_json(text: str | bytes) -> object:
 
 def dump_json(value: object) -> bytes:
     return (json.dumps(value, indent=1, sort_keys=True, allow_nan=False, ensure_ascii=False) + "\n").encode("utf-8")
-
-
-# ---------------------------------------------------------------- schema checks
-# Each raises ValueError naming the field; the callers add the file's name.
-
-def check_int(name: str, value: object, low: int, high: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"{name} must be a whole number, got {_show(value)}")
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be from {low} to {high}, got {_show(value)}")
-    return value
-
-
-def check_float(name: str, value: object, low: float, high: float, low_open: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{name} must be a number, got {_show(value)}")
-    value = float(value)
-    if not math.isfinite(value) or not (low < value if low_open else low <= value) or value > high:
-        interval = f"above {low:g} and at most {high:g}" if low_open else f"from {low:g} to {high:g}"
-        raise ValueError(f"{name} must be a finite number {interval}, got {_show(value)}")
-    return value
-
-
-def check_str(name: str, value: object, max_len: int, printable: bool = True) -> str:
-    if not isinstance(value, str):
-        raise ValueError(f"{name} must be text, got {_show(value)}")
-    if len(value) > max_len:
-        raise ValueError(f"{name} must be at most {max_len} characters, got {len(value)}")
-    if printable and not value.isprintable():
-        raise ValueError(f"{name} must not contain control characters, got {_show(value)}")
-    return value
-
-
-def check_keys(name: str, value: object, required: set[str], optional: frozenset[str] = frozenset()) -> dict:
-    if not isinstance(value, dict):
-        raise ValueError(f"{name} must be a JSON object, got {_show(value)}")
-    missing = required - value.keys()
-    if missing:
-        raise ValueError(f"{name} lacks {', '.join(sorted(missing))}")
-    unknown = value.keys() - required - optional
-    if unknown:
-        raise ValueError(f"{name} has unknown field(s) {', '.join(sorted(unknown)[:5])}")
-    return value
-
-
-def _show(value: object) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."

@@ -59,16 +59,15 @@ from pathlib import Path
 from ..errors import UserError
 from ..files import _BINARY, _CLOEXEC, _NOFOLLOW
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES, MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
+from ..valid import COUNT_MAX, INT64_MAX, check_int, check_keys
 from ..words import plural
-from .entry import _COUNT_MAX, _OPTIONAL, _SEED_MAX, ScoreEntry, entry_order, sort_key
+from .entry import _OPTIONAL, ScoreEntry, entry_order, sort_key
 from .locking import LockBusyError, LockError, file_lock
 from .replay import Replay, now_iso
 from .storage import (
     STRICT_DECODER,
     DataFileError,
     atomic_write_bytes,
-    check_int,
-    check_keys,
     check_path_length,
     copy_aside,
     fsync_folder,
@@ -421,7 +420,7 @@ class TableFile:
             return None
         last = max([0, *(e.entered or 0 for e in entries)])
         next_entry = max(head.next_entry, last + 1)
-        if next_entry + MAX_TABLE_ENTRIES > _COUNT_MAX:  # near the counter's end: the whole write renumbers
+        if next_entry + MAX_TABLE_ENTRIES > COUNT_MAX:  # near the counter's end: the whole write renumbers
             return None
         self._seed = head.seed
         return _Index(self._signature(), {e.replay_sha256 for e in entries},
@@ -576,7 +575,7 @@ def _numbered(entries: list[ScoreEntry], head: _Head, adding: int = 1) -> tuple[
 
     Entries carried over from an older table get their places, in the order of their dates, once. The
     counter never goes back past a place in use (places are never reused), but it never passes
-    ``_COUNT_MAX`` either, where a place or ``next_entry`` would no longer read back: a planted
+    ``COUNT_MAX`` either, where a place or ``next_entry`` would no longer read back: a planted
     ``next_entry`` that high is set after the last entry, and a planted ``entered`` that high renumbers
     the entries 1, 2, ... in their order. The ``adding`` entries of this write and the ``next_entry``
     after them must fit.
@@ -587,14 +586,14 @@ def _numbered(entries: list[ScoreEntry], head: _Head, adding: int = 1) -> tuple[
     note = None
     if head.counter_problem is not None:
         note = f"the table's next_entry counter is not valid ({head.counter_problem}): set after its last entry"
-    if start + len(old) + adding > _COUNT_MAX:
-        if last + 1 + len(old) + adding <= _COUNT_MAX:
-            note = (f"the table's next_entry counter was {head.next_entry:,}, at its limit ({_COUNT_MAX:,}): set "
+    if start + len(old) + adding > COUNT_MAX:
+        if last + 1 + len(old) + adding <= COUNT_MAX:
+            note = (f"the table's next_entry counter was {head.next_entry:,}, at its limit ({COUNT_MAX:,}): set "
                     f"after its last entry")
             start = last + 1
         else:
             ordered = sorted(entries, key=lambda e: (e.entered is None, *entry_order(e)))
-            note = (f"the table's order of entry had reached {last:,}, its limit ({_COUNT_MAX:,}): its "
+            note = (f"the table's order of entry had reached {last:,}, its limit ({COUNT_MAX:,}): its "
                     f"{plural(len(ordered), 'entry')} are renumbered 1 to {len(ordered)} in their order")
             return [replace(e, entered=i) for i, e in enumerate(ordered, 1)], len(ordered) + 1, note
     if not old:
@@ -673,7 +672,7 @@ def _head_of(table: dict) -> _Head:
     ``next_entry`` that is not valid is read as 1 (the next write sets it after the last entry)."""
     counter, counter_problem = table.get("next_entry", 1), None
     try:
-        counter = check_int("next_entry", counter, 1, _COUNT_MAX)
+        counter = check_int("next_entry", counter, 1, COUNT_MAX)
     except ValueError as exc:
         counter, counter_problem = 1, str(exc)
     if "seed" not in table:
@@ -682,7 +681,7 @@ def _head_of(table: dict) -> _Head:
         return _Head(DEFAULT_SEED, counter, counter_problem=counter_problem)
     raw = table["seed"]
     try:
-        return _Head(check_int("seed", raw, 0, _SEED_MAX), counter, counter_problem=counter_problem)
+        return _Head(check_int("seed", raw, 0, INT64_MAX), counter, counter_problem=counter_problem)
     except ValueError as exc:
         problem = str(exc)
     try:
@@ -705,7 +704,7 @@ def _salvaged_head(text: str) -> _Head:
     if f'"{FORMAT}"' not in head:
         return _Head()
     seed = _HEAD_SEED.search(head)
-    if seed is not None and int(seed.group(1)) <= _SEED_MAX:
+    if seed is not None and int(seed.group(1)) <= INT64_MAX:
         return _Head(int(seed.group(1)))
     version = _HEAD_VERSION.search(head)
     if '"seed"' not in head and (version is None or int(version.group(1)) != FORMAT_VERSION):

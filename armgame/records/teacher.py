@@ -34,7 +34,6 @@ import contextlib
 import hashlib
 import json
 import os
-import re
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -42,18 +41,14 @@ from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
 from ..limits import MAX_TABLE_BYTES, MAX_TABLE_ENTRIES
+from ..valid import COUNT_MAX, HEX32, HEX64, INT64_MAX, check_date, check_int, check_keys
 from .cache import private_place_reason, usable_cache_dir
-from .replay import check_date
-from .storage import DataFileError, atomic_write_bytes, check_int, check_keys, parse_json, read_limited
+from .storage import DataFileError, atomic_write_bytes, parse_json, read_limited
 
 RECORD_FORMAT = "armgame-table-record"
 RECORD_VERSION = 1
 #: The most entries one record keeps: a table's limit, twice (entries deleted from the table stay known).
 MAX_RECORDED = 2 * MAX_TABLE_ENTRIES
-_COUNT_MAX = 10**9
-_SEED_MAX = 2**63 - 1
-_HEX64 = re.compile(r"[0-9a-f]{64}")
-_HEX32 = re.compile(r"[0-9a-f]{32}")
 
 
 class _Entry(Protocol):
@@ -120,11 +115,11 @@ def _parse_record(data: bytes) -> RecordData:
         if not (isinstance(item, list) and len(item) == 5):
             raise ValueError("an entry must be [id, replay_sha256, game_sha256, order, at]")
         id_, replay, game, order, at = item
-        if not (isinstance(id_, str) and _HEX32.fullmatch(id_) and isinstance(replay, str) and _HEX64.fullmatch(replay)
-                and (game is None or (isinstance(game, str) and _HEX64.fullmatch(game)))):
+        if not (isinstance(id_, str) and HEX32.fullmatch(id_) and isinstance(replay, str) and HEX64.fullmatch(replay)
+                and (game is None or (isinstance(game, str) and HEX64.fullmatch(game)))):
             raise ValueError(f"entry {id_!r}: not an entry id, replay digest and game digest")
-        entries[id_] = Recorded(id_, replay, game, check_int("order", order, 1, _COUNT_MAX), check_date("at", at))
-    return RecordData(check_int("seed", top["seed"], 0, _SEED_MAX), folder,
+        entries[id_] = Recorded(id_, replay, game, check_int("order", order, 1, COUNT_MAX), check_date("at", at))
+    return RecordData(check_int("seed", top["seed"], 0, INT64_MAX), folder,
                       check_int("device", top["device"], 0, 2**64), check_int("inode", top["inode"], 0, 2**64),
                       check_date("started", top["started"]), entries)
 
@@ -228,7 +223,7 @@ class TeacherRecord:
         recorded = dict(data.entries)
         order = max((r.order for r in recorded.values()), default=0)
         for e in entries:
-            if len(recorded) >= MAX_RECORDED or order >= _COUNT_MAX:
+            if len(recorded) >= MAX_RECORDED or order >= COUNT_MAX:
                 self._say(f"note: this account's record of the table in {self.table_folder} is full "
                           f"({len(recorded):,} entries): new entries are not recorded")
                 break

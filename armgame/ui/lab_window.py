@@ -259,12 +259,15 @@ class LabWindow(GameWindow):
     def __init__(self, session: LabSession, screen: pygame.Surface, clock: Callable[[], float] = time.perf_counter,
                  fps: int = 60, driver: RealTimeDriver | None = None, mode: str = "LAB", *,
                  replay: LabReplay | None = None, on_finish: Callable[[LabSession], Sequence[str]] | None = None,
-                 cards: bool | None = None, palette: str = "okabe-ito", text_scale: float = 1.0) -> None:
+                 cards: bool | None = None, palette: str = "okabe-ito", text_scale: float = 1.0,
+                 bot: str | None = None) -> None:
         if replay is not None and driver is None:
             session, driver = replay.start()
         super().__init__(session, screen, clock, fps, driver, ask_name=False, countdown=False, palette=palette)
         #: What drives the run, as the help line and the cards say it ("LAB": the person at the keys).
         self.mode = mode
+        #: The bot that plays the run, by name, as its intro card says it (None: a person, or a replay).
+        self.bot = bot
         pygame.display.set_caption(CAPTION)
         self.renderer = LabRenderer(session.muscles.keys, tuple(m.name for m in session.config.muscles), palette,
                                     text_scale=text_scale)
@@ -307,8 +310,8 @@ class LabWindow(GameWindow):
             f"Block 1 of {len(blocks)}: {first.instruction or 'reach each target and hold it.'}",
         )
         if not self.keyboard:
-            who = self.mode.split(":", 1)[-1].strip() or "a bot"
-            lines = (f"The {who} bot plays this run: watch its cursor.", *lines[3:])
+            who = f"The {self.bot} bot" if self.bot else "A replay"
+            lines = (f"{who} plays this run: watch its cursor.", *lines[3:])
         return Card("The reaching lab", lines, self._prompt())
 
     def _block_card(self) -> Card | None:

@@ -94,7 +94,7 @@ def parse_size(text: str, what: str = "size") -> tuple[int, int]:
     return w, h
 
 
-def check_keys(text: object, what: str = "keys") -> str:
+def check_muscle_keys(text: object, what: str = "keys") -> str:
     """Four different muscle keys as ``--keys`` takes them (``"dfjk"`` or ``"a,s,d,f"``)."""
     if not isinstance(text, str) or len(text) > 80:
         raise ValueError(f"{what} must be text such as \"dfjk\", got {str(text)[:40]!r}")
@@ -124,7 +124,7 @@ def from_toml(data: bytes, source: str) -> Settings:
     settings = Settings()
     try:
         if "keys" in table:
-            settings = settings.with_changes(keys=check_keys(table["keys"]))
+            settings = settings.with_changes(keys=check_muscle_keys(table["keys"]))
         if "mute" in table:
             if not isinstance(table["mute"], bool):
                 raise ValueError(f"mute must be true or false, got {table['mute']!r}"[:120])
