@@ -1,12 +1,12 @@
-"""Lab protocols are written as they always were: ``Protocol.as_dict`` and what a replay stores of it, byte for byte.
+"""Lab protocols are written as they always were: ``protocol_as_dict`` and what a replay stores of it, byte for byte.
 
 ``tests/data/lab_protocols.json`` holds, for every preset, every protocol file in the docs (``toml file=`` blocks
 with ``[[blocks]]``) and the protocols below (every perturbation kind and every optional key of a protocol file),
 what the code wrote when the file was made (before issue 42's split of ``lab/protocol.py``):
 
-* ``as_dict``: ``json.dumps(protocol.as_dict())``, keys in their order (a class's digest of a hand-in hashes the
-  task's ``repr``, so the order is part of what is written);
-* ``replay``: ``dump_json(protocol.as_dict())``, the protocol's section of a lab replay's file;
+* ``as_dict``: ``json.dumps(protocol_as_dict(protocol))`` (``Protocol.as_dict()`` then), keys in their order (a
+  class's digest of a hand-in hashes the task's ``repr``, so the order is part of what is written);
+* ``replay``: ``dump_json`` of the same, the protocol's section of a lab replay's file;
 * ``labels``: each block's ``perturbation.label()``, which a mixed block's replay keeps per trial, and
   ``opposites``: the label of each opposite a block has (a mixed block's ``opposite`` trials).
 
@@ -25,15 +25,10 @@ from pathlib import Path
 import pytest
 from test_docs import DOCS, blocks
 
-from armgame.lab.protocol import (
-    PRESETS,
-    Perturbation,
-    preset,
-    protocol_from_dict,
-    savings,
-    with_catch_trials,
-    with_perturbation,
-)
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import PRESETS, preset, savings
+from armgame.lab.protocol import with_catch_trials, with_perturbation
+from armgame.lab.protocol_file import protocol_as_dict, protocol_from_dict
 from armgame.records.storage import dump_json
 
 GOLDEN = Path(__file__).parent / "data" / "lab_protocols.json"
@@ -188,7 +183,7 @@ def _golden() -> dict[str, dict[str, object]]:
 
 
 def written(protocol) -> dict[str, object]:
-    data = protocol.as_dict()
+    data = protocol_as_dict(protocol)
     return {"as_dict": json.dumps(data, ensure_ascii=False), "replay": dump_json(data).decode("utf-8"),
             "labels": [b.perturbation.label() for b in protocol.blocks],
             "opposites": [b.perturbation.opposite().label() for b in protocol.blocks

@@ -669,7 +669,7 @@ class Clerk:
 
     def choose_lab(self, protocol: object) -> str:
         """The protocol the class curve shows (the teacher's choice; None: none until chosen)."""
-        from ..lab.protocol import PRESETS
+        from ..lab.presets import PRESETS
 
         if protocol is not None and (not isinstance(protocol, str) or protocol not in PRESETS):
             raise RefusedError(400, f"the class curve shows one of the presets: {', '.join(sorted(PRESETS))}")
@@ -747,7 +747,7 @@ class Clerk:
         """For the teacher's page: every joined name with the machine (address) it joined from and its games
         (0: joined, not played yet), grouped by address, most names first; whether the list is locked, and the
         class curve's protocol."""
-        from ..lab.protocol import PRESETS
+        from ..lab.presets import PRESETS
 
         played: dict[str, int] = {}
         for entry in self.entries:
