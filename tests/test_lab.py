@@ -103,6 +103,9 @@ trials = 8
     ("[[blocks]]\ntrials = 1500\n[[blocks]]\ntrials = 1500", "more than 2000"),
     ("[[blocks]\ntrials = 3", "not valid TOML"),
     ("home_elbow_deg = 1.0\n[[blocks]]\ntrials = 3", "home_elbow_deg must be a finite number from 5 to 175"),
+    (f"distance = 1{'0' * 400}\n[[blocks]]\ntrials = 3", "distance must be a finite number from 0.01 to 0.3, got inf"),
+    (f"[[blocks]]\ntrials = 3\nperturbation = 'curl'\nb = -1{'0' * 400}", "blocks[0].b must be a finite number "
+                                                                       "from -50 to 50, got -inf"),
 ])
 def test_bad_protocol_files_get_one_line_naming_the_key(tmp_path, text, message):
     path = tmp_path / "p.toml"
