@@ -51,7 +51,10 @@ def check_float(name: str, value: object, low: float, high: float, low_open: boo
     """``value`` as a float: a finite number (not a bool) from ``low`` (above it, if ``low_open``) to ``high``."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ValueError(f"{name} must be a number, got {show_value(value)}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:  # a whole number past any float's (TOML and JSON read them): as far out as inf
+        value = math.inf if value > 0 else -math.inf
     if not math.isfinite(value) or not (low < value if low_open else low <= value) or value > high:
         interval = f"above {low:g} and at most {high:g}" if low_open else f"from {low:g} to {high:g}"
         raise ValueError(f"{name} must be a finite number {interval}, got {show_value(value)}")

@@ -21,7 +21,7 @@ from armgame.game import bots
 from armgame.game.bots import Autopilot, make_bot, play_bot
 from armgame.game.rules import GameConfig
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import preset
+from armgame.lab.presets import preset
 from armgame.lab.session import LabSession, lab_config
 
 

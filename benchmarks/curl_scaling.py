@@ -28,7 +28,9 @@ from doc_text import Claims
 from armgame.game.bots import Autopilot
 from armgame.game.muscles import ELBOW_MAX_TORQUE, SHOULDER_MAX_TORQUE
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import Block, Perturbation, Protocol, preset
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import preset
+from armgame.lab.protocol import Block, Protocol
 from armgame.lab.session import LabSession, lab_config
 
 SEED, REACHES = 3, 16

@@ -11,7 +11,7 @@ from armgame.game.bots import Autopilot, MotorNoise
 from armgame.lab.analysis import trial_rows
 from armgame.lab.bots import make_lab_bot
 from armgame.lab.designs import frames_summary
-from armgame.lab.protocol import HUMAN_NOISE, preset
+from armgame.lab.presets import HUMAN_NOISE, preset
 from armgame.lab.session import LabSession, lab_config
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "lab.md"

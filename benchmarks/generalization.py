@@ -15,7 +15,7 @@ import math
 from armgame.game.bots import Autopilot, MotorNoise
 from armgame.lab.analysis import baseline_offsets, generalization, trial_rows
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import PRESET_MOTOR_NOISE, preset
+from armgame.lab.presets import PRESET_MOTOR_NOISE, preset
 from armgame.lab.session import LabSession, lab_config
 
 

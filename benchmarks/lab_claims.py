@@ -33,15 +33,9 @@ from armgame.game.bots import Autopilot, MotorNoise
 from armgame.lab.analysis import block_summary, channel_summary, figure_metric, fit_schedule, trial_rows
 from armgame.lab.bots import LearningRates, make_lab_bot
 from armgame.lab.fit import compare
-from armgame.lab.protocol import (
-    HUMAN_NOISE,
-    PRESET_MOTOR_NOISE,
-    PRESET_REPRESENTATION,
-    Block,
-    Perturbation,
-    Protocol,
-    preset,
-)
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import HUMAN_NOISE, PRESET_MOTOR_NOISE, PRESET_REPRESENTATION, preset
+from armgame.lab.protocol import Block, Protocol
 from armgame.lab.session import LabSession, lab_config
 
 CLAIMS = Claims()

@@ -20,7 +20,8 @@ from pathlib import Path
 
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
-from armgame.lab.protocol import Block, Perturbation, Protocol
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.protocol import Block, Protocol
 from armgame.lab.session import LabSession, lab_config
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

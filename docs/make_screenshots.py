@@ -29,7 +29,7 @@ from armgame.game.bots import Autopilot, make_bot
 from armgame.game.rules import GameConfig
 from armgame.game.session import GameSession
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import preset
+from armgame.lab.presets import preset
 from armgame.lab.session import LabSession, lab_config
 from armgame.ui.lab_window import LabRenderer
 from armgame.ui.render import GameRenderer, Hud

@@ -105,7 +105,7 @@ def test_the_curl_load_equals_the_lab_bots_unit_field_and_torque():
 
     from armgame.game.bots import CurlLoad
     from armgame.lab.bots import curl_unit_force, curl_unit_torque, make_lab_bot
-    from armgame.lab.protocol import preset
+    from armgame.lab.presets import preset
     from armgame.lab.session import LabSession, lab_config
 
     session = LabSession(lab_config(preset("curl"), 10), preset("curl"))

@@ -318,7 +318,9 @@ def test_a_lab_run_with_the_compiled_step_is_the_python_loops_bit_for_bit():
     """A curl field (loaded steps in Python) between unloaded blocks (the compiled step), the adapting bot."""
     from armgame.game.bots import Autopilot
     from armgame.lab.bots import make_lab_bot
-    from armgame.lab.protocol import CURL_B, Block, Perturbation, Protocol
+    from armgame.lab.perturbations import Perturbation
+    from armgame.lab.presets import CURL_B
+    from armgame.lab.protocol import Block, Protocol
     from armgame.lab.session import LabSession, lab_config
 
     kinds = (Perturbation(), Perturbation.make("curl", b=CURL_B), Perturbation())

@@ -125,7 +125,7 @@ def test_every_documented_command_line_parses(block, capsys):
 def test_every_toml_example_is_valid(block):
     data = tomllib.loads(block.text)
     if "blocks" in data:  # a lab protocol: the lab's own reader, every key checked
-        from armgame.lab.protocol import protocol_from_dict
+        from armgame.lab.protocol_file import protocol_from_dict
 
         protocol_from_dict(data)
     else:  # a settings file

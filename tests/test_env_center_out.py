@@ -24,7 +24,9 @@ from armgame.env.reach import EnvArgumentError
 from armgame.game.bots import Autopilot
 from armgame.lab.analysis import trial_rows
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import Block, Perturbation, Protocol, preset
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import preset
+from armgame.lab.protocol import Block, Protocol
 from armgame.lab.session import LabSession, lab_config
 
 CENTER_OUT, CONTINUOUS = "armgame/CenterOut-v0", "armgame/CenterOutContinuous-v0"

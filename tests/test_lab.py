@@ -13,20 +13,10 @@ from armgame.errors import UserError
 from armgame.game.bots import Autopilot
 from armgame.game.session import InputEvent
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.perturbations import joint_space, mirror, rotation
-from armgame.lab.protocol import (
-    CURL_B,
-    PRESETS,
-    VISCOUS_B,
-    Block,
-    Perturbation,
-    Protocol,
-    load_protocol,
-    preset,
-    protocol_from_dict,
-    target_positions,
-    with_catch_trials,
-)
+from armgame.lab.perturbations import Perturbation, joint_space, mirror, rotation
+from armgame.lab.presets import CURL_B, PRESETS, VISCOUS_B, preset
+from armgame.lab.protocol import Block, Protocol, with_catch_trials
+from armgame.lab.protocol_file import load_protocol, protocol_as_dict, protocol_from_dict
 from armgame.lab.record import LabTask
 from armgame.lab.session import LabSession, lab_config, schedule
 from armgame.records.replay import Replay, now_iso
@@ -59,7 +49,7 @@ def perpendicular(session: LabSession, outcome) -> float:
 @pytest.mark.parametrize("name", PRESETS)
 def test_presets_round_trip_through_plain_data(name):
     p = preset(name)
-    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    assert protocol_from_dict(json.loads(json.dumps(protocol_as_dict(p)))) == p
     if name in ("savings", "spontaneous", "generalization"):
         assert p.blocks[1].perturbation == Perturbation.make("curl", b=CURL_B)
         return
@@ -113,6 +103,9 @@ trials = 8
     ("[[blocks]]\ntrials = 1500\n[[blocks]]\ntrials = 1500", "more than 2000"),
     ("[[blocks]\ntrials = 3", "not valid TOML"),
     ("home_elbow_deg = 1.0\n[[blocks]]\ntrials = 3", "home_elbow_deg must be a finite number from 5 to 175"),
+    (f"distance = 1{'0' * 400}\n[[blocks]]\ntrials = 3", "distance must be a finite number from 0.01 to 0.3, got inf"),
+    (f"[[blocks]]\ntrials = 3\nperturbation = 'curl'\nb = -1{'0' * 400}", "blocks[0].b must be a finite number "
+                                                                       "from -50 to 50, got -inf"),
 ])
 def test_bad_protocol_files_get_one_line_naming_the_key(tmp_path, text, message):
     path = tmp_path / "p.toml"
@@ -163,7 +156,7 @@ def test_schedule_cycles_targets_and_draws_delays_and_catch_trials():
 
 def test_targets_lie_evenly_around_home():
     p = preset("null")
-    positions = target_positions(p, (0.1, 0.5))
+    positions = p.target_positions((0.1, 0.5))
     assert len(positions) == 8
     for i, (x, y) in enumerate(positions):
         assert math.isclose(math.hypot(x - 0.1, y - 0.5), 0.10)
@@ -465,7 +458,7 @@ def test_viscous_matrix_in_a_protocol_file(tmp_path):
     p = load_protocol(path)
     assert p.blocks[0].perturbation == preset("viscous").blocks[1].perturbation
     assert p.blocks[0].perturbation.matrix == ((-1.2625, -1.4), (-1.4, 1.3875)) == VISCOUS_B
-    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    assert protocol_from_dict(json.loads(json.dumps(protocol_as_dict(p)))) == p
     assert p.blocks[0].perturbation.label() == "viscous B=[[-1.2625, -1.4], [-1.4, 1.3875]] N s/m"
 
 
@@ -631,7 +624,7 @@ def test_the_paradigms_presets_show_their_signatures_in_the_bots_learner():
     null washout long enough to zero the adaptation, re-learning is barely faster."""
     from armgame.lab.analysis import disturbance_schedule
     from armgame.lab.fit import run_model
-    from armgame.lab.protocol import savings
+    from armgame.lab.presets import savings
 
     def estimate(protocol):
         plans = schedule(protocol, 10, 0.004, (0.0, 0.5))

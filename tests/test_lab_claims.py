@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from armgame.lab.learner import TwoRateLearner, simulate
-from armgame.lab.protocol import CHANNEL_DAMPING, CHANNEL_STIFFNESS, SAVINGS_WASHOUT, preset, target_positions
+from armgame.lab.presets import SAVINGS_WASHOUT, preset
+from armgame.lab.protocol import CHANNEL_DAMPING, CHANNEL_STIFFNESS
 from armgame.lab.session import LabSession, lab_config
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
@@ -77,7 +78,7 @@ def test_the_task_geometry_the_endpoint_mass_and_the_channel():
     hx, hy = session.home
     _says(LAB, f"({hx:.3f}, {hy:.3f}) m); {protocol.targets} targets lie {protocol.distance:.2f} m around it")
     postures = [np.asarray(session.config.start_posture)]
-    postures += [arm.inverse_kinematics(np.array(t)) for t in target_positions(protocol, session.home)]
+    postures += [arm.inverse_kinematics(np.array(t)) for t in protocol.target_positions(session.home)]
     masses = [np.linalg.eigvalsh(np.linalg.inv(arm.jacobian(q) @ np.linalg.inv(arm.mass_matrix(q))
                                                @ arm.jacobian(q).T)) for q in postures]
     lightest = min(m[0] for m in masses)
@@ -127,7 +128,8 @@ def test_the_task_protocol_and_option_numbers():
     from armgame.lab.learner import MAX_TUNING_WIDTH_DEG as WIDEST
     from armgame.lab.learner import MIN_TUNING_WIDTH_DEG as NARROWEST
     from armgame.lab.learner import TUNING_CENTRES, TUNING_WIDTH_DEG, DirectionalLearner
-    from armgame.lab.protocol import MAX_CHANNEL_DAMPING, MAX_CHANNEL_STIFFNESS, PARAMETERS, Protocol
+    from armgame.lab.perturbations import Viscous
+    from armgame.lab.protocol import MAX_CHANNEL_DAMPING, MAX_CHANNEL_STIFFNESS, Protocol
     from armgame.ui.playback import REPLAY_SPEEDS
 
     p = Protocol("defaults", preset("curl").blocks)
@@ -146,7 +148,7 @@ def test_the_task_protocol_and_option_numbers():
     lesson = preset("lesson")
     program, person = (lab_config(lesson, 10, person=who).time_limit for who in (False, True))
     _says(LAB, f"(`lesson`: {program:.0f} s and {person:.0f} s)")
-    low, high = PARAMETERS["viscous"][0][1:3]
+    low, high = Viscous.parameters()[0][1:3]
     _says(LAB, f"each entry from {low:.0f} to {high:.0f})",
           f"`channel_stiffness` (N/m, default {CHANNEL_STIFFNESS:.0f}, above 0 and at most "
           f"{MAX_CHANNEL_STIFFNESS:,.0f})",
@@ -194,7 +196,7 @@ def test_the_channel_step_limit_and_rk4s_stability():
     session = LabSession(lab_config(protocol, 10), protocol)
     arm = session.model
     postures = [np.asarray(session.config.start_posture)]
-    postures += [arm.inverse_kinematics(np.array(t)) for t in target_positions(protocol, session.home)]
+    postures += [arm.inverse_kinematics(np.array(t)) for t in protocol.target_positions(session.home)]
     lightest = min(np.linalg.eigvalsh(np.linalg.inv(arm.jacobian(q) @ np.linalg.inv(arm.mass_matrix(q))
                                                     @ arm.jacobian(q).T))[0] for q in postures)
     mode = np.roots([lightest, CHANNEL_DAMPING, CHANNEL_STIFFNESS])[0]
@@ -279,6 +281,6 @@ def test_issue_39s_corrected_numbers():
     # Krakauer et al. (2000) is a visuomotor-rotation study: cited for rotation, never for a force field's design.
     _says(LAB, "Gandolfo, Mussa-Ivaldi & Bizzi (1996) trained a force field", "(Krakauer et al. 2000 asked the same of "
                "a visuomotor rotation)", "Generalization of a visuomotor rotation across directions.")
-    from armgame.lab import protocol as protocols
+    from armgame.lab import presets
 
-    assert "Krakauer" not in protocols.generalization.__doc__
+    assert "Krakauer" not in presets.generalization.__doc__

@@ -16,7 +16,7 @@ from armgame.classroom.intake import Clerk
 from armgame.classroom.roster import Roster
 from armgame.classroom.views import lab_curve
 from armgame.cli import main
-from armgame.lab.protocol import load_protocol
+from armgame.lab.protocol_file import load_protocol, protocol_as_dict
 from armgame.records.replay import Replay
 
 #: The teacher's protocol, and another one a student ran too (a longer washout): short to run.
@@ -51,7 +51,7 @@ def test_analyze_class_is_the_projectors_curve(tmp_path, runs, monkeypatch, caps
     folder = tmp_path / "class"
     folder.mkdir()
     roster, _ = Roster.open(folder, None)
-    roster.changed(lab=load_protocol(runs / "short.toml").as_dict())  # the teacher's --lab short.toml
+    roster.changed(lab=protocol_as_dict(load_protocol(runs / "short.toml")))  # the teacher's --lab short.toml
     clerk = Clerk(folder, roster)
     tokens = {name: clerk.join(name, None)[1] for name in ("Ann", "Bo", "Cy", "Dee", "Bot")}
     for name, run in (("Ann", "short1"), ("Bo", "short2"), ("Ann", "short3"),  # Ann's second run: kept apart

@@ -15,17 +15,10 @@ from armgame.lab.analysis import trial_rows
 from armgame.lab.bots import LearningRates, make_lab_bot
 from armgame.lab.designs import frames_summary, hand_twin, jacobian, joint_twin
 from armgame.lab.metrics import read_trials_csv, write_trials_csv
-from armgame.lab.perturbations import loads_for
-from armgame.lab.protocol import (
-    FRAMES_TEST_POSTURE,
-    VISCOUS_B,
-    Block,
-    Perturbation,
-    Protocol,
-    load_protocol,
-    preset,
-    protocol_from_dict,
-)
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import FRAMES_TEST_POSTURE, VISCOUS_B, preset
+from armgame.lab.protocol import Block, Protocol
+from armgame.lab.protocol_file import load_protocol, protocol_as_dict, protocol_from_dict
 from armgame.lab.record import LabTask
 from armgame.lab.session import LabSession, lab_config
 from armgame.lab.trialfit import (
@@ -50,7 +43,7 @@ def _run(protocol: Protocol, bot, seed: int = 10) -> LabSession:
 @pytest.mark.parametrize("name", ["frames", "rotation-generalization", "random-fields"])
 def test_the_designs_presets_round_trip(name):
     p = preset(name)
-    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    assert protocol_from_dict(json.loads(json.dumps(protocol_as_dict(p)))) == p
 
 
 def test_a_file_sets_posture_feedback_and_mix_and_bad_values_are_refused(tmp_path):
@@ -76,7 +69,7 @@ home_elbow_deg = 80
     mixed = p.blocks[1]
     assert mixed.home_posture_deg == (100.0, 80.0) and mixed.feedback == "endpoint"
     assert mixed.mix == ("on", "off", "opposite") and mixed.perturbation.joint_matrix == ((0.1, -0.2), (0.3, 0.05))
-    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
+    assert protocol_from_dict(json.loads(json.dumps(protocol_as_dict(p)))) == p
     for bad, words in (('feedback = "dim"', "feedback"), ('mix = ["on", "sometimes"]', "mix"),
                        ("home_shoulder_deg = 10", "both")):
         path.write_text(f"[[blocks]]\nname = \"b\"\ntrials = 8\nperturbation = \"curl\"\nb = 2.0\n{bad}\n")
@@ -113,8 +106,7 @@ def test_a_joint_field_is_its_hand_twin_where_it_was_learned_and_turns_with_the_
     b = np.asarray(VISCOUS_B)
     w = joint_twin(VISCOUS_B, L1, L2, qa)
     # The physics: the joint load's torque W qdot equals J^T B v at the training posture, for any joint velocity.
-    load = loads_for(Perturbation.make("joint_viscous", w11=w[0, 0], w12=w[0, 1], w21=w[1, 0], w22=w[1, 1]),
-                     (0.0, 0.0))
+    load = Perturbation.make("joint_viscous", w11=w[0, 0], w12=w[0, 1], w21=w[1, 0], w22=w[1, 1]).loads((0.0, 0.0))
     assert load is not None and load.hand is None
     qdot = np.array([0.7, -1.3])
     j = jacobian(L1, L2, *qa)
@@ -227,7 +219,7 @@ def test_the_docs_account_of_the_bots_random_fields_run_is_its_learners_and_prot
     from pathlib import Path
 
     from armgame.lab.learner import TwoRateLearner
-    from armgame.lab.protocol import preset
+    from armgame.lab.presets import preset
 
     text = " ".join((Path(__file__).resolve().parent.parent / "docs" / "lab.md").read_text(encoding="utf-8").split())
     learner = TwoRateLearner()

@@ -16,16 +16,10 @@ from armgame.errors import UserError
 from armgame.lab.bots import make_lab_bot
 from armgame.lab.learner import DirectionalLearner, TwoRateLearner
 from armgame.lab.metrics import read_trials_csv
-from armgame.lab.protocol import (
-    Block,
-    Perturbation,
-    Protocol,
-    lesson,
-    load_protocol,
-    preset,
-    protocol_from_dict,
-    with_catch_trials,
-)
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import lesson, preset
+from armgame.lab.protocol import Block, Protocol, with_catch_trials
+from armgame.lab.protocol_file import load_protocol, protocol_as_dict, protocol_from_dict
 from armgame.lab.record import LabTask
 from armgame.lab.session import LabSession, lab_config, schedule
 
@@ -74,8 +68,8 @@ def test_generalization_trains_one_direction_and_probes_them_all():
     assert {q.target_deg for q in test if not q.channel} == {90.0}
     assert Counter(q.target_deg for q in test if q.channel) == dict.fromkeys(range(0, 360, 45), 2)
     assert {q.target_deg for q in plans if q.block == 0 and q.channel} == set(map(float, range(0, 360, 45)))
-    assert protocol_from_dict(json.loads(json.dumps(p.as_dict()))) == p
-    assert p.as_dict()["blocks"][2]["probe_directions_deg"] == [float(a) for a in range(0, 360, 45)]
+    assert protocol_from_dict(json.loads(json.dumps(protocol_as_dict(p)))) == p
+    assert protocol_as_dict(p)["blocks"][2]["probe_directions_deg"] == [float(a) for a in range(0, 360, 45)]
 
 
 def test_back_to_back_probes_only_when_asked(tmp_path):
@@ -88,7 +82,7 @@ def test_back_to_back_probes_only_when_asked(tmp_path):
         load_protocol(path)
     path.write_text(text.format("consecutive_probes = true"))
     p = load_protocol(path)
-    assert p.consecutive_probes and p.as_dict()["consecutive_probes"] is True
+    assert p.consecutive_probes and protocol_as_dict(p)["consecutive_probes"] is True
     assert sum(q.catch or q.channel for q in schedule(p, 3, 0.004, (0.0, 0.5))) == 4
 
 
@@ -137,9 +131,9 @@ def test_a_replay_recorded_before_the_balanced_placement_still_verifies():
     assert schedule(replace(old, probe_schedule="balanced"), 5, config.dt, session.home) != session.plans
     # A protocol without probes is written as before and reads back equal either way (the class curve groups
     # runs by protocol: an old lesson replay and a new one stay one class).
-    assert set(lesson().as_dict()) == set(protocol_from_dict(lesson().as_dict()).as_dict()) \
-        and "probe_schedule" not in lesson().as_dict()
-    assert protocol_from_dict(lesson().as_dict(), recorded=True) == lesson()
+    assert set(protocol_as_dict(lesson())) == set(protocol_as_dict(protocol_from_dict(protocol_as_dict(lesson())))) \
+        and "probe_schedule" not in protocol_as_dict(lesson())
+    assert protocol_from_dict(protocol_as_dict(lesson()), recorded=True) == lesson()
 
 
 def test_the_versioned_envs_keep_their_schedule():

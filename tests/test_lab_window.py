@@ -15,7 +15,9 @@ import pytest
 from armgame.game.bots import Autopilot
 from armgame.game.session import RealTimeDriver
 from armgame.lab.bots import make_lab_bot
-from armgame.lab.protocol import Block, Perturbation, Protocol, preset
+from armgame.lab.perturbations import Perturbation
+from armgame.lab.presets import preset
+from armgame.lab.protocol import Block, Protocol
 from armgame.lab.session import LabSession, lab_config
 from armgame.limits import MAX_GAME_SECONDS
 from armgame.ui.frontend import open_window
@@ -367,7 +369,8 @@ def test_the_header_names_the_block_of_the_reach_on_screen(screen):
 
 
 def test_the_cards_say_what_to_do_never_what_will_happen(screen):
-    from armgame.lab.protocol import DEFAULT_INSTRUCTIONS, preset
+    from armgame.lab.presets import preset
+    from armgame.lab.protocol import DEFAULT_INSTRUCTIONS
 
     lesson = preset("lesson")
     assert [b.trials for b in lesson.blocks] == [4, 16, 4] and lesson.targets == 4

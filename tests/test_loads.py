@@ -197,7 +197,7 @@ def test_a_time_dependent_field_reads_the_clock():
 def test_viscous_field_does_the_work_of_its_symmetric_part(integrator):
     """F = B v with Shadmehr & Mussa-Ivaldi's B: v . B v = v . sym(B) v is not zero, so the passive arm's
     energy changes, by exactly the work the field did (the power v . B v integrated along the motion)."""
-    from armgame.lab.protocol import PUBLISHED_VISCOUS_B
+    from armgame.lab.presets import PUBLISHED_VISCOUS_B
 
     arm = TwoJointArm(GAME_ARM)
     field = ViscousField(PUBLISHED_VISCOUS_B)

@@ -67,7 +67,7 @@ def test_the_games_bots_have_no_noise_and_bad_levels_are_one_line_errors():
 def test_each_preset_brings_its_bot_a_motor_noise_that_the_option_overrides(argv, level):
     from armgame.cli import build_parser
     from armgame.commands.lab import _motor_noise, _noise_line, _resolve_motor_noise
-    from armgame.lab.protocol import HUMAN_NOISE, PRESET_MOTOR_NOISE, PRESETS
+    from armgame.lab.presets import HUMAN_NOISE, PRESET_MOTOR_NOISE, PRESETS
 
     assert HUMAN_NOISE == 0.3 and {p for p in PRESETS if PRESET_MOTOR_NOISE[p]} == set(PRESETS) - {"lesson"}
     args = build_parser().parse_args(["lab", *argv, "--seed", "10"])

@@ -53,7 +53,8 @@ def test_a_fit_to_nothing_to_fit_is_one_line(tmp_path, capsys, perturbation, tri
 def test_the_zero_field_is_no_reference_for_a_later_one():
     """A zero field before a real one counts as no disturbance; the real one is the unit."""
     from armgame.lab.analysis import disturbance_schedule
-    from armgame.lab.protocol import Block, Perturbation, Protocol
+    from armgame.lab.perturbations import Perturbation
+    from armgame.lab.protocol import Block, Protocol
 
     zero, field = Perturbation.make("curl", b=0.0), Perturbation.make("curl", b=2.0)
     protocol = Protocol("p", (Block("a", 1, zero), Block("b", 1, field),

@@ -556,7 +556,7 @@ class Clerk:
 
     def choose_lab(self, protocol: object) -> str:
         """The protocol the class curve shows (the teacher's choice; None: none until chosen)."""
-        from ..lab.protocol import PRESETS
+        from ..lab.presets import PRESETS
 
         if protocol is not None and (not isinstance(protocol, str) or protocol not in PRESETS):
             raise RefusedError(400, f"the class curve shows one of the presets: {', '.join(sorted(PRESETS))}")

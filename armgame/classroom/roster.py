@@ -227,7 +227,7 @@ class Roster:
                 raise ValueError("locked must be true or false")
             lab = d.get("lab")
             if isinstance(lab, dict):
-                from ..lab.protocol import protocol_from_dict
+                from ..lab.protocol_file import protocol_from_dict
 
                 protocol_from_dict(lab, "lab")  # a class record's own protocol is checked like any other
             elif lab is not None:

@@ -202,16 +202,17 @@ def _class_uvicorn(config: Any, end_streams: Callable[[], None]) -> Any:
 
 
 def _curve_protocol(lab: str | None) -> str | dict | None:
-    """``--lab``: a preset's name as it is, a protocol file as its ``as_dict`` (kept in the class record, so the
-    curve stays the file's protocol whatever becomes of the file)."""
-    from ..lab.protocol import PRESETS, load_protocol
+    """``--lab``: a preset's name as it is, a protocol file as plain data (``protocol_as_dict``, kept in the class
+    record, so the curve stays the file's protocol whatever becomes of the file)."""
+    from ..lab.presets import PRESETS
+    from ..lab.protocol_file import load_protocol, protocol_as_dict
     from ..records.storage import user_path
 
     if lab is None or lab in PRESETS:
         return lab
     if not lab.endswith(".toml"):
         raise UserError(f"--lab {lab}: a preset ({', '.join(PRESETS)}) or a protocol's .toml file")
-    return load_protocol(user_path(lab, "--lab")).as_dict()
+    return protocol_as_dict(load_protocol(user_path(lab, "--lab")))
 
 
 def _hold_folder(folder: Path) -> Any:

@@ -98,7 +98,7 @@ def roster_view(clerk: Clerk) -> dict[str, object]:
     """For the teacher's page: every joined name with the machine (address) it joined from and its games
     (0: joined, not played yet), grouped by address, most names first; whether the list is locked, and the
     class curve's protocol."""
-    from ..lab.protocol import PRESETS
+    from ..lab.presets import PRESETS
 
     roster = clerk.roster
     played: dict[str, int] = {}

@@ -34,7 +34,7 @@ def _count(text: str) -> int:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    from ..lab.protocol import HUMAN_NOISE, PRESETS
+    from ..lab.presets import HUMAN_NOISE, PRESETS
 
     p = subparsers.add_parser(
         "lab",
@@ -100,7 +100,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _noise_level(text: str) -> float:
-    from ..lab.protocol import HUMAN_NOISE
+    from ..lab.presets import HUMAN_NOISE
 
     if text == "human":
         return HUMAN_NOISE
@@ -116,7 +116,7 @@ def _noise_level(text: str) -> float:
 def _resolve_motor_noise(args: argparse.Namespace) -> None:
     """``args.motor_noise`` as the run uses it: as given, else the preset's (``PRESET_MOTOR_NOISE``) for a bot,
     else none; ``args.motor_noise_given`` says which, for the run's output."""
-    from ..lab.protocol import PRESET_MOTOR_NOISE
+    from ..lab.presets import PRESET_MOTOR_NOISE
 
     args.motor_noise_given = args.motor_noise is not None
     if args.motor_noise is None:
@@ -125,7 +125,7 @@ def _resolve_motor_noise(args: argparse.Namespace) -> None:
 
 def _noise_line(args: argparse.Namespace) -> str:
     """The motor noise a bot's run used and where its level came from, for the run's output."""
-    from ..lab.protocol import PRESETS
+    from ..lab.presets import PRESETS
     from ..lab.record import motor_noise_words
 
     words = motor_noise_words(_motor_noise(args))
@@ -167,7 +167,8 @@ def _speed(text: str) -> float:
 
 
 def load_protocol_argument(text: str):
-    from ..lab.protocol import PRESETS, load_protocol, preset
+    from ..lab.presets import PRESETS, preset
+    from ..lab.protocol_file import load_protocol
 
     if text in PRESETS:
         return preset(text)
@@ -203,7 +204,7 @@ def run(args: argparse.Namespace) -> int:
     if (args.retention or args.learning or args.representation or args.frame) and args.bot != "adaptive":
         raise UserError("--retention, --learning, --representation and --frame set the adaptive bot's learner: add "
                         "--bot adaptive")
-    from ..lab.protocol import PRESET_REPRESENTATION
+    from ..lab.presets import PRESET_REPRESENTATION
 
     if args.bot == "adaptive" and args.representation is None:  # the preset's own learner (generalization: local)
         args.representation = PRESET_REPRESENTATION.get(args.protocol, "global")

@@ -27,16 +27,9 @@ from ..game.rules import MAX_CONFIG_SECONDS, Target
 from ..game.session import DOWN
 from ..lab.analysis import trial_row
 from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
-from ..lab.protocol import (
-    MAX_TRIALS,
-    PARAMETERS,
-    PRESETS,
-    Perturbation,
-    Protocol,
-    preset,
-    viscous_matrix,
-    with_perturbation,
-)
+from ..lab.perturbations import KINDS, NONE, Perturbation
+from ..lab.presets import PRESETS, preset
+from ..lab.protocol import MAX_TRIALS, Protocol, with_perturbation
 from ..lab.session import HOLD, REACH, LabSession, lab_config
 from ..physics.hand import hand_xy
 from ..physics.twojoint import TwoJointArm
@@ -79,7 +72,7 @@ def perturbation_option(value: object) -> Perturbation:
         return value
     if isinstance(value, str):
         if value == "none":
-            return Perturbation()
+            return NONE
         if value in PRESETS and value != "null":
             return next(b.perturbation for b in preset(value).blocks if b.perturbation.kind != "none")
         raise EnvArgumentError(f"perturbation {value!r}: give none, a preset's name (curl, rotation, mirror, "
@@ -89,17 +82,18 @@ def perturbation_option(value: object) -> Perturbation:
         kind = values.pop("perturbation", None)
         if not isinstance(kind, str):
             raise EnvArgumentError("a perturbation mapping names its kind under 'perturbation'")
-        if kind == "viscous" and "matrix" in values:  # as in a protocol file: matrix = [[b11, b12], [b21, b22]]
-            try:
-                values.update(viscous_matrix("perturbation viscous: matrix", values.pop("matrix")))
-            except (ValueError, TypeError) as exc:
-                raise EnvArgumentError(str(exc)) from None
+        known = KINDS.get(kind)
+        if known is not None and "matrix" in values and "matrix" in known.file_keys():
+            try:  # as a protocol file writes it: matrix = [[b11, b12], [b21, b22]]
+                values.update(known.read({"matrix": values.pop("matrix")}).items())
+            except UserError as exc:
+                raise EnvArgumentError(f"perturbation {kind}: {exc}") from None
+        limits = {p.name: p for p in known.parameters()} if known is not None else {}
         for name, number in values.items():
-            limits = {p[0]: (p[1], p[2]) for p in PARAMETERS.get(kind, ())}
             if name in limits and (isinstance(number, bool) or not isinstance(number, int | float)
-                                   or not limits[name][0] <= number <= limits[name][1]):
-                raise EnvArgumentError(f"perturbation {kind}: {name} must be a number from {limits[name][0]:g} "
-                                       f"to {limits[name][1]:g}, got {number!r}")
+                                   or not limits[name].low <= number <= limits[name].high):
+                raise EnvArgumentError(f"perturbation {kind}: {name} must be a number from {limits[name].low:g} "
+                                       f"to {limits[name].high:g}, got {number!r}")
         try:
             return Perturbation.make(kind, **values)
         except UserError as exc:
@@ -355,7 +349,8 @@ class CenterOutEnv(CenterOutBaseEnv):
     ```
 
     * ``protocol``: a lab preset's name (``null``, ``curl``, ``rotation``, ``mirror``, ``jointspace``;
-      default ``null``) or an ``armgame.lab.protocol.Protocol`` (``load_protocol`` reads a TOML file).
+      default ``null``) or an ``armgame.lab.protocol.Protocol`` (``armgame.lab.protocol_file.load_protocol`` reads a
+      TOML file).
     * ``perturbation``: replaces the protocol's perturbation in its perturbed blocks (in the ``null``
       preset: its exposure block): a ``Perturbation``, a preset's name for its exposure (``"curl"``,
       b = 2 N s/m), ``"none"``, or a mapping such as ``{"perturbation": "rotation", "angle": 45.0}``.

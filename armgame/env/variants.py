@@ -112,7 +112,7 @@ class ReachVariant:
         if self.field == "curl":
             parameter = self.field_strength
         elif self.field == "viscous":
-            from ..lab.protocol import VISCOUS_B  # the lab's matrix, once
+            from ..lab.presets import VISCOUS_B  # the lab's matrix, once
 
             parameter = tuple(tuple(self.field_strength * v for v in row) for row in VISCOUS_B)
         return GameVariant(self.hold_steps(config.dt) if self.hold_time else 0, self.motor_noise, decision_steps,

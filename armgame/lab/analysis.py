@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from .metrics import NO_CHANNEL, ChannelMeasures, Reach, channel_measures, reach_metrics
-from .protocol import FORCE_KINDS
 from .session import LabSession, TrialOutcome
 
 #: The paths figure's groups: (label, block kind, which trials of the block).
@@ -177,19 +176,15 @@ def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndar
     def scale(p) -> float:
         if p.is_null:  # none, or a zero field: no disturbance (and no division by a zero reference)
             return 0.0
-        if p.kind in ("curl", "viscous") and reference.kind in ("curl", "viscous"):
-            b, r = np.asarray(p.matrix), np.asarray(reference.matrix)
-            along = float(np.sum(b * r)) / float(np.sum(r * r))
-            if np.allclose(b, along * r):
-                return along
-        elif p.kind == reference.kind == "joint_viscous":
-            w, r = np.asarray(p.joint_matrix), np.asarray(reference.joint_matrix)
-            along = float(np.sum(w * r)) / float(np.sum(r * r))
-            if np.allclose(w, along * r):
-                return along
-        elif p.kind == reference.kind == "rotation":
+        for mine, theirs in ((p.matrix, reference.matrix), (p.joint_matrix, reference.joint_matrix)):
+            if mine is not None and theirs is not None:  # two hand fields (curl or viscous), or two joint fields
+                m, r = np.asarray(mine), np.asarray(theirs)
+                along = float(np.sum(m * r)) / float(np.sum(r * r))
+                if np.allclose(m, along * r):
+                    return along
+        if p.kind == reference.kind == "rotation":
             return p["angle"] / reference["angle"]
-        elif p == reference:
+        if p == reference:
             return 1.0
         raise ValueError(f"{p.label()} is not a multiple of the run's first perturbation ({reference.label()}): "
                          "one learner cannot be fitted to both")
@@ -202,8 +197,8 @@ def disturbance_schedule(protocol, plans: Sequence) -> tuple[np.ndarray, np.ndar
 def figure_metric(protocol) -> str:
     """What a learning curve plots: the perpendicular error for force fields (a velocity-dependent field
     bends the path after the first 100 ms), the initial direction error for visual transforms."""
-    kinds = {b.perturbation.kind for b in protocol.blocks}
-    return "max_perpendicular_error_m" if kinds & set(FORCE_KINDS) else "initial_direction_error_deg"
+    forces = any(b.perturbation.is_force for b in protocol.blocks)
+    return "max_perpendicular_error_m" if forces else "initial_direction_error_deg"
 
 
 def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> list[Path]:
@@ -217,13 +212,12 @@ def write_run_outputs(session: LabSession, out: Path, figures: bool = True) -> l
     write_trials_csv(written[0], rows)
     if figures:
         from .figures import learning_figure, paths_figure
-        from .protocol import target_positions
 
         learning_figure(rows, out / "learning.png", metric=figure_metric(session.protocol))
         perturbed = [b.perturbation.label() for b in session.protocol.blocks if b.perturbation.kind != "none"]
         caption = f"{session.protocol.name}: {', '.join(dict.fromkeys(perturbed)) or 'no perturbation'}; " \
                   f"seed {session.config.seed}"
-        paths_figure(path_groups(session), session.home, target_positions(session.protocol, session.home),
+        paths_figure(path_groups(session), session.home, session.protocol.target_positions(session.home),
                      out / "paths.png", target_radius=session.protocol.target_radius, caption=caption)
         written += [out / "learning.png", out / "paths.png"]
         if any(r["perturbation"] == "channel" and math.isfinite(float(r["adaptation_index"])) for r in rows):
@@ -476,7 +470,8 @@ class ClassCurve:
 def curve_protocol(choice: object):
     """The class curve's protocol from the teacher's choice as a class keeps it (``Roster.lab`` in ``class.json``):
     a preset's name, a protocol as plain data, or None (no protocol chosen)."""
-    from .protocol import preset, protocol_from_dict
+    from .presets import preset
+    from .protocol_file import protocol_from_dict
 
     if isinstance(choice, dict):
         return protocol_from_dict(choice, "lab")

@@ -21,7 +21,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from .protocol import Perturbation, Protocol
+from .perturbations import Perturbation
+from .protocol import Protocol
 from .session import LabSession, TrialOutcome
 
 Matrix = tuple[tuple[float, float], tuple[float, float]]

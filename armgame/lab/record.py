@@ -24,7 +24,8 @@ from ..game.rules import GameConfig
 from ..game.session import GameResult, InputEvent
 from ..records.replay import register_task, same_outcome
 from ..valid import HEX64, INT64_MAX, check_int, check_keys, check_str
-from .protocol import Protocol, protocol_from_dict
+from .protocol import Protocol
+from .protocol_file import protocol_as_dict, protocol_from_dict
 from .session import LAB_SCENE, LabSession
 
 TASK_KIND = "centre-out"
@@ -55,8 +56,8 @@ class LabTask:
     def as_dict(self) -> dict[str, object]:
         noise = {} if self.motor_noise is None else {"motor_noise": self.motor_noise.as_dict()}
         fields = {} if self.fields is None else {"fields": list(self.fields)}
-        return {"kind": TASK_KIND, "protocol": self.protocol.as_dict(), "trials": [list(t) for t in self.trials],
-                "paths_sha256": self.paths_sha256, **noise, **fields}
+        return {"kind": TASK_KIND, "protocol": protocol_as_dict(self.protocol),
+                "trials": [list(t) for t in self.trials], "paths_sha256": self.paths_sha256, **noise, **fields}
 
     @classmethod
     def from_dict(cls, data: object, config: GameConfig, last_step: int) -> LabTask:

@@ -39,8 +39,8 @@ from ..limits import MAX_GAME_SECONDS
 from ..physics.hand import hand_from_trig, hand_xy
 from ..physics.integrators import Integrator
 from ..physics.loads import ChannelField, Loads, loaded_arm
-from .perturbations import Display, display_for, loads_for
-from .protocol import MAX_CHANNEL_LAMBDA_DT, NONE, STILL_SPEED, Block, Perturbation, Protocol, target_positions
+from .perturbations import NONE, Display, Perturbation
+from .protocol import MAX_CHANNEL_LAMBDA_DT, STILL_SPEED, Block, Protocol
 
 HOLD, REACH = "hold", "reach"
 _WENT, _ENDED = 1, 2
@@ -125,7 +125,7 @@ def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]
             block_home, block_q = home, start_q
         else:
             block_home, block_q = homes[block.posture_of(protocol)]
-        positions = target_positions(protocol, block_home)
+        positions = protocol.target_positions(block_home)
         own = block.targets_of(protocol)
         if block.channel_block:
             order = _cycles(rng, block.probe_targets_of(protocol), block.trials)
@@ -264,7 +264,7 @@ class LabSession(GameSession):
         #: Each posture's (home, posture in rad), by the posture in degrees (one for most protocols).
         self.homes = {deg: self._home_at(deg) for deg in protocol.postures_deg}
         for home, _q in self.homes.values():
-            for x, y in target_positions(protocol, home):
+            for x, y in protocol.target_positions(home):
                 self.model.inverse_kinematics((x, y))  # UnreachableError (one line) for a target out of reach
         self.plans = schedule(protocol, config.seed, config.dt, self.home,
                               self.homes if len(self.homes) > 1 else None)
@@ -368,10 +368,10 @@ class LabSession(GameSession):
         """(step function, shown-hand transform) of a perturbation, built once per run."""
         key = (perturbation, self.home)
         if key not in self._physics:
-            loads = loads_for(perturbation, self.home)
+            loads = perturbation.loads(self.home)
             step = self.unloaded_step() if loads is None else \
                 Integrator(self.config.integrator, loaded_arm(self.model, loads)).step_components
-            self._physics[key] = (step, display_for(perturbation, self.home, self.home_q))
+            self._physics[key] = (step, perturbation.display(self.home, self.home_q))
         return self._physics[key]
 
     def channel_for(self, target: int) -> tuple[object, ChannelField]:
@@ -379,7 +379,7 @@ class LabSession(GameSession):
         key = (target, self.home)
         if key not in self._channels:
             hx, hy = self.home
-            tx, ty = target_positions(self.protocol, self.home)[target]
+            tx, ty = self.protocol.target_positions(self.home)[target]
             length = math.hypot(tx - hx, ty - hy)
             channel = ChannelField(self.protocol.channel_stiffness, self.protocol.channel_damping, self.home,
                                    ((tx - hx) / length, (ty - hy) / length))
@@ -401,7 +401,7 @@ class LabSession(GameSession):
         p, dt = self.protocol, self.config.dt
         postures = [q for home, q in self.homes.values()]
         postures += [tuple(self.model.inverse_kinematics(xy)) for home, _q in self.homes.values()
-                     for xy in target_positions(p, home)]
+                     for xy in p.target_positions(home)]
         lightest = math.inf
         for q in postures:
             jac = self.model.jacobian(np.asarray(q, dtype=float))

@@ -28,7 +28,6 @@ from ..game.rules import GameConfig
 from ..game.session import UP, InputEvent, RealTimeDriver
 from ..game.timeline import TimelineDriver
 from ..lab.analysis import LearningCurve, figure_metric, learning_curve, result_words, trial_rows
-from ..lab.protocol import target_positions
 from ..lab.session import HOLD, LabSession, TrialOutcome
 from ..words import plural
 from .frontend import GameWindow, key_name, seek
@@ -100,7 +99,7 @@ class LabRenderer(GameRenderer):
         view = self.view(screen.get_size(), session, shown)
         line = max(3, round(min(screen.get_size()) / 240))
         screen.fill(p.scene)
-        for x, y in target_positions(session.protocol, shown):
+        for x, y in session.protocol.target_positions(shown):
             pygame.draw.circle(screen, p.edge, view.to_screen(x, y), view.length(session.protocol.target_radius), line)
         home = session.home_target
         holding = session.phase == HOLD and not session.over
