@@ -5,9 +5,10 @@ Python step), ``armgame/game/_cbots.c`` (the bots' forward model) and ``armgame/
 (Reach-v1's observations of a batch) must compute exactly what the Python code computes, so their build
 turns off floating-point contraction (no fused multiply-add) and the compiler's own sin and cos (no
 merging them into sincos; ``_ckernel.c`` calls glibc's sincos itself for the hand, after checking it
-against sin and cos): see each file's opening comment. All are optional: without a C compiler the
-install goes on, ``BatchGameSession`` and the v1 vector env's observations run numpy, the arm's sine and
-the bots run in Python, with the same results.
+against sin and cos): see each file's opening comment. ``armgame/records/_ctimeline.c`` (a replay's
+timeline read, its identity's forms) has no floating point. All are optional: without a C compiler the
+install goes on, ``BatchGameSession`` and the v1 vector env's observations run numpy, the arm's sine, the
+bots and the timeline's passes run in Python, with the same results.
 """
 
 from setuptools import Extension, setup

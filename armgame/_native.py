@@ -1,8 +1,9 @@
 """The compiled modules, loaded one way: where built, and only if they speak this package's convention.
 
-``setup.py`` builds four optional C extensions where a compiler is found: ``armgame.game._ckernel``
-(the game's loop and the batch's kernel), ``armgame.game._cbots`` (the bots' forward model),
-``armgame.physics._ctrig`` (the arm's sine) and ``armgame.env._cvector`` (the vector env's passes).
+``setup.py`` builds five optional C extensions where a compiler is found: ``armgame.game._ckernel``
+(the game's loop, the batch's kernel and its event columns), ``armgame.game._cbots`` (the bots' forward
+model), ``armgame.physics._ctrig`` (the arm's sine), ``armgame.env._cvector`` (the vector env's passes)
+and ``armgame.records._ctimeline`` (a replay's timeline read and its identity's forms).
 Each has a Python twin that gives the same bits, so a missing build only costs speed. A build of
 another version of its ``.c`` file (a stale ``.so`` left by an older install) is worse than none:
 its calling convention may differ, and it would be misread. So each module carries integer
