@@ -146,6 +146,7 @@ def close(opened, closed: bool) -> None:
         assert json.loads(r.read())["ok"]
 
 
+@pytest.mark.slow  # in chromium: CI's slow tier runs every page after the suite
 def test_a_closed_class_starts_no_game_until_the_teacher_opens_it(tmp_path):
     with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
         errors = open_page(page, f"http://127.0.0.1:{opened.port}")

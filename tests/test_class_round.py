@@ -70,6 +70,7 @@ def teacher(opened, path: str, body: dict) -> dict:
         return json.loads(r.read())
 
 
+@pytest.mark.slow  # in chromium: CI's slow tier runs every page after the suite
 def test_the_projector_counts_a_round_down_and_shows_its_winners(tmp_path, monkeypatch):
     with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
         address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")

@@ -259,6 +259,7 @@ def test_changes_come_as_json_from_the_class_own_pages_only(opened):
     assert call(opened, "POST", "/api/join", body, {"Origin": f"http://127.0.0.1:{opened.port}"})[0] == 200
 
 
+@pytest.mark.slow  # in chromium: CI's slow tier runs every page after the suite
 def test_a_page_on_another_site_cannot_join_guess_or_lock_anyone_out(opened, tmp_path):
     from browser import browser_page
 

@@ -204,8 +204,14 @@ def _run_in_bash(script: str, where: str, work: Path, env: dict[str, str], pytho
     assert "Traceback" not in proc.stderr, f"{where}:\n{proc.stderr[-2000:]}"
 
 
+#: The guides whose examples serve a class and train and evaluate programs end to end (4 and 3 s): CI's slow tier
+#: runs them after the suite, so the README's command keeps its minute.
+SLOW_GUIDES = {"teaching.md", "programs.md"}
+
+
 @pytest.mark.skipif(shutil.which("bash") is None, reason="the examples are POSIX shell")
-@pytest.mark.parametrize("path", RUNNABLE, ids=lambda p: p.name)
+@pytest.mark.parametrize("path", [pytest.param(p, marks=pytest.mark.slow) if p.name in SLOW_GUIDES else p
+                                  for p in RUNNABLE], ids=lambda p: p.name)
 def test_runnable_examples_run_as_printed(path, tmp_path, monkeypatch, capfd):
     """A file's ``run`` blocks, in order, in one folder, as a user would type them: each line that is
     one plain ``armgame`` command through ``armgame.cli.main`` (what the console script calls), in

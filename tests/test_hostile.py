@@ -580,6 +580,7 @@ def test_a_table_over_the_limit_is_refused_whole_never_set_aside(tmp_path, monke
     assert table.path.read_bytes() == before
 
 
+@pytest.mark.slow  # 2.6 s to read the table the limits allow: CI runs it after the suite (the slow tier)
 def test_a_table_of_100000_entries_is_read(tmp_path):
     from armgame.records.scores import ScoreEntry, table_bytes
 

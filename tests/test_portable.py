@@ -34,6 +34,7 @@ SELECTION = [
 ]
 
 
+@pytest.mark.slow  # a second pytest over the records' tests (5 s): CI's slow tier runs it after the suite
 @pytest.mark.skipif(SIMULATED, reason="runs the others; not itself again")
 def test_records_tests_pass_without_posix_locks_or_flags():
     env = {**os.environ, "ARMGAME_TEST_NO_POSIX": "1"}
