@@ -383,3 +383,16 @@ def test_the_off_policy_recipe_runs(capsys):
     out = capsys.readouterr().out
     assert "hits per game" in out and "best validation mean hits per game" in out
 
+
+
+def test_the_size_cap_of_each_suite_ids_vector_env_is_the_one_the_docs_state():
+    """A suite id's vector env is single envs in Gymnasium's SyncVectorEnv: at most SingleEnvsVectorEnv.MAX_ENVS,
+    refused in one line past it, as docs/programs.md says (the native vector env's larger cap is Reach's plain game)."""
+    from armgame.env.vector_common import SingleEnvsVectorEnv
+
+    cap = SingleEnvsVectorEnv.MAX_ENVS
+    guide = (Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
+    assert f"holds at most {cap:,} envs" in " ".join(guide.split())
+    for env_id in suite_ids():
+        with pytest.raises(EnvArgumentError, match=f"from 1 to {cap}, got {cap + 1}"):
+            gym.make_vec(env_id, num_envs=cap + 1, vectorization_mode="vector_entry_point")
