@@ -19,6 +19,7 @@ from __future__ import annotations
 import errno
 import os
 import stat
+import tomllib
 from pathlib import Path
 
 from .errors import UserError
@@ -191,3 +192,16 @@ def read_limited(path: Path, limit: int, what: str, follow: bool = True) -> byte
 
 def _size(n: int) -> str:
     return f"{n // (1024 * 1024)} MiB" if n >= 1024 * 1024 else f"{n} bytes"
+
+
+def parse_toml(data: bytes, source: object, not_text: str, error: type[Exception] = UserError) -> dict:
+    """A TOML file's bytes as data; ``error`` in one line naming ``source`` on any fault (``not_text``: what the
+    file should have been, said when it is not UTF-8 text)."""
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise error(f"{source}: {not_text}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{source}: not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses into nested arrays and tables
+        raise error(f"{source}: not valid TOML: nested too deeply") from None

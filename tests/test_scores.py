@@ -379,22 +379,13 @@ def test_no_prompt_when_the_name_is_known(finished_window):
 def _entry_by_the_generic_checks(data: object) -> ScoreEntry:
     """What ``ScoreEntry.from_dict`` did before it was written out field by field: the reference its
     fast paths must agree with, value for value and first error for first error."""
+    from armgame import valid as v
     from armgame.records.replay import DRIVEN
-    from armgame.valid import (
-        HEX32,
-        HEX64,
-        check_bool,
-        check_date,
-        check_float,
-        check_int,
-        check_keys,
-        check_name,
-        check_pattern,
-        check_str,
-        check_word,
-    )
 
-    m, big = check_pattern, 10**9
+    check_date, check_float, check_int, check_name, check_str, check_word = (
+        v.check_date, v.check_float, v.check_int, v.check_name, v.check_str, v.check_word)
+    check_bool, check_keys, HEX32, HEX64 = v.check_bool, v.check_keys, v.HEX32, v.HEX64
+    m, big = v.check_pattern, 10**9
     d = check_keys("entry", data, entry_module._REQUIRED, entry_module._OPTIONAL)
     driven = check_str("driven", d["driven"], 20)
     if driven not in DRIVEN:

@@ -79,9 +79,8 @@ async def _not_written(request: Request, exc: Exception) -> Response:
 EXCEPTION_HANDLERS: dict[Any, Any] = {RefusedError: _refused, UserError: _not_written}
 
 
-class SecurityHeaders:
-    """Pure ASGI middleware: ``SECURITY_HEADERS`` first in every answer's headers (a header an answer sets itself
-    is kept as it is)."""
+class _HTTPMiddleware:
+    """Pure ASGI middleware that acts on HTTP requests (``http``) and passes anything else (the lifespan) on."""
 
     def __init__(self, app: ASGIApp) -> None:
         self.app = app
@@ -90,7 +89,17 @@ class SecurityHeaders:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
+        await self.http(scope, receive, send)
 
+    async def http(self, scope: Scope, receive: Receive, send: Send) -> None:
+        raise NotImplementedError
+
+
+class SecurityHeaders(_HTTPMiddleware):
+    """Pure ASGI middleware: ``SECURITY_HEADERS`` first in every answer's headers (a header an answer sets itself
+    is kept as it is)."""
+
+    async def http(self, scope: Scope, receive: Receive, send: Send) -> None:
         async def send_with_headers(message: Message) -> None:
             if message["type"] == "http.response.start":
                 headers = list(message.get("headers", ()))
@@ -101,18 +110,12 @@ class SecurityHeaders:
         await self.app(scope, receive, send_with_headers)
 
 
-class OneLineErrors:
+class OneLineErrors(_HTTPMiddleware):
     """Pure ASGI middleware: an exception no handler answered (a bug) is a 500 in one line, and one line in
     the teacher's terminal; nothing is raised further (the class goes on). After an answer has begun (the
     event stream) there is nothing to answer: the exception goes on to the server."""
 
-    def __init__(self, app: ASGIApp) -> None:
-        self.app = app
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
+    async def http(self, scope: Scope, receive: Receive, send: Send) -> None:
         started = False
 
         async def sending(message: Message) -> None:
@@ -132,16 +135,12 @@ class OneLineErrors:
                                             "why); nothing was entered"))(scope, receive, send)
 
 
-class SameSite:
+class SameSite(_HTTPMiddleware):
     """Pure ASGI middleware on each of the class's routes: ``same_site`` before the endpoint (a refusal goes to
     ``EXCEPTION_HANDLERS`` like any other)."""
 
-    def __init__(self, app: ASGIApp) -> None:
-        self.app = app
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] == "http":
-            same_site(scope["method"], Headers(scope=scope))
+    async def http(self, scope: Scope, receive: Receive, send: Send) -> None:
+        same_site(scope["method"], Headers(scope=scope))
         await self.app(scope, receive, send)
 
 

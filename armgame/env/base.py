@@ -44,6 +44,21 @@ class SessionEnv(gym.Env):
             raise EnvArgumentError(f"render_mode must be one of {self.metadata['render_modes']} or None, "
                                    f"got {render_mode!r}")
 
+    # ---------------------------------------------------------------- an episode's edges
+    def _first_view(self) -> tuple[np.ndarray, dict]:
+        """What ``reset`` returns once the episode has begun: its first frame drawn in ``"human"`` mode, then its
+        first observation and info (each version's ``_observation`` and ``_info``)."""
+        if self.render_mode == "human":
+            self.render()
+        return self._observation(), self._info()  # type: ignore[attr-defined]
+
+    def _session_begun(self) -> GameSession:
+        """The session ``step`` acts on; Gymnasium's ResetNeeded before the first ``reset``."""
+        session = self.session
+        if session is None:
+            raise gym.error.ResetNeeded("call reset() before step()")
+        return session
+
     # ---------------------------------------------------------------- actions
     def _press_keys(self, action: Any, n: int) -> None:
         """Hold the four muscle keys as the action says (a fifth entry presses the reset key)."""

@@ -162,14 +162,10 @@ class CenterOutBaseEnv(SessionEnv):
     # ----------------------------------------------------------------- the API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict]:
         self._start_episode(seed, options)
-        if self.render_mode == "human":
-            self.render()
-        return self._observation(), self._info()
+        return self._first_view()
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        session = self.session
-        if session is None:
-            raise gym.error.ResetNeeded("call reset() before step()")
+        session = self._session_begun()
         if self._episode_over():
             raise gym.error.ResetNeeded("the episode is over: call reset() before another step()")
         if self.continuous:

@@ -217,14 +217,10 @@ class ReachBaseEnv(SessionEnv):
         super().reset(seed=seed)
         game_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
         self.session = self._new_session(self.settings.game(game_seed))
-        if self.render_mode == "human":
-            self.render()
-        return self._observation(), self._info()
+        return self._first_view()
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict]:
-        session = self.session
-        if session is None:
-            raise gym.error.ResetNeeded("call reset() before step()")
+        session = self._session_begun()
         if session.over:
             raise gym.error.ResetNeeded("the game is over (truncated): call reset() before another step()")
         board = session.rules.board

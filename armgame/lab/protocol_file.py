@@ -16,10 +16,10 @@ before they existed (``tests/data/lab_protocols.json`` holds it).
 
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 
 from ..errors import UserError
+from ..files import parse_toml
 from ..records.storage import read_limited
 from ..valid import check_float, check_int, check_keys, check_str
 from .perturbations import KINDS, ProtocolError
@@ -177,14 +177,7 @@ def _directions(where: str, value: object, angles: tuple[float, ...]) -> tuple[i
 def load_protocol(path: Path) -> Protocol:
     """Read a TOML protocol file; one line naming the file and the bad key on any fault."""
     raw = read_limited(Path(path), MAX_PROTOCOL_BYTES, "protocol file")
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise UserError(f"{path}: not a text file (UTF-8 TOML expected)") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{path}: not valid TOML: {exc}") from None
-    except RecursionError:  # tomllib recurses into nested arrays and tables
-        raise UserError(f"{path}: not valid TOML: nested too deeply") from None
+    data = parse_toml(raw, path, "not a text file (UTF-8 TOML expected)")
     try:
         return protocol_from_dict(data)
     except (ValueError, TypeError, UserError) as exc:

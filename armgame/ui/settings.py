@@ -17,11 +17,11 @@ from __future__ import annotations
 import os
 import stat
 import sys
-import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import UserError
+from ..files import parse_toml
 
 FILE_NAME = "settings.toml"
 #: A settings file is a few lines; anything larger is not one.
@@ -110,14 +110,7 @@ def check_muscle_keys(text: object, what: str = "keys") -> str:
 
 
 def from_toml(data: bytes, source: str) -> Settings:
-    try:
-        table = tomllib.loads(data.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise SettingsError(f"{source}: not UTF-8 text") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SettingsError(f"{source}: not valid TOML: {exc}") from None
-    except RecursionError:  # tomllib recurses into nested arrays and tables
-        raise SettingsError(f"{source}: not valid TOML: nested too deeply") from None
+    table = parse_toml(data, source, "not UTF-8 text", SettingsError)
     unknown = sorted(set(table) - {"keys", "mute", "palette", "text_scale", "size"})
     if unknown:
         raise SettingsError(f"{source}: unknown key {unknown[0]!r} (known: keys, mute, palette, text_scale, size)")
