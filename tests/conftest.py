@@ -29,6 +29,12 @@ def pytest_configure(config) -> None:
     os.chmod(folder, 0o700)
     os.environ["ARMGAME_CACHE"] = folder
     config.add_cleanup(lambda: shutil.rmtree(folder, ignore_errors=True))
+    # Nor into the checkout: Hypothesis keeps its examples and caches in the same private folder (its default is
+    # ./.hypothesis), as do the subprocesses the tests start; pytest's own cache is off (pyproject's addopts).
+    from hypothesis.configuration import set_hypothesis_home_dir
+
+    os.environ["HYPOTHESIS_STORAGE_DIRECTORY"] = os.path.join(folder, "hypothesis")
+    set_hypothesis_home_dir(os.environ["HYPOTHESIS_STORAGE_DIRECTORY"])
     config.add_cleanup(_close_browser)
     if sys.dont_write_bytecode:
         sys.dont_write_bytecode = False

@@ -150,3 +150,17 @@ def test_the_supported_pythons_are_said_alike_everywhere():
     tested = re.search(r"Python 3\.(\d+) or newer \([^)]*CI tests 3\.(\d+) and 3\.(\d+)\)", readme.replace("\n", " "))
     assert tested.group(1) == tested.group(2) == oldest and int(tested.group(3)) == minors[-1]
     assert sys.version_info[:2] >= (3, int(oldest))
+
+
+def test_the_run_writes_nothing_into_the_checkout(pytestconfig):
+    """Tests write only to temporary folders: Hypothesis's examples and caches go to the run's private folder
+    (tests/conftest.py), not ./.hypothesis, and pytest's own cache (./.pytest_cache) is off."""
+    import tempfile
+    from pathlib import Path
+
+    from hypothesis.configuration import storage_directory
+
+    home = Path(storage_directory("examples", intent_to_write=False).path).resolve()
+    assert home.is_relative_to(Path(tempfile.gettempdir()).resolve()), home
+    assert not home.is_relative_to(Path(__file__).resolve().parent.parent)
+    assert os.environ["HYPOTHESIS_STORAGE_DIRECTORY"] and not pytestconfig.pluginmanager.has_plugin("cacheprovider")
