@@ -298,6 +298,60 @@ def test_the_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, 
     assert resets >= 7 and ended >= 4
 
 
+@pytest.mark.parametrize("mode", list(AutoresetMode))
+@pytest.mark.parametrize(("env_id", "extra"), [
+    ("armgame/ReachDelay-v1", {}), ("armgame/ReachDelayContinuous-v1", {}),
+    (REACH, {"observation_delay": 1, "observation_dtype": "float64"}),
+    (CONTINUOUS, {"observation_delay": 23, "reset_key": True, "reward": "sparse"}),  # longer than a game
+])
+def test_the_delayed_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, extra, mode):
+    """The observation delay in the batched env (each game's ring of past observations) hands out what each single
+    env's deque does: through steps, restarts of either autoreset, SameStep's final observations and masked resets."""
+    n, rng = 5, np.random.default_rng(3)
+    kwargs = {"time_limit": 0.3, "decision_steps": 4, **extra}
+    native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode,
+                          **kwargs)
+    assert isinstance(native.unwrapped, ReachV1VectorEnv) and native.unwrapped._past is not None
+    singles = SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(n)], autoreset_mode=mode)
+    native.action_space.seed(2)
+    a, b = native.reset(seed=5), singles.reset(seed=5)
+    assert data_equivalence(a[1], b[1], exact=True) and np.abs(a[0] - b[0]).max() <= 1e-5
+    resets = ended = 0
+    for step in range(120):
+        if step % 11 == 4 or (mode is AutoresetMode.DISABLED and singles._autoreset_envs.any()):
+            mask = rng.random(n) < 0.5
+            if mode is AutoresetMode.DISABLED:
+                mask |= singles._autoreset_envs
+            if mask.any():
+                seed = [int(s) if rng.random() < 0.5 else None for s in rng.integers(0, 1000, n)]
+                ra = native.reset(seed=seed, options={"reset_mask": mask})
+                rb = singles.reset(seed=seed, options={"reset_mask": mask})
+                assert data_equivalence(ra[1], rb[1], exact=True)
+                assert np.abs(ra[0] - rb[0]).max() <= 1e-5
+                resets += 1
+        actions = native.action_space.sample()
+        a, b = native.step(actions), singles.step(actions)
+        same_step(a, b, False)
+        ended += int(a[3].sum())
+    assert resets >= 9 and ended >= 4
+
+
+def test_a_delayed_observation_is_the_one_delay_steps_old():
+    """The ring's arithmetic on its own (the comparison above would pass if both sides lost the delay)."""
+    plain = ReachV1VectorEnv(3, observation_dtype="float64")
+    delayed = ReachV1VectorEnv(3, observation_dtype="float64", observation_delay=2)
+    first = plain.reset(seed=1)[0]
+    assert (delayed.reset(seed=1)[0] == first).all()
+    seen = [first, first]
+    actions = np.ones((3, 4))
+    for _ in range(6):
+        now = plain.step(actions)[0]
+        assert (delayed.step(actions)[0] == seen[-2]).all() and not (now == seen[-2]).all()
+        seen.append(now)
+    with pytest.raises(EnvArgumentError, match="observation_delay"):
+        ReachV1VectorEnv(2, observation_delay=101)
+
+
 def test_a_reset_mask_is_checked_as_gymnasium_checks_it():
     envs = ReachV1VectorEnv(3)
     with pytest.raises(EnvArgumentError, match="first reset"):
