@@ -4,8 +4,8 @@
 (``armgame.env.variants``), ``CENTER_OUT_SUITE`` each harder CenterOut id to
 ``armgame/CenterOut-v1``'s; ``armgame.env`` registers them. Their vector entry points are
 ``Reach-v1``'s and ``CenterOut-v1``'s (``vector.reach_v1_vector_env`` gives the native vector env for
-``ReachDelay``, whose delay it keeps per game, and Gymnasium's ``SyncVectorEnv`` of single envs for the
-others: the batch kernel steps no dwell, noise or field), so
+``ReachHold`` and ``ReachDelay``, whose dwell and delay the batch keeps per game, and Gymnasium's
+``SyncVectorEnv`` of single envs for the others: the batch kernel steps no noise or field), so
 ``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they take ``Reach-v1``.
 
 Three disjoint ranges of game seeds make the protocol (docs/programs.md, "The protocol"):

@@ -163,7 +163,8 @@ class ReachVectorEnv(VectorEnv):
             for start in range(0, n, GAMES_PER_BATCH):
                 part = slice(start, min(n, start + GAMES_PER_BATCH))
                 self.parts.append((part, BatchGameSession(
-                    [self.settings.game(game_seeds[i]) for i in range(part.start, part.stop)], exact=False)))
+                    [self.settings.game(game_seeds[i]) for i in range(part.start, part.stop)], exact=False,
+                    hold_steps=self._hold_steps())))
         else:
             for part, batch in self.parts:
                 here = chosen[part]
@@ -254,6 +255,10 @@ class ReachVectorEnv(VectorEnv):
         mask[chosen] = True
         self._started(mask)
 
+    def _hold_steps(self) -> int:
+        """The games' dwell in physics steps (v1's ``hold_time``); 0, the game's rule."""
+        return 0
+
     def _started(self, games: np.ndarray) -> None:
         """Games ``games`` (a mask over all) have just begun: v1 measures their first distances here."""
 
@@ -343,7 +348,8 @@ class _BatchGame:
 
 class ReachV1VectorEnv(ReachVectorEnv):
     """``num_envs`` Reach-v1 games in lockstep: ``ReachVectorEnv`` with v1's observations and reward
-    (see ``armgame.env.reach_v1.ReachV1Env``; the arguments are its). ``observation_delay`` (``ReachDelay-v1``)
+    (see ``armgame.env.reach_v1.ReachV1Env``; the arguments are its). ``hold_time`` (``ReachHold-v1``) gives the
+    batch's games the dwell (``BatchGameSession``'s ``hold_steps``); ``observation_delay`` (``ReachDelay-v1``)
     hands each game's observation out that many steps late, as the single env's ``DelayedObservations`` does.
 
     >>> import gymnasium as gym
@@ -358,13 +364,14 @@ class ReachV1VectorEnv(ReachVectorEnv):
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
                  hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
-                 observation_delay: int = 0, config: GameConfig | None = None, render_mode: str | None = None,
+                 hold_time: float = 0.0, observation_delay: int = 0, config: GameConfig | None = None,
+                 render_mode: str | None = None,
                  render_size: tuple[int, int] = (600, 600),
                  autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
         if reward == "score":  # its shaping needs each game's reset and end: make_vec plays it on single envs
             raise EnvArgumentError("the batched vector env has no reward='score': gymnasium.make_vec gives single "
                                    "envs for it")
-        variant = ReachVariant.of(observation_delay=observation_delay)
+        variant = ReachVariant.of(hold_time=hold_time, observation_delay=observation_delay)
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
                                     progress_weight, hit_bonus, observation_dtype, variant)
         self._configure(num_envs, settings, render_mode, render_size, autoreset_mode,
@@ -395,6 +402,10 @@ class ReachV1VectorEnv(ReachVectorEnv):
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         self._unpushed = self._past is not None
         return super().step(actions)
+
+    def _hold_steps(self) -> int:
+        variant = self.variant
+        return variant.hold_steps(self.config.dt) if variant.hold_time else 0
 
     def _measure(self, part: slice, batch: BatchGameSession, obs: np.ndarray, edges: np.ndarray | None) -> None:
         """Part ``part``'s observation rows into ``obs[part]`` and, unless None, its edge distances into ``edges``."""
@@ -487,8 +498,8 @@ def reach_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
 
 def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
     """The vector entry point of ``armgame/Reach-v1``, ``ReachContinuous-v1`` and the suite's harder Reach ids:
-    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games of the game itself or with an observation delay, else
-    ``SyncVectorEnv`` of single envs: below that size, and for a dwell, noise, a field or the score reward,
+    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games of the game itself or with a dwell or an observation
+    delay, else ``SyncVectorEnv`` of single envs: below that size, and for noise, a field or the score reward,
     which the batch does not play."""
     from .reach_v1 import ReachV1Env
 
