@@ -3,6 +3,7 @@
     python benchmarks/env_speed.py              # about three minutes
     python benchmarks/env_speed.py --quick      # a few seconds a figure, fewer repeats
     python benchmarks/env_speed.py --json       # one JSON object
+    python benchmarks/env_speed.py --suite armgame/ReachDelay-v1 --sizes 1 64 1024 8192 --seconds 0.3
 
 Env steps per second (one env step = one decision: 5 physics steps of the game, 20 ms; one
 RK4 step of 0.2 s for Acrobot) with random actions drawn before the clock starts, episodes
@@ -13,7 +14,10 @@ reset as they end:
 * vector env at 1, 4, 16, 64, 1,024 and 8,192 envs: armgame's native ``ReachVectorEnv``
   (``make_vec(..., vectorization_mode="vector_entry_point")``) and Acrobot's ``SyncVectorEnv``; and
   Reach-v1's native vector env against ``SyncVectorEnv`` of Reach-v1 single envs, side by side
-  (issue 28: no slower at any size; at least 4 M env-steps/s at 8,192 envs).
+  (issue 28: no slower at any size; at least 4 M env-steps/s at 8,192 envs);
+* with ``--suite ID ...``, instead: each suite id's ``make_vec`` vector env (the native one where the batch
+  plays the id, else single envs in ``SyncVectorEnv``) against ``SyncVectorEnv`` of its single envs, side by
+  side (issue 40, item 5: at least 1 M env-steps/s at 8,192 envs); a size past the id's cap is reported so.
 
 Each figure is measured in several repeats, interleaved with its peer so that load from
 elsewhere falls on both; the report gives the median and the range over repeats, and the
@@ -35,6 +39,7 @@ import gymnasium as gym
 import numpy as np
 
 import armgame.env  # noqa: F401  (registers armgame/Reach-v0)
+from armgame.env.vector import BATCH_MIN_ENVS
 
 VECTOR_SIZES = (1, 4, 16, 64, 1024, 8192)
 SINGLE_GOAL = 1.0  # Reach-v0 steps per second over Acrobot-v1's
@@ -137,6 +142,55 @@ def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float |
     }
 
 
+def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, repeats: int) -> dict[str, object]:
+    """Each id's ``make_vec`` vector env against ``SyncVectorEnv`` of its single envs, paired, at each size."""
+    from armgame.env.base import EnvArgumentError
+    from armgame.env.vector import batch_plays
+
+    load_before = os.getloadavg()[0]
+    ids: dict[str, object] = {}
+    for env_id in env_ids:
+        rates: dict[int, object] = {}
+        for n in sizes:
+            try:
+                runners = {"make_vec": vector_runner(env_id, n, "vector_entry_point"),
+                           "sync": vector_runner(env_id, n, "sync")}
+            except EnvArgumentError as exc:  # past the id's cap
+                rates[n] = {"refused": str(exc)}
+                continue
+            rates[n] = paired(runners, seconds, repeats)
+            rates[n]["ratio"] = spread([a / b for a, b in zip(rates[n]["make_vec"]["cpu_rates"],  # type: ignore[index]
+                                                              rates[n]["sync"]["cpu_rates"], strict=True)])
+        ids[env_id] = {"batched": batch_plays(env_id, {}), "sizes": rates}
+    return {
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+                   f"numpy {np.__version__}, gymnasium {gym.__version__}",
+        "load_average": [load_before, os.getloadavg()[0]],
+        "seconds_per_repeat": seconds,
+        "repeats": repeats,
+        "ids": ids,
+    }
+
+
+def report_suite(result: dict) -> None:
+    load = result["load_average"]
+    print(f"env steps per second, wall clock: median [min - max] of {result['repeats']} repeats of "
+          f"{result['seconds_per_repeat']} s, interleaved with the peer; per CPU second: median")
+    print(f"{result['machine']}; load average {load[0]:.1f} before, {load[1]:.1f} after")
+    cpu = "per CPU s"
+    for env_id, found in result["ids"].items():
+        kind = "the batch" if found["batched"] else "single envs"
+        print(f"{env_id} (make_vec steps {kind} from {BATCH_MIN_ENVS} envs)")
+        print(f"{'envs':>6}  {'make_vec':>32} {cpu:>11}  {'SyncVectorEnv':>30} {cpu:>11}  make_vec / sync per CPU s")
+        for n, rates in found["sizes"].items():
+            if "refused" in rates:
+                print(f"{n:>6}  refused: {rates['refused']}")
+                continue
+            ours, theirs, r = rates["make_vec"], rates["sync"], rates["ratio"]
+            print(f"{n:>6}  {fmt(ours['wall']):>32} {ours['cpu']['median']:>11,.0f}  {fmt(theirs['wall']):>30} "
+                  f"{theirs['cpu']['median']:>11,.0f}  {r['median']:.2f} [{r['min']:.2f} - {r['max']:.2f}]")
+
+
 def profile(num_envs: int = 8192, steps: int = 60) -> list[tuple[str, float]]:
     """Where a vector step's time goes: the share of each function's own time, largest first."""
     import cProfile
@@ -203,8 +257,22 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="shorter repeats, fewer of them")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     parser.add_argument("--profile", action="store_true", help="also profile the vector env at 8,192 envs")
+    parser.add_argument("--suite", nargs="+", metavar="ID",
+                        help="instead: these ids' make_vec vector envs against SyncVectorEnv of their single envs")
+    parser.add_argument("--sizes", nargs="+", type=int, help=f"the vector sizes (default {VECTOR_SIZES})")
+    parser.add_argument("--seconds", type=float, help="the seconds of one repeat (default 1, --quick 0.3)")
+    parser.add_argument("--repeats", type=int, help="the repeats of each figure (default 5, --quick 3)")
     args = parser.parse_args()
-    result = measure(args.quick)
+    sizes = tuple(args.sizes or VECTOR_SIZES)
+    if args.suite:
+        result = measure_suite(args.suite, sizes, args.seconds or (0.3 if args.quick else 1.0),
+                               args.repeats or (3 if args.quick else 5))
+        if args.json:
+            print(json.dumps(result, default=str))
+        else:
+            report_suite(result)
+        return
+    result = measure(args.quick, sizes, args.seconds, args.repeats)
     if args.profile:
         result["profile"] = profile()
     if args.json:

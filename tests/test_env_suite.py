@@ -19,13 +19,15 @@ from armgame.env.policies import BotPolicy, bot_policy
 from armgame.env.references import REFERENCE_HITS
 from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, suite_ids
 from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
-from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv
+from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv, batch_plays
 from armgame.env.vector_common import SingleEnvsVectorEnv
 from armgame.errors import UserError
 from armgame.game.rules import DwellRules, GameConfig
 from armgame.game.session import GameSession
 
 REACH = "armgame/Reach-v1"
+#: The harder Reach ids the batch plays (the others step single envs), as docs/programs.md's id table says.
+BATCHED = {"ReachDelay", "ReachHold"}
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
@@ -56,7 +58,9 @@ def test_gymnasiums_checker_passes_on_every_suite_id(env_id):
         assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, CenterOutVectorEnv)
         assert env.unwrapped.trial_start == CENTER_OUT_SUITE[name]["trial_start"]
         return
-    assert isinstance(gym.make_vec(env_id, num_envs=8).unwrapped, SingleEnvsVectorEnv)  # the batch plays no variant
+    vector = type(gym.make_vec(env_id, num_envs=8).unwrapped)
+    assert vector is (ReachV1VectorEnv if name in BATCHED else SingleEnvsVectorEnv), vector
+    assert batch_plays(env_id, {}) == (name in BATCHED)
     for argument, value in SUITE[name].items():  # the id's arguments are the env's
         if argument == "target_radius":
             assert env.unwrapped.config.target_radius == value
@@ -87,7 +91,7 @@ def test_make_vec_steps_single_envs_below_the_batchs_size_and_for_what_the_batch
     assert type(gym.make_vec(env_id, num_envs=BATCH_MIN_ENVS).unwrapped) is native
     if env_id.endswith("v1"):
         assert isinstance(gym.make_vec(env_id, num_envs=16, reward="score").unwrapped, SingleEnvsVectorEnv)
-        assert isinstance(gym.make_vec(env_id, num_envs=16, hold_time=0.1).unwrapped, SingleEnvsVectorEnv)
+        assert isinstance(gym.make_vec(env_id, num_envs=16, motor_noise=0.1).unwrapped, SingleEnvsVectorEnv)
         with pytest.raises(EnvArgumentError, match="score"):
             ReachV1VectorEnv(2, reward="score")
     for bad in (0, 10**9, 2.5):
@@ -102,7 +106,7 @@ def test_the_sb3_adapter_gives_sb3s_own_vec_env_where_no_batch_is_faster():
     from armgame.env.sb3 import ADAPTER_MIN_ENVS, SB3VecEnv, make_sb3_vec_env
 
     assert isinstance(make_sb3_vec_env(REACH, ADAPTER_MIN_ENVS), SB3VecEnv)
-    for env_id, n, kwargs in ((REACH, ADAPTER_MIN_ENVS - 1, {}), (REACH, 1, {}), ("armgame/ReachHold-v1", 32, {}),
+    for env_id, n, kwargs in ((REACH, ADAPTER_MIN_ENVS - 1, {}), (REACH, 1, {}), ("armgame/ReachNoisy-v1", 32, {}),
                               (REACH, 32, {"reward": "score"}), ("armgame/CenterOut-v1", 2, {})):
         envs = make_sb3_vec_env(env_id, n, seed=4, **kwargs)
         assert isinstance(envs, DummyVecEnv) and envs.num_envs == n, env_id
@@ -386,13 +390,21 @@ def test_the_off_policy_recipe_runs(capsys):
 
 
 def test_the_size_cap_of_each_suite_ids_vector_env_is_the_one_the_docs_state():
-    """A suite id's vector env is single envs in Gymnasium's SyncVectorEnv: at most SingleEnvsVectorEnv.MAX_ENVS,
-    refused in one line past it, as docs/programs.md says (the native vector env's larger cap is Reach's plain game)."""
-    from armgame.env.vector_common import SingleEnvsVectorEnv
-
+    """A suite id the batch does not play is single envs in Gymnasium's SyncVectorEnv: at most
+    SingleEnvsVectorEnv.MAX_ENVS; one it plays (BATCHED) takes the native env's memory budget over a game's, a
+    delay's ring included. Each is refused in one line past its cap, as docs/programs.md says."""
     cap = SingleEnvsVectorEnv.MAX_ENVS
-    guide = (Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
-    assert f"holds at most {cap:,} envs" in " ".join(guide.split())
+    guide = " ".join((Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
+                     .split())
+    assert f"holds at most {cap:,} envs" in guide
     for env_id in suite_ids():
+        name = env_id.split("/")[1].removesuffix("-v1").removesuffix("Continuous")
+        if name in BATCHED:
+            ring = 15 * 4 * (SUITE[name].get("observation_delay", -1) + 1)  # float32 observations, delay + 1
+            most = armgame.env.vector.MAX_ENV_MEMORY // (armgame.env.vector.BYTES_PER_ENV + ring)
+            assert f"`{name}-v1` and its twin at most {most:,} envs" in guide
+            with pytest.raises(EnvArgumentError, match=f"at most {most:,} games"):
+                gym.make_vec(env_id, num_envs=most + 1, vectorization_mode="vector_entry_point")
+            continue
         with pytest.raises(EnvArgumentError, match=f"from 1 to {cap}, got {cap + 1}"):
             gym.make_vec(env_id, num_envs=cap + 1, vectorization_mode="vector_entry_point")

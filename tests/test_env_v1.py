@@ -25,6 +25,7 @@ import armgame.env.vector
 from armgame.env.base import EnvArgumentError
 from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.env.vector import ReachV1VectorEnv
+from armgame.game.rules import DwellRules, GameConfig
 from armgame.lab.protocol import Block, Protocol
 from armgame.lab.session import REACH as REACH_PHASE
 
@@ -296,6 +297,96 @@ def test_the_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, 
         same_step(a, b, exact)
         ended += int(a[3].sum())
     assert resets >= 7 and ended >= 4
+
+
+@pytest.mark.parametrize("mode", list(AutoresetMode))
+@pytest.mark.parametrize(("env_id", "extra"), [
+    ("armgame/ReachDelay-v1", {}), ("armgame/ReachDelayContinuous-v1", {}),
+    (REACH, {"observation_delay": 1, "observation_dtype": "float64"}),
+    (CONTINUOUS, {"observation_delay": 23, "reset_key": True, "reward": "sparse"}),  # longer than a game
+    ("armgame/ReachHold-v1", {}), ("armgame/ReachHoldContinuous-v1", {}),
+    (CONTINUOUS, {"hold_time": 0.04, "observation_delay": 2, "config": GameConfig(target_radius=0.2)}),
+])
+def test_the_harder_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, extra, mode):
+    """The observation delay in the batched env (each game's ring of past observations) hands out what each single
+    env's deque does, and the batch's dwell scores what each single game's ``DwellRules`` does: through steps,
+    restarts of either autoreset, SameStep's final observations and masked resets."""
+    n, rng = 5, np.random.default_rng(3)
+    kwargs = {"time_limit": 0.3, "decision_steps": 4, **extra}
+    native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode,
+                          **kwargs)
+    assert isinstance(native.unwrapped, ReachV1VectorEnv)
+    singles = SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(n)], autoreset_mode=mode)
+    native.action_space.seed(2)
+    a, b = native.reset(seed=5), singles.reset(seed=5)
+    assert data_equivalence(a[1], b[1], exact=True) and np.abs(a[0] - b[0]).max() <= 1e-5
+    resets = ended = 0
+    for step in range(120):
+        if step % 11 == 4 or (mode is AutoresetMode.DISABLED and singles._autoreset_envs.any()):
+            mask = rng.random(n) < 0.5
+            if mode is AutoresetMode.DISABLED:
+                mask |= singles._autoreset_envs
+            if mask.any():
+                seed = [int(s) if rng.random() < 0.5 else None for s in rng.integers(0, 1000, n)]
+                ra = native.reset(seed=seed, options={"reset_mask": mask})
+                rb = singles.reset(seed=seed, options={"reset_mask": mask})
+                assert data_equivalence(ra[1], rb[1], exact=True)
+                assert np.abs(ra[0] - rb[0]).max() <= 1e-5
+                resets += 1
+        actions = native.action_space.sample()
+        a, b = native.step(actions), singles.step(actions)
+        same_step(a, b, False)
+        ended += int(a[3].sum())
+    assert resets >= 9 and ended >= 4
+
+
+@pytest.mark.parametrize("kernel", ["numpy", None])
+@pytest.mark.parametrize("hold_time", [0.2, 0.05])
+def test_the_batchs_dwell_equals_single_envs_with_bots_scoring(hold_time, kernel, monkeypatch):
+    """Random play seldom reaches a target, so the model bot plays: every hit the batch's dwell scores (the hand
+    held in the target ``hold_time``, rules.DwellRules seeing each step inside) is the single env's, through two
+    games each; and the dwell changes the games (a test that would pass had both sides lost it would not)."""
+    from armgame.env.policies import BotPolicy
+    from armgame.game.batch import BatchGameSession
+
+    if kernel:  # both kernels flag a hand inside its target after every step: numpy's here, else the compiled one
+        monkeypatch.setattr(armgame.env.vector, "BatchGameSession",
+                            lambda *args, **kw: BatchGameSession(*args, **kw, kernel=kernel))
+    n, kwargs = 4, {"time_limit": 2.0, "hold_time": hold_time, "observation_dtype": "float64"}
+    native = gym.make_vec(REACH, num_envs=n, vectorization_mode="vector_entry_point", **kwargs)
+    assert isinstance(native.unwrapped, ReachV1VectorEnv)
+    singles = SyncVectorEnv([lambda: gym.make(REACH, **kwargs) for _ in range(n)])
+    plain = gym.make_vec(REACH, num_envs=n, vectorization_mode="vector_entry_point",
+                         **{**kwargs, "hold_time": 0.0})
+    policies = [BotPolicy("model", gym.make(REACH, **kwargs)) for _ in range(n)]
+    a, b, c = native.reset(seed=40), singles.reset(seed=40), plain.reset(seed=40)
+    rules = native.unwrapped.parts[0][1].rules[0]
+    assert (native.unwrapped.parts[0][1].compiled is None) == (kernel == "numpy")
+    assert isinstance(rules, DwellRules) and rules.hold_steps == round(hold_time / 0.004)
+    hits = plain_hits = 0
+    for _ in range(2 * (native.unwrapped.settings.episode_steps + 1)):
+        actions = np.array([policy(row) for policy, row in zip(policies, a[0], strict=True)])
+        a, b, c = native.step(actions), singles.step(actions), plain.step(actions)
+        same_step(a, b, False)
+        hits += int(a[4]["hits"].sum())
+        plain_hits += int(c[4]["hits"].sum())
+    assert hits > 0 and hits != plain_hits
+
+
+def test_a_delayed_observation_is_the_one_delay_steps_old():
+    """The ring's arithmetic on its own (the comparison above would pass if both sides lost the delay)."""
+    plain = ReachV1VectorEnv(3, observation_dtype="float64")
+    delayed = ReachV1VectorEnv(3, observation_dtype="float64", observation_delay=2)
+    first = plain.reset(seed=1)[0]
+    assert (delayed.reset(seed=1)[0] == first).all()
+    seen = [first, first]
+    actions = np.ones((3, 4))
+    for _ in range(6):
+        now = plain.step(actions)[0]
+        assert (delayed.step(actions)[0] == seen[-2]).all() and not (now == seen[-2]).all()
+        seen.append(now)
+    with pytest.raises(EnvArgumentError, match="observation_delay"):
+        ReachV1VectorEnv(2, observation_delay=101)
 
 
 def test_a_reset_mask_is_checked_as_gymnasium_checks_it():

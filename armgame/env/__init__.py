@@ -24,7 +24,7 @@ Importing this package registers, with ``gymnasium.register``:
 
 Every id but the two CenterOut-v0 ones has a vector entry point, so ``gymnasium.make_vec(id,
 num_envs=N)`` gives one vector env: for Reach, from 8 games, ``vector.ReachVectorEnv`` stepping N
-games as numpy arrays on ``BatchGameSession`` (below 8, for the suite's harder tasks and for the score
+games as numpy arrays on ``BatchGameSession`` (below 8, for the suite's noise and field and for the score
 reward, ``vector_common.SingleEnvsVectorEnv``, Gymnasium's ``SyncVectorEnv`` of single envs); for
 CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
 them to Stable-Baselines3 (and is the only module that imports it). ``import armgame`` imports neither

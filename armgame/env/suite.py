@@ -3,8 +3,9 @@
 ``SUITE`` maps each harder Reach id to the ``armgame/Reach-v1`` arguments it fixes
 (``armgame.env.variants``), ``CENTER_OUT_SUITE`` each harder CenterOut id to
 ``armgame/CenterOut-v1``'s; ``armgame.env`` registers them. Their vector entry points are
-``Reach-v1``'s and ``CenterOut-v1``'s (``vector.reach_v1_vector_env`` gives Gymnasium's
-``SyncVectorEnv`` of single envs for the harder tasks: the batch kernel steps only the game itself), so
+``Reach-v1``'s and ``CenterOut-v1``'s (``vector.reach_v1_vector_env`` gives the native vector env for
+``ReachHold`` and ``ReachDelay``, whose dwell and delay the batch keeps per game, and Gymnasium's
+``SyncVectorEnv`` of single envs for the others: the batch kernel steps no noise or field), so
 ``gymnasium.make_vec`` and the SB3 adapter take the suite's ids as they take ``Reach-v1``.
 
 Three disjoint ranges of game seeds make the protocol (docs/programs.md, "The protocol"):

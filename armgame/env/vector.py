@@ -49,6 +49,7 @@ from .reach import (
     _check_size,
     check_seed,
 )
+from .variants import ReachVariant
 from .vector_common import AutoresetBook, SingleEnvsVectorEnv, check_reset_mask
 
 #: Memory one game of a vector env takes at its peak (reset and the first step): 5.1-5.2 KB measured at
@@ -104,14 +105,17 @@ class ReachVectorEnv(VectorEnv):
                         render_mode, render_size, autoreset_mode)
 
     def _configure(self, num_envs: int, settings: ReachSettings, render_mode: str | None,
-                   render_size: tuple[int, int], autoreset_mode: str | AutoresetMode) -> None:
+                   render_size: tuple[int, int], autoreset_mode: str | AutoresetMode, extra_bytes: int = 0) -> None:
+        # extra_bytes: what a game takes beyond the batch's (an observation delay's ring), known in advance too.
+        per_game = BYTES_PER_ENV + extra_bytes
+        most = MAX_ENV_MEMORY // per_game
         if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) or num_envs < 1:
-            raise EnvArgumentError(f"num_envs must be a whole number from 1 to {MAX_ENVS:,}, got {num_envs!r}")
-        if num_envs > MAX_ENVS:
+            raise EnvArgumentError(f"num_envs must be a whole number from 1 to {most:,}, got {num_envs!r}")
+        if num_envs > most:
             raise EnvArgumentError(
-                f"num_envs {int(num_envs):,} would take about {num_envs * BYTES_PER_ENV / 1024**3:.1f} GiB "
-                f"({BYTES_PER_ENV // 1024} KiB a game), more than a vector env may ({MAX_ENV_MEMORY // 1024**3} GiB: "
-                f"at most {MAX_ENVS:,} games); run several envs in several processes")
+                f"num_envs {int(num_envs):,} would take about {num_envs * per_game / 1024**3:.1f} GiB "
+                f"({per_game / 1024:.3g} KiB a game), more than a vector env may ({MAX_ENV_MEMORY // 1024**3} GiB: "
+                f"at most {most:,} games); run several envs in several processes")
         if render_mode not in (None, "rgb_array"):
             raise EnvArgumentError(f"a vector env renders with render_mode='rgb_array' (a frame per game) or None, "
                                    f"got {render_mode!r}: for a window, render one game with gymnasium.make")
@@ -159,7 +163,8 @@ class ReachVectorEnv(VectorEnv):
             for start in range(0, n, GAMES_PER_BATCH):
                 part = slice(start, min(n, start + GAMES_PER_BATCH))
                 self.parts.append((part, BatchGameSession(
-                    [self.settings.game(game_seeds[i]) for i in range(part.start, part.stop)], exact=False)))
+                    [self.settings.game(game_seeds[i]) for i in range(part.start, part.stop)], exact=False,
+                    hold_steps=self._hold_steps())))
         else:
             for part, batch in self.parts:
                 here = chosen[part]
@@ -250,6 +255,10 @@ class ReachVectorEnv(VectorEnv):
         mask[chosen] = True
         self._started(mask)
 
+    def _hold_steps(self) -> int:
+        """The games' dwell in physics steps (v1's ``hold_time``); 0, the game's rule."""
+        return 0
+
     def _started(self, games: np.ndarray) -> None:
         """Games ``games`` (a mask over all) have just begun: v1 measures their first distances here."""
 
@@ -339,7 +348,9 @@ class _BatchGame:
 
 class ReachV1VectorEnv(ReachVectorEnv):
     """``num_envs`` Reach-v1 games in lockstep: ``ReachVectorEnv`` with v1's observations and reward
-    (see ``armgame.env.reach_v1.ReachV1Env``; the arguments are its).
+    (see ``armgame.env.reach_v1.ReachV1Env``; the arguments are its). ``hold_time`` (``ReachHold-v1``) gives the
+    batch's games the dwell (``BatchGameSession``'s ``hold_steps``); ``observation_delay`` (``ReachDelay-v1``)
+    hands each game's observation out that many steps late, as the single env's ``DelayedObservations`` does.
 
     >>> import gymnasium as gym
     >>> import armgame.env
@@ -353,21 +364,48 @@ class ReachV1VectorEnv(ReachVectorEnv):
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
                  hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
-                 config: GameConfig | None = None, render_mode: str | None = None,
+                 hold_time: float = 0.0, observation_delay: int = 0, config: GameConfig | None = None,
+                 render_mode: str | None = None,
                  render_size: tuple[int, int] = (600, 600),
                  autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
         if reward == "score":  # its shaping needs each game's reset and end: make_vec plays it on single envs
             raise EnvArgumentError("the batched vector env has no reward='score': gymnasium.make_vec gives single "
                                    "envs for it")
+        variant = ReachVariant.of(hold_time=hold_time, observation_delay=observation_delay)
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
-                                    progress_weight, hit_bonus, observation_dtype)
-        self._configure(num_envs, settings, render_mode, render_size, autoreset_mode)
+                                    progress_weight, hit_bonus, observation_dtype, variant)
+        self._configure(num_envs, settings, render_mode, render_size, autoreset_mode,
+                        delay_bytes(variant.observation_delay, observation_dtype))
+        self.variant = variant
         self._edges = np.zeros(self.num_envs)
         self._edges_new = np.zeros(self.num_envs)
         # This step's observations, measured with the distances for the dense reward (one pass over each
         # batch: the hand and its trig once, where the observation and the reward each took them): valid until
         # a game restarts, and handed out once, as each step returns a new array.
         self._measured: np.ndarray | None = None
+        # The observation delay (ReachDelay-v1): the last ``delay + 1`` observations of every game in a ring,
+        # ``_head`` the newest's slot, so the oldest is the one the single env's deque hands out.
+        delay = variant.observation_delay
+        self._past = np.zeros((delay + 1, self.num_envs, 15), dtype=settings.observation_dtype) if delay else None
+        self._head = 0
+        #: Games begun since the observations were last read: their ring starts full of their first observation.
+        self._fresh = np.zeros(self.num_envs, dtype=bool)
+        #: Whether this step's observations are still to go into the ring (read twice a step in SameStep mode:
+        #: once for ``final_obs``, once after the restarts).
+        self._unpushed = False
+
+    def reset(self, *, seed: int | list[int | None] | None = None,
+              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        self._unpushed = False  # a reset steps no game (and a step refused half-way pushed nothing)
+        return super().reset(seed=seed, options=options)
+
+    def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        self._unpushed = self._past is not None
+        return super().step(actions)
+
+    def _hold_steps(self) -> int:
+        variant = self.variant
+        return variant.hold_steps(self.config.dt) if variant.hold_time else 0
 
     def _measure(self, part: slice, batch: BatchGameSession, obs: np.ndarray, edges: np.ndarray | None) -> None:
         """Part ``part``'s observation rows into ``obs[part]`` and, unless None, its edge distances into ``edges``."""
@@ -380,6 +418,7 @@ class ReachV1VectorEnv(ReachVectorEnv):
 
     def _started(self, games: np.ndarray) -> None:
         self._measured = None  # restarted games have new states and targets
+        self._fresh |= games
         for part, batch in self.parts:
             self._edges[part] = np.where(games[part], self._edges_now(batch), self._edges[part])
 
@@ -405,6 +444,23 @@ class ReachV1VectorEnv(ReachVectorEnv):
         return progress
 
     def _observations(self) -> np.ndarray:
+        obs = self._observed()
+        past = self._past
+        if past is None:
+            return obs
+        # As ``variants.DelayedObservations`` per game: a step appends the game's observation and hands out
+        # the one ``delay`` steps older; a game's first observation fills its ring and is handed out itself.
+        if self._unpushed:
+            self._unpushed = False
+            self._head = (self._head + 1) % len(past)
+            past[self._head] = obs
+        fresh, self._fresh = self._fresh, np.zeros(self.num_envs, dtype=bool)
+        if fresh.any():
+            past[:, fresh] = obs[fresh]
+        return past[(self._head + 1) % len(past)].copy()
+
+    def _observed(self) -> np.ndarray:
+        """The games' observations now, undelayed."""
         obs, self._measured = self._measured, None
         if obs is not None:
             return obs
@@ -412,6 +468,11 @@ class ReachV1VectorEnv(ReachVectorEnv):
         for part, batch in self.parts:
             self._measure(part, batch, obs, None)
         return obs
+
+
+def delay_bytes(delay: int, observation_dtype: str) -> int:
+    """The memory a game's ring of ``delay + 1`` observations takes (0 without a delay)."""
+    return 0 if not delay else (delay + 1) * 15 * np.dtype(observation_dtype).itemsize
 
 
 #: How far Reach-v1's batched dense reward may lie from the single env's at the default progress weight
@@ -437,8 +498,9 @@ def reach_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
 
 def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
     """The vector entry point of ``armgame/Reach-v1``, ``ReachContinuous-v1`` and the suite's harder Reach ids:
-    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games of the game itself, else ``SyncVectorEnv`` of single
-    envs: below that size, and for a harder task or the score reward, which the batch does not play."""
+    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games of the game itself or with a dwell or an observation
+    delay, else ``SyncVectorEnv`` of single envs: below that size, and for noise, a field or the score reward,
+    which the batch does not play."""
     from .reach_v1 import ReachV1Env
 
     return _chosen(ReachV1VectorEnv, ReachV1Env, _NATIVE_V1, num_envs, kwargs)

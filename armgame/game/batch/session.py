@@ -52,7 +52,7 @@ from ...physics.hand import hand_from_trig
 from ...physics.integrators import Integrator
 from ...physics.twojoint import TwoJointArm
 from ..muscles import MuscleLevelError, MuscleSet
-from ..rules import GameConfig, GameRules, hand_position
+from ..rules import DwellRules, GameConfig, GameRules, hand_position
 from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
 from .compiled import CompiledKernel
 from .compiled import available as compiled_available
@@ -118,10 +118,17 @@ class BatchGameSession:
     are arrays indexed by game: ``steps``, ``total_steps``, ``over``, ``q1 q2 w1 w2`` (rad,
     rad/s), ``activation`` and ``held`` (n, 4), ``score hits resets``, ``target_x target_y`` (m).
     Where an argument is a boolean mask ``games`` of shape (n,), only those games are touched.
+
+    ``hold_steps``: every game's dwell (``rules.DwellRules``: a hit counts once the hand has stayed that many
+    physics steps in the target); 0, the game's rule. The kernels flag a hand inside its target after every
+    step (its slack is negative there), so the rules see each such step, as the single session's loops show
+    them.
     """
 
-    def __init__(self, configs: Sequence[GameConfig], exact: bool = True, kernel: str | None = None) -> None:
+    def __init__(self, configs: Sequence[GameConfig], exact: bool = True, kernel: str | None = None,
+                 hold_steps: int = 0) -> None:
         configs = list(configs)
+        self.hold_steps = hold_steps
         problem = batch_problem(configs)
         if problem:
             raise UserError(problem)
@@ -192,7 +199,7 @@ class BatchGameSession:
 
     def _start(self, i: int, config: GameConfig) -> None:
         self.configs[i] = config
-        self.rules[i] = rules = GameRules(config)
+        self.rules[i] = rules = DwellRules(config, self.hold_steps) if self.hold_steps else GameRules(config)
         self._x[:, i] = (*config.start_posture, 0.0, 0.0)
         self._act[:, i] = 0.0
         self._goal[:, i] = 0.0
