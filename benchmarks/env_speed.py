@@ -131,15 +131,19 @@ def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float |
         vector[n]["v1_ratio"] = spread([a / b for a, b in zip(vector[n]["reach_v1"]["cpu_rates"],
                                                               vector[n]["reach_v1_sync"]["cpu_rates"], strict=True)])
     return {
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-                   f"numpy {np.__version__}, gymnasium {gym.__version__}",
-        "load_average": [load_before, os.getloadavg()[0]],
-        "seconds_per_repeat": seconds,
+        **_run_facts(load_before, seconds),
         "single": single,
         "single_ratio": spread(ratios),
         "v1_ratio": spread(v1_ratios),
         "vector": vector,
     }
+
+
+def _run_facts(load_before: float, seconds: float) -> dict[str, object]:
+    """The machine, its load average before and after, and each repeat's length: beside every figure."""
+    return {"machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+                       f"numpy {np.__version__}, gymnasium {gym.__version__}",
+            "load_average": [load_before, os.getloadavg()[0]], "seconds_per_repeat": seconds}
 
 
 def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, repeats: int) -> dict[str, object]:
@@ -163,10 +167,7 @@ def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, re
                                                               rates[n]["sync"]["cpu_rates"], strict=True)])
         ids[env_id] = {"batched": batch_plays(env_id, {}), "sizes": rates}
     return {
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-                   f"numpy {np.__version__}, gymnasium {gym.__version__}",
-        "load_average": [load_before, os.getloadavg()[0]],
-        "seconds_per_repeat": seconds,
+        **_run_facts(load_before, seconds),
         "repeats": repeats,
         "ids": ids,
     }

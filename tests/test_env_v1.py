@@ -279,9 +279,19 @@ def test_the_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, 
     # v0's float64 observation is the single env's bit for bit where the batch runs the exact numpy kernel.
     exact = env_id.endswith("v0") and native.unwrapped.parts[0][1].compiled is None
     assert data_equivalence(a, b, exact=True)
+    resets, ended = _step_both_with_masked_resets(native, singles, mode, rng, n, steps=90, every=(13, 6),
+                                                  exact=exact)
+    assert resets >= 7 and ended >= 4
+
+
+def _step_both_with_masked_resets(native, singles, mode, rng, n: int, steps: int, every: tuple[int, int],
+                                  exact: bool) -> tuple[int, int]:
+    """The same random actions on both vector envs for ``steps`` steps, a masked reset (random seeds or none) at
+    every ``every[0]``-th step from ``every[1]`` and wherever Disabled mode needs one; each step's results held
+    equal (``same_step``). Returns how many masked resets and how many games ended."""
     resets = ended = 0
-    for step in range(90):
-        if step % 13 == 6 or (mode is AutoresetMode.DISABLED and singles._autoreset_envs.any()):
+    for step in range(steps):
+        if step % every[0] == every[1] or (mode is AutoresetMode.DISABLED and singles._autoreset_envs.any()):
             mask = rng.random(n) < 0.5
             if mode is AutoresetMode.DISABLED:
                 mask |= singles._autoreset_envs
@@ -296,7 +306,7 @@ def test_the_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, 
         a, b = native.step(actions), singles.step(actions)
         same_step(a, b, exact)
         ended += int(a[3].sum())
-    assert resets >= 7 and ended >= 4
+    return resets, ended
 
 
 @pytest.mark.parametrize("mode", list(AutoresetMode))
@@ -320,23 +330,8 @@ def test_the_harder_vector_env_equals_sync_vector_env_under_random_reset_masks(e
     native.action_space.seed(2)
     a, b = native.reset(seed=5), singles.reset(seed=5)
     assert data_equivalence(a[1], b[1], exact=True) and np.abs(a[0] - b[0]).max() <= 1e-5
-    resets = ended = 0
-    for step in range(120):
-        if step % 11 == 4 or (mode is AutoresetMode.DISABLED and singles._autoreset_envs.any()):
-            mask = rng.random(n) < 0.5
-            if mode is AutoresetMode.DISABLED:
-                mask |= singles._autoreset_envs
-            if mask.any():
-                seed = [int(s) if rng.random() < 0.5 else None for s in rng.integers(0, 1000, n)]
-                ra = native.reset(seed=seed, options={"reset_mask": mask})
-                rb = singles.reset(seed=seed, options={"reset_mask": mask})
-                assert data_equivalence(ra[1], rb[1], exact=True)
-                assert np.abs(ra[0] - rb[0]).max() <= 1e-5
-                resets += 1
-        actions = native.action_space.sample()
-        a, b = native.step(actions), singles.step(actions)
-        same_step(a, b, False)
-        ended += int(a[3].sum())
+    resets, ended = _step_both_with_masked_resets(native, singles, mode, rng, n, steps=120, every=(11, 4),
+                                                  exact=False)
     assert resets >= 9 and ended >= 4
 
 
