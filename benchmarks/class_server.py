@@ -340,13 +340,19 @@ def student_thread(address: Any, code: str, student: dict[str, Any], phase: str,
             return
         headers = {"Content-Type": "application/json", "Authorization": f"Bearer {student['token']}",
                    "X-Armgame-Code": code}
-        record = request("/api/handin", games[index], headers)
-        answer = record.pop("answer", None)
-        if answer is not None and not (answer.get("ok") and answer.get("name") == student["name"]):
-            record["outcome"] = "wrong answer"
-            record["error"] = json.dumps(answer)[:200]
-        record.update(game=index, name=student["name"], already=bool(answer and answer.get("already")))
-        out.append(record)
+        out.append(handed_in(request, games[index], index, headers, student))
+
+
+def handed_in(request: Callable[..., dict[str, Any]], game: bytes, index: int, headers: dict[str, str],
+              student: dict[str, Any]) -> dict[str, Any]:
+    """One game handed in by ``student`` through ``request``: its record, the answer checked to be theirs."""
+    record = request("/api/handin", game, headers)
+    answer = record.pop("answer", None)
+    if answer is not None and not (answer.get("ok") and answer.get("name") == student["name"]):
+        record["outcome"] = "wrong answer"
+        record["error"] = json.dumps(answer)[:200]
+    record.update(game=index, name=student["name"], already=bool(answer and answer.get("already")))
+    return record
 
 
 def flood_thread(address: Any, code: str, student: dict[str, Any], start_at: float, games: dict[int, bytes],
@@ -384,13 +390,7 @@ def flood_thread(address: Any, code: str, student: dict[str, Any], start_at: flo
     for index in student["games"]:
         if time.time() >= end:
             break
-        record = request("/api/handin", games[index], headers)
-        answer = record.pop("answer", None)
-        if answer is not None and not (answer.get("ok") and answer.get("name") == student["name"]):
-            record["outcome"] = "wrong answer"
-            record["error"] = json.dumps(answer)[:200]
-        record.update(game=index, name=student["name"], already=bool(answer and answer.get("already")))
-        out.append(record)
+        out.append(handed_in(request, games[index], index, headers, student))
         time.sleep(FLOOD_HONEST_EVERY)
 
 

@@ -42,9 +42,9 @@ from ..game.session import GameResult, InputEvent, LevelEvent
 from ..game.variant import play_inputs
 from ..lab.record import LabTask, paths_digest, trial_fields
 from ..lab.session import LabSession
-from ..records.env_game import EnvGameTask, levels_from_list, register
+from ..records.env_game import EnvGameTask, levels_from_list, register, section_head
 from ..records.replay import Replay, now_iso, register_task, same_outcome
-from ..valid import check_bool, check_int, check_keys, check_str
+from ..valid import check_bool, check_keys
 from .errors import EnvArgumentError
 
 CENTRE_OUT_KIND = "centre-out-env"
@@ -127,13 +127,7 @@ class CenterOutEnvTask:
     def from_dict(cls, data: object, config: GameConfig, last_step: int) -> CenterOutEnvTask:
         """Rebuild and check a section; raises ValueError naming the bad field."""
         d = check_keys("task", data, {"kind", "version", "env_id", "hold_at_home", "levels", "lab"})
-        if d["kind"] != CENTRE_OUT_KIND:
-            raise ValueError(f"task.kind must be {CENTRE_OUT_KIND!r}, got {d['kind']!r}")
-        version = check_int("task.version", d["version"], 1, 10**6)
-        if version != CENTRE_OUT_VERSION:
-            raise ValueError(f"task.version {version}: this armgame reads a CenterOut env's section of version "
-                             f"{CENTRE_OUT_VERSION}")
-        env_id = None if d["env_id"] is None else check_str("task.env_id", d["env_id"], 100)
+        env_id = section_head(d, CENTRE_OUT_KIND, CENTRE_OUT_VERSION, "a CenterOut env's")
         hold_at_home = check_bool("task.hold_at_home", d["hold_at_home"])
         lab = LabTask.from_dict(d["lab"], config, last_step)
         return cls(lab, hold_at_home, levels_from_list(d["levels"], last_step), env_id)

@@ -409,17 +409,23 @@ def _save(fig: Any, path: Path) -> None:
         raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
-@_lab_style
-def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str, other: Any = None) -> None:
-    """A learner's fit (``armgame.lab.fit.LearnerFit``) drawn over the data it was fitted to, blocks shaded,
-    the parameters in the title; ``metric`` the fitted column (``adaptation_index`` for indices); ``other``, a
-    second model's fit to the same data, dashed beside it."""
+def _fit_axes(rows: Sequence[Mapping[str, Any]], metric: str) -> tuple[Any, Any, np.ndarray, str, float]:
+    """A fit figure's frame: the figure, its axes with the blocks shaded, the trials' numbers, and the metric's
+    axis label and scale (``adaptation_index``: the channel trials' index, as it is)."""
     label, scale = ("adaptation index (channel trials)", 1.0) if metric == "adaptation_index" else _measure(metric)
     rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
     fig = _figure()
     ax = fig.add_subplot()
     _shade_blocks(ax, blocks_of(rows))
-    trial = np.arange(1, len(rows) + 1, dtype=float)
+    return fig, ax, np.arange(1, len(rows) + 1, dtype=float), label, scale
+
+
+@_lab_style
+def fit_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str, other: Any = None) -> None:
+    """A learner's fit (``armgame.lab.fit.LearnerFit``) drawn over the data it was fitted to, blocks shaded,
+    the parameters in the title; ``metric`` the fitted column (``adaptation_index`` for indices); ``other``, a
+    second model's fit to the same data, dashed beside it."""
+    fig, ax, trial, label, scale = _fit_axes(rows, metric)
     seen = np.isfinite(fit.observed)
     ax.plot(trial[seen], fit.observed[seen] * scale, "o", color=LINE, ms=_marker_size(len(rows)), label="data")
     shown = np.isfinite(fit.predicted) & (seen | (fit.observed_kind == "index"))

@@ -19,7 +19,15 @@ from typing import Any
 
 import numpy as np
 
-from .figures import CATCH, LINE, _figure, _lab_style, _legend_below, _measure, _save, _shade_blocks, blocks_of
+from .figures import (
+    CATCH,
+    LINE,
+    _figure,
+    _fit_axes,
+    _lab_style,
+    _legend_below,
+    _save,
+)
 
 
 @_lab_style
@@ -87,12 +95,7 @@ def generalization_fit_figure(fit: Any, path: Path, unit: str = "", scale: float
 @_lab_style
 def state_space_figure(rows: Sequence[Mapping[str, Any]], fit: Any, path: Path, metric: str) -> None:
     """A state-space fit over its data: the observations and the smoothed state's prediction, blocks shaded."""
-    label, scale = ("adaptation index (channel trials)", 1.0) if metric == "adaptation_index" else _measure(metric)
-    rows = [{**r, "trial": n} for n, r in enumerate(rows, start=1)]
-    fig = _figure()
-    ax = fig.add_subplot()
-    _shade_blocks(ax, blocks_of(rows))
-    trial = np.arange(1, len(rows) + 1, dtype=float)
+    fig, ax, trial, label, scale = _fit_axes(rows, metric)
     y = np.array([float(r[metric]) for r in rows]) * scale
     ax.plot(trial, y, "o", color=LINE, ms=4, label="data")
     if fit.observed_kind == "error":

@@ -40,6 +40,17 @@ MAX_FIELD = 1_000.0
 MAX_SPEED_LIMIT = 1e6
 
 
+def section_head(d: dict, kind: str, version: int, whose: str) -> str | None:
+    """An env's task section's ``kind`` and ``version`` checked against the ones this armgame reads (``whose``
+    section, for the message), and its ``env_id`` (None, or the id that played it)."""
+    if d["kind"] != kind:
+        raise ValueError(f"task.kind must be {kind!r}, got {d['kind']!r}")
+    read = check_int("task.version", d["version"], 1, 10**6)
+    if read != version:
+        raise ValueError(f"task.version {read}: this armgame reads {whose} section of version {version}")
+    return None if d["env_id"] is None else check_str("task.env_id", d["env_id"], 100)
+
+
 @dataclass(frozen=True)
 class EnvGameTask:
     """A Reach env's game beyond its key timeline: the variant, the level events, and whether a runaway ended it."""
@@ -85,13 +96,7 @@ class EnvGameTask:
         """Rebuild and check a section; raises ValueError naming the bad field."""
         d = check_keys("task", data, {"kind", "version", "env_id", "decision_steps", "hold_steps", "motor_noise",
                                       "field", "speed_limit", "observation_delay", "levels", "stopped"})
-        if d["kind"] != TASK_KIND:
-            raise ValueError(f"task.kind must be {TASK_KIND!r}, got {d['kind']!r}")
-        version = check_int("task.version", d["version"], 1, 10**6)
-        if version != SECTION_VERSION:
-            raise ValueError(f"task.version {version}: this armgame reads a Reach env's section of version "
-                             f"{SECTION_VERSION}")
-        env_id = None if d["env_id"] is None else check_str("task.env_id", d["env_id"], 100)
+        env_id = section_head(d, TASK_KIND, SECTION_VERSION, "a Reach env's")
         decision_steps = check_int("task.decision_steps", d["decision_steps"], 1, MAX_DECISION_STEPS)
         hold_steps = check_int("task.hold_steps", d["hold_steps"], 0, MAX_HOLD_STEPS)
         noise = check_float("task.motor_noise", d["motor_noise"], 0.0, 1.0)

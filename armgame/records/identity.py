@@ -196,12 +196,11 @@ def _native_digests(replay: Replay) -> tuple[str, str] | None:
         return None
     held, resets, events = texts
 
-    def head(version: int) -> str:  # the form's dict up to its lists, as json.dumps writes it, without its "}"
-        return json.dumps({"identity": version, "rules": config_digest(replay.config), "seed": replay.config.seed,
-                           "steps": steps}, separators=(",", ":"))[:-1]
-
-    current = f'{head(IDENTITY_VERSION)},"held":{held},"resets":{resets}}}'
-    first = f'{head(1)},"timeline":{events}}}'
+    # The forms' dict up to their lists, as json.dumps writes it, without its "}"; only the version differs.
+    rest = json.dumps({"rules": config_digest(replay.config), "seed": replay.config.seed, "steps": steps},
+                      separators=(",", ":"))[1:-1]
+    current = f'{{"identity":{IDENTITY_VERSION},{rest},"held":{held},"resets":{resets}}}'
+    first = f'{{"identity":1,{rest},"timeline":{events}}}'
     return (hashlib.sha256(current.encode()).hexdigest(), hashlib.sha256(first.encode()).hexdigest())
 
 

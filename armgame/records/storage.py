@@ -37,9 +37,8 @@ import os
 import secrets
 import stat
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from ..files import (
     _CLOEXEC,
@@ -343,7 +342,7 @@ def atomic_write_many(items: list[tuple[Path, bytes]], what: str = "file") -> No
 
 
 #: Threads that fsync a batch's files at once (``atomic_write_many``); made when first needed.
-_SYNCERS: ThreadPoolExecutor | None = None
+_SYNCERS: Any = None
 
 
 def _fsync_together(fds: list[int]) -> None:
@@ -353,6 +352,8 @@ def _fsync_together(fds: list[int]) -> None:
             os.fsync(fd)
         return
     if _SYNCERS is None:
+        from concurrent.futures import ThreadPoolExecutor  # here: only a batch's writer needs it (7 ms to import)
+
         _SYNCERS = ThreadPoolExecutor(max_workers=8, thread_name_prefix="armgame-fsync")
     for _ in _SYNCERS.map(os.fsync, fds):  # an error raised by any is raised here
         pass
