@@ -8,7 +8,6 @@ in a float32 observation, a dense reward (``armgame.env.features``), and centred
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Any
 
@@ -17,10 +16,9 @@ import numpy as np
 from ..game.rules import GameConfig
 from ..game.session import GameSession
 from ..game.variant import GameVariant, MuscleNoise, RunawayError
-from .errors import EnvArgumentError
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, hand_and_velocity
 from .reach import DEFAULT_DECISION_STEPS, ReachBaseEnv, ReachSettings, wrap_angle
-from .variants import DelayedObservations, ReachVariant
+from .variants import DelayedObservations, ReachVariant, with_target_radius
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
                         "to_target_x", "to_target_y", "time_left_fraction")
@@ -242,12 +240,3 @@ class ReachV1Env(ReachBaseEnv):
         left = (total - min(session.steps, total)) / total
         return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *session.muscles.activation, hx, hy, vx, vy,
                          target.x - hx, target.y - hy, left), dtype=self.settings.observation_dtype)
-
-
-def with_target_radius(config: GameConfig, radius: object) -> GameConfig:
-    """``config`` with targets of ``radius`` metres (1 mm to 20 cm)."""
-    if isinstance(radius, bool) or not isinstance(radius, int | float | np.floating) \
-            or not (math.isfinite(radius) and 0.001 <= radius <= 0.2):
-        raise EnvArgumentError(f"target_radius must be a number of metres from 0.001 to 0.2, got {radius!r}")
-    return dataclasses.replace(config, target_radius=float(radius))
-

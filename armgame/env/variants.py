@@ -51,7 +51,7 @@ from ..game.variant import NOISE_CORRELATION_TIME, NOISE_FACTOR_MAX, GameVariant
 from .errors import EnvArgumentError
 
 __all__ = ["FIELDS", "MAX_FIELD_STRENGTH", "MAX_VISCOUS_STRENGTH", "NOISE_CORRELATION_TIME", "NOISE_FACTOR_MAX",
-           "DelayedObservations", "MuscleNoise", "ReachVariant"]
+           "DelayedObservations", "MuscleNoise", "ReachVariant", "with_target_radius"]
 
 FIELDS = ("curl", "viscous")
 MAX_HOLD_TIME = 5.0
@@ -161,3 +161,11 @@ class DelayedObservations:
     def step(self, observation: np.ndarray) -> np.ndarray:
         self._queue.append(observation)
         return self._queue[0].copy()  # an agent may keep and change what it was given
+
+
+def with_target_radius(config: GameConfig, radius: object) -> GameConfig:
+    """``config`` with targets of ``radius`` metres (1 mm to 20 cm)."""
+    if isinstance(radius, bool) or not isinstance(radius, int | float | np.floating) \
+            or not (math.isfinite(radius) and 0.001 <= radius <= 0.2):
+        raise EnvArgumentError(f"target_radius must be a number of metres from 0.001 to 0.2, got {radius!r}")
+    return dataclasses.replace(config, target_radius=float(radius))

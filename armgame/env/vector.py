@@ -31,7 +31,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ..game.batch import BatchGameSession
+from ..game.batch.compiled import available as compiled_available
+from ..game.batch.variant import BatchMuscleNoise
 from ..game.rules import GameConfig
+from ..game.variant import GameVariant
 from . import features
 from .features import (
     DEFAULT_HIT_BONUS,
@@ -49,7 +52,7 @@ from .reach import (
     _check_size,
     check_seed,
 )
-from .variants import ReachVariant
+from .variants import ReachVariant, with_target_radius
 from .vector_common import AutoresetBook, SingleEnvsVectorEnv, check_reset_mask
 
 #: Memory one game of a vector env takes at its peak (reset and the first step): 5.1-5.2 KB measured at
@@ -164,7 +167,7 @@ class ReachVectorEnv(VectorEnv):
                 part = slice(start, min(n, start + GAMES_PER_BATCH))
                 self.parts.append((part, BatchGameSession(
                     [self.settings.game(game_seeds[i]) for i in range(part.start, part.stop)], exact=False,
-                    hold_steps=self._hold_steps())))
+                    variant=self._game_variant())))
         else:
             for part, batch in self.parts:
                 here = chosen[part]
@@ -184,23 +187,26 @@ class ReachVectorEnv(VectorEnv):
         book.before_step()
         n = self.num_envs
         rewards = np.zeros(n)
+        terminated = np.zeros(n, dtype=bool)
         truncated = np.zeros(n, dtype=bool)
         restart = book.restart_now.copy()  # next-step mode: the games that ended last step
         for part, batch in self.parts:
-            self._step_part(part, batch, actions, rewards, truncated, restart[part])
+            self._step_part(part, batch, actions, rewards, terminated, truncated, restart[part])
+        ended = terminated | truncated
         infos = self._infos(np.ones(n, dtype=bool))
-        if book.mode is AutoresetMode.SAME_STEP and truncated.any():
+        if book.mode is AutoresetMode.SAME_STEP and ended.any():
             final_obs = self._observations()
             infos["final_obs"] = np.full(n, None, dtype=object)
-            for i in np.flatnonzero(truncated):
+            for i in np.flatnonzero(ended):
                 infos["final_obs"][i] = final_obs[i]
-            infos["_final_obs"] = truncated.copy()
-            infos["final_info"] = self._infos(truncated)
-            infos["_final_info"] = truncated.copy()
-            self._restart(truncated)
+            infos["_final_obs"] = ended.copy()
+            infos["final_info"] = self._infos(ended)
+            infos["_final_info"] = ended.copy()
+            self._restart(ended)
+            infos = {k: v for k, v in infos.items() if k.startswith("final") or k.startswith("_final")}
             infos.update(self._infos(np.ones(n, dtype=bool)))
-        book.after_step(truncated)
-        return self._observations(), rewards, np.zeros(n, dtype=bool), truncated, infos
+        book.after_step(ended)
+        return self._observations(), rewards, terminated, truncated, infos
 
     def render(self) -> tuple[np.ndarray, ...] | None:
         """Each game's frame now, as the single env draws it (a tuple of (height, width, 3) arrays)."""
@@ -230,18 +236,22 @@ class ReachVectorEnv(VectorEnv):
         return [_BatchGame(batch, i) for _, batch in self.parts for i in range(batch.n)]
 
     def _step_part(self, part: slice, batch: BatchGameSession, actions: np.ndarray, rewards: np.ndarray,
-                   truncated: np.ndarray, restart: np.ndarray) -> None:
+                   terminated: np.ndarray, truncated: np.ndarray, restart: np.ndarray) -> None:
         # Games that ended at the last step are over, so neither their actions (the batch ignores
         # input to a game that is over) nor the physics touch them here; they start their next
         # game after the others have stepped.
         hits, resets = batch.hits.copy(), batch.resets.copy()  # before the actions: a reset key costs
         self._apply(batch, actions[part])
+        batch.apply_noise()  # the single env's order: the action, then the decision's noise, then physics
         batch.advance(self.decision_steps)
         rewards[part] = self._rewards(part, batch, batch.hits - hits, batch.resets - resets)
         if restart.any():
             self._restart_part(part, batch, restart)
             rewards[part] = np.where(restart, 0.0, rewards[part])
-        truncated[part] = batch.over  # a restarted game is not over
+        # A game the guard stopped ends before its clock (terminated, as the single env's), the others at it.
+        stopped = batch.stopped
+        terminated[part] = stopped
+        truncated[part] = batch.over & ~stopped  # a restarted game is not over
 
     def _restart(self, games: np.ndarray) -> None:
         for part, batch in self.parts:
@@ -255,9 +265,9 @@ class ReachVectorEnv(VectorEnv):
         mask[chosen] = True
         self._started(mask)
 
-    def _hold_steps(self) -> int:
-        """The games' dwell in physics steps (v1's ``hold_time``); 0, the game's rule."""
-        return 0
+    def _game_variant(self) -> GameVariant | None:
+        """The games' dwell, noise, field and guard (v1's ``ReachVariant``); None, the game itself."""
+        return None
 
     def _started(self, games: np.ndarray) -> None:
         """Games ``games`` (a mask over all) have just begun: v1 measures their first distances here."""
@@ -329,6 +339,18 @@ class ReachVectorEnv(VectorEnv):
             values = np.concatenate(values) if len(values) > 1 else values[0].copy()
             info[name] = values if every else np.where(games, values, 0)
             info[f"_{name}"] = games.copy()
+        # A stopped game's reason, as SyncVectorEnv gathers a single env's info["stopped"]: only where there is one.
+        stopped = np.zeros(self.num_envs, dtype=bool)
+        for part, batch in self.parts:
+            stopped[part] = batch.stopped
+        stopped &= games
+        if stopped.any():
+            reasons = np.full(self.num_envs, None, dtype=object)
+            for part, batch in self.parts:
+                for i, reason in batch.stop_reasons.items():
+                    if stopped[part.start + i]:
+                        reasons[part.start + i] = reason
+            info["stopped"], info["_stopped"] = reasons, stopped
         return info
 
 
@@ -364,18 +386,25 @@ class ReachV1VectorEnv(ReachVectorEnv):
                  decision_steps: int = DEFAULT_DECISION_STEPS, continuous: bool = False, reset_key: bool = False,
                  reward: str = "dense", progress_weight: float = DEFAULT_PROGRESS_WEIGHT,
                  hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
-                 hold_time: float = 0.0, observation_delay: int = 0, config: GameConfig | None = None,
-                 render_mode: str | None = None,
+                 hold_time: float = 0.0, motor_noise: float = 0.0, observation_delay: int = 0,
+                 field: str | None = None, field_strength: float | None = None, target_radius: float | None = None,
+                 config: GameConfig | None = None, render_mode: str | None = None,
                  render_size: tuple[int, int] = (600, 600),
                  autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
         if reward == "score":  # its shaping needs each game's reset and end: make_vec plays it on single envs
             raise EnvArgumentError("the batched vector env has no reward='score': gymnasium.make_vec gives single "
                                    "envs for it")
-        variant = ReachVariant.of(hold_time=hold_time, observation_delay=observation_delay)
+        variant = ReachVariant.of(hold_time, motor_noise, observation_delay, field, field_strength)
+        if target_radius is not None:
+            config = with_target_radius(config or GameConfig(), target_radius)
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
                                     progress_weight, hit_bonus, observation_dtype, variant)
+        if (variant.motor_noise or variant.field) and not compiled_available():
+            raise EnvArgumentError("the batched vector env plays motor noise and fields in the compiled kernel, which "
+                                   "is not built here: gymnasium.make_vec gives single envs for them")
         self._configure(num_envs, settings, render_mode, render_size, autoreset_mode,
-                        delay_bytes(variant.observation_delay, observation_dtype))
+                        delay_bytes(variant.observation_delay, observation_dtype)
+                        + (BatchMuscleNoise.BYTES_PER_GAME if variant.motor_noise else 0))
         self.variant = variant
         self._edges = np.zeros(self.num_envs)
         self._edges_new = np.zeros(self.num_envs)
@@ -403,9 +432,9 @@ class ReachV1VectorEnv(ReachVectorEnv):
         self._unpushed = self._past is not None
         return super().step(actions)
 
-    def _hold_steps(self) -> int:
-        variant = self.variant
-        return variant.hold_steps(self.config.dt) if variant.hold_time else 0
+    def _game_variant(self) -> GameVariant | None:
+        s = self.settings
+        return self.variant.game_variant(s.config, s.decision_steps, s.joint_speed_bound)
 
     def _measure(self, part: slice, batch: BatchGameSession, obs: np.ndarray, edges: np.ndarray | None) -> None:
         """Part ``part``'s observation rows into ``obs[part]`` and, unless None, its edge distances into ``edges``."""
@@ -498,9 +527,9 @@ def reach_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
 
 def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
     """The vector entry point of ``armgame/Reach-v1``, ``ReachContinuous-v1`` and the suite's harder Reach ids:
-    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games of the game itself or with a dwell or an observation
-    delay, else ``SyncVectorEnv`` of single envs: below that size, and for noise, a field or the score reward,
-    which the batch does not play."""
+    ``ReachV1VectorEnv`` from ``BATCH_MIN_ENVS`` games, else ``SyncVectorEnv`` of single envs: below that size,
+    for the score reward, and for noise or a field where the compiled kernel is not built (the numpy kernel
+    does not play them)."""
     from .reach_v1 import ReachV1Env
 
     return _chosen(ReachV1VectorEnv, ReachV1Env, _NATIVE_V1, num_envs, kwargs)
@@ -517,9 +546,11 @@ def batch_plays(env_id: str, kwargs: dict[str, Any]) -> bool:
 
 
 def _batch_takes(kwargs: dict[str, Any], native_arguments: frozenset[str]) -> bool:
-    """Whether the batch plays a game of these arguments: its own arguments only, and no score reward (whose
-    shaping needs each game's reset and end)."""
-    return set(kwargs) <= native_arguments and kwargs.get("reward", "dense") != "score"
+    """Whether the batch plays a game of these arguments: its own arguments only, no score reward (whose
+    shaping needs each game's reset and end), and motor noise or a field only where the compiled kernel is built."""
+    loaded = bool(kwargs.get("motor_noise")) or kwargs.get("field") is not None
+    return (set(kwargs) <= native_arguments and kwargs.get("reward", "dense") != "score"
+            and (not loaded or compiled_available()))
 
 
 def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozenset[str], num_envs: Any,

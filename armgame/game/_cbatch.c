@@ -146,17 +146,23 @@ const char armgame_run_doc[] =
 "With fast true, RK4's elbow trig comes by angle addition (the numpy fast kernel's method):\n"
 "round-off, not bit for bit. lanes: step several games side by side (the same results; false: one\n"
 "at a time, the reference). Refused before any step (ValueError): params not finite or dt not positive,\n"
-"steps or halt outside 0 to the steps of a 24 h game at dt, a command's goal or rate not finite.";
+"steps or halt outside 0 to the steps of a 24 h game at dt, a command's goal or rate not finite.\n\n"
+"moments (8, n) float64 or None: each game's muscle moments, rows shoulder s0-s3 then elbow e0-e3, in\n"
+"place of the params' (motor noise). loads (6,) float64 or None: the field at the hand, kind (0 none,\n"
+"1 curl: F = b [[0, 1], [-1, 0]] v, 2 viscous: F = B v), its parameters (b, 0, 0, 0 or b11 b12 b21 b22)\n"
+"and the speed guard (rad/s, inf: none): a game whose joint speed passes it after a step stops there,\n"
+"flags[i] = 2, its state that step's. Both need the lanes and an arm without gravity.";
 
 PyObject *armgame_run(PyObject *self, PyObject *args)
 {
     (void)self;
-    PyObject *obj[18];
+    PyObject *obj[20];
     int mode, fast, lanes;
     Py_ssize_t n;
-    if (!PyArg_ParseTuple(args, "OipnOOOOOOOOOOOOOOOOOp", &obj[0], &mode, &fast, &n, &obj[1], &obj[2], &obj[3],
+    obj[18] = obj[19] = Py_None;
+    if (!PyArg_ParseTuple(args, "OipnOOOOOOOOOOOOOOOOOp|OO", &obj[0], &mode, &fast, &n, &obj[1], &obj[2], &obj[3],
                           &obj[4], &obj[5], &obj[6], &obj[7], &obj[8], &obj[9], &obj[10], &obj[11], &obj[12],
-                          &obj[13], &obj[14], &obj[15], &obj[16], &obj[17], &lanes))
+                          &obj[13], &obj[14], &obj[15], &obj[16], &obj[17], &lanes, &obj[18], &obj[19]))
         return NULL;
     /* n bounded first: every size below is n times at most 4 * 8 bytes, which must not overflow (a wrapped
        n * D of 0 would divide by zero below: SIGFPE, the process gone). */
@@ -165,8 +171,8 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
                      n, PY_SSIZE_T_MAX / (4 * (Py_ssize_t)sizeof(double)));
         return NULL;
     }
-    const int with_trig = obj[17] != Py_None;
-    Buf b[18];
+    const int with_trig = obj[17] != Py_None, with_moments = obj[18] != Py_None, with_loads = obj[19] != Py_None;
+    Buf b[20];
     memset(b, 0, sizeof b);
     PyObject *result = NULL;
     const Py_ssize_t D = sizeof(double), I = sizeof(int64_t);
@@ -190,6 +196,30 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
         goto done;
     if (with_trig && get(obj[17], &b[17], 6 * n, D, 1, "trig") < 0)
         goto done;
+    if ((with_moments && get(obj[18], &b[18], 8 * n, D, 0, "moments") < 0)
+        || (with_loads && get(obj[19], &b[19], 6, D, 0, "loads") < 0))
+        goto done;
+    const double *loads = with_loads ? b[19].view.buf : NULL;
+    if ((with_moments || with_loads) && (!lanes || mode == MODE_GRAVITY)) {
+        PyErr_SetString(PyExc_ValueError, "run: moments and loads need the lanes and an arm without gravity");
+        goto done;
+    }
+    if (loads != NULL && !((loads[0] == FIELD_NONE || loads[0] == FIELD_CURL || loads[0] == FIELD_VISCOUS)
+                           && isfinite(loads[1]) && isfinite(loads[2]) && isfinite(loads[3]) && isfinite(loads[4])
+                           && loads[5] > 0.0)) {
+        PyErr_SetString(PyExc_ValueError, "run: loads: expected kind 0, 1 or 2, finite parameters and a guard "
+                                          "above 0 (inf: none)");
+        goto done;
+    }
+    if (with_moments) {
+        const double *m = b[18].view.buf;
+        for (Py_ssize_t j = 0; j < 8 * n; j++) {
+            if (!isfinite(m[j])) {
+                PyErr_Format(PyExc_ValueError, "run: moments: game %zd's are not finite", j % n);
+                goto done;
+            }
+        }
+    }
 
     const double *p = b[0].view.buf;
     if (check_params("run", p, 1) < 0)
@@ -206,6 +236,11 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
         .dt = p[P_DT], .h = p[P_H], .k = p[P_K], .l1 = p[P_L1], .l2 = p[P_L2], .radius = p[P_RADIUS],
         .near = p[P_NEAR], .reach1 = p[P_REACH1], .reach2 = p[P_REACH2], .limit2 = p[P_LIMIT2],
         .s = {p[P_S0], p[P_S1], p[P_S2], p[P_S3]}, .e = {p[P_E0], p[P_E1], p[P_E2], p[P_E3]},
+        .mom = with_moments ? b[18].view.buf : NULL,
+        .field = loads != NULL ? (int)loads[0] : FIELD_NONE,
+        .fp = {loads != NULL ? loads[1] : 0.0, loads != NULL ? loads[2] : 0.0, loads != NULL ? loads[3] : 0.0,
+               loads != NULL ? loads[4] : 0.0},
+        .limit = loads != NULL ? loads[5] : INFINITY,
     };
 
     /* The work is bounded before it starts: cursors within the events, muscles 0-3, finite commands, and
@@ -242,6 +277,6 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
     Py_END_ALLOW_THREADS
     result = PyLong_FromSsize_t(flagged);
 done:
-    release(b, 18);
+    release(b, 20);
     return result;
 }

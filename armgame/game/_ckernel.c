@@ -393,7 +393,7 @@ PyMODINIT_FUNC PyInit__ckernel(void)
     PyObject *m = PyModule_Create(&module);
     /* VERSION changes with the calling convention, so a stale build is refused, not misread. */
     if (m != NULL && (PyModule_AddIntConstant(m, "PARAMS", P_COUNT) < 0
-                      || PyModule_AddIntConstant(m, "VERSION", 6) < 0
+                      || PyModule_AddIntConstant(m, "VERSION", 7) < 0
                       || PyModule_AddIntConstant(m, "SINCOS", armgame_use_sincos) < 0)) {
         Py_DECREF(m);
         return NULL;

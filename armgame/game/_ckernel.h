@@ -190,7 +190,20 @@ typedef struct {
     double *trig;   /* (6, n): cos q1, sin q1, cos(q1 + q2), sin(q1 + q2), q1, q2 after a game's last step, or NULL */
     double dt, h, k, l1, l2, radius, near, reach1, reach2, limit2;
     double s[4], e[4];
+    /* The harder tasks' physics (game/variant.py), or none: every game's muscle moments, (8, n) rows s0-s3
+     * then e0-e3 (motor noise rescales them before each decision), or NULL for s and e above; a field at
+     * the hand (FIELD_*, its parameters: curl b, or viscous b11 b12 b21 b22); the speed guard (rad/s,
+     * infinite: none), past which a game stops (flags 2) with the state of the step that passed it. */
+    const double *mom;
+    int field;
+    double fp[4];
+    double limit;
 } Batch;
+
+/* A field at the hand (loads.CurlField, loads.ViscousField) and the flag of a game the guard stopped. */
+enum { FIELD_NONE = 0, FIELD_CURL = 1, FIELD_VISCOUS = 2 };
+#define FLAG_NEAR 1
+#define FLAG_RUNAWAY 2
 
 /* The hand's trig of game i, for the caller's observations (the single session's cos and sin), with the
  * angles it is of: the caller knows it current while they are the game's. */

@@ -47,6 +47,8 @@ typedef struct {
     double qs[LANES], ds[LANES];        /* a stage's elbow angle and, in the fast kernel, its increment */
     double ec[LANES], es[LANES];        /* that stage's b cos and b sin of it */
     int ok[LANES];                      /* the fast kernel's series held for the lane (else: in full) */
+    double ms[4][LANES], me[4][LANES];  /* the loaded step's muscle moments (motor noise: each game's own) */
+    int run[LANES];                     /* the loaded step: the lane's joint speed passed the guard */
     int anchor[LANES];
     int64_t s[LANES], stop[LANES], next[LANES], c[LANES], end[LANES];
     Py_ssize_t game[LANES];             /* the lane's game, or -1 */
@@ -57,19 +59,65 @@ typedef struct {
     double b, d, det0, amd, k1, k2, dt, h, k, limit2, reach1, reach2;
     double s[4], e[4];
     int damping, fast;
+    /* The loaded step's (Batch's mom, field, fp, limit): the arm's lengths for the hand's Jacobian. */
+    double l1, l2, fp[4], limit;
+    int field;
 } Step;
 
-/* TwoJointArm's accel_unforced or accel_with_damping (``accel_trig``) for every lane, the lanes' stage
- * angles in q1, q2, speeds in w1, w2, elbow trig in L->ec, L->es. */
-LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, const double *w1,
-                               const double *w2, const double *t1, const double *t2, double *o1, double *o2)
+/* The torque of the field at the hand at every lane's stage (loads._with_loads's ``external`` with no joint
+ * load: ``J(q)^T F(v)``, operation for operation), into e1, e2. The exact kernel takes the hand's cos and sin
+ * from the C library, as Python's ``math`` does there; the fast kernel from the arm's own trig, which
+ * vectorises (round-off: it is within an ulp of the C library's). */
+LANES_INLINE void field_lanes(const Step *k, const double *q1, const double *q2, const double *w1,
+                               const double *w2, double *e1, double *e2)
 {
-    (void)q1;
+    double s1[LANES], c1[LANES], s12[LANES], c12[LANES];
+    if (k->fast) {
+        for (int l = 0; l < LANES; l++) {
+            arm_sin_cos(q1[l], &s1[l], &c1[l]);
+            arm_sin_cos(q1[l] + q2[l], &s12[l], &c12[l]);
+        }
+    } else {
+        for (int l = 0; l < LANES; l++) {
+            sin_cos(q1[l], &s1[l], &c1[l]);
+            sin_cos(q1[l] + q2[l], &s12[l], &c12[l]);
+        }
+    }
+    for (int l = 0; l < LANES; l++) {
+        const double j12 = -k->l2 * s12[l], j22 = k->l2 * c12[l];
+        const double j11 = -k->l1 * s1[l] + j12, j21 = k->l1 * c1[l] + j22;
+        const double vx = j11 * w1[l] + j12 * w2[l], vy = j21 * w1[l] + j22 * w2[l];
+        double fx, fy;
+        if (k->field == FIELD_CURL) {
+            fx = k->fp[0] * vy;
+            fy = -k->fp[0] * vx;
+        } else {
+            fx = k->fp[0] * vx + k->fp[1] * vy;
+            fy = k->fp[2] * vx + k->fp[3] * vy;
+        }
+        /* No joint load: Python's 0.0 + 0.0 * w1 + 0.0 * w2 (+0, or NaN where w is not finite). */
+        e1[l] = 0.0 + 0.0 * w1[l] + 0.0 * w2[l] + j11 * fx + j21 * fy;
+        e2[l] = 0.0 + 0.0 * w1[l] + 0.0 * w2[l] + j12 * fx + j22 * fy;
+    }
+}
+
+/* TwoJointArm's accel_unforced or accel_with_damping (``accel_trig``) for every lane, the lanes' stage
+ * angles in q1, q2, speeds in w1, w2, elbow trig in L->ec, L->es; ``loaded`` (a constant where inlined):
+ * the field's torque added to the muscles', as loads' ``accel`` passes ``t1 + e1`` on. */
+LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, const double *q2, const double *w1,
+                               const double *w2, const double *t1, const double *t2, double *o1, double *o2,
+                               const int loaded)
+{
+    double e1[LANES], e2[LANES];
+    if (loaded && k->field != FIELD_NONE)
+        field_lanes(k, q1, q2, w1, w2, e1, e2);
     for (int l = 0; l < LANES; l++) {
         const double bc = L->ec[l], h = L->es[l];
         const double m12 = k->d + bc;
-        double f1 = t1[l] + h * (w1[l] + w1[l] + w2[l]) * w2[l];
-        double f2 = t2[l] - h * w1[l] * w1[l];
+        const double u1 = loaded && k->field != FIELD_NONE ? t1[l] + e1[l] : t1[l];
+        const double u2 = loaded && k->field != FIELD_NONE ? t2[l] + e2[l] : t2[l];
+        double f1 = u1 + h * (w1[l] + w1[l] + w2[l]) * w2[l];
+        double f2 = u2 - h * w1[l] * w1[l];
         if (k->damping) {
             f1 = f1 - k->k1 * w1[l];
             f2 = f2 - k->k2 * w2[l];
@@ -127,17 +175,27 @@ LANES_INLINE void elbow_lanes(const Step *k, Lanes *L)
 }
 
 /* One RK4 step of every lane (``run_scalar``'s step, lane by lane): the muscles, the four stages, the
- * fast kernel's trig carried to the next step, and the slack. Returns whether some lane's slack ran out. */
-LANES_CLONES
-static int step_lanes(const Step *k, Lanes *L)
+ * fast kernel's trig carried to the next step, and the slack. Returns whether some lane's slack ran out,
+ * or, ``loaded``, its joint speed passed the guard (L->run). ``loaded``: each lane's own muscle moments
+ * (L->ms, L->me), the field and the guard (game/variant.py's physics); a constant, so that the plain
+ * step (``step_lanes``) carries none of it. */
+LANES_INLINE int step_lanes_as(const Step *k, Lanes *L, const int loaded)
 {
     double t1[LANES], t2[LANES], p1[LANES], p2[LANES];
     double a1[LANES], a2[LANES], b1[LANES], b2[LANES], c1[LANES], c2[LANES], d1[LANES], d2[LANES];
     double v1[LANES], v2[LANES], u1[LANES], u2[LANES], z1[LANES], z2[LANES], qa[LANES];
-    for (int l = 0; l < LANES; l++) {
-        double a0 = L->a[0][l], a1_ = L->a[1][l], a2_ = L->a[2][l], a3 = L->a[3][l];
-        t1[l] = a0 * k->s[0] + a1_ * k->s[1] + a2_ * k->s[2] + a3 * k->s[3];
-        t2[l] = a0 * k->e[0] + a1_ * k->e[1] + a2_ * k->e[2] + a3 * k->e[3];
+    if (loaded) {
+        for (int l = 0; l < LANES; l++) {
+            double a0 = L->a[0][l], a1_ = L->a[1][l], a2_ = L->a[2][l], a3 = L->a[3][l];
+            t1[l] = a0 * L->ms[0][l] + a1_ * L->ms[1][l] + a2_ * L->ms[2][l] + a3 * L->ms[3][l];
+            t2[l] = a0 * L->me[0][l] + a1_ * L->me[1][l] + a2_ * L->me[2][l] + a3 * L->me[3][l];
+        }
+    } else {
+        for (int l = 0; l < LANES; l++) {
+            double a0 = L->a[0][l], a1_ = L->a[1][l], a2_ = L->a[2][l], a3 = L->a[3][l];
+            t1[l] = a0 * k->s[0] + a1_ * k->s[1] + a2_ * k->s[2] + a3 * k->s[3];
+            t2[l] = a0 * k->e[0] + a1_ * k->e[1] + a2_ * k->e[2] + a3 * k->e[3];
+        }
     }
     for (int m = 0; m < 4; m++)
         for (int l = 0; l < LANES; l++)
@@ -160,7 +218,7 @@ static int step_lanes(const Step *k, Lanes *L)
         L->ec[l] = L->bc[l];
         L->es[l] = L->bs[l];
     }
-    accel_lanes(k, L, L->q1, L->w1, L->w2, t1, t2, a1, a2);
+    accel_lanes(k, L, L->q1, L->q2, L->w1, L->w2, t1, t2, a1, a2, loaded);
     for (int l = 0; l < LANES; l++) {
         v1[l] = L->w1[l] + k->h * a1[l];
         v2[l] = L->w2[l] + k->h * a2[l];
@@ -169,7 +227,7 @@ static int step_lanes(const Step *k, Lanes *L)
         qa[l] = L->q1[l] + k->h * L->w1[l];
     }
     elbow_lanes(k, L);
-    accel_lanes(k, L, qa, v1, v2, t1, t2, b1, b2);
+    accel_lanes(k, L, qa, L->qs, v1, v2, t1, t2, b1, b2, loaded);
     for (int l = 0; l < LANES; l++) {
         u1[l] = L->w1[l] + k->h * b1[l];
         u2[l] = L->w2[l] + k->h * b2[l];
@@ -178,7 +236,7 @@ static int step_lanes(const Step *k, Lanes *L)
         qa[l] = L->q1[l] + k->h * v1[l];
     }
     elbow_lanes(k, L);
-    accel_lanes(k, L, qa, u1, u2, t1, t2, c1, c2);
+    accel_lanes(k, L, qa, L->qs, u1, u2, t1, t2, c1, c2, loaded);
     for (int l = 0; l < LANES; l++) {
         z1[l] = L->w1[l] + k->dt * c1[l];
         z2[l] = L->w2[l] + k->dt * c2[l];
@@ -187,7 +245,7 @@ static int step_lanes(const Step *k, Lanes *L)
         qa[l] = L->q1[l] + k->dt * u1[l];
     }
     elbow_lanes(k, L);
-    accel_lanes(k, L, qa, z1, z2, t1, t2, d1, d2);
+    accel_lanes(k, L, qa, L->qs, z1, z2, t1, t2, d1, d2, loaded);
     int out = 0;
     for (int l = 0; l < LANES; l++) {
         const double w1 = L->w1[l], w2 = L->w2[l];
@@ -201,6 +259,15 @@ static int step_lanes(const Step *k, Lanes *L)
         /* A lower bound on the hand's distance from the disc, lowered by a bound on its move. */
         L->sl[l] -= fabs(q1 - p1[l]) * k->reach1 + fabs(q2 - p2[l]) * k->reach2;
         out |= L->sl[l] < 0.0;
+    }
+    if (loaded) {
+        /* variant.guarded's test (NaN fails it too). */
+        const double lim = k->limit;
+        for (int l = 0; l < LANES; l++) {
+            const double w1 = L->w1[l], w2 = L->w2[l];
+            L->run[l] = !(-lim <= w1 && w1 <= lim && -lim <= w2 && w2 <= lim);
+            out |= L->run[l];
+        }
     }
     if (k->fast) {
         /* The next step's elbow trig: this one's turned by the step's change of q2 (``turned``); where the
@@ -225,6 +292,29 @@ static int step_lanes(const Step *k, Lanes *L)
     return out;
 }
 
+/* The plain game's step, and the harder tasks' (see ``step_lanes_as``). */
+LANES_CLONES
+static int step_lanes(const Step *k, Lanes *L)
+{
+    return step_lanes_as(k, L, 0);
+}
+
+LANES_CLONES
+static int step_lanes_loaded(const Step *k, Lanes *L)
+{
+    return step_lanes_as(k, L, 1);
+}
+
+/* Game i's muscle moments into lane l: its own (B->mom) or the batch's. */
+static void moments_lane(const Batch *B, Lanes *L, int l, Py_ssize_t i)
+{
+    L->run[l] = 0;
+    for (int m = 0; m < 4; m++) {
+        L->ms[m][l] = B->mom != NULL ? B->mom[m * B->n + i] : B->s[m];
+        L->me[m][l] = B->mom != NULL ? B->mom[(4 + m) * B->n + i] : B->e[m];
+    }
+}
+
 /* Game i's arrays into lane l; no game (i < 0): a still arm that never needs attention. */
 static void load_lane(const Batch *B, Lanes *L, int l, Py_ssize_t i)
 {
@@ -241,8 +331,12 @@ static void load_lane(const Batch *B, Lanes *L, int l, Py_ssize_t i)
         L->s[l] = 0;
         L->stop[l] = L->next[l] = INT64_MAX;
         L->c[l] = L->end[l] = 0;
+        L->run[l] = 0;
+        for (int m = 0; m < 4; m++)
+            L->ms[m][l] = L->me[m][l] = 0.0;
         return;
     }
+    moments_lane(B, L, l, i);
     L->q1[l] = B->x[i];
     L->q2[l] = B->x[n + i];
     L->w1[l] = B->x[2 * n + i];
@@ -378,6 +472,8 @@ static int fill_block(const Batch *B, Lanes *L, Py_ssize_t *queue)
     }
     *queue = i + LANES;
     for (int l = 0; l < LANES; l++)
+        moments_lane(B, L, l, i + l);
+    for (int l = 0; l < LANES; l++)
         due_lane(B, L, l);  /* each has steps before its halt: none stops here */
     return 1;
 }
@@ -392,7 +488,11 @@ Py_ssize_t armgame_run_lanes(const Batch *B)
     const Arm *arm = &B->arm;
     const Step k = {arm->b, arm->d, arm->det0, arm->amd, arm->k1, arm->k2, B->dt, B->h, B->k, B->limit2,
                     B->reach1, B->reach2, {B->s[0], B->s[1], B->s[2], B->s[3]},
-                    {B->e[0], B->e[1], B->e[2], B->e[3]}, arm->mode == MODE_DAMPING, B->fast};
+                    {B->e[0], B->e[1], B->e[2], B->e[3]}, arm->mode == MODE_DAMPING, B->fast,
+                    B->l1, B->l2, {B->fp[0], B->fp[1], B->fp[2], B->fp[3]}, B->limit, B->field};
+    /* The loaded step where the games have their own moments, a field or a guard; else the plain one. */
+    const int loaded = B->mom != NULL || B->field != FIELD_NONE || B->limit < INFINITY;
+    int (*const step)(const Step *, Lanes *) = loaded ? step_lanes_loaded : step_lanes;
     Py_ssize_t queue = 0, flagged = 0;
     int busy = 0;
     for (int l = 0; l < LANES; l++) {
@@ -408,7 +508,7 @@ Py_ssize_t armgame_run_lanes(const Batch *B)
         int short_ = 0;
         while (run > 0) {
             run--;
-            if (step_lanes(&k, &L)) {
+            if (step(&k, &L)) {
                 short_ = 1;
                 break;
             }
@@ -419,6 +519,14 @@ Py_ssize_t armgame_run_lanes(const Batch *B)
             done[l] = 0;
             if (i < 0)
                 continue;
+            if (short_ && L.run[l]) {
+                /* The guard: the game stops with this step's state, which the caller puts back. */
+                B->flags[i] = FLAG_RUNAWAY;
+                flagged++;
+                done[l] = 1;
+                finished++;
+                continue;
+            }
             if (short_ && L.sl[l] < 0.0) {
                 /* The slack ran out: measure the hand (as the single session does, on its floats). */
                 double sa, ca, sb, cb;
@@ -429,7 +537,7 @@ Py_ssize_t armgame_run_lanes(const Batch *B)
                 const double d2h = dx * dx + dy * dy;
                 L.sl[l] = sqrt(d2h) - B->radius - 1e-9;
                 if (d2h <= B->near) {
-                    B->flags[i] = 1;
+                    B->flags[i] = FLAG_NEAR;
                     flagged++;
                     done[l] = 1;
                     finished++;

@@ -31,7 +31,7 @@ from .rules import GameConfig, GameRules
 
 #: The calling convention of ``_ckernel.c`` this package speaks: this module's one game and
 #: ``batch/compiled.py``'s batches. A build of another (a stale ``.so``) is not used.
-KERNEL_VERSION = 6
+KERNEL_VERSION = 7
 #: How many doubles the kernel's params hold (its P_* enum).
 KERNEL_PARAMS = 26
 

@@ -106,11 +106,20 @@ def guarded(step: Callable[..., tuple[float, float, float, float]],
                      dt: float) -> tuple[float, float, float, float]:
         q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
         if not (-limit <= w1 <= limit and -limit <= w2 <= limit):
-            raise RunawayError(f"the force field drove a joint past {limit:.1f} rad/s "
-                               f"({max(abs(w1), abs(w2)):.4g}): the game stops")
+            raise RunawayError(runaway_message(limit, w1, w2))
         return q1, q2, w1, w2
 
     return step_guarded
+
+
+def runaway_message(limit: float, w1: float, w2: float) -> str:
+    """Why a game stopped at the guard, in one line, from the joint speeds that passed ``limit``."""
+    return f"the force field drove a joint past {limit:.1f} rad/s ({max(abs(w1), abs(w2)):.4g}): the game stops"
+
+
+def noise_generator(seed: int) -> np.random.Generator:
+    """The motor noise's stream of the game of seed ``seed`` (apart from the targets' stream of the same seed)."""
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence([seed, 0x5EED_0015E])))
 
 
 class MuscleNoise:
@@ -123,7 +132,7 @@ class MuscleNoise:
 
     def __init__(self, level: float, seed: int, decision_time: float, session: GameSession) -> None:
         self.level = level
-        self._rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence([seed, 0x5EED_0015E])))
+        self._rng = noise_generator(seed)
         self._keep = math.exp(-decision_time / NOISE_CORRELATION_TIME)
         self._fresh = level * math.sqrt(1.0 - self._keep * self._keep)
         # Started from its stationary spread, so the first decision is as noisy as the last.

@@ -34,9 +34,10 @@ import numpy as np
 
 from ...physics.batch import SERIES_LIMIT
 from ..session import DOWN, KERNEL_VERSION, compiled_kernel, kernel_mode, kernel_params, speaks_our_convention
-from .kernel_inputs import BatchArrays, HitTest, KernelInputs
+from .kernel_inputs import BatchArrays, HitTest, KernelInputs, Runaway
 from .numpy_kernel import NEAR, hand_move_bounds
 from .schedule import MuscleEvents
+from .variant import FLAG_RUNAWAY
 
 #: The C module, or None (not built, or a build of another convention).
 _ckernel = compiled_kernel()
@@ -60,12 +61,13 @@ def available() -> bool:
 class CompiledKernel:
     """Runs a batch's games to given steps with ``_ckernel``, on the batch's own arrays (``arrays``).
 
-    ``hit`` is called for each game the kernel stops at a target's edge; it decides and scores the hit."""
+    ``hit`` is called for each game the kernel stops at a target's edge; it decides and scores the hit.
+    ``runaway`` for each game the speed guard stopped (``arrays.loads``), which runs no further in the call."""
 
-    def __init__(self, inputs: KernelInputs, arrays: BatchArrays, hit: HitTest) -> None:
+    def __init__(self, inputs: KernelInputs, arrays: BatchArrays, hit: HitTest, runaway: Runaway | None = None) -> None:
         if _ckernel is None:
             raise RuntimeError("the compiled kernel is not built (reinstall with a C compiler: pip install -e .)")
-        self.arrays, self.hit = arrays, hit
+        self.arrays, self.hit, self.runaway = arrays, hit, runaway
         #: RK4's elbow trig by angle addition (round-off, not bit for bit; see ``_ckernel.c``).
         self.fast = bool(inputs.fast)
         model, config = inputs.model, inputs.config
@@ -82,12 +84,16 @@ class CompiledKernel:
         """Every game ``i`` to step ``halt[i]`` (none past its end), its hits scored on the way."""
         a = self.arrays
         ev = self.no_events if events is None else events
-        halt = np.ascontiguousarray(halt, dtype=np.int64)
+        halt = np.array(halt, dtype=np.int64)  # a copy: a game the guard stops halts where it is put back
         while _ckernel.run(self.params, self.mode, self.fast, a.n, a.xs, a.act, a.goal, a.rate, a.slack,
                            a.target_x, a.target_y, a.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal,
-                           ev.rate, self.flags, a.trig, LANES):
+                           ev.rate, self.flags, a.trig, LANES, a.moments, a.loads):
             for i in np.flatnonzero(self.flags).tolist():
-                self.hit(i, a.xs[:4, i], int(a.steps[i]))
+                if self.flags[i] == FLAG_RUNAWAY and self.runaway is not None:
+                    self.runaway(i)
+                    halt[i] = a.steps[i]
+                else:
+                    self.hit(i, a.xs[:4, i], int(a.steps[i]))
 
     def play(self, events: MuscleEvents, specials: list[tuple[int, int, str]], limits: np.ndarray,
              press: Callable[[int, str, str], object]) -> None:

@@ -25,6 +25,8 @@ from ..rules import GameConfig
 
 #: The batch's hit test and scoring of game ``i`` after step ``step`` from its state column; True on a hit.
 HitTest = Callable[[int, np.ndarray, int], bool]
+#: The batch's handling of game ``i``, which the speed guard stopped (``variant.BatchVariant.runaway``).
+Runaway = Callable[[int], None]
 
 
 @dataclass(frozen=True)
@@ -71,6 +73,10 @@ class BatchArrays:
     steps: np.ndarray
     #: The hand's trig and the angles it is of, (6, n) (see ``BatchGameSession.hand_trig``).
     trig: np.ndarray
+    #: The harder tasks' physics (``variant.BatchVariant``), for the compiled kernel: each game's muscle moments
+    #: (8, n) under motor noise, and the field and guard (6,); None where the batch's games have none.
+    moments: np.ndarray | None = None
+    loads: np.ndarray | None = None
 
     @property
     def n(self) -> int:

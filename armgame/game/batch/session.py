@@ -54,11 +54,13 @@ from ...physics.twojoint import TwoJointArm
 from ..muscles import MuscleLevelError, MuscleSet
 from ..rules import DwellRules, GameConfig, GameRules, hand_position
 from ..session import DOWN, RESET_KEY, TOGGLE_ARM_KEY, GameResult, GameSession, InputEvent, NonFiniteStateError
+from ..variant import GameVariant
 from .compiled import CompiledKernel
 from .compiled import available as compiled_available
 from .kernel_inputs import BatchArrays, KernelInputs
 from .numpy_kernel import NumpyKernel
 from .schedule import MuscleEvents, schedule
+from .variant import BatchVariant
 
 #: ``BatchGameSession(kernel=...)``: None, the compiled kernel where built (and RK4), else numpy.
 KERNELS = (None, "compiled", "numpy")
@@ -123,11 +125,20 @@ class BatchGameSession:
     physics steps in the target); 0, the game's rule. The kernels flag a hand inside its target after every
     step (its slack is negative there), so the rules see each such step, as the single session's loops show
     them.
+
+    ``variant``: the harder tasks' game (``armgame.game.variant.GameVariant``: its dwell, and its motor noise,
+    field and speed guard, which ``variant.BatchVariant`` keeps and only the compiled kernel steps). With
+    noise, call ``apply_noise()`` before each decision's ``advance``; a game the guard stops is ``stopped``
+    (over, with ``stop_reasons[i]``) at its state at that ``advance``'s start, until restarted.
     """
 
     def __init__(self, configs: Sequence[GameConfig], exact: bool = True, kernel: str | None = None,
-                 hold_steps: int = 0) -> None:
+                 hold_steps: int = 0, variant: GameVariant | None = None) -> None:
         configs = list(configs)
+        if variant is not None:
+            if hold_steps and hold_steps != variant.hold_steps:
+                raise ValueError(f"hold_steps {hold_steps} and the variant's {variant.hold_steps} differ")
+            hold_steps = variant.hold_steps
         self.hold_steps = hold_steps
         problem = batch_problem(configs)
         if problem:
@@ -136,6 +147,10 @@ class BatchGameSession:
             raise ValueError(f"kernel {kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
         if kernel == "compiled" and not compiled_available():
             raise ValueError("kernel 'compiled': the compiled kernel is not built here (no C compiler at install?)")
+        if BatchVariant.needs_compiled(variant) and (kernel == "numpy" or not compiled_available()
+                                                     or configs[0].integrator != "rk4"):
+            raise UserError("a batch plays motor noise and force fields in its compiled kernel only (RK4, built "
+                            "where pip install found a C compiler): play such games one at a time")
         self.configs = configs
         #: True: the single session's arithmetic, bit for bit; False: the kernels may use their fast RK4
         #: stages (see ``numpy_kernel`` and ``compiled``), within ``STATE_TOLERANCE``.
@@ -188,14 +203,20 @@ class BatchGameSession:
             elbow=tuple(m[1] for m in muscles.moments), muscle_keys=muscles.keys, rise=self._rise,
             decay=self._decay, physics_step=Integrator(c.integrator, self.model, "numpy").step_components,
             fast=self._rounds, series_from=SERIES_MIN_GAMES, series_limit=SERIES_LIMIT)
+        #: The noise, field and guard of ``variant`` (None: the game's physics).
+        self.variant = None if not BatchVariant.needs_compiled(variant) else BatchVariant(
+            variant, c.dt, n, self.kernel_inputs.shoulder, self.kernel_inputs.elbow)  # type: ignore[arg-type]
+        loaded = self.variant
         self.arrays = BatchArrays(self._xs, self._act, self._goal, self._rate, self._slack, self.target_x,
-                                  self.target_y, self.steps, self._trig)
+                                  self.target_y, self.steps, self._trig, None if loaded is None else loaded.moments,
+                                  None if loaded is None else loaded.loads)
         self.rules: list[GameRules] = [None] * n  # type: ignore[list-item]
         self._kernels: dict[int, NumpyKernel] = {}
         for i in range(n):
             self._start(i, configs[i])
         #: The compiled kernel where built (and asked for) and the integrator is RK4; else None: numpy.
-        self.compiled = CompiledKernel(self.kernel_inputs, self.arrays, self._hit_test) if use_compiled else None
+        self.compiled = CompiledKernel(self.kernel_inputs, self.arrays, self._hit_test,
+                                       self._runaway) if use_compiled else None
 
     def _start(self, i: int, config: GameConfig) -> None:
         self.configs[i] = config
@@ -210,6 +231,8 @@ class BatchGameSession:
         self.target_x[i], self.target_y[i] = rules.target.x, rules.target.y
         self._slack[i] = -1.0
         self.knife_edge[i] = False
+        if self.variant is not None:
+            self.variant.start(i, config.seed)
 
     # ------------------------------------------------------------------ queries
     q1 = property(lambda self: self._x[0], doc="shoulder angles (rad), one per game")
@@ -229,7 +252,18 @@ class BatchGameSession:
 
     @property
     def over(self) -> np.ndarray:
-        return self.steps >= self.total_steps
+        over = self.steps >= self.total_steps
+        return over if self.variant is None else over | self.variant.stopped
+
+    @property
+    def stopped(self) -> np.ndarray:
+        """Games the speed guard stopped (over; ``stop_reasons`` says why): none without a guard."""
+        return np.zeros(self.n, dtype=bool) if self.variant is None else self.variant.stopped
+
+    @property
+    def stop_reasons(self) -> dict[int, str]:
+        """Each stopped game's reason, in one line (``GameSession``'s ``RunawayError`` message)."""
+        return {} if self.variant is None else self.variant.reasons
 
     @property
     def time_left(self) -> np.ndarray:
@@ -391,12 +425,26 @@ class BatchGameSession:
             raise
         self._stop_if_non_finite()
 
+    def apply_noise(self) -> None:
+        """The motor noise's next decision on every game's muscles (``MuscleNoise.apply`` for each); none without."""
+        if self.variant is not None:
+            self.variant.apply_noise()
+
+    def _runaway(self, i: int) -> None:
+        assert self.variant is not None
+        self.variant.runaway(i, self._xs, self._act, self.steps)
+        self._slack[i] = -1.0
+
     def _advance(self, steps: int) -> None:
         left = int(steps)
         if left <= 0:
             return
         if self.compiled is not None:
-            self.compiled.run(np.minimum(self.steps + min(left, int(self.total_steps.max())), self.total_steps))
+            halt = np.minimum(self.steps + min(left, int(self.total_steps.max())), self.total_steps)
+            if self.variant is not None:
+                self.variant.keep(self._xs, self._act, self.steps)
+                halt = np.where(self.variant.stopped, self.steps, halt)
+            self.compiled.run(halt)
             return
         while left > 0:
             running = self.steps < self.total_steps
@@ -494,6 +542,8 @@ class BatchGameSession:
 
     def _play(self, timelines: Sequence[Sequence[InputEvent]],
               stop_steps: Sequence[int | None] | None) -> list[GameResult]:
+        if self.variant is not None:
+            raise ValueError("play: a batch with motor noise or a field is stepped decision by decision (advance)")
         if len(timelines) != self.n:
             raise ValueError(f"{self.n} games but {len(timelines)} timelines")
         stops = [None] * self.n if stop_steps is None else list(stop_steps)
