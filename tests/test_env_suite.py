@@ -22,12 +22,13 @@ from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
 from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv, batch_plays
 from armgame.env.vector_common import SingleEnvsVectorEnv
 from armgame.errors import UserError
+from armgame.game.batch.variant import BatchMuscleNoise
 from armgame.game.rules import DwellRules, GameConfig
 from armgame.game.session import GameSession
 
 REACH = "armgame/Reach-v1"
 #: The harder Reach ids the batch plays (the others step single envs), as docs/programs.md's id table says.
-BATCHED = {"ReachDelay", "ReachHold"}
+BATCHED = {"ReachDelay", "ReachHold", "ReachNoisy", "ReachField", "ReachHard"}
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
@@ -91,7 +92,15 @@ def test_make_vec_steps_single_envs_below_the_batchs_size_and_for_what_the_batch
     assert type(gym.make_vec(env_id, num_envs=BATCH_MIN_ENVS).unwrapped) is native
     if env_id.endswith("v1"):
         assert isinstance(gym.make_vec(env_id, num_envs=16, reward="score").unwrapped, SingleEnvsVectorEnv)
-        assert isinstance(gym.make_vec(env_id, num_envs=16, motor_noise=0.1).unwrapped, SingleEnvsVectorEnv)
+        assert isinstance(gym.make_vec(env_id, num_envs=16, motor_noise=0.1).unwrapped, ReachV1VectorEnv)
+        # Noise and fields are the compiled kernel's: without it, single envs.
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(armgame.env.vector, "compiled_available", lambda: False)
+            assert isinstance(gym.make_vec(env_id, num_envs=16, motor_noise=0.1).unwrapped, SingleEnvsVectorEnv)
+            assert isinstance(gym.make_vec(env_id, num_envs=16, field="curl").unwrapped, SingleEnvsVectorEnv)
+            assert isinstance(gym.make_vec(env_id, num_envs=16, hold_time=0.1).unwrapped, ReachV1VectorEnv)
+            with pytest.raises(EnvArgumentError, match="compiled kernel"):
+                ReachV1VectorEnv(16, field="curl")
         with pytest.raises(EnvArgumentError, match="score"):
             ReachV1VectorEnv(2, reward="score")
     for bad in (0, 10**9, 2.5):
@@ -106,7 +115,7 @@ def test_the_sb3_adapter_gives_sb3s_own_vec_env_where_no_batch_is_faster():
     from armgame.env.sb3 import ADAPTER_MIN_ENVS, SB3VecEnv, make_sb3_vec_env
 
     assert isinstance(make_sb3_vec_env(REACH, ADAPTER_MIN_ENVS), SB3VecEnv)
-    for env_id, n, kwargs in ((REACH, ADAPTER_MIN_ENVS - 1, {}), (REACH, 1, {}), ("armgame/ReachNoisy-v1", 32, {}),
+    for env_id, n, kwargs in ((REACH, ADAPTER_MIN_ENVS - 1, {}), (REACH, 1, {}), ("armgame/CenterOutHold-v1", 32, {}),
                               (REACH, 32, {"reward": "score"}), ("armgame/CenterOut-v1", 2, {})):
         envs = make_sb3_vec_env(env_id, n, seed=4, **kwargs)
         assert isinstance(envs, DummyVecEnv) and envs.num_envs == n, env_id
@@ -401,7 +410,8 @@ def test_the_size_cap_of_each_suite_ids_vector_env_is_the_one_the_docs_state():
         name = env_id.split("/")[1].removesuffix("-v1").removesuffix("Continuous")
         if name in BATCHED:
             ring = 15 * 4 * (SUITE[name].get("observation_delay", -1) + 1)  # float32 observations, delay + 1
-            most = armgame.env.vector.MAX_ENV_MEMORY // (armgame.env.vector.BYTES_PER_ENV + ring)
+            noise = BatchMuscleNoise.BYTES_PER_GAME if SUITE[name].get("motor_noise") else 0
+            most = armgame.env.vector.MAX_ENV_MEMORY // (armgame.env.vector.BYTES_PER_ENV + ring + noise)
             assert f"`{name}-v1` and its twin at most {most:,} envs" in guide
             with pytest.raises(EnvArgumentError, match=f"at most {most:,} games"):
                 gym.make_vec(env_id, num_envs=most + 1, vectorization_mode="vector_entry_point")

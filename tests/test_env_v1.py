@@ -316,11 +316,16 @@ def _step_both_with_masked_resets(native, singles, mode, rng, n: int, steps: int
     (CONTINUOUS, {"observation_delay": 23, "reset_key": True, "reward": "sparse"}),  # longer than a game
     ("armgame/ReachHold-v1", {}), ("armgame/ReachHoldContinuous-v1", {}),
     (CONTINUOUS, {"hold_time": 0.04, "observation_delay": 2, "config": GameConfig(target_radius=0.2)}),
+    ("armgame/ReachNoisy-v1", {}), ("armgame/ReachNoisyContinuous-v1", {"motor_noise": 1.0}),
+    ("armgame/ReachField-v1", {}), ("armgame/ReachFieldContinuous-v1", {"field_strength": -50.0}),
+    (REACH, {"field": "viscous", "field_strength": 2.0, "target_radius": 0.2}),
+    ("armgame/ReachHard-v1", {}), ("armgame/ReachHardContinuous-v1", {"target_radius": 0.2}),
 ])
 def test_the_harder_vector_env_equals_sync_vector_env_under_random_reset_masks(env_id, extra, mode):
     """The observation delay in the batched env (each game's ring of past observations) hands out what each single
-    env's deque does, and the batch's dwell scores what each single game's ``DwellRules`` does: through steps,
-    restarts of either autoreset, SameStep's final observations and masked resets."""
+    env's deque does, the batch's dwell scores what each single game's ``DwellRules`` does, and its motor noise
+    (each game's own stream) and field push as each single game's do: through steps, restarts of either
+    autoreset, SameStep's final observations and masked resets."""
     n, rng = 5, np.random.default_rng(3)
     kwargs = {"time_limit": 0.3, "decision_steps": 4, **extra}
     native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode,
@@ -366,6 +371,58 @@ def test_the_batchs_dwell_equals_single_envs_with_bots_scoring(hold_time, kernel
         hits += int(a[4]["hits"].sum())
         plain_hits += int(c[4]["hits"].sum())
     assert hits > 0 and hits != plain_hits
+
+
+@pytest.mark.parametrize("env_id", ["armgame/ReachHard-v1", "armgame/ReachNoisyContinuous-v1"])
+def test_the_batchs_noise_and_field_equal_single_envs_with_bots_scoring(env_id):
+    """The model bot scores on the batch's noisy, pushed games the hits it scores on single envs, through two games."""
+    from armgame.env.policies import BotPolicy
+
+    n, kwargs = 4, {"time_limit": 3.0, "observation_dtype": "float64"}
+    native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kwargs)
+    singles = SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(n)])
+    policies = [BotPolicy("model", gym.make(env_id, **kwargs)) for _ in range(n)]
+    a, b = native.reset(seed=60), singles.reset(seed=60)
+    assert isinstance(native.unwrapped, ReachV1VectorEnv) and native.unwrapped.parts[0][1].variant is not None
+    hits = 0
+    for _ in range(2 * (native.unwrapped.settings.episode_steps + 1)):
+        actions = np.array([policy(row) for policy, row in zip(policies, a[0], strict=True)])
+        a, b = native.step(actions), singles.step(actions)
+        same_step(a, b, False)
+        hits += int(a[4]["hits"].sum())
+    assert hits > 0
+
+
+@pytest.mark.parametrize("mode", list(AutoresetMode))
+def test_a_runaway_in_the_batch_ends_its_game_as_the_single_env_ends_it(mode):
+    """A viscous field beyond its range (set directly, as tests/test_env_protocol.py does) and the keys that feed
+    each arm energy: every game runs away, terminated with info["stopped"], restarted as each autoreset mode says."""
+    from armgame.env.variants import ReachVariant
+
+    n, kwargs = 3, {"time_limit": 6.0, "observation_dtype": "float64"}
+    beyond = ReachVariant(field="viscous", field_strength=10.0)
+    native = gym.make_vec(REACH, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode, **kwargs)
+    native.unwrapped.variant = beyond
+    singles = SyncVectorEnv([lambda: gym.make(REACH, **kwargs) for _ in range(n)], autoreset_mode=mode)
+    for env in singles.envs:
+        env.unwrapped.variant = beyond
+    a, b = native.reset(seed=8), singles.reset(seed=8)
+    stops = 0
+    for _ in range(400):
+        if mode is AutoresetMode.DISABLED and singles._autoreset_envs.any():
+            mask = singles._autoreset_envs.copy()
+            a, b = native.reset(options={"reset_mask": mask}), singles.reset(options={"reset_mask": mask})
+            assert np.abs(a[0] - b[0]).max() <= 1e-9
+        w = a[0][:, 2:4]
+        actions = np.column_stack([w[:, 0] > 0, w[:, 0] <= 0, w[:, 1] > 0, w[:, 1] <= 0]).astype(np.int64)
+        a, b = native.step(actions), singles.step(actions)
+        same_step(a, b, False)
+        if a[2].any():
+            stops += int(a[2].sum())
+            assert not (a[2] & a[3]).any()
+            info = a[4]["final_info"] if mode is AutoresetMode.SAME_STEP else a[4]
+            assert all("past 34.4 rad/s" in info["stopped"][i] for i in np.flatnonzero(a[2]))
+    assert stops >= n
 
 
 def test_a_delayed_observation_is_the_one_delay_steps_old():

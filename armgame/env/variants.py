@@ -31,8 +31,9 @@ and ``ReachHard-v1``, all four at once. What each does to the game:
 A variant's game is not the game of ``armgame play``, and its score is not comparable with a player's,
 but it is recorded all the same: ``armgame.env.record.replay_of(env)`` writes a replay whose task
 section carries the variant (``armgame.game.variant.GameVariant``), which ``armgame verify`` replays.
-The noise and the field run the physics in Python (about five times slower a step than the compiled
-loop); the others cost nothing.
+In a single env the noise and the field run the physics in Python (about five times slower a step than the
+compiled loop); the others cost nothing. ``gymnasium.make_vec`` plays every one in the batch's compiled kernel
+(``armgame.game.batch.variant``), each game equal to its single env.
 """
 
 from __future__ import annotations

@@ -372,7 +372,12 @@ class ReachV1VectorEnv(ReachVectorEnv):
     """``num_envs`` Reach-v1 games in lockstep: ``ReachVectorEnv`` with v1's observations and reward
     (see ``armgame.env.reach_v1.ReachV1Env``; the arguments are its). ``hold_time`` (``ReachHold-v1``) gives the
     batch's games the dwell (``BatchGameSession``'s ``hold_steps``); ``observation_delay`` (``ReachDelay-v1``)
-    hands each game's observation out that many steps late, as the single env's ``DelayedObservations`` does.
+    hands each game's observation out that many steps late, as the single env's ``DelayedObservations`` does;
+    ``motor_noise`` and ``field`` (``ReachNoisy-v1``, ``ReachField-v1``, ``ReachHard-v1``) are the batch's
+    ``variant`` (``armgame.game.batch.variant``: each game's own noise stream, the field and the speed guard in
+    the compiled kernel), and a game the guard stops is ``terminated`` with ``info["stopped"]``, as the single
+    env's. Noise and fields need the compiled kernel (refused in one line without it; ``make_vec`` then gives
+    single envs).
 
     >>> import gymnasium as gym
     >>> import armgame.env
@@ -510,9 +515,14 @@ def delay_bytes(delay: int, observation_dtype: str) -> int:
 REWARD_TOLERANCE = 1e-9
 
 #: Below this many games, ``gymnasium.make_vec`` of a Reach id steps single envs (``SingleEnvsVectorEnv``):
-#: a game's compiled loop costs less than a batch's fixed numpy work a step (benchmarks/env_speed.py: the
-#: batch at 0.25 times single envs' speed at 1 env, 0.77 at 4, 2.5 at 16).
-BATCH_MIN_ENVS = 8
+#: a game's compiled loop costs less than a batch's fixed numpy work a step. Per CPU second, the batch against
+#: single envs (issue 40, AMD EPYC, load 4 to 5): Reach-v1 0.86 at 2 envs, 1.74 at 4, 2.34 at 6; its continuous
+#: twin 0.81, 1.65, 1.66; ReachDelay-v1 1.15, 1.62, 2.37; Reach-v0 0.53, 1.04, 1.57 (it was 8 before the compiled
+#: observation pass, when the batch made 0.77 times single envs' speed at 4).
+BATCH_MIN_ENVS = 4
+#: The same for motor noise or a field, whose single envs run the physics in Python: the batch made 0.88 to 1.18
+#: times their speed at 1 env, 1.59 to 2.52 at 2 and 2.6 to 4.4 at 4 (ReachNoisy-v1, ReachField-v1, ReachHard-v1).
+LOADED_BATCH_MIN_ENVS = 2
 _NATIVE_V0 = frozenset(inspect.signature(ReachVectorEnv.__init__).parameters) - {"self", "num_envs"}
 _NATIVE_V1 = frozenset(inspect.signature(ReachV1VectorEnv.__init__).parameters) - {"self", "num_envs"}
 
@@ -536,7 +546,7 @@ def reach_v1_vector_env(num_envs: int = 1, **kwargs: Any) -> VectorEnv:
 
 
 def batch_plays(env_id: str, kwargs: dict[str, Any]) -> bool:
-    """Whether ``gymnasium.make_vec(env_id, num_envs=N, **kwargs)`` steps a batch from ``BATCH_MIN_ENVS`` games."""
+    """Whether ``gymnasium.make_vec(env_id, num_envs=N, **kwargs)`` steps a batch (from ``batch_min_envs`` games)."""
     import gymnasium
 
     spec = gymnasium.spec(env_id)
@@ -548,9 +558,8 @@ def batch_plays(env_id: str, kwargs: dict[str, Any]) -> bool:
 def _batch_takes(kwargs: dict[str, Any], native_arguments: frozenset[str]) -> bool:
     """Whether the batch plays a game of these arguments: its own arguments only, no score reward (whose
     shaping needs each game's reset and end), and motor noise or a field only where the compiled kernel is built."""
-    loaded = bool(kwargs.get("motor_noise")) or kwargs.get("field") is not None
     return (set(kwargs) <= native_arguments and kwargs.get("reward", "dense") != "score"
-            and (not loaded or compiled_available()))
+            and (not _loaded(kwargs) or compiled_available()))
 
 
 def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozenset[str], num_envs: Any,
@@ -558,11 +567,22 @@ def _chosen(native: type[ReachVectorEnv], single: type, native_arguments: frozen
     if kwargs.get("render_mode") not in (None, "rgb_array"):
         raise EnvArgumentError(f"a vector env renders with render_mode='rgb_array' (a frame per game) or None, "
                                f"got {kwargs['render_mode']!r}: for a window, render one game with gymnasium.make")
-    if _batch_takes(kwargs, native_arguments) and not _small(num_envs):  # a bad count meets the native env's check
+    # A bad count meets the native env's check.
+    if _batch_takes(kwargs, native_arguments) and not _small(num_envs, batch_min_envs(kwargs)):
         return native(num_envs, **kwargs)
     return SingleEnvsVectorEnv(single, num_envs, **kwargs)
 
 
-def _small(num_envs: Any) -> bool:
-    """Whether ``num_envs`` is a valid count below ``BATCH_MIN_ENVS`` (a bad one goes to the native env's check)."""
-    return isinstance(num_envs, int | np.integer) and not isinstance(num_envs, bool) and 1 <= num_envs < BATCH_MIN_ENVS
+def batch_min_envs(kwargs: dict[str, Any]) -> int:
+    """From how many games ``make_vec`` of these arguments steps the batch (``LOADED_BATCH_MIN_ENVS`` for motor
+    noise or a field, else ``BATCH_MIN_ENVS``), where it plays them at all (``batch_plays``)."""
+    return LOADED_BATCH_MIN_ENVS if _loaded(kwargs) else BATCH_MIN_ENVS
+
+
+def _loaded(kwargs: dict[str, Any]) -> bool:
+    return bool(kwargs.get("motor_noise")) or kwargs.get("field") is not None
+
+
+def _small(num_envs: Any, least: int) -> bool:
+    """Whether ``num_envs`` is a valid count below ``least`` (a bad one goes to the native env's check)."""
+    return isinstance(num_envs, int | np.integer) and not isinstance(num_envs, bool) and 1 <= num_envs < least

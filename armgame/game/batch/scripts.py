@@ -18,7 +18,7 @@ from ...errors import UserError
 from ...files import user_path
 from ..rules import GameConfig
 from ..session import RESET_KEY, TOGGLE_ARM_KEY, GameResult
-from .session import replay_many
+from .replays import replay_many
 
 #: Bounds on one class run (``armgame play --headless --script A B ...``), checked before any game runs.
 MAX_SCRIPTS = 5000
