@@ -4,6 +4,7 @@
     python benchmarks/env_speed.py --quick      # a few seconds a figure, fewer repeats
     python benchmarks/env_speed.py --json       # one JSON object
     python benchmarks/env_speed.py --suite armgame/ReachDelay-v1 --sizes 1 64 1024 8192 --seconds 0.3
+    python benchmarks/env_speed.py --suite armgame/Reach-v1 armgame/ReachHard-v1 --motornet --seconds 0.3 --repeats 3
 
 Env steps per second (one env step = one decision: 5 physics steps of the game, 20 ms; one
 RK4 step of 0.2 s for Acrobot) with random actions drawn before the clock starts, episodes
@@ -17,7 +18,26 @@ reset as they end:
   (issue 28: no slower at any size; at least 4 M env-steps/s at 8,192 envs);
 * with ``--suite ID ...``, instead: each suite id's ``make_vec`` vector env (the native one where the batch
   plays the id, else single envs in ``SyncVectorEnv``) against ``SyncVectorEnv`` of its single envs, side by
-  side (issue 40, item 5: at least 1 M env-steps/s at 8,192 envs); a size past the id's cap is reported so.
+  side (issue 40, item 5: at least 1 M env-steps/s at 8,192 envs); a size past the id's cap is reported so;
+* with ``--suite ID ... --motornet``, instead of ``SyncVectorEnv``: MotorNet's reaching env beside each id's
+  ``make_vec`` vector env at 1 to 8,192 envs (issue 40, item 5: at least 20 times MotorNet's env at every size).
+
+MotorNet's env is ``motornet.environment.RandomTargetReach`` (MotorNet 0.3.0's one reaching task: a start
+posture and a target drawn at random, the batch stepped as one ``batch_size``) on the ``Reacher`` effector with
+``ReluMuscle`` muscles, because that is MotorNet's arm closest to armgame's: the same two-joint planar arm
+(``TwoDofArm``), four muscles (shoulder and elbow, flexor and extensor) of constant moment arm whose force is
+the activation times the largest force, the activation following first-order dynamics toward the command, as
+armgame's four muscles of constant torque do. (``--motornet-effector arm26`` takes MotorNet's
+``RigidTendonArm26`` instead: six Hill muscles, ``RigidTendonHillMuscle``, with length- and velocity-dependent
+forces and moment arms, a costlier model than armgame's.) MotorNet's defaults are kept: one env step is its
+effector's ``timestep`` of 10 ms, one Euler step (``n_ministeps`` 1), against armgame's 20 ms (5 RK4 steps of
+4 ms), so the report prints each side's simulated seconds per env step and the ratio per simulated second
+beside the ratio per env step. ``differentiable=False`` (the reinforcement-learning mode: numpy observations
+and rewards, as Gymnasium's envs give) and ``torch.set_num_threads(1)``: one core against one core, as
+armgame's vector env is single-threaded. The actions, uniform in MotorNet's action space [0, 1], are tensors
+drawn before the clock starts; MotorNet's episodes end for the whole batch at once (``max_ep_duration``, 1 s
+by default: 100 steps), and the clock includes the ``reset`` that its API then expects. Where torch or
+motornet does not import, the report says so in one line and gives armgame's columns alone.
 
 Each figure is measured in several repeats, interleaved with its peer so that load from
 elsewhere falls on both; the report gives the median and the range over repeats, and the
@@ -34,6 +54,7 @@ import platform
 import statistics
 import time
 from collections.abc import Callable
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -42,6 +63,8 @@ import armgame.env  # noqa: F401  (registers armgame/Reach-v0)
 from armgame.env.vector import BATCH_MIN_ENVS
 
 VECTOR_SIZES = (1, 4, 16, 64, 1024, 8192)
+MOTORNET_SIZES = (1, 4, 16, 64, 256, 1024, 4096, 8192)  # issue 40: every size from 1 to 8,192
+MOTORNET_GOAL = 20.0  # armgame's env steps per CPU second over MotorNet's, at every size (issue 40)
 SINGLE_GOAL = 1.0  # Reach-v0 steps per second over Acrobot-v1's
 VECTOR_GOAL = 1e6  # env-steps per second at 8,192 envs (v0)
 V1_VECTOR_GOAL = 4e6  # Reach-v1's, at 8,192 envs (issue 28)
@@ -83,6 +106,60 @@ def vector_runner(env_id: str, num_envs: int, mode: str) -> Callable[[float], tu
         end = start + seconds
         while True:
             envs.step(actions[steps % 8])
+            steps += 1
+            now = time.perf_counter()
+            if now >= end:
+                return steps * num_envs / (now - start), steps * num_envs / (time.process_time() - cpu)
+
+    return run
+
+
+def motornet_env(effector: str) -> Any:
+    """MotorNet's reaching env on ``effector`` ("reacher" or "arm26"), its defaults kept (see the module's doc)."""
+    import motornet as mn
+    import torch
+
+    torch.set_num_threads(1)  # one core against one core: armgame's vector env is single-threaded
+    if effector == "reacher":
+        arm = mn.effector.Reacher(muscle=mn.muscle.ReluMuscle())
+    else:
+        arm = mn.effector.RigidTendonArm26(muscle=mn.muscle.RigidTendonHillMuscle())
+    return mn.environment.RandomTargetReach(effector=arm, differentiable=False)
+
+
+def motornet_facts(effector: str) -> dict[str, object]:
+    """MotorNet's versions and its env step (simulated seconds, integration), or why it could not be imported."""
+    try:
+        import motornet as mn
+        import torch
+    except ImportError as exc:  # the benchmark runs without it: armgame's columns alone
+        return {"missing": f"{type(exc).__name__}: {exc}"}
+    env = motornet_env(effector)
+    arm = env.effector
+    return {"versions": f"torch {torch.__version__}, motornet {mn.__version__}, {torch.get_num_threads()} thread",
+            "env": f"RandomTargetReach({type(arm).__name__}({type(arm.muscle).__name__}))",
+            "dt": env.dt, "ministeps": arm.n_ministeps, "integration": arm.integration_method,
+            "episode_seconds": env.max_ep_duration}
+
+
+def motornet_runner(num_envs: int, effector: str) -> Callable[[float], tuple[float, float]]:
+    """Env-steps per second (vector steps x batch size) of MotorNet's env for about ``seconds``: (wall, CPU)."""
+    import torch
+
+    env = motornet_env(effector)
+    generator = torch.Generator().manual_seed(0)
+    actions = [torch.rand(num_envs, env.action_space.shape[0], generator=generator) for _ in range(8)]
+    options = {"batch_size": num_envs}
+    env.reset(seed=0, options=options)
+    env.step(actions[0])  # as vector_runner's: the first step may build what later steps reuse
+
+    def run(seconds: float) -> tuple[float, float]:
+        steps, start, cpu = 0, time.perf_counter(), time.process_time()
+        end = start + seconds
+        while True:
+            _, _, terminated, _, _ = env.step(actions[steps % 8])
+            if terminated:  # the whole batch's episode ends at once: its API resets the batch
+                env.reset(options=options)
             steps += 1
             now = time.perf_counter()
             if now >= end:
@@ -142,33 +219,64 @@ def measure(quick: bool, sizes: tuple[int, ...] = VECTOR_SIZES, seconds: float |
 def _run_facts(load_before: float, seconds: float) -> dict[str, object]:
     """The machine, its load average before and after, and each repeat's length: beside every figure."""
     return {"machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-                       f"numpy {np.__version__}, gymnasium {gym.__version__}",
+                       f"numpy {np.__version__}, gymnasium {gym.__version__}, {_compiled()}",
             "load_average": [load_before, os.getloadavg()[0]], "seconds_per_repeat": seconds}
 
 
-def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, repeats: int) -> dict[str, object]:
-    """Each id's ``make_vec`` vector env against ``SyncVectorEnv`` of its single envs, paired, at each size."""
+def _compiled() -> str:
+    """Which of the batch's compiled modules this process loaded: without them it runs their Python twins,
+    several times slower (a rebuild of the extensions while a run imports armgame can leave it without)."""
+    from armgame.env import features
+    from armgame.game.batch import compiled
+
+    loaded = {"_ckernel": compiled._ckernel, "_cvector": features._cvector}  # what the batch steps with
+    missing = [name for name, module in loaded.items() if module is None]
+    return f"Python twins for {', '.join(missing)}" if missing else "compiled _ckernel and _cvector"
+
+
+def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, repeats: int,
+                  motornet: str | None = None) -> dict[str, object]:
+    """Each id's ``make_vec`` vector env against its peer, paired, at each size: ``SyncVectorEnv`` of its single
+    envs, or with ``motornet`` (an effector) MotorNet's env, where it imports (else ``make_vec`` alone)."""
     from armgame.env.base import EnvArgumentError
     from armgame.env.vector import batch_plays
 
     load_before = os.getloadavg()[0]
+    facts = motornet_facts(motornet) if motornet else None
+    if facts is None:
+        peer: str | None = "sync"
+    else:  # MotorNet, or where it does not import no peer: make_vec's columns alone
+        peer = None if "missing" in facts else "motornet"
     ids: dict[str, object] = {}
     for env_id in env_ids:
+        single = gym.make(env_id)
+        game = single.unwrapped  # its simulated time a step, beside MotorNet's
+        step_seconds = game.decision_time
+        physics = (f"{game.decision_steps} {game.settings.config.integrator.upper()} steps of "
+                   f"{game.settings.config.dt * 1e3:g} ms")
+        single.close()
         rates: dict[int, object] = {}
         for n in sizes:
             try:
-                runners = {"make_vec": vector_runner(env_id, n, "vector_entry_point"),
-                           "sync": vector_runner(env_id, n, "sync")}
+                runners = {"make_vec": vector_runner(env_id, n, "vector_entry_point")}
+                if peer == "sync":
+                    runners["sync"] = vector_runner(env_id, n, "sync")
             except EnvArgumentError as exc:  # past the id's cap
                 rates[n] = {"refused": str(exc)}
                 continue
+            if peer == "motornet":
+                runners["motornet"] = motornet_runner(n, motornet)  # type: ignore[arg-type]
             rates[n] = paired(runners, seconds, repeats)
-            rates[n]["ratio"] = spread([a / b for a, b in zip(rates[n]["make_vec"]["cpu_rates"],  # type: ignore[index]
-                                                              rates[n]["sync"]["cpu_rates"], strict=True)])
-        ids[env_id] = {"batched": batch_plays(env_id, {}), "sizes": rates}
+            if peer:
+                rates[n]["ratio"] = spread([a / b for a, b in zip(rates[n]["make_vec"]["cpu_rates"],  # type: ignore[index]
+                                                                  rates[n][peer]["cpu_rates"], strict=True)])
+        ids[env_id] = {"batched": batch_plays(env_id, {}), "sizes": rates, "step_seconds": step_seconds,
+                       "physics": physics}
     return {
         **_run_facts(load_before, seconds),
         "repeats": repeats,
+        "peer": peer,
+        "motornet": facts,
         "ids": ids,
     }
 
@@ -178,6 +286,19 @@ def report_suite(result: dict) -> None:
     print(f"env steps per second, wall clock: median [min - max] of {result['repeats']} repeats of "
           f"{result['seconds_per_repeat']} s, interleaved with the peer; per CPU second: median")
     print(f"{result['machine']}; load average {load[0]:.1f} before, {load[1]:.1f} after")
+    facts = result["motornet"]
+    if facts is not None:
+        if "missing" in facts:
+            print(f"MotorNet not measured (does not import: {facts['missing']}): make_vec's columns alone")
+        else:
+            report_motornet(result)
+            return
+    if result["peer"] is None:
+        for env_id, found in result["ids"].items():
+            print(f"{env_id}: make_vec per CPU s " + ", ".join(
+                f"{n}: {'refused' if 'refused' in rates else format(rates['make_vec']['cpu']['median'], ',.0f')}"
+                for n, rates in found["sizes"].items()))
+        return
     cpu = "per CPU s"
     for env_id, found in result["ids"].items():
         kind = "the batch" if found["batched"] else "single envs"
@@ -190,6 +311,32 @@ def report_suite(result: dict) -> None:
             ours, theirs, r = rates["make_vec"], rates["sync"], rates["ratio"]
             print(f"{n:>6}  {fmt(ours['wall']):>32} {ours['cpu']['median']:>11,.0f}  {fmt(theirs['wall']):>30} "
                   f"{theirs['cpu']['median']:>11,.0f}  {r['median']:.2f} [{r['min']:.2f} - {r['max']:.2f}]")
+
+
+def report_motornet(result: dict) -> None:
+    """Each id's ``make_vec`` vector env beside MotorNet's env: per CPU second, the ratio per env step and per
+    simulated second (the two sides' env steps simulate different times)."""
+    facts = result["motornet"]
+    print(f"MotorNet: {facts['env']}, {facts['versions']}; its env step {facts['dt'] * 1e3:g} ms simulated "
+          f"({facts['ministeps']} {facts['integration']} step), episodes of {facts['episode_seconds']:g} s "
+          f"reset for the whole batch inside the clock")
+    cpu = "per CPU s"
+    for env_id, found in result["ids"].items():
+        kind = "the batch" if found["batched"] else "single envs"
+        per_sim = found["step_seconds"] / facts["dt"]  # armgame's simulated seconds per MotorNet's, per env step
+        print(f"{env_id} (make_vec steps {kind} from {BATCH_MIN_ENVS} envs; its env step "
+              f"{found['step_seconds'] * 1e3:g} ms simulated, {found['physics']})")
+        print(f"{'envs':>6}  {'make_vec':>32} {cpu:>11}  {'MotorNet':>30} {cpu:>11}  "
+              f"{'armgame / MotorNet per CPU s':>30}  {'per simulated s':>15}")
+        for n, rates in found["sizes"].items():
+            if "refused" in rates:
+                print(f"{n:>6}  refused: {rates['refused']}")
+                continue
+            ours, theirs, r = rates["make_vec"], rates["motornet"], rates["ratio"]
+            ratio = f"{r['median']:.2f} [{r['min']:.2f} - {r['max']:.2f}]"
+            short = "" if r["median"] >= MOTORNET_GOAL else f" (< {MOTORNET_GOAL:g})"
+            print(f"{n:>6}  {fmt(ours['wall']):>32} {ours['cpu']['median']:>11,.0f}  {fmt(theirs['wall']):>30} "
+                  f"{theirs['cpu']['median']:>11,.0f}  {ratio + short:>30}  {r['median'] * per_sim:>15.2f}")
 
 
 def profile(num_envs: int = 8192, steps: int = 60) -> list[tuple[str, float]]:
@@ -260,14 +407,23 @@ def main() -> None:
     parser.add_argument("--profile", action="store_true", help="also profile the vector env at 8,192 envs")
     parser.add_argument("--suite", nargs="+", metavar="ID",
                         help="instead: these ids' make_vec vector envs against SyncVectorEnv of their single envs")
-    parser.add_argument("--sizes", nargs="+", type=int, help=f"the vector sizes (default {VECTOR_SIZES})")
+    parser.add_argument("--motornet", action="store_true",
+                        help="with --suite: MotorNet's reaching env as the peer instead of SyncVectorEnv")
+    parser.add_argument("--motornet-effector", choices=("reacher", "arm26"), default="reacher",
+                        help="MotorNet's arm: Reacher with ReluMuscle (default, the closest to armgame's) or "
+                             "RigidTendonArm26 with RigidTendonHillMuscle")
+    parser.add_argument("--sizes", nargs="+", type=int,
+                        help=f"the vector sizes (default {VECTOR_SIZES}; with --motornet {MOTORNET_SIZES})")
     parser.add_argument("--seconds", type=float, help="the seconds of one repeat (default 1, --quick 0.3)")
     parser.add_argument("--repeats", type=int, help="the repeats of each figure (default 5, --quick 3)")
     args = parser.parse_args()
-    sizes = tuple(args.sizes or VECTOR_SIZES)
+    if args.motornet and not args.suite:
+        parser.error("--motornet is measured beside --suite ID ...")
+    sizes = tuple(args.sizes or (MOTORNET_SIZES if args.motornet else VECTOR_SIZES))
     if args.suite:
         result = measure_suite(args.suite, sizes, args.seconds or (0.3 if args.quick else 1.0),
-                               args.repeats or (3 if args.quick else 5))
+                               args.repeats or (3 if args.quick else 5),
+                               args.motornet_effector if args.motornet else None)
         if args.json:
             print(json.dumps(result, default=str))
         else:
