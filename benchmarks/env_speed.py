@@ -60,7 +60,7 @@ import gymnasium as gym
 import numpy as np
 
 import armgame.env  # noqa: F401  (registers armgame/Reach-v0)
-from armgame.env.vector import BATCH_MIN_ENVS
+from armgame.env.vector import batch_min_envs
 
 VECTOR_SIZES = (1, 4, 16, 64, 1024, 8192)
 MOTORNET_SIZES = (1, 4, 16, 64, 256, 1024, 4096, 8192)  # issue 40: every size from 1 to 8,192
@@ -270,7 +270,8 @@ def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, re
             if peer:
                 rates[n]["ratio"] = spread([a / b for a, b in zip(rates[n]["make_vec"]["cpu_rates"],  # type: ignore[index]
                                                                   rates[n][peer]["cpu_rates"], strict=True)])
-        ids[env_id] = {"batched": batch_plays(env_id, {}), "sizes": rates, "step_seconds": step_seconds,
+        ids[env_id] = {"batched": batch_plays(env_id, {}), "batch_from": batch_min_envs(gym.spec(env_id).kwargs),
+                       "sizes": rates, "step_seconds": step_seconds,
                        "physics": physics}
     return {
         **_run_facts(load_before, seconds),
@@ -302,7 +303,7 @@ def report_suite(result: dict) -> None:
     cpu = "per CPU s"
     for env_id, found in result["ids"].items():
         kind = "the batch" if found["batched"] else "single envs"
-        print(f"{env_id} (make_vec steps {kind} from {BATCH_MIN_ENVS} envs)")
+        print(f"{env_id} (make_vec steps {kind} from {found['batch_from']} envs)")
         print(f"{'envs':>6}  {'make_vec':>32} {cpu:>11}  {'SyncVectorEnv':>30} {cpu:>11}  make_vec / sync per CPU s")
         for n, rates in found["sizes"].items():
             if "refused" in rates:
@@ -324,7 +325,7 @@ def report_motornet(result: dict) -> None:
     for env_id, found in result["ids"].items():
         kind = "the batch" if found["batched"] else "single envs"
         per_sim = found["step_seconds"] / facts["dt"]  # armgame's simulated seconds per MotorNet's, per env step
-        print(f"{env_id} (make_vec steps {kind} from {BATCH_MIN_ENVS} envs; its env step "
+        print(f"{env_id} (make_vec steps {kind} from {found['batch_from']} envs; its env step "
               f"{found['step_seconds'] * 1e3:g} ms simulated, {found['physics']})")
         print(f"{'envs':>6}  {'make_vec':>32} {cpu:>11}  {'MotorNet':>30} {cpu:>11}  "
               f"{'armgame / MotorNet per CPU s':>30}  {'per simulated s':>15}")

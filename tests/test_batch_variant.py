@@ -173,3 +173,29 @@ def test_the_kernel_refuses_bad_loads_and_moments_before_any_step():
     assert batch.steps[0] == 0  # nothing ran
     run(np.ones((8, 1)), good)
     assert batch.steps[0] == 10
+
+
+def test_a_single_noisy_game_runs_its_compiled_loop_with_the_python_loops_floats():
+    """``GameSession.set_muscle_moments`` packs the compiled loop's moments again each decision, so a noisy single
+    game runs in C (it ran the Python loop) with the same floats; a field's game still runs the Python loop."""
+    variant = VARIANTS["noise"]
+    config = GameConfig(seed=5, time_limit=10.0, target_radius=0.15)
+    games = []
+    for compiled in (True, False):
+        session = variant.session(config)
+        if not compiled:
+            session._compiled = None  # the Python loop, the reference
+        noise = variant.noise(config, session)
+        rng = np.random.default_rng(1)
+        held = np.zeros(4, dtype=bool)
+        while not session.over:
+            held = np.where(rng.random() < 0.1, rng.random(4) < 0.5, held)
+            for m, key in enumerate(session.muscles.keys):
+                if session.held[m] != held[m]:
+                    session.key_event(key, "down" if held[m] else "up")
+            noise.apply(session)
+            session.advance(variant.decision_steps)
+        games.append((session.state, session.rules.board.hits, session.muscles.activation))
+    assert games[0] == games[1] and games[0][1] > 0
+    pushed = VARIANTS["curl"].session(config)
+    assert pushed._compiled is not None and pushed._compiled[2] is not pushed._physics_step  # the Python loop

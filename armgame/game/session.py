@@ -229,6 +229,17 @@ class GameSession:
             else:
                 self.level_events_overflow = True
 
+    def set_muscle_moments(self, moments: tuple[tuple[float, float], ...]) -> None:
+        """Each muscle's (shoulder, elbow) moment from the next step on (motor noise rescales them between
+        decisions): the Python loop reads them afresh each ``advance``, the compiled one from its params, packed
+        again here."""
+        self.muscles.moments = moments
+        compiled = self._compiled
+        if compiled is not None:
+            params, mode, _ = self._compiled_loop()  # type: ignore[misc]
+            # Still the step it replaced: a step swapped in since (a field's) keeps the Python loop running.
+            self._compiled = params, mode, compiled[2]
+
     def _compiled_loop(self) -> tuple[bytes, int, object] | None:
         """(params, mode, the step it replaces) for ``_ckernel.game_steps``, or None where it cannot run."""
         if _c_game_steps is None or self.config.integrator != "rk4":

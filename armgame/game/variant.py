@@ -16,8 +16,9 @@ everything its result depends on and ``armgame verify`` recomputes it (issue 40)
   there (``RunawayError``, raised before the step's state is kept), which keeps the env's declared speed
   bounds true. Infinite: no guard.
 
-The session runs the Python loop whenever a field or noise is on (the compiled loop has no loads and
-packs the muscles' moments once); the result is the same floats either way for the game itself.
+A single session runs the Python loop whenever a field is on (its compiled loop has no loads); noise runs
+in either (``GameSession.set_muscle_moments`` packs the compiled loop's moments again), the same floats.
+A batch plays all of them in its compiled kernel (``armgame.game.batch.variant``).
 """
 
 from __future__ import annotations
@@ -81,8 +82,7 @@ class GameVariant:
         """A new game of ``config`` with this variant's rules and physics (noise: ``MuscleNoise``, applied by the
         caller before each decision)."""
         rules: GameRules | None = DwellRules(config, self.hold_steps) if self.hold_steps else None
-        # Noise rescales the muscles' moments between decisions, which only the Python loop reads afresh.
-        session = GameSession(config, compiled=not self.motor_noise, rules=rules)
+        session = GameSession(config, rules=rules)
         loads = self.loads()
         if loads is not None:
             # A step swapped in runs through the session's Python loop (the compiled one has no loads).
@@ -142,7 +142,7 @@ class MuscleNoise:
     def apply(self, session: GameSession) -> None:
         self.state = self._keep * self.state + self._fresh * self._rng.standard_normal(4)
         factors = np.clip(1.0 + self.state, 0.0, NOISE_FACTOR_MAX).tolist()
-        session.muscles.moments = tuple((f * s, f * e) for f, (s, e) in zip(factors, self._moments, strict=True))
+        session.set_muscle_moments(tuple((f * s, f * e) for f, (s, e) in zip(factors, self._moments, strict=True)))
 
 
 class VariantPlay:
