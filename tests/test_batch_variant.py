@@ -199,3 +199,23 @@ def test_a_single_noisy_game_runs_its_compiled_loop_with_the_python_loops_floats
     assert games[0] == games[1] and games[0][1] > 0
     pushed = VARIANTS["curl"].session(config)
     assert pushed._compiled is not None and pushed._compiled[2] is not pushed._physics_step  # the Python loop
+
+
+@pytest.mark.parametrize("name", ["curl", "viscous"])
+def test_a_single_fields_compiled_step_is_the_python_loaded_arms_step(name):
+    """``GameSession.field_step`` (``_ckernel.rk4_step_loaded``) against ``physics.loads``' RK4 in Python, on states
+    across and beyond the game's range: the same floats, so a field's replays recorded before it still verify."""
+    from armgame.physics.integrators import Integrator
+    from armgame.physics.loads import loaded_arm
+
+    variant = VARIANTS[name]
+    session = variant.session(GameConfig())
+    compiled = session.field_step(1 if name == "curl" else 2, variant.field_parameters)
+    python = Integrator("rk4", loaded_arm(session.model, variant.loads())).step_components
+    rng = np.random.default_rng(4)
+    for q1, q2, w1, w2, t1, t2 in rng.uniform(-1, 1, (2000, 6)) * (4.0, 3.0, 40.0, 40.0, 30.0, 30.0):
+        assert compiled(q1, q2, w1, w2, t1, t2, 0.004) == python(q1, q2, w1, w2, t1, t2, 0.004)
+    with pytest.raises(ValueError, match="kind"):
+        session.field_step(3, variant.field_parameters)(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.004)
+    with pytest.raises(ValueError, match="p0 is not finite"):
+        session.field_step(1, (np.inf, 0.0, 0.0, 0.0))(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.004)

@@ -56,32 +56,43 @@ static int sincos_agrees(void)
 #endif
 }
 
-/* A stage of RK4 in full: GameSession's accel with its own b cos q2 and b sin q2. */
-static inline void accel_full(const Arm *arm, double q1, double q2, double w1, double w2, double t1, double t2,
-                              double *o1, double *o2)
+/* A stage of RK4 in full: GameSession's accel with its own b cos q2 and b sin q2; with a field (not NULL),
+ * loads' accel: the field's torque at the stage added to the muscles' (the hand's trig the C library's, as
+ * Python's ``math`` is there). */
+static inline void accel_full(const Arm *arm, const Field *field, double q1, double q2, double w1, double w2,
+                              double t1, double t2, double *o1, double *o2)
 {
     double sn, cs;
+    if (field != NULL) {
+        double s1, c1, s12, c12, e1, e2;
+        sin_cos(q1, &s1, &c1);
+        sin_cos(q1 + q2, &s12, &c12);
+        field_torque(field, s1, c1, s12, c12, w1, w2, &e1, &e2);
+        t1 = t1 + e1;
+        t2 = t2 + e2;
+    }
     arm_sin_cos(q2, &sn, &cs);
     accel_trig(arm, q1, q2, arm->b * cs, arm->b * sn, w1, w2, t1, t2, o1, o2);
 }
 
-/* integrators._rk4, exactly: x (q1, q2, w1, w2) one step of dt on, torques t1, t2 held. h and k are
- * taken from dt as the Python step takes them (0.5 dt and dt times _SIXTH, 1/6 rounded once). */
-static inline void rk4_exact(const Arm *arm, double t1, double t2, double dt, double x[4])
+/* integrators._rk4, exactly: x (q1, q2, w1, w2) one step of dt on, torques t1, t2 held, the field's added
+ * where one is given. h and k are taken from dt as the Python step takes them (0.5 dt and dt times _SIXTH,
+ * 1/6 rounded once). */
+static inline void rk4_exact(const Arm *arm, const Field *field, double t1, double t2, double dt, double x[4])
 {
     const double q1 = x[0], q2 = x[1], w1 = x[2], w2 = x[3];
     const double h = 0.5 * dt;
     double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
-    accel_full(arm, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
+    accel_full(arm, field, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
     const double v1 = w1 + h * ka1;
     const double v2 = w2 + h * ka2;
-    accel_full(arm, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
+    accel_full(arm, field, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
     const double u1 = w1 + h * kb1;
     const double u2 = w2 + h * kb2;
-    accel_full(arm, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
+    accel_full(arm, field, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
     const double z1 = w1 + dt * kc1;
     const double z2 = w2 + dt * kc2;
-    accel_full(arm, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
+    accel_full(arm, field, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
     const double k = dt * (1.0 / 6.0);
     x[0] = q1 + k * (w1 + z1 + 2.0 * (v1 + u1));
     x[1] = q2 + k * (w2 + z2 + 2.0 * (v2 + u2));
@@ -236,7 +247,7 @@ static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t na
         a2 += (g2 - a2) * r2;
         a3 += (g3 - a3) * r3;
         memcpy(previous, x, sizeof previous);
-        rk4_exact(&arm, t1, t2, dt, x);
+        rk4_exact(&arm, NULL, t1, t2, dt, x);
         ran++;
         /* The hand's four cos and sin cost a third of a step: it is measured only when a lower bound on its
          * distance from the disc, lowered by a bound on each step's move, runs out (the batch's slack, see
@@ -293,7 +304,32 @@ static PyObject *rk4_step(PyObject *self, PyObject *const *args, Py_ssize_t narg
     if (one_game_args("rk4_step", args, nargs, 9, p, &arm, 2, 7, v, "q1 q2 w1 w2 t1 t2 dt", 0) < 0)
         return NULL;
     double x[4] = {v[0], v[1], v[2], v[3]};
-    rk4_exact(&arm, v[4], v[5], v[6], x);
+    rk4_exact(&arm, NULL, v[4], v[5], v[6], x);
+    return Py_BuildValue("(dddd)", x[0], x[1], x[2], x[3]);
+}
+
+PyDoc_STRVAR(rk4_step_loaded_doc,
+"rk4_step_loaded(params, mode, kind, p0, p1, p2, p3, q1, q2, w1, w2, t1, t2, dt) -> (q1, q2, w1, w2)\n\n"
+"rk4_step with a field at the hand: loads.loaded_arm's RK4 step, its operations in order (the hand's cos\n"
+"and sin the C library's, as Python's math is there). kind 1: the curl field of b = p0; 2: the viscous\n"
+"field of the matrix ((p0, p1), (p2, p3)). The arm's lengths are the params'. Refused (ValueError): a value\n"
+"or param not finite, another kind.");
+
+static PyObject *rk4_step_loaded(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    double p[P_COUNT], v[12];
+    Arm arm;
+    if (one_game_args("rk4_step_loaded", args, nargs, 14, p, &arm, 2, 12, v,
+                      "kind p0 p1 p2 p3 q1 q2 w1 w2 t1 t2 dt", 0) < 0)
+        return NULL;
+    if (v[0] != FIELD_CURL && v[0] != FIELD_VISCOUS) {
+        PyErr_SetString(PyExc_ValueError, "rk4_step_loaded: kind must be 1 (curl) or 2 (viscous)");
+        return NULL;
+    }
+    const Field field = {(int)v[0], {v[1], v[2], v[3], v[4]}, p[P_L1], p[P_L2]};
+    double x[4] = {v[5], v[6], v[7], v[8]};
+    rk4_exact(&arm, &field, v[9], v[10], v[11], x);
     return Py_BuildValue("(dddd)", x[0], x[1], x[2], x[3]);
 }
 
@@ -355,7 +391,7 @@ static PyObject *rk4_run(PyObject *self, PyObject *args)
     Py_BEGIN_ALLOW_THREADS
     while (ran < steps) {
         const Py_ssize_t row = ran < rows ? ran : rows - 1;
-        rk4_exact(&arm, tq[2 * row], tq[2 * row + 1], dt, x);
+        rk4_exact(&arm, NULL, tq[2 * row], tq[2 * row + 1], dt, x);
         ran++;
         if (ran % every == 0 && slot < slots) {
             memcpy(out + 4 * slot, x, 4 * sizeof(double));
@@ -374,6 +410,7 @@ done:
 
 static PyMethodDef methods[] = {
     {"run", armgame_run, METH_VARARGS, armgame_run_doc},
+    {"rk4_step_loaded", (PyCFunction)(void (*)(void))rk4_step_loaded, METH_FASTCALL, rk4_step_loaded_doc},
     {"event_columns", armgame_event_columns, METH_VARARGS, armgame_event_columns_doc},
     {"game_steps", (PyCFunction)(void (*)(void))game_steps, METH_FASTCALL, game_steps_doc},
     {"rk4_step", (PyCFunction)(void (*)(void))rk4_step, METH_FASTCALL, rk4_step_doc},

@@ -202,6 +202,33 @@ typedef struct {
 
 /* A field at the hand (loads.CurlField, loads.ViscousField) and the flag of a game the guard stopped. */
 enum { FIELD_NONE = 0, FIELD_CURL = 1, FIELD_VISCOUS = 2 };
+
+/* A field at the hand: its kind, parameters (curl b; viscous b11 b12 b21 b22) and the arm's lengths. */
+typedef struct {
+    int kind;
+    double p[4], l1, l2;
+} Field;
+
+/* The field's joint torque ``J(q)^T F(v)`` (loads._with_loads's ``external`` with no joint load, operation
+ * for operation) from the hand's trig: sin and cos of q1 (s1, c1) and of q1 + q2 (s12, c12). */
+static inline void field_torque(const Field *f, double s1, double c1, double s12, double c12, double w1, double w2,
+                                double *e1, double *e2)
+{
+    const double j12 = -f->l2 * s12, j22 = f->l2 * c12;
+    const double j11 = -f->l1 * s1 + j12, j21 = f->l1 * c1 + j22;
+    const double vx = j11 * w1 + j12 * w2, vy = j21 * w1 + j22 * w2;
+    double fx, fy;
+    if (f->kind == FIELD_CURL) {
+        fx = f->p[0] * vy;
+        fy = -f->p[0] * vx;
+    } else {
+        fx = f->p[0] * vx + f->p[1] * vy;
+        fy = f->p[2] * vx + f->p[3] * vy;
+    }
+    /* No joint load: Python's 0.0 + 0.0 * w1 + 0.0 * w2 (+0, or NaN where w is not finite). */
+    *e1 = 0.0 + 0.0 * w1 + 0.0 * w2 + j11 * fx + j21 * fy;
+    *e2 = 0.0 + 0.0 * w1 + 0.0 * w2 + j12 * fx + j22 * fy;
+}
 #define FLAG_NEAR 1
 #define FLAG_RUNAWAY 2
 

@@ -59,15 +59,14 @@ typedef struct {
     double b, d, det0, amd, k1, k2, dt, h, k, limit2, reach1, reach2;
     double s[4], e[4];
     int damping, fast;
-    /* The loaded step's (Batch's mom, field, fp, limit): the arm's lengths for the hand's Jacobian. */
-    double l1, l2, fp[4], limit;
-    int field;
+    /* The loaded step's (Batch's field and limit). */
+    Field field;
+    double limit;
 } Step;
 
-/* The torque of the field at the hand at every lane's stage (loads._with_loads's ``external`` with no joint
- * load: ``J(q)^T F(v)``, operation for operation), into e1, e2. The exact kernel takes the hand's cos and sin
- * from the C library, as Python's ``math`` does there; the fast kernel from the arm's own trig, which
- * vectorises (round-off: it is within an ulp of the C library's). */
+/* The torque of the field at the hand at every lane's stage (``field_torque``), into e1, e2. The exact kernel
+ * takes the hand's cos and sin from the C library, as Python's ``math`` does there; the fast kernel from the
+ * arm's own trig, which vectorises (round-off: it is within an ulp of the C library's). */
 LANES_INLINE void field_lanes(const Step *k, const double *q1, const double *q2, const double *w1,
                                const double *w2, double *e1, double *e2)
 {
@@ -83,22 +82,8 @@ LANES_INLINE void field_lanes(const Step *k, const double *q1, const double *q2,
             sin_cos(q1[l] + q2[l], &s12[l], &c12[l]);
         }
     }
-    for (int l = 0; l < LANES; l++) {
-        const double j12 = -k->l2 * s12[l], j22 = k->l2 * c12[l];
-        const double j11 = -k->l1 * s1[l] + j12, j21 = k->l1 * c1[l] + j22;
-        const double vx = j11 * w1[l] + j12 * w2[l], vy = j21 * w1[l] + j22 * w2[l];
-        double fx, fy;
-        if (k->field == FIELD_CURL) {
-            fx = k->fp[0] * vy;
-            fy = -k->fp[0] * vx;
-        } else {
-            fx = k->fp[0] * vx + k->fp[1] * vy;
-            fy = k->fp[2] * vx + k->fp[3] * vy;
-        }
-        /* No joint load: Python's 0.0 + 0.0 * w1 + 0.0 * w2 (+0, or NaN where w is not finite). */
-        e1[l] = 0.0 + 0.0 * w1[l] + 0.0 * w2[l] + j11 * fx + j21 * fy;
-        e2[l] = 0.0 + 0.0 * w1[l] + 0.0 * w2[l] + j12 * fx + j22 * fy;
-    }
+    for (int l = 0; l < LANES; l++)
+        field_torque(&k->field, s1[l], c1[l], s12[l], c12[l], w1[l], w2[l], &e1[l], &e2[l]);
 }
 
 /* TwoJointArm's accel_unforced or accel_with_damping (``accel_trig``) for every lane, the lanes' stage
@@ -109,13 +94,13 @@ LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, c
                                const int loaded)
 {
     double e1[LANES], e2[LANES];
-    if (loaded && k->field != FIELD_NONE)
+    if (loaded && k->field.kind != FIELD_NONE)
         field_lanes(k, q1, q2, w1, w2, e1, e2);
     for (int l = 0; l < LANES; l++) {
         const double bc = L->ec[l], h = L->es[l];
         const double m12 = k->d + bc;
-        const double u1 = loaded && k->field != FIELD_NONE ? t1[l] + e1[l] : t1[l];
-        const double u2 = loaded && k->field != FIELD_NONE ? t2[l] + e2[l] : t2[l];
+        const double u1 = loaded && k->field.kind != FIELD_NONE ? t1[l] + e1[l] : t1[l];
+        const double u2 = loaded && k->field.kind != FIELD_NONE ? t2[l] + e2[l] : t2[l];
         double f1 = u1 + h * (w1[l] + w1[l] + w2[l]) * w2[l];
         double f2 = u2 - h * w1[l] * w1[l];
         if (k->damping) {
@@ -489,7 +474,7 @@ Py_ssize_t armgame_run_lanes(const Batch *B)
     const Step k = {arm->b, arm->d, arm->det0, arm->amd, arm->k1, arm->k2, B->dt, B->h, B->k, B->limit2,
                     B->reach1, B->reach2, {B->s[0], B->s[1], B->s[2], B->s[3]},
                     {B->e[0], B->e[1], B->e[2], B->e[3]}, arm->mode == MODE_DAMPING, B->fast,
-                    B->l1, B->l2, {B->fp[0], B->fp[1], B->fp[2], B->fp[3]}, B->limit, B->field};
+                    {B->field, {B->fp[0], B->fp[1], B->fp[2], B->fp[3]}, B->l1, B->l2}, B->limit};
     /* The loaded step where the games have their own moments, a field or a guard; else the plain one. */
     const int loaded = B->mom != NULL || B->field != FIELD_NONE || B->limit < INFINITY;
     int (*const step)(const Step *, Lanes *) = loaded ? step_lanes_loaded : step_lanes;

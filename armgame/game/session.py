@@ -248,6 +248,15 @@ class GameSession:
         values = kernel_params(self.model, self.config.dt, [m[0] for m in moments], [m[1] for m in moments])
         return struct.pack(f"={KERNEL_PARAMS}d", *values), kernel_mode(self.model.params), self._physics_step
 
+    def field_step(self, kind: int, parameters: tuple[float, float, float, float]
+                   ) -> Callable[..., tuple[float, float, float, float]] | None:
+        """The physics step with a field at the hand (``_ckernel.c``'s FIELD_* ``kind`` and its ``parameters``) in C,
+        ``_ckernel.rk4_step_loaded``: ``physics.loads``' RK4 step, the same floats; None where it is not built."""
+        compiled = self._compiled
+        if compiled is None or _ckernel is None:
+            return None
+        return functools.partial(_ckernel.rk4_step_loaded, compiled[0], compiled[1], kind, *parameters)
+
     def unloaded_step(self) -> Callable[..., tuple[float, float, float, float]]:
         """The physics step of the arm with nothing added: ``_physics_step`` itself, or its operations in C
         (``_ckernel.rk4_step``, the same floats) where the compiled loop runs. For loops of their own

@@ -40,6 +40,8 @@ NOISE_CORRELATION_TIME = 0.05
 #: The largest factor noise puts on a muscle's force: the speed bounds are computed for it.
 NOISE_FACTOR_MAX = 2.0
 FIELD_KINDS = ("curl", "viscous")
+#: Each field's code in the compiled kernels (``_ckernel.h``'s FIELD_*).
+FIELD_CODES = {None: 0, "curl": 1, "viscous": 2}
 
 Matrix = tuple[tuple[float, float], tuple[float, float]]
 
@@ -85,10 +87,26 @@ class GameVariant:
         session = GameSession(config, rules=rules)
         loads = self.loads()
         if loads is not None:
-            # A step swapped in runs through the session's Python loop (the compiled one has no loads).
-            step = Integrator(config.integrator, loaded_arm(session.model, loads)).step_components
+            # A step swapped in runs through the session's Python loop (the compiled one has no loads): loads' RK4
+            # step in C where built, the same floats as its Python.
+            step = session.field_step(FIELD_CODES[self.field], self.field_parameters) \
+                if config.integrator == "rk4" else None
+            if step is None:
+                step = Integrator(config.integrator, loaded_arm(session.model, loads)).step_components
             session._physics_step = guarded(step, self.speed_limit) if math.isfinite(self.speed_limit) else step
         return session
+
+    @property
+    def field_parameters(self) -> tuple[float, float, float, float]:
+        """The field's parameter as the kernels take it: the curl field's ``(b, 0, 0, 0)``, the viscous field's
+        matrix row by row (zeros without a field)."""
+        parameter = self.field_parameter
+        if self.field == "curl":
+            return (float(parameter), 0.0, 0.0, 0.0)  # type: ignore[arg-type]
+        if self.field == "viscous":
+            (b11, b12), (b21, b22) = parameter  # type: ignore[misc]
+            return (float(b11), float(b12), float(b21), float(b22))
+        return (0.0, 0.0, 0.0, 0.0)
 
     def noise(self, config: GameConfig, session: GameSession) -> MuscleNoise | None:
         """The game's motor noise (None without): seeded by the game's seed."""

@@ -30,10 +30,16 @@ import math
 
 import numpy as np
 
-from ..variant import NOISE_CORRELATION_TIME, NOISE_FACTOR_MAX, GameVariant, noise_generator, runaway_message
+from ..variant import (
+    FIELD_CODES,
+    NOISE_CORRELATION_TIME,
+    NOISE_FACTOR_MAX,
+    GameVariant,
+    noise_generator,
+    runaway_message,
+)
 
-#: The kernel's field kinds (``_ckernel.h``'s FIELD_*) and its flag of a game the guard stopped.
-FIELD_CODES = {None: 0, "curl": 1, "viscous": 2}
+#: The kernel's flag of a game the guard stopped (``_ckernel.h``'s FLAG_RUNAWAY).
 FLAG_RUNAWAY = 2
 
 
@@ -104,10 +110,8 @@ class BatchVariant:
         #: The kernel's loads (kind, four parameters, the guard), or None: no field and no guard.
         self.loads: np.ndarray | None = None
         if variant.field is not None or math.isfinite(variant.speed_limit):
-            parameter = variant.field_parameter
-            values = ((parameter, 0.0, 0.0, 0.0) if variant.field == "curl" else
-                      (*parameter[0], *parameter[1]) if variant.field == "viscous" else (0.0, 0.0, 0.0, 0.0))  # type: ignore[index]
-            self.loads = np.array((FIELD_CODES[variant.field], *values, variant.speed_limit), dtype=float)
+            self.loads = np.array((FIELD_CODES[variant.field], *variant.field_parameters, variant.speed_limit),
+                                  dtype=float)
         #: Games the guard stopped (over until restarted), and the single game's message for each.
         self.stopped = np.zeros(n, dtype=bool)
         self.reasons: dict[int, str] = {}
