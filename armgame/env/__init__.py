@@ -23,9 +23,10 @@ Importing this package registers, with ``gymnasium.register``:
   ``armgame/CenterOutContinuous-v0``: the first versions, unchanged (``reach``, ``center_out``).
 
 Every id but the two CenterOut-v0 ones has a vector entry point, so ``gymnasium.make_vec(id,
-num_envs=N)`` gives one vector env: for Reach, from 8 games, ``vector.ReachVectorEnv`` stepping N
-games as numpy arrays on ``BatchGameSession`` (below 8, for the suite's noise and field and for the score
-reward, ``vector_common.SingleEnvsVectorEnv``, Gymnasium's ``SyncVectorEnv`` of single envs); for
+num_envs=N)`` gives one vector env: for Reach, from 4 games (2 with noise or a field:
+``vector.batch_min_envs``), ``vector.ReachVectorEnv`` stepping N games as numpy arrays on
+``BatchGameSession`` (below that, for the score reward, and for noise and fields without the compiled kernel,
+``vector_common.SingleEnvsVectorEnv``, Gymnasium's ``SyncVectorEnv`` of single envs); for
 CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
 them to Stable-Baselines3 (and is the only module that imports it). ``import armgame`` imports neither
 gymnasium nor this package, and nothing here imports pygame until an env renders::

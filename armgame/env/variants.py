@@ -31,8 +31,10 @@ and ``ReachHard-v1``, all four at once. What each does to the game:
 A variant's game is not the game of ``armgame play``, and its score is not comparable with a player's,
 but it is recorded all the same: ``armgame.env.record.replay_of(env)`` writes a replay whose task
 section carries the variant (``armgame.game.variant.GameVariant``), which ``armgame verify`` replays.
-In a single env the noise and the field run the physics in Python (about five times slower a step than the
-compiled loop); the others cost nothing. ``gymnasium.make_vec`` plays every one in the batch's compiled kernel
+A single env with noise runs the game's compiled loop (its moments packed again each decision); with a field,
+the session's Python loop around a compiled RK4 step with the field (``GameSession.field_step``). At 1 env
+(docs/programs.md, "Beside MotorNet") ReachNoisy-v1 stepped at 0.68 times Reach-v1's rate, ReachField-v1 at 0.79
+and ReachHard-v1 at 0.58. ``gymnasium.make_vec`` plays every one in the batch's compiled kernel
 (``armgame.game.batch.variant``), each game equal to its single env.
 """
 
