@@ -2,6 +2,7 @@
 the noise and the field as documented, the score reward's return, checkers on every suite id, evaluate()."""
 
 import importlib.util
+import json
 import math
 import warnings
 from pathlib import Path
@@ -418,3 +419,19 @@ def test_the_size_cap_of_each_suite_ids_vector_env_is_the_one_the_docs_state():
             continue
         with pytest.raises(EnvArgumentError, match=f"from 1 to {cap}, got {cap + 1}"):
             gym.make_vec(env_id, num_envs=cap + 1, vectorization_mode="vector_entry_point")
+
+
+def test_the_docs_motornet_table_is_the_committed_run():
+    """docs/programs.md's table beside MotorNet is the committed run's (benchmarks/results/env_speed_motornet.json),
+    each id's median ratios and its rate at 8,192 envs, and every suite Reach id made 1 M env steps per CPU second."""
+    root = Path(__file__).resolve().parent.parent
+    run = json.loads((root / "benchmarks" / "results" / "env_speed_motornet.json").read_text(encoding="utf-8"))
+    guide = (root / "docs" / "programs.md").read_text(encoding="utf-8")
+    sizes = ("1", "4", "16", "64", "256", "1024", "4096", "8192")
+    for env_id, found in run["ids"].items():
+        ratios = " | ".join(f"{found['sizes'][n]['ratio']['median']:.2f}" for n in sizes)
+        fastest = f"{found['sizes']['8192']['make_vec']['cpu']['median']:,.0f}"
+        assert f"| `{env_id.split('/')[1]}` | {ratios} | {fastest} |" in guide, env_id
+        assert found["batched"] and found["sizes"]["8192"]["make_vec"]["cpu"]["median"] >= 1e6, env_id
+    assert set(run["ids"]) == {i for i in suite_ids() if "Reach" in i} | {
+        "armgame/Reach-v0", "armgame/ReachContinuous-v0", "armgame/Reach-v1", "armgame/ReachContinuous-v1"}
