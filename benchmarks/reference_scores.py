@@ -6,6 +6,7 @@
     python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
     python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
+    python benchmarks/reference_scores.py curves benchmarks/results/ppo  # the committed runs' curves over seeds
 
 Every score is ``armgame.env.evaluate`` on the evaluation seeds (the first 100 of
 ``EVALUATION_SEEDS``), so the numbers here and a paper's are hits on the same games. PPO is
@@ -159,6 +160,50 @@ def aggregate(folder: Path) -> str:
     return "\n".join(lines)
 
 
+def curves(folder: Path) -> str:
+    """Each id's PPO runs under ``folder`` (``train_ppo.py --out`` folders: ``curve.csv`` and ``result.json``): its
+    validation curve over training seeds (the median and range of the seeds' mean hits on the 10 validation games
+    at each budget), whether it has flattened, and the test games' hits of each seed with the mean over seeds and
+    its 95 % interval (Student's t over seeds: the training seed's spread, not one policy's game-to-game)."""
+    import csv
+
+    from armgame.env.evaluation import mean_interval
+
+    by_id: dict[str, list[tuple[int, dict[int, float], dict]]] = {}
+    for result_path in sorted(folder.rglob("result.json")):
+        result = json.loads(result_path.read_text(encoding="utf-8"))
+        with (result_path.parent / "curve.csv").open(newline="", encoding="utf-8") as f:
+            curve = {int(row["env_steps"]) // 1000 * 1000: float(row["mean_hits"]) for row in csv.DictReader(f)}
+        by_id.setdefault(result["env_id"], []).append((int(result["training_seed"]), curve, result))
+    if not by_id:
+        raise SystemExit(f"{folder}: no result.json under it")
+    out = []
+    for env_id, runs in by_id.items():
+        runs.sort(key=lambda run: run[0])
+        seeds = [seed for seed, _, _ in runs]
+        steps = sorted(set.intersection(*(set(curve) for _, curve, _ in runs)))
+        out.append(f"{env_id}: PPO, training seeds {seeds}, validation mean hits (10 games) by env steps")
+        out.append("| env steps | median over seeds | range |")
+        out.append("|---:|---:|---:|")
+        medians = []
+        for step in steps:
+            values = [curve[step] for _, curve, _ in runs]
+            medians.append(float(np.median(values)))
+            out.append(f"| {step:,} | {medians[-1]:.1f} | {min(values):.1f} - {max(values):.1f} |")
+        if len(medians) >= 6:
+            last, before = np.mean(medians[-3:]), np.mean(medians[-6:-3])
+            out.append(f"last three budgets' median {last:.1f}, the three before {before:.1f}: "
+                       f"{'flat within 1 hit' if abs(last - before) <= 1.0 else 'still moving'}")
+        means = [float(result["mean_hits"]) for _, _, result in runs]
+        low, high = mean_interval(means)
+        budgets = sorted({int(result["env_steps"]) for _, _, result in runs})
+        after = ", ".join(f"{b:,}" for b in budgets)
+        out.append(f"test games (100): {', '.join(f'{m:.1f}' for m in means)}; mean {np.mean(means):.1f} "
+                   f"(95% CI over seeds {low:.1f} to {high:.1f}) after {after} env steps")
+        out.append("")
+    return "\n".join(out)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -180,6 +225,8 @@ def main(argv: list[str] | None = None) -> int:
     refs.add_argument("folder", type=Path)
     agg = sub.add_parser("aggregate")
     agg.add_argument("folder", type=Path)
+    cur = sub.add_parser("curves")
+    cur.add_argument("folder", type=Path)
     args = parser.parse_args(argv)
     if args.command == "bots":
         run_bots(args.out, tuple(args.ids), args.games, tuple(args.policies))
@@ -189,6 +236,8 @@ def main(argv: list[str] | None = None) -> int:
         print(references(args.folder))
     elif args.command == "aggregate":
         print(aggregate(args.folder))
+    elif args.command == "curves":
+        print(curves(args.folder))
     else:
         print(table(args.folder))
     return 0
