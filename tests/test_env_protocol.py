@@ -6,6 +6,7 @@ from __future__ import annotations
 import doctest
 import itertools
 import json
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -295,3 +296,28 @@ def test_the_batched_dense_reward_is_the_single_envs_to_round_off():
         returns += rb, rs
     assert largest <= REWARD_TOLERANCE and np.abs(returns[0] - returns[1]).max() <= 200 * REWARD_TOLERANCE
     assert returns.std() > 0  # the rewards were not all zero
+
+
+# ------------------------------------------------------------------ item 1: the committed PPO runs
+def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_curves():
+    """benchmarks/results/ppo holds train_ppo.py --out runs (curve, result, a game): each result's mean is its 100
+    test games', each kept game verifies, and ``reference_scores.py curves`` reports every run from its files."""
+    import importlib.util
+
+    from armgame.records import env_game
+
+    env_game.register()  # as the commands that verify do: records' own readers never need it
+    root = Path(__file__).resolve().parent.parent
+    spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    folder = root / "benchmarks" / "results" / "ppo"
+    results = sorted(folder.rglob("result.json"))
+    assert results
+    report = module.curves(folder)
+    for path in results:
+        result = json.loads(path.read_text(encoding="utf-8"))
+        hits = result["test_hits"]
+        assert len(hits) == 100 and result["mean_hits"] == pytest.approx(sum(hits) / 100)
+        assert result["env_steps"] >= result["budget_steps"] and f"{result['mean_hits']:.1f}" in report
+        assert Replay.load(path.parent / "game.json").verify()[0]
