@@ -7,6 +7,13 @@
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
     python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
     python benchmarks/reference_scores.py curves benchmarks/results/ppo  # the committed runs' curves over seeds
+    python benchmarks/reference_scores.py runs --ids armgame/ReachHard-v1 --seeds 0 1 2 3 4 --steps 4000000 \
+        --out benchmarks/results/ppo                                 # protocol runs, over as many sittings as it takes
+
+``runs`` is how long runs are spread over sittings (issue 40, item 1): each (id, training seed) is one
+``examples/train_ppo.py --out OUT/ID/seedN`` run; a finished one (its ``result.json``) is skipped, an interrupted
+one started again, so the same command goes on where the last sitting stopped, and its files (not the model,
+which .gitignore leaves out) are committed as they come; ``curves`` and ``aggregate`` are made from them.
 
 Every score is ``armgame.env.evaluate`` on the evaluation seeds (the first 100 of
 ``EVALUATION_SEEDS``), so the numbers here and a paper's are hits on the same games. PPO is
@@ -160,6 +167,31 @@ def aggregate(folder: Path) -> str:
     return "\n".join(lines)
 
 
+def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_games: int,
+                  every: int | None = None) -> None:
+    """``examples/train_ppo.py`` for each id and training seed not yet finished under ``out``, one after another,
+    validating every ``every`` env steps (a twentieth of the budget by default)."""
+    import importlib.util
+    import shutil
+
+    example = Path(__file__).resolve().parent.parent / "examples" / "train_ppo.py"
+    spec = importlib.util.spec_from_file_location("train_ppo", example)
+    train_ppo = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(train_ppo)  # type: ignore[union-attr]
+    for env_id in ids:
+        for seed in seeds:
+            folder = out / slug(env_id) / f"seed{seed}"
+            if (folder / "result.json").is_file():
+                print(f"{env_id} seed {seed}: done before ({folder / 'result.json'})", flush=True)
+                continue
+            if folder.is_dir():  # a run a sitting left unfinished starts again: its curve would have a gap
+                shutil.rmtree(folder)
+            print(f"{env_id} seed {seed}: {steps:,} env steps into {folder}", flush=True)
+            every = every or max(1, steps // 20)
+            train_ppo.main(["--env", env_id, "--steps", str(steps), "--eval-every", str(every),
+                            "--seed", str(seed), "--test-games", str(test_games), "--out", str(folder)])
+
+
 def curves(folder: Path) -> str:
     """Each id's PPO runs under ``folder`` (``train_ppo.py --out`` folders: ``curve.csv`` and ``result.json``): its
     validation curve over training seeds (the median and range of the seeds' mean hits on the 10 validation games
@@ -227,6 +259,13 @@ def main(argv: list[str] | None = None) -> int:
     agg.add_argument("folder", type=Path)
     cur = sub.add_parser("curves")
     cur.add_argument("folder", type=Path)
+    many = sub.add_parser("runs")
+    many.add_argument("--ids", nargs="+", required=True)
+    many.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2, 3, 4])
+    many.add_argument("--steps", type=int, required=True, help="each run's budget in env steps")
+    many.add_argument("--games", type=int, default=GAMES)
+    many.add_argument("--eval-every", type=int, help="env steps between validations (default: a twentieth)")
+    many.add_argument("--out", type=Path, required=True)
     args = parser.parse_args(argv)
     if args.command == "bots":
         run_bots(args.out, tuple(args.ids), args.games, tuple(args.policies))
@@ -238,6 +277,8 @@ def main(argv: list[str] | None = None) -> int:
         print(aggregate(args.folder))
     elif args.command == "curves":
         print(curves(args.folder))
+    elif args.command == "runs":
+        protocol_runs(args.out, args.ids, args.seeds, args.steps, args.games, args.eval_every)
     else:
         print(table(args.folder))
     return 0
