@@ -139,7 +139,7 @@ def test_the_noise_draws_a_games_stream_in_blocks_as_the_single_game_draws_it():
         for i, (session, single, base) in singles.items():
             single.apply(session)
             moments = session.muscles.moments
-            assert [f * s for f, (s, _) in zip(factors[:, i].tolist(), base, strict=True)] == [m[0] for m in moments]
+            assert [f * s for f, (s, _) in zip(factors[i].tolist(), base, strict=True)] == [m[0] for m in moments]
     assert len(singles) == 3 and noise_generator(11).standard_normal() != noise_generator(12).standard_normal()
 
 
