@@ -195,7 +195,8 @@ def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_
 def curves(folder: Path) -> str:
     """Each id's PPO runs under ``folder`` (``train_ppo.py --out`` folders: ``curve.csv`` and ``result.json``): its
     validation curve over training seeds (the median and range of the seeds' mean hits on the 10 validation games
-    at each budget), whether it has flattened, and the test games' hits of each seed with the mean over seeds and
+    at each budget), how much it still rises over the last half of the budget (a line's slope, flat where it is
+    about 0), and the test games' hits of each seed with the mean over seeds and
     its 95 % interval (Student's t over seeds: the training seed's spread, not one policy's game-to-game)."""
     import csv
 
@@ -222,10 +223,16 @@ def curves(folder: Path) -> str:
             values = [curve[step] for _, curve, _ in runs]
             medians.append(float(np.median(values)))
             out.append(f"| {step:,} | {medians[-1]:.1f} | {min(values):.1f} - {max(values):.1f} |")
-        if len(medians) >= 6:
-            last, before = np.mean(medians[-3:]), np.mean(medians[-6:-3])
-            out.append(f"last three budgets' median {last:.1f}, the three before {before:.1f}: "
-                       f"{'flat within 1 hit' if abs(last - before) <= 1.0 else 'still moving'}")
+        half = [i for i, step in enumerate(steps) if step >= steps[-1] / 2]
+        if len(half) >= 4:
+            # Flattened or not, as a slope: 10 validation games make each point noisy (a few hits), so two
+            # points' difference says little; a line through the last half of the budget says how much is left.
+            from scipy.stats import linregress
+
+            fit = linregress(np.array(steps)[half] / 1e6, np.array(medians)[half])
+            width = float(fit.stderr) * 2.0
+            out.append(f"over the last half of the budget the median rises {fit.slope:+.2f} hits per million env "
+                       f"steps (+-2 standard errors: {fit.slope - width:+.2f} to {fit.slope + width:+.2f})")
         means = [float(result["mean_hits"]) for _, _, result in runs]
         low, high = mean_interval(means)
         budgets = sorted({int(result["env_steps"]) for _, _, result in runs})
