@@ -219,3 +219,31 @@ def test_a_single_fields_compiled_step_is_the_python_loaded_arms_step(name):
         session.field_step(3, variant.field_parameters)(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.004)
     with pytest.raises(ValueError, match="p0 is not finite"):
         session.field_step(1, (np.inf, 0.0, 0.0, 0.0))(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.004)
+
+
+def test_noise_alone_has_no_guard_a_state_gone_non_finite_is_the_single_games_error():
+    """Without a field there is no guard: a game whose physics blows up (muscles a million times too strong) raises
+    NonFiniteStateError in the batch as in the single game, not a runaway's stop."""
+    import dataclasses
+
+    from armgame.game.muscles import MuscleSpec
+    from armgame.game.session import NonFiniteStateError
+
+    base = GameConfig(seed=2, time_limit=2.0)
+    strong = dataclasses.replace(base, muscles=tuple(
+        MuscleSpec(m.name, m.key, (m.moment[0] * 1e6, m.moment[1] * 1e6), m.rise_time, m.decay_time)
+        for m in base.muscles))
+    variant = VARIANTS["noise"]
+    single = variant.session(strong)
+    batch = BatchGameSession([strong], variant=variant)
+    single.key_event(single.muscles.keys[0], "down")
+    batch.set_held(np.array([[True, False, False, False]]))
+    with pytest.raises(NonFiniteStateError):
+        for _ in range(100):
+            variant.noise(strong, single).apply(single)
+            single.advance(5)
+    with pytest.raises(NonFiniteStateError):
+        for _ in range(100):
+            batch.apply_noise()
+            batch.advance(5)
+    assert not batch.stopped.any()

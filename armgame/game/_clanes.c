@@ -245,8 +245,9 @@ LANES_INLINE int step_lanes_as(const Step *k, Lanes *L, const int loaded)
         L->sl[l] -= fabs(q1 - p1[l]) * k->reach1 + fabs(q2 - p2[l]) * k->reach2;
         out |= L->sl[l] < 0.0;
     }
-    if (loaded) {
-        /* variant.guarded's test (NaN fails it too). */
+    if (loaded && k->limit < INFINITY) {
+        /* variant.guarded's test (NaN fails it too). No guard (noise alone): a state gone non-finite runs on, as
+         * the plain step's, to the batch's NonFiniteStateError, as the single game's. */
         const double lim = k->limit;
         for (int l = 0; l < LANES; l++) {
             const double w1 = L->w1[l], w2 = L->w2[l];
