@@ -311,16 +311,17 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
     spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    folder = root / "benchmarks" / "results" / "ppo"
-    results = sorted(folder.rglob("result.json"))
-    assert results
-    report = module.curves(folder)
-    for path in results:
-        result = json.loads(path.read_text(encoding="utf-8"))
-        hits = result["test_hits"]
-        assert len(hits) == 100 and result["mean_hits"] == pytest.approx(sum(hits) / 100)
-        assert result["env_steps"] >= result["budget_steps"] and f"{result['mean_hits']:.1f}" in report
-        assert Replay.load(path.parent / "game.json").verify()[0]
+    folders = sorted((root / "benchmarks" / "results").glob("ppo*"))  # a folder a budget: ppo (4 M), ppo-10m
+    assert folders
+    for folder in folders:
+        report = module.curves(folder)
+        for path in sorted(folder.rglob("result.json")):
+            result = json.loads(path.read_text(encoding="utf-8"))
+            hits = result["test_hits"]
+            assert len(hits) == 100 and result["mean_hits"] == pytest.approx(sum(hits) / 100)
+            assert result["env_steps"] >= result["budget_steps"] and f"{result['mean_hits']:.1f}" in report
+            assert Replay.load(path.parent / "game.json").verify()[0]
+    results = sorted((root / "benchmarks" / "results" / "ppo").rglob("result.json"))
     # docs/programs.md reports ReachHard-v1's runs: each seed's test mean and their average, as the files hold them.
     hard = [json.loads(path.read_text(encoding="utf-8"))["mean_hits"] for path in results
             if path.parent.parent.name == "ReachHard-v1"]
