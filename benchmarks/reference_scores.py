@@ -174,6 +174,7 @@ def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_
     import importlib.util
     import shutil
 
+    every = every or max(1, steps // 20)
     example = Path(__file__).resolve().parent.parent / "examples" / "train_ppo.py"
     spec = importlib.util.spec_from_file_location("train_ppo", example)
     train_ppo = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
@@ -187,7 +188,6 @@ def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_
             if folder.is_dir():  # a run a sitting left unfinished starts again: its curve would have a gap
                 shutil.rmtree(folder)
             print(f"{env_id} seed {seed}: {steps:,} env steps into {folder}", flush=True)
-            every = every or max(1, steps // 20)
             train_ppo.main(["--env", env_id, "--steps", str(steps), "--eval-every", str(every),
                             "--seed", str(seed), "--test-games", str(test_games), "--out", str(folder)])
 

@@ -248,10 +248,13 @@ class ReachVectorEnv(VectorEnv):
         if restart.any():
             self._restart_part(part, batch, restart)
             rewards[part] = np.where(restart, 0.0, rewards[part])
+        if batch.variant is None:  # the game's own physics: a game ends at its clock only
+            truncated[part] = batch.over  # a restarted game is not over
+            return
         # A game the guard stopped ends before its clock (terminated, as the single env's), the others at it.
         stopped = batch.stopped
         terminated[part] = stopped
-        truncated[part] = batch.over & ~stopped  # a restarted game is not over
+        truncated[part] = batch.over & ~stopped
 
     def _restart(self, games: np.ndarray) -> None:
         for part, batch in self.parts:
@@ -340,6 +343,8 @@ class ReachVectorEnv(VectorEnv):
             info[name] = values if every else np.where(games, values, 0)
             info[f"_{name}"] = games.copy()
         # A stopped game's reason, as SyncVectorEnv gathers a single env's info["stopped"]: only where there is one.
+        if all(batch.variant is None for _, batch in self.parts):
+            return info
         stopped = np.zeros(self.num_envs, dtype=bool)
         for part, batch in self.parts:
             stopped[part] = batch.stopped

@@ -237,11 +237,14 @@ PyObject *armgame_run(PyObject *self, PyObject *args)
         .near = p[P_NEAR], .reach1 = p[P_REACH1], .reach2 = p[P_REACH2], .limit2 = p[P_LIMIT2],
         .s = {p[P_S0], p[P_S1], p[P_S2], p[P_S3]}, .e = {p[P_E0], p[P_E1], p[P_E2], p[P_E3]},
         .mom = with_moments ? b[18].view.buf : NULL,
-        .field = loads != NULL ? (int)loads[0] : FIELD_NONE,
-        .fp = {loads != NULL ? loads[1] : 0.0, loads != NULL ? loads[2] : 0.0, loads != NULL ? loads[3] : 0.0,
-               loads != NULL ? loads[4] : 0.0},
+        .field = {FIELD_NONE, {0.0, 0.0, 0.0, 0.0}, p[P_L1], p[P_L2]},
         .limit = loads != NULL ? loads[5] : INFINITY,
     };
+    if (loads != NULL) {
+        B.field.kind = (int)loads[0];
+        for (int j = 0; j < 4; j++)
+            B.field.p[j] = loads[1 + j];
+    }
 
     /* The work is bounded before it starts: cursors within the events, muscles 0-3, finite commands, and
      * every game's steps and halt from 0 to a game's most steps at this dt. */

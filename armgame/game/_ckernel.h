@@ -175,6 +175,15 @@ static inline int get(PyObject *obj, Buf *buf, Py_ssize_t count, Py_ssize_t item
     return 0;
 }
 
+/* A field at the hand (loads.CurlField, loads.ViscousField) and the flag of a game the guard stopped. */
+enum { FIELD_NONE = 0, FIELD_CURL = 1, FIELD_VISCOUS = 2 };
+
+/* A field at the hand: its kind, parameters (curl b; viscous b11 b12 b21 b22) and the arm's lengths. */
+typedef struct {
+    int kind;
+    double p[4], l1, l2;
+} Field;
+
 /* The batch (_cbatch.c: the call, one game at a time; _clanes.c: games side by side). */
 /* A call's arrays and constants (the arguments of ``run``, checked). */
 typedef struct {
@@ -191,23 +200,14 @@ typedef struct {
     double dt, h, k, l1, l2, radius, near, reach1, reach2, limit2;
     double s[4], e[4];
     /* The harder tasks' physics (game/variant.py), or none: every game's muscle moments, (8, n) rows s0-s3
-     * then e0-e3 (motor noise rescales them before each decision), or NULL for s and e above; a field at
-     * the hand (FIELD_*, its parameters: curl b, or viscous b11 b12 b21 b22); the speed guard (rad/s,
-     * infinite: none), past which a game stops (flags 2) with the state of the step that passed it. */
+     * then e0-e3 (motor noise rescales them before each decision), or NULL for s and e above; the field at
+     * the hand (kind FIELD_NONE: none); the speed guard (rad/s, infinite: none), past which a game stops
+     * (flags 2) with the state of the step that passed it. */
     const double *mom;
-    int field;
-    double fp[4];
+    Field field;
     double limit;
 } Batch;
 
-/* A field at the hand (loads.CurlField, loads.ViscousField) and the flag of a game the guard stopped. */
-enum { FIELD_NONE = 0, FIELD_CURL = 1, FIELD_VISCOUS = 2 };
-
-/* A field at the hand: its kind, parameters (curl b; viscous b11 b12 b21 b22) and the arm's lengths. */
-typedef struct {
-    int kind;
-    double p[4], l1, l2;
-} Field;
 
 /* The field's joint torque ``J(q)^T F(v)`` (loads._with_loads's ``external`` with no joint load, operation
  * for operation) from the hand's trig: sin and cos of q1 (s1, c1) and of q1 + q2 (s12, c12). */

@@ -94,13 +94,14 @@ LANES_INLINE void accel_lanes(const Step *k, const Lanes *L, const double *q1, c
                                const int loaded)
 {
     double e1[LANES], e2[LANES];
-    if (loaded && k->field.kind != FIELD_NONE)
+    const int pushed = loaded && k->field.kind != FIELD_NONE;
+    if (pushed)
         field_lanes(k, q1, q2, w1, w2, e1, e2);
     for (int l = 0; l < LANES; l++) {
         const double bc = L->ec[l], h = L->es[l];
         const double m12 = k->d + bc;
-        const double u1 = loaded && k->field.kind != FIELD_NONE ? t1[l] + e1[l] : t1[l];
-        const double u2 = loaded && k->field.kind != FIELD_NONE ? t2[l] + e2[l] : t2[l];
+        const double u1 = pushed ? t1[l] + e1[l] : t1[l];
+        const double u2 = pushed ? t2[l] + e2[l] : t2[l];
         double f1 = u1 + h * (w1[l] + w1[l] + w2[l]) * w2[l];
         double f2 = u2 - h * w1[l] * w1[l];
         if (k->damping) {
@@ -475,9 +476,9 @@ Py_ssize_t armgame_run_lanes(const Batch *B)
     const Step k = {arm->b, arm->d, arm->det0, arm->amd, arm->k1, arm->k2, B->dt, B->h, B->k, B->limit2,
                     B->reach1, B->reach2, {B->s[0], B->s[1], B->s[2], B->s[3]},
                     {B->e[0], B->e[1], B->e[2], B->e[3]}, arm->mode == MODE_DAMPING, B->fast,
-                    {B->field, {B->fp[0], B->fp[1], B->fp[2], B->fp[3]}, B->l1, B->l2}, B->limit};
+                    B->field, B->limit};
     /* The loaded step where the games have their own moments, a field or a guard; else the plain one. */
-    const int loaded = B->mom != NULL || B->field != FIELD_NONE || B->limit < INFINITY;
+    const int loaded = B->mom != NULL || B->field.kind != FIELD_NONE || B->limit < INFINITY;
     int (*const step)(const Step *, Lanes *) = loaded ? step_lanes_loaded : step_lanes;
     Py_ssize_t queue = 0, flagged = 0;
     int busy = 0;

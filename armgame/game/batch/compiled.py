@@ -84,13 +84,15 @@ class CompiledKernel:
         """Every game ``i`` to step ``halt[i]`` (none past its end), its hits scored on the way."""
         a = self.arrays
         ev = self.no_events if events is None else events
-        halt = np.array(halt, dtype=np.int64)  # a copy: a game the guard stops halts where it is put back
+        given = halt = np.ascontiguousarray(halt, dtype=np.int64)
         while _ckernel.run(self.params, self.mode, self.fast, a.n, a.xs, a.act, a.goal, a.rate, a.slack,
                            a.target_x, a.target_y, a.steps, halt, ev.cursor, ev.end, ev.step, ev.muscle, ev.goal,
                            ev.rate, self.flags, a.trig, LANES, a.moments, a.loads):
             for i in np.flatnonzero(self.flags).tolist():
                 if self.flags[i] == FLAG_RUNAWAY and self.runaway is not None:
                     self.runaway(i)
+                    if halt is given:  # the caller's array stays as it was: a copy halts the game where it is put back
+                        halt = halt.copy()
                     halt[i] = a.steps[i]
                 else:
                     self.hit(i, a.xs[:4, i], int(a.steps[i]))

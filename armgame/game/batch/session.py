@@ -147,8 +147,8 @@ class BatchGameSession:
             raise ValueError(f"kernel {kernel!r}: expected one of {', '.join(map(repr, KERNELS))}")
         if kernel == "compiled" and not compiled_available():
             raise ValueError("kernel 'compiled': the compiled kernel is not built here (no C compiler at install?)")
-        if BatchVariant.needs_compiled(variant) and (kernel == "numpy" or not compiled_available()
-                                                     or configs[0].integrator != "rk4"):
+        loaded = BatchVariant.needs_compiled(variant)
+        if loaded and (kernel == "numpy" or not compiled_available() or configs[0].integrator != "rk4"):
             raise UserError("a batch plays motor noise and force fields in its compiled kernel only (RK4, built "
                             "where pip install found a C compiler): play such games one at a time")
         self.configs = configs
@@ -204,12 +204,12 @@ class BatchGameSession:
             decay=self._decay, physics_step=Integrator(c.integrator, self.model, "numpy").step_components,
             fast=self._rounds, series_from=SERIES_MIN_GAMES, series_limit=SERIES_LIMIT)
         #: The noise, field and guard of ``variant`` (None: the game's physics).
-        self.variant = None if not BatchVariant.needs_compiled(variant) else BatchVariant(
+        self.variant = None if not loaded else BatchVariant(
             variant, c.dt, n, self.kernel_inputs.shoulder, self.kernel_inputs.elbow)  # type: ignore[arg-type]
-        loaded = self.variant
+        physics = self.variant
         self.arrays = BatchArrays(self._xs, self._act, self._goal, self._rate, self._slack, self.target_x,
-                                  self.target_y, self.steps, self._trig, None if loaded is None else loaded.moments,
-                                  None if loaded is None else loaded.loads)
+                                  self.target_y, self.steps, self._trig, None if physics is None else physics.moments,
+                                  None if physics is None else physics.loads)
         self.rules: list[GameRules] = [None] * n  # type: ignore[list-item]
         self._kernels: dict[int, NumpyKernel] = {}
         for i in range(n):
