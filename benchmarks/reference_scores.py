@@ -244,6 +244,13 @@ def curves(folder: Path) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:
+        return _main(argv)
+    except (OSError, ValueError, KeyError, TypeError) as exc:  # a run's file unreadable, not JSON or not a run's
+        raise SystemExit(f"reference_scores.py: {type(exc).__name__}: {exc}") from None
+
+
+def _main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     bots = sub.add_parser("bots")
