@@ -28,7 +28,8 @@ class BuildExactExt(build_ext):
 
 setup(
     ext_modules=[Extension("armgame.game._ckernel", ["armgame/game/_ckernel.c", "armgame/game/_cbatch.c",
-                                                     "armgame/game/_clanes.c", "armgame/game/_cevents.c"],
+                                                     "armgame/game/_clanes.c", "armgame/game/_cevents.c",
+                                                     "armgame/game/_cshoot.c"],
                            depends=["armgame/game/_ckernel.h", "armgame/physics/_trig.h"], optional=True),
                  Extension("armgame.physics._ctrig", ["armgame/physics/_ctrig.c"],
                            depends=["armgame/physics/_trig.h"], optional=True),

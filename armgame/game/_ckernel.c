@@ -56,50 +56,6 @@ static int sincos_agrees(void)
 #endif
 }
 
-/* A stage of RK4 in full: GameSession's accel with its own b cos q2 and b sin q2; with a field (not NULL),
- * loads' accel: the field's torque at the stage added to the muscles' (the hand's trig the C library's, as
- * Python's ``math`` is there). */
-static inline void accel_full(const Arm *arm, const Field *field, double q1, double q2, double w1, double w2,
-                              double t1, double t2, double *o1, double *o2)
-{
-    double sn, cs;
-    if (field != NULL) {
-        double s1, c1, s12, c12, e1, e2;
-        sin_cos(q1, &s1, &c1);
-        sin_cos(q1 + q2, &s12, &c12);
-        field_torque(field, s1, c1, s12, c12, w1, w2, &e1, &e2);
-        t1 = t1 + e1;
-        t2 = t2 + e2;
-    }
-    arm_sin_cos(q2, &sn, &cs);
-    accel_trig(arm, q1, q2, arm->b * cs, arm->b * sn, w1, w2, t1, t2, o1, o2);
-}
-
-/* integrators._rk4, exactly: x (q1, q2, w1, w2) one step of dt on, torques t1, t2 held, the field's added
- * where one is given. h and k are taken from dt as the Python step takes them (0.5 dt and dt times _SIXTH,
- * 1/6 rounded once). */
-static inline void rk4_exact(const Arm *arm, const Field *field, double t1, double t2, double dt, double x[4])
-{
-    const double q1 = x[0], q2 = x[1], w1 = x[2], w2 = x[3];
-    const double h = 0.5 * dt;
-    double ka1, ka2, kb1, kb2, kc1, kc2, kd1, kd2;
-    accel_full(arm, field, q1, q2, w1, w2, t1, t2, &ka1, &ka2);
-    const double v1 = w1 + h * ka1;
-    const double v2 = w2 + h * ka2;
-    accel_full(arm, field, q1 + h * w1, q2 + h * w2, v1, v2, t1, t2, &kb1, &kb2);
-    const double u1 = w1 + h * kb1;
-    const double u2 = w2 + h * kb2;
-    accel_full(arm, field, q1 + h * v1, q2 + h * v2, u1, u2, t1, t2, &kc1, &kc2);
-    const double z1 = w1 + dt * kc1;
-    const double z2 = w2 + dt * kc2;
-    accel_full(arm, field, q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2, &kd1, &kd2);
-    const double k = dt * (1.0 / 6.0);
-    x[0] = q1 + k * (w1 + z1 + 2.0 * (v1 + u1));
-    x[1] = q2 + k * (w2 + z2 + 2.0 * (v2 + u2));
-    x[2] = w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1));
-    x[3] = w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
-}
-
 /* Nonzero if ``x`` is NaN or infinite: its exponent bits all ones. No branch, so checking a call's
  * arguments as they are read costs next to nothing. */
 static inline uint64_t not_finite(double x)
@@ -410,6 +366,7 @@ done:
 
 static PyMethodDef methods[] = {
     {"run", armgame_run, METH_VARARGS, armgame_run_doc},
+    {"shoot", armgame_shoot, METH_VARARGS, armgame_shoot_doc},
     {"rk4_step_loaded", (PyCFunction)(void (*)(void))rk4_step_loaded, METH_FASTCALL, rk4_step_loaded_doc},
     {"event_columns", armgame_event_columns, METH_VARARGS, armgame_event_columns_doc},
     {"game_steps", (PyCFunction)(void (*)(void))game_steps, METH_FASTCALL, game_steps_doc},

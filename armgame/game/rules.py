@@ -219,6 +219,11 @@ class DwellRules(GameRules):
         self.dwell = 0
         self._last_step = -2
 
+    def dwell_at(self, step: int) -> int:
+        """The physics steps in a row the hand has stayed in the target as of step ``step`` (0: it is not in it
+        after that step)."""
+        return self.dwell if self._last_step == step else 0
+
     def hand_moved(self, x: float, y: float, t: float) -> bool:
         if not self.target.contains(x, y):
             return False

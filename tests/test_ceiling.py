@@ -1,0 +1,156 @@
+"""The reference controller (``armgame.env.ceiling``): its model is the game's, so the hit it plans is the hit the
+game scores; its rollouts refuse bad input; ``benchmarks/ceiling.py`` keeps its results across sittings."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium")
+
+import armgame.env  # noqa: E402  (registers the ids)
+from armgame.env import ceiling  # noqa: E402
+from armgame.env.errors import EnvArgumentError  # noqa: E402
+from armgame.game.rules import GameConfig  # noqa: E402
+
+pytestmark = pytest.mark.skipif(ceiling._shoot is None, reason="the compiled kernel is not built")
+
+ROOT = Path(__file__).resolve().parent.parent
+SEED = 1_000_000_000
+
+
+def _first_hit(env_id: str, **kwargs: object) -> tuple[int, int, int]:
+    """(the physics step of the first hit the controller's first plan predicts, the game's first hit's step,
+    the game's hits) over a 3 s game played open loop (no replanning: the first plan runs to its hit)."""
+    env = gym.make(env_id, time_limit=3.0, **kwargs)
+    observation, _ = env.reset(seed=SEED)
+    controller = ceiling.ShootingController(env, replan=0, margin=0.0)
+    session = env.unwrapped.session
+    planned, done, info = None, False, {}
+    while not done:
+        action = controller(observation)
+        if planned is None:
+            planned = controller.predicted_steps
+        observation, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    env.close()
+    first = round(session.rules.board.hit_times[0] / session.config.dt)
+    return planned, first, info["hits"]
+
+
+@pytest.mark.parametrize("env_id", ["armgame/Reach-v1", "armgame/ReachField-v1", "armgame/ReachHold-v1"])
+def test_the_planned_hit_is_the_games_hit_to_the_physics_step(env_id):
+    """From rest, the hit the first plan predicts is the game's first hit, to the step: a wrong sign, moment,
+    rate, field or dwell count in the rollouts fails here (the field's and the dwell's ids as well)."""
+    planned, first, hits = _first_hit(env_id)
+    assert planned > 0
+    assert first == planned
+    assert hits >= 2
+
+
+def test_a_continuous_twin_plays_its_key_ids_games_and_the_delay_never_reaches_the_controller():
+    games = {env_id: armgame.env.evaluate("shooting", env_id, games=1, time_limit=3.0,
+                                          policy_factory=ceiling.ShootingController).hits
+             for env_id in ("armgame/ReachHold-v1", "armgame/ReachHoldContinuous-v1")}
+    assert games["armgame/ReachHold-v1"] == games["armgame/ReachHoldContinuous-v1"]
+    assert games["armgame/ReachHold-v1"][0] >= 2
+    delayed = armgame.env.evaluate("shooting", "armgame/ReachDelay-v1", games=1, time_limit=2.0,
+                                   policy_factory=ceiling.ShootingController).hits
+    plain = armgame.env.evaluate("shooting", "armgame/Reach-v1", games=1, time_limit=2.0,
+                                 policy_factory=ceiling.ShootingController).hits
+    assert delayed == plain
+
+
+def test_the_controller_outscores_the_model_bot_where_the_dwell_cripples_it():
+    kwargs = {"games": 1, "time_limit": 8.0}
+    shooting = armgame.env.evaluate("shooting", "armgame/ReachHold-v1", policy_factory=ceiling.ShootingController,
+                                    **kwargs)
+    model = armgame.env.evaluate("model", "armgame/ReachHold-v1", **kwargs)
+    assert shooting.hits[0] >= model.hits[0] + 2
+
+
+def test_a_plan_shifted_past_its_end_is_both_muscles_off():
+    assert ceiling.shifted(np.array([1, 2, 3, -1, 4, 0]), 3).tolist() == [-1, 2, 0, -1, 1, 0]
+    assert ceiling.shifted(np.array([1, 2, 3, -1, 4, 0]), 10).tolist() == [1, 0, 0, 1, 0, 0]
+
+
+def test_the_controller_refuses_an_env_it_cannot_play():
+    with pytest.raises(EnvArgumentError, match="Reach ids"):
+        ceiling.ShootingController(gym.make("CartPole-v1"))
+
+
+def _shoot_args(controller: ceiling.ShootingController, **change: object) -> list:
+    args = {"params": controller.params, "mode": controller.mode, "rates": controller.rates, "field": controller.field,
+            "x0": np.array([0.5, 1.5, 0.0, 0.0]), "act0": np.zeros(4), "plans": np.array([[1, 3, 3, 1, 2, 2]]),
+            "substeps": 5, "horizon": 10, "target": np.array([0.1, 0.4, 0.0004]), "hold": 1, "dwelt": 0,
+            "box": np.array(ceiling.JOINT_BOX), "out": np.empty((1, 6))}
+    args.update(change)
+    return list(args.values())
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"x0": np.array([math.nan, 1.5, 0.0, 0.0])}, "x0 is not finite"),
+    ({"plans": np.array([[2, 3, 3, 1, 2, 2]])}, "signs must be 1 or -1"),
+    ({"plans": np.array([[1, -3, 3, 1, 2, 2]])}, "counts 0 to 1e6"),
+    ({"horizon": 10**9}, "at most 2e9 physics steps"),
+    ({"hold": 0}, "hold >= 1"),
+    ({"field": np.array([3.0, 0, 0, 0, 0])}, "field kind"),
+    ({"out": np.empty((2, 6))}, "out:"),
+    ({"params": np.full(5, 1.0)}, "params:"),
+])
+def test_the_rollouts_refuse_bad_input_in_one_line(change, message):
+    controller = ceiling.ShootingController(gym.make("armgame/Reach-v1"))
+    with pytest.raises(ValueError, match=message):
+        ceiling._shoot(*_shoot_args(controller, **change))
+
+
+def test_a_rollout_leaving_the_joint_box_is_refused_and_one_missing_says_how_far_it_ended():
+    controller = ceiling.ShootingController(gym.make("armgame/Reach-v1"))
+    out = np.empty((2, 6))
+    # The elbow's first muscle full on for the whole horizon folds the arm past the box; both off stays put.
+    ceiling._shoot(*_shoot_args(controller, plans=np.array([[1, 0, 0, 1, 100, 0], [1, 0, 0, 1, 0, 0]]),
+                                horizon=100, box=np.array([-1.0, 2.8, 0.15, 1.6]), out=out))
+    assert out[0, 0] == -2
+    assert out[1, 0] == -1
+    assert out[1, 1:5].tolist() == [0.5, 1.5, 0.0, 0.0]
+    arm = GameConfig().arm
+    l1, l2 = arm.l1, arm.l2
+    hand = (l1 * math.cos(0.5) + l2 * math.cos(2.0), l1 * math.sin(0.5) + l2 * math.sin(2.0))
+    assert out[1, 5] == pytest.approx(math.hypot(hand[0] - 0.1, hand[1] - 0.4), rel=1e-12)
+
+
+def _benchmark():
+    spec = importlib.util.spec_from_file_location("ceiling_benchmark", ROOT / "benchmarks" / "ceiling.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_benchmark_goes_on_where_a_sitting_stopped_and_refuses_what_is_not_a_result(tmp_path, capsys):
+    bench = _benchmark()
+    bench.main(["run", "--ids", "armgame/Reach-v1", "--games", "1", "--seconds", "1", "--out", str(tmp_path)])
+    first = json.loads((tmp_path / "Reach-v1.json").read_text())
+    assert len(first["hits"]) == 1
+    bench.main(["run", "--ids", "armgame/Reach-v1", "--games", "2", "--seconds", "1", "--out", str(tmp_path)])
+    second = json.loads((tmp_path / "Reach-v1.json").read_text())
+    assert second["hits"][:1] == first["hits"] and len(second["hits"]) == 2
+    alone = armgame.env.evaluate("shooting", "armgame/Reach-v1", seeds=[SEED + 1], time_limit=1.0,
+                                 policy_factory=ceiling.ShootingController)
+    assert second["hits"][1] == alone.hits[0]
+    rows = bench.summary(tmp_path)
+    assert rows["armgame/ReachDelayContinuous-v1"][-1] == "armgame/Reach-v1"
+    with pytest.raises(SystemExit, match="other settings"):
+        bench.main(["run", "--ids", "armgame/Reach-v1", "--games", "3", "--seconds", "2", "--out", str(tmp_path)])
+    (tmp_path / "Reach-v1.json").write_text('{"env_id": "armgame/Reach-v1", "hits": [1, true]}')
+    with pytest.raises(SystemExit, match="not a ceiling result"):
+        bench.main(["show", str(tmp_path)])
+    (tmp_path / "Reach-v1.json").write_bytes(b"\xff\xfe")
+    with pytest.raises(SystemExit, match="not a ceiling result"):
+        bench.main(["show", str(tmp_path)])
+    with pytest.raises(SystemExit, match="not a Reach id"):
+        bench.main(["run", "--ids", "armgame/CenterOut-v1", "--out", str(tmp_path)])
