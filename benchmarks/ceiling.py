@@ -38,7 +38,7 @@ from armgame.env.suite import EVALUATION_SEEDS, suite_ids
 #: (``--games 3 --seconds 20``), the cheapest setting within a hit a minute of the best tried.
 SETTINGS: dict[str, dict[str, Any]] = {
     "armgame/ReachNoisy-v1": {"replan": 1},
-    "armgame/ReachHard-v1": {"replan": 1, "margin": 0.005},
+    "armgame/ReachHard-v1": {"coarse": 15, "fine": 4},
 }
 
 #: The ids whose games differ for the controller; every other Reach id's games are one of these (``STANDS_FOR``).

@@ -3,7 +3,9 @@
     python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
     python benchmarks/reference_scores.py bots --out refs --ids armgame/CenterOutHold-v1 --policies naive model
     python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
-    python benchmarks/reference_scores.py table refs                 # the table for docs/programs.md
+    python benchmarks/reference_scores.py table                      # docs/programs.md's table, from the results
+    python benchmarks/reference_scores.py ceilings                   # armgame/env/references.py's CEILINGS
+    python benchmarks/reference_scores.py table-v1 refs              # protocol 1's table (the model bot normalising)
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
     python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
     python benchmarks/reference_scores.py curves benchmarks/results/ppo  # the committed runs' curves over seeds
@@ -113,8 +115,8 @@ def references_of(folder: Path, first: int = 5) -> dict[str, dict[str, Any]]:
     return entries
 
 
-def table(folder: Path) -> str:
-    """docs/programs.md's table: the reference entries, the normalised score as ``evaluate`` gives it."""
+def table_v1(folder: Path) -> str:
+    """Protocol 1's table (the model bot normalising): the reference entries and PPO's normalised score."""
     lines = ["| id | random | naive bot | model bot | PPO: mean (each training seed) | PPO normalised |",
              "|---|---|---|---|---|---|"]
     for env_id, entry in references_of(folder).items():
@@ -137,6 +139,120 @@ def references(folder: Path) -> str:
         lines.append(f"    {json.dumps(env_id)}: {{")
         lines.append(textwrap.fill(items, width=116, initial_indent=" " * 8, subsequent_indent=" " * 8))
         lines.append("    },")
+    lines.append("}")
+    return "\n".join(lines)
+
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+#: The fewest training seeds whose mean counts toward a ceiling (the protocol's five).
+CEILING_SEEDS = 5
+
+
+def long_runs(root: Path = RESULTS) -> dict[str, dict[int, list[float]]]:
+    """Each id's protocol runs committed under ``root`` (``runs``' folders ``ppo*``, a budget each): budget (env
+    steps) -> every finished training seed's mean hits on the test games, by seed."""
+    found: dict[str, dict[int, dict[int, float]]] = {}
+    for path in sorted(root.glob("ppo*/*/seed*/result.json")):
+        r = json.loads(path.read_text(encoding="utf-8"))
+        found.setdefault(r["env_id"], {}).setdefault(int(r["budget_steps"]), {})[int(r["training_seed"])] = \
+            float(r["mean_hits"])
+    return {env_id: {budget: [by_seed[s] for s in sorted(by_seed)] for budget, by_seed in sorted(budgets.items())}
+            for env_id, budgets in found.items()}
+
+
+def _reference_hits() -> dict[str, dict[str, Any]]:
+    from armgame.env.references import REFERENCE_HITS
+
+    return REFERENCE_HITS
+
+
+def _controller_rows(folder: Path) -> dict[str, tuple[float, float, float, int, str]]:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
+    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module.summary(folder)
+
+
+def ceilings(reference: dict[str, dict[str, Any]] | None = None, controller_folder: Path = RESULTS / "ceiling",
+             root: Path = RESULTS) -> dict[str, dict[str, Any]]:
+    """Protocol 2's ceiling of every id with reference scores: the best mean hits measured on its 100 test games by
+    a policy that knows the task or has learnt it, and which that is. The candidates: the shooting controller
+    (``benchmarks/ceiling.py``'s results), PPO's protocol runs of five training seeds or more at any budget (the
+    mean over seeds), protocol 1's PPO (500,000 env steps, three seeds), for CenterOut the trials an episode holds
+    (every one hit), and for a continuous twin its key id's ceiling (its levels 0 and 1 are the keys, so it can play
+    whatever the key id plays)."""
+    if reference is None:
+        reference = _reference_hits()
+    controller = _controller_rows(controller_folder) if controller_folder.is_dir() else {}
+    runs = long_runs(root)
+    out: dict[str, dict[str, Any]] = {}
+    for env_id in sorted(reference, key=lambda i: "Continuous" in i):  # key ids first: a twin reads its key id's
+        entry = reference[env_id]
+        candidates: list[tuple[float, str]] = []
+        if "CenterOut" in env_id:
+            from armgame.env.center_out_v1 import DEFAULT_EPISODE_TRIALS
+
+            candidates.append((float(DEFAULT_EPISODE_TRIALS), "every trial of the episode hit"))
+        if env_id in controller:
+            mean, _, _, games, source = controller[env_id]
+            seen = "" if source == env_id else f", {slug(source)}'s games"
+            candidates.append((round(mean, 4), f"the shooting controller ({games} games{seen})"))
+        if "ppo" in entry:
+            candidates.append((entry["ppo"], f"PPO, {PPO_STEPS:,} env steps, {len(entry['ppo_seeds'])} seeds"))
+        for budget, means in runs.get(env_id, {}).items():
+            if len(means) >= CEILING_SEEDS:
+                candidates.append((round(float(np.mean(means)), 4), f"PPO, {budget:,} env steps, {len(means)} seeds"))
+        key = env_id.replace("Continuous", "")
+        if key != env_id and key in out:
+            candidates.append((out[key]["hits"], f"{slug(key)}'s ceiling"))
+        hits, by = max(candidates, key=lambda c: c[0])
+        out[env_id] = {"hits": hits, "by": by}
+    return {env_id: out[env_id] for env_id in reference if env_id in out}
+
+
+def table(reference: dict[str, dict[str, Any]] | None = None, controller_folder: Path = RESULTS / "ceiling",
+          root: Path = RESULTS) -> str:
+    """docs/programs.md's reference table (protocol 2): the bots, the shooting controller, PPO (its longest protocol
+    runs of five seeds or more, else protocol 1's) and the ceiling, each with its interval, PPO normalised by it."""
+    from armgame.env.evaluation import mean_interval
+
+    if reference is None:
+        reference = _reference_hits()
+    controller = _controller_rows(controller_folder) if controller_folder.is_dir() else {}
+    runs = long_runs(root)
+    tops = ceilings(reference, controller_folder, root)
+    lines = ["| id | random | model bot | shooting controller (95% CI) | PPO: env steps, seeds: mean (95% CI over "
+             "seeds) | ceiling: hits, by | PPO normalised |", "|---|---:|---:|---|---|---|---:|"]
+    for env_id, entry in reference.items():
+        cells = [f"{entry['random']:.1f}", f"{entry['model']:.1f}"]
+        if env_id in controller:
+            mean, low, high, _, source = controller[env_id]
+            cells.append(f"{mean:.1f} ({low:.1f}-{high:.1f})" + ("" if source == env_id else f" = {slug(source)}"))
+        else:
+            cells.append("")
+        long = [(budget, means) for budget, means in runs.get(env_id, {}).items() if len(means) >= CEILING_SEEDS]
+        budget, means = long[-1] if long else (PPO_STEPS, entry.get("ppo_seeds", []))
+        if means:
+            low, high = mean_interval(means)
+            ppo = float(np.mean(means))
+            cells.append(f"{budget / 1e6:g} M, {len(means)}: {ppo:.1f} ({low:.1f}-{high:.1f})")
+        else:
+            cells.append("")
+        top = tops[env_id]
+        cells.append(f"**{top['hits']:.1f}**, {top['by']}")
+        cells.append(f"{(ppo - entry['random']) / (top['hits'] - entry['random']):.2f}" if means else "")
+        lines.append(f"| `{slug(env_id)}` | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def ceilings_source(reference: dict[str, dict[str, Any]] | None = None) -> str:
+    """``armgame/env/references.py``'s ``CEILINGS``, as Python source."""
+    lines = ["CEILINGS: dict[str, dict[str, Any]] = {"]
+    for env_id, entry in ceilings(reference).items():
+        lines.append(f"    {json.dumps(env_id)}: {{\"hits\": {entry['hits']!r}, \"by\": {json.dumps(entry['by'])}}},")
     lines.append("}")
     return "\n".join(lines)
 
@@ -265,7 +381,9 @@ def _main(argv: list[str] | None = None) -> int:
     ppo.add_argument("--steps", type=int, default=PPO_STEPS)
     ppo.add_argument("--games", type=int, default=GAMES)
     ppo.add_argument("--out", type=Path, required=True)
-    tab = sub.add_parser("table")
+    sub.add_parser("table", help="docs/programs.md's reference table, from the committed results (protocol 2)")
+    sub.add_parser("ceilings", help="armgame/env/references.py's CEILINGS, from the committed results")
+    tab = sub.add_parser("table-v1", help="protocol 1's table from a folder of bots' and PPO's runs")
     tab.add_argument("folder", type=Path)
     refs = sub.add_parser("references")
     refs.add_argument("folder", type=Path)
@@ -293,8 +411,12 @@ def _main(argv: list[str] | None = None) -> int:
         print(curves(args.folder))
     elif args.command == "runs":
         protocol_runs(args.out, args.ids, args.seeds, args.steps, args.games, args.eval_every)
+    elif args.command == "table":
+        print(table())
+    elif args.command == "ceilings":
+        print(ceilings_source())
     else:
-        print(table(args.folder))
+        print(table_v1(args.folder))
     return 0
 
 

@@ -3,6 +3,7 @@ game scores; its rollouts refuse bad input; ``benchmarks/ceiling.py`` keeps its 
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import json
 import math
@@ -154,3 +155,19 @@ def test_the_benchmark_goes_on_where_a_sitting_stopped_and_refuses_what_is_not_a
         bench.main(["show", str(tmp_path)])
     with pytest.raises(SystemExit, match="not a Reach id"):
         bench.main(["run", "--ids", "armgame/CenterOut-v1", "--out", str(tmp_path)])
+
+
+@pytest.mark.slow
+def test_the_committed_ceiling_results_replay_their_first_game():
+    """Each committed result's first game, played again with its settings, scores the hits the file holds (the slow
+    tier: a 60 s game each)."""
+    bench = _benchmark()
+    paths = sorted((ROOT / "benchmarks" / "results" / "ceiling").glob("*.json"))
+    assert paths
+    for path in paths:
+        result = bench.read_result(path)
+        kwargs = {} if result["time_limit"] is None else {"time_limit": result["time_limit"]}
+        make = functools.partial(ceiling.ShootingController, **result["settings"])
+        again = armgame.env.evaluate("shooting", result["env_id"], seeds=[result["first_seed"]], policy_factory=make,
+                                     **kwargs)
+        assert again.hits[0] == result["hits"][0], path.name

@@ -132,7 +132,11 @@ def test_each_task_is_resampled_from_its_own_runs_only():
 
 
 def test_aggregate_runs_normalises_by_the_references_and_refuses_uneven_runs():
-    runs = {"armgame/Reach-v1": [53.21, 53.21, 0.53], "armgame/ReachHold-v1": [45.87, 0.46, 45.87]}
+    from armgame.env.references import CEILINGS
+
+    top = {env_id: CEILINGS[env_id]["hits"] for env_id in ("armgame/Reach-v1", "armgame/ReachHold-v1")}
+    runs = {"armgame/Reach-v1": [top["armgame/Reach-v1"], top["armgame/Reach-v1"], 0.53],
+            "armgame/ReachHold-v1": [top["armgame/ReachHold-v1"], 0.46, top["armgame/ReachHold-v1"]]}
     result = armgame.env.aggregate_runs(runs, reps=1_000)
     assert result.scores.shape == (3, 2) and result.scores.max() == pytest.approx(1.0)
     # The six scores 1, 1, 0, 1, 0, 1 (normalised): their middle four 0, 1, 1, 1.

@@ -17,7 +17,7 @@ from armgame.env.base import EnvArgumentError
 from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.env.evaluation import evaluate, mean_interval, normalised_score
 from armgame.env.policies import BotPolicy, bot_policy
-from armgame.env.references import REFERENCE_HITS
+from armgame.env.references import CEILINGS, REFERENCE_HITS
 from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, suite_ids
 from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
 from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv, batch_plays
@@ -304,7 +304,7 @@ def test_evaluate_is_deterministic_and_reports_an_interval():
     assert a.normalised is None  # another time limit than the references': no normalised score
     model = evaluate("model", REACH, seeds=[5])  # the id's own arguments: a normalised score
     assert model.normalised == pytest.approx(normalised_score(REACH, model.mean_hits)) and 0.5 < model.normalised < 1.5
-    low, high = REFERENCE_HITS[REACH]["random"], REFERENCE_HITS[REACH]["model"]
+    low, high = REFERENCE_HITS[REACH]["random"], CEILINGS[REACH]["hits"]
     assert (normalised_score(REACH, low), normalised_score(REACH, high)) == (0.0, 1.0)
     assert normalised_score("armgame/Reach-v0", 50.0) is None
     assert mean_interval([2, 4]) == pytest.approx((3 - 12.706 * 1.0, 3 + 12.706 * 1.0), abs=1e-3)
@@ -367,24 +367,25 @@ def test_the_small_learner_still_beats_random_play_on_a_harder_task():
     assert learned.mean() >= 1.0 and learned.mean() >= 4 * random.mean(), (learned, random)
 
 
-def test_the_docs_reference_table_is_the_references():
-    """docs/programs.md's table, row by row, against armgame/env/references.py (both from one benchmark run)."""
-    text = (Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
-    rows = {}
-    for line in text.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 6 and cells[0].startswith("`") and f"armgame/{cells[0].strip('`')}" in REFERENCE_HITS:
-            rows[f"armgame/{cells[0].strip('`')}"] = cells
-    assert set(rows) == set(REFERENCE_HITS)
-    for env_id, cells in rows.items():
-        reference = REFERENCE_HITS[env_id]
-        assert cells[1:4] == [f"{reference[p]:.1f}" for p in ("random", "naive", "model")], env_id
-        if "ppo" in reference:
-            assert cells[4].startswith(f"{reference['ppo']:.1f} ("), env_id
-            low, high = reference["random"], reference["model"]
-            assert cells[5] == f"{(reference['ppo'] - low) / (high - low):.2f}", env_id
-        else:
-            assert cells[4] == "not measured", env_id
+def test_the_docs_reference_table_and_the_ceilings_are_the_committed_results():
+    """docs/programs.md's reference table is ``reference_scores.py table`` of the committed results (the bots and
+    protocol 1's PPO in armgame/env/references.py, the controller's and PPO's runs under benchmarks/results), and
+    references.py's CEILINGS, which normalise every score, are ``reference_scores.py ceilings`` of the same files."""
+    from armgame.env.references import CEILINGS
+
+    root = Path(__file__).resolve().parent.parent
+    spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
+    scores = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(scores)
+    assert scores.ceilings() == CEILINGS
+    assert set(CEILINGS) == set(REFERENCE_HITS)
+    for env_id, ceiling in CEILINGS.items():
+        # A ceiling is at least every reference policy's score on the same games, and a twin's at least its key id's.
+        assert ceiling["hits"] >= max(REFERENCE_HITS[env_id][p] for p in ("random", "naive", "model")), env_id
+        key = env_id.replace("Continuous", "")
+        assert ceiling["hits"] >= CEILINGS[key]["hits"], env_id
+    text = (root / "docs" / "programs.md").read_text(encoding="utf-8")
+    assert scores.table() in text
 
 
 def test_the_off_policy_recipe_runs(capsys):

@@ -34,6 +34,16 @@ not know the motor noise's draws (its plans assume none; the closed loop correct
 inside the target) and does not know the next target, only its distribution: it is no oracle. It acts through
 the env's own ``step`` (keys, or levels 0 and 1 for the continuous twins, which act exactly as keys), so every
 hit is the game's, recorded and verifiable. It needs the compiled kernel (``pip install`` with a C compiler).
+
+**What did not work** (short games of 20 s, hits a minute): the cross-entropy method over continuous levels with
+one coarse RK4 step a decision and the present target only, 54 (the model bot 49.5); bang-bang on the exact model
+with the present target only, 55: a reach from rest is slow whatever the controller (the muscles rise in 80 ms),
+so the hand's momentum must be carried from one target to the next, which the next target's term does. Closing
+the loop by refining only the running plan's switching times lost the target for good under noise and dwells
+(ReachNoisy 49, ReachHold 55); searching afresh when the refined plan no longer hits gave 61 on both.
+Replanning every decision rather than every third gave ReachNoisy 65 (its setting in ``benchmarks/ceiling.py``)
+and Reach, ReachHold and ReachField nothing; switching times refined within two decisions rather than one gave
+nothing at two to four times the CPU.
 """
 
 from __future__ import annotations

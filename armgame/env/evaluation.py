@@ -5,7 +5,8 @@
 per seed, and returns an ``Evaluation``: the hits of every game, their mean with a 95 % confidence
 interval (Student's t over games), the score, the rates per minute (so games of another
 ``time_limit`` compare) and, where the id has reference scores (``REFERENCE_HITS``), the
-normalised score: 0 for the random policy, 1 for the model bot.
+normalised score: 0 for the random policy, 1 for the id's ceiling (``CEILINGS``: the best mean hits measured
+on the test games, by the shooting controller, PPO or the most a CenterOut episode holds; protocol 2).
 
 The same policy, id, seeds and arguments give the same result, bit for bit: every game is reset
 with its seed and a policy that samples (``"random"``) samples from a generator seeded by it.
@@ -254,13 +255,14 @@ def _game_minutes(env: gym.Env) -> float:
 
 
 def normalised_score(env_id: str, mean_hits: float) -> float | None:
-    """``(hits - random) / (model bot - random)`` by the id's reference scores; None for an id without them."""
-    from .references import REFERENCE_HITS
+    """``(hits - random) / (ceiling - random)`` by the id's reference scores (protocol 2: ``CEILINGS``); None for an
+    id without them."""
+    from .references import CEILINGS, REFERENCE_HITS
 
-    reference = REFERENCE_HITS.get(env_id)
-    if reference is None:
+    reference, ceiling = REFERENCE_HITS.get(env_id), CEILINGS.get(env_id)
+    if reference is None or ceiling is None:
         return None
-    low, high = reference["random"], reference["model"]
+    low, high = reference["random"], ceiling["hits"]
     return (mean_hits - low) / (high - low) if high != low else None
 
 

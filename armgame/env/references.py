@@ -2,7 +2,8 @@
 
 Made by ``python benchmarks/reference_scores.py references FOLDER`` from that benchmark's runs (its
 ``bots`` and ``ppo`` steps; docs/programs.md's reference table is its ``table`` step of the same
-runs). ``armgame.env.evaluation.normalised_score`` scales by ``random`` (0) and ``model`` (1);
+runs). ``armgame.env.evaluation.normalised_score`` scales by ``random`` (0) and the id's ceiling (1,
+``CEILINGS``, protocol 2; protocol 1 scaled by ``model``);
 ``random_first`` and ``model_first`` are the first games' hits, which ``tests/test_env_suite.py``
 replays. ``ppo`` is the mean over ``ppo_seeds``, each a training seed's policy evaluated on the same
 games.
@@ -83,4 +84,27 @@ REFERENCE_HITS: dict[str, dict[str, Any]] = {
         "random": 0.02, "naive": 0.12, "model": 8.0, "ppo": 8.0, "ppo_seeds": [8.0, 8.0, 8.0], "random_first": [0, 0,
         0, 0, 0], "model_first": [8, 8, 8, 8, 8]
     },
+}
+
+
+# Protocol 2's ceilings (``python benchmarks/reference_scores.py ceilings``, from the committed results under
+# benchmarks/results; tests/test_env_protocol.py holds them to those files): each id's best mean hits on the 100
+# test games by a policy that knows the task or has learnt it, and which. The normalised score's 1.
+CEILINGS: dict[str, dict[str, Any]] = {
+    "armgame/Reach-v1": {"hits": 72.16, "by": "the shooting controller (100 games)"},
+    "armgame/ReachContinuous-v1": {"hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
+    "armgame/CenterOut-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/CenterOutContinuous-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/ReachHold-v1": {"hits": 61.3, "by": "PPO, 500,000 env steps, 3 seeds"},
+    "armgame/ReachHoldContinuous-v1": {"hits": 62.4033, "by": "PPO, 500,000 env steps, 3 seeds"},
+    "armgame/ReachNoisy-v1": {"hits": 68.5867, "by": "PPO, 500,000 env steps, 3 seeds"},
+    "armgame/ReachNoisyContinuous-v1": {"hits": 68.5867, "by": "ReachNoisy-v1's ceiling"},
+    "armgame/ReachDelay-v1": {"hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
+    "armgame/ReachDelayContinuous-v1": {"hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
+    "armgame/ReachField-v1": {"hits": 76.4333, "by": "PPO, 500,000 env steps, 3 seeds"},
+    "armgame/ReachFieldContinuous-v1": {"hits": 76.4333, "by": "ReachField-v1's ceiling"},
+    "armgame/ReachHard-v1": {"hits": 52.624, "by": "PPO, 10,000,000 env steps, 5 seeds"},
+    "armgame/ReachHardContinuous-v1": {"hits": 52.624, "by": "ReachHard-v1's ceiling"},
+    "armgame/CenterOutHold-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/CenterOutHoldContinuous-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
 }

@@ -47,8 +47,10 @@ CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
 
 #: The protocol these seeds, ``evaluate`` and ``aggregate_runs`` make (docs/programs.md, "The protocol"): name it
 #: in a paper. 1: three seed ranges, a fresh policy each game, normalised by random play (0) and the model bot
-#: (1). A score normalised by a ceiling controller instead will be protocol 2, once every id has one.
-PROTOCOL_VERSION = 1
+#: (1). 2: the same, normalised by each id's ceiling (1; ``armgame.env.references.CEILINGS``: the best mean hits
+#: measured on the test games, by the shooting controller, PPO at a budget where its curve has flattened, or the
+#: most a CenterOut episode holds).
+PROTOCOL_VERSION = 2
 
 #: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
 EVALUATION_SEED_START = 10**9
