@@ -24,14 +24,15 @@ const char armgame_shoot_doc[] =
 "Roll each plan out from state x0 (4 float64: q1 q2 w1 w2) and activations act0 (4 float64). plans: (N, 6)\n"
 "int64 rows (shoulder sign, n1, n2, elbow sign, n1, n2): a joint's first muscle (sign 1; its second, -1) is\n"
 "pressed for n1 decisions of ``substeps`` physics steps, the other for n2, then both released, for at most\n"
-"``horizon`` decisions (counts from 0 to 1e6; beyond the horizon never reached). rates: 8 float64, the muscles' rise then decay rates a step; field: 5 float64\n"
-"(kind 0 none, 1 curl b = p0, 2 viscous ((p0, p1), (p2, p3)); then p0-p3); target: 3 float64 (x, y, radius\n"
-"squared); hold: the physics steps the hand must stay in the disc (1: entering it), dwelt: steps it has\n"
-"stayed already; box: 4 float64 (q1 low, high, q2 low, high) a plan may not leave. out: (N, 6) float64,\n"
-"each plan's physics step of the hit counted from the start (-1: none within the horizon, -2: it left the\n"
-"box), the state then (or at its end) and the hand's distance from the target's centre then. params: the\n"
-"kernel's P_* doubles (the arm, dt, lengths, moments). Refused (ValueError): anything not finite, counts\n"
-"out of range, more than 2e9 physics steps in all.";
+"``horizon`` decisions (counts 0 to 1e6: past the horizon they are never reached, so a caller may cut a search\n"
+"short). rates: 8 float64, the muscles' rise then decay rates a step; field: 5 float64 (kind 0 none, 1 curl\n"
+"b = p0, 2 viscous ((p0, p1), (p2, p3)); then p0-p3); target: 3 float64 (x, y, radius squared); hold: the\n"
+"physics steps the hand must stay in the disc (1: entering it), dwelt: steps it has stayed already; box: 4\n"
+"float64 (q1 low, high, q2 low, high) a plan may not leave. out: (N, 6) float64, each plan's physics step of\n"
+"the hit counted from the start (-1: none within the horizon, -2: it left the box), the state then (or at its\n"
+"end) and the hand's distance from the target's centre then. params: the kernel's P_* doubles (the arm, dt,\n"
+"lengths, moments). Refused (ValueError): anything not finite, counts out of range, more than 2e9 physics\n"
+"steps in all.";
 
 PyObject *armgame_shoot(PyObject *self, PyObject *args)
 {
