@@ -75,6 +75,15 @@ def test_the_controller_outscores_the_model_bot_where_the_dwell_cripples_it():
     assert shooting.hits[0] >= model.hits[0] + 2
 
 
+def test_a_dwell_out_of_reach_is_approached_not_waited_for():
+    """Test game 26 of ReachHold-v1 drew a target no plan could reach and stop in within the horizon: the
+    controller, ranking its misses by where they ended, left the arm still there for the rest of the game (6 hits
+    in 60 s). It now enters the target first, and goes on hitting."""
+    result = armgame.env.evaluate("shooting", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=12.0,
+                                  policy_factory=ceiling.ShootingController)
+    assert result.hits[0] >= 10
+
+
 def test_a_plan_shifted_past_its_end_is_both_muscles_off():
     assert ceiling.shifted(np.array([1, 2, 3, -1, 4, 0]), 3).tolist() == [-1, 2, 0, -1, 1, 0]
     assert ceiling.shifted(np.array([1, 2, 3, -1, 4, 0]), 10).tolist() == [1, 0, 0, 1, 0, 0]

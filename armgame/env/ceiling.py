@@ -219,7 +219,21 @@ class ShootingController:
 
     def search(self, x0: np.ndarray, act0: np.ndarray, target: tuple[float, float], dwelt: int) -> None:
         """Both joints' (sign, n1, n2) on the coarse grid together, then each joint's on the fine grid with the other
-        held (coordinate descent), then both joints' switching times within one decision of the best."""
+        held (coordinate descent), then both joints' switching times within one decision of the best. Where no plan
+        completes a dwell, the plan that enters the target soonest: from inside it, a dwell is within reach (a
+        search that ranked the misses by where they end left the arm still, far from a target it could not reach
+        and stop in within the horizon, for the rest of a game)."""
+        hold = self.hold
+        try:
+            self._search(x0, act0, target, dwelt)
+            if self.predicted_steps < 0 and hold > 1:
+                self.hold = 1
+                self._search(x0, act0, target, 0)
+                self.predicted_steps = -1  # the dwell's hit is not what it plans
+        finally:
+            self.hold = hold
+
+    def _search(self, x0: np.ndarray, act0: np.ndarray, target: tuple[float, float], dwelt: int) -> None:
         # A sample of the coarse grid first: its best cost bounds how far the rest is followed.
         sample = self._coarse_pairs[::COARSE_SAMPLE]
         best, cost, steps = self._best(sample, x0, act0, target, dwelt)
