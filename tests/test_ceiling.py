@@ -27,8 +27,8 @@ SEED = 1_000_000_000
 
 def _first_hit(env_id: str, **kwargs: object) -> tuple[int, int, int]:
     """(the physics step of the first hit the controller's first plan predicts, the game's first hit's step,
-    the game's hits) over a 3 s game played open loop (no replanning: the first plan runs to its hit)."""
-    env = gym.make(env_id, time_limit=3.0, **kwargs)
+    the game's hits) over a 2 s game played open loop (no replanning: the first plan runs to its hit)."""
+    env = gym.make(env_id, time_limit=2.0, **kwargs)
     observation, _ = env.reset(seed=SEED)
     controller = ceiling.ShootingController(env, replan=0, margin=0.0)
     session = env.unwrapped.session
