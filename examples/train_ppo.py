@@ -40,7 +40,7 @@ import armgame.env  # noqa: F401  (registers the ids)
 from armgame.env.evaluation import evaluate
 from armgame.env.record import replay_of
 from armgame.env.sb3 import make_sb3_vec_env
-from armgame.env.suite import VALIDATION_SEEDS
+from armgame.env.suite import PROTOCOL_VERSION, VALIDATION_SEEDS
 
 # What a run watches: validation games, never the test games evaluate() plays at the end (armgame.env.suite).
 VALIDATION = list(VALIDATION_SEEDS[:10])
@@ -131,7 +131,8 @@ def main(argv: list[str] | None = None) -> int:
         model.save(args.out / "model.zip")
         result = {"env_id": args.env, "algorithm": "PPO", "training_seed": args.seed, "env_steps": model.num_timesteps,
                   "budget_steps": args.steps, "test_seeds": [test.seeds[0], test.seeds[-1]],
-                  "test_hits": list(test.hits), "mean_hits": test.mean_hits, "normalised": test.normalised}
+                  "test_hits": list(test.hits), "mean_hits": test.mean_hits, "normalised": test.normalised,
+                  "protocol": PROTOCOL_VERSION}  # the normalised score's: a file without it is protocol 1's
         (args.out / "result.json").write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
         hits = keep_a_game(model, args.env, args.out / "game.json")
         print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")
