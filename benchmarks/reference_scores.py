@@ -252,7 +252,8 @@ def ceilings_source(reference: dict[str, dict[str, Any]] | None = None) -> str:
     """``armgame/env/references.py``'s ``CEILINGS``, as Python source."""
     lines = ["CEILINGS: dict[str, dict[str, Any]] = {"]
     for env_id, entry in ceilings(reference).items():
-        lines.append(f"    {json.dumps(env_id)}: {{\"hits\": {entry['hits']!r}, \"by\": {json.dumps(entry['by'])}}},")
+        lines.append(f"    {json.dumps(env_id)}: {{")
+        lines.append(f"        \"hits\": {entry['hits']!r}, \"by\": {json.dumps(entry['by'])}}},")
     lines.append("}")
     return "\n".join(lines)
 

@@ -386,6 +386,17 @@ def test_the_docs_reference_table_and_the_ceilings_are_the_committed_results():
         assert ceiling["hits"] >= CEILINGS[key]["hits"], env_id
     text = (root / "docs" / "programs.md").read_text(encoding="utf-8")
     assert scores.table() in text
+    # The page's reading of the table: PPO's shortfall from the ceiling, by the table's PPO column.
+    short = {}
+    for row in scores.table().splitlines()[2:]:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        short[cells[0].strip("`")] = round(100 * (1 - float(cells[-1])))
+    prose = " ".join(text.split())
+    assert max(short[f"{name}{twin}-v1"] for name in ("Reach", "ReachHold", "ReachNoisy")
+               for twin in ("", "Continuous")) <= 6 and "within 6 % of it on Reach, ReachHold and ReachNoisy" in prose
+    assert short["ReachField-v1"] == short["ReachHard-v1"] == 0 and "On ReachField and ReachHard PPO *is*" in prose
+    assert (f"costs PPO {short['ReachDelay-v1']} % of the ceiling with keys and {short['ReachDelayContinuous-v1']} % "
+            f"with continuous actions, and ReachHard's continuous twin ({short['ReachHardContinuous-v1']} %") in prose
 
 
 def test_the_off_policy_recipe_runs(capsys):

@@ -91,20 +91,36 @@ REFERENCE_HITS: dict[str, dict[str, Any]] = {
 # benchmarks/results; tests/test_env_protocol.py holds them to those files): each id's best mean hits on the 100
 # test games by a policy that knows the task or has learnt it, and which. The normalised score's 1.
 CEILINGS: dict[str, dict[str, Any]] = {
-    "armgame/Reach-v1": {"hits": 72.16, "by": "the shooting controller (100 games)"},
-    "armgame/ReachContinuous-v1": {"hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
-    "armgame/CenterOut-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
-    "armgame/CenterOutContinuous-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
-    "armgame/ReachHold-v1": {"hits": 65.858, "by": "PPO, 4,000,000 env steps, 5 seeds"},
-    "armgame/ReachHoldContinuous-v1": {"hits": 65.858, "by": "ReachHold-v1's ceiling"},
-    "armgame/ReachNoisy-v1": {"hits": 70.63, "by": "the shooting controller (100 games)"},
-    "armgame/ReachNoisyContinuous-v1": {"hits": 70.63, "by": "the shooting controller (100 games, ReachNoisy-v1's games)"},
-    "armgame/ReachDelay-v1": {"hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
-    "armgame/ReachDelayContinuous-v1": {"hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
-    "armgame/ReachField-v1": {"hits": 76.4333, "by": "PPO, 500,000 env steps, 3 seeds"},
-    "armgame/ReachFieldContinuous-v1": {"hits": 76.4333, "by": "ReachField-v1's ceiling"},
-    "armgame/ReachHard-v1": {"hits": 52.624, "by": "PPO, 10,000,000 env steps, 5 seeds"},
-    "armgame/ReachHardContinuous-v1": {"hits": 52.624, "by": "ReachHard-v1's ceiling"},
-    "armgame/CenterOutHold-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
-    "armgame/CenterOutHoldContinuous-v1": {"hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/Reach-v1": {
+        "hits": 72.16, "by": "the shooting controller (100 games)"},
+    "armgame/ReachContinuous-v1": {
+        "hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
+    "armgame/CenterOut-v1": {
+        "hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/CenterOutContinuous-v1": {
+        "hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/ReachHold-v1": {
+        "hits": 65.858, "by": "PPO, 4,000,000 env steps, 5 seeds"},
+    "armgame/ReachHoldContinuous-v1": {
+        "hits": 65.858, "by": "ReachHold-v1's ceiling"},
+    "armgame/ReachNoisy-v1": {
+        "hits": 70.63, "by": "the shooting controller (100 games)"},
+    "armgame/ReachNoisyContinuous-v1": {
+        "hits": 70.63, "by": "the shooting controller (100 games, ReachNoisy-v1's games)"},
+    "armgame/ReachDelay-v1": {
+        "hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
+    "armgame/ReachDelayContinuous-v1": {
+        "hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
+    "armgame/ReachField-v1": {
+        "hits": 76.4333, "by": "PPO, 500,000 env steps, 3 seeds"},
+    "armgame/ReachFieldContinuous-v1": {
+        "hits": 76.4333, "by": "ReachField-v1's ceiling"},
+    "armgame/ReachHard-v1": {
+        "hits": 52.624, "by": "PPO, 10,000,000 env steps, 5 seeds"},
+    "armgame/ReachHardContinuous-v1": {
+        "hits": 52.624, "by": "ReachHard-v1's ceiling"},
+    "armgame/CenterOutHold-v1": {
+        "hits": 8.0, "by": "every trial of the episode hit"},
+    "armgame/CenterOutHoldContinuous-v1": {
+        "hits": 8.0, "by": "every trial of the episode hit"},
 }
