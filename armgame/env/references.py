@@ -88,7 +88,7 @@ REFERENCE_HITS: dict[str, dict[str, Any]] = {
 
 
 # Protocol 2's ceilings (``python benchmarks/reference_scores.py ceilings``, from the committed results under
-# benchmarks/results; tests/test_env_protocol.py holds them to those files): each id's best mean hits on the 100
+# benchmarks/results; tests/test_env_suite.py holds them to those files): each id's best mean hits on the 100
 # test games by a policy that knows the task or has learnt it, and which. The normalised score's 1.
 CEILINGS: dict[str, dict[str, Any]] = {
     "armgame/Reach-v1": {
