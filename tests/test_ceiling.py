@@ -56,7 +56,7 @@ def test_the_planned_hit_is_the_games_hit_to_the_physics_step(env_id):
 
 def test_a_continuous_twin_plays_its_key_ids_games_and_the_delay_never_reaches_the_controller():
     # ReachHard: the dwell, motor noise (the same draws in both) and the field at once.
-    games = {env_id: armgame.env.evaluate("shooting", env_id, games=1, time_limit=3.0,
+    games = {env_id: armgame.env.evaluate("shooting", env_id, games=1, time_limit=2.0,
                                           policy_factory=ceiling.ShootingController).hits
              for env_id in ("armgame/ReachHard-v1", "armgame/ReachHardContinuous-v1")}
     assert games["armgame/ReachHard-v1"] == games["armgame/ReachHardContinuous-v1"]
@@ -68,21 +68,14 @@ def test_a_continuous_twin_plays_its_key_ids_games_and_the_delay_never_reaches_t
     assert delayed == plain
 
 
-def test_the_controller_outscores_the_model_bot_where_the_dwell_cripples_it():
-    kwargs = {"games": 1, "time_limit": 8.0}
-    shooting = armgame.env.evaluate("shooting", "armgame/ReachHold-v1", policy_factory=ceiling.ShootingController,
-                                    **kwargs)
-    model = armgame.env.evaluate("model", "armgame/ReachHold-v1", **kwargs)
-    assert shooting.hits[0] >= model.hits[0] + 2
-
-
 def test_a_dwell_out_of_reach_is_approached_not_waited_for():
     """Test game 26 of ReachHold-v1 drew a target no plan could reach and stop in within the horizon: the
     controller, ranking its misses by where they ended, left the arm still there for the rest of the game (6 hits
     in 60 s). It now enters the target first, and goes on hitting."""
     result = armgame.env.evaluate("shooting", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=12.0,
                                   policy_factory=ceiling.ShootingController)
-    assert result.hits[0] >= 10
+    model = armgame.env.evaluate("model", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=12.0)
+    assert result.hits[0] >= 10 and result.hits[0] > model.hits[0]
 
 
 def test_a_plan_shifted_past_its_end_is_both_muscles_off():
