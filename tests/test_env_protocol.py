@@ -339,3 +339,13 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
             assert f"**{sum(means) / len(means):.1f} on average" in guide, id_folder
             assert ", ".join(f"{m:.1f}" for m in means[:-1]) + f" and {means[-1]:.1f} hits" in guide, id_folder
     assert reported >= 2
+
+
+def test_the_protocols_example_in_the_docs_prints_what_its_comment_says():
+    """docs/programs.md's aggregate example, its made-up runs normalised by the ceilings (protocol 2)."""
+    runs = {"armgame/ReachHold-v1": [61.2, 60.7, 62.3, 44.0, 61.0],
+            "armgame/ReachDelay-v1": [60.3, 61.2, 66.8, 58.1, 63.0]}
+    printed = armgame.env.aggregate_runs(runs, reps=2_000).summary()
+    guide = (Path(__file__).resolve().parent.parent / "docs" / "programs.md").read_text(encoding="utf-8")
+    assert f"# {printed.split(' over ')[0]} over 5 ..." in guide
+    assert all(", ".join(map(str, hits)) in guide for hits in runs.values())
