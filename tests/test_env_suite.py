@@ -396,7 +396,8 @@ def test_the_docs_reference_table_and_the_ceilings_are_the_committed_results():
                for twin in ("", "Continuous")) <= 6 and "within 6 % of it on Reach, ReachHold and ReachNoisy" in prose
     assert short["ReachField-v1"] == short["ReachHard-v1"] == 0 and "On ReachField and ReachHard PPO *is*" in prose
     assert (f"costs PPO {short['ReachDelay-v1']} % of the ceiling with keys and {short['ReachDelayContinuous-v1']} % "
-            f"with continuous actions, and ReachHard's continuous twin ({short['ReachHardContinuous-v1']} %") in prose
+            f"with continuous actions, and the continuous twins of ReachField and ReachHard "
+            f"({short['ReachFieldContinuous-v1']} % and {short['ReachHardContinuous-v1']} %") in prose
 
 
 def test_the_off_policy_recipe_runs(capsys):
