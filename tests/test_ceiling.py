@@ -72,10 +72,10 @@ def test_a_dwell_out_of_reach_is_approached_not_waited_for():
     """Test game 26 of ReachHold-v1 drew a target no plan could reach and stop in within the horizon: the
     controller, ranking its misses by where they ended, left the arm still there for the rest of the game (6 hits
     in 60 s). It now enters the target first, and goes on hitting."""
-    result = armgame.env.evaluate("shooting", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=12.0,
+    result = armgame.env.evaluate("shooting", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=8.0,
                                   policy_factory=ceiling.ShootingController)
-    model = armgame.env.evaluate("model", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=12.0)
-    assert result.hits[0] >= 10 and result.hits[0] > model.hits[0]
+    model = armgame.env.evaluate("model", "armgame/ReachHold-v1", seeds=[SEED + 26], time_limit=8.0)
+    assert result.hits[0] >= 8 and result.hits[0] > model.hits[0]  # stuck, it had 6
 
 
 def test_a_plan_shifted_past_its_end_is_both_muscles_off():
@@ -145,7 +145,7 @@ def test_the_benchmark_goes_on_where_a_sitting_stopped_and_refuses_what_is_not_a
     assert second["hits"][:1] == first["hits"] and len(second["hits"]) == 2
     alone = armgame.env.evaluate("shooting", "armgame/Reach-v1", seeds=[SEED + 1], time_limit=1.0,
                                  policy_factory=ceiling.ShootingController)
-    assert second["hits"][1] == alone.hits[0]
+    assert second["hits"][1] == alone.hits[0] == 1
     rows = bench.summary(tmp_path)
     assert rows["armgame/ReachDelayContinuous-v1"][-1] == "armgame/Reach-v1"
     with pytest.raises(SystemExit, match="other settings"):
