@@ -54,6 +54,7 @@ def test_the_planned_hit_is_the_games_hit_to_the_physics_step(env_id):
     assert hits >= 2
 
 
+@pytest.mark.slow  # whole seconds of the controller's play: the slow tier, which CI runs too
 def test_a_continuous_twin_plays_its_key_ids_games_and_the_delay_never_reaches_the_controller():
     # ReachNoisy: the motor noise's draws the same in both, as the actions' effect must be.
     games = {env_id: armgame.env.evaluate("shooting", env_id, games=1, time_limit=2.5,
@@ -68,6 +69,7 @@ def test_a_continuous_twin_plays_its_key_ids_games_and_the_delay_never_reaches_t
     assert delayed == plain
 
 
+@pytest.mark.slow  # whole seconds of the controller's play: the slow tier, which CI runs too
 def test_a_dwell_out_of_reach_is_approached_not_waited_for():
     """Test game 26 of ReachHold-v1 drew a target no plan could reach and stop in within the horizon: the
     controller, ranking its misses by where they ended, left the arm still there for the rest of the game (6 hits
