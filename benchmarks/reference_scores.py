@@ -168,8 +168,11 @@ def _reference_hits() -> dict[str, dict[str, Any]]:
 
 
 def _controller_rows(folder: Path) -> dict[str, tuple[float, float, float, int, str]]:
+    """``benchmarks/ceiling.py``'s ``summary`` of ``folder`` (none where there is no folder)."""
     import importlib.util
 
+    if not folder.is_dir():
+        return {}
     spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
     module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
     spec.loader.exec_module(module)  # type: ignore[union-attr]
@@ -186,8 +189,11 @@ def ceilings(reference: dict[str, dict[str, Any]] | None = None, controller_fold
     whatever the key id plays)."""
     if reference is None:
         reference = _reference_hits()
-    controller = _controller_rows(controller_folder) if controller_folder.is_dir() else {}
-    runs = long_runs(root)
+    return _ceilings_of(reference, _controller_rows(controller_folder), long_runs(root))
+
+
+def _ceilings_of(reference: dict[str, dict[str, Any]], controller: dict[str, tuple[float, float, float, int, str]],
+                 runs: dict[str, dict[int, list[float]]]) -> dict[str, dict[str, Any]]:
     out: dict[str, dict[str, Any]] = {}
     for env_id in sorted(reference, key=lambda i: "Continuous" in i):  # key ids first: a twin reads its key id's
         entry = reference[env_id]
@@ -221,9 +227,9 @@ def table(reference: dict[str, dict[str, Any]] | None = None, controller_folder:
 
     if reference is None:
         reference = _reference_hits()
-    controller = _controller_rows(controller_folder) if controller_folder.is_dir() else {}
+    controller = _controller_rows(controller_folder)
     runs = long_runs(root)
-    tops = ceilings(reference, controller_folder, root)
+    tops = _ceilings_of(reference, controller, runs)
     lines = ["| id | random | model bot | shooting controller (95% CI) | PPO: env steps, seeds: mean (95% CI over "
              "seeds) | ceiling: hits, by | PPO normalised |", "|---|---:|---:|---|---|---|---:|"]
     for env_id, entry in reference.items():

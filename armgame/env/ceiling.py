@@ -49,7 +49,7 @@ nothing at two to four times the CPU.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -69,13 +69,24 @@ COARSE_SAMPLE = 16
 JOINT_BOX = (-1.0, 2.8, 0.15, 2.8)
 
 
-def bang_bang(sign: np.ndarray, first: np.ndarray, second: np.ndarray, horizon: int) -> np.ndarray:
-    """One joint's plans as signs a decision (N, horizon): ``sign`` for ``first`` decisions, ``-sign`` for
-    ``second``, then 0."""
-    k = np.arange(horizon)[None, :]
-    s = sign[:, None]
-    f = first[:, None]
-    return np.where(k < f, s, np.where(k < f + second[:, None], -s, 0)).astype(np.int8)
+class Goal(NamedTuple):
+    """What a plan aims at: the target's centre (m), the dwell's physics steps in a row (1: entering it) and those
+    the hand has stayed already."""
+
+    x: float
+    y: float
+    hold: int
+    dwelt: int
+
+
+def pressed(best: np.ndarray, k: int) -> tuple[int, int]:
+    """Each joint's muscle pressed at decision ``k`` of the plan ``best`` (sign, n1, n2 a joint): +1 its first, -1
+    its second, 0 neither (``_cshoot.c``'s reading of a plan)."""
+    out = []
+    for j in (0, 3):
+        s, n1, n2 = (int(v) for v in best[j:j + 3])
+        out.append(s if k < n1 else -s if k < n1 + n2 else 0)
+    return out[0], out[1]
 
 
 def shifted(best: np.ndarray, elapsed: int) -> np.ndarray:
@@ -128,8 +139,7 @@ class ShootingController:
         self.continuous = settings.continuous
         self.hold = max(1, game.hold_steps)
         self.radius = config.target_radius
-        self.margin, self.beta, self.horizon, self.replan = margin, beta, horizon, replan
-        self.coarse, self.fine, self.research = coarse, fine, research
+        self.margin, self.beta, self.horizon, self.replan, self.research = margin, beta, horizon, replan, research
         self.accel = np.array(accel)
         lo1, hi1 = np.radians(config.target_shoulder_range)
         lo2, hi2 = np.radians(config.target_elbow_range)
@@ -143,24 +153,23 @@ class ShootingController:
         self._coarse_pairs = self._pairs_of(self._options(coarse))
         self._fine_options = self._options(fine)
         self._neighbours = np.array(np.meshgrid(*[range(-reach, reach + 1)] * 4, indexing="ij")).reshape(4, -1).T
-        self.plan: np.ndarray | None = None
+        #: The running plan (sign, n1, n2 a joint), the decisions of it played, and the target it was made for.
         self.best = np.array([1, 0, 0, 1, 0, 0])
         self.position = 0
         self.target: Any = None
         #: The physics steps from the last plan's start to the hit it predicts (-1: none within the horizon).
         self.predicted_steps = -1
-        self.plans_made = 0
 
     def reset(self) -> None:
         """A new game: nothing carried over (``evaluate`` calls it before each game)."""
-        self.plan, self.target, self.position, self.predicted_steps = None, None, 0, -1
+        self.target, self.position, self.predicted_steps = None, 0, -1
 
     # ------------------------------------------------------------------ the cost
-    def next_time(self, states: np.ndarray, target: tuple[float, float]) -> np.ndarray:
+    def next_time(self, states: np.ndarray, target: Goal) -> np.ndarray:
         """Each state's expected time (s) to reach the next target: the mean over the grid's targets far enough
         from this one (the game draws none within 3 radii of the hand) of the slower joint's time as a double
         integrator of acceleration ``accel`` that need only pass through its target (it need not stop)."""
-        far = np.hypot(self.grid_hand[:, 0] - target[0], self.grid_hand[:, 1] - target[1]) > 3.0 * self.radius
+        far = np.hypot(self.grid_hand[:, 0] - target.x, self.grid_hand[:, 1] - target.y) > 3.0 * self.radius
         goals = self.grid[far]
         q = states[:, None, 0:2]
         w = states[:, None, 2:4]
@@ -173,8 +182,8 @@ class ShootingController:
         back = -u / a + np.sqrt(2.0 * (x + u * u / (2.0 * a)) / a)
         return np.where(u >= 0, toward, back).max(axis=2).mean(axis=1)
 
-    def rollouts(self, pairs: np.ndarray, x0: np.ndarray, act0: np.ndarray, target: tuple[float, float],
-                 dwelt: int, bound: float = math.inf) -> np.ndarray:
+    def rollouts(self, pairs: np.ndarray, x0: np.ndarray, act0: np.ndarray, goal: Goal,
+                 bound: float = math.inf) -> np.ndarray:
         """Each plan of ``pairs`` (N, 6) rolled out by ``_ckernel.shoot``: (N, 6) rows of the hit's physics step
         (-1 none, -2 out of the box), the state then and the distance from the target's centre. ``bound`` (s): no
         plan is followed past it (one hitting later could not beat a cost already found)."""
@@ -187,15 +196,15 @@ class ShootingController:
         horizon = self.horizon if bound >= self.horizon * self.decision_time \
             else int(bound / self.decision_time) + 1
         _shoot(self.params, self.mode, self.rates, self.field, x0, act0, np.ascontiguousarray(pairs, dtype=np.int64),
-               self.substeps, horizon, np.array([target[0], target[1], rr]), self.hold, dwelt, box, out)
+               self.substeps, horizon, np.array([goal.x, goal.y, rr]), goal.hold, goal.dwelt, box, out)
         return out
 
-    def cost(self, out: np.ndarray, target: tuple[float, float]) -> np.ndarray:
+    def cost(self, out: np.ndarray, goal: Goal) -> np.ndarray:
         """Each rollout's cost (s): a plan that misses ranks below every plan that hits, by its final distance."""
         hit = out[:, 0] >= 0
         t = np.where(hit, out[:, 0] * self.params[0], np.where(out[:, 0] == -1, 100.0, 1000.0) + out[:, 5])
         if self.beta and hit.any():
-            t[hit] += self.beta * self.next_time(out[hit, 1:5], target)
+            t[hit] += self.beta * self.next_time(out[hit, 1:5], goal)
         return t
 
     # ---------------------------------------------------------------- the search
@@ -210,60 +219,51 @@ class ShootingController:
         i, j = np.meshgrid(np.arange(len(options)), np.arange(len(options)), indexing="ij")
         return np.concatenate([options[i.ravel()], options[j.ravel()]], axis=1)
 
-    def _best(self, pairs: np.ndarray, x0: np.ndarray, act0: np.ndarray, target: tuple[float, float],
-              dwelt: int, bound: float = math.inf) -> tuple[np.ndarray, float, int]:
-        out = self.rollouts(pairs, x0, act0, target, dwelt, bound)
-        costs = self.cost(out, target)
+    def _best(self, pairs: np.ndarray, x0: np.ndarray, act0: np.ndarray, goal: Goal,
+              bound: float = math.inf) -> tuple[np.ndarray, float, int]:
+        out = self.rollouts(pairs, x0, act0, goal, bound)
+        costs = self.cost(out, goal)
         i = int(np.argmin(costs))
         return pairs[i], float(costs[i]), int(out[i, 0])
 
-    def search(self, x0: np.ndarray, act0: np.ndarray, target: tuple[float, float], dwelt: int) -> None:
+    def search(self, x0: np.ndarray, act0: np.ndarray, goal: Goal) -> None:
         """Both joints' (sign, n1, n2) on the coarse grid together, then each joint's on the fine grid with the other
         held (coordinate descent), then both joints' switching times within one decision of the best. Where no plan
         completes a dwell, the plan that enters the target soonest: from inside it, a dwell is within reach (a
         search that ranked the misses by where they end left the arm still, far from a target it could not reach
         and stop in within the horizon, for the rest of a game)."""
-        hold = self.hold
-        try:
-            self._search(x0, act0, target, dwelt)
-            if self.predicted_steps < 0 and hold > 1:
-                self.hold = 1
-                self._search(x0, act0, target, 0)
-                self.predicted_steps = -1  # the dwell's hit is not what it plans
-        finally:
-            self.hold = hold
+        self._search(x0, act0, goal)
+        if self.predicted_steps < 0 and goal.hold > 1:
+            self._search(x0, act0, goal._replace(hold=1, dwelt=0))
+            self.predicted_steps = -1  # the dwell's hit is not what it plans
 
-    def _search(self, x0: np.ndarray, act0: np.ndarray, target: tuple[float, float], dwelt: int) -> None:
+    def _search(self, x0: np.ndarray, act0: np.ndarray, goal: Goal) -> None:
         # A sample of the coarse grid first: its best cost bounds how far the rest is followed.
         sample = self._coarse_pairs[::COARSE_SAMPLE]
-        best, cost, steps = self._best(sample, x0, act0, target, dwelt)
-        candidate, c, s = self._best(self._coarse_pairs, x0, act0, target, dwelt, cost)
+        best, cost, steps = self._best(sample, x0, act0, goal)
+        candidate, c, s = self._best(self._coarse_pairs, x0, act0, goal, cost)
         if c < cost:
             best, cost, steps = candidate, c, s
         fine = self._fine_options
         for joint in (0, 1):
             pairs = np.tile(best, (len(fine), 1))
             pairs[:, 3 * joint:3 * joint + 3] = fine
-            candidate, c, s = self._best(pairs, x0, act0, target, dwelt, cost)
+            candidate, c, s = self._best(pairs, x0, act0, goal, cost)
             if c < cost:
                 best, cost, steps = candidate, c, s
-        self.refine(best, cost, steps, x0, act0, target, dwelt)
+        self.refine(best, cost, steps, x0, act0, goal)
 
-    def refine(self, best: np.ndarray, cost: float, steps: int, x0: np.ndarray, act0: np.ndarray,
-               target: tuple[float, float], dwelt: int) -> None:
+    def refine(self, best: np.ndarray, cost: float, steps: int, x0: np.ndarray, act0: np.ndarray, goal: Goal) -> None:
         """``best`` or the best of its neighbours (both joints' switching times within one decision of it) becomes
         the plan."""
         pairs = np.tile(best, (len(self._neighbours), 1))
         pairs[:, [1, 2, 4, 5]] = np.minimum(np.maximum(pairs[:, [1, 2, 4, 5]] + self._neighbours, 0), self.horizon)
-        candidate, c, s = self._best(pairs, x0, act0, target, dwelt, cost)
+        candidate, c, s = self._best(pairs, x0, act0, goal, cost)
         if c < cost:
             best, steps = candidate, s
         self.best = best.copy()
         self.predicted_steps = steps
-        self.plan = np.stack([bang_bang(best[None, 0], best[None, 1], best[None, 2], self.horizon)[0],
-                              bang_bang(best[None, 3], best[None, 4], best[None, 5], self.horizon)[0]], axis=1)
         self.position = 0
-        self.plans_made += 1
 
     # ------------------------------------------------------------------ playing
     def __call__(self, observation: Any) -> np.ndarray:
@@ -274,16 +274,16 @@ class ShootingController:
         dwelt = rules.dwell_at(session.steps) if isinstance(rules, DwellRules) else 0
         x0 = np.array(session.state, dtype=np.float64)
         act0 = np.array(session.muscles.activation, dtype=np.float64)
-        goal = (target.x, target.y)
-        if target is not self.target or self.plan is None or self.position >= self.horizon:
-            self.search(x0, act0, goal, dwelt)
+        goal = Goal(target.x, target.y, self.hold, dwelt)
+        if target is not self.target or self.position >= self.horizon:
+            self.search(x0, act0, goal)
             self.target = target
         elif self.replan and self.position % self.replan == 0:
             # Closed loop: from the state reached, the plan still running and its neighbours rolled out again.
-            self.refine(shifted(self.best, self.position), math.inf, -1, x0, act0, goal, dwelt)
+            self.refine(shifted(self.best, self.position), math.inf, -1, x0, act0, goal)
             if self.predicted_steps < 0 and self.research:  # the running plan and its neighbours all miss now
-                self.search(x0, act0, goal, dwelt)
-        s, e = self.plan[self.position]  # type: ignore[index]
+                self.search(x0, act0, goal)
+        s, e = pressed(self.best, self.position)
         self.position += 1
         keys = np.array([s > 0, s < 0, e > 0, e < 0], dtype=np.float32)
         if self.continuous:

@@ -19,6 +19,16 @@
 /* A plan's counts of decisions (beyond the horizon they are never reached: a caller may cut a search short). */
 #define MAX_PLAN_DECISIONS 1000000
 
+/* The squared distance of the rules' hand (rules.hand_position: the arm's own sine) from (tx, ty). */
+static inline double hand_distance2(double l1, double l2, double q1, double q2, double tx, double ty)
+{
+    double sa, ca, sb, cb;
+    arm_sin_cos(q1, &sa, &ca);
+    arm_sin_cos(q1 + q2, &sb, &cb);
+    const double dx = l1 * ca + l2 * cb - tx, dy = l1 * sa + l2 * sb - ty;
+    return dx * dx + dy * dy;
+}
+
 const char armgame_shoot_doc[] =
 "shoot(params, mode, rates, field, x0, act0, plans, substeps, horizon, target, hold, dwelt, box, out) -> None\n\n"
 "Roll each plan out from state x0 (4 float64: q1 q2 w1 w2) and activations act0 (4 float64). plans: (N, 6)\n"
@@ -127,11 +137,7 @@ PyObject *armgame_shoot(PyObject *self, PyObject *args)
                     hit = -2.0;  /* out of the box, or not finite */
                     break;
                 }
-                double sa, ca, sb, cb;
-                arm_sin_cos(x[0], &sa, &ca);  /* the rules' hand (rules.hand_position) */
-                arm_sin_cos(x[0] + x[1], &sb, &cb);
-                const double dx = l1 * ca + l2 * cb - tx, dy = l1 * sa + l2 * sb - ty;
-                if (dx * dx + dy * dy <= rr) {
+                if (hand_distance2(l1, l2, x[0], x[1], tx, ty) <= rr) {
                     if (++inside >= hold) {
                         hit = (double)step;
                         break;
@@ -141,17 +147,13 @@ PyObject *armgame_shoot(PyObject *self, PyObject *args)
                 }
             }
         }
-        double sa, ca, sb, cb;
-        arm_sin_cos(x[0], &sa, &ca);
-        arm_sin_cos(x[0] + x[1], &sb, &cb);
-        const double dx = l1 * ca + l2 * cb - tx, dy = l1 * sa + l2 * sb - ty;
         double *o = out + 6 * i;
         o[0] = hit;
         o[1] = x[0];
         o[2] = x[1];
         o[3] = x[2];
         o[4] = x[3];
-        o[5] = sqrt(dx * dx + dy * dy);
+        o[5] = sqrt(hand_distance2(l1, l2, x[0], x[1], tx, ty));
     }
     Py_END_ALLOW_THREADS
     Py_INCREF(Py_None);
