@@ -5,6 +5,7 @@
     python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
     python benchmarks/reference_scores.py table                      # docs/programs.md's table, from the results
     python benchmarks/reference_scores.py ceilings                   # armgame/env/references.py's CEILINGS
+    python benchmarks/reference_scores.py runs-table                 # docs/programs.md's table of the protocol runs
     python benchmarks/reference_scores.py table-v1 refs              # protocol 1's table (the model bot normalising)
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
     python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
@@ -315,17 +316,14 @@ def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_
                             "--seed", str(seed), "--test-games", str(test_games), "--out", str(folder)])
 
 
-def curves(folder: Path) -> str:
-    """Each id's PPO runs under ``folder`` (``train_ppo.py --out`` folders: ``curve.csv`` and ``result.json``): its
-    validation curve over training seeds (the median and range of the seeds' mean hits on the 10 validation games
-    at each budget), how much it still rises over the last half of the budget (a line's slope, flat where it is
-    about 0), and the test games' hits of each seed with the mean over seeds and
-    its 95 % interval (Student's t over seeds: the training seed's spread, not one policy's game-to-game)."""
+Run = tuple[int, dict[int, float], dict[str, Any]]  # (training seed, validation mean hits by env steps, result)
+
+
+def runs_of(folder: Path) -> dict[str, list[Run]]:
+    """Each id's ``train_ppo.py --out`` runs under ``folder`` (``curve.csv`` and ``result.json``), by training seed."""
     import csv
 
-    from armgame.env.evaluation import mean_interval
-
-    by_id: dict[str, list[tuple[int, dict[int, float], dict]]] = {}
+    by_id: dict[str, list[Run]] = {}
     for result_path in sorted(folder.rglob("result.json")):
         result = json.loads(result_path.read_text(encoding="utf-8"))
         with (result_path.parent / "curve.csv").open(newline="", encoding="utf-8") as f:
@@ -333,37 +331,101 @@ def curves(folder: Path) -> str:
         by_id.setdefault(result["env_id"], []).append((int(result["training_seed"]), curve, result))
     if not by_id:
         raise SystemExit(f"{folder}: no result.json under it")
+    return {env_id: sorted(runs, key=lambda run: run[0]) for env_id, runs in by_id.items()}
+
+
+def validation_medians(runs: list[Run]) -> tuple[list[int], list[float], list[tuple[float, float]]]:
+    """The validation curve over training seeds: the env steps every run validated at, the median of the seeds' mean
+    hits there and their range."""
+    steps = sorted(set.intersection(*(set(curve) for _, curve, _ in runs)))
+    values = [[curve[step] for _, curve, _ in runs] for step in steps]
+    return steps, [float(np.median(v)) for v in values], [(min(v), max(v)) for v in values]
+
+
+def late_slope(steps: list[int], medians: list[float]) -> tuple[float, float, float] | None:
+    """How much the median still rises over the last half of the budget, in hits per million env steps, with +-2
+    standard errors (None with fewer than 4 points there). 10 validation games make each point noisy (a few hits),
+    so two points' difference says little; a line through the last half says how much is left."""
+    from scipy.stats import linregress
+
+    half = [i for i, step in enumerate(steps) if step >= steps[-1] / 2]
+    if len(half) < 4:
+        return None
+    fit = linregress(np.array(steps)[half] / 1e6, np.array(medians)[half])
+    width = float(fit.stderr) * 2.0
+    return float(fit.slope), float(fit.slope) - width, float(fit.slope) + width
+
+
+def curves(folder: Path) -> str:
+    """Each id's PPO runs under ``folder``: its validation curve over training seeds (the median and range of the
+    seeds' mean hits on the 10 validation games at each budget), how much it still rises over the last half of the
+    budget (``late_slope``), and the test games' hits of each seed with the mean over seeds and its 95 % interval
+    (Student's t over seeds: the training seed's spread, not one policy's game-to-game)."""
+    from armgame.env.evaluation import mean_interval
+
     out = []
-    for env_id, runs in by_id.items():
-        runs.sort(key=lambda run: run[0])
-        seeds = [seed for seed, _, _ in runs]
-        steps = sorted(set.intersection(*(set(curve) for _, curve, _ in runs)))
-        out.append(f"{env_id}: PPO, training seeds {seeds}, validation mean hits (10 games) by env steps")
+    for env_id, runs in runs_of(folder).items():
+        out.append(f"{env_id}: PPO, training seeds {[seed for seed, _, _ in runs]}, validation mean hits (10 games) "
+                   "by env steps")
         out.append("| env steps | median over seeds | range |")
         out.append("|---:|---:|---:|")
-        medians = []
-        for step in steps:
-            values = [curve[step] for _, curve, _ in runs]
-            medians.append(float(np.median(values)))
-            out.append(f"| {step:,} | {medians[-1]:.1f} | {min(values):.1f} - {max(values):.1f} |")
-        half = [i for i, step in enumerate(steps) if step >= steps[-1] / 2]
-        if len(half) >= 4:
-            # Flattened or not, as a slope: 10 validation games make each point noisy (a few hits), so two
-            # points' difference says little; a line through the last half of the budget says how much is left.
-            from scipy.stats import linregress
-
-            fit = linregress(np.array(steps)[half] / 1e6, np.array(medians)[half])
-            width = float(fit.stderr) * 2.0
-            out.append(f"over the last half of the budget the median rises {fit.slope:+.2f} hits per million env "
-                       f"steps (+-2 standard errors: {fit.slope - width:+.2f} to {fit.slope + width:+.2f})")
+        steps, medians, ranges = validation_medians(runs)
+        for step, median, (low, high) in zip(steps, medians, ranges, strict=True):
+            out.append(f"| {step:,} | {median:.1f} | {low:.1f} - {high:.1f} |")
+        slope = late_slope(steps, medians)
+        if slope is not None:
+            out.append(f"over the last half of the budget the median rises {slope[0]:+.2f} hits per million env "
+                       f"steps (+-2 standard errors: {slope[1]:+.2f} to {slope[2]:+.2f})")
         means = [float(result["mean_hits"]) for _, _, result in runs]
         low, high = mean_interval(means)
-        budgets = sorted({int(result["env_steps"]) for _, _, result in runs})
-        after = ", ".join(f"{b:,}" for b in budgets)
+        after = ", ".join(f"{b:,}" for b in sorted({int(result["env_steps"]) for _, _, result in runs}))
         out.append(f"test games (100): {', '.join(f'{m:.1f}' for m in means)}; mean {np.mean(means):.1f} "
                    f"(95% CI over seeds {low:.1f} to {high:.1f}) after {after} env steps")
         out.append("")
     return "\n".join(out)
+
+
+#: Where ``runs_table`` reads the validation curve, in twentieths of the budget (``runs``' default validation).
+CURVE_POINTS = (1, 2, 5, 10, 15, 20)
+
+
+def runs_table(root: Path = RESULTS) -> str:
+    """docs/programs.md's table of PPO's protocol runs: every id and budget with five training seeds or more under
+    ``root``'s ``ppo*`` folders, its validation curve (the median over seeds at a twentieth, a tenth, a quarter,
+    half, three quarters and all of the budget), whether it has flattened (the last half's slope, ``late_slope``:
+    flat where its +-2 standard errors hold 0), each seed's mean hits on the 100 test games, and their mean with its
+    95 % interval over seeds."""
+    from armgame.env.evaluation import mean_interval
+
+    order = {env_id: i for i, env_id in enumerate(IDS)}
+    rows = []
+    for folder in sorted(root.glob("ppo*")):
+        for env_id, runs in runs_of(folder).items():
+            if len(runs) < CEILING_SEEDS:
+                continue
+            budget = int(runs[0][2]["budget_steps"])
+            steps, medians, _ = validation_medians(runs)
+            at = {step: median for step, median in zip(steps, medians, strict=True)}
+            curve = []
+            for twentieths in CURVE_POINTS:
+                step = budget * twentieths // 20 // 1000 * 1000
+                curve.append(f"{at[step]:.1f}" if step in at else "")
+            slope = late_slope(steps, medians)
+            if slope is None:
+                shape = ""
+            else:
+                word = "flat" if slope[1] <= 0 <= slope[2] else ("rising" if slope[0] > 0 else "falling")
+                shape = f"{word}: {slope[0]:+.2f} ({slope[1]:+.2f} to {slope[2]:+.2f})"
+            means = [float(result["mean_hits"]) for _, _, result in runs]
+            low, high = mean_interval(means)
+            cells = [f"`{slug(env_id)}`", f"{budget / 1e6:g} M, {len(runs)}", *curve, shape,
+                     ", ".join(f"{m:.1f}" for m in means), f"**{np.mean(means):.1f}** ({low:.1f}-{high:.1f})"]
+            rows.append(((order.get(env_id, len(order)), budget), "| " + " | ".join(cells) + " |"))
+    head = ["| id | env steps, seeds | validation median at " + " | ".join(
+                ("1/20", "1/10", "1/4", "1/2", "3/4", "all")) + " of the budget | last half, hits per M steps "
+            "(+-2 SE) | test hits by training seed | mean (95% CI over seeds) |",
+            "|---|---|" + "---:|" * len(CURVE_POINTS) + "---|---|---|"]
+    return "\n".join(head + [row for _, row in sorted(rows)])
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -390,6 +452,7 @@ def _main(argv: list[str] | None = None) -> int:
     ppo.add_argument("--out", type=Path, required=True)
     sub.add_parser("table", help="docs/programs.md's reference table, from the committed results (protocol 2)")
     sub.add_parser("ceilings", help="armgame/env/references.py's CEILINGS, from the committed results")
+    sub.add_parser("runs-table", help="docs/programs.md's table of PPO's protocol runs, from the committed results")
     tab = sub.add_parser("table-v1", help="protocol 1's table from a folder of bots' and PPO's runs")
     tab.add_argument("folder", type=Path)
     refs = sub.add_parser("references")
@@ -422,6 +485,8 @@ def _main(argv: list[str] | None = None) -> int:
         print(table())
     elif args.command == "ceilings":
         print(ceilings_source())
+    elif args.command == "runs-table":
+        print(runs_table())
     else:
         print(table_v1(args.folder))
     return 0
