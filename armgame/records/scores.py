@@ -68,11 +68,9 @@ from .tablefile import (  # noqa: F401 (imported from here by the commands and t
     TableBusyError,
     TableError,
     TableFile,
-    _Head,
-    _parse,
-    parse_table,
     table_bytes,
 )
+from .tableformat import TableHead, parse_table, parse_with_head  # noqa: F401 (parse_table: from here too)
 from .teacher import disagreements, in_recorded_order
 
 SCORES_ENV = "ARMGAME_SCORES"
@@ -141,12 +139,12 @@ class ScoreTable(TableFile, TableChecks):
         data = self._file_bytes()
         if data is None:
             return [], None
-        entries, damage, head = _parse(data, self._replay_backs())
+        entries, damage, head = parse_with_head(data, self._replay_backs())
         entries, _, damage = self._with_journal(entries, damage)
         entries, self._seed, self.notes = self._as_recorded(entries, head)
         return entries, damage
 
-    def _as_recorded(self, entries: list[ScoreEntry], head: _Head) -> tuple[list[ScoreEntry], int, list[str]]:
+    def _as_recorded(self, entries: list[ScoreEntry], head: TableHead) -> tuple[list[ScoreEntry], int, list[str]]:
         """The entries as this account's record of the table has them (``records.teacher``), the seed
         that ranks and the notes: without a record, the table as it says. With one, the entries are
         numbered 1, 2, ... in the record's order of entry (those it knows first; the others after, in the
