@@ -6,7 +6,8 @@ event stream for JSON and sets every name and number as text (``textContent``), 
 ``<script>`` or one with right-to-left marks shows as the characters it is. The projector's sizes
 follow the window (CSS viewport units, 19 px at the least at 1024x768) in the high-contrast palette
 of the game's windows (``ui.render.PALETTES["high-contrast"]``): black on white, red for news.
-``play.html`` is the game itself for a browser (``/play``): ``engine.js`` plays it, ``play.js`` draws it.
+``play.html`` is the game itself for a browser (``/play``): ``engine.js`` plays it, ``play.js`` draws it
+(``body.js``: the arm and torso).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ PAGES = {
     "play.css": "text/css; charset=utf-8",
     "play.js": "text/javascript; charset=utf-8",
     "engine.js": "text/javascript; charset=utf-8",
+    "body.js": "text/javascript; charset=utf-8",
     "icon.svg": "image/svg+xml",
 }
 
