@@ -186,8 +186,9 @@ def ceilings(reference: dict[str, dict[str, Any]] | None = None, controller_fold
     a policy that knows the task or has learnt it, and which that is. The candidates: the shooting controller
     (``benchmarks/ceiling.py``'s results), PPO's protocol runs of five training seeds or more at any budget (the
     mean over seeds), protocol 1's PPO (500,000 env steps, three seeds), for CenterOut the trials an episode holds
-    (every one hit), and for a continuous twin its key id's ceiling (its levels 0 and 1 are the keys, so it can play
-    whatever the key id plays)."""
+    (every one hit), for a continuous twin its key id's ceiling (its levels 0 and 1 are the keys, so it can play
+    whatever the key id plays), and for an id without an observation delay the ceiling of its delayed variant (the
+    same games: a policy can delay what it sees itself, so the delay can only cost)."""
     if reference is None:
         reference = _reference_hits()
     return _ceilings_of(reference, _controller_rows(controller_folder), long_runs(root))
@@ -195,8 +196,10 @@ def ceilings(reference: dict[str, dict[str, Any]] | None = None, controller_fold
 
 def _ceilings_of(reference: dict[str, dict[str, Any]], controller: dict[str, tuple[float, float, float, int, str]],
                  runs: dict[str, dict[int, list[float]]]) -> dict[str, dict[str, Any]]:
+    delayed = delayed_variants(list(reference))
     out: dict[str, dict[str, Any]] = {}
-    for env_id in sorted(reference, key=lambda i: "Continuous" in i):  # key ids first: a twin reads its key id's
+    # Delayed ids first (the id without the delay reads theirs), then key ids before twins (a twin reads its key id's).
+    for env_id in sorted(reference, key=lambda i: (i in delayed, "Continuous" in i)):
         entry = reference[env_id]
         candidates: list[tuple[float, str]] = []
         if "CenterOut" in env_id:
@@ -215,9 +218,31 @@ def _ceilings_of(reference: dict[str, dict[str, Any]], controller: dict[str, tup
         key = env_id.replace("Continuous", "")
         if key != env_id and key in out:
             candidates.append((out[key]["hits"], f"{slug(key)}'s ceiling"))
+        for variant in delayed.get(env_id, ()):
+            candidates.append((out[variant]["hits"], f"{slug(variant)}'s ceiling (a delay can only cost)"))
         hits, by = max(candidates, key=lambda c: c[0])
         out[env_id] = {"hits": hits, "by": by}
     return {env_id: out[env_id] for env_id in reference if env_id in out}
+
+
+def delayed_variants(env_ids: list[str]) -> dict[str, list[str]]:
+    """For each of ``env_ids``, the others that are the same game with an observation delay added (the same spec
+    but ``observation_delay``): ``{"armgame/Reach-v1": ["armgame/ReachDelay-v1"], ...}``."""
+    import gymnasium
+
+    def game(env_id: str) -> tuple[str, tuple]:
+        spec = gymnasium.spec(env_id)
+        kwargs = {k: v for k, v in spec.kwargs.items() if k != "observation_delay"}
+        return str(spec.entry_point), tuple(sorted(kwargs.items()))
+
+    found: dict[str, list[str]] = {}
+    for env_id in env_ids:
+        if gymnasium.spec(env_id).kwargs.get("observation_delay"):
+            plain = [other for other in env_ids if other != env_id and game(other) == game(env_id)
+                     and not gymnasium.spec(other).kwargs.get("observation_delay")]
+            for other in plain:
+                found.setdefault(other, []).append(env_id)
+    return found
 
 
 def table(reference: dict[str, dict[str, Any]] | None = None, controller_folder: Path = RESULTS / "ceiling",

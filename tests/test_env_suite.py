@@ -384,6 +384,9 @@ def test_the_docs_reference_table_and_the_ceilings_are_the_committed_results():
         assert ceiling["hits"] >= max(REFERENCE_HITS[env_id][p] for p in ("random", "naive", "model")), env_id
         key = env_id.replace("Continuous", "")
         assert ceiling["hits"] >= CEILINGS[key]["hits"], env_id
+        # And an id without the observation delay at least its delayed variant's: the delay can only cost.
+        for delayed in scores.delayed_variants(list(CEILINGS)).get(env_id, ()):
+            assert ceiling["hits"] >= CEILINGS[delayed]["hits"], env_id
     text = (root / "docs" / "programs.md").read_text(encoding="utf-8")
     assert scores.table() in text
     # The page's reading of the table: PPO's shortfall from the ceiling, by the table's PPO column.
@@ -398,6 +401,31 @@ def test_the_docs_reference_table_and_the_ceilings_are_the_committed_results():
     assert (f"costs PPO {short['ReachDelay-v1']} % of the ceiling with keys and {short['ReachDelayContinuous-v1']} % "
             f"with continuous actions, and the continuous twins of ReachField and ReachHard "
             f"({short['ReachFieldContinuous-v1']} % and {short['ReachHardContinuous-v1']} %") in prose
+
+
+def test_a_ceiling_is_the_best_candidate_and_reaches_the_ids_that_play_the_same_game():
+    """``reference_scores._ceilings_of`` on made-up results: PPO's five-seed runs beat the controller on the delayed
+    id, so the delay-free id and both twins take that ceiling; fewer than five seeds never count."""
+    root = Path(__file__).resolve().parent.parent
+    spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
+    scores = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(scores)
+    ids = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", "armgame/ReachDelay-v1", "armgame/ReachDelayContinuous-v1")
+    assert scores.delayed_variants(list(ids)) == {"armgame/Reach-v1": ["armgame/ReachDelay-v1"],
+                                                  "armgame/ReachContinuous-v1": ["armgame/ReachDelayContinuous-v1"]}
+    reference = {env_id: {"random": 0.5, "model": 50.0} for env_id in ids}
+    controller = {"armgame/Reach-v1": (72.0, 71.0, 73.0, 100, "armgame/Reach-v1"),
+                  "armgame/ReachDelay-v1": (72.0, 71.0, 73.0, 100, "armgame/Reach-v1")}
+    runs = {"armgame/ReachDelay-v1": {4_000_000: [75.0, 76.0, 77.0, 78.0, 79.0]},
+            "armgame/ReachContinuous-v1": {4_000_000: [90.0, 90.0, 90.0, 90.0]}}  # four seeds: not a candidate
+    tops = scores._ceilings_of(reference, controller, runs)
+    assert tops["armgame/ReachDelay-v1"] == {"hits": 77.0, "by": "PPO, 4,000,000 env steps, 5 seeds"}
+    assert tops["armgame/Reach-v1"] == {"hits": 77.0, "by": "ReachDelay-v1's ceiling (a delay can only cost)"}
+    assert tops["armgame/ReachDelayContinuous-v1"]["hits"] == tops["armgame/ReachContinuous-v1"]["hits"] == 77.0
+    assert list(tops) == list(ids)  # in the reference's order, whatever order they were worked out in
+    runs["armgame/ReachDelay-v1"] = {4_000_000: [60.0] * 5}
+    assert scores._ceilings_of(reference, controller, runs)["armgame/Reach-v1"]["by"] == \
+        "the shooting controller (100 games)"
 
 
 def test_the_off_policy_recipe_runs(capsys):
