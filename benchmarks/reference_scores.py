@@ -6,6 +6,7 @@
     python benchmarks/reference_scores.py table                      # docs/programs.md's table, from the results
     python benchmarks/reference_scores.py ceilings                   # armgame/env/references.py's CEILINGS
     python benchmarks/reference_scores.py runs-table                 # docs/programs.md's table of the protocol runs
+    python benchmarks/reference_scores.py figure                     # docs/img/ppo_curves.png, their curves
     python benchmarks/reference_scores.py table-v1 refs              # protocol 1's table (the model bot normalising)
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
     python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
@@ -453,6 +454,60 @@ def runs_table(root: Path = RESULTS) -> str:
     return "\n".join(head + [row for _, row in sorted(rows)])
 
 
+def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
+    """docs/img/ppo_curves.png: every id with five seeds or more, at its longest budget, a panel of its validation
+    curve over training seeds (the median, and the range shaded) against env steps, with its ceiling, the shooting
+    controller where it plays the id and random play as lines. Returns the panels' titles, in order."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # a file, never a window
+    import matplotlib.pyplot as plt
+
+    from armgame.env.references import CEILINGS, REFERENCE_HITS
+
+    controller = _controller_rows(root / "ceiling")
+    longest: dict[str, list[Run]] = {}
+    for folder in sorted(root.glob("ppo*")):
+        for env_id, runs in runs_of(folder).items():
+            budget = int(runs[0][2]["budget_steps"])
+            if len(runs) >= CEILING_SEEDS and budget >= int(longest.get(env_id, [(0, {}, {"budget_steps": 0})])[0][2]
+                                                             ["budget_steps"]):
+                longest[env_id] = runs
+    order = sorted(longest, key=lambda i: IDS.index(i) if i in IDS else len(IDS))
+    if not order:
+        raise SystemExit(f"{root}: no id has {CEILING_SEEDS} seeds of protocol runs")
+    columns = min(3, len(order))
+    rows = -(-len(order) // columns)
+    figure, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.1 * rows), squeeze=False)
+    titles = []
+    for ax, env_id in zip(axes.flat, order, strict=False):
+        runs = longest[env_id]
+        steps, medians, ranges = validation_medians(runs)
+        x = np.array(steps) / 1e6
+        ax.fill_between(x, [r[0] for r in ranges], [r[1] for r in ranges], color="#9ecae1", lw=0,
+                        label=f"range over {len(runs)} seeds")
+        ax.plot(x, medians, color="#08519c", lw=1.6, label="median (10 validation games)")
+        ax.axhline(CEILINGS[env_id]["hits"], color="black", ls="--", lw=1, label="ceiling")
+        if env_id in controller:
+            ax.axhline(controller[env_id][0], color="#d95f02", ls=":", lw=1.4, label="shooting controller")
+        ax.axhline(REFERENCE_HITS[env_id]["random"], color="grey", lw=0.8, label="random")
+        budget = int(runs[0][2]["budget_steps"])
+        titles.append(f"{slug(env_id)}, {budget / 1e6:g} M steps")
+        ax.set_title(titles[-1], fontsize=10)
+        ax.set_xlabel("env steps (millions)", fontsize=9)
+        ax.set_ylabel("hits per game", fontsize=9)
+        ax.set_xlim(0, x[-1])
+        ax.grid(alpha=0.3)
+    for ax in list(axes.flat)[len(order):]:
+        ax.axis("off")
+    axes.flat[0].legend(fontsize=7, loc="lower right")
+    figure.suptitle("PPO's validation curves (examples/train_ppo.py's recipe; reference_scores.py figure)", fontsize=11)
+    figure.tight_layout()
+    figure.savefig(out, dpi=110)
+    plt.close(figure)
+    return titles
+
+
 def main(argv: list[str] | None = None) -> int:
     try:
         return _main(argv)
@@ -478,6 +533,9 @@ def _main(argv: list[str] | None = None) -> int:
     sub.add_parser("table", help="docs/programs.md's reference table, from the committed results (protocol 2)")
     sub.add_parser("ceilings", help="armgame/env/references.py's CEILINGS, from the committed results")
     sub.add_parser("runs-table", help="docs/programs.md's table of PPO's protocol runs, from the committed results")
+    fig = sub.add_parser("figure", help="docs/img/ppo_curves.png: the protocol runs' validation curves (matplotlib)")
+    fig.add_argument("--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "img" /
+                     "ppo_curves.png")
     tab = sub.add_parser("table-v1", help="protocol 1's table from a folder of bots' and PPO's runs")
     tab.add_argument("folder", type=Path)
     refs = sub.add_parser("references")
@@ -512,6 +570,8 @@ def _main(argv: list[str] | None = None) -> int:
         print(ceilings_source())
     elif args.command == "runs-table":
         print(runs_table())
+    elif args.command == "figure":
+        print(f"wrote {args.out}: {', '.join(curves_figure(args.out))}")
     else:
         print(table_v1(args.folder))
     return 0

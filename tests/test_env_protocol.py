@@ -350,6 +350,26 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
     assert round(slopes["10 M, 5"] * 5) == 3 and "by a fifth as much, about 3 hits more for another 5 M" in prose
 
 
+@pytest.mark.slow
+def test_the_docs_figure_of_the_ppo_curves_is_drawn_from_the_committed_runs(tmp_path):
+    """docs/img/ppo_curves.png is ``reference_scores.py figure`` of the committed runs: a panel for every id of the
+    runs table, at its longest budget, and the committed picture the size a fresh one is (a panel more or less
+    changes it: the figure was not redrawn)."""
+    import importlib.util
+
+    from matplotlib.image import imread
+
+    root = Path(__file__).resolve().parent.parent
+    spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    titles = module.curves_figure(tmp_path / "curves.png")
+    listed = {row.split("|")[1].strip().strip("`") for row in module.runs_table().splitlines()[2:]}
+    assert sorted(title.split(",")[0] for title in titles) == sorted(listed)
+    assert imread(tmp_path / "curves.png").shape == imread(root / "docs" / "img" / "ppo_curves.png").shape
+    assert "(img/ppo_curves.png)" in (root / "docs" / "programs.md").read_text(encoding="utf-8")
+
+
 def test_the_protocols_example_in_the_docs_prints_what_its_comment_says():
     """docs/programs.md's aggregate example, its made-up runs normalised by the ceilings (protocol 2)."""
     runs = {"armgame/ReachHold-v1": [61.2, 60.7, 62.3, 44.0, 61.0],
