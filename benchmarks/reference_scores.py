@@ -340,6 +340,10 @@ def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_
             print(f"{env_id} seed {seed}: {steps:,} env steps into {folder}", flush=True)
             train_ppo.main(["--env", env_id, "--steps", str(steps), "--eval-every", str(every),
                             "--seed", str(seed), "--test-games", str(test_games), "--out", str(folder)])
+    # Every run asked for is in: what they add up to, and where it goes next.
+    print(curves(out), flush=True)
+    print(f"next: `python {Path(__file__).name} aggregate {out}` for the IQM over ids; runs committed under "
+          f"benchmarks/results/ppo* go into `ceilings`, `table`, `runs-table` and `figure`", flush=True)
 
 
 Run = tuple[int, dict[int, float], dict[str, Any]]  # (training seed, validation mean hits by env steps, result)
@@ -405,7 +409,9 @@ def curves(folder: Path) -> str:
         means = [float(result["mean_hits"]) for _, _, result in runs]
         low, high = mean_interval(means)
         after = ", ".join(f"{b:,}" for b in sorted({int(result["env_steps"]) for _, _, result in runs}))
-        out.append(f"test games (100): {', '.join(f'{m:.1f}' for m in means)}; mean {np.mean(means):.1f} "
+        games = sorted({len(result["test_hits"]) for _, _, result in runs})
+        out.append(f"test games ({', '.join(map(str, games))}): {', '.join(f'{m:.1f}' for m in means)}; mean "
+                   f"{np.mean(means):.1f} "
                    f"(95% CI over seeds {low:.1f} to {high:.1f}) after {after} env steps")
         out.append("")
     return "\n".join(out)

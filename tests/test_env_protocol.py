@@ -351,6 +351,33 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
 
 
 @pytest.mark.slow
+def test_protocol_runs_go_on_where_the_last_sitting_stopped(tmp_path, capsys):
+    """``reference_scores.py runs``: every (id, seed) a ``train_ppo.py --out`` run; a finished one is skipped, one a
+    sitting left unfinished (no result.json) is started again from nothing, and the curves are printed at the end."""
+    pytest.importorskip("stable_baselines3")  # the rl extra, not the test extra: run where it is installed
+    import importlib.util
+
+    root = Path(__file__).resolve().parent.parent
+    spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    ask = dict(out=tmp_path, ids=["armgame/ReachHold-v1"], seeds=[0, 1], steps=256, test_games=2, every=4096)
+    module.protocol_runs(**ask)
+    first = capsys.readouterr().out
+    results = sorted(tmp_path.glob("ReachHold-v1/seed*/result.json"))
+    assert [path.parent.name for path in results] == ["seed0", "seed1"] and "test games (2): " in first
+    assert "armgame/ReachHold-v1: PPO, training seeds [0, 1]" in first and "next: " in first
+    kept = results[0].read_bytes()
+    results[1].unlink()  # seed 1 cut off by the end of a sitting: its curve half written
+    (results[1].parent / "curve.csv").write_text("env_steps,wall_seconds,mean_hits,min_hits,max_hits\n")
+    module.protocol_runs(**ask)
+    again = capsys.readouterr().out
+    assert "seed 0: done before" in again and "seed 1: 256 env steps into" in again  # a rollout: 4,096 steps
+    assert results[0].read_bytes() == kept and results[1].is_file()
+    assert json.loads(results[1].read_text(encoding="utf-8"))["training_seed"] == 1
+
+
+@pytest.mark.slow
 def test_the_docs_figure_of_the_ppo_curves_is_drawn_from_the_committed_runs(tmp_path):
     """docs/img/ppo_curves.png is ``reference_scores.py figure`` of the committed runs: a panel for every id of the
     runs table, at its longest budget, and the committed picture the size a fresh one is (a panel more or less
