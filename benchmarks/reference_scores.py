@@ -320,28 +320,47 @@ def aggregate(folder: Path) -> str:
 def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_games: int,
                   every: int | None = None) -> None:
     """``examples/train_ppo.py`` for each id and training seed not yet finished under ``out``, one after another,
-    validating every ``every`` env steps (a twentieth of the budget by default)."""
+    validating every ``every`` env steps (a twentieth of the budget by default).
+
+    Each run is claimed by a lock on ``OUT/ID/seedN.lock`` while it trains (``armgame.records.locking``: the kernel
+    drops it when its process ends, killed or not), so the same command in several terminals shares the runs out, one
+    core each, and a run another process is training is left to it, never started again over its files."""
     import importlib.util
     import shutil
+
+    from armgame.records.locking import LockBusyError, file_lock
 
     every = every or max(1, steps // 20)
     example = Path(__file__).resolve().parent.parent / "examples" / "train_ppo.py"
     spec = importlib.util.spec_from_file_location("train_ppo", example)
     train_ppo = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
     spec.loader.exec_module(train_ppo)  # type: ignore[union-attr]
+    elsewhere = []
     for env_id in ids:
         for seed in seeds:
             folder = out / slug(env_id) / f"seed{seed}"
             if (folder / "result.json").is_file():
                 print(f"{env_id} seed {seed}: done before ({folder / 'result.json'})", flush=True)
                 continue
-            if folder.is_dir():  # a run a sitting left unfinished starts again: its curve would have a gap
-                shutil.rmtree(folder)
-            print(f"{env_id} seed {seed}: {steps:,} env steps into {folder}", flush=True)
-            train_ppo.main(["--env", env_id, "--steps", str(steps), "--eval-every", str(every),
-                            "--seed", str(seed), "--test-games", str(test_games), "--out", str(folder)])
-    # Every run asked for is in: what they add up to, and where it goes next.
+            folder.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                with file_lock(folder.parent / f"seed{seed}.lock", wait=0.0, mode=0o644):
+                    if (folder / "result.json").is_file():  # finished by another process since the look above
+                        print(f"{env_id} seed {seed}: done before ({folder / 'result.json'})", flush=True)
+                        continue
+                    if folder.is_dir():  # a run a sitting left unfinished starts again: its curve would have a gap
+                        shutil.rmtree(folder)
+                    print(f"{env_id} seed {seed}: {steps:,} env steps into {folder}", flush=True)
+                    train_ppo.main(["--env", env_id, "--steps", str(steps), "--eval-every", str(every),
+                                    "--seed", str(seed), "--test-games", str(test_games), "--out", str(folder)])
+            except LockBusyError:
+                print(f"{env_id} seed {seed}: another process is training it; left to it", flush=True)
+                elsewhere.append(f"{slug(env_id)} seed {seed}")
+    # Every run asked for is in (or in another process's hands): what they add up to, and where it goes next.
     print(curves(out), flush=True)
+    if elsewhere:
+        print(f"still training elsewhere: {', '.join(elsewhere)}; the same command again afterwards reports them",
+              flush=True)
     print(f"next: `python {Path(__file__).name} aggregate {out}` for the IQM over ids; runs committed under "
           f"benchmarks/results/ppo* go into `ceilings`, `table`, `runs-table` and `figure`", flush=True)
 

@@ -375,6 +375,15 @@ def test_protocol_runs_go_on_where_the_last_sitting_stopped(tmp_path, capsys):
     assert "seed 0: done before" in again and "seed 1: 256 env steps into" in again  # a rollout: 4,096 steps
     assert results[0].read_bytes() == kept and results[1].is_file()
     assert json.loads(results[1].read_text(encoding="utf-8"))["training_seed"] == 1
+    # A run another process holds (the same command in another terminal) is left to it, its files untouched.
+    from armgame.records.locking import file_lock
+
+    results[1].unlink()
+    with file_lock(tmp_path / "ReachHold-v1" / "seed1.lock", wait=0.0):
+        module.protocol_runs(**ask)
+    held = capsys.readouterr().out
+    assert "seed 1: another process is training it" in held and "still training elsewhere: ReachHold-v1 seed 1" in held
+    assert (results[1].parent / "curve.csv").is_file() and not results[1].exists()
 
 
 @pytest.mark.slow
