@@ -472,9 +472,11 @@ def runs_table(root: Path = RESULTS) -> str:
             cells = [f"`{slug(env_id)}`", f"{budget / 1e6:g} M, {len(runs)}", *curve, shape,
                      ", ".join(f"{m:.1f}" for m in means), f"**{np.mean(means):.1f}** ({low:.1f}-{high:.1f})"]
             rows.append(((order.get(env_id, len(order)), budget), "| " + " | ".join(cells) + " |"))
-    head = ["| id | env steps, seeds | validation median at " + " | ".join(
-                ("1/20", "1/10", "1/4", "1/2", "3/4", "all")) + " of the budget | last half, hits per M steps "
-            "(+-2 SE) | test hits by training seed | mean (95% CI over seeds) |",
+    from fractions import Fraction
+
+    points = [str(Fraction(t, 20)) if t < 20 else "all" for t in CURVE_POINTS]
+    head = ["| id | env steps, seeds | validation median at " + " | ".join(points) + " of the budget | last half, "
+            "hits per M steps (+-2 SE) | test hits by training seed | mean (95% CI over seeds) |",
             "|---|---|" + "---:|" * len(CURVE_POINTS) + "---|---|---|"]
     return "\n".join(head + [row for _, row in sorted(rows)])
 
@@ -491,13 +493,12 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
     from armgame.env.references import CEILINGS, REFERENCE_HITS
 
     controller = _controller_rows(root / "ceiling")
-    longest: dict[str, list[Run]] = {}
+    longest: dict[str, tuple[int, list[Run]]] = {}  # id -> (budget, its runs)
     for folder in sorted(root.glob("ppo*")):
         for env_id, runs in runs_of(folder).items():
             budget = int(runs[0][2]["budget_steps"])
-            if len(runs) >= CEILING_SEEDS and budget >= int(longest.get(env_id, [(0, {}, {"budget_steps": 0})])[0][2]
-                                                             ["budget_steps"]):
-                longest[env_id] = runs
+            if len(runs) >= CEILING_SEEDS and budget >= longest.get(env_id, (0, []))[0]:
+                longest[env_id] = budget, runs
     order = sorted(longest, key=lambda i: IDS.index(i) if i in IDS else len(IDS))
     if not order:
         raise SystemExit(f"{root}: no id has {CEILING_SEEDS} seeds of protocol runs")
@@ -506,7 +507,7 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
     figure, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.1 * rows), squeeze=False)
     titles = []
     for ax, env_id in zip(axes.flat, order, strict=False):
-        runs = longest[env_id]
+        budget, runs = longest[env_id]
         steps, medians, ranges = validation_medians(runs)
         x = np.array(steps) / 1e6
         ax.fill_between(x, [r[0] for r in ranges], [r[1] for r in ranges], color="#9ecae1", lw=0,
@@ -516,7 +517,6 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
         if env_id in controller:
             ax.axhline(controller[env_id][0], color="#d95f02", ls=":", lw=1.4, label="shooting controller")
         ax.axhline(REFERENCE_HITS[env_id]["random"], color="grey", lw=0.8, label="random")
-        budget = int(runs[0][2]["budget_steps"])
         titles.append(f"{slug(env_id)}, {budget / 1e6:g} M steps")
         ax.set_title(titles[-1], fontsize=10)
         ax.set_xlabel("env steps (millions)", fontsize=9)
