@@ -396,21 +396,25 @@ def test_the_docs_reference_table_and_the_ceilings_are_the_committed_results():
         short[cells[0].strip("`")] = round(100 * (1 - float(cells[-1])))
         budgets[cells[0].strip("`")] = cells[4].split(",")[0]
     prose = " ".join(text.split())
-    assert max(short[f"{name}{twin}-v1"] for name in ("Reach", "ReachHold", "ReachNoisy")
-               for twin in ("", "Continuous")) <= 6 and "within 6 % of it on Reach, ReachHold and ReachNoisy" in prose
-    assert short["ReachField-v1"] == short["ReachHard-v1"] == 0 and "On ReachField and ReachHard PPO *is*" in prose
-    # The delay's cost at 4 M steps (the table) and at protocol 1's 500,000 (references.py), by the same ceiling.
-    early = {name: round(100 * (1 - (REFERENCE_HITS[f"armgame/{name}"]["ppo"] - REFERENCE_HITS[f"armgame/{name}"]
-                                     ["random"]) / (CEILINGS[f"armgame/{name}"]["hits"]
-                                                    - REFERENCE_HITS[f"armgame/{name}"]["random"])))
-             for name in ("ReachDelay-v1", "ReachDelayContinuous-v1")}
-    assert (f"The observation delay costs PPO {short['ReachDelay-v1']} % of the ceiling with keys and "
-            f"{short['ReachDelayContinuous-v1']} % with continuous actions at 4 M steps, where at 500,000 it cost "
-            f"{early['ReachDelay-v1']} % and {early['ReachDelayContinuous-v1']} %") in prose
-    assert budgets["ReachDelay-v1"] == budgets["ReachDelayContinuous-v1"] == "4 M"
-    assert budgets["ReachFieldContinuous-v1"] == budgets["ReachHardContinuous-v1"] == "0.5 M"
-    assert (f"the continuous twins of ReachField and ReachHard ({short['ReachFieldContinuous-v1']} % and "
-            f"{short['ReachHardContinuous-v1']} % at 500,000 steps)") in prose
+    # Where PPO ran five seeds at 4 M steps or more, it is the ceiling or within a few % of it.
+    long = [name for name in short if "Continuous" not in name and "CenterOut" not in name and budgets[name] != "0.5 M"]
+    tops = [name.removesuffix("-v1") for name in long if short[name] == 0]
+    near = [name.removesuffix("-v1") for name in long if short[name] > 0]
+    assert (f"it is the ceiling ({', '.join(tops)}) or within {max(short[n + '-v1'] for n in near)} % of it "
+            f"({', '.join(near)})") in prose
+    # The delay's cost with continuous actions, at its budget and at protocol 1's 500,000 (references.py).
+    twin = "ReachDelayContinuous-v1"
+    early = round(100 * (1 - (REFERENCE_HITS[f"armgame/{twin}"]["ppo"] - REFERENCE_HITS[f"armgame/{twin}"]["random"])
+                          / (CEILINGS[f"armgame/{twin}"]["hits"] - REFERENCE_HITS[f"armgame/{twin}"]["random"])))
+    assert budgets[twin] == "4 M" and (f"With continuous actions the delay costs PPO {short[twin]} % at 4 M steps "
+                                       f"({early} % at 500,000") in prose
+    # The rows still at 500,000 steps: the two far ones named, the rest within a bound.
+    early_rows = [name for name in short if budgets[name] == "0.5 M" and "CenterOut" not in name]
+    far = ("ReachFieldContinuous-v1", "ReachHardContinuous-v1")
+    assert all(name in early_rows for name in far)
+    assert (f"the continuous twins of ReachField and ReachHard ({short[far[0]]} % and {short[far[1]]} % at 500,000 "
+            f"steps); the other rows at 500,000 steps are within "
+            f"{max(short[n] for n in early_rows if n not in far)} %") in prose
 
 
 def test_a_ceiling_is_the_best_candidate_and_reaches_the_ids_that_play_the_same_game():
