@@ -45,12 +45,13 @@ Replanning every decision rather than every third gave ReachNoisy 65 (its settin
 and Reach, ReachHold and ReachField nothing; switching times refined within two decisions rather than one gave
 nothing at two to four times the CPU.
 
-**Where it falls short.** PPO's five-seed runs at 4 M env steps pass it on Reach-v1 (by 2 hits), ReachHold-v1
-(1) and ReachField-v1 (12), so those ceilings are PPO's (docs/programs.md, "The ceiling"). On ReachField-v1's
-game of seed 0 (the game each PPO run keeps) its hand moves as fast on average as PPO's (0.64 and 0.62 m/s) for
-65 hits against PPO's 79 to 81, with the new target as far from the hand (0.42 and 0.40 m): its paths are longer. A plan switches each joint's muscles once, so it cannot straighten a
-path the curl field bends; plans of two switches a joint, and a next-reach estimate that knows the field (a value
-of the hit state learnt from its own games) are the next things to try.
+**Where it falls short.** PPO's five-seed runs at 4 M env steps pass it on Reach-v1 (by 2 hits), ReachNoisy-v1 (3),
+ReachHold-v1 (1) and ReachField-v1 (12), so those ceilings are PPO's (docs/programs.md, "The ceiling"). On
+ReachField-v1's game of seed 0 (the game each PPO run keeps) its hand moves as fast on average as PPO's (0.64 and
+0.62 m/s) for 65 hits against PPO's 79 to 81, with the new target as far from the hand (0.42 and 0.40 m): its paths
+are longer. A plan switches each joint's muscles once, so it cannot straighten a path the curl field bends; plans
+of two switches a joint, and a next-reach estimate that knows the field (a value of the hit state learnt from its
+own games) are the next things to try.
 """
 
 from __future__ import annotations

@@ -104,9 +104,9 @@ CEILINGS: dict[str, dict[str, Any]] = {
     "armgame/ReachHoldContinuous-v1": {
         "hits": 65.858, "by": "ReachHold-v1's ceiling"},
     "armgame/ReachNoisy-v1": {
-        "hits": 70.63, "by": "the shooting controller (100 games)"},
+        "hits": 73.61, "by": "PPO, 4,000,000 env steps, 5 seeds"},
     "armgame/ReachNoisyContinuous-v1": {
-        "hits": 70.63, "by": "the shooting controller (100 games, ReachNoisy-v1's games)"},
+        "hits": 73.61, "by": "ReachNoisy-v1's ceiling"},
     "armgame/ReachDelay-v1": {
         "hits": 72.16, "by": "the shooting controller (100 games, Reach-v1's games)"},
     "armgame/ReachDelayContinuous-v1": {
