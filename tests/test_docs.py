@@ -303,8 +303,11 @@ def test_the_screenshot_script_draws_every_picture(tmp_path):
                           env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     pictures = sorted(p.name for p in tmp_path.iterdir())
-    # The live class's pages are drawn by a browser (docs/make_class_screenshots.py, run by test_class_page).
-    assert pictures == sorted(p.name for p in (ROOT / "docs" / "img").glob("*.png") if not p.name.startswith("class_"))
+    # The live class's pages are drawn by a browser (docs/make_class_screenshots.py, run by test_class_page), and
+    # PPO's curves by benchmarks/reference_scores.py figure (test_env_protocol redraws it from the committed runs).
+    drawn_elsewhere = {"ppo_curves.png"}
+    assert pictures == sorted(p.name for p in (ROOT / "docs" / "img").glob("*.png")
+                              if not p.name.startswith("class_") and p.name not in drawn_elsewhere)
     for name in pictures:
         data = (tmp_path / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) < 200_000
