@@ -154,13 +154,10 @@ CEILING_SEEDS = 5
 def long_runs(root: Path = RESULTS) -> dict[str, dict[int, list[float]]]:
     """Each id's protocol runs committed under ``root`` (``runs``' folders ``ppo*``, a budget each): budget (env
     steps) -> every finished training seed's mean hits on the test games, by seed."""
-    found: dict[str, dict[int, dict[int, float]]] = {}
-    for path in sorted(root.glob("ppo*/*/seed*/result.json")):
-        r = json.loads(path.read_text(encoding="utf-8"))
-        found.setdefault(r["env_id"], {}).setdefault(int(r["budget_steps"]), {})[int(r["training_seed"])] = \
-            float(r["mean_hits"])
-    return {env_id: {budget: [by_seed[s] for s in sorted(by_seed)] for budget, by_seed in sorted(budgets.items())}
-            for env_id, budgets in found.items()}
+    found: dict[str, dict[int, list[float]]] = {}
+    for (env_id, budget), runs in protocol_run_sets(root).items():
+        found.setdefault(env_id, {})[budget] = [float(result["mean_hits"]) for _, _, result in runs]
+    return found
 
 
 def _reference_hits() -> dict[str, dict[str, Any]]:
@@ -231,18 +228,16 @@ def delayed_variants(env_ids: list[str]) -> dict[str, list[str]]:
     but ``observation_delay``): ``{"armgame/Reach-v1": ["armgame/ReachDelay-v1"], ...}``."""
     import gymnasium
 
-    def game(env_id: str) -> tuple[str, tuple]:
-        spec = gymnasium.spec(env_id)
-        kwargs = {k: v for k, v in spec.kwargs.items() if k != "observation_delay"}
-        return str(spec.entry_point), tuple(sorted(kwargs.items()))
-
+    specs = {env_id: gymnasium.spec(env_id) for env_id in env_ids}
+    delay = {env_id: spec.kwargs.get("observation_delay") for env_id, spec in specs.items()}
+    game = {env_id: (str(spec.entry_point), sorted((k, v) for k, v in spec.kwargs.items() if k != "observation_delay"))
+            for env_id, spec in specs.items()}
     found: dict[str, list[str]] = {}
     for env_id in env_ids:
-        if gymnasium.spec(env_id).kwargs.get("observation_delay"):
-            plain = [other for other in env_ids if other != env_id and game(other) == game(env_id)
-                     and not gymnasium.spec(other).kwargs.get("observation_delay")]
-            for other in plain:
-                found.setdefault(other, []).append(env_id)
+        if delay[env_id]:
+            for other in env_ids:
+                if not delay[other] and game[other] == game[env_id]:
+                    found.setdefault(other, []).append(env_id)
     return found
 
 
@@ -339,13 +334,10 @@ def protocol_runs(out: Path, ids: list[str], seeds: list[int], steps: int, test_
     for env_id in ids:
         for seed in seeds:
             folder = out / slug(env_id) / f"seed{seed}"
-            if (folder / "result.json").is_file():
-                print(f"{env_id} seed {seed}: done before ({folder / 'result.json'})", flush=True)
-                continue
             folder.parent.mkdir(parents=True, exist_ok=True)
             try:
                 with file_lock(folder.parent / f"seed{seed}.lock", wait=0.0, mode=0o644):
-                    if (folder / "result.json").is_file():  # finished by another process since the look above
+                    if (folder / "result.json").is_file():  # looked at under the lock: never half a run's
                         print(f"{env_id} seed {seed}: done before ({folder / 'result.json'})", flush=True)
                         continue
                     if folder.is_dir():  # a run a sitting left unfinished starts again: its curve would have a gap
@@ -369,7 +361,26 @@ Run = tuple[int, dict[int, float], dict[str, Any]]  # (training seed, validation
 
 
 def runs_of(folder: Path) -> dict[str, list[Run]]:
-    """Each id's ``train_ppo.py --out`` runs under ``folder`` (``curve.csv`` and ``result.json``), by training seed."""
+    """Each id's ``train_ppo.py --out`` runs under ``folder`` (``curve.csv`` and ``result.json``), by training seed;
+    one line (SystemExit) where there is none."""
+    by_id = _runs_in(folder)
+    if not by_id:
+        raise SystemExit(f"{folder}: no result.json under it")
+    return by_id
+
+
+def protocol_run_sets(root: Path = RESULTS) -> dict[tuple[str, int], list[Run]]:
+    """Every protocol run committed under ``root``'s ``ppo*`` folders, by (id, budget in env steps), in that order:
+    each training seed's run, in seed order. ``long_runs``, ``runs_table`` and ``curves_figure`` all read these."""
+    found: dict[tuple[str, int], dict[int, Run]] = {}
+    for folder in sorted(root.glob("ppo*")):
+        for env_id, runs in _runs_in(folder).items():
+            for run in runs:
+                found.setdefault((env_id, int(run[2]["budget_steps"])), {})[run[0]] = run
+    return {key: [by_seed[seed] for seed in sorted(by_seed)] for key, by_seed in sorted(found.items())}
+
+
+def _runs_in(folder: Path) -> dict[str, list[Run]]:
     import csv
 
     by_id: dict[str, list[Run]] = {}
@@ -378,8 +389,6 @@ def runs_of(folder: Path) -> dict[str, list[Run]]:
         with (result_path.parent / "curve.csv").open(newline="", encoding="utf-8") as f:
             curve = {int(row["env_steps"]) // 1000 * 1000: float(row["mean_hits"]) for row in csv.DictReader(f)}
         by_id.setdefault(result["env_id"], []).append((int(result["training_seed"]), curve, result))
-    if not by_id:
-        raise SystemExit(f"{folder}: no result.json under it")
     return {env_id: sorted(runs, key=lambda run: run[0]) for env_id, runs in by_id.items()}
 
 
@@ -446,34 +455,32 @@ def runs_table(root: Path = RESULTS) -> str:
     half, three quarters and all of the budget), whether it has flattened (the last half's slope, ``late_slope``:
     flat where its +-2 standard errors hold 0), each seed's mean hits on the 100 test games, and their mean with its
     95 % interval over seeds."""
+    from fractions import Fraction
+
     from armgame.env.evaluation import mean_interval
 
     order = {env_id: i for i, env_id in enumerate(IDS)}
     rows = []
-    for folder in sorted(root.glob("ppo*")):
-        for env_id, runs in runs_of(folder).items():
-            if len(runs) < CEILING_SEEDS:
-                continue
-            budget = int(runs[0][2]["budget_steps"])
-            steps, medians, _ = validation_medians(runs)
-            at = {step: median for step, median in zip(steps, medians, strict=True)}
-            curve = []
-            for twentieths in CURVE_POINTS:
-                step = budget * twentieths // 20 // 1000 * 1000
-                curve.append(f"{at[step]:.1f}" if step in at else "")
-            slope = late_slope(steps, medians)
-            if slope is None:
-                shape = ""
-            else:
-                word = "flat" if slope[1] <= 0 <= slope[2] else ("rising" if slope[0] > 0 else "falling")
-                shape = f"{word}: {slope[0]:+.2f} ({slope[1]:+.2f} to {slope[2]:+.2f})"
-            means = [float(result["mean_hits"]) for _, _, result in runs]
-            low, high = mean_interval(means)
-            cells = [f"`{slug(env_id)}`", f"{budget / 1e6:g} M, {len(runs)}", *curve, shape,
-                     ", ".join(f"{m:.1f}" for m in means), f"**{np.mean(means):.1f}** ({low:.1f}-{high:.1f})"]
-            rows.append(((order.get(env_id, len(order)), budget), "| " + " | ".join(cells) + " |"))
-    from fractions import Fraction
-
+    for (env_id, budget), runs in protocol_run_sets(root).items():
+        if len(runs) < CEILING_SEEDS:
+            continue
+        steps, medians, _ = validation_medians(runs)
+        at = {step: median for step, median in zip(steps, medians, strict=True)}
+        curve = []
+        for twentieths in CURVE_POINTS:
+            step = budget * twentieths // 20 // 1000 * 1000
+            curve.append(f"{at[step]:.1f}" if step in at else "")
+        slope = late_slope(steps, medians)
+        if slope is None:
+            shape = ""
+        else:
+            word = "flat" if slope[1] <= 0 <= slope[2] else ("rising" if slope[0] > 0 else "falling")
+            shape = f"{word}: {slope[0]:+.2f} ({slope[1]:+.2f} to {slope[2]:+.2f})"
+        means = [float(result["mean_hits"]) for _, _, result in runs]
+        low, high = mean_interval(means)
+        cells = [f"`{slug(env_id)}`", f"{budget / 1e6:g} M, {len(runs)}", *curve, shape,
+                 ", ".join(f"{m:.1f}" for m in means), f"**{np.mean(means):.1f}** ({low:.1f}-{high:.1f})"]
+        rows.append(((order.get(env_id, len(order)), budget), "| " + " | ".join(cells) + " |"))
     points = [str(Fraction(t, 20)) if t < 20 else "all" for t in CURVE_POINTS]
     head = ["| id | env steps, seeds | validation median at " + " | ".join(points) + " of the budget | last half, "
             "hits per M steps (+-2 SE) | test hits by training seed | mean (95% CI over seeds) |",
@@ -493,12 +500,10 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
     from armgame.env.references import CEILINGS, REFERENCE_HITS
 
     controller = _controller_rows(root / "ceiling")
-    longest: dict[str, tuple[int, list[Run]]] = {}  # id -> (budget, its runs)
-    for folder in sorted(root.glob("ppo*")):
-        for env_id, runs in runs_of(folder).items():
-            budget = int(runs[0][2]["budget_steps"])
-            if len(runs) >= CEILING_SEEDS and budget >= longest.get(env_id, (0, []))[0]:
-                longest[env_id] = budget, runs
+    longest: dict[str, tuple[int, list[Run]]] = {}  # id -> (budget, its runs): the budgets come in rising order
+    for (env_id, budget), runs in protocol_run_sets(root).items():
+        if len(runs) >= CEILING_SEEDS:
+            longest[env_id] = budget, runs
     order = sorted(longest, key=lambda i: IDS.index(i) if i in IDS else len(IDS))
     if not order:
         raise SystemExit(f"{root}: no id has {CEILING_SEEDS} seeds of protocol runs")

@@ -57,20 +57,24 @@ from .rulesets import CUSTOM, RULESETS, ruleset_by_digest
 from .standings import one_row_per_player, rank_of
 from .storage import DataFileError, atomic_write_many, read_limited, user_path
 from .tablefile import (  # noqa: F401 (imported from here by the commands and tests)
-    FORMAT,
-    FORMAT_VERSION,
     LOCK_NAME,
     LOCK_WAIT,
-    READS_FORMATS,
     REPLAYS_DIR,
     TABLE_NAME,
-    Damage,
     TableBusyError,
     TableError,
     TableFile,
+)
+from .tableformat import (  # noqa: F401 (imported from here by the commands and tests)
+    FORMAT,
+    FORMAT_VERSION,
+    READS_FORMATS,
+    Damage,
+    TableHead,
+    parse_table,
+    parse_with_head,
     table_bytes,
 )
-from .tableformat import TableHead, parse_table, parse_with_head  # noqa: F401 (parse_table: from here too)
 from .teacher import disagreements, in_recorded_order
 
 SCORES_ENV = "ARMGAME_SCORES"

@@ -68,10 +68,7 @@ from .storage import (
     parse_json,
     read_limited,
 )
-from .tableformat import (  # noqa: F401 (FORMAT, READS_FORMATS: the table's, imported from here)
-    FORMAT,
-    FORMAT_VERSION,
-    READS_FORMATS,
+from .tableformat import (
     Damage,
     TableHead,
     entry_line,
