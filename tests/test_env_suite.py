@@ -502,3 +502,41 @@ def test_the_docs_motornet_table_is_the_committed_run():
         f"{int(at):,})") in prose
     assert set(run["ids"]) == {i for i in suite_ids() if "Reach" in i} | {
         "armgame/Reach-v0", "armgame/ReachContinuous-v0", "armgame/Reach-v1", "armgame/ReachContinuous-v1"}
+
+
+def test_the_docs_env_share_of_ppo_is_the_committed_run():
+    """docs/programs.md's table of the env's share of PPO's training (benchmarks/results/ppo_env_share.json,
+    ``sb3_speed.py --share``) and what it says of 20 times MotorNet between 4 and 1,024 envs are the runs' figures."""
+    root = Path(__file__).resolve().parent.parent
+    results = root / "benchmarks" / "results"
+    run = json.loads((results / "ppo_env_share.json").read_text(encoding="utf-8"))
+    guide = (root / "docs" / "programs.md").read_text(encoding="utf-8")
+    prose = " ".join(guide.split())
+    motornet_us = 1e6 / run["motornet"]["cpu"]["median"]
+    gains, losses = [], []
+    for env_id, e in run["ids"].items():
+        assert e["ppo_us_per_step"] == pytest.approx(e["us_per_step"] - e["env_us_per_step"])
+        assert e["with_20x_motornet_us_per_step"] == pytest.approx(e["ppo_us_per_step"] + motornet_us / 20)
+        now, mn, x20 = (1e6 / e[k] for k in ("us_per_step", "with_motornet_us_per_step",
+                                            "with_20x_motornet_us_per_step"))
+        share = e["share"]
+        assert x20 / now - 1 <= share["max"], env_id  # a faster env saves at most its share
+        gains.append(100 * (x20 / now - 1))
+        losses.append(100 * (1 - mn / now))
+        row = (f"| `{env_id.split('/')[1]}` | {now:,.0f} | {e['ppo_us_per_step']:.1f} | {e['env_us_per_step']:.1f} | "
+               f"{100 * share['median']:.1f} % ({100 * share['min']:.1f}-{100 * share['max']:.1f}) | {mn:,.0f} | "
+               f"{x20:,.0f} ({gains[-1]:+.1f} %) |")
+        assert row in guide, row
+    cpu = run["motornet"]["cpu"]
+    assert (f"{cpu['median']:,.0f} env steps per CPU second ({motornet_us:.1f} µs a step; {cpu['min']:,.0f} to "
+            f"{cpu['max']:,.0f})") in prose
+    assert (f"would make its training {min(gains):.1f} to {max(gains):.1f} % faster, never more than the env's "
+            f"share, where MotorNet's env in armgame's place makes it {min(losses):.1f} to {max(losses):.1f} % "
+            "slower") in prose
+    # The fixed cost of a vector step: the side-by-side run's rates at 4 envs.
+    speed = json.loads((results / "env_speed_motornet.json").read_text(encoding="utf-8"))
+    at4 = {env_id: 4e6 / found["sizes"]["4"]["make_vec"]["cpu"]["median"] for env_id, found in speed["ids"].items()}
+    theirs = 4e6 / speed["ids"][REACH]["sizes"]["4"]["motornet"]["cpu"]["median"]
+    fastest, slowest = min(at4, key=at4.__getitem__), max(at4, key=at4.__getitem__)
+    assert (f"{at4[fastest]:.0f} to {at4[slowest]:.0f} µs at 4 envs in the run above (`{fastest.split('/')[1]}` to "
+            f"`{slowest.split('/')[1]}`), against MotorNet's {theirs:.0f} µs") in prose

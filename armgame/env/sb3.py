@@ -5,9 +5,9 @@ hold its next episode's first observation, with the last one in ``info["terminal
 That is Gymnasium's same-step autoreset, so the adapter makes the native vector env with
 ``autoreset_mode="SameStep"`` and only reshapes what it returns. One ``BatchGameSession`` steps
 every game, which is what makes this faster than SB3's ``DummyVecEnv`` of single envs from
-``ADAPTER_MIN_ENVS`` games; below that, and for ids and arguments the batch does not play (the
-suite's harder tasks but the dwell and the delay, CenterOut, the score reward), ``make_sb3_vec_env`` gives
-that ``DummyVecEnv``.
+``ADAPTER_MIN_ENVS`` games; below that, and for ids and arguments the batch does not play
+(CenterOut's ids, the score reward: ``armgame.env.vector.batch_plays``), ``make_sb3_vec_env`` gives that
+``DummyVecEnv``.
 
 >>> from armgame.env.sb3 import make_sb3_vec_env      # doctest: +SKIP
 >>> from stable_baselines3 import PPO                  # doctest: +SKIP
