@@ -373,7 +373,7 @@ def protocol_run_sets(root: Path = RESULTS) -> dict[tuple[str, int], list[Run]]:
     """Every protocol run committed under ``root``'s ``ppo*`` folders, by (id, budget in env steps), in that order:
     each training seed's run, in seed order. ``long_runs``, ``runs_table`` and ``curves_figure`` all read these."""
     found: dict[tuple[str, int], dict[int, Run]] = {}
-    for folder in sorted(root.glob("ppo*")):
+    for folder in sorted(path for path in root.glob("ppo*") if path.is_dir()):  # not a file named so
         for env_id, runs in _runs_in(folder).items():
             for run in runs:
                 found.setdefault((env_id, int(run[2]["budget_steps"])), {})[run[0]] = run

@@ -505,11 +505,11 @@ def test_the_docs_motornet_table_is_the_committed_run():
 
 
 def test_the_docs_env_share_of_ppo_is_the_committed_run():
-    """docs/programs.md's table of the env's share of PPO's training (benchmarks/results/ppo_env_share.json,
+    """docs/programs.md's table of the env's share of PPO's training (benchmarks/results/sb3_env_share.json,
     ``sb3_speed.py --share``) and what it says of 20 times MotorNet between 4 and 1,024 envs are the runs' figures."""
     root = Path(__file__).resolve().parent.parent
     results = root / "benchmarks" / "results"
-    run = json.loads((results / "ppo_env_share.json").read_text(encoding="utf-8"))
+    run = json.loads((results / "sb3_env_share.json").read_text(encoding="utf-8"))
     guide = (root / "docs" / "programs.md").read_text(encoding="utf-8")
     prose = " ".join(guide.split())
     motornet_us = 1e6 / run["motornet"]["cpu"]["median"]
