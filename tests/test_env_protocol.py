@@ -338,13 +338,19 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
                  for path in sorted(id_folder.glob("seed*/result.json"))]
         assert any(f"`{id_folder.name}`" in row and f"**{sum(means) / len(means):.1f}**" in row
                    and ", ".join(f"{m:.1f}" for m in means) in row for row in rows), id_folder
+    # The curves the page says fall over the last half are the table's falling ones.
+    prose = " ".join(text.split())
+    falling = [row.split("`")[1] for row in rows if "| falling:" in row]
+    assert f"Some curves fall over the last half ({', '.join(falling)})" in prose
+    # PPO's aggregate over the 4 M runs is ``aggregate``'s report of them, as printed.
+    report = module.aggregate(root / "benchmarks" / "results" / "ppo")
+    assert "\n".join("    " + line for line in report.splitlines()) in text and "x 12 ids" in report
     # The page's reading of ReachHard-v1's rows: protocol 1's 500 k far below, still rising at 10 M by a fifth of
     # the rise at 4 M, about 3 hits for another 5 M.
     from armgame.env.references import REFERENCE_HITS
 
     hard = {row.split("|")[2].strip(): row for row in rows if "`ReachHard-v1`" in row}
     slopes = {budget: float(row.split("|")[9].split(":")[1].split("(")[0]) for budget, row in hard.items()}
-    prose = " ".join(text.split())
     assert f"far from PPO's reach on ReachHard-v1 ({REFERENCE_HITS['armgame/ReachHard-v1']['ppo']:.1f} hits)" in prose
     assert "rising" in hard["10 M, 5"] and round(slopes["4 M, 5"] / slopes["10 M, 5"]) == 5
     assert round(slopes["10 M, 5"] * 5) == 3 and "by a fifth as much, about 3 hits more for another 5 M" in prose
