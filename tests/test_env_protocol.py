@@ -82,6 +82,30 @@ def test_evaluate_resets_a_policy_with_state_before_every_game_or_makes_one_a_ga
         armgame.env.evaluate("naive", "armgame/Reach-v1", games=1, policy_factory=3)
 
 
+class RestAndPush:
+    """A model (``predict``, so ``evaluate`` plays its games batched) whose even rows rest at home, so their trials
+    time out and their episodes end in bounded time, and whose odd rows hold a key, so the hold's go cue never comes
+    and their run's clock runs out: a finished row's replacement game ends again while the odd rows play on."""
+
+    def predict(self, observation, deterministic=True):
+        action = np.zeros((len(observation), 4), dtype=np.int64)
+        action[1::2, 0] = 1
+        return action, None
+
+
+@pytest.mark.slow  # a second: the README's command is at its minute
+def test_a_model_s_games_of_unequal_length_all_end_and_count_once():
+    """A CenterOut episode is as long as its trials take: a finished game's place plays on, uncounted, and may end
+    again before the others; ``evaluate`` starts it again each time (a PPO run's test games once stopped on an
+    ``AssertionError`` there) and counts every game once, as the same games one at a time do."""
+    kwargs = {"episode_trials": 1, "decision_steps": 25}
+    batched = armgame.env.evaluate(RestAndPush(), "armgame/CenterOutHold-v1", games=2, **kwargs)
+    rest = armgame.env.evaluate(lambda _obs: np.zeros(4, dtype=np.int64), "armgame/CenterOutHold-v1", games=1,
+                                **kwargs)
+    assert batched.seeds == (suite.EVALUATION_SEED_START, suite.EVALUATION_SEED_START + 1)
+    assert batched.hits[0] == rest.hits[0] and batched.hits[1] == 0
+
+
 def test_the_statistics_docstring_runs():
     failed, attempted = doctest.testmod(armgame.env.statistics)
     assert attempted >= 3 and failed == 0

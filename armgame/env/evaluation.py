@@ -205,15 +205,18 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
             while not done.all():
                 action, _ = model.predict(observation, deterministic=deterministic)
                 observation, _, terminated, truncated, info = envs.step(action)
-                ended = (terminated | truncated) & ~done
+                over = terminated | truncated
+                ended = over & ~done
                 final_hits[ended] = info["hits"][ended]
                 final_scores[ended] = info["score"][ended] if "score" in info else info["hits"][ended]
                 for i in np.flatnonzero(ended):
                     final_minutes[i] = _game_minutes(envs.envs[i])
                 done |= ended
-                if ended.any() and not done.all():
-                    # Finished games stand still until the others end: a masked reset keeps them out of the way.
-                    envs.reset(options={"reset_mask": ended})
+                if over.any() and not done.all():
+                    # A finished game's place plays on, uncounted, until the others end; a game there may end
+                    # again (a CenterOut episode is as long as its trials take), so every game that ended now
+                    # starts again, not only the counted ones: a vector env without autoreset steps none ended.
+                    envs.reset(options={"reset_mask": over})
         finally:
             envs.close()
         hits += final_hits.tolist()
