@@ -409,6 +409,8 @@ def late_slope(steps: list[int], medians: list[float]) -> tuple[float, float, fl
     half = [i for i, step in enumerate(steps) if step >= steps[-1] / 2]
     if len(half) < 4:
         return None
+    if len({medians[i] for i in half}) == 1:  # a curve at its ceiling throughout: no spread for a standard error
+        return 0.0, 0.0, 0.0
     fit = linregress(np.array(steps)[half] / 1e6, np.array(medians)[half])
     width = float(fit.stderr) * 2.0
     return float(fit.slope), float(fit.slope) - width, float(fit.slope) + width

@@ -332,9 +332,10 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
     test games', each kept game verifies, and ``reference_scores.py curves`` reports every run from its files."""
     import importlib.util
 
-    from armgame.records import env_game
+    from armgame.commands import read_env_games, read_lab_replays
 
-    env_game.register()  # as the commands that verify do: records' own readers never need it
+    read_lab_replays()  # as the commands that verify do: records' own readers never need them
+    read_env_games()
     root = Path(__file__).resolve().parent.parent
     spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
     module = importlib.util.module_from_spec(spec)
@@ -366,6 +367,25 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
     prose = " ".join(text.split())
     falling = [row.split("`")[1] for row in rows if "| falling:" in row]
     assert f"Some curves fall over the last half ({', '.join(falling)})" in prose
+    # CenterOut's ids at 1 M: the median over seeds hits every trial by half the budget (the table's 1/2 column).
+    centre = [row for row in rows if "`CenterOut" in row]
+    assert len(centre) == 4 and all(row.split("|")[2].strip() == "1 M, 5" and row.split("|")[6].strip() == "8.0"
+                                     for row in centre)
+    assert "CenterOut's four ids at 2 times (`--steps 1000000 --out benchmarks/results/ppo-1m`: their median over " \
+           "seeds hits every trial by half of it)" in prose
+    # CenterOutHold-v1: the seeds whose last policy fell had hit every trial in validation up to 900,000 steps.
+    runs = {json.loads(p.read_text(encoding="utf-8"))["training_seed"]: p.parent
+            for p in (root / "benchmarks" / "results" / "ppo-1m" / "CenterOutHold-v1").glob("seed*/result.json")}
+    means = {seed: json.loads((folder / "result.json").read_text(encoding="utf-8"))["mean_hits"]
+             for seed, folder in runs.items()}
+    fell = sorted(seed for seed, mean in means.items() if f"{mean:.1f}" != "8.0")
+    for seed in fell:
+        curve = (runs[seed] / "curve.csv").read_text(encoding="utf-8").splitlines()[1:]
+        assert all(float(line.split(",")[2]) == 8.0 for line in curve if 500_000 <= int(line.split(",")[0]) <= 900_000)
+    assert len(fell) == 2 and len(means) == 5
+    assert (f"two seeds' validation games hit every trial up to 900,000 steps, and their last policies score "
+            f"{means[fell[0]]:.1f} and {means[fell[1]]:.1f} on the test games, so PPO's mean there is "
+            f"{sum(means.values()) / 5:.1f} of the 8.0 its other three seeds score") in prose
     # PPO's aggregate over the 4 M runs is ``aggregate``'s report of them, as printed.
     report = module.aggregate(root / "benchmarks" / "results" / "ppo")
     assert "\n".join("    " + line for line in report.splitlines()) in text and "x 12 ids" in report
