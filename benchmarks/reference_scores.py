@@ -511,7 +511,9 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
         raise SystemExit(f"{root}: no id has {CEILING_SEEDS} seeds of protocol runs")
     columns = min(3, len(order))
     rows = -(-len(order) // columns)
-    figure, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.1 * rows), squeeze=False)
+    # Constrained layout keeps the title clear of the first row's panels, however many rows there are.
+    figure, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.1 * rows), squeeze=False,
+                                layout="constrained")
     titles = []
     for ax, env_id in zip(axes.flat, order, strict=False):
         budget, runs = longest[env_id]
@@ -534,7 +536,6 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
         ax.axis("off")
     axes.flat[0].legend(fontsize=7, loc="lower right")
     figure.suptitle("PPO's validation curves (examples/train_ppo.py's recipe; reference_scores.py figure)", fontsize=11)
-    figure.tight_layout()
     figure.savefig(out, dpi=110)
     plt.close(figure)
     return titles
