@@ -5,4 +5,4 @@ import os
 # pygame prints a banner on import; a command-line tool's output should be its own.
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-__version__ = "0.4.0"
+__version__ = "0.5.0"

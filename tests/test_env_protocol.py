@@ -327,15 +327,24 @@ def test_the_batched_dense_reward_is_the_single_envs_to_round_off():
 
 
 # ------------------------------------------------------------------ item 1: the committed PPO runs
-def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_curves():
-    """benchmarks/results/ppo holds train_ppo.py --out runs (curve, result, a game): each result's mean is its 100
-    test games', each kept game verifies, and ``reference_scores.py curves`` reports every run from its files."""
-    import importlib.util
-
+@pytest.mark.slow  # some hundred games replayed: seconds, which the README's minute has no room for
+def test_every_committed_ppo_run_s_kept_game_verifies():
+    """Each protocol run's ``game.json`` (``train_ppo.py --out``) replays to what it recorded, on every id."""
     from armgame.commands import read_env_games, read_lab_replays
 
     read_lab_replays()  # as the commands that verify do: records' own readers never need them
     read_env_games()
+    games = sorted((Path(__file__).resolve().parent.parent / "benchmarks" / "results").glob("ppo*/*/seed*/game.json"))
+    assert len(games) >= 16 * 5
+    for path in games:
+        assert Replay.load(path).verify()[0], path
+
+
+def test_the_committed_ppo_runs_are_whole_and_summarised_by_their_curves():
+    """benchmarks/results/ppo* hold train_ppo.py --out runs (curve, result, a game): each result's mean is its 100
+    test games', and ``reference_scores.py curves`` reports every run from its files (their games verify: above)."""
+    import importlib.util
+
     root = Path(__file__).resolve().parent.parent
     spec = importlib.util.spec_from_file_location("reference_scores", root / "benchmarks" / "reference_scores.py")
     module = importlib.util.module_from_spec(spec)
@@ -349,7 +358,7 @@ def test_the_committed_ppo_runs_are_whole_verifiable_and_summarised_by_their_cur
             hits = result["test_hits"]
             assert len(hits) == 100 and result["mean_hits"] == pytest.approx(sum(hits) / 100)
             assert result["env_steps"] >= result["budget_steps"] and f"{result['mean_hits']:.1f}" in report
-            assert Replay.load(path.parent / "game.json").verify()[0]
+            assert (path.parent / "game.json").is_file()
     # docs/programs.md reports every id's runs of each budget once five seeds are in: ``runs-table`` of the files.
     text = (root / "docs" / "programs.md").read_text(encoding="utf-8")
     table = module.runs_table()

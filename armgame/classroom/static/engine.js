@@ -14,7 +14,7 @@
 /** The arithmetic's version: bumped whenever a result could change. */
 export const ENGINE_VERSION = "1";
 /** The armgame (Python package) version whose GameSession this engine reproduces; replays name it. */
-export const ARMGAME_VERSION = "0.4.0";
+export const ARMGAME_VERSION = "0.5.0";
 
 const MAX_EVENTS = 200000; // armgame.limits.MAX_EVENTS
 const MAX_GAME_STEPS = 900000; // armgame.limits.MAX_GAME_STEPS
