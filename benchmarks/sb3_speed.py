@@ -88,24 +88,21 @@ class _Timed(VecEnvWrapper):
         super().__init__(venv)
         self.cpu = 0.0
 
-    def reset(self) -> Any:
+    def _timed(self, call: Any, *args: Any) -> Any:
         start = time.process_time()
         try:
-            return self.venv.reset()
+            return call(*args)
         finally:
             self.cpu += time.process_time() - start
+
+    def reset(self) -> Any:
+        return self._timed(self.venv.reset)
 
     def step_async(self, actions: np.ndarray) -> None:
-        start = time.process_time()
-        self.venv.step_async(actions)
-        self.cpu += time.process_time() - start
+        self._timed(self.venv.step_async, actions)
 
     def step_wait(self) -> Any:
-        start = time.process_time()
-        try:
-            return self.venv.step_wait()
-        finally:
-            self.cpu += time.process_time() - start
+        return self._timed(self.venv.step_wait)
 
 
 def env_share(env_id: str, steps: int) -> dict[str, float]:
