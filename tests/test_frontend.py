@@ -3,6 +3,9 @@ the countdown, the end screen, replays' controls, and the layout of every screen
 
 import math
 import os
+import signal
+import subprocess
+import sys
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
 os.environ["SDL_AUDIODRIVER"] = "dummy"
@@ -251,6 +254,58 @@ def test_escape_and_close_end_the_window(window):
     pygame.event.post(pygame.event.Event(pygame.QUIT))
     win2.run(max_frames=5)
     assert not win2.running
+
+
+def test_ctrl_c_ends_the_game_at_the_frame_s_end_as_closing_the_window_does(window):
+    """The first Ctrl-C asks the window to close and the frame under way ends whole; a second one raises, for a
+    loop that would not stop; the SIGINT handler before the window is put back."""
+    before = signal.getsignal(signal.SIGINT)
+    win, _ = window()
+    frames, draw = [], win.frame
+
+    def frame(seconds):
+        frames.append(seconds)
+        if len(frames) == 3:
+            signal.raise_signal(signal.SIGINT)  # Ctrl-C in the terminal, on every platform
+        draw(0.1)
+
+    win.frame = frame
+    win.run(max_frames=50)
+    assert len(frames) == 3 and not win.running and win.session.time > 0
+    assert signal.getsignal(signal.SIGINT) is before
+    stuck, _ = window()
+    stuck.frame = lambda _seconds: (signal.raise_signal(signal.SIGINT), signal.raise_signal(signal.SIGINT))
+    with pytest.raises(KeyboardInterrupt):
+        stuck.run(max_frames=50)
+    assert signal.getsignal(signal.SIGINT) is before
+
+
+@pytest.mark.slow  # a process with a window: a second or two
+def test_ctrl_c_during_a_game_keeps_its_replay_and_says_so(tmp_path):
+    """``armgame play`` stopped by Ctrl-C in the terminal (here raised at the 30th frame drawn) prints the score and
+    keeps the game's replay, as closing the window does, and exits 0: a stopped game is not an error."""
+    code = (
+        "import os, signal, sys\n"
+        "os.environ['SDL_VIDEODRIVER'] = 'dummy'; os.environ['SDL_AUDIODRIVER'] = 'dummy'\n"
+        "import pygame\n"
+        "flip, frames = pygame.display.flip, []\n"
+        "def counted():\n"
+        "    frames.append(1)\n"
+        "    if len(frames) == 1:  # any key skips the countdown\n"
+        "        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_d))\n"
+        "    if len(frames) == 30:\n"
+        "        signal.raise_signal(signal.SIGINT)\n"
+        "    flip()\n"
+        "pygame.display.flip = counted\n"
+        "from armgame.cli import main\n"
+        f"sys.exit(main(['play', '--scores', {str(tmp_path / 'scores')!r}, '--settings', "
+        f"{str(tmp_path / 'settings.toml')!r}]))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "interrupted" not in out.stderr and "the game was stopped at" in out.stdout, out.stdout
+    kept = list((tmp_path / "scores").rglob("*.json"))
+    assert len(kept) == 1 and str(kept[0]) in out.stdout
 
 
 def labels_of(win):

@@ -435,8 +435,13 @@ class GameWindow:
         pygame.display.flip()
 
     def run(self, max_frames: int | None = None) -> GameSession:
-        run_loop(self.frame, lambda: self.running, fps=self.fps, max_frames=max_frames, clock=self.clock)
+        run_loop(self.frame, lambda: self.running, fps=self.fps, max_frames=max_frames, clock=self.clock,
+                 on_interrupt=self.close)
         return self.session
+
+    def close(self) -> None:
+        """End the window at the end of this frame, as its close button does (Ctrl-C in the terminal calls it)."""
+        self.running = False
 
 
 @dataclass
