@@ -60,6 +60,7 @@ def test_convergence_orders():
         assert observed == pytest.approx(scheme.order, abs=0.3), name
 
 
+@pytest.mark.slow  # ten minutes of arm, two seconds: the README's minute has no room for it
 def test_energy_keeping_schemes_hold_energy_without_trend_for_600_seconds():
     arm = TwoJointArm(TUTORIAL_ARM)
     # A hard start: the arm whirling at over 10 rad/s, under gravity.
