@@ -139,12 +139,13 @@ def measure_share(env_ids: list[str], steps: int, repeats: int, seconds: float) 
     for env_id, found in runs.items():
         total = statistics.median(1e6 * r["cpu"] / r["steps"] for r in found)
         env = statistics.median(1e6 * r["env_cpu"] / r["steps"] for r in found)
+        own = total - env  # PPO's work an env step, whichever env it steps
         shares = [r["env_cpu"] / r["cpu"] for r in found]
-        entry = {"runs": found, "us_per_step": total, "env_us_per_step": env, "ppo_us_per_step": total - env,
+        entry = {"runs": found, "us_per_step": total, "env_us_per_step": env, "ppo_us_per_step": own,
                  "share": {"median": statistics.median(shares), "min": min(shares), "max": max(shares)}}
         if mn_step is not None:
-            entry["with_motornet_us_per_step"] = total - env + mn_step
-            entry["with_20x_motornet_us_per_step"] = total - env + mn_step / 20
+            entry["with_motornet_us_per_step"] = own + mn_step
+            entry["with_20x_motornet_us_per_step"] = own + mn_step / 20
         result["ids"][env_id] = entry  # type: ignore[index]
     return result
 

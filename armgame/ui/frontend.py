@@ -207,7 +207,7 @@ class GameWindow:
     def handle(self, event: pygame.event.Event) -> None:
         self._track(event)
         if event.type == pygame.QUIT:
-            self.running = False
+            self.close()
         elif event.type == pygame.VIDEORESIZE and not self.fullscreen:
             # SDL also reports the size a window opens at, or comes back to from fullscreen: not a change.
             if (event.w, event.h) != self.windowed_size:
