@@ -5,6 +5,10 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import re
+import socket
+import subprocess
+import sys
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -33,6 +37,27 @@ def running_class(folder: Path, seed: int | None = None, lines: list[str] | None
         opened.stop()
         thread.join(20)
         assert not thread.is_alive(), "the class did not stop"
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def serve_process(folder: Path, port: int, *options: str, env: dict[str, str] | None = None
+                  ) -> tuple[subprocess.Popen, str]:
+    """``armgame class serve`` on 127.0.0.1:``port`` in its own process (``options``: more of its own);
+    (process, code) once it takes requests. The caller ends it (Ctrl-C: ``send_signal(SIGINT)``)."""
+    proc = subprocess.Popen([sys.executable, "-m", "armgame", "class", "serve", "--folder", str(folder), "--host",
+                             "127.0.0.1", "--port", str(port), *options], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, env=env)
+    first = proc.stdout.readline()
+    found = re.search(r"code ([A-Z]{4})", first)
+    assert found, first + proc.stdout.read()
+    while "Ctrl-C stops the class" not in proc.stdout.readline():  # the banner's last line: it takes requests
+        assert proc.poll() is None, "the class stopped as it started"
+    return proc, found.group(1)
 
 
 @functools.cache

@@ -13,7 +13,7 @@ import threading
 import time
 
 import pytest
-from class_server import tapped_games
+from class_server import free_port, serve_process, tapped_games
 
 from armgame.classroom import client
 from armgame.records.scores import ScoreTable
@@ -25,31 +25,12 @@ GAMES = int(os.environ.get("ARMGAME_TEST_BURST", "400"))
 CLIENTS, KILL_AFTER = 20, GAMES * 3 // 10
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def start(folder, port: int) -> tuple[subprocess.Popen, str]:
-    """The class served by ``armgame class serve`` in its own process; (process, code) once it listens."""
-    proc = subprocess.Popen([sys.executable, "-m", "armgame", "class", "serve", "--folder", str(folder), "--host",
-                             "127.0.0.1", "--port", str(port)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True)
-    first = proc.stdout.readline()
-    found = re.search(r"code ([A-Z]{4})", first)
-    assert found, first + proc.stdout.read()
-    while "Ctrl-C stops the class" not in proc.stdout.readline():  # the banner's last line: it takes requests
-        assert proc.poll() is None, "the class stopped as it started"
-    return proc, found.group(1)
-
-
 @pytest.mark.slow  # a server killed in a burst (4 s here; CI runs it at the issue's 1,000 hand-ins after the suite)
 def test_every_acknowledged_game_survives_a_kill_in_a_burst(tmp_path, monkeypatch):
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machines"))
     folder, port = tmp_path / "class", free_port()
     games = tapped_games(GAMES, [f"s{c}" for c in range(CLIENTS)])
-    proc, code = start(folder, port)
+    proc, code = serve_process(folder, port)
     address = client.ClassAddress.parse(f"127.0.0.1:{port}")
     members = [client.join(address, code, f"s{c}") for c in range(CLIENTS)]
     acked: list[int] = []
@@ -86,7 +67,7 @@ def test_every_acknowledged_game_survives_a_kill_in_a_burst(tmp_path, monkeypatc
     assert damage is None  # whole: never half-written
     names = {e.replay for e in entries}
     assert len(entries) >= len(survived) and all((folder / "replays" / name).is_file() for name in names)
-    proc, again = start(folder, port)  # the same class goes on: its code, its games
+    proc, again = serve_process(folder, port)  # the same class goes on: its code, its games
     try:
         assert again == code
         up.set()
