@@ -4,11 +4,7 @@ half-written, and started again on its folder it goes on with the same class; Ct
 from __future__ import annotations
 
 import os
-import re
 import signal
-import socket
-import subprocess
-import sys
 import threading
 import time
 
