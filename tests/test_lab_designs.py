@@ -213,6 +213,23 @@ def test_the_state_space_fit_separates_process_from_output_noise():
     assert 0.5 < fit.values["Q"] / truth["Q"] < 2.0
 
 
+@pytest.mark.parametrize("kind", ["error", "index"])
+def test_a_state_space_fit_whose_process_noise_reaches_zero_reports_an_unbounded_interval(kind):
+    """No process noise at all (a deterministic learner, or a bot's run): Q's likelihood never falls off towards 0,
+    its Wald interval's ends run past any float, and the fit once stopped on exp's OverflowError (a frames run's
+    replay, spontaneous --fit-on index). The interval is reported as unbounded instead, and JSON keeps it as null."""
+    f = np.concatenate([np.zeros(8), np.ones(24), np.zeros(8)])
+    clamp = np.zeros(f.size, dtype=bool)
+    clamp[:: 2 if kind == "index" else 4] = True
+    y = simulate_state_space(np.random.default_rng(0), f, clamp, 0.95, 0.1, 1.0, 0.0, 0.01, kind)
+    fit = fit_state_space(f, clamp, y, kind)
+    low, high = fit.intervals["Q"]
+    assert low == 0.0 and math.isinf(high) and fit.values["Q"] < 1e-3
+    assert any(line.startswith("  Q = ") and "to unbounded)" in line for line in fit.lines("cm", 100.0))
+    parameters = json.loads(json.dumps(fit.as_dict("cm"), allow_nan=False))["parameters"]
+    assert parameters["Q"]["ci95_high"] is None
+
+
 def test_the_docs_account_of_the_bots_random_fields_run_is_its_learners_and_protocols():
     """docs/lab.md says why the bot's random-fields run shows no generalization function: its fast process
     forgets 41% a trial, a direction comes back about 8 trials later, its slow process learns 2% an error."""
