@@ -247,6 +247,17 @@ def result_words(session: LabSession, outcome: TrialOutcome) -> str:
     return f"aimed {abs(value):.0f} deg {'anticlockwise' if value > 0 else 'clockwise'} of the target"
 
 
+def outcome_word(session: LabSession, outcome: TrialOutcome) -> str | None:
+    """What the player is told of how a reach ended: "hit", "missed" (the hand stopped off the target, on a trial
+    without a cursor) or "time out"; None on a trial that gives no feedback (a no-vision probe tells nothing, not
+    even whether it hit)."""
+    if outcome.plan.feedback == "none":
+        return None
+    if outcome.hit:
+        return "hit"
+    return "time out" if outcome.end_step - outcome.go_step >= session.timeout_steps else "missed"
+
+
 @dataclass(frozen=True)
 class CurveBlock:
     name: str
