@@ -178,10 +178,23 @@ def test_an_old_table_without_the_new_columns_reads_with_full_feedback(tmp_path)
     path = tmp_path / "t.csv"
     write_trials_csv(path, rows)
     lines = path.read_text().splitlines()
-    keep = len(lines[0].split(",")) - 4  # the four issue-41 columns are the last
+    keep = len(lines[0].split(",")) - 6  # the four issue-41 columns and the home posture's two are the last
     path.write_text("\n".join(",".join(line.split(",")[:keep]) for line in lines) + "\n")
     back = read_trials_csv(path)
     assert {r["feedback"] for r in back} == {"full"} and all(math.isnan(r["disturbance"]) for r in back)
+    assert all(math.isnan(r["home_shoulder_deg"]) and math.isnan(r["home_elbow_deg"]) for r in back)
+
+
+def test_every_trial_names_its_home_posture():
+    """A frames run trains at one posture and tests at another: each row says which, as its block's posture."""
+    protocol = _frames_protocol()
+    session = _run(protocol, make_lab_bot("model"))
+    rows = trial_rows(session)
+    postures = {(r["home_shoulder_deg"], r["home_elbow_deg"]) for r in rows}
+    assert postures == {tuple(map(float, b.posture_of(protocol))) for b in protocol.blocks} and len(postures) == 2
+    for r, o in zip(rows, session.outcomes, strict=True):
+        assert (r["home_shoulder_deg"], r["home_elbow_deg"]) == protocol.blocks[o.plan.block].posture_of(protocol)
+    assert (FRAMES_TEST_POSTURE[0], FRAMES_TEST_POSTURE[1]) in postures
 
 
 # ------------------------------------------------------------------------------------------- fits

@@ -77,6 +77,7 @@ def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.na
 
     m = reach_metrics(reach_of(session, o))
     hand, joint = frame_indices(session, o)
+    shoulder, elbow = session.protocol.blocks[o.plan.block].posture_of(session.protocol)
     return {
         "block": o.plan.block_name,
         "trial": o.plan.index + 1,
@@ -95,6 +96,8 @@ def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.na
         "disturbance": disturbance,
         "adaptation_index_hand": hand,
         "adaptation_index_joint": joint,
+        "home_shoulder_deg": float(shoulder),
+        "home_elbow_deg": float(elbow),
     }
 
 
