@@ -178,10 +178,23 @@ def test_an_old_table_without_the_new_columns_reads_with_full_feedback(tmp_path)
     path = tmp_path / "t.csv"
     write_trials_csv(path, rows)
     lines = path.read_text().splitlines()
-    keep = len(lines[0].split(",")) - 4  # the four issue-41 columns are the last
+    keep = len(lines[0].split(",")) - 6  # the four issue-41 columns and the home posture's two are the last
     path.write_text("\n".join(",".join(line.split(",")[:keep]) for line in lines) + "\n")
     back = read_trials_csv(path)
     assert {r["feedback"] for r in back} == {"full"} and all(math.isnan(r["disturbance"]) for r in back)
+    assert all(math.isnan(r["home_shoulder_deg"]) and math.isnan(r["home_elbow_deg"]) for r in back)
+
+
+def test_every_trial_names_its_home_posture():
+    """A frames run trains at one posture and tests at another: each row says which, as its block's posture."""
+    protocol = _frames_protocol()
+    session = _run(protocol, make_lab_bot("model"))
+    rows = trial_rows(session)
+    postures = {(r["home_shoulder_deg"], r["home_elbow_deg"]) for r in rows}
+    assert postures == {tuple(map(float, b.posture_of(protocol))) for b in protocol.blocks} and len(postures) == 2
+    for r, o in zip(rows, session.outcomes, strict=True):
+        assert (r["home_shoulder_deg"], r["home_elbow_deg"]) == protocol.blocks[o.plan.block].posture_of(protocol)
+    assert (FRAMES_TEST_POSTURE[0], FRAMES_TEST_POSTURE[1]) in postures
 
 
 # ------------------------------------------------------------------------------------------- fits
@@ -211,6 +224,23 @@ def test_the_state_space_fit_separates_process_from_output_noise():
         low, high = fit.intervals[name]
         assert low <= value <= high, (name, value, fit.intervals[name])
     assert 0.5 < fit.values["Q"] / truth["Q"] < 2.0
+
+
+@pytest.mark.parametrize("kind", ["error", "index"])
+def test_a_state_space_fit_whose_process_noise_reaches_zero_reports_an_unbounded_interval(kind):
+    """No process noise at all (a deterministic learner, or a bot's run): Q's likelihood never falls off towards 0,
+    its Wald interval's ends run past any float, and the fit once stopped on exp's OverflowError (a frames run's
+    replay, spontaneous --fit-on index). The interval is reported as unbounded instead, and JSON keeps it as null."""
+    f = np.concatenate([np.zeros(8), np.ones(24), np.zeros(8)])
+    clamp = np.zeros(f.size, dtype=bool)
+    clamp[:: 2 if kind == "index" else 4] = True
+    y = simulate_state_space(np.random.default_rng(0), f, clamp, 0.95, 0.1, 1.0, 0.0, 0.01, kind)
+    fit = fit_state_space(f, clamp, y, kind)
+    low, high = fit.intervals["Q"]
+    assert low == 0.0 and math.isinf(high) and fit.values["Q"] < 1e-3
+    assert any(line.startswith("  Q = ") and "to unbounded)" in line for line in fit.lines("cm", 100.0))
+    parameters = json.loads(json.dumps(fit.as_dict("cm"), allow_nan=False))["parameters"]
+    assert parameters["Q"]["ci95_high"] is None
 
 
 def test_the_docs_account_of_the_bots_random_fields_run_is_its_learners_and_protocols():

@@ -239,7 +239,7 @@ def row(number, **changes):
             "channel_force_at_peak_speed_n": float("nan"), "adaptation_index": float("nan"),
             "hand_sent_home": False,
             "feedback": "full", "disturbance": 1.0, "adaptation_index_hand": float("nan"),
-            "adaptation_index_joint": float("nan")}
+            "adaptation_index_joint": float("nan"), "home_shoulder_deg": 45.0, "home_elbow_deg": 90.0}
     base.update(changes)
     return base
 
@@ -401,7 +401,7 @@ text = st.text(st.characters(codec="utf-8", categories=("L", "N", "P", "S", "Zs"
     "path_length_ratio": measure.map(abs), "hit": st.booleans(), "channel_force_peak_n": measure,
     "channel_force_at_peak_speed_n": measure, "adaptation_index": measure, "hand_sent_home": st.booleans(),
     "feedback": st.sampled_from(FEEDBACK), "disturbance": measure, "adaptation_index_hand": measure,
-    "adaptation_index_joint": measure}), max_size=5))
+    "adaptation_index_joint": measure, "home_shoulder_deg": measure, "home_elbow_deg": measure}), max_size=5))
 def test_any_table_round_trips_exactly(tmp_path_factory, rows):
     path = tmp_path_factory.mktemp("round") / "trials.csv"
     write_trials_csv(path, rows)

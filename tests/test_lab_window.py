@@ -4,6 +4,7 @@ session says, and a bot in the window plays the same trials as headless."""
 import argparse
 import json
 import os
+import re
 from pathlib import Path
 
 os.environ["SDL_VIDEODRIVER"] = "dummy"
@@ -540,3 +541,41 @@ def test_a_bots_intro_card_names_the_bot_and_a_replays_says_so(screen):
     win = LabWindow(watched, screen, clock=FakeClock(), fps=0, driver=TimelineDriver(watched, recorded.timeline, 0),
                     mode="REPLAY   Ann", cards=True)
     assert win.card is not None and win.card.lines[0] == "A replay plays this run: watch its cursor."
+
+
+NO_VISION = Protocol("probes", (Block("baseline", 2, Perturbation(), 0, "Reach straight."),
+                                Block("endpoint", 4, Perturbation.make("rotation", angle=30.0), 0, "Keep reaching.",
+                                      feedback="endpoint"),
+                                Block("no vision", 4, Perturbation(), 0, "Reach without the cursor.",
+                                      feedback="none")), timeout=1.0)
+
+
+def test_a_no_vision_probe_says_nothing_of_how_it_ended_and_a_miss_is_called_a_miss(screen):
+    """A probe without vision gives no knowledge of results: neither the line under the header while its reach is
+    on screen nor the status line after it says hit, miss or time out. A reach that stopped off the target before
+    its time ran out (a trial without a cursor) is "missed", not "time out"."""
+    win = bot_window(screen, NO_VISION)
+    told: dict[int, list[str]] = {}
+    for _ in range(2000):
+        if win.ended:
+            break
+        win.frame(0.05)
+        if win.feedback is not None and win.feedback.outcome.plan.index not in told:
+            index = win.feedback.outcome.plan.index
+            shown = spoken(win)
+            win.feedback = None  # the path's time on screen over: the status line of the trial before
+            told[index] = shown + spoken(win)
+    outcomes = win.session.outcomes
+    assert sorted(told) == list(range(len(outcomes))) == list(range(10))
+    for o in outcomes:
+        said = told[o.plan.index]
+        if o.plan.feedback == "none":
+            assert "last trial: reach done" in said, said
+            assert not any(re.search(r"\b(hit|miss|missed|time out)\b", t) for t in said), said
+            continue
+        ran_out = o.end_step - o.go_step >= win.session.timeout_steps
+        word = "hit" if o.hit else "time out" if ran_out else "missed"
+        verdicts = [t for t in said if t.startswith(("last trial: ", "hit", "missed", "time out"))]
+        assert verdicts and all(t.removeprefix("last trial: ").startswith(word) for t in verdicts), (word, said)
+    assert any(not o.hit and o.end_step - o.go_step < win.session.timeout_steps and o.plan.feedback == "endpoint"
+               for o in outcomes)  # a miss was met, and named as one

@@ -77,6 +77,7 @@ def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.na
 
     m = reach_metrics(reach_of(session, o))
     hand, joint = frame_indices(session, o)
+    shoulder, elbow = session.protocol.blocks[o.plan.block].posture_of(session.protocol)
     return {
         "block": o.plan.block_name,
         "trial": o.plan.index + 1,
@@ -95,6 +96,8 @@ def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.na
         "disturbance": disturbance,
         "adaptation_index_hand": hand,
         "adaptation_index_joint": joint,
+        "home_shoulder_deg": float(shoulder),
+        "home_elbow_deg": float(elbow),
     }
 
 
@@ -245,6 +248,17 @@ def result_words(session: LabSession, outcome: TrialOutcome) -> str:
     if abs(value) < 0.5:
         return "aimed straight at the target"
     return f"aimed {abs(value):.0f} deg {'anticlockwise' if value > 0 else 'clockwise'} of the target"
+
+
+def outcome_word(session: LabSession, outcome: TrialOutcome) -> str | None:
+    """What the player is told of how a reach ended: "hit", "missed" (the hand stopped off the target, on a trial
+    without a cursor) or "time out"; None on a trial that gives no feedback (a no-vision probe tells nothing, not
+    even whether it hit)."""
+    if outcome.plan.feedback == "none":
+        return None
+    if outcome.hit:
+        return "hit"
+    return "time out" if outcome.end_step - outcome.go_step >= session.timeout_steps else "missed"
 
 
 @dataclass(frozen=True)

@@ -278,13 +278,17 @@ HAND_SENT_HOME = "hand_sent_home"
 #: held at the hand and at the joints (``armgame.lab.designs``). A table without them still reads (``feedback`` as
 #: full, the rest empty).
 DESIGN_COLUMNS: tuple[str, ...] = ("feedback", "disturbance", "adaptation_index_hand", "adaptation_index_joint")
+#: The arm's posture at home for the trial (its block's, in degrees): a run whose blocks move home (``frames``)
+#: reads by posture without the protocol at hand. A table written before them reads with them empty.
+POSTURE_COLUMNS: tuple[str, ...] = ("home_shoulder_deg", "home_elbow_deg")
 TRIAL_COLUMNS: tuple[str, ...] = ("block", "trial", "target_deg", "perturbation", "reaction_time_s",
                                   "movement_time_s", "peak_speed_m_per_s", "initial_direction_error_deg",
                                   "max_perpendicular_error_m", "path_length_ratio", "hit", *CHANNEL_COLUMNS,
-                                  HAND_SENT_HOME, *DESIGN_COLUMNS)
+                                  HAND_SENT_HOME, *DESIGN_COLUMNS, *POSTURE_COLUMNS)
 #: Columns a table may lack (written before they existed), and what each then reads as.
 LATER_COLUMNS: dict[str, object] = {**dict.fromkeys(CHANNEL_COLUMNS, NAN), HAND_SENT_HOME: False,
-                                    **dict.fromkeys(DESIGN_COLUMNS, NAN), "feedback": "full"}
+                                    **dict.fromkeys(DESIGN_COLUMNS, NAN), "feedback": "full",
+                                    **dict.fromkeys(POSTURE_COLUMNS, NAN)}
 _FLAGS = ("hit", HAND_SENT_HOME)
 METRIC_COLUMNS: tuple[str, ...] = tuple(f.name for f in fields(ReachMetrics))
 _TEXT_COLUMNS = ("block", "perturbation", "feedback")

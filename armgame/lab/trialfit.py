@@ -34,6 +34,7 @@ fit (``armgame.lab.fit``) puts all the noise in ``v``; this one splits it.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -91,6 +92,15 @@ class GeneralizationFit:
                 "gain_unit": f"{unit} per unit of field", "residual_rms": _number(self.sigma),
                 "residual_unit": unit, "r_squared": _number(self.r_squared),
                 "log_likelihood": _number(self.log_likelihood), "n_parameters": self.n_parameters}
+
+
+def interval_text(low: float, high: float, scale: float = 1.0) -> str:
+    """A 95% interval as the reports print it: an end past any number is "unbounded" (a variance whose likelihood
+    never falls off), and an interval the data cannot give (a flat likelihood, a fit at its range's edge) says so."""
+    if math.isnan(low) or math.isnan(high):
+        return "no 95% CI: the likelihood is flat there"
+    ends = ["unbounded" if math.isinf(v) else f"{scale * v:.4g}" for v in (low, high)]
+    return f"95% CI {ends[0]} to {ends[1]}"
 
 
 def _number(v: float) -> float | None:
@@ -205,7 +215,7 @@ class StateSpaceFit:
                 s, what = scale * scale, f" {unit}^2" if unit else ""
             elif name == "Q":
                 what = " (field units)^2"
-            out.append(f"  {name} = {s * value:.4g}{what}  (95% CI {s * low:.4g} to {s * high:.4g})")
+            out.append(f"  {name} = {s * value:.4g}{what}  ({interval_text(low, high, s)})")
         out.append(f"  noise s.d.: process {math.sqrt(self.values['Q']):.4g} of the field a trial, output "
                    f"{scale * math.sqrt(self.values['R']):.4g}{(' ' + unit) if unit else ''}; log-likelihood "
                    f"{self.log_likelihood:.2f} (Kalman filter), {self.n_parameters} parameters, EM "
@@ -330,10 +340,33 @@ def fit_state_space(disturbance: Sequence[float] | np.ndarray, clamped: Sequence
     return StateSpaceFit(observed_kind, values, intervals, int(seen.sum()), log_l, iterations, ms[:-1])
 
 
-_TO = {"A": lambda v: math.log(v / (1.0 - v)), "B": lambda v: math.log(v / (1.0 - v)), "k": lambda v: v,
-       "Q": math.log, "R": math.log}
-_FROM = {"A": lambda u: 1.0 / (1.0 + math.exp(-u)), "B": lambda u: 1.0 / (1.0 + math.exp(-u)), "k": lambda u: u,
-         "Q": math.exp, "R": math.exp}
+def _logistic(u: float) -> float:
+    # Written both ways so neither overflows: exp of a large -u would (a Wald end far out on the logit scale).
+    if u >= 0.0:
+        return 1.0 / (1.0 + math.exp(-u))
+    e = math.exp(u)
+    return e / (1.0 + e)
+
+
+def _logit(v: float) -> float:
+    v = min(max(v, 1e-300), 1.0 - 1e-16)  # a rate fitted to 0 or 1 (the logistic rounds there) has a finite logit
+    return math.log(v / (1.0 - v))
+
+
+#: ``math.exp`` overflows past this: beyond it a variance is unbounded, which an interval reports as such.
+_LOG_MAX = math.log(1.7976931348623157e308)
+
+
+def _exp(u: float) -> float:
+    return math.exp(u) if u < _LOG_MAX else math.inf
+
+
+def _log(v: float) -> float:
+    return math.log(max(v, 1e-300))  # a variance fitted to 0 (no process noise at all) keeps a finite log
+
+
+_TO = {"A": _logit, "B": _logit, "k": lambda v: v, "Q": _log, "R": _log}
+_FROM = {"A": _logistic, "B": _logistic, "k": lambda u: u, "Q": _exp, "R": _exp}
 
 
 def _polish(values: dict[str, float], names: list[str], f, learn, seen, y, kind: str) -> dict[str, float]:
@@ -350,7 +383,10 @@ def _polish(values: dict[str, float], names: list[str], f, learn, seen, y, kind:
             return math.inf
         return -_filter(p["A"], p["B"], p.get("k", 1.0), p["Q"], p["R"], f, learn, seen, y, kind)
 
-    best = minimize(cost, u0, method="BFGS", options={"maxiter": POLISH_ITERATIONS, "gtol": 1e-6})
+    with warnings.catch_warnings():
+        # A step out of the parameters' range costs inf (refused); the finite differences across it are inf - inf.
+        warnings.simplefilter("ignore", RuntimeWarning)
+        best = minimize(cost, u0, method="BFGS", options={"maxiter": POLISH_ITERATIONS, "gtol": 1e-6})
     u = best.x if best.fun <= cost(u0) else u0
     return {name: _FROM[name](float(v)) for name, v in zip(names, u, strict=True)}
 

@@ -27,7 +27,7 @@ import pygame
 from ..game.rules import GameConfig
 from ..game.session import UP, InputEvent, RealTimeDriver
 from ..game.timeline import TimelineDriver
-from ..lab.analysis import LearningCurve, figure_metric, learning_curve, result_words, trial_rows
+from ..lab.analysis import LearningCurve, figure_metric, learning_curve, outcome_word, result_words, trial_rows
 from ..lab.session import HOLD, LabSession, TrialOutcome
 from ..words import plural
 from .frontend import GameWindow, key_name, seek
@@ -173,17 +173,22 @@ class LabRenderer(GameRenderer):
             screen.blit(self.text(self.fit_text(block.instruction, normal, screen.get_width() - 2 * margin), normal),
                         (margin, y))
             y += normal + small // 3
-        if feedback is not None and feedback.outcome.plan.feedback == "none":
+        verdict = outcome_word(session, feedback.outcome) if feedback is not None else None
+        if feedback is not None and verdict is None:
             screen.blit(self.text(self.fit_text(feedback.words, big, screen.get_width() - 2 * margin), big,
                                   p.faint), (margin, y))
         elif feedback is not None:
-            verdict = "hit" if feedback.outcome.hit else "time out"
             screen.blit(self.text(self.fit_text(f"{verdict}: {feedback.words}", big, screen.get_width() - 2 * margin),
                                   big, HIT if feedback.outcome.hit else p.warn), (margin, y))
         elif session.outcomes:
             last = session.outcomes[-1]
-            seconds = (last.end_step - last.go_step) * session.config.dt
-            line, colour = (f"last trial: hit, {seconds:.2f} s", HIT) if last.hit else ("last trial: time out", p.warn)
+            said = outcome_word(session, last)
+            if said is None:  # a probe without vision: not even whether it hit
+                line, colour = "last trial: reach done", p.faint
+            elif last.hit:
+                line, colour = f"last trial: hit, {(last.end_step - last.go_step) * session.config.dt:.2f} s", HIT
+            else:
+                line, colour = f"last trial: {said}", p.warn
             screen.blit(self.text(line, small, colour), (margin, y))
         if hud.progress is not None or hud.speed is not None:
             shown = f"{hud.progress[0]:.0f} s   " if hud.progress is not None else ""
