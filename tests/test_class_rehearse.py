@@ -114,3 +114,31 @@ def test_rehearse_with_a_folder_is_refused_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "--rehearse keeps nothing" in err and "--folder" in err
     assert not folder.exists()
+
+
+@pytest.mark.slow  # in chromium: CI's slow tier runs every page after the suite
+def test_the_browser_plays_the_rehearsals_15_s_game_and_every_page_says_rehearsal(places):
+    from browser import browser_page
+    from play_page import join, open_page, play_keys, to_the_end
+
+    with running_class(None, rehearse=True) as opened, browser_page(1024, 768) as page:
+        base = f"http://127.0.0.1:{opened.port}"
+        errors = open_page(page, base)
+        join(page, opened.clerk.roster.code, "Zoë")
+        sent = []
+        page.on("request", lambda r: sent.append(r.post_data) if r.url.endswith("/api/handin") else None)
+        play_keys(page, rounds=1)
+        to_the_end(page)
+        page.wait_for_selector("#end-answer:has-text('handed in: 1st of 1 in the class')")
+        replay = Replay.from_bytes(sent[0].encode(), "sent")
+        assert replay.config.time_limit == 15.0 and replay.result.duration == 15.0 and replay.result.steps == 3750
+        assert class_game_name(replay.config) == "rehearsal"
+        shown = int(page.inner_text("#end-score").rsplit(" ", 1)[1])
+        assert [(e.name, e.score) for e in opened.clerk.entries] == [("Zoë", shown)]  # verified as the page showed
+        assert errors == []
+        page.goto(base + "/")
+        page.wait_for_selector("#students tr[data-name='Zoë']")
+        assert page.inner_text("#rehearsal").startswith("REHEARSAL")
+        page.goto(base + "/teacher")
+        page.wait_for_selector("#rehearsal", state="visible")
+        assert "REHEARSAL" in page.inner_text("header")
