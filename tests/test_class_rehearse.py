@@ -142,3 +142,37 @@ def test_the_browser_plays_the_rehearsals_15_s_game_and_every_page_says_rehearsa
         page.goto(base + "/teacher")
         page.wait_for_selector("#rehearsal", state="visible")
         assert "REHEARSAL" in page.inner_text("header")
+
+
+def test_the_guide_says_what_a_rehearsal_prints_and_plays(places, tmp_path):
+    """docs/teaching.md's rehearsal: the banner's first line and the stop's lines as printed (only the code
+    differing), its clocks as the class has them, and the refusal it quotes as the class words it."""
+    import re
+    from pathlib import Path
+
+    from armgame.classroom.rounds import GRACE_SECONDS, REHEARSAL_ROUND_SECONDS, REHEARSAL_WINNERS_SECONDS
+    from armgame.classroom.serve import serve
+
+    guide = (Path(__file__).resolve().parent.parent / "docs" / "teaching.md").read_text(encoding="utf-8")
+    section = guide.split("## Rehearse the lesson in five minutes", 1)[1].split("\n## ", 1)[0]
+    banner, stopped = (block.split("```", 1)[0] for block in section.split("```text\n")[1:3])
+    prose = " ".join(section.split())
+    assert f"with {REHEARSAL.config.time_limit:g} s games and {REHEARSAL_ROUND_SECONDS} s rounds" in prose
+    assert f"a rehearsal's round lasts {REHEARSAL_ROUND_SECONDS} s" in prose
+    assert f"{GRACE_SECONDS} s after its clock runs out the projector shows the winners for " \
+           f"{REHEARSAL_WINNERS_SECONDS - GRACE_SECONDS} s" in prose
+    with running_class(tmp_path / "class") as opened:
+        places["machine"]("bo")
+        bo = client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Bo")
+        refused = client.hand_in(bo, keyboard_game(3, player="Bo", duration=15.0).to_bytes()).message
+    quoted = re.search(r'\("(this class plays [^"]+)"\)', prose).group(1)
+    assert quoted in refused
+    # The banner's first line and the stop's lines (their counts aside): serve() as the command runs it, stopped as
+    # soon as it is ready.
+    lines: list[str] = []
+    assert serve(None, "127.0.0.1", 0, None, say=lines.append, rehearse=True, on_ready=lambda opened: opened.stop()) \
+        == 0
+    assert re.fullmatch(re.escape(banner.splitlines()[0]).replace("FROG", "[A-Z]{4}"), lines[0])
+    counted = [re.escape(line).replace("4\\ games", r"\d+\ games?").replace("1\\ lab\\ run", r"\d+\ lab\ runs?")
+               for line in stopped.splitlines()]
+    assert len(lines) >= 2 and all(re.fullmatch(p, line) for p, line in zip(counted, lines[-2:], strict=True)), lines

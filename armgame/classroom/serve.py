@@ -296,10 +296,11 @@ class _QuietWhenFull(logging.Filter):
 
 
 def serve(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
-          lab: str | None = None, proxy: str | None = None, rehearse: bool = False) -> int:
+          lab: str | None = None, proxy: str | None = None, rehearse: bool = False,
+          on_ready: Callable[[ClassServer], None] | None = None) -> int:
     """Run the class in ``folder`` (a rehearsal: None) on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit
-    status."""
-    opened = open_class(folder, host, port, seed, say, lab=lab, proxy=proxy, rehearse=rehearse)
+    status. ``on_ready``: as ``open_class``'s."""
+    opened = open_class(folder, host, port, seed, say, on_ready, lab=lab, proxy=proxy, rehearse=rehearse)
     opened.run()
     if opened.temporary is not None:
         played = f"{plural(len(opened.clerk.entries), 'game')} and {plural(len(opened.clerk.lab_runs), 'lab run')}"
