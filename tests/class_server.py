@@ -21,13 +21,14 @@ from armgame.records.replay import Replay
 
 
 @contextlib.contextmanager
-def running_class(folder: Path, seed: int | None = None, lines: list[str] | None = None,
-                  lab: str | None = None) -> Iterator[ClassServer]:
+def running_class(folder: Path | None, seed: int | None = None, lines: list[str] | None = None,
+                  lab: str | None = None, rehearse: bool = False) -> Iterator[ClassServer]:
     """The class in ``folder`` served on 127.0.0.1 (a free port) until the block ends (``lab``: its curve's
-    protocol, as ``--lab``)."""
+    protocol, as ``--lab``; ``rehearse``: a rehearsal, ``folder`` None, as ``--rehearse``)."""
     ready = threading.Event()
     said = lines if lines is not None else []
-    opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set(), lab=lab)
+    opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set(), lab=lab,
+                        rehearse=rehearse)
     thread = threading.Thread(target=opened.run, daemon=True)
     thread.start()
     try:
@@ -67,10 +68,12 @@ def _bot_timeline(seed: int) -> tuple[InputEvent, ...]:
     return tuple(session.timeline)
 
 
-def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, driven: str = "keyboard") -> Replay:
-    """A whole standard game whose keys were the model bot's for its first ``seconds`` and then none: the
-    longer, the higher the score, and each length another game. Cheap: the bot plays once per seed."""
-    session = GameSession(GameConfig(seed=seed))
+def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, driven: str = "keyboard",
+                  duration: float = 60.0) -> Replay:
+    """A whole standard game (on a clock of ``duration`` s: a rehearsal's is 15) whose keys were the model bot's
+    for its first ``seconds`` and then none: the longer, the higher the score, and each length another game.
+    Cheap: the bot plays once per seed."""
+    session = GameSession(GameConfig(seed=seed, time_limit=duration))
     last = round(seconds / session.config.dt)
     events = [e for e in _bot_timeline(seed) if e.step < last]
     events += [InputEvent(last, m.key, UP) for m in session.config.muscles]  # whatever was held, let go

@@ -56,6 +56,7 @@ const answer = {
   }),
   sin_cos: (request.sin_cos ?? []).map((x) => sinCos(x).map(bits)),
   expm1: (request.expm1 ?? []).map((x) => bits(expm1(x))),
-  standard: (request.standard ?? []).map((seed) => toJSON(standardConfig(seed))),
+  // a seed, or [seed, duration] (a rehearsal's clock)
+  standard: (request.standard ?? []).map((s) => toJSON(Array.isArray(s) ? standardConfig(...s) : standardConfig(s))),
 };
 process.stdout.write(JSON.stringify(answer));

@@ -15,6 +15,7 @@ Skipped only where ``node`` is missing and ``ARMGAME_REQUIRE_BROWSER`` is unset 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -34,6 +35,7 @@ from armgame.game.session import GameSession
 from armgame.physics import trig
 from armgame.records.identity import game_digest
 from armgame.records.replay import Replay, config_from_dict, config_to_dict
+from armgame.records.rulesets import REHEARSAL, class_game_name, config_digest
 
 ROOT = Path(__file__).resolve().parent.parent
 RUNNER = ROOT / "tests" / "engine_runner.mjs"
@@ -283,16 +285,21 @@ def test_the_arm_sine_the_muscle_rates_and_the_standard_config():
     # the muscles' rates: -expm1(-dt / T) over replays' ranges (dt 1e-4 to 0.02 s, T from dt to 10 s)
     ratios = [-rng.uniform(1e-4, 0.02) / rng.uniform(1e-3, 10.0) for _ in range(3000)] + [-1.0, -20.0, -0.05, -0.04]
     seeds = [0, 10, 2**53 + 1, TOP_SEED]
-    answer = run_node({"sin_cos": angles, "expm1": ratios, "standard": [str(s) for s in seeds]})
+    rehearsals = [[str(s), REHEARSAL.config.time_limit] for s in seeds]  # the rehearsal's clock, as its join says
+    answer = run_node({"sin_cos": angles, "expm1": ratios, "standard": [str(s) for s in seeds] + rehearsals})
     for x, got in zip(angles, answer["sin_cos"], strict=True):
         want = [bits(v) for v in trig.sin_cos_python(x)]
         assert got == want == [bits(v) for v in trig.sin_cos(x)], x
     for x, got in zip(ratios, answer["expm1"], strict=True):
         assert got == bits(math.expm1(x)), x
-    for seed, text in zip(seeds, answer["standard"], strict=True):
+    for seed, text in zip(seeds, answer["standard"][:len(seeds)], strict=True):
         data = json.loads(text)
         assert data == config_to_dict(GameConfig(seed=seed))
         assert config_from_dict(data) == GameConfig(seed=seed)
+    for seed, text in zip(seeds, answer["standard"][len(seeds):], strict=True):
+        config = config_from_dict(json.loads(text))  # as the class reads the replay's config
+        assert config == dataclasses.replace(REHEARSAL.config, seed=seed)
+        assert class_game_name(config) == "rehearsal" and config_digest(config) == REHEARSAL.digest
 
 
 def test_a_hit_is_decided_on_the_rules_hand():

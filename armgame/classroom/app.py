@@ -275,8 +275,11 @@ async def join(request: Request) -> Response:
     if new_token is not None and not own:
         state.joins.add(address)
         state.class_joins.add("class")
+    # The class's game: its seed, its rules and their clock (a rehearsal's games are 15 s), which the student's
+    # machine plays; a game of other rules is refused at hand-in.
     return json_answer({"ok": True, "name": player.name, "token": new_token or token, "seed": clerk.roster.seed,
-                        "closed": clerk.roster.closed,
+                        "rules": clerk.game.name, "duration": clerk.game.config.time_limit,
+                        "rehearsal": clerk.rehearsal, "closed": clerk.roster.closed,
                         "message": f"joined the class as {player.name}" if new_token is None
                         else f"joined the class as {player.name} (the name is now this machine's)"})
 

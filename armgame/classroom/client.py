@@ -3,6 +3,7 @@
 Kept in the user's own folder (``client_folder``)::
 
     memberships.json          per class (by its code): the name joined under, its token, the class's seed
+                              and its game's clock (a rehearsal's games are 15 s)
     outbox/<code>/*.json      replays the class could not be reached for, handed in at the next join
 
 A class is known by its code, not its address: the teacher's laptop has another address in
@@ -23,6 +24,7 @@ import hashlib
 import http.client
 import ipaddress
 import json
+import math
 import os
 import re
 import time
@@ -207,6 +209,10 @@ class Membership:
     seed: int
     #: The class took no more games when this machine joined (the teacher closed it).
     closed: bool = False
+    #: The class's game's clock, in seconds: the standard 60, or a rehearsal's 15 (the class takes only its own).
+    duration: float = 60.0
+    #: The class is a rehearsal (``armgame class serve --rehearse``): nothing it takes is kept.
+    rehearsal: bool = False
 
     @property
     def key(self) -> str:
@@ -241,8 +247,8 @@ def last_class() -> tuple[str, str, str] | None:
 
 def _remember(m: Membership) -> None:
     data = remembered()
-    data[m.key] = {"name": m.name, "token": m.token, "seed": str(m.seed), "address": m.address.label,
-                   "at": f"{time.time():.3f}"}
+    data[m.key] = {"name": m.name, "token": m.token, "seed": str(m.seed), "duration": repr(m.duration),
+                   "address": m.address.label, "at": f"{time.time():.3f}"}
     folder = client_folder()
     folder.mkdir(parents=True, exist_ok=True)
     atomic_write_bytes(_memberships_path(), json.dumps(data, indent=1, ensure_ascii=False).encode(),
@@ -271,7 +277,8 @@ def join(address: ClassAddress, code: str, name: str | None) -> Membership:
     answer = _request(address, "/api/join", body, {"Content-Type": "application/json"})
     try:
         membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]),
-                                answer.get("closed") is True)
+                                answer.get("closed") is True, _duration(answer.get("duration", 60.0)),
+                                answer.get("rehearsal") is True)
     except (KeyError, TypeError, ValueError):
         raise BadAnswerError("the class's answer is not armgame's (is that address an armgame class?)") from None
     _remember(membership)
@@ -287,9 +294,20 @@ def offline(address: ClassAddress, code: str, name: str | None) -> Membership | 
     if known is None or (name is not None and player_key(name) != player_key(known["name"])):
         return None
     try:
-        return Membership(address, check_code(code), known["name"], known["token"], int(known.get("seed", "")))
-    except ValueError:
+        return Membership(address, check_code(code), known["name"], known["token"], int(known.get("seed", "")),
+                          duration=_duration(float(known.get("duration", "60.0"))))
+    except (TypeError, ValueError):
         return None
+
+
+def _duration(value: object) -> float:
+    """The class's game's clock from its answer (a class from before it was sent: 60 s); ValueError if not a game's."""
+    from ..limits import MAX_GAME_SECONDS
+
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or \
+            not 0 < value <= MAX_GAME_SECONDS:
+        raise ValueError(f"not a game's length: {value!r}")
+    return float(value)
 
 
 # ------------------------------------------------------------------ handing in

@@ -42,7 +42,7 @@ from ..records.batch_verify import batchable
 from ..records.identity import game_digests
 from ..records.lookalikes import name_problem
 from ..records.replay import Replay, now_iso, same_outcome
-from ..records.rulesets import RULESETS, ruleset_name
+from ..records.rulesets import CLASS_GAMES, Ruleset, class_game_name, config_digest
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
 from ..records.standings import player_key, shared_rank
 from ..records.storage import DataFileError
@@ -131,10 +131,15 @@ def ordinal(n: int) -> str:
 class Clerk:
     """The class's state and its one writer. Not thread-safe by design: call it from one thread."""
 
-    def __init__(self, folder: Path, roster: Roster) -> None:
+    def __init__(self, folder: Path, roster: Roster, rehearsal: bool = False, records: Path | None = None) -> None:
+        """``rehearsal``: the class plays the rehearsal's 15 s game and short rounds (``serve --rehearse``);
+        ``records``: where the table's record is kept (``records.teacher``; None: the teacher's own records)."""
         self.folder = Path(folder)
         self.roster = roster
-        self.table = ScoreTable(self.folder, warn=lambda message: None)
+        self.rehearsal = rehearsal
+        #: The one game this class takes: a game of other rules is refused, whatever its score.
+        self.game: Ruleset = CLASS_GAMES["rehearsal" if rehearsal else "standard"]
+        self.table = ScoreTable(self.folder, warn=lambda message: None, records=records)
         self.table.lock_mode = 0o600  # only the server writes a class's table: nobody else may open its lock
         with contextlib.suppress(OSError):
             if stat.S_ISREG(os.lstat(self.table.lock_path).st_mode):
@@ -293,10 +298,10 @@ class Clerk:
         r = replay.result
         if not replay.complete:
             raise RefusedError(400, "the game stopped before its clock ran out: only a whole game is handed in")
-        rules = ruleset_name(replay.config)
-        if rules not in RULESETS or r.seed != self.roster.seed:
-            raise RefusedError(400, f"this class plays the standard game of seed {self.roster.seed}; this game is "
-                               f"{rules} rules, seed {r.seed} (play it with --join to get the class's game)")
+        if config_digest(replay.config) != self.game.digest or r.seed != self.roster.seed:
+            raise RefusedError(400, f"this class plays the {self.game.name} game ({self.game.config.time_limit:g} s) "
+                               f"of seed {self.roster.seed}; this game is {class_game_name(replay.config)} rules "
+                               f"({r.duration:g} s), seed {r.seed} (play it with --join to get the class's game)")
         # An entry keeps the digest of the identity version that entered it: the game is looked up by each.
         # Computed here once and carried to the table's entry (``Checked.digests``).
         digests = game_digests(replay)
@@ -572,13 +577,15 @@ class Clerk:
     def start_round(self, minutes: object) -> str:
         """A new round of ``minutes``, from now (the last one ends here if it was still on)."""
         try:
-            rnd = new_round(self.current_round(), minutes, max((e.entered or 0 for e in self.entries), default=0))
+            rnd = new_round(self.current_round(), minutes, max((e.entered or 0 for e in self.entries), default=0),
+                            rehearsal=self.rehearsal)
         except ValueError as exc:
             raise RefusedError(400, str(exc)) from None
         self.roster.changed(round=rnd.as_dict())
         self.version += 1
         self.round_over = False
-        return f"round {rnd.number}: {rnd.minutes} min, from now"
+        length = f"{rnd.seconds} s (a rehearsal's round)" if rnd.seconds else f"{rnd.minutes} min"
+        return f"round {rnd.number}: {length}, from now"
 
     def stop_round(self) -> str:
         rnd = self.current_round()

@@ -6,7 +6,9 @@ clock runs out, the round's winners, large, for the room to cheer. A game counts
 is entered after the round's start (by the table's own order of entry, exact where a clock's second
 is not) and by its end plus ``GRACE_SECONDS`` (a game finished as the clock runs out is still on its
 way). The class's overall standings are untouched: a round is a view
-of the games, not a table of its own.
+of the games, not a table of its own. A rehearsal's round (``armgame class serve --rehearse``) lasts
+``REHEARSAL_ROUND_SECONDS`` whatever minutes the teacher chose, and its winners come down
+``REHEARSAL_WINNERS_SECONDS`` after its end, so the whole round is walked through in under a minute.
 
 Kept in the roster (``Roster.round``: its number, start and length), so a server restarted during a
 round goes on with it. Pure: no I/O, no clock of its own (``now`` is given).
@@ -27,6 +29,11 @@ GRACE_SECONDS = 10
 MIN_MINUTES, MAX_MINUTES = 1, 30
 #: The winners the projector names at a round's end.
 WINNERS = 3
+#: Seconds from a round's end until the projector takes its winners down (they show once the grace is over).
+WINNERS_SECONDS = 90
+#: A rehearsal's round, and its winners' seconds as above: 15 s of winners after the 10 s of grace.
+REHEARSAL_ROUND_SECONDS = 30
+REHEARSAL_WINNERS_SECONDS = 25
 
 
 @dataclass(frozen=True)
@@ -36,10 +43,17 @@ class Round:
     minutes: int
     #: The table's entries entered before the round began (its first game is entry ``after + 1``).
     after: int = 0
+    #: A rehearsal's round: its length in seconds, in place of its minutes (0: an ordinary round).
+    seconds: int = 0
 
     @property
     def end(self) -> datetime:
-        return self.start + timedelta(minutes=self.minutes)
+        return self.start + (timedelta(seconds=self.seconds) if self.seconds else timedelta(minutes=self.minutes))
+
+    @property
+    def hold(self) -> int:
+        """Seconds from the round's end until the projector takes its winners down."""
+        return REHEARSAL_WINNERS_SECONDS if self.seconds else WINNERS_SECONDS
 
     def counts(self, entered: int | None, entered_at: str | None) -> bool:
         """Whether a game entered as the table's ``entered``-th, at ``entered_at`` (ISO, with its zone), counts."""
@@ -53,14 +67,18 @@ class Round:
 
     def as_dict(self) -> dict[str, object]:
         return {"number": self.number, "start": self.start.isoformat(timespec="seconds"), "minutes": self.minutes,
-                "after": self.after}
+                "after": self.after, **({"seconds": self.seconds} if self.seconds else {})}
 
     @classmethod
     def from_dict(cls, data: object) -> Round:
         """A round as the roster keeps it; ValueError naming what is wrong."""
-        if not isinstance(data, dict) or set(data) != {"number", "start", "minutes", "after"}:
-            raise ValueError("round must be an object of number, start, minutes and after")
+        if not isinstance(data, dict) or not {"number", "start", "minutes", "after"} <= set(data) <= \
+                {"number", "start", "minutes", "after", "seconds"}:
+            raise ValueError("round must be an object of number, start, minutes and after (and a rehearsal's seconds)")
         number, minutes, start, after = data["number"], data["minutes"], data["start"], data["after"]
+        seconds = data.get("seconds", 0)
+        if isinstance(seconds, bool) or not isinstance(seconds, int) or not 0 <= seconds <= 60 * MAX_MINUTES:
+            raise ValueError(f"round's seconds must be a whole number from 0 to {60 * MAX_MINUTES}")
         if isinstance(after, bool) or not isinstance(after, int) or not 0 <= after <= INT64_MAX:
             raise ValueError("round's after must be a whole number of entries")
         if isinstance(number, bool) or not isinstance(number, int) or not 1 <= number <= 10_000:
@@ -72,24 +90,26 @@ class Round:
         when = datetime.fromisoformat(start)
         if when.tzinfo is None:
             raise ValueError("round's start must carry its time zone")
-        return cls(number, when, minutes, after)
+        return cls(number, when, minutes, after, seconds)
 
 
-def new_round(previous: Round | None, minutes: object, entered: int, now: datetime | None = None) -> Round:
+def new_round(previous: Round | None, minutes: object, entered: int, now: datetime | None = None,
+              rehearsal: bool = False) -> Round:
     """The next round, starting ``now`` after the table's ``entered`` entries; ValueError if ``minutes`` is not a
-    round's length."""
+    round's length. A rehearsal's round lasts ``REHEARSAL_ROUND_SECONDS``, whatever its minutes."""
     if isinstance(minutes, bool) or not isinstance(minutes, int) or not MIN_MINUTES <= minutes <= MAX_MINUTES:
         raise ValueError(f"a round lasts a whole number of minutes from {MIN_MINUTES} to {MAX_MINUTES}")
     start = (now or datetime.now(UTC)).replace(microsecond=0)
-    return Round((previous.number + 1) if previous else 1, start, minutes, entered)
+    return Round((previous.number + 1) if previous else 1, start, minutes, entered,
+                 REHEARSAL_ROUND_SECONDS if rehearsal else 0)
 
 
 def round_view(rnd: Round | None, best_first: Sequence, hidden: Iterable[str], now: datetime,
                rows: int, name_of: Callable[[str], str] = lambda name: name) -> dict[str, object] | None:
     """What the projector shows of ``rnd``: its clock (start and end, ISO: the page counts down), whether it is
     over, its standings (each student's best game handed in during it; programs and hidden names never), and
-    once over, its winners. ``best_first``: the class's entries in rank order; ``name_of``: the name the class
-    shows for a game's (the teacher may have changed it)."""
+    once over, its winners (taken down ``hold`` seconds after its end). ``best_first``: the class's entries in
+    rank order; ``name_of``: the name the class shows for a game's (the teacher may have changed it)."""
     if rnd is None:
         return None
     hidden = set(hidden)
@@ -103,6 +123,6 @@ def round_view(rnd: Round | None, best_first: Sequence, hidden: Iterable[str], n
             break
     over = rnd.over(now)
     return {"number": rnd.number, "start": rnd.start.isoformat(timespec="seconds"),
-            "end": rnd.end.isoformat(timespec="seconds"), "minutes": rnd.minutes, "over": over,
+            "end": rnd.end.isoformat(timespec="seconds"), "minutes": rnd.minutes, "hold": rnd.hold, "over": over,
             "players": len({player_key(name_of(e.name)) for e in games}), "students": table,
             "winners": [r for r in table if r["rank"] <= WINNERS] if over else []}

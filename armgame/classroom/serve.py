@@ -11,6 +11,11 @@ connections per address), and without proxy headers: a client's address is its s
 ``X-Forwarded-For`` it wrote, unless the teacher names a proxy (``--proxy ADDRESS``). One server at
 a time serves a folder: it holds ``server.lock`` (owner-only) for its life, and a second one says so
 in one line and stops.
+
+A rehearsal (``--rehearse``) is a class like any other but for three things: its game is the rehearsal's
+15 s one (``records.rulesets.REHEARSAL``) and its rounds are short (``rounds.REHEARSAL_ROUND_SECONDS``); it
+lives in a new private temporary folder, removed when the server stops; and the table's record that a
+class's starter keeps (``records.teacher``) is kept in that folder too, so nothing is written anywhere else.
 """
 
 from __future__ import annotations
@@ -20,9 +25,11 @@ import errno
 import logging
 import os
 import shlex
+import shutil
 import signal
 import socket
 import sys
+import tempfile
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -32,6 +39,7 @@ from typing import Any
 
 from ..errors import UserError
 from ..words import plural
+from .rounds import REHEARSAL_ROUND_SECONDS
 
 GRACE_SECONDS = 3
 SERVER_LOCK = "server.lock"
@@ -45,6 +53,9 @@ CONCURRENCY = 2500
 #: second later, then three: at 128, a round's end of 1,000 students at once, or a flood of clients, cost an
 #: honest student seconds before the server even saw their game.
 BACKLOG = 2048
+#: Why a rehearsal takes no folder, in one line.
+REHEARSE_NO_FOLDER = ("--rehearse keeps nothing: it plays in a temporary folder removed at Ctrl-C, so it takes no "
+                      "--folder (leave out --rehearse to serve the class in that folder)")
 
 
 def lan_address() -> str:
@@ -89,6 +100,8 @@ class ClassServer:
     join_line: str
     new: bool
     held: Any = None
+    #: A rehearsal's temporary folder (the class's folder is inside it), removed once the server has stopped.
+    temporary: Path | None = None
 
     @property
     def port(self) -> int:
@@ -110,6 +123,8 @@ class ClassServer:
             self.sock.close()
             if self.held is not None:
                 self.held.release()
+            if self.temporary is not None:  # after the lock is let go: Windows removes no open file
+                shutil.rmtree(self.temporary, ignore_errors=True)
             if main:
                 signal.signal(signal.SIGTERM, before)
 
@@ -117,14 +132,15 @@ class ClassServer:
         self.server.should_exit = True
 
 
-def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
+def open_class(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
                on_ready: Callable[[ClassServer], None] | None = None, lab: str | None = None,
-               proxy: str | None = None) -> ClassServer:
+               proxy: str | None = None, rehearse: bool = False) -> ClassServer:
     """The class in ``folder`` (gone on with, or new) bound to ``host:port`` (0: a free port), not yet serving.
 
     ``say`` gets the teacher's lines: the banner once the server takes requests, notices after. ``lab``:
     the preset the class curve shows (a new class: ``lesson`` unless given; a class gone on with keeps its
-    own unless given). ``proxy``: the address of a reverse proxy whose ``X-Forwarded-For`` is believed."""
+    own unless given). ``proxy``: the address of a reverse proxy whose ``X-Forwarded-For`` is believed.
+    ``rehearse``: a rehearsal (``folder`` None), in a temporary folder removed when ``run`` ends."""
     import uvicorn
 
     from ..lab.record import register
@@ -135,19 +151,31 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
 
     curve = _curve_protocol(lab)
     register()  # lab runs are read as replays with their task section
+    temporary = records = None
+    if rehearse:
+        if folder is not None:
+            raise UserError(REHEARSE_NO_FOLDER)
+        temporary = Path(tempfile.mkdtemp(prefix="armgame-rehearsal-"))  # the user's alone (0700)
+        folder, records = temporary / "class", temporary / "records"
+    assert folder is not None, "a class needs its folder, or is a rehearsal"
     try:
-        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-    except OSError as exc:
-        raise UserError(f"--folder {folder}: cannot create it: {exc.strerror or exc}") from None
-    held = _hold_folder(folder)
-    try:
-        roster, new = Roster.open(folder, seed)
-        if (new and roster.lab is None) or (curve is not None and curve != roster.lab):
-            roster.changed(lab=curve or "lesson")
-        clerk = Clerk(folder, roster)
-        sock = _bind(host, port)
+        try:
+            folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+        except OSError as exc:
+            raise UserError(f"--folder {folder}: cannot create it: {exc.strerror or exc}") from None
+        held = _hold_folder(folder)
+        try:
+            roster, new = Roster.open(folder, seed)
+            if (new and roster.lab is None) or (curve is not None and curve != roster.lab):
+                roster.changed(lab=curve or "lesson")
+            clerk = Clerk(folder, roster, rehearsal=rehearse, records=records)
+            sock = _bind(host, port)
+        except BaseException:
+            held.release()
+            raise
     except BaseException:
-        held.release()
+        if temporary is not None:
+            shutil.rmtree(temporary, ignore_errors=True)
         raise
     port = sock.getsockname()[1]
     join_line = f"armgame play --join {_label(host)}:{port} --code {roster.code}"
@@ -156,8 +184,12 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
 
     def ready() -> None:
         others = other_addresses(host) if host not in ("127.0.0.1", "localhost", "::1") else []
-        say(f"armgame class {'started' if new else 'goes on'}: code {roster.code}, seed {roster.seed}, "
-            f"{plural(len(clerk.entries), 'game')} so far, kept in {folder}")
+        if rehearse:
+            say(f"armgame class REHEARSAL: code {roster.code}, seed {roster.seed}; {clerk.game.config.time_limit:g} s "
+                f"games, {REHEARSAL_ROUND_SECONDS} s rounds; nothing is kept (a temporary folder, removed at Ctrl-C)")
+        else:
+            say(f"armgame class {'started' if new else 'goes on'}: code {roster.code}, seed {roster.seed}, "
+                f"{plural(len(clerk.entries), 'game')} so far, kept in {folder}")
         say(f"  students type:  {join_line} --name NAME")
         say(f"  browser:        {play_url}   (Chromebooks, tablets: nothing to install)")
         say(f"  projector:      http://{_label(host)}:{port}/?key={roster.projector_key()}   (shows the code; "
@@ -168,7 +200,10 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
             say(f"  this machine also answers at {', '.join(others)}, if students are on that network")
         say("  the first time, Windows or macOS may ask to allow incoming connections for Python: allow it on "
             "private networks")
-        say(f"  Ctrl-C stops the class; to go on with it later: armgame class serve --folder {shell_path(folder)}")
+        if rehearse:
+            say("  Ctrl-C ends the rehearsal and removes all it kept; the real class: armgame class serve")
+        else:
+            say(f"  Ctrl-C stops the class; to go on with it later: armgame class serve --folder {shell_path(folder)}")
         if on_ready is not None:
             on_ready(opened)
 
@@ -184,7 +219,8 @@ def open_class(folder: Path, host: str, port: int, seed: int | None, say: Callab
     errors = logging.getLogger("uvicorn.error")  # configured by uvicorn.Config, just above
     if not any(isinstance(f, _QuietWhenFull) for f in errors.filters):
         errors.addFilter(_QuietWhenFull())
-    opened = ClassServer(clerk, sock, _class_uvicorn(config, app.state.armgame.end_streams), join_line, new, held)
+    opened = ClassServer(clerk, sock, _class_uvicorn(config, app.state.armgame.end_streams), join_line, new, held,
+                         temporary)
     return opened
 
 
@@ -259,11 +295,22 @@ class _QuietWhenFull(logging.Filter):
         return record.getMessage() != "Exceeded concurrency limit."
 
 
-def serve(folder: Path, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
-          lab: str | None = None, proxy: str | None = None) -> int:
-    """Run the class in ``folder`` on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit status."""
-    opened = open_class(folder, host, port, seed, say, lab=lab, proxy=proxy)
+def serve(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
+          lab: str | None = None, proxy: str | None = None, rehearse: bool = False,
+          on_ready: Callable[[ClassServer], None] | None = None) -> int:
+    """Run the class in ``folder`` (a rehearsal: None) on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit
+    status. ``on_ready``: as ``open_class``'s."""
+    opened = open_class(folder, host, port, seed, say, on_ready, lab=lab, proxy=proxy, rehearse=rehearse)
     opened.run()
+    if opened.temporary is not None:
+        played = f"{plural(len(opened.clerk.entries), 'game')} and {plural(len(opened.clerk.lab_runs), 'lab run')}"
+        if opened.temporary.exists():
+            say(f"armgame class rehearsal stopped: {played}; its folder could not be removed: {opened.temporary}")
+            return 1
+        say(f"armgame class rehearsal stopped: {played}, none kept (its folder is removed)")
+        say("  the real class: armgame class serve")
+        return 0
+    folder = opened.clerk.folder
     where = shell_path(folder)
     say(f"armgame class stopped: {plural(len(opened.clerk.entries), 'game')} kept in {folder}")
     say(f"  the standings, one row a student:  armgame scores --scores {where}")

@@ -51,7 +51,7 @@ def standings(clerk: Clerk, teacher: bool = False) -> dict[str, object]:
     arrival = clerk.arrival
     if arrival is not None and roster.is_hidden(arrival.name):
         arrival = None
-    return {"version": clerk.version, "seed": roster.seed, "closed": roster.closed,
+    return {"version": clerk.version, "seed": roster.seed, "closed": roster.closed, "rehearsal": clerk.rehearsal,
             "joined": len(roster.players), "games": len(clerk.entries),
             "round": None if teacher else round_shown(clerk),
             "students": rows(False), "programs": rows(True),

@@ -51,6 +51,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        "the teacher's page can change it)")
     serve.add_argument("--proxy", metavar="ADDRESS", help="believe X-Forwarded-For from this address only (a reverse "
                        "proxy in front of the class; default: none, a client's address is its socket's)")
+    serve.add_argument("--rehearse", action="store_true", help="a rehearsal of the lesson: 15 s games and 30 s "
+                       "rounds, in a temporary folder removed at Ctrl-C (nothing is kept; not with --folder)")
     serve.set_defaults(run=run_serve)
     submit = sub.add_parser("submit", help="hand replay files in to a class (games or lab runs)",
                             description="Hand replays in by hand: games kept while the class could not be reached, "
@@ -73,17 +75,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run_serve(args: argparse.Namespace) -> int:
-    from ..classroom.serve import default_folder, lan_address, serve
+    from ..classroom.serve import REHEARSE_NO_FOLDER, default_folder, lan_address, serve
+    from ..errors import UserError
     from ..records.storage import user_path
 
-    folder = user_path(args.folder, "--folder") if args.folder else default_folder()
-    if folder.exists() and not folder.is_dir():
-        from ..errors import UserError
-
+    if args.rehearse and args.folder:
+        raise UserError(REHEARSE_NO_FOLDER)
+    folder = None if args.rehearse else user_path(args.folder, "--folder") if args.folder else default_folder()
+    if folder is not None and folder.exists() and not folder.is_dir():
         raise UserError(f"--folder {folder}: not a folder")
     host = args.host or lan_address()
     return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True), lab=args.lab,
-                 proxy=args.proxy)
+                 proxy=args.proxy, rehearse=args.rehearse)
 
 
 def run_submit(args: argparse.Namespace) -> int:
@@ -156,7 +159,9 @@ def join_class(args: argparse.Namespace):
         if membership.closed:  # before a game that could not be handed in, not after it
             raise UserError(f"the class at {address.label} is closed: it takes no more games (the teacher can open "
                             f"it again)")
-        print(f"joined the class at {address.label} as {membership.name} (seed {membership.seed})", file=sys.stderr)
+        what = f"seed {membership.seed}" + (f"; a rehearsal: {membership.duration:g} s games" if membership.rehearsal
+                                             else "")
+        print(f"joined the class at {address.label} as {membership.name} ({what})", file=sys.stderr)
         for line in client.send_outbox(membership):
             print(line, file=sys.stderr)
     args.name = membership.name

@@ -133,12 +133,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _join(args: argparse.Namespace):
-    """With --join: the class joined, and the game set to the class's (its seed, the standard clock)."""
+    """With --join: the class joined, and the game set to the class's (its seed and its clock: the standard 60 s,
+    or a rehearsal's 15 s)."""
     from .classroom import join_class
 
     if args.join is not None:
         if args.duration != 60.0:
-            raise UserError("a class plays the standard 60 s game: leave out --duration")
+            raise UserError("a class plays its own game (the standard 60 s game, a rehearsal's 15 s one): leave out "
+                            "--duration")
         if args.name is not None:
             _check_score_options(args)  # the name is checked before it is sent
     membership = join_class(args)
@@ -146,6 +148,7 @@ def _join(args: argparse.Namespace):
         if args.seed not in (DEFAULT_SEED, membership.seed):
             raise UserError(f"the class plays seed {membership.seed}: leave out --seed")
         args.seed = membership.seed
+        args.duration = membership.duration
     return membership
 
 

@@ -79,6 +79,24 @@ RULESETS: dict[str, Ruleset] = {
 _BY_DIGEST = {r.digest: r for r in RULESETS.values()}
 
 
+#: The rehearsal's clock, in seconds: a teacher walks the whole lesson in five minutes (docs/teaching.md).
+REHEARSAL_SECONDS = 15.0
+#: The game of a rehearsal class (``armgame class serve --rehearse``): the standard game on a 15 s clock. A class
+#: verifies it as it verifies the standard game, but it never ranks in a high-score table (it is not in
+#: ``RULESETS``): there it is a custom game, kept apart from the 60 s games it could never be compared with.
+REHEARSAL = Ruleset("rehearsal", GameConfig(time_limit=REHEARSAL_SECONDS),
+                    "the rehearsal's game: the standard game, 15 s")
+#: The games a live class plays, by name: a class takes its own and refuses the other.
+CLASS_GAMES: dict[str, Ruleset] = {r.name: r for r in (RULESETS["standard"], REHEARSAL)}
+_CLASS_BY_DIGEST = {r.digest: r for r in CLASS_GAMES.values()}
+
+
+def class_game_name(config: GameConfig) -> str:
+    """The class game ``config`` plays, whatever its seed and key bindings ("standard", "rehearsal"), or "custom"."""
+    found = _CLASS_BY_DIGEST.get(config_digest(config))
+    return found.name if found else CUSTOM
+
+
 def ruleset_of(config: GameConfig) -> Ruleset | None:
     """The ranked ruleset ``config`` plays (whatever its seed and key bindings), or None for a custom game."""
     return _BY_DIGEST.get(config_digest(config))

@@ -279,13 +279,15 @@ const STANDARD_MUSCLES = [
   ["triceps", "k", [0.0, -1.125]],
 ];
 
-/** The replay "config" of the class's standard game (records.replay.config_to_dict(GameConfig(seed=seed))). */
-export function standardConfig(seed) {
+/** The replay "config" of the class's standard game (records.replay.config_to_dict(GameConfig(seed=seed))), on
+ * a clock of `duration` seconds: 60, or a rehearsal's 15 (records.rulesets.REHEARSAL), as the class's join answer
+ * says. The replay records it (config.time_limit, result.duration), so the class verifies the game it names. */
+export function standardConfig(seed, duration = 60.0) {
   return {
     arm: { l1: 0.34, l2: 0.46, r1: 0.17, r2: 0.23, m1: 2.1, m2: 1.65, i1: 0.025, i2: 0.075, gravity: 0.0,
       damping1: 0.36, damping2: 0.27 },
     start_posture: [45.0 * DEG_TO_RAD, 90.0 * DEG_TO_RAD],
-    time_limit: 60.0,
+    time_limit: duration,
     target_radius: 0.05,
     target_shoulder_range: [15.0, 90.0],
     target_elbow_range: [45.0, 90.0],

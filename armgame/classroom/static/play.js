@@ -44,7 +44,7 @@ const statusLine = document.getElementById("status");
 // The last frames' times (ms of script and drawing each): benchmarks/browser_page.py and the tests read them.
 canvas.frameTimes = [];
 
-let member = load(MEMBER, null);  // {code, name, token, seed}
+let member = load(MEMBER, null);  // {code, name, token, seed, duration}
 let config = null, game = null, names = [], keys = [];
 let phase = "join";  // join, countdown, playing, over
 let countdownLeft = 0, clock = 0, taken = 0, last = null, alpha = 1;
@@ -173,7 +173,8 @@ joinForm.addEventListener("submit", async (event) => {
 });
 
 function joined(code, data) {
-  member = { code, name: data.name, token: data.token, seed: data.seed };
+  // The class's game: its seed and its clock (a rehearsal's games are 15 s; a class that does not say: 60 s).
+  member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60 };
   save(MEMBER, member);
   joinForm.hidden = true;
   statusLine.textContent = "";
@@ -209,7 +210,7 @@ async function playAgain() {
 
 // ------------------------------------------------------------------ a game
 function newGame() {
-  config = standardConfig(member.seed);
+  config = standardConfig(member.seed, member.duration ?? 60);
   game = new Game(config);
   names = config.muscles.map((m) => m.name);
   keys = game.muscleKeys;

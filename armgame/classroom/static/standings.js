@@ -166,8 +166,8 @@ function showPlay(url) {
 }
 
 // A round: its clock counted down on the projector, its own standings while it runs, and its winners, large,
-// for WINNERS_SECONDS once it is over. The clock is the class's (the round's end, as the server set it).
-const WINNERS_SECONDS = 90;
+// for as long as the class says once it is over (its hold: a minute and a half, a rehearsal's 15 s). The clock is
+// the class's (the round's end, as the server set it).
 let roundTimer = null;
 
 function mmss(seconds) {
@@ -176,7 +176,7 @@ function mmss(seconds) {
 }
 
 function roundShown(r) {
-  return r && !(r.over && (Date.now() - Date.parse(r.end)) / 1000 > WINNERS_SECONDS);
+  return r && !(r.over && (Date.now() - Date.parse(r.end)) / 1000 > r.hold);
 }
 
 function showRound(r) {
@@ -220,7 +220,7 @@ function showRound(r) {
     list.appendChild(li);
   }
   // Back to the class's standings once the moment has passed.
-  roundTimer = setTimeout(() => { if (latest) render(latest); }, WINNERS_SECONDS * 1000);
+  roundTimer = setTimeout(() => { if (latest) render(latest); }, r.hold * 1000);
 }
 
 function render(s) {
@@ -232,6 +232,7 @@ function render(s) {
   document.getElementById("games").textContent = String(s.games);
   document.getElementById("seed").textContent = String(s.seed);
   document.getElementById("closed").hidden = !s.closed;
+  document.getElementById("rehearsal").hidden = !s.rehearsal;
   const a = s.arrival;
   const isNew = a && lastArrival !== null && a.seq > lastArrival;
   if (a) lastArrival = Math.max(lastArrival || 0, a.seq); else if (lastArrival === null) lastArrival = 0;

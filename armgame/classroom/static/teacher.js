@@ -179,6 +179,7 @@ refresh();
 
 // The browser game's address (public: the projector shows it too), for students who cannot install Python.
 fetch("/api/standings").then((r) => r.json()).then((s) => {
+  $("rehearsal").hidden = !s.rehearsal;  // said plainly, so nobody takes a rehearsal for the class
   if (!s.play) return;
   $("play-url").textContent = s.play;
   $("play").hidden = false;
