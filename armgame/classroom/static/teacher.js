@@ -120,7 +120,8 @@ async function refresh() {
     table.replaceChildren();
     for (const r of s.students) row(table, r, "student");
     for (const r of s.programs) row(table, r, "program");
-    say(s.closed ? "The class is closed to new games." : "The class takes games.");
+    say(s.closed ? "The class is closed to new games; the lab's volunteers still join, and their runs count."
+      : "The class takes games.");
   } catch (e) {
     $("controls").hidden = true;
     $("ask-secret").hidden = false;
