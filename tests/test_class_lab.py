@@ -177,3 +177,32 @@ def test_the_lessons_volunteers_join_a_closed_class_and_their_runs_count_while_g
     assert (lab["students"], lab["programs"]) == (1, 1)
     assert [e.name for e in opened.clerk.entries] == ["Ann"]
     assert {p.name for p in opened.clerk.roster.players.values()} == {"Ann", "Volunteer 1", "Volunteer 2"}
+
+
+def test_the_projector_counts_students_apart_from_lab_volunteers_and_programs(tmp_path, runs, monkeypatch):
+    """A class of two students who played, one about to, a volunteer who only ran the lab, a lab bot and a game bot:
+    "3 students · 1 in the lab only · 2 programs", not "6 joined"; the teacher's roster names each one's lab runs."""
+    from class_server import tapped_game
+
+    with running_class(tmp_path / "class", lab=str(runs / "short.toml")) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        members = {}
+        for name in ("Ann", "Bo", "Cy", "Vi", "Lab bot", "Game bot"):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            members[name] = client.join(address, code, name)
+        for i, name in enumerate(("Ann", "Bo")):
+            assert client.hand_in(members[name], tapped_game(i, player=name).to_bytes()).answer is not None
+        client.hand_in(members["Ann"], as_person(runs / "run2.json", "Ann"))  # a student who also ran the lab
+        client.hand_in(members["Vi"], as_person(runs / "run1.json", "Vi"))
+        client.hand_in(members["Lab bot"], dataclasses.replace(Replay.load(runs / "run3.json"),
+                                                               player="Lab bot").to_bytes())
+        bot_game = dataclasses.replace(tapped_game(5), driven="bot", driver="model", player="Game bot")
+        assert client.hand_in(members["Game bot"], bot_game.to_bytes()).answer["list"] == "programs"
+        standings = json.loads(get(opened, "/api/standings"))
+        roster = json.loads(get(opened, "/api/teacher/roster", opened.clerk.roster.secret))
+    assert standings["people"] == {"students": 3, "lab_only": 1, "programs": 2} and standings["joined"] == 6
+    assert roster["people"] == standings["people"] and roster["waiting"] == 1  # Cy: nothing handed in yet
+    names = {n["name"]: (n["games"], n["lab"]) for m in roster["machines"] for n in m["names"]}
+    assert names == {"Ann": (1, ["short"]), "Bo": (1, []), "Cy": (0, []), "Vi": (0, ["short"]),
+                     "Lab bot": (0, ["short"]), "Game bot": (1, [])}
