@@ -230,7 +230,7 @@ def planning_frame(out: Path) -> Path:
 
 def interaction_frame(out: Path) -> Path:
     """`armgame demo interaction` at 1024 x 768 with a bright room's settings (high-contrast, 1.5)."""
-    return _demo("interaction", out, 0.55, "high-contrast", 1.5)
+    return _demo("interaction", out, 0.15, "high-contrast", 1.5)  # 0.15 s into the reach out
 
 
 def autopilot_frame(out: Path) -> Path:
