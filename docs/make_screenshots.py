@@ -141,6 +141,7 @@ def class_frame(out: Path) -> Path:
                                                           ("naive", 38, "bot (naive)"),
                                                           ("Kai's script", 31, "script")))]
     answer = {"version": 40, "seed": 10, "closed": False, "joined": 27, "games": 61, "students": students,
+              "people": {"students": 24, "lab_only": 0, "programs": 3},
               "programs": programs, "join": "armgame play --join 192.168.1.20:8765 --code HAPF",
               "arrival": {"seq": 61, "name": "Yusuf", "score": 51, "note": "new personal best", "program": False}}
     window = ClassWindow("192.168.1.20:8765", None)
@@ -229,7 +230,7 @@ def planning_frame(out: Path) -> Path:
 
 def interaction_frame(out: Path) -> Path:
     """`armgame demo interaction` at 1024 x 768 with a bright room's settings (high-contrast, 1.5)."""
-    return _demo("interaction", out, 0.55, "high-contrast", 1.5)
+    return _demo("interaction", out, 0.15, "high-contrast", 1.5)  # 0.15 s into the reach out
 
 
 def autopilot_frame(out: Path) -> Path:

@@ -260,6 +260,23 @@ def test_the_guide_shows_the_lines_the_class_prints(tmp_path):
         assert re.fullmatch(pattern, line), (pattern, line)
 
 
+def test_the_teachers_page_is_a_link_to_open_on_the_laptop_not_a_page_that_opens(tmp_path):
+    """Nothing opens a browser: the banner and the guide tell the teacher to open the teacher's link in a browser on
+    the laptop, where it asks no secret, and no page says it opens by itself."""
+    from pathlib import Path
+
+    printed: list[str] = []
+    with running_class(tmp_path / "class", lines=printed):
+        pass
+    line = next(line for line in printed if "teacher only:" in line)
+    assert "/teacher   (open it in a browser on this laptop: it asks no secret here;" in line
+    root = Path(__file__).resolve().parent.parent
+    guide = " ".join((root / "docs" / "teaching.md").read_text(encoding="utf-8").split())
+    assert "open it in a browser on the teacher's laptop (nothing opens one by itself)" in guide
+    for text in (guide, (root / "armgame" / "classroom" / "static" / "teacher.html").read_text(encoding="utf-8")):
+        assert "opens by itself" not in " ".join(text.split())
+
+
 def test_a_closed_class_refuses_a_game_before_it_is_played(tmp_path, students, capsys):
     import time
 

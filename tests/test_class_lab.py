@@ -116,3 +116,93 @@ def test_the_curve_is_the_teachers_protocol_not_the_one_most_names_ran(tmp_path,
         with urllib.request.urlopen(req, timeout=10) as r:
             assert json.loads(r.read())["message"] == "the class curve shows curl"
         assert json.loads(get(opened, "/api/lab"))["protocol"] == "curl"
+
+
+def post(opened, path: str, body: dict) -> tuple[int, dict]:
+    """A JSON POST from this machine (the teacher's own: its routes need no secret), and the class's answer."""
+    req = urllib.request.Request(f"http://127.0.0.1:{opened.port}{path}", data=json.dumps(body).encode(),
+                                 headers={"Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=10) as r:
+            return r.status, json.loads(r.read())
+    except urllib.error.HTTPError as exc:
+        return exc.code, json.loads(exc.read())
+
+
+def test_the_lessons_volunteers_join_a_closed_class_and_their_runs_count_while_games_stay_refused(
+        tmp_path, runs, monkeypatch, capsys):
+    """docs/teaching.md's order: students play, the teacher closes the class (30-35 min), then the lab runs on
+    volunteers (35-47 min). A closed class is closed to new games, and the lab is not one: a join that says it is
+    for the lab is taken and its runs reach the class curve; a game, and a new name for a game (the Python game's
+    join, the browser's), stay refused, whoever joined. A locked list refuses the lab's new names too."""
+    from class_server import tapped_game
+
+    with running_class(tmp_path / "class", lab=str(runs / "short.toml")) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann"))
+        ann = client.join(address, code, "Ann")
+        assert client.hand_in(ann, tapped_game(1, player="Ann").to_bytes()).answer is not None
+        assert post(opened, "/api/teacher/close", {"closed": True})[0] == 200
+        # The first volunteer, at the keys: joined for the lab, the run in /lab's curve.
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "volunteer"))
+        volunteer = client.join(address, code, "Volunteer 1", lab=True)
+        assert volunteer.closed
+        answer = client.hand_in(volunteer, as_person(runs / "run1.json", "Volunteer 1"))
+        assert answer.message == "lab run handed in: in the class curve"
+        assert json.loads(get(opened, "/api/lab"))["students"] == 1
+        # armgame lab --join says it joins for the lab (here the adapting bot, a program's run: kept apart).
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "volunteer 2"))
+        assert main(["lab", str(runs / "short.toml"), "--bot", "adaptive", "--headless", "--join",
+                     f"127.0.0.1:{opened.port}", "--code", code, "--name", "Volunteer 2"]) == 0
+        said = capsys.readouterr()
+        assert "a program's run" in said.out and "it takes this lab run" in said.err
+        # A game stays refused, the volunteer's as a student's.
+        for member, n in ((volunteer, 2), (ann, 3)):
+            refused = client.hand_in(member, tapped_game(n, player=member.name).to_bytes(), keep=False)
+            assert refused.refused and "closed to new games" in refused.message
+        # A new name for a game: the Python game's join, and the browser's (play.js posts the code and name).
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "late"))
+        with pytest.raises(client.RefusalError, match="closed to new games, so it takes no new players"):
+            client.join(address, code, "Late")
+        assert main(["play", "--headless", "--bot", "model", "--join", f"127.0.0.1:{opened.port}", "--code", code,
+                     "--name", "Late"]) == 2
+        status, browser = post(opened, "/api/join", {"code": code, "name": "Late B"})
+        assert status == 403 and "closed to new games" in browser["error"]
+        # The teacher's lock is "nobody new": the lab's volunteers too.
+        assert post(opened, "/api/teacher/lock", {"locked": True})[0] == 200
+        with pytest.raises(client.RefusalError, match="locked the list"):
+            client.join(address, code, "Volunteer 3", lab=True)
+        lab = json.loads(get(opened, "/api/lab"))
+    assert (lab["students"], lab["programs"]) == (1, 1)
+    assert [e.name for e in opened.clerk.entries] == ["Ann"]
+    assert {p.name for p in opened.clerk.roster.players.values()} == {"Ann", "Volunteer 1", "Volunteer 2"}
+
+
+def test_the_projector_counts_students_apart_from_lab_volunteers_and_programs(tmp_path, runs, monkeypatch):
+    """A class of two students who played, one about to, a volunteer who only ran the lab, a lab bot and a game bot:
+    "3 students · 1 in the lab only · 2 programs", not "6 joined"; the teacher's roster names each one's lab runs."""
+    from class_server import tapped_game
+
+    with running_class(tmp_path / "class", lab=str(runs / "short.toml")) as opened:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        members = {}
+        for name in ("Ann", "Bo", "Cy", "Vi", "Lab bot", "Game bot"):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            members[name] = client.join(address, code, name)
+        for i, name in enumerate(("Ann", "Bo")):
+            assert client.hand_in(members[name], tapped_game(i, player=name).to_bytes()).answer is not None
+        client.hand_in(members["Ann"], as_person(runs / "run2.json", "Ann"))  # a student who also ran the lab
+        client.hand_in(members["Vi"], as_person(runs / "run1.json", "Vi"))
+        client.hand_in(members["Lab bot"], dataclasses.replace(Replay.load(runs / "run3.json"),
+                                                               player="Lab bot").to_bytes())
+        bot_game = dataclasses.replace(tapped_game(5), driven="bot", driver="model", player="Game bot")
+        assert client.hand_in(members["Game bot"], bot_game.to_bytes()).answer["list"] == "programs"
+        standings = json.loads(get(opened, "/api/standings"))
+        roster = json.loads(get(opened, "/api/teacher/roster", opened.clerk.roster.secret))
+    assert standings["people"] == {"students": 3, "lab_only": 1, "programs": 2} and standings["joined"] == 6
+    assert roster["people"] == standings["people"] and roster["waiting"] == 1  # Cy: nothing handed in yet
+    names = {n["name"]: (n["games"], n["lab"]) for m in roster["machines"] for n in m["names"]}
+    assert names == {"Ann": (1, ["short"]), "Bo": (1, []), "Cy": (0, []), "Vi": (0, ["short"]),
+                     "Lab bot": (0, ["short"]), "Game bot": (1, [])}

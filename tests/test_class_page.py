@@ -52,11 +52,15 @@ def _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch) -> No
     client.hand_in(client.join(address, code, "Ann"), tapped_game(7, player="Ann").to_bytes())
     monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "cy's machine"))
     client.join(address, code, "Cy")  # joined, no game yet
+    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "the volunteer's machine"))
+    client.hand_in(client.join(address, code, "Vi", lab=True), _lab_run(tmp_path, "Vi"))  # a lab run, no game
     page.goto(f"http://127.0.0.1:{opened.port}/teacher")
     page.wait_for_selector(f"#everyone tr:nth-child({len(HOSTILE) + 1})")
     assert not page.is_visible("#ask-secret") and opened.clerk.roster.secret not in page.content()
     page.wait_for_selector("#machines tr:has-text('Cy'):has-text('joined, no game yet')")
-    assert "have not handed a game in yet" in page.inner_text("#waiting")
+    page.wait_for_selector("#machines tr:has-text('Vi'):has-text('lab: 1 run (short)')")
+    assert page.inner_text("#waiting") == ("5 students, 1 in the lab only joined; 1 name has handed nothing in yet (no "
+                                           "game, no lab run).")
     names = page.eval_on_selector_all("#everyone td:nth-child(2)", "cells => cells.map(c => c.textContent)")
     assert sorted(names) == sorted(["Ann", *HOSTILE]) and page.dialogs == []
     page.click("#everyone tr:has-text('Ann') button")
@@ -65,7 +69,22 @@ def _the_teachers_page(page, opened, address, code, tmp_path, monkeypatch) -> No
     page.fill("#release-name", "ann")
     page.click("#release")
     page.wait_for_selector("#status:has-text('Ann is free')")
-    assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == len(HOSTILE) + 1
+    assert "ann" not in opened.clerk.roster.players and len(opened.clerk.roster.players) == len(HOSTILE) + 2
+
+
+def _lab_run(tmp_path, name: str) -> bytes:
+    """A short lab run (the adapting bot's, relabelled as a person's, as a volunteer's at the keys)."""
+    import dataclasses
+
+    from armgame.cli import main
+    from armgame.records.replay import Replay
+
+    protocol = tmp_path / "short.toml"
+    protocol.write_text('name = "short"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
+                        'perturbation = "curl"\nb = 10.0\n')
+    assert main(["lab", str(protocol), "--bot", "adaptive", "--headless", "--record", str(tmp_path / "run.json")]) == 0
+    replay = Replay.load(tmp_path / "run.json")
+    return dataclasses.replace(replay, driven="keyboard", driver=None, player=name).to_bytes()
 
 
 @pytest.mark.slow
@@ -88,3 +107,46 @@ def test_the_class_screenshot_script_draws_every_class_picture(tmp_path, monkeyp
     drawn = sorted(p.name for p in (tmp_path / "img").iterdir())
     assert drawn == sorted(script.PICTURES) == sorted(p.name for p in (docs / "img").glob("class_*.png"))
     assert all((tmp_path / "img" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for name in drawn)
+
+
+def _columns(page) -> list[tuple[str, str | None, float]]:
+    """Every student row the projector shows: its name, its count of games (None: not shown), and the name's room
+    in ems of its text."""
+    return [tuple(row) for row in page.eval_on_selector_all(
+        "#students tr", "rows => rows.map(r => { const name = r.querySelector('td.name');"
+        " const games = r.querySelector('td.games');"
+        " return [name.textContent, games ? games.textContent : null,"
+        " name.getBoundingClientRect().width / parseFloat(getComputedStyle(name).fontSize)]; })")]
+
+
+@pytest.mark.slow  # in chromium
+def test_the_projector_keeps_each_students_count_of_games_in_every_column(tmp_path, monkeypatch):
+    """docs/teaching.md: the projector "shows each student once, at their best game, with how many they played".
+    At 1024x768 thirty students take two columns and sixty two pages of them: every row keeps its count of games,
+    its text at 19 px or more and room for a name. The facts count the students apart from the programs."""
+    monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "machine"))
+    with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        code = opened.clerk.roster.code
+        page.goto(f"http://127.0.0.1:{opened.port}/")
+        page.wait_for_selector("body[data-version]", state="attached")
+        played: dict[str, int] = {}
+        for students in (30, 60):
+            while len(played) < students:
+                member = client.join(address, code, f"Student {len(played) + 1}")
+                played[member.name] = 1 + len(played) % 3  # one, two or three games each
+                for game in range(played[member.name]):
+                    client.hand_in(member, tapped_game(3 * len(played) + game, player=member.name).to_bytes())
+            page.wait_for_selector(f"#people:has-text('{students} students')")
+            page.wait_for_timeout(200)
+            rows = _columns(page)
+            assert page.get_attribute("#students", "data-columns") == "2", students
+            assert page.get_attribute("#students", "data-pages") == ("1" if students == 30 else "2")
+            assert len(rows) == 30 or students == 60  # sixty: the page with the last arrival
+            assert [games for _, games, _ in rows] == [f"{played[name]} game" + "s" * (played[name] > 1)
+                                                        for name, _, _ in rows]
+            assert min(room for _, _, room in rows) >= 5.5, rows  # "Student 12" whole at any size
+            sizes = page.eval_on_selector_all("#students td", "els => els.map(e => parseFloat(getComputedStyle(e)"
+                                              ".fontSize))")
+            assert min(sizes) >= 19 and page.evaluate("document.documentElement.scrollWidth <= window.innerWidth")
+            page.screenshot(path=str(tmp_path / f"class-{students}.png"))

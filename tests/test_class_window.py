@@ -137,6 +137,9 @@ def test_waiting_and_a_new_arrival_said_for_a_few_seconds():
     (json.dumps({**answer(), "closed": "no"}).encode(), "'closed'"),
     (json.dumps({**answer(), "seed": True}).encode(), "'seed'"),
     (json.dumps({**answer(), "joined": 10**30}).encode(), "'joined'"),
+    (json.dumps({**answer(), "people": [30, 2, 3]}).encode(), "'people'"),
+    (json.dumps({**answer(), "people": {"students": 30, "lab_only": "2", "programs": 3}}).encode(),
+     "'people' lab_only"),
     (json.dumps({**answer(), "students": {"a": 1}}).encode(), "'students' is not a list"),
     (json.dumps({**answer(), "programs": [7]}).encode(), "a row of 'programs'"),
     (json.dumps({**answer(), "students": [{"rank": 1, "name": ["x"], "score": 1, "games": 1}]}).encode(), "a name"),
@@ -236,7 +239,7 @@ def test_class_show_against_a_real_class(tmp_path, monkeypatch):
         assert show_class(address, Settings(size=(1024, 768)), max_frames=500, screenshot=shot) == 0
     assert len(seen) == 2 and shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     texts = [lab.text for lab in seen[0].labels]
-    assert code in texts and "2 joined · 2 games · seed 10" in texts
+    assert code in texts and "2 students · 2 games · seed 10" in texts
     rows = {lab.rect.top: lab.text for lab in seen[0].labels if lab.role == "rank"}
     ranks = {lab.text: rows[lab.rect.top] for lab in seen[0].labels if lab.role == "name"}
     assert ranks == {"Ann": "1.", "<script>alert(1)</script>": "2."}  # the longer game, the better score
@@ -263,3 +266,12 @@ def test_right_to_left_names_read_in_their_order():
         assert pygame.image.tobytes(font.render(run, True, (0, 0, 0), (255, 255, 255)), "RGB") == \
             pygame.image.tobytes(ltr.render(run[::-1], True, (0, 0, 0), (255, 255, 255)), "RGB")
     assert r.text_size("שלום", 30) == (ltr.size(run)[0], r.font(30).get_height())
+
+
+def test_the_facts_count_students_apart_from_the_labs_volunteers_and_the_programs():
+    w = window(answer(students=30, programs=3, closed=False, people={"students": 30, "lab_only": 2, "programs": 3}))
+    facts = [lab.text for lab in w.layout((1024, 768)).labels if lab.role == "facts"]
+    assert facts == ["30 students · 2 in the lab only · 3 programs · 60 games · seed 10"]
+    w = window(answer(students=1, programs=0, closed=False, people={"students": 1, "lab_only": 0, "programs": 0}))
+    facts = [lab.text for lab in w.layout((1024, 768)).labels if lab.role == "facts"]
+    assert facts == ["1 student · 2 games · seed 10"]

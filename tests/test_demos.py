@@ -4,6 +4,7 @@ import csv
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -161,6 +162,33 @@ def test_torque_split_sums_to_inverse_dynamics(gravity):
     # The tutorial's reading: C_1 holds only elbow velocity, C_2 only shoulder velocity.
     assert np.all(torque_split(arm, q, qd * [1, 0], qdd)["coriolis_centrifugal"][:, 0] == 0)
     assert np.all(torque_split(arm, q, qd * [0, 1], qdd)["coriolis_centrifugal"][:, 1] == 0)
+
+
+DEMOS_PAGE = Path(__file__).resolve().parent.parent / "docs" / "demos.md"
+
+
+def test_the_interaction_demo_moves_within_a_second_at_the_lessons_quarter_speed():
+    """docs/teaching.md projects `armgame demo interaction --speed 0.25`: a wall second is 0.25 s of the demo's. The
+    hand is on its way from the first steps and halfway by then (it once rested 0.4 s first: 1.6 s of a still arm
+    on the projector), and the cycle still rests at the target and at home between the moves."""
+    from armgame.demos.catalog import get_info, make_run
+
+    run = make_run("interaction")
+    start = run.arm_points(*run.states[0][:2])[-1]
+    moved = []
+    for _ in range(250):
+        run.step()
+        moved.append(math.dist(start, run.arm_points(*run.states[0][:2])[-1]))
+    assert moved[99] > 0.01 and moved[-1] > 0.15  # 1 cm by 0.1 s (0.4 s of wall time), 15 cm by 0.25 s
+    plan = run.plan
+    speed = np.hypot(*run.table.hand_velocity.T)
+    rests = speed < 1e-9
+    assert rests[round((plan.move_time + plan.rest / 2) / run.dt)] and rests[-1]  # at the target, then at home
+    assert plan.cycle == pytest.approx(2.6) == get_info("interaction").duration  # one cycle, as before
+    # docs/demos.md's cycle: out 0.5 s, 0.4 s at the target, back, 1.2 s at home
+    assert (plan.move_time, plan.rest, plan.cycle - 2 * plan.move_time - plan.rest) == pytest.approx((0.5, 0.4, 1.2))
+    assert "Each 2.6 s cycle starts with the reach out (0.5 s), rests 0.4 s at the target, comes back and rests " \
+           "1.2 s at home" in " ".join(DEMOS_PAGE.read_text(encoding="utf-8").split())
 
 
 def test_minimum_jerk_reach_is_consistent():

@@ -23,7 +23,7 @@ Every request is hostile until checked, and what it can cost is bounded before a
   (and the queued bodies under ``QUEUE_BYTES``) whatever arrives;
 * changes go to one worker thread (the ``Clerk``'s, ``worker``), never the event loop; at most ``QUEUE_LIMIT``
   jobs and ``HANDIN_QUEUE`` hand-ins wait for it, one hand-in a player (``TOKEN_SHARE``, checked
-  before the body is read, with the token and a closed class), and past that a client is told to
+  before the body is read, with the token), and past that a client is told to
   come back (503 with Retry-After): its replay stays on its machine, and the client hands it in again;
 * a hand-in is answered only after the clerk has written it durably (fsynced file and folder);
 * the projector's event stream sends the latest standings, never a backlog, to at most
@@ -271,7 +271,9 @@ async def join(request: Request) -> Response:
                                     f"name a student; ask the teacher if you need another")
         if state.class_joins.full("class"):
             raise RefusedError(503, "many names are joining at once: try again in a moment")
-    player, new_token = await state.run(lambda: clerk.join(body.get("name"), token, address))
+    # A join for the lab says so (``armgame lab --join``): a closed class still takes it (``Clerk.join``).
+    lab = body.get("for") == "lab"
+    player, new_token = await state.run(lambda: clerk.join(body.get("name"), token, address, lab=lab))
     if new_token is not None and not own:
         state.joins.add(address)
         state.class_joins.add("class")

@@ -255,10 +255,11 @@ def _remember(m: Membership) -> None:
                        "class memberships", private=True)  # the tokens prove the names: the owner's alone
 
 
-def join(address: ClassAddress, code: str, name: str | None) -> Membership:
+def join(address: ClassAddress, code: str, name: str | None, lab: bool = False) -> Membership:
     """Join the class (or rejoin: the token kept from the last time proves the name is this machine's).
 
-    ``name`` None: the name this machine joined under last time. Raises UnreachableError or RefusalError."""
+    ``name`` None: the name this machine joined under last time. ``lab``: the join says it is for the lab,
+    which a closed class still takes (the teacher's volunteers). Raises UnreachableError or RefusalError."""
     from ..records.standings import player_key
     from ..valid import check_name
 
@@ -273,7 +274,8 @@ def join(address: ClassAddress, code: str, name: str | None) -> Membership:
     except ValueError as exc:
         raise UserError(str(exc)) from None
     token = known["token"] if known is not None and player_key(known["name"]) == player_key(name) else None
-    body = json.dumps({"code": code, "name": name, **({"token": token} if token else {})}).encode()
+    body = json.dumps({"code": code, "name": name, **({"token": token} if token else {}),
+                       **({"for": "lab"} if lab else {})}).encode()
     answer = _request(address, "/api/join", body, {"Content-Type": "application/json"})
     try:
         membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]),

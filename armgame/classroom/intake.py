@@ -61,7 +61,9 @@ MAX_HANDIN_BYTES = 4 * 1024 * 1024
 MAX_HANDIN_WORK = 1_500_000
 NOT_JOINED = ("this machine has not joined the class under that name: join first "
               "(armgame play --join HOST:PORT --code CODE --name NAME)")
-CLOSED = "the class is closed: no more games are taken (your replay stays on your machine)"
+CLOSED = "the class is closed to new games: this game is not taken (your replay stays on your machine)"
+#: A new name refused by a closed class (a join for a game: the lab's volunteers still join, ``Clerk.join``).
+CLOSED_TO_PLAYERS = "the class is closed to new games, so it takes no new players (the teacher can open it again)"
 #: Forged games whose re-simulated result is kept (by identity), so one sent again is not played again:
 #: a result is about 200 bytes.
 REMEMBERED_FORGERIES = 4096
@@ -176,10 +178,15 @@ class Clerk:
                             stale.unlink()
 
     # ------------------------------------------------------------------ joining
-    def join(self, name: object, token: str | None, address: str = "") -> tuple[Player, str | None]:
+    def join(self, name: object, token: str | None, address: str = "",
+             lab: bool = False) -> tuple[Player, str | None]:
         """The player ``name`` for this client: (player, a new token) for a new name, (player, None)
         when ``token`` proves the name is already theirs. RefusedError if another client holds the name
-        or one a reader would take it for, if the name hides part of itself, or if the roster is locked."""
+        or one a reader would take it for, if the name hides part of itself, or if the roster is locked.
+
+        ``lab``: the join says it is for the lab (``armgame lab --join``). A closed class is closed to new
+        games, and the teacher's lab is not one: its volunteers join a closed class (their games stay refused,
+        ``_read``). A locked list is the teacher's "nobody new", and refuses them like any new name."""
         try:
             name = check_name(name)
         except ValueError as exc:
@@ -202,8 +209,8 @@ class Clerk:
         if alike is not None:
             raise RefusedError(409, f"that name reads like {alike.name}, who is in this class already: choose a name "
                                f"nobody could mistake for a classmate's")
-        if self.roster.closed:
-            raise RefusedError(403, "the class is closed to new players")
+        if self.roster.closed and not lab:
+            raise RefusedError(403, CLOSED_TO_PLAYERS)
         if self.roster.locked:
             raise RefusedError(403, "the class takes no new names now (the teacher locked the list): ask the teacher")
         if len(self.roster.players) >= MAX_PLAYERS:
@@ -276,16 +283,17 @@ class Clerk:
         return [judged[id(o)] if isinstance(o, _Pending) else o for o in outcomes]
 
     def _read(self, token: str | None, data: bytes) -> Checked | _Pending:
-        """One hand-in up to its verification: the checks that cost nothing first (the token, a closed
-        class), then the replay read once, its work bounded, its rules and seed, its identity computed once
-        and looked up; a lab run is kept here (its own verification). Raises RefusedError."""
+        """One hand-in up to its verification: the token first (it costs nothing), then the replay read once
+        (a closed class refuses a game, and takes a lab run: the lab is not a new game), its work bounded, its
+        rules and seed, its identity computed once and looked up; a lab run is kept here (its own
+        verification). Raises RefusedError."""
         player = self.player(token)
-        if self.roster.closed:
-            raise RefusedError(403, CLOSED)
         try:
             replay = Replay.from_bytes(data, "the replay")
         except DataFileError as exc:
             raise RefusedError(400, str(exc)) from None
+        if self.roster.closed and replay.task is None:
+            raise RefusedError(403, CLOSED)
         work = replay_work(replay)
         if work > MAX_HANDIN_WORK:
             raise RefusedError(413, f"the replay claims {replay.result.hits} hits in {replay.result.steps} steps, more "
@@ -551,13 +559,15 @@ class Clerk:
     def close(self, closed: bool) -> str:
         self.roster.changed(closed=bool(closed))
         self.version += 1
-        return "the class is closed to new games" if closed else "the class takes games again"
+        return ("the class is closed to new games (the lab's volunteers still join, and their runs count)" if closed
+                else "the class takes games again")
 
     def lock(self, locked: bool) -> str:
-        """No new names (the students already in play on); or new names again."""
+        """No new names (the students already in play on), the lab's volunteers' neither; or new names again."""
         self.roster.changed(locked=bool(locked))
         self.version += 1
-        return "the class takes no new names" if locked else "the class takes new names again"
+        return ("the class takes no new names, not even the lab's volunteers'" if locked
+                else "the class takes new names again")
 
     def choose_lab(self, protocol: object) -> str:
         """The protocol the class curve shows (the teacher's choice; None: none until chosen)."""

@@ -194,8 +194,8 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
         say(f"  browser:        {play_url}   (Chromebooks, tablets: nothing to install)")
         say(f"  projector:      http://{_label(host)}:{port}/?key={roster.projector_key()}   (shows the code; "
             f"the lab's class curve: /lab)")
-        say(f"  teacher only:   http://{_label(host)}:{port}/teacher   (on this laptop: no secret to type; "
-            f"another machine needs the one in {SECRET_NAME})")
+        say(f"  teacher only:   http://{_label(host)}:{port}/teacher   (open it in a browser on this laptop: it asks "
+            f"no secret here; another machine needs the one in {SECRET_NAME})")
         if others:
             say(f"  this machine also answers at {', '.join(others)}, if students are on that network")
         say("  the first time, Windows or macOS may ask to allow incoming connections for Python: allow it on "

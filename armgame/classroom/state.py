@@ -24,7 +24,7 @@ from starlette.requests import Request
 
 from . import views
 from .guard import Guard
-from .intake import CLOSED, Answer, Clerk, RefusedError
+from .intake import Answer, Clerk, RefusedError
 from .roster import token_digest
 from .worker import ClerkThread
 
@@ -217,13 +217,11 @@ class ClassState:
     @contextmanager
     def hand_in_share(self, token: str) -> Iterator[None]:
         """A joined player's hand-in's place (``_check_token`` found the token a player's), taken before its
-        body is read, with the refusals that cost nothing: a closed class (403), a player who already has
-        ``TOKEN_SHARE`` hand-ins waiting or whose last one did not reproduce less than ``COOL_DOWN`` s ago (503:
-        the client hands it in again in a moment). The clerk checks the token and the class again: a name may
-        be released meanwhile."""
+        body is read, with the refusals that cost nothing: a player who already has ``TOKEN_SHARE`` hand-ins
+        waiting or whose last one did not reproduce less than ``COOL_DOWN`` s ago (503: the client hands it in
+        again in a moment). The clerk checks the token again (a name may be released meanwhile) and a closed
+        class, which only the body tells: it refuses a game and takes a lab run."""
         digest = token_digest(token)
-        if self.clerk.roster.closed:
-            raise RefusedError(403, CLOSED)
         if self.shares.get(digest, 0) >= TOKEN_SHARE:
             raise RefusedError(503, BUSY)
         if digest in self.cooling:

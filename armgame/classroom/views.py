@@ -52,11 +52,38 @@ def standings(clerk: Clerk, teacher: bool = False) -> dict[str, object]:
     if arrival is not None and roster.is_hidden(arrival.name):
         arrival = None
     return {"version": clerk.version, "seed": roster.seed, "closed": roster.closed, "rehearsal": clerk.rehearsal,
-            "joined": len(roster.players), "games": len(clerk.entries),
+            "joined": len(roster.players), "people": who_joined(clerk), "games": len(clerk.entries),
             "round": None if teacher else round_shown(clerk),
             "students": rows(False), "programs": rows(True),
             "arrival": None if arrival is None else {"seq": arrival.seq, "name": arrival.name, "score": arrival.score,
                                                      "note": arrival.note, "program": arrival.program}}
+
+
+def who_joined(clerk: Clerk) -> dict[str, int]:
+    """The joined names (``Roster.players``) as the pages count them, so a class of thirty reads as thirty:
+    ``programs``, the names whose every game and lab run says a program played it (``ScoreEntry.program``,
+    docs/scores.md); ``lab_only``, a person's lab run and no person's game (the lesson's volunteers); and
+    ``students``, the rest: a person's game, or nothing handed in yet (a student about to play)."""
+    played = {player_key(row.name) for row in clerk.boards[False].each()}
+    programs = {player_key(row.name) for row in clerk.boards[True].each()}
+    lab_people: set[str] = set()
+    for run in clerk.lab_runs:
+        key = player_key(clerk.shown_name(run.player))
+        (programs if run.program else lab_people).add(key)
+    counts = {"students": 0, "lab_only": 0, "programs": 0}
+    for key in clerk.roster.players:
+        kind = ("students" if key in played else "lab_only" if key in lab_people
+                else "programs" if key in programs else "students")
+        counts[kind] += 1
+    return counts
+
+
+def lab_runs_by_name(clerk: Clerk) -> dict[str, list[str]]:
+    """Each name's lab runs (its ``player_key``), as the protocol each ran, in the order they came."""
+    runs: dict[str, list[str]] = {}
+    for run in clerk.lab_runs:
+        runs.setdefault(player_key(clerk.shown_name(run.player)), []).append(str(run.protocol.name))
+    return runs
 
 
 def round_shown(clerk: Clerk, now: datetime | None = None) -> dict[str, object] | None:
@@ -95,9 +122,9 @@ def lab_curve(clerk: Clerk) -> dict[str, object]:
 
 
 def roster_view(clerk: Clerk) -> dict[str, object]:
-    """For the teacher's page: every joined name with the machine (address) it joined from and its games
-    (0: joined, not played yet), grouped by address, most names first; whether the list is locked, and the
-    class curve's protocol."""
+    """For the teacher's page: every joined name with the machine (address) it joined from, its games (0: joined,
+    not played yet) and its lab runs (the protocol of each), grouped by address, most names first; who joined
+    (``who_joined``); whether the list is locked, and the class curve's protocol."""
     from ..lab.presets import PRESETS
 
     roster = clerk.roster
@@ -105,18 +132,20 @@ def roster_view(clerk: Clerk) -> dict[str, object]:
     for entry in clerk.entries:
         key = player_key(clerk.shown_name(entry.name))
         played[key] = played.get(key, 0) + 1
+    lab = lab_runs_by_name(clerk)
     machines: dict[str, list[dict[str, object]]] = {}
     for key, p in roster.players.items():
         machines.setdefault(p.address or "unknown", []).append(
-            {"name": p.name, "joined": p.joined, "games": played.get(key, 0), "hidden": key in roster.hidden})
+            {"name": p.name, "joined": p.joined, "games": played.get(key, 0), "lab": lab.get(key, []),
+             "hidden": key in roster.hidden})
     groups = [{"address": address, "names": sorted(names, key=lambda n: str(n["joined"]))}
               for address, names in machines.items()]
     groups.sort(key=lambda g: (-len(g["names"]), g["address"]))  # type: ignore[arg-type]
-    lab = roster.lab
-    return {"machines": groups, "joined": len(roster.players),
-            "waiting": sum(1 for k in roster.players if not played.get(k)),
+    chosen = roster.lab
+    return {"machines": groups, "joined": len(roster.players), "people": who_joined(clerk),
+            "waiting": sum(1 for k in roster.players if not played.get(k) and not lab.get(k)),
             "locked": roster.locked, "closed": roster.closed,
-            "lab": lab.get("name") if isinstance(lab, dict) else lab, "presets": list(PRESETS)}
+            "lab": chosen.get("name") if isinstance(chosen, dict) else chosen, "presets": list(PRESETS)}
 
 
 def games_csv(clerk: Clerk) -> str:

@@ -130,11 +130,12 @@ def run_show(args: argparse.Namespace) -> int:
     return show_class(address, settings, fullscreen=args.fullscreen, key=args.key)
 
 
-def join_class(args: argparse.Namespace):
+def join_class(args: argparse.Namespace, lab: bool = False):
     """The class ``--join``/``--code`` name, joined (the outbox handed in first); None without --join.
 
     Sets ``args.name`` to the name joined under. A class that cannot be reached is played offline when
-    this machine joined it before: its games wait in the outbox for the next join."""
+    this machine joined it before: its games wait in the outbox for the next join. ``lab``: joined for the
+    lab, which a closed class takes (its games would be refused, so the outbox waits for it to open)."""
     import sys
 
     from ..classroom import client
@@ -148,7 +149,7 @@ def join_class(args: argparse.Namespace):
         raise UserError("--join needs --code CODE: the class's code, as the projector shows it")
     address = client.ClassAddress.parse(args.join)
     try:
-        membership = client.join(address, args.code, args.name)
+        membership = client.join(address, args.code, args.name, lab=lab)
     except client.UnreachableError as exc:
         membership = client.offline(address, args.code, args.name)
         if membership is None:
@@ -156,13 +157,17 @@ def join_class(args: argparse.Namespace):
         print(f"armgame: {exc}; playing on: your games are kept and handed in the next time you join",
               file=sys.stderr)
     else:
-        if membership.closed:  # before a game that could not be handed in, not after it
+        if membership.closed and not lab:  # before a game that could not be handed in, not after it
             raise UserError(f"the class at {address.label} is closed: it takes no more games (the teacher can open "
                             f"it again)")
         what = f"seed {membership.seed}" + (f"; a rehearsal: {membership.duration:g} s games" if membership.rehearsal
                                              else "")
         print(f"joined the class at {address.label} as {membership.name} ({what})", file=sys.stderr)
-        for line in client.send_outbox(membership):
-            print(line, file=sys.stderr)
+        if membership.closed:  # a kept game would be refused now, and a refusal is final: it waits for the class
+            print("the class is closed to new games: it takes this lab run (games kept on this machine wait until "
+                  "it opens)", file=sys.stderr)
+        else:
+            for line in client.send_outbox(membership):
+                print(line, file=sys.stderr)
     args.name = membership.name
     return membership

@@ -218,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
     _check_outputs(args)
     from .classroom import join_class
 
-    args.membership = join_class(args)  # before the run: a wrong code is said now, not after ten minutes
+    args.membership = join_class(args, lab=True)  # before the run: a wrong code is said now, not after ten minutes
     config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys),
                                          person=not args.bot), str(args.protocol))
     session = LabSession(config, protocol)

@@ -93,7 +93,9 @@ def torque_split(arm: TwoJointArm, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) 
 
 @dataclass(frozen=True)
 class ReachPlan:
-    """Out to ``target`` and back to ``home``, with rests: one cycle that repeats."""
+    """Out to ``target``, a rest, back to ``home`` and a rest three times as long: one cycle that repeats. The cycle
+    starts with the move out, so a projector shows motion from the first frame: at the lesson's quarter speed a
+    rest first would hold the arm still for four times its length."""
 
     home: Point = (-0.2, 0.45)
     target: Point = (0.2, 0.45)
@@ -106,11 +108,11 @@ class ReachPlan:
 
     @property
     def out_starts(self) -> float:
-        return self.rest
+        return 0.0
 
     @property
     def back_starts(self) -> float:
-        return 2.0 * self.rest + self.move_time
+        return self.move_time + self.rest
 
     @property
     def cycle(self) -> float:

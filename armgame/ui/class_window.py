@@ -95,6 +95,17 @@ class Standings:
     programs: tuple[Row, ...]
     arrival: Arrival | None
     join: str
+    #: Who joined as the class counts them (students, lab only, programs: ``classroom.views.who_joined``); None
+    #: from a class before it, which counted only names.
+    people: tuple[int, int, int] | None = None
+
+    def joined_words(self) -> str:
+        """'30 students · 2 in the lab only · 3 programs' (the last two where there are any), or 'N joined'."""
+        if self.people is None:
+            return f"{self.joined} joined"
+        students, lab_only, programs = self.people
+        return " · ".join([plural(students, "student"), *([f"{lab_only} in the lab only"] if lab_only else []),
+                           *([plural(programs, "program")] if programs else [])])
 
 
 def _text(value: object, what: str, limit: int) -> str:
@@ -147,10 +158,15 @@ def parse_standings(data: bytes) -> Standings:
                           _number(arrival.get("score"), "an arrival's score"),
                           "" if note is None else _text(note, "an arrival's note", MAX_WORDS), arrival["program"])
     join = value.get("join") or ""  # null: a window that is not the projector's (no --key) shows no code
+    people = value.get("people")
+    if people is not None:
+        if not isinstance(people, dict):
+            raise ValueError("'people' is not the count of who joined")
+        people = tuple(_number(people.get(k), f"'people' {k}") for k in ("students", "lab_only", "programs"))
     return Standings(_number(value.get("version"), "'version'"), _number(value.get("seed"), "'seed'"), closed,
                      _number(value.get("joined"), "'joined'"), _number(value.get("games"), "'games'"),
                      _rows(value.get("students"), "'students'"), _rows(value.get("programs"), "'programs'"),
-                     arrival, _text(join, "'join'", MAX_JOIN))
+                     arrival, _text(join, "'join'", MAX_JOIN), people)
 
 
 def _reason(exc: BaseException) -> str:
@@ -419,11 +435,11 @@ class ClassWindow:
         return y - gap // 2
 
     def _facts(self, lay: ClassLayout, s: Standings, height: int, y: int, pad: int, gap: int) -> int:
-        """'N joined · M games · seed S', and CLOSED beside it (below, if the window is narrow)."""
+        """'N students · M games · seed S', and CLOSED beside it (below, if the window is narrow)."""
         r, p = self.renderer, self.palette
         w = lay.size[0]
         width = w - 2 * pad
-        facts = f"{s.joined} joined · {plural(s.games, 'game')} · seed {s.seed}"
+        facts = f"{s.joined_words()} · {plural(s.games, 'game')} · seed {s.seed}"
         closed = "CLOSED: no more games" if s.closed else ""
         sep = " · "
         fw = r.text_size(facts, height)[0]

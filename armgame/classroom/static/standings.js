@@ -15,9 +15,10 @@ function gamesText(n) { return n === 1 ? "1 game" : n + " games"; }
 
 // Seconds each page of students stays up when a class does not fit the projector at once.
 const PAGE_SECONDS = 8;
-// The smallest text the students' rows take (px), and a column's narrowest width (in that text's ems).
+// The smallest text the students' rows take (px), and a column's narrowest width (in that text's ems): the rank,
+// the score and the count of games (about 10 em) and room for a name.
 const MIN_TEXT = 19;
-const COLUMN_EMS = 13;
+const COLUMN_EMS = 17;
 let page = 0;
 let pageTimer = null;
 
@@ -107,7 +108,7 @@ function fillStudents(container, rows, fresh) {
   grid.style.setProperty("--columns", String(columns));
   for (let c = 0; c < columns; c++) {
     const part = shown.slice(c * perColumn, (c + 1) * perColumn);
-    if (part.length > 0) grid.appendChild(table(part, false, fresh, columns === 1));
+    if (part.length > 0) grid.appendChild(table(part, false, fresh, true));  // each student's games, in any column
   }
   container.appendChild(grid);
   container.dataset.pages = String(pages);
@@ -121,6 +122,20 @@ function fillStudents(container, rows, fresh) {
     pageTimer = setTimeout(() => { page += 1; if (latest) fillStudents(container, latest.students, null); },
       PAGE_SECONDS * 1000);
   }
+}
+
+// Who joined, as the class counts them (views.who_joined): the students, then the names that only ran the lab
+// (the lesson's volunteers) and the programs where there are any, so a class of thirty reads as thirty.
+function showPeople(box, people) {
+  const parts = [[people.students, people.students === 1 ? "student" : "students"]];
+  if (people.lab_only) parts.push([people.lab_only, "in the lab only"]);
+  if (people.programs) parts.push([people.programs, people.programs === 1 ? "program" : "programs"]);
+  box.replaceChildren();
+  parts.forEach(([n, words], i) => {
+    const b = document.createElement("b");
+    b.textContent = String(n);
+    box.append(i ? " \u00b7 " : "", b, " " + words);
+  });
 }
 
 function showJoin(line) {
@@ -228,7 +243,7 @@ function render(s) {
   // anyone on the network opens shows the standings without the code.
   showJoin(s.join || "armgame play --join \u2026 (the code is on the teacher's projector)");
   showPlay(s.play);
-  document.getElementById("joined").textContent = String(s.joined);
+  showPeople(document.getElementById("people"), s.people || {students: s.joined});
   document.getElementById("games").textContent = String(s.games);
   document.getElementById("seed").textContent = String(s.seed);
   document.getElementById("closed").hidden = !s.closed;

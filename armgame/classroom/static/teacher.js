@@ -58,10 +58,30 @@ function button(text, action) {
   return b;
 }
 
+// Who joined, as the projector counts them (views.who_joined): students, the lab's volunteers, programs.
+function joinedWords(people) {
+  const words = [people.students + (people.students === 1 ? " student" : " students")];
+  if (people.lab_only) words.push(people.lab_only + " in the lab only");
+  if (people.programs) words.push(people.programs + (people.programs === 1 ? " program" : " programs"));
+  return words.join(", ") + " joined";
+}
+
+// What a name has handed in: its games and its lab runs (a volunteer's run is not "no game yet").
+function handedIn(n) {
+  const parts = [];
+  if (n.games > 0) parts.push(n.games === 1 ? "1 game" : n.games + " games");
+  if (n.lab.length > 0) {
+    parts.push("lab: " + (n.lab.length === 1 ? "1 run" : n.lab.length + " runs") + " (" +
+      [...new Set(n.lab)].join(", ") + ")");
+  }
+  return parts.length ? parts.join("; ") : "joined, no game yet";
+}
+
 function machines(view) {
   const box = $("machines");
   box.replaceChildren();
-  $("waiting").textContent = view.joined + " joined; " + view.waiting + " of them have not handed a game in yet.";
+  $("waiting").textContent = joinedWords(view.people) + "; " + view.waiting +
+    (view.waiting === 1 ? " name has" : " names have") + " handed nothing in yet (no game, no lab run).";
   $("list-state").textContent = view.locked ? "The list is locked: no new names." : "New names can join.";
   const select = $("lab-protocol");
   if (select.options.length === 0) {
@@ -95,8 +115,7 @@ function machines(view) {
     const table = document.createElement("table");
     for (const n of m.names) {
       const tr = document.createElement("tr");
-      const games = n.games === 0 ? "joined, no game yet" : (n.games === 1 ? "1 game" : n.games + " games");
-      for (const text of [n.name, games, n.hidden ? "hidden on the projector" : "shown"]) {
+      for (const text of [n.name, handedIn(n), n.hidden ? "hidden on the projector" : "shown"]) {
         const td = document.createElement("td");
         td.textContent = text;
         tr.appendChild(td);
@@ -120,7 +139,8 @@ async function refresh() {
     table.replaceChildren();
     for (const r of s.students) row(table, r, "student");
     for (const r of s.programs) row(table, r, "program");
-    say(s.closed ? "The class is closed to new games." : "The class takes games.");
+    say(s.closed ? "The class is closed to new games; the lab's volunteers still join, and their runs count."
+      : "The class takes games.");
   } catch (e) {
     $("controls").hidden = true;
     $("ask-secret").hidden = false;
