@@ -90,7 +90,25 @@ def _check(page, size: tuple[int, int], phase: str) -> dict:
         for c in controls:
             assert not _overlap(reach, c["box"]), f"{where}: {c['name']!r} lies over the arm's reach"
         assert not _overlap(reach, look["status"]), f"{where}: the status line lies over the arm's reach"
+        _arranged(look, size, {c["name"]: c["box"] for c in touch}, where)
     return look
+
+
+def _arranged(look, size: tuple[int, int], boxes: dict, where: str) -> None:
+    """The buttons where docs/teaching.md says: the shoulder's (d, f) under the left thumb and the elbow's (j, k)
+    under the right, reset between; down both sides of the game on a phone held sideways, under it otherwise,
+    one row on a tablet."""
+    canvas = look["canvas"]
+    if size[0] > size[1] and size[1] <= 600:  # a phone held sideways
+        assert all(boxes[k][2] <= canvas[0] for k in "df") and all(boxes[k][0] >= canvas[2] for k in "jk"), where
+        return
+    assert all(b[1] >= canvas[3] for b in boxes.values()), f"{where}: a button is not under the game"
+    if size[0] > 600:  # a tablet: one row, d f reset j k
+        order = sorted(boxes, key=lambda k: boxes[k][0])
+        assert order == ["d", "f", "reset", "j", "k"] and len({round(b[1]) for b in boxes.values()}) == 1, where
+    else:  # a phone held upright: the thumbs' columns, reset between them
+        assert max(boxes[k][2] for k in "df") <= boxes["reset"][0] <= boxes["reset"][2] <= min(
+            boxes[k][0] for k in "jk"), where
 
 
 def _debug(page) -> dict:

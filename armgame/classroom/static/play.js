@@ -545,7 +545,10 @@ new ResizeObserver(([entry]) => {
   box = { w: css.inlineSize, h: css.blockSize };
   const w = device ? device.inlineSize : Math.round(box.w * dpr), h = device ? device.blockSize : Math.round(box.h * dpr);
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; backgroundKey = ""; }
-  if (game !== null && member !== null) draw();  // before the page is painted: a resized canvas is never blank
+  if (game !== null && member !== null) { draw(); return; }  // before the page is painted: never blank
+  ctx.setTransform(1, 0, 0, 1, 0, 0);  // no game yet (the join form over it): the window's colour, not black
+  ctx.fillStyle = PALETTE.window;
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
 }).observe(canvas);
 
 function draw() {
