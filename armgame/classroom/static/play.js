@@ -471,19 +471,19 @@ function clockText(seconds) {
 }
 
 function layout(w, h) {
+  // The canvas is its own cell: the buttons and the status line have cells of their own (play.css).
   const u = Math.min(w, h) / 720;
   const pad = Math.max(6, Math.round(16 * u)), gap = Math.max(4, Math.round(8 * u));
   const { small, normal, big } = textSizes(w, h);
-  const hh = h;  // the canvas is its own cell: the buttons and the status line have cells of their own (play.css)
-  const landscape = w >= 1.15 * hh;
+  const landscape = w >= 1.15 * h;
   let hud, scene;
   if (landscape) {
     const needed = width("Time 00.0", big, true) + 2 * pad;
-    const side = Math.min(Math.max(Math.round(w * 0.27), 200, needed), Math.max(480, needed), w - Math.round(hh * 0.55));
-    hud = { x: pad, y: pad, w: side - 2 * pad, h: hh - 2 * pad };
-    scene = { x: side, y: pad, w: w - side - pad, h: hh - 2 * pad };
+    const side = Math.min(Math.max(Math.round(w * 0.27), 200, needed), Math.max(480, needed), w - Math.round(h * 0.55));
+    hud = { x: pad, y: pad, w: side - 2 * pad, h: h - 2 * pad };
+    scene = { x: side, y: pad, w: w - side - pad, h: h - 2 * pad };
   } else {
-    hud = { x: pad, y: pad, w: w - 2 * pad, h: hh - 2 * pad };
+    hud = { x: pad, y: pad, w: w - 2 * pad, h: h - 2 * pad };
     scene = { x: pad, y: 0, w: w - 2 * pad, h: 0 };
   }
   return { w, h, u, pad, gap, small, normal, big, landscape, hud, scene };
@@ -539,17 +539,20 @@ function drawBackground(lay, view, sx, sy) {
 
 // The canvas's box (CSS px), as play.css's grid sizes its cell; its bitmap follows it in device pixels.
 let box = { w: 0, h: 0 };
-new ResizeObserver(([entry]) => {
-  const css = entry.contentBoxSize[0], device = entry.devicePixelContentBoxSize?.[0];
+const resized = new ResizeObserver(([entry]) => {
+  const device = entry.devicePixelContentBoxSize?.[0];
   const dpr = window.devicePixelRatio || 1;
-  box = { w: css.inlineSize, h: css.blockSize };
+  box = { w: entry.contentRect.width, h: entry.contentRect.height };
   const w = device ? device.inlineSize : Math.round(box.w * dpr), h = device ? device.blockSize : Math.round(box.h * dpr);
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; backgroundKey = ""; }
   if (game !== null && member !== null) { draw(); return; }  // before the page is painted: never blank
   ctx.setTransform(1, 0, 0, 1, 0, 0);  // no game yet (the join form over it): the window's colour, not black
   ctx.fillStyle = PALETTE.window;
   ctx.fillRect(0, 0, canvas.width, canvas.height);
-}).observe(canvas);
+});
+// Its device pixels watched too, where the browser can (a window moved to a screen of another density); Safari
+// watches the CSS box only.
+try { resized.observe(canvas, { box: "device-pixel-content-box" }); } catch { resized.observe(canvas); }
 
 function draw() {
   const { w, h } = box;
