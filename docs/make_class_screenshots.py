@@ -1,6 +1,7 @@
 """Draw the live class's pages as a projector shows them: docs/img/class_page.png (thirty students) and
-class_lab.png, and a round's end, class_round.png; and the browser game (/play) as a student's laptop shows
-it, mid-game and at its end: class_play.png, class_play_end.png.
+class_lab.png, and a round's end, class_round.png; the browser game (/play) as a student's laptop shows
+it, mid-game and at its end: class_play.png, class_play_end.png; and mid-game on a phone and a tablet, played
+with fingers on the touch buttons: class_play_phone.png (390x844), class_play_tablet.png (820x1180).
 
     python docs/make_class_screenshots.py             # writes docs/img/class_*.png
     python docs/make_class_screenshots.py --out DIR   # somewhere else, at 1024x768 and 1920x1080 both
@@ -24,7 +25,7 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 
 from browser import FLAGS, chromium_path  # noqa: E402
 from class_server import keyboard_game, running_class  # noqa: E402
-from play_page import join, open_page, play_keys, run_for, to_the_end  # noqa: E402
+from play_page import PATTERN, join, open_page, play_keys, run_for, to_the_end  # noqa: E402
 
 from armgame.classroom import client  # noqa: E402
 from armgame.cli import main  # noqa: E402
@@ -43,7 +44,10 @@ LAB = "lesson"
 QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "field"\ntrials = 2\n'
              'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')
 #: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
-PICTURES = ("class_page.png", "class_lab.png", "class_round.png", "class_play.png", "class_play_end.png")
+PICTURES = ("class_page.png", "class_lab.png", "class_round.png", "class_play.png", "class_play_end.png",
+            "class_play_phone.png", "class_play_tablet.png")
+#: The touch screens drawn (each once, whatever the laptops' sizes): name, size, student.
+TOUCH = (("class_play_phone.png", (390, 844), "Léa"), ("class_play_tablet.png", (820, 1180), "Sofía"))
 
 
 def curve_protocol(work: Path, quick: bool) -> str:
@@ -95,6 +99,27 @@ def play(browser, opened, size: tuple[int, int], out: Path, suffix: str) -> None
     page.close()
     if errors:
         raise SystemExit(f"the browser game at {size[0]}x{size[1]} logged {errors}")
+
+
+def touch_play(browser, opened, size: tuple[int, int], path: Path, name: str) -> None:
+    """A student on a phone or a tablet joins and plays with fingers on the touch buttons: mid-game, a muscle held."""
+    context = browser.new_context(viewport={"width": size[0], "height": size[1]}, has_touch=True, is_mobile=True)
+    page = context.new_page()
+    errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+    join(page, opened.clerk.roster.code, name)
+    page.dispatch_event("#game", "pointerdown", {"pointerId": 1, "pointerType": "touch"})  # "a tap starts"
+    for finger, (key, hold, rest) in enumerate(PATTERN * 3, start=2):
+        button = "#reset" if key == "space" else f"#touch button[data-key='{key}']"
+        page.dispatch_event(button, "pointerdown", {"pointerId": finger, "pointerType": "touch"})
+        run_for(page, hold or 20)
+        page.dispatch_event(button, "pointerup", {"pointerId": finger, "pointerType": "touch"})
+        run_for(page, rest)
+    page.dispatch_event("#touch button[data-key='j']", "pointerdown", {"pointerId": 99, "pointerType": "touch"})
+    run_for(page, 300)  # the biceps held as the picture is taken: its button, its bar and its belly show it
+    page.screenshot(path=str(path))
+    context.close()
+    if errors:
+        raise SystemExit(f"the browser game at {size[0]}x{size[1]} with touch logged {errors}")
 
 
 def teacher(opened, path: str, body: dict) -> None:
@@ -167,6 +192,9 @@ def main_(argv: list[str] | None = None) -> int:
                 round_end(browser, opened, Path(tmp), (width, height), out, suffix)
                 play(browser, opened, (width, height), out, suffix)
                 print(f"wrote {out / f'class_page{suffix}.png'}, class_lab{suffix}.png and class_play*{suffix}.png")
+            for name, size, student in TOUCH:
+                touch_play(browser, opened, size, out / name, student)
+                print(f"wrote {out / name}")
             browser.close()
     return 0
 

@@ -214,11 +214,7 @@ function newGame() {
   game = new Game(config);
   names = config.muscles.map((m) => m.name);
   keys = game.muscleKeys;
-  touch.querySelectorAll("button.muscle").forEach((b) => {
-    const i = Number(b.dataset.index);
-    b.textContent = keys[i] + " " + names[i].split(" ").pop();
-    b.dataset.key = keys[i];
-  });
+  labelButtons();
   phase = "countdown";
   countdownLeft = COUNTDOWN;
   clock = 0; taken = 0; alpha = 1; hits = []; seenHits = 0; lastTarget = game.target;
@@ -386,12 +382,29 @@ for (const button of touch.querySelectorAll("button")) {
   button.addEventListener("lostpointercapture", fingerUp);
   button.addEventListener("contextmenu", (e) => e.preventDefault());
 }
+// Each muscle's button: its key's letter, large, and its muscle's name under it; reset says what it costs.
+function labelButtons() {
+  touch.querySelectorAll("button.muscle").forEach((b) => {
+    const i = Number(b.dataset.index);
+    const letter = document.createElement("span"), name = document.createElement("span");
+    letter.className = "key"; letter.textContent = keys[i];
+    name.className = "name"; name.textContent = names[i].split(" ").pop();
+    b.replaceChildren(letter, name);
+    b.setAttribute("aria-label", keys[i] + " " + names[i]);
+    b.dataset.key = keys[i];
+  });
+  touch.querySelector("#reset .name").textContent = "-" + config.reset_cost;
+}
+// What the tests read of the page as it is played: the keys held, each muscle's activation, the resets, and the
+// canvas's box as the last resize saw it.
+Object.defineProperty(canvas, "debug", { get: () => ({ phase, held: [...held],
+  activation: game ? game.muscleActivation : [], resets: game ? game.resets : 0, box: [box.w, box.h] }) });
 // A touch anywhere shows the buttons (a laptop with a touch screen too); so does a coarse pointer at load.
 function showTouch() {
   if (!touch.hidden) return;
   touch.hidden = false;
+  document.body.classList.add("touch");  // play.css gives the buttons their cells
   touchMode = true;
-  backgroundKey = "";
 }
 window.addEventListener("pointerdown", (e) => { if (e.pointerType === "touch") showTouch(); }, true);
 canvas.addEventListener("pointerdown", () => { if (phase === "countdown") start(); });
@@ -459,23 +472,30 @@ function clockText(seconds) {
 }
 
 function layout(w, h) {
+  // The canvas is its own cell: the buttons and the status line have cells of their own (play.css).
   const u = Math.min(w, h) / 720;
   const pad = Math.max(6, Math.round(16 * u)), gap = Math.max(4, Math.round(8 * u));
   const { small, normal, big } = textSizes(w, h);
-  const band = touch.hidden ? 0 : Math.round(Math.max(h * 0.17, 64));
-  const hh = h - band;
-  const landscape = w >= 1.15 * hh;
+  const landscape = w >= 1.15 * h;
   let hud, scene;
   if (landscape) {
     const needed = width("Time 00.0", big, true) + 2 * pad;
-    const side = Math.min(Math.max(Math.round(w * 0.27), 200, needed), Math.max(480, needed), w - Math.round(hh * 0.55));
-    hud = { x: pad, y: pad, w: side - 2 * pad, h: hh - 2 * pad };
-    scene = { x: side, y: pad, w: w - side - pad, h: hh - 2 * pad };
+    const side = Math.min(Math.max(Math.round(w * 0.27), 200, needed), Math.max(480, needed), w - Math.round(h * 0.55));
+    hud = { x: pad, y: pad, w: side - 2 * pad, h: h - 2 * pad };
+    scene = { x: side, y: pad, w: w - side - pad, h: h - 2 * pad };
   } else {
-    hud = { x: pad, y: pad, w: w - 2 * pad, h: hh - 2 * pad };
+    hud = { x: pad, y: pad, w: w - 2 * pad, h: h - 2 * pad };
     scene = { x: pad, y: 0, w: w - 2 * pad, h: 0 };
   }
-  return { w, h, u, pad, gap, small, normal, big, band, landscape, hud, scene };
+  return { w, h, u, pad, gap, small, normal, big, landscape, hud, scene };
+}
+
+// The scene shows the arm's whole reach, every target in it, and a margin for the palm and a target's flash at its
+// edge. The game's view (ui/render.py's) runs 0.4 m above the reach, where nothing is drawn, and cuts its bottom.
+const REACH_MARGIN = 0.04;
+function sceneWorld() {
+  const r = config.arm.l1 + config.arm.l2 + REACH_MARGIN;
+  return [-r, r, -r, r];
 }
 
 function viewport(scene, world) {
@@ -493,14 +513,13 @@ function roundRect(x, y, w, h, r, fill, stroke, line) {
 }
 
 // What never moves (the window, the scene, the reachable annulus, the torso): drawn once per size.
-function drawBackground(lay, view) {
-  const dpr = window.devicePixelRatio || 1;
+function drawBackground(lay, view, sx, sy) {
   const off = document.createElement("canvas");
   off.width = canvas.width; off.height = canvas.height;
   const g = off.getContext("2d", { alpha: false });
-  g.scale(dpr, dpr);
   g.fillStyle = PALETTE.window;
-  g.fillRect(0, 0, lay.w, lay.h);
+  g.fillRect(0, 0, off.width, off.height);  // every device pixel, the last row of a fractional box too
+  g.scale(sx, sy);
   const s = lay.scene;
   g.beginPath();
   g.roundRect(s.x, s.y, s.w, s.h, Math.max(4, Math.round(12 * lay.u)));
@@ -519,19 +538,30 @@ function drawBackground(lay, view) {
   return off;
 }
 
-function resize() {
+// The canvas's box (CSS px), as play.css's grid sizes its cell; its bitmap follows it in device pixels.
+let box = { w: 0, h: 0 };
+const resized = new ResizeObserver(([entry]) => {
+  const device = entry.devicePixelContentBoxSize?.[0];
   const dpr = window.devicePixelRatio || 1;
-  const w = Math.round(window.innerWidth * dpr), h = Math.round(window.innerHeight * dpr);
+  box = { w: entry.contentRect.width, h: entry.contentRect.height };
+  const w = device ? device.inlineSize : Math.round(box.w * dpr), h = device ? device.blockSize : Math.round(box.h * dpr);
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; backgroundKey = ""; }
-}
+  if (game !== null && member !== null) { draw(); return; }  // before the page is painted: never blank
+  ctx.setTransform(1, 0, 0, 1, 0, 0);  // no game yet (the join form over it): the window's colour, not black
+  ctx.fillStyle = PALETTE.window;
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
+});
+// Its device pixels watched too, where the browser can (a window moved to a screen of another density); Safari
+// watches the CSS box only.
+try { resized.observe(canvas, { box: "device-pixel-content-box" }); } catch { resized.observe(canvas); }
 
 function draw() {
-  resize();
-  const dpr = window.devicePixelRatio || 1;
-  const w = canvas.width / dpr, h = canvas.height / dpr;
+  const { w, h } = box;
+  if (w < 1 || h < 1) return;
+  const sx = canvas.width / w, sy = canvas.height / h;  // the device pixels a CSS px has, as the bitmap has them
   const lay = layout(w, h);
   const p = PALETTE, { hud, gap, small, normal, big } = lay;
-  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.setTransform(sx, 0, 0, sy, 0, 0);
   ctx.textBaseline = "top";
   ctx.textAlign = "left";
   // The HUD's top: the mode, the score and the clock.
@@ -593,12 +623,15 @@ function draw() {
     labels.push([line, lay.landscape ? hud.x : (w - width(line, small)) / 2, ly, small, p.faint, false]);
   });
   if (!lay.landscape) { lay.scene.y = y; lay.scene.h = Math.max(helpTop - gap - y, 10); }
-  const view = viewport(lay.scene, game.view);
-  const key = [w, h, dpr, lay.scene.x, lay.scene.y, lay.scene.w, lay.scene.h].join(",");
-  if (key !== backgroundKey) { background = drawBackground(lay, view); backgroundKey = key; }
+  const view = viewport(lay.scene, sceneWorld());
+  const key = [w, h, canvas.width, canvas.height, lay.scene.x, lay.scene.y, lay.scene.w, lay.scene.h].join(",");
+  if (key !== backgroundKey) { background = drawBackground(lay, view, sx, sy); backgroundKey = key; }
+  // The reach's outer circle, in CSS px of the canvas's box: the tests hold it inside the screen, clear of the buttons.
+  const reach = (config.arm.l1 + config.arm.l2) * view.scale;
+  canvas.workspace = { x: view.ox - reach, y: view.oy - reach, width: 2 * reach, height: 2 * reach };
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.drawImage(background, 0, 0);
-  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.setTransform(sx, 0, 0, sy, 0, 0);
   // The scene: target, arm, hand, clipped to it.
   const s = lay.scene;
   ctx.save();
