@@ -169,9 +169,17 @@ def test_the_guide_says_what_a_rehearsal_prints_and_plays(places, tmp_path):
     assert quoted in refused
     # The banner's first line and the stop's lines (their counts aside): serve() as the command runs it, stopped as
     # soon as it is ready.
+    # On a thread of its own, as running_class serves: a worker's chromium (tests/browser.py) keeps an event loop
+    # running on the main thread, where asyncio.run cannot start another.
+    import threading
+
     lines: list[str] = []
-    assert serve(None, "127.0.0.1", 0, None, say=lines.append, rehearse=True, on_ready=lambda opened: opened.stop()) \
-        == 0
+    status: list[int] = []
+    thread = threading.Thread(target=lambda: status.append(serve(
+        None, "127.0.0.1", 0, None, say=lines.append, rehearse=True, on_ready=lambda opened: opened.stop())))
+    thread.start()
+    thread.join(30)
+    assert status == [0]
     assert re.fullmatch(re.escape(banner.splitlines()[0]).replace("FROG", "[A-Z]{4}"), lines[0])
     counted = [re.escape(line).replace("4\\ games", r"\d+\ games?").replace("1\\ lab\\ run", r"\d+\ lab\ runs?")
                for line in stopped.splitlines()]
