@@ -129,7 +129,10 @@ def run(args: argparse.Namespace) -> int:
         session = _play_in_window(session, args, window)  # the last game, when Enter played again
         result = session.result()
     _report(session, result, args)
-    return 0
+    _wait_for_hand_ins(args)
+    # A game the class refused is the command's failure, as a refused file is armgame class submit's (exit 1);
+    # a game kept in the outbox is not: it goes in at the next join (exit 0).
+    return 1 if getattr(args, "refused", False) else 0
 
 
 def _join(args: argparse.Namespace):
@@ -149,14 +152,33 @@ def _join(args: argparse.Namespace):
     return membership
 
 
-def _hand_in(replay, membership, out) -> object:
+def _hand_in(replay, membership, args: argparse.Namespace, out=None) -> object:
     """Hand a finished game in to the class; one line on what became of it (kept in the outbox if the
-    class could not be reached)."""
+    class could not be reached), on ``out`` (stdout), or for a refusal on stderr (and ``args.refused``
+    set: the command exits 1). The window's games are handed in on a thread, and say so here too: the
+    terminal's scrollback keeps the record of every game."""
+    import sys
+
     from ..classroom.client import hand_in
 
     result = hand_in(membership, replay.to_bytes())
-    print(result.message, file=out)
+    if result.refused:
+        args.refused = True
+        print(f"armgame play: {result.message}", file=sys.stderr, flush=True)
+    else:
+        print(result.message, file=out or sys.stdout, flush=True)
     return result
+
+
+def _wait_for_hand_ins(args: argparse.Namespace) -> None:
+    """The window closed with a game still on its way to the class: wait for its answer (bounded by the
+    client's patience with a busy class), so the game is not cut off with the process and its line is
+    printed."""
+    waiting = [t for t in getattr(args, "handing_in", ()) if t.is_alive()]
+    if waiting:
+        print("handing your last game in to the class...", flush=True)
+    for thread in waiting:
+        thread.join()
 
 
 def _report(session, result, args: argparse.Namespace) -> None:
@@ -250,7 +272,7 @@ def _keep(session, args: argparse.Namespace):
         print("no key was pressed in this game: nothing saved for --record", file=out)
     membership = getattr(args, "membership", None)
     if membership is not None and replay.complete:
-        _hand_in(replay, membership, out)
+        _hand_in(replay, membership, args, out)
         return None
     if args.name is None or not replay.complete or membership is not None:
         if membership is not None:
@@ -419,16 +441,16 @@ def _class_standing(session, args: argparse.Namespace, membership):
                 print(f"armgame play: error: {exc}", file=sys.stderr)
         saved = _saved_line(args)
         done: list = []
-        thread = threading.Thread(target=lambda: done.append(_quiet_hand_in(replay, membership)), daemon=True)
+        thread = threading.Thread(target=lambda: done.append(_hand_in(replay, membership, args)), daemon=True)
         thread.start()
+        args.handing_in = [*(t for t in getattr(args, "handing_in", ()) if t.is_alive()), thread]
 
         def later() -> Standing | None:
             if not done:
                 return None
             result = done[0]
             answer = result.answer
-            if result.kept is not None:  # the whole reason goes to the terminal; the screen says what matters
-                print(f"armgame play: {result.message}", file=sys.stderr)
+            if result.kept is not None:  # the whole reason went to the terminal; the screen says what matters
                 return Standing(None, 0, (), "the class", note="Not handed in: the class cannot be reached.\n"
                                 "Your game is kept: it goes in the next time you join", saved=saved)
             if answer is None:
@@ -441,12 +463,6 @@ def _class_standing(session, args: argparse.Namespace, membership):
         return Standing(None, 0, (), "the class", note="Handing your game in...", later=later, saved=saved)
 
     return standing
-
-
-def _quiet_hand_in(replay, membership):
-    from ..classroom.client import hand_in
-
-    return hand_in(membership, replay.to_bytes())
 
 
 def _screen_line(message: str) -> str:
