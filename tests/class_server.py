@@ -45,12 +45,18 @@ def _bot_timeline(seed: int) -> tuple[InputEvent, ...]:
 def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, driven: str = "keyboard") -> Replay:
     """A whole standard game whose keys were the model bot's for its first ``seconds`` and then none: the
     longer, the higher the score, and each length another game. Cheap: the bot plays once per seed."""
+    session = keyboard_session(seconds, seed)
+    return Replay.from_session(session, driven, None if driven == "keyboard" else "test", player)
+
+
+def keyboard_session(seconds: float, seed: int = 10) -> GameSession:
+    """``keyboard_game``'s game as the session that played it (for the end screen's callbacks)."""
     session = GameSession(GameConfig(seed=seed))
     last = round(seconds / session.config.dt)
     events = [e for e in _bot_timeline(seed) if e.step < last]
     events += [InputEvent(last, m.key, UP) for m in session.config.muscles]  # whatever was held, let go
     session.play(events)
-    return Replay.from_session(session, driven, None if driven == "keyboard" else "test", player)
+    return session
 
 
 def tapped_game(n: int, seed: int = 10, player: str | None = None) -> Replay:

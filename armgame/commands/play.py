@@ -377,19 +377,27 @@ def _table_of_list(session, args: argparse.Namespace, entry=None):
     return table, one_row_per_player(table.of_list(kind, everything)), kind
 
 
-def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[int, str, int], ...]:
-    """The top 10 as (rank, name, score), and the player's own row after them if it ranks lower."""
-    rows = [(i, name, score) for i, (name, score) in enumerate(ranked[:10], 1)]
-    if own is not None and own > 10:
-        rows.append((own, *ranked[own - 1]))
-    return tuple(rows)
+def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[tuple[int, str, int], ...], int | None]:
+    """The top 10 as (place, name, score), equal scores sharing a place (``standings.places``), and the
+    player's own row (``own``: its position, 1-based) after them if it is lower; and the index of that row
+    among them, the one row the end screen shows as theirs (None: no row is)."""
+    from ..records.standings import places
+
+    shown = places(score for _, score in ranked)
+    rows = [(shown[i], name, score) for i, (name, score) in enumerate(ranked[:10])]
+    if own is None:
+        return tuple(rows), None
+    if own > 10:
+        rows.append((shown[own - 1], *ranked[own - 1]))
+        return tuple(rows), len(rows) - 1
+    return tuple(rows), own - 1
 
 
 def _standing(session, args: argparse.Namespace):
     """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
     import sys
 
-    from ..records.standings import rank_of
+    from ..records.standings import rank_of, row_of
     from ..ui.render import Standing
 
     membership = getattr(args, "membership", None)
@@ -405,10 +413,10 @@ def _standing(session, args: argparse.Namespace):
         except UserError as exc:
             print(f"armgame play: error: {exc}", file=sys.stderr)
             return None
-        # The player's place, at their best game (maybe an earlier one): "#3" is the third player.
+        # The player's place, at their best game (maybe an earlier one): "#3" is the third place.
         rank = None if entry is None else rank_of(rows, entry.name)
-        return Standing(rank, len(rows), _rows([(r.name, r.best.score) for r in rows], rank), list_name(kind),
-                        saved=_saved_line(args))
+        top, mine = _rows([(r.name, r.best.score) for r in rows], None if entry is None else row_of(rows, entry.name))
+        return Standing(rank, len(rows), top, list_name(kind), saved=_saved_line(args), mine=mine)
 
     return standing
 
@@ -457,8 +465,10 @@ def _class_standing(session, args: argparse.Namespace, membership):
                 return Standing(None, 0, (), "the class", note=_screen_line(result.message), saved=saved)
             top = tuple((int(r), str(n), int(v)) for r, n, v in answer.get("top", ()))
             where = "the class" if answer.get("list") == "students" else "the programs"
+            yours = answer.get("yours")  # which row is the player's: a place may be several rows'
+            mine = yours if isinstance(yours, int) and not isinstance(yours, bool) and 0 <= yours < len(top) else None
             return Standing(int(answer["rank"]), int(answer["of"]), top, where,
-                            note=_screen_line(result.message), saved=saved)
+                            note=_screen_line(result.message), saved=saved, mine=mine)
 
         return Standing(None, 0, (), "the class", note="Handing your game in...", later=later, saved=saved)
 
@@ -485,7 +495,8 @@ def _list_it_would_join(session, args: argparse.Namespace, table) -> str:
 
 def _preview(session, args: argparse.Namespace):
     """The end screen's first look: where the score would rank, before any name is typed, as a new
-    player's (nothing is entered: an equal score already in the table stays ahead, as the earlier game)."""
+    player's (nothing is entered: an equal score already in the table shares the place, its row first, as
+    the earlier game)."""
     import sys
 
     from ..records.standings import place_of_new
@@ -499,10 +510,11 @@ def _preview(session, args: argparse.Namespace):
             print(f"armgame play: {exc}", file=sys.stderr)
             return None
         score = session.rules.board.score
-        rank = place_of_new(rows, score)
         ranked = [(r.name, r.best.score) for r in rows]
-        ranked.insert(rank - 1, ("", score))
-        return Standing(rank, len(ranked), _rows(ranked, rank), list_name(kind), pending=True)
+        position = 1 + sum(1 for _, s in ranked if s >= score)  # after the equal scores, the earlier games
+        ranked.insert(position - 1, ("", score))
+        top, mine = _rows(ranked, position)
+        return Standing(place_of_new(rows, score), len(ranked), top, list_name(kind), pending=True, mine=mine)
 
     return preview
 

@@ -307,9 +307,11 @@ function showEnd(line, kind, data) {
   const table = document.getElementById("end-top");
   table.replaceChildren();
   if (data && Array.isArray(data.top)) {
-    for (const [rank, name, score] of data.top) {
+    // The student's own row is the one the class names (data.yours): equal scores share a place, so the
+    // place alone would mark every row tied with theirs.
+    for (const [i, [rank, name, score]] of data.top.entries()) {
       const row = table.insertRow();
-      if (rank === data.rank) row.className = "mine";
+      if (i === data.yours) row.className = "mine";
       for (const [text, kind] of [[rank + ".", "rank"], [name, "name"], [String(score), "score"]]) {
         const cell = row.insertCell();
         cell.className = kind;
