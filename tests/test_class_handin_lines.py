@@ -73,3 +73,20 @@ def test_each_game_handed_in_from_the_window_prints_its_line_in_the_terminal(tmp
         assert captured.out == "" and captured.err == ("armgame play: not handed in: this game was already handed in "
                                                        "by Ann: a game counts once, whoever hands it in\n")
         assert args.refused and final.note.startswith("Not handed in:")
+
+
+def test_a_window_closed_while_its_game_is_on_the_way_waits_for_the_class(tmp_path, machine, capsys):
+    """Esc on the end screen as it says "Handing your game in...": the command waits for the answer (the hand-in
+    runs on a thread the process would otherwise cut off) and prints its line."""
+    from armgame.commands.play import _wait_for_hand_ins
+
+    machine("ann")
+    with running_class(tmp_path / "class") as opened:
+        ann = client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Ann")
+        session = GameSession(GameConfig(seed=ann.seed))
+        session.play([])
+        args = argparse.Namespace(bot=None)
+        _class_standing(session, args, ann)(None)  # the window closes at once: later() is never asked
+        _wait_for_hand_ins(args)
+        assert len(opened.clerk.entries) == 1
+    assert capsys.readouterr().out.splitlines()[-1] == "handed in: 1st of 1 in the class (your best so far)"
