@@ -73,12 +73,18 @@ def keyboard_game(seconds: float, seed: int = 10, player: str | None = None, dri
     """A whole standard game (on a clock of ``duration`` s: a rehearsal's is 15) whose keys were the model bot's
     for its first ``seconds`` and then none: the longer, the higher the score, and each length another game.
     Cheap: the bot plays once per seed."""
+    session = keyboard_session(seconds, seed, duration)
+    return Replay.from_session(session, driven, None if driven == "keyboard" else "test", player)
+
+
+def keyboard_session(seconds: float, seed: int = 10, duration: float = 60.0) -> GameSession:
+    """``keyboard_game``'s game as the session that played it (for the end screen's callbacks)."""
     session = GameSession(GameConfig(seed=seed, time_limit=duration))
     last = round(seconds / session.config.dt)
     events = [e for e in _bot_timeline(seed) if e.step < last]
     events += [InputEvent(last, m.key, UP) for m in session.config.muscles]  # whatever was held, let go
     session.play(events)
-    return Replay.from_session(session, driven, None if driven == "keyboard" else "test", player)
+    return session
 
 
 def tapped_game(n: int, seed: int = 10, player: str | None = None) -> Replay:

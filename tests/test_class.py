@@ -219,8 +219,8 @@ def test_the_end_screen_says_in_one_line_that_a_game_is_kept_when_the_class_is_a
         time.sleep(0.02)
     assert final.note == ("Not handed in: the class cannot be reached.\nYour game is kept: it goes in the next "
                           "time you join")
-    err = capsys.readouterr().err  # it joined before: the network reached the class, so no Wi-Fi hint
-    assert "the class at 127.0.0.1:1 did not answer" in err and "Wi-Fi" not in err
+    out = capsys.readouterr().out  # it joined before: the network reached the class, so no Wi-Fi hint
+    assert "the class at 127.0.0.1:1 did not answer" in out and "Wi-Fi" not in out
     assert len(list(client.outbox(gone).glob("*.json"))) == 1
 
 

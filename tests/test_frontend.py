@@ -460,7 +460,7 @@ def screens(session, renderer):
     keys = session.muscles.keys
     play_help = (f"{keys[0]}/{keys[1]} shoulder", f"{keys[2]}/{keys[3]} elbow", "space reset (-1)", "tab hide arm",
                  "p pause", "m mute", "F11 fullscreen", "Esc quit")
-    table = Standing(3, 40, tuple((i, "W" * 24, 999) for i in range(1, 11)))
+    table = Standing(3, 40, tuple((i, "W" * 24, 999) for i in range(1, 11)), mine=2)
     return {
         "play": Hud(details=("seed 10",), help=play_help),
         "countdown": Hud(details=("seed 10",), help=play_help, countdown=3),
@@ -475,7 +475,7 @@ def screens(session, renderer):
                               "game's replay is kept)", standing=Standing(3, 40, table.top, "custom games", True)),
         "end": Hud(ended=True, standing=table),
         "end, ranked low": Hud(ended=True, standing=Standing(
-            38, 40, (*table.top, (38, "W" * 24, 0)), "the ranked table")),
+            38, 40, (*table.top, (38, "W" * 24, 0)), "the ranked table", mine=10)),
         "end, no table": Hud(driver="REPLAY", ended=True),
     }
 

@@ -122,8 +122,8 @@ def test_every_rank_a_game_is_told_is_its_players(tmp_path, capsys):
 
     table, entries = class_table(tmp_path / "t")
     bo, cy = entries[6], entries[7]
-    assert table.rank(bo) == 2 and table.rank(cy) == 3 and table.rank(entries[0]) == 1
-    assert where_it_went(table, cy).startswith("#3 in the ranked table")  # third student, eighth game
+    assert table.rank(bo) == 2 and table.rank(cy) == 2 and table.rank(entries[0]) == 1  # Bo and Cy tie at 0
+    assert where_it_went(table, cy).startswith("#2 in the ranked table")  # third student, tied second, eighth game
     # play --name for a student with a game in: their place at their best (Keen's 0 is below their 1).
     assert main(["scores", "--scores", str(table.folder), "--add", str(_saved(tmp_path, "Keen", 20)),
                  "--name", "Keen"]) == 0
@@ -133,10 +133,11 @@ def test_every_rank_a_game_is_told_is_its_players(tmp_path, capsys):
     session = GameSession(game_config(args))
     session.play([InputEvent(14_000 + 30, "f", "down")])
     preview = _preview(session, args)()
-    assert (preview.rank, preview.entries, preview.pending) == (4, 4, True)  # after every 0 already in
-    assert [row[1] for row in preview.top] == ["Keen", "Bo", "Cy", ""]
+    assert (preview.rank, preview.entries, preview.pending) == (2, 4, True)  # tied with every 0 already in
+    assert [row[:2] for row in preview.top] == [(1, "Keen"), (2, "Bo"), (2, "Cy"), (2, "")] and preview.own_row == 3
     standing = _standing(session, args)("Dee")
-    assert (standing.rank, standing.entries) == (4, 4) and [row[1] for row in standing.top][-1] == "Dee"
+    assert (standing.rank, standing.entries) == (2, 4) and [row[1] for row in standing.top][-1] == "Dee"
+    assert standing.mine == 3  # the row that is Dee's, not every row of their place
     keen_again = GameSession(game_config(args))
     keen_again.play([InputEvent(14_000 + 31, "f", "down")])
     standing = _standing(keen_again, args)("keen")  # the same player, however it is typed
@@ -152,7 +153,7 @@ def _saved(tmp_path, player: str, press: int):
 
 def test_a_new_players_place():
     rows = one_row_per_player([_Game("Ann", 5), _Game("Bo", 3), _Game("Ann", 2), _Game("Cy", 3)])
-    assert [place_of_new(rows, s) for s in (6, 5, 4, 3, 0)] == [1, 2, 2, 4, 4]
+    assert [place_of_new(rows, s) for s in (6, 5, 4, 3, 0)] == [1, 1, 2, 2, 4]  # an equal score shares a place
 
 
 class _Game:

@@ -2,8 +2,9 @@
 
 Kept in the user's own folder (``client_folder``)::
 
-    memberships.json          per class (by its code): the name joined under, its token, the class's seed
-                              and its game's clock (a rehearsal's games are 15 s)
+    memberships.json          per class (by its code): every name joined under, each its token; the class's
+                              seed and its game's clock (a rehearsal's games are 15 s) (``memberships``:
+                              bounded, read as hostile, private)
     outbox/<code>/*.json      replays the class could not be reached for, handed in at the next join
 
 A class is known by its code, not its address: the teacher's laptop has another address in
@@ -35,7 +36,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import UserError
-from ..records.storage import DataFileError, atomic_write_bytes, parse_json, read_limited, user_path
+from ..records.storage import DataFileError, atomic_write_bytes, read_limited, user_path
+from . import memberships
 from .intake import MAX_HANDIN_BYTES
 from .roster import CODE_ALPHABET, CODE_LENGTH, normal_code
 
@@ -223,65 +225,54 @@ def _memberships_path() -> Path:
     return client_folder() / "memberships.json"
 
 
-def remembered() -> dict[str, dict[str, str]]:
-    """Every class this machine joined: ``{CODE: {"name", "token", "seed", "address"}}`` (unreadable: none)."""
-    path = _memberships_path()
-    try:
-        data = parse_json(read_limited(path, 1 << 20, "class memberships", follow=False))
-    except (DataFileError, ValueError, OSError):
-        return {}
-    if not isinstance(data, dict):
-        return {}
-    return {k: v for k, v in data.items() if isinstance(k, str) and isinstance(v, dict)
-            and isinstance(v.get("name"), str) and isinstance(v.get("token"), str)}
-
-
 def last_class() -> tuple[str, str, str] | None:
-    """The class this machine joined last, as (address, code, name), for the menu to offer again."""
-    data = remembered()
-    if not data:
+    """The class this machine joined last, as (address, code, name), for the menu to offer again (None: none,
+    or a memberships file that cannot be read: the join itself says why)."""
+    try:
+        classes = memberships.read(_memberships_path())
+    except DataFileError:
         return None
-    code, value = max(data.items(), key=lambda kv: str(kv[1].get("at", "")))
-    return str(value.get("address", "")), code, value["name"]
+    if not classes:
+        return None
+    code, joined = max(classes.items(), key=lambda kv: kv[1].at)
+    return joined.address, code, joined.names[0].name
 
 
 def _remember(m: Membership) -> None:
-    data = remembered()
-    data[m.key] = {"name": m.name, "token": m.token, "seed": str(m.seed), "duration": repr(m.duration),
-                   "address": m.address.label, "at": f"{time.time():.3f}"}
-    folder = client_folder()
-    folder.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(_memberships_path(), json.dumps(data, indent=1, ensure_ascii=False).encode(),
-                       "class memberships", private=True)  # the tokens prove the names: the owner's alone
+    path = _memberships_path()
+    classes = memberships.joined(memberships.read(path), m.code, m.address.label, m.seed, m.name, m.token,
+                                 round(time.time(), 3), m.duration)
+    memberships.write(path, classes)
 
 
 def join(address: ClassAddress, code: str, name: str | None, lab: bool = False) -> Membership:
-    """Join the class (or rejoin: the token kept from the last time proves the name is this machine's).
+    """Join the class (or rejoin: the token kept from the last time this machine joined under the name proves
+    it is this machine's; every name it joined the class under keeps its own).
 
     ``name`` None: the name this machine joined under last time. ``lab``: the join says it is for the lab,
     which a closed class still takes (the teacher's volunteers). Raises UnreachableError or RefusalError."""
-    from ..records.standings import player_key
-    from ..valid import check_name
+    from ..valid import check_name, check_pattern
 
     code = check_code(code)
-    known = remembered().get(code)
+    known = memberships.read(_memberships_path()).get(code)
     if name is None:
         if known is None:
             raise UserError(f"--name is needed: this machine has not joined the class with code {code} before")
-        name = known["name"]
+        name = known.names[0].name
     try:
         name = check_name(name, "--name")
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    token = known["token"] if known is not None and player_key(known["name"]) == player_key(name) else None
-    body = json.dumps({"code": code, "name": name, **({"token": token} if token else {}),
+    mine = known.name(name) if known is not None else None
+    body = json.dumps({"code": code, "name": name, **({"token": mine.token} if mine else {}),
                        **({"for": "lab"} if lab else {})}).encode()
     answer = _request(address, "/api/join", body, {"Content-Type": "application/json"})
     try:
-        membership = Membership(address, code, str(answer["name"]), str(answer["token"]), int(answer["seed"]),
+        membership = Membership(address, code, check_name(answer["name"], "name"),
+                                check_pattern("token", answer["token"], memberships.TOKEN), int(answer["seed"]),
                                 answer.get("closed") is True, _duration(answer.get("duration", 60.0)),
                                 answer.get("rehearsal") is True)
-    except (KeyError, TypeError, ValueError):
+    except (KeyError, TypeError, ValueError):  # what is kept is what a later read takes
         raise BadAnswerError("the class's answer is not armgame's (is that address an armgame class?)") from None
     _remember(membership)
     return membership
@@ -289,17 +280,12 @@ def join(address: ClassAddress, code: str, name: str | None, lab: bool = False) 
 
 def offline(address: ClassAddress, code: str, name: str | None) -> Membership | None:
     """The membership this machine had in the class, to play while it cannot be reached (its games wait
-    in the outbox); None if it never joined under that name."""
-    from ..records.standings import player_key
-
-    known = remembered().get(check_code(code))
-    if known is None or (name is not None and player_key(name) != player_key(known["name"])):
+    in the outbox); None if it never joined under that name (``name`` None: the last name it joined under)."""
+    known = memberships.read(_memberships_path()).get(check_code(code))
+    mine = known.name(name) if known is not None else None
+    if known is None or mine is None:
         return None
-    try:
-        return Membership(address, check_code(code), known["name"], known["token"], int(known.get("seed", "")),
-                          duration=_duration(float(known.get("duration", "60.0"))))
-    except (TypeError, ValueError):
-        return None
+    return Membership(address, check_code(code), mine.name, mine.token, known.seed, duration=known.duration)
 
 
 def _duration(value: object) -> float:

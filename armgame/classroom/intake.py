@@ -418,13 +418,16 @@ class Clerk:
         placed: list[dict[str, object]] = []
         for r in board.rows(10):
             placed.append({"rank": shared_rank(placed, r.best.score), "score": r.best.score, "name": r.name})
-        top = [[p["rank"], p["name"], p["score"]] for i, p in enumerate(placed, 1)
-               if not self.roster.is_hidden(str(p["name"])) or i == position]
+        shown = [(i, p) for i, p in enumerate(placed, 1) if not self.roster.is_hidden(str(p["name"])) or i == position]
+        top = [[p["rank"], p["name"], p["score"]] for _, p in shown]
+        # The player's own row, by its index in top: rows of an equal score share the place, so it cannot say.
+        yours = next((j for j, (i, _) in enumerate(shown) if i == position), len(top))
         if position > 10:
             top.append([rank, row.name, best.score])
         return {"ok": True, "already": already, "name": entry.name, "score": entry.score, "rank": rank,
                 "of": len(board), "best": best.score, "list": "programs" if entry.program else "students",
-                "note": note, "top": top, "message": ("already handed in: " if already else "handed in: ") + line}
+                "note": note, "top": top, "yours": yours,
+                "message": ("already handed in: " if already else "handed in: ") + line}
 
     def _build_boards(self) -> None:
         self.boards = {programs: Board((e for e in self.entries if e.program == programs), self.roster.renamed)

@@ -231,6 +231,7 @@ def replays_page(launch: Callable[[Sequence[str]], int]):
     """The ranked table's top five (as recorded: ``armgame scores`` checks them) and the newest replays."""
     from ..records.replay import Replay
     from ..records.scores import ScoreTable, default_scores_dir
+    from ..records.standings import places
     from ..records.storage import DataFileError
     from ..ui.menu import Item, Page
     from . import read_lab_replays
@@ -242,7 +243,8 @@ def replays_page(launch: Callable[[Sequence[str]], int]):
         table = ScoreTable(default_scores_dir(), warn=warnings.append)
         entries = table.entries()
         lines.append(f"The ranked table ({table.path}):" if entries else f"No ranked scores yet in {table.path}")
-        lines += [f"{i}. {e.name}   {e.score}" for i, e in enumerate(entries[:5], 1)]
+        top = entries[:5]
+        lines += [f"{i}. {e.name}   {e.score}" for i, e in zip(places(e.score for e in top), top, strict=True)]
         folder = table.replays
     except (DataFileError, OSError) as exc:
         lines.append(f"the table cannot be read: {exc}")

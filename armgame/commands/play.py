@@ -129,7 +129,10 @@ def run(args: argparse.Namespace) -> int:
         session = _play_in_window(session, args, window)  # the last game, when Enter played again
         result = session.result()
     _report(session, result, args)
-    return 0
+    _wait_for_hand_ins(args)
+    # A game the class refused is the command's failure, as a refused file is armgame class submit's (exit 1);
+    # a game kept in the outbox is not: it goes in at the next join (exit 0).
+    return 1 if getattr(args, "refused", False) else 0
 
 
 def _join(args: argparse.Namespace):
@@ -152,14 +155,33 @@ def _join(args: argparse.Namespace):
     return membership
 
 
-def _hand_in(replay, membership, out) -> object:
+def _hand_in(replay, membership, args: argparse.Namespace, out=None) -> object:
     """Hand a finished game in to the class; one line on what became of it (kept in the outbox if the
-    class could not be reached)."""
+    class could not be reached), on ``out`` (stdout), or for a refusal on stderr (and ``args.refused``
+    set: the command exits 1). The window's games are handed in on a thread, and say so here too: the
+    terminal's scrollback keeps the record of every game."""
+    import sys
+
     from ..classroom.client import hand_in
 
     result = hand_in(membership, replay.to_bytes())
-    print(result.message, file=out)
+    if result.refused:
+        args.refused = True
+        print(f"armgame play: {result.message}", file=sys.stderr, flush=True)
+    else:
+        print(result.message, file=out or sys.stdout, flush=True)
     return result
+
+
+def _wait_for_hand_ins(args: argparse.Namespace) -> None:
+    """The window closed with a game still on its way to the class: wait for its answer (bounded by the
+    client's patience with a busy class), so the game is not cut off with the process and its line is
+    printed."""
+    waiting = [t for t in getattr(args, "handing_in", ()) if t.is_alive()]
+    if waiting:
+        print("handing your last game in to the class...", flush=True)
+    for thread in waiting:
+        thread.join()
 
 
 def _report(session, result, args: argparse.Namespace) -> None:
@@ -253,7 +275,7 @@ def _keep(session, args: argparse.Namespace):
         print("no key was pressed in this game: nothing saved for --record", file=out)
     membership = getattr(args, "membership", None)
     if membership is not None and replay.complete:
-        _hand_in(replay, membership, out)
+        _hand_in(replay, membership, args, out)
         return None
     if args.name is None or not replay.complete or membership is not None:
         if membership is not None:
@@ -358,19 +380,27 @@ def _table_of_list(session, args: argparse.Namespace, entry=None):
     return table, one_row_per_player(table.of_list(kind, everything)), kind
 
 
-def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[int, str, int], ...]:
-    """The top 10 as (rank, name, score), and the player's own row after them if it ranks lower."""
-    rows = [(i, name, score) for i, (name, score) in enumerate(ranked[:10], 1)]
-    if own is not None and own > 10:
-        rows.append((own, *ranked[own - 1]))
-    return tuple(rows)
+def _rows(ranked: list[tuple[str, int]], own: int | None) -> tuple[tuple[tuple[int, str, int], ...], int | None]:
+    """The top 10 as (place, name, score), equal scores sharing a place (``standings.places``), and the
+    player's own row (``own``: its position, 1-based) after them if it is lower; and the index of that row
+    among them, the one row the end screen shows as theirs (None: no row is)."""
+    from ..records.standings import places
+
+    shown = places(score for _, score in ranked)
+    rows = [(shown[i], name, score) for i, (name, score) in enumerate(ranked[:10])]
+    if own is None:
+        return tuple(rows), None
+    if own > 10:
+        rows.append((shown[own - 1], *ranked[own - 1]))
+        return tuple(rows), len(rows) - 1
+    return tuple(rows), own - 1
 
 
 def _standing(session, args: argparse.Namespace):
     """The end screen's callback: keep the game (under the name typed there) and say where it stands."""
     import sys
 
-    from ..records.standings import rank_of
+    from ..records.standings import rank_of, row_of
     from ..ui.render import Standing
 
     membership = getattr(args, "membership", None)
@@ -386,10 +416,10 @@ def _standing(session, args: argparse.Namespace):
         except UserError as exc:
             print(f"armgame play: error: {exc}", file=sys.stderr)
             return None
-        # The player's place, at their best game (maybe an earlier one): "#3" is the third player.
+        # The player's place, at their best game (maybe an earlier one): "#3" is the third place.
         rank = None if entry is None else rank_of(rows, entry.name)
-        return Standing(rank, len(rows), _rows([(r.name, r.best.score) for r in rows], rank), list_name(kind),
-                        saved=_saved_line(args))
+        top, mine = _rows([(r.name, r.best.score) for r in rows], None if entry is None else row_of(rows, entry.name))
+        return Standing(rank, len(rows), top, list_name(kind), saved=_saved_line(args), mine=mine)
 
     return standing
 
@@ -422,34 +452,30 @@ def _class_standing(session, args: argparse.Namespace, membership):
                 print(f"armgame play: error: {exc}", file=sys.stderr)
         saved = _saved_line(args)
         done: list = []
-        thread = threading.Thread(target=lambda: done.append(_quiet_hand_in(replay, membership)), daemon=True)
+        thread = threading.Thread(target=lambda: done.append(_hand_in(replay, membership, args)), daemon=True)
         thread.start()
+        args.handing_in = [*(t for t in getattr(args, "handing_in", ()) if t.is_alive()), thread]
 
         def later() -> Standing | None:
             if not done:
                 return None
             result = done[0]
             answer = result.answer
-            if result.kept is not None:  # the whole reason goes to the terminal; the screen says what matters
-                print(f"armgame play: {result.message}", file=sys.stderr)
+            if result.kept is not None:  # the whole reason went to the terminal; the screen says what matters
                 return Standing(None, 0, (), "the class", note="Not handed in: the class cannot be reached.\n"
                                 "Your game is kept: it goes in the next time you join", saved=saved)
             if answer is None:
                 return Standing(None, 0, (), "the class", note=_screen_line(result.message), saved=saved)
             top = tuple((int(r), str(n), int(v)) for r, n, v in answer.get("top", ()))
             where = "the class" if answer.get("list") == "students" else "the programs"
+            yours = answer.get("yours")  # which row is the player's: a place may be several rows'
+            mine = yours if isinstance(yours, int) and not isinstance(yours, bool) and 0 <= yours < len(top) else None
             return Standing(int(answer["rank"]), int(answer["of"]), top, where,
-                            note=_screen_line(result.message), saved=saved)
+                            note=_screen_line(result.message), saved=saved, mine=mine)
 
         return Standing(None, 0, (), "the class", note="Handing your game in...", later=later, saved=saved)
 
     return standing
-
-
-def _quiet_hand_in(replay, membership):
-    from ..classroom.client import hand_in
-
-    return hand_in(membership, replay.to_bytes())
 
 
 def _screen_line(message: str) -> str:
@@ -472,7 +498,8 @@ def _list_it_would_join(session, args: argparse.Namespace, table) -> str:
 
 def _preview(session, args: argparse.Namespace):
     """The end screen's first look: where the score would rank, before any name is typed, as a new
-    player's (nothing is entered: an equal score already in the table stays ahead, as the earlier game)."""
+    player's (nothing is entered: an equal score already in the table shares the place, its row first, as
+    the earlier game)."""
     import sys
 
     from ..records.standings import place_of_new
@@ -486,10 +513,11 @@ def _preview(session, args: argparse.Namespace):
             print(f"armgame play: {exc}", file=sys.stderr)
             return None
         score = session.rules.board.score
-        rank = place_of_new(rows, score)
         ranked = [(r.name, r.best.score) for r in rows]
-        ranked.insert(rank - 1, ("", score))
-        return Standing(rank, len(ranked), _rows(ranked, rank), list_name(kind), pending=True)
+        position = 1 + sum(1 for _, s in ranked if s >= score)  # after the equal scores, the earlier games
+        ranked.insert(position - 1, ("", score))
+        top, mine = _rows(ranked, position)
+        return Standing(place_of_new(rows, score), len(ranked), top, list_name(kind), pending=True, mine=mine)
 
     return preview
 

@@ -185,11 +185,13 @@ def _print_listing(table, count: int, lists, flagged, no_check: bool, note: str 
 
 
 def _print_rows(rows_in, games: bool) -> None:
-    """The rows of one list (``records.listing.listing``'s), ranked; ``games``: with the column of each
-    player's games."""
+    """The rows of one list (``records.listing.listing``'s), ranked (equal scores share a place:
+    ``standings.places``); ``games``: with the column of each player's games."""
+    from ..records.standings import places
+
     rows = [("#", "name", "score", *(("games",) if games else ()), "hits", "resets", "driven", "seed", "length",
              "date", "version", "replay")]
-    for rank, row in enumerate(rows_in, 1):
+    for rank, row in zip(places(row.best[0].score for row in rows_in), rows_in, strict=True):
         e, c = row.best
         when = e.when.astimezone().strftime("%Y-%m-%d %H:%M")
         rows.append((str(rank), e.name, str(e.score), *((str(row.games),) if games else ()), str(e.hits),

@@ -294,7 +294,8 @@ class ScoreTable(TableFile, TableChecks):
 
     def rank(self, entry: ScoreEntry) -> int:
         """The place of the entry's player in its list, one row a player (``standings``): #3 is the third
-        player, ranked by their best game, whichever of theirs this entry is. Unchecked, like ``of_list``."""
+        place, ranked by their best game, whichever of theirs this entry is (equal scores share a place).
+        Unchecked, like ``of_list``."""
         rows = one_row_per_player(self.of_list(self.list_of(entry)))
         return rank_of(rows, entry.name) or len(rows)
 

@@ -3,9 +3,14 @@
 A table holds games; a class ranks people. ``one_row_per_player`` folds a best-first list of games
 into one row a player, in the order of each player's best game, so one keen student cannot fill the
 top of the table. ``armgame scores`` (each of its lists, unless ``--all-games``), ``play`` and
-``scores --add`` ("#3 in the ranked table": the third player, ``ScoreTable.rank``) and the play
+``scores --add`` ("#3 in the ranked table": the third place, ``ScoreTable.rank``) and the play
 window's end screen (``rank_of``; before a name is typed, ``place_of_new``) all ask it, so "your
 rank" means the same thing everywhere.
+
+Equal scores share a place, and the places after them skip as many: 1, 2, 2, 4 (standard competition
+ranking; ``places``). The projector, a round's winners, a hand-in's answer, the end screens and
+``armgame scores`` all number their rows so. A place names no row, so the row that is a player's own
+is found by their name (``row_of``), never by the place: two players tied at 2nd are two rows.
 
 Players are told apart by ``player_key``: two names a projector shows alike are one player. The name
 as typed, compatibility-normalised (NFKC: a full-width "Ａlice" is "Alice"), case-folded, its spaces
@@ -73,17 +78,38 @@ def one_row_per_player(best_first: Iterable[T], name_of: Callable[[T], str] = la
     return [PlayerRow(name, best, games) for name, best, games in rows.values()]
 
 
-def rank_of(rows: list[PlayerRow[T]], name: str) -> int | None:
-    """A player's place (1-based) in the rows, or None if they have none."""
+def places(scores: Iterable[int]) -> list[int]:
+    """The place of each of a best-first list's scores: equal scores share a place, and the next place skips
+    as many (30, 20, 20, 10 are 1, 2, 2, 4)."""
+    out: list[int] = []
+    previous = None
+    for i, score in enumerate(scores, 1):
+        out.append(out[-1] if out and score == previous else i)
+        previous = score
+    return out
+
+
+def row_of(rows: list[PlayerRow[T]], name: str) -> int | None:
+    """The position (1-based) of a player's own row in the rows, or None if they have none."""
     key = player_key(name)
     return next((i for i, row in enumerate(rows, 1) if player_key(row.name) == key), None)
 
 
+def rank_of(rows: list[PlayerRow[T]], name: str, score_of: Callable[[T], int] = lambda e: e.score  # type: ignore[attr-defined]
+            ) -> int | None:
+    """A player's place (1-based; shared with every row of an equal score) in the rows, or None if they have
+    none."""
+    position = row_of(rows, name)
+    if position is None:
+        return None
+    return place_of_new(rows[:position - 1], score_of(rows[position - 1].best), score_of)
+
+
 def place_of_new(rows: list[PlayerRow[T]], score: int, score_of: Callable[[T], int] = lambda e: e.score  # type: ignore[attr-defined]
                  ) -> int:
-    """The place (1-based) a new player whose game scores ``score`` would take: after every row whose
-    best scores as much (an equal score already in is the earlier game)."""
-    return 1 + sum(1 for row in rows if score_of(row.best) >= score)
+    """The place (1-based) a new player whose game scores ``score`` would take: shared with every row of an
+    equal score (their row goes after those, the earlier games)."""
+    return 1 + sum(1 for row in rows if score_of(row.best) > score)
 
 
 def shared_rank(above: Sequence[Mapping[str, object]], score: int) -> int:

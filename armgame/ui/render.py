@@ -103,7 +103,8 @@ class Standing:
     ``list_name`` is the heading of the list the game went to (or would go to), as the scores layer
     names it: the ranked table, custom games, programs, practice. ``pending``: the game is not entered
     yet (its name is being typed): ``rank`` and ``entries`` say where it would stand, and its own row
-    in ``top`` has an empty name, drawn as the name being typed.
+    in ``top`` has an empty name, drawn as the name being typed. ``mine`` says which row of ``top`` is the
+    player's own, the one drawn as theirs: equal scores share a place, so the place cannot say it.
     """
 
     rank: int | None  # None: the game was not entered
@@ -118,6 +119,18 @@ class Standing:
     later: Callable[[], Standing | None] | None = None
     #: The line naming the file the game was saved to ("Saved as ann-b-game3.json"): the one to hand in.
     saved: str | None = None
+    #: The index in ``top`` of the player's own row; None: none of them is (a pending standing's is its row
+    #: with the empty name).
+    mine: int | None = None
+
+    @property
+    def own_row(self) -> int | None:
+        """The index in ``top`` of the row drawn as the player's, if any."""
+        if self.mine is not None:
+            return self.mine
+        if self.pending:
+            return next((i for i, row in enumerate(self.top) if row[1] == ""), None)
+        return None
 
 
 @dataclass
@@ -383,7 +396,7 @@ class GameRenderer(TextKit):
         lines += [(f"Your score: {board.score}" if playing else f"Score: {board.score}", big, p.ink),
                   (f"{plural(board.hits, 'hit')}, {plural(board.resets, 'reset')}", normal, p.ink)]
         standing = hud.standing
-        rows: list[tuple[int, str, int]] = []
+        rows: list[tuple[int, tuple[int, str, int]]] = []  # (index in standing.top, row)
         if standing is not None:
             if standing.note is not None:
                 lines += [(part, normal, p.ink) for part in standing.note.split("\n")]
@@ -394,7 +407,7 @@ class GameRenderer(TextKit):
                 lines.append(("Not entered in the table", normal, p.ink))
             if standing.saved is not None:
                 lines.append((standing.saved, normal, p.ink))
-            rows = list(standing.top)
+            rows = list(enumerate(standing.top))
         margin = max(8, round(24 * lay.unit))
         panel_w = min(w - 2 * margin, max(round(560 * lay.unit), 300))
         # A long line (the class's answer, "your game is kept ...") wraps in the panel rather than being cut off.
@@ -408,7 +421,7 @@ class GameRenderer(TextKit):
             content_h += self.font(small).get_height() + gap // 2 + self.font(normal).get_height() + 3 * gap
         content_h += self.font(small).get_height() + 2 * gap  # the hint
         room = h - 2 * margin - content_h - 2 * margin
-        own = standing.rank if standing is not None else None
+        own = standing.own_row if standing is not None else None
         # The table in the size of the lines above it where it fits (the back row reads it), else smaller.
         row_size = normal if len(rows) * (self.font(normal).get_height() + gap // 2) <= room else small
         row_h = self.font(row_size).get_height() + gap // 2
@@ -438,8 +451,8 @@ class GameRenderer(TextKit):
             rank_w = self.text_size("999.", cell)[0] + gap
             score_w = self.text_size("9999", cell)[0]
             name_w = inner.width - rank_w - score_w - 2 * gap
-            for rank, name, score in rows:
-                mine = rank == own
+            for index, (rank, name, score) in rows:
+                mine = index == own
                 if mine and standing.pending:
                     name = hud.name_entry or "you"
                 colour = p.warn if mine else p.ink

@@ -19,6 +19,48 @@ function save(key, value) {
   try { localStorage.setItem(key, JSON.stringify(value)); return true; } catch { return false; }
 }
 
+// Every name this browser joined a class under, each with its token, by the class's code, the newest first:
+// {CODE: [{name, token, at}]}. A token is what proves a name is this browser's, and the class gives it once,
+// so "not Ann?" and a join under another name never cost Ann hers. At most MAX_NAMES a class and MAX_CLASSES
+// classes, those joined longest ago dropped (as memberships.json keeps them, classroom/memberships.py).
+const NAMES = "armgame.play.names";
+const MAX_NAMES = 8, MAX_CLASSES = 40;
+const CODE = /^[A-Z]{4}$/, TOKEN = /^[A-Za-z0-9_-]{1,200}$/;
+
+// Names as the class tells them apart, near enough (the class decides: a token sent for another name is unused).
+function nameKey(name) { return name.normalize("NFKC").toLowerCase().split(/\s+/).filter(Boolean).join(" "); }
+
+// What is kept, each field checked: anything else in the store (another page's, a damaged one) is left out.
+function knownNames() {
+  const kept = load(NAMES, {});
+  const out = {};
+  if (kept === null || typeof kept !== "object" || Array.isArray(kept)) return out;
+  for (const [code, list] of Object.entries(kept).slice(0, 2 * MAX_CLASSES)) {
+    if (!CODE.test(code) || !Array.isArray(list)) continue;
+    const names = list.slice(0, MAX_NAMES).filter((n) => n !== null && typeof n === "object" &&
+      typeof n.name === "string" && [...n.name].length <= 40 && typeof n.token === "string" && TOKEN.test(n.token) &&
+      Number.isFinite(n.at));
+    if (names.length > 0) out[code] = names;
+  }
+  return out;
+}
+
+function tokenFor(code, name) {
+  const key = nameKey(name);
+  const found = (knownNames()[code.toUpperCase()] || []).find((n) => nameKey(n.name) === key);
+  return found ? found.token : null;
+}
+
+function keepName(code, name, token) {
+  if (typeof token !== "string" || !TOKEN.test(token)) return;
+  const all = knownNames();
+  code = code.toUpperCase();
+  const others = (all[code] || []).filter((n) => nameKey(n.name) !== nameKey(name));
+  all[code] = [{ name, token, at: Date.now() }, ...others].slice(0, MAX_NAMES);
+  const codes = Object.keys(all).sort((a, b) => all[b][0].at - all[a][0].at).slice(0, MAX_CLASSES);
+  save(NAMES, Object.fromEntries(codes.map((c) => [c, all[c]])));
+}
+
 // ------------------------------------------------------------------ the looks (ui/palette.py, ui/render.py)
 // PALETTES["high-contrast"]: black on white, every colour at least 4.5:1 on white (a bright classroom).
 const PALETTE = {
@@ -44,7 +86,16 @@ const statusLine = document.getElementById("status");
 // The last frames' times (ms of script and drawing each): benchmarks/browser_page.py and the tests read them.
 canvas.frameTimes = [];
 
-let member = load(MEMBER, null);  // {code, name, token, seed, duration}
+let member = load(MEMBER, null);  // {code, name, token, seed, duration}: the name playing now
+if (member === null || typeof member !== "object" || typeof member.code !== "string" ||
+    typeof member.name !== "string" || typeof member.token !== "string") {
+  member = null;
+} else if (tokenFor(member.code, member.name) === null) {
+  keepName(member.code, member.name, member.token);  // kept before every name was: the one name it knew
+}
+if (member !== null && !(Number.isFinite(member.duration) && member.duration > 0 && member.duration <= 3600)) {
+  member.duration = 60;  // kept before a class said its clock, or damaged: the standard game's (the class checks)
+}
 let config = null, game = null, names = [], keys = [];
 let phase = "join";  // join, countdown, playing, over
 let countdownLeft = 0, clock = 0, taken = 0, last = null, alpha = 1;
@@ -145,6 +196,7 @@ function askToJoin(error) {
   showOutbox();
 }
 
+// "not Ann?": another name plays next; Ann's token stays (NAMES), for when she joins on this browser again.
 function forget() {
   member = null;
   localStorage.removeItem(MEMBER);
@@ -157,9 +209,8 @@ joinForm.addEventListener("submit", async (event) => {
   const name = document.getElementById("name").value.trim();
   const button = document.getElementById("join-button");
   button.disabled = true;
-  // The same name again on this machine keeps its token (the class knows it); another name starts afresh.
-  const token = member && member.name.toLowerCase() === name.toLowerCase() ? member.token : null;
-  const answer = await join(code, name, token);
+  // A name this browser joined under before keeps its token (the class knows it); a new one starts afresh.
+  const answer = await join(code, name, tokenFor(code, name));
   button.disabled = false;
   if (answer.status === 0) {
     document.getElementById("join-error").textContent = "the class could not be reached: is this the address on the projector?";
@@ -176,6 +227,7 @@ function joined(code, data) {
   // The class's game: its seed and its clock (a rehearsal's games are 15 s; a class that does not say: 60 s).
   member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60 };
   save(MEMBER, member);
+  keepName(code, data.name, data.token);
   joinForm.hidden = true;
   statusLine.textContent = "";
   if (data.closed) waitWhileClosed(); else newGame();
@@ -304,9 +356,11 @@ function showEnd(line, kind, data) {
   const table = document.getElementById("end-top");
   table.replaceChildren();
   if (data && Array.isArray(data.top)) {
-    for (const [rank, name, score] of data.top) {
+    // The student's own row is the one the class names (data.yours): equal scores share a place, so the
+    // place alone would mark every row tied with theirs.
+    for (const [i, [rank, name, score]] of data.top.entries()) {
       const row = table.insertRow();
-      if (rank === data.rank) row.className = "mine";
+      if (i === data.yours) row.className = "mine";
       for (const [text, kind] of [[rank + ".", "rank"], [name, "name"], [String(score), "score"]]) {
         const cell = row.insertCell();
         cell.className = kind;
