@@ -206,3 +206,16 @@ def test_the_projector_counts_students_apart_from_lab_volunteers_and_programs(tm
     names = {n["name"]: (n["games"], n["lab"]) for m in roster["machines"] for n in m["names"]}
     assert names == {"Ann": (1, ["short"]), "Bo": (1, []), "Cy": (0, []), "Vi": (0, ["short"]),
                      "Lab bot": (0, ["short"]), "Game bot": (1, [])}
+
+
+def test_a_lab_run_the_class_refuses_exits_non_zero_with_its_reason(tmp_path, runs, monkeypatch, capsys):
+    """As ``armgame play --join`` and ``class submit`` do: a refusal is no success. (What the class refuses of a lab
+    run is a forged one, which the command cannot make: the refusal is the class's answer, stood in for here.)"""
+    with running_class(tmp_path / "class", lab=str(runs / "short.toml")) as opened:
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "bot"))
+        refused = client.HandIn("not handed in: the lab run does not reproduce its trials: not taken", refused=True)
+        monkeypatch.setattr(client, "hand_in", lambda membership, data, keep=True: refused)
+        status = main(["lab", str(runs / "short.toml"), "--bot", "adaptive", "--headless", "--join",
+                       f"127.0.0.1:{opened.port}", "--code", opened.clerk.roster.code, "--name", "Bot"])
+    err = capsys.readouterr().err
+    assert status == 1 and "armgame lab: not handed in: the lab run does not reproduce" in err

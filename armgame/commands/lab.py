@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 from pathlib import Path
 
 from ..errors import UserError
@@ -219,6 +220,7 @@ def run(args: argparse.Namespace) -> int:
     from .classroom import join_class
 
     args.membership = join_class(args, lab=True)  # before the run: a wrong code is said now, not after ten minutes
+    args.refused = False
     config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys),
                                          person=not args.bot), str(args.protocol))
     session = LabSession(config, protocol)
@@ -237,8 +239,9 @@ def run(args: argparse.Namespace) -> int:
         _report(session, args)
         _keep(session, args)
         if args.membership is not None:
-            print(_hand_in(session, args))
-        return 0
+            line = _hand_in(session, args)
+            print(f"armgame lab: {line}" if args.refused else line, file=sys.stderr if args.refused else sys.stdout)
+        return 1 if args.refused else 0
     if not 1 <= args.fps <= 1000:
         raise UserError(f"--fps must be from 1 to 1000, got {args.fps}")
 
@@ -262,7 +265,7 @@ def run(args: argparse.Namespace) -> int:
             raise keeper.error
 
     _play_in_window(args, new_run, end_run)
-    return 0
+    return 1 if args.refused else 0
 
 
 def _bot(args: argparse.Namespace, rates):
@@ -495,13 +498,17 @@ def _save(session, args: argparse.Namespace, record: RecordTarget | None, out: P
 
 
 def _hand_in(session, args: argparse.Namespace) -> str:
-    """Hand a finished run in to the class; the line saying what became of it."""
+    """Hand a finished run in to the class; the line saying what became of it. A refusal sets ``args.refused``:
+    the command then exits 1, as ``armgame play --join`` and ``class submit`` do (a run kept to hand in later
+    is not refused)."""
     from ..classroom.client import hand_in
 
     if not session.finished:
         how = "ran out of time" if session.out_of_time else "stopped"
         return f"the run {how} before its last trial: not handed in to the class"
-    return hand_in(args.membership, _replay(session, args).to_bytes()).message
+    result = hand_in(args.membership, _replay(session, args).to_bytes())
+    args.refused = args.refused or result.refused
+    return result.message
 
 
 def _replay(session, args: argparse.Namespace):
