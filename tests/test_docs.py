@@ -325,3 +325,25 @@ def test_ci_installs_and_tests_as_the_readme_says():
     assert any(line.endswith(f"pip install --quiet {install.group(1)}") for line in ci)
     assert "python -m pytest" in ci  # exactly the README's test command, its options in pyproject.toml
     assert any(re.fullmatch(r'"\$python" -m venv "\.venv-\$version"', line) for line in ci)  # fresh, per Python
+
+
+def test_the_test_time_the_readme_states_is_the_committed_runs():
+    """The README's and development.md's test times are benchmarks/suite_time.py's committed run, idle and
+    beside busy programs (issue 51: a newcomer held "about a minute" to a loaded laptop)."""
+    import json
+
+    root = ROOT
+    run = json.loads((root / "benchmarks" / "results" / "suite_time.json").read_text(encoding="utf-8"))
+    walls = {r["busy"]: round(r["wall_s"]) for r in run["runs"]}
+    assert sorted(walls) == [0, 2, 4]
+    readme = " ".join((root / "README.md").read_text(encoding="utf-8").split())
+    assert (f"tests took {walls[0]} s on two idle cores, {walls[2]} s beside two busy programs and {walls[4]} s "
+            f"beside four") in readme
+    development = (root / "docs" / "development.md").read_text(encoding="utf-8")
+    for r in run["runs"]:
+        beside = "nothing (idle)" if r["busy"] == 0 else f"{r['busy']} busy programs"
+        counted = f"{r['counted']['passed']:,} passed, {r['counted']['skipped']} skipped"
+        row = f"| {beside} | {round(r['wall_s'])} s | {r['load_before']:.1f} | {counted} |"
+        assert row in development, row
+    assert f"On the {run['machine']['processor']}, {run['machine']['cores']} cores, Python {run['machine']['python']}" \
+        in " ".join(development.split())
