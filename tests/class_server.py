@@ -10,6 +10,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -38,6 +39,16 @@ def running_class(folder: Path | None, seed: int | None = None, lines: list[str]
         opened.stop()
         thread.join(20)
         assert not thread.is_alive(), "the class did not stop"
+
+
+def final_answer(standing):
+    """What a window's hand-in (``commands.play._class_standing``'s) came to, once the class has answered."""
+    for _ in range(500):
+        final = standing.later()
+        if final is not None:
+            return final
+        time.sleep(0.02)
+    raise AssertionError("no answer from the class")
 
 
 def free_port() -> int:

@@ -5,10 +5,9 @@ window prints its line in the terminal too."""
 from __future__ import annotations
 
 import argparse
-import time
 
 import pytest
-from class_server import running_class
+from class_server import final_answer, running_class
 
 from armgame.classroom import client
 from armgame.cli import main
@@ -45,15 +44,6 @@ def test_a_bot_game_the_class_refuses_exits_1_with_its_reason_on_stderr_and_one_
     assert "your game is kept and will be handed in the next time you join" in capsys.readouterr().out
 
 
-def _final(standing):
-    for _ in range(500):
-        final = standing.later()
-        if final is not None:
-            return final
-        time.sleep(0.02)
-    raise AssertionError("no answer from the class")
-
-
 def test_each_game_handed_in_from_the_window_prints_its_line_in_the_terminal(tmp_path, machine, capsys):
     with running_class(tmp_path / "class") as opened:
         address, code = client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code
@@ -64,11 +54,11 @@ def test_each_game_handed_in_from_the_window_prints_its_line_in_the_terminal(tmp
         session = GameSession(GameConfig(seed=ann.seed))
         session.play([])
         args = argparse.Namespace(bot=None)
-        final = _final(_class_standing(session, args, ann)(None))
+        final = final_answer(_class_standing(session, args, ann)(None))
         assert final.note.startswith("Handed in:")
         assert capsys.readouterr().out == "handed in: 1st of 1 in the class (your best so far)\n"
         assert not getattr(args, "refused", False)
-        final = _final(_class_standing(session, args, bo)(None))  # Ann's game, from Bo's machine: refused
+        final = final_answer(_class_standing(session, args, bo)(None))  # Ann's game, from Bo's machine: refused
         captured = capsys.readouterr()
         assert captured.out == "" and captured.err == ("armgame play: not handed in: this game was already handed in "
                                                        "by Ann: a game counts once, whoever hands it in\n")

@@ -6,12 +6,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 import urllib.request
 
 import pygame
 import pytest
-from class_server import keyboard_game, keyboard_session, running_class
+from class_server import final_answer, keyboard_game, keyboard_session, running_class
 
 from armgame.classroom import client
 from armgame.cli import build_parser, main
@@ -29,15 +28,6 @@ RANKING = [(1, "Ann", 18), (2, "Bo", 11), (2, "Cy", 11), (4, "Dee", 5)]
 def test_places_share_equal_scores_and_skip_after_them():
     assert places([30, 20, 20, 10]) == [1, 2, 2, 4]
     assert places([5, 5, 5]) == [1, 1, 1] and places([3, 2, 1]) == [1, 2, 3] and places([]) == []
-
-
-def _final(standing):
-    for _ in range(500):
-        final = standing.later()
-        if final is not None:
-            return final
-        time.sleep(0.02)
-    raise AssertionError("no answer from the class")
 
 
 def _scores_rows(out: str) -> list[tuple[int, str, int]]:
@@ -76,7 +66,7 @@ def test_every_view_of_a_tied_table_ranks_it_alike_and_marks_only_the_players_ro
                 answer = client.hand_in(members[name], keyboard_game(seconds, player=name).to_bytes()).answer
                 assert answer["score"] == score
         # Cy's game from the window's end screen: handed in, and the class's top with Cy's own row marked.
-        cy = _final(_class_standing(keyboard_session(13), argparse.Namespace(bot=None), members["Cy"])(None))
+        cy = final_answer(_class_standing(keyboard_session(13), argparse.Namespace(bot=None), members["Cy"])(None))
         with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}/api/standings", timeout=10) as r:
             projector = [(row["rank"], row["name"], row["score"]) for row in json.loads(r.read())["students"]]
     assert projector == RANKING
