@@ -173,3 +173,32 @@ def test_a_closed_class_starts_no_game_until_the_teacher_opens_it(tmp_path):
         page.keyboard.up("d")
         assert "not Nia?" not in page.inner_text("#status")  # offered only between games
         assert errors == []
+
+
+#: Outboxes another page, a damaged store or last week's code may have left: valid JSON, not a list of games.
+BAD_OUTBOXES = ("{}", "5", "[null]", '[{"id": "x"}]', '"games"')
+
+
+@pytest.mark.slow  # in chromium: a game for each
+def test_a_wrongly_shaped_outbox_or_a_browser_that_stores_nothing_never_stops_the_next_game(tmp_path):
+    """Issue 54: an outbox of the wrong shape threw in the hand-in and the game's end, so the end card never showed
+    and no later game was kept or handed in. A browser that refuses to store (private browsing, a full store) said
+    "handing in" and handed in nothing: the game now waits in the page while it is open."""
+    with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
+        errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+        join(page, opened.clerk.roster.code, "Ama")
+        for n, box in enumerate(BAD_OUTBOXES, 1):
+            page.evaluate("box => localStorage.setItem('armgame.play.outbox', box)", box)
+            play_keys(page, rounds=1 + n % 2)  # each game its own: a game counts once
+            to_the_end(page)
+            page.wait_for_selector("#end-answer:has-text('handed in: ')")
+            assert len(_scores(opened, "Ama")) == n, box
+            page.keyboard.press("Enter")  # play again
+            page.wait_for_selector("#end", state="hidden")
+        # The store refuses every write from now on: the game is still handed in, from the page's memory.
+        page.evaluate("() => { Storage.prototype.setItem = () => { throw new DOMException('full', 'QuotaExceededError'); }; }")
+        play_keys(page, rounds=3)
+        to_the_end(page)
+        page.wait_for_selector("#end-answer:has-text('handed in: ')")
+        assert len(_scores(opened, "Ama")) == len(BAD_OUTBOXES) + 1
+        assert errors == []

@@ -7,7 +7,7 @@ event stream for JSON and sets every name and number as text (``textContent``), 
 follow the window (CSS viewport units, 19 px at the least at 1024x768) in the high-contrast palette
 of the game's windows (``ui.render.PALETTES["high-contrast"]``): black on white, red for news.
 ``play.html`` is the game itself for a browser (``/play``): ``engine.js`` plays it, ``play.js`` draws it
-(``body.js``: the arm and torso).
+(``body.js``: the arm and torso), ``kept.js`` keeps what the browser keeps (names, tokens, games not yet taken).
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ PAGES = {
     "play.js": "text/javascript; charset=utf-8",
     "engine.js": "text/javascript; charset=utf-8",
     "body.js": "text/javascript; charset=utf-8",
+    "kept.js": "text/javascript; charset=utf-8",
     "icon.svg": "image/svg+xml",
 }
 

@@ -3,63 +3,9 @@
 // Everything a student or the server wrote is set as text (textContent, fillText), never as HTML.
 import { blend, circle, drawArm, drawTorso, rgb } from "./body.js";
 import { Game, standardConfig } from "./engine.js";
+import { dropGame, forgetMember, keepGame, loadMember, outbox, saveMember, tokenFor } from "./kept.js";
 
-// ------------------------------------------------------------------ what is kept on this machine
-// The name's token and the class's code: a reload, or the next game, plays under the same name.
-const MEMBER = "armgame.play.member";
-// Games finished but not yet taken by the class, oldest first: handed in at the next chance (the next
-// page load, the next game's end, a timer while the page is open).
-const OUTBOX = "armgame.play.outbox";
 const RETRY_MS = 5000;
-
-function load(key, fallback) {
-  try { return JSON.parse(localStorage.getItem(key)) ?? fallback; } catch { return fallback; }
-}
-function save(key, value) {
-  try { localStorage.setItem(key, JSON.stringify(value)); return true; } catch { return false; }
-}
-
-// Every name this browser joined a class under, each with its token, by the class's code, the newest first:
-// {CODE: [{name, token, at}]}. A token is what proves a name is this browser's, and the class gives it once,
-// so "not Ann?" and a join under another name never cost Ann hers. At most MAX_NAMES a class and MAX_CLASSES
-// classes, those joined longest ago dropped (as memberships.json keeps them, classroom/memberships.py).
-const NAMES = "armgame.play.names";
-const MAX_NAMES = 8, MAX_CLASSES = 40;
-const CODE = /^[A-Z]{4}$/, TOKEN = /^[A-Za-z0-9_-]{1,200}$/;
-
-// Names as the class tells them apart, near enough (the class decides: a token sent for another name is unused).
-function nameKey(name) { return name.normalize("NFKC").toLowerCase().split(/\s+/).filter(Boolean).join(" "); }
-
-// What is kept, each field checked: anything else in the store (another page's, a damaged one) is left out.
-function knownNames() {
-  const kept = load(NAMES, {});
-  const out = {};
-  if (kept === null || typeof kept !== "object" || Array.isArray(kept)) return out;
-  for (const [code, list] of Object.entries(kept).slice(0, 2 * MAX_CLASSES)) {
-    if (!CODE.test(code) || !Array.isArray(list)) continue;
-    const names = list.slice(0, MAX_NAMES).filter((n) => n !== null && typeof n === "object" &&
-      typeof n.name === "string" && [...n.name].length <= 40 && typeof n.token === "string" && TOKEN.test(n.token) &&
-      Number.isFinite(n.at));
-    if (names.length > 0) out[code] = names;
-  }
-  return out;
-}
-
-function tokenFor(code, name) {
-  const key = nameKey(name);
-  const found = (knownNames()[code.toUpperCase()] || []).find((n) => nameKey(n.name) === key);
-  return found ? found.token : null;
-}
-
-function keepName(code, name, token) {
-  if (typeof token !== "string" || !TOKEN.test(token)) return;
-  const all = knownNames();
-  code = code.toUpperCase();
-  const others = (all[code] || []).filter((n) => nameKey(n.name) !== nameKey(name));
-  all[code] = [{ name, token, at: Date.now() }, ...others].slice(0, MAX_NAMES);
-  const codes = Object.keys(all).sort((a, b) => all[b][0].at - all[a][0].at).slice(0, MAX_CLASSES);
-  save(NAMES, Object.fromEntries(codes.map((c) => [c, all[c]])));
-}
 
 // ------------------------------------------------------------------ the looks (ui/palette.py, ui/render.py)
 // PALETTES["high-contrast"]: black on white, every colour at least 4.5:1 on white (a bright classroom).
@@ -86,16 +32,7 @@ const statusLine = document.getElementById("status");
 // The last frames' times (ms of script and drawing each): benchmarks/browser_page.py and the tests read them.
 canvas.frameTimes = [];
 
-let member = load(MEMBER, null);  // {code, name, token, seed, duration}: the name playing now
-if (member === null || typeof member !== "object" || typeof member.code !== "string" ||
-    typeof member.name !== "string" || typeof member.token !== "string") {
-  member = null;
-} else if (tokenFor(member.code, member.name) === null) {
-  keepName(member.code, member.name, member.token);  // kept before every name was: the one name it knew
-}
-if (member !== null && !(Number.isFinite(member.duration) && member.duration > 0 && member.duration <= 3600)) {
-  member.duration = 60;  // kept before a class said its clock, or damaged: the standard game's (the class checks)
-}
+let member = loadMember();  // {code, name, token, seed, duration}: the name playing now
 let config = null, game = null, names = [], keys = [];
 let phase = "join";  // join, countdown, playing, over
 let countdownLeft = 0, clock = 0, taken = 0, last = null, alpha = 1;
@@ -140,7 +77,7 @@ function flushOutbox() {
 async function doFlush() {
   const results = [];
   for (;;) {
-    const box = load(OUTBOX, []);
+    const box = outbox();
     if (box.length === 0) break;
     const item = box[0];
     const answer = await post("/api/handin", item.body,
@@ -154,7 +91,7 @@ async function doFlush() {
       scheduleRetry();
       break;  // busy or unreachable: the rest wait with it
     }
-    save(OUTBOX, load(OUTBOX, []).filter((g) => g.id !== item.id));
+    dropGame(item.id);
   }
   showOutbox();
   return results;
@@ -167,7 +104,7 @@ function scheduleRetry() {
 }
 
 function showOutbox() {
-  const kept = load(OUTBOX, []).length;
+  const kept = outbox().length;
   statusLine.replaceChildren();
   if (phase === "closed") statusLine.append(CLOSED + " · ");
   if (member) statusLine.append("playing as " + member.name + " ");
@@ -199,7 +136,7 @@ function askToJoin(error) {
 // "not Ann?": another name plays next; Ann's token stays (NAMES), for when she joins on this browser again.
 function forget() {
   member = null;
-  localStorage.removeItem(MEMBER);
+  forgetMember();
   askToJoin("");
 }
 
@@ -226,8 +163,7 @@ joinForm.addEventListener("submit", async (event) => {
 function joined(code, data) {
   // The class's game: its seed and its clock (a rehearsal's games are 15 s; a class that does not say: 60 s).
   member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60 };
-  save(MEMBER, member);
-  keepName(code, data.name, data.token);
+  saveMember(member);
   joinForm.hidden = true;
   statusLine.textContent = "";
   if (data.closed) waitWhileClosed(); else newGame();
@@ -307,7 +243,7 @@ async function finish() {
   const body = game.replayJSON(member.name);  // any seed's digits exact (a seed past 2^53 is a BigInt)
   const id = Date.now().toString(36) + Math.random().toString(36).slice(2, 8);
   // Kept first, then sent: a page closed while the answer is on its way hands the game in next time.
-  const kept = save(OUTBOX, [...load(OUTBOX, []), { id, code: member.code, token: member.token, body }]);
+  const kept = keepGame({ id, code: member.code, token: member.token, body });
   showEnd(kept ? "handing in…" : "handing in (this browser keeps nothing: stay on the page)…", "");
   const results = await flushOutbox();
   const mine = results.find((r) => r.id === id);
@@ -339,7 +275,7 @@ function showAnswers(results) {
     statusLine.textContent = (taken.length === 1 ? "a kept game was " : taken.length + " kept games were ") +
       last.message;
   }
-  if (phase === "over" && endCard.dataset.kept === "kept" && load(OUTBOX, []).length === 0 && taken.length > 0) {
+  if (phase === "over" && endCard.dataset.kept === "kept" && outbox().length === 0 && taken.length > 0) {
     const mine = taken[taken.length - 1];
     showHandIn(mine.answer);
   }
