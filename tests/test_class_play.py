@@ -196,7 +196,8 @@ def test_a_wrongly_shaped_outbox_or_a_browser_that_stores_nothing_never_stops_th
             page.keyboard.press("Enter")  # play again
             page.wait_for_selector("#end", state="hidden")
         # The store refuses every write from now on: the game is still handed in, from the page's memory.
-        page.evaluate("() => { Storage.prototype.setItem = () => { throw new DOMException('full', 'QuotaExceededError'); }; }")
+        page.evaluate("() => { Storage.prototype.setItem = () => { throw new DOMException('full', "
+                      "'QuotaExceededError'); }; }")
         play_keys(page, rounds=3)
         to_the_end(page)
         page.wait_for_selector("#end-answer:has-text('handed in: ')")
