@@ -361,6 +361,7 @@ def csv_download(make: Callable[[Clerk], str], filename: str) -> Endpoint:
 
 teacher_games_csv = csv_download(views.games_csv, "class-games.csv")
 teacher_lab_csv = csv_download(views.lab_csv, "class-lab-reaches.csv")
+teacher_students_csv = csv_download(views.students_table, "class-lab-students.csv")
 
 
 async def teacher_lab_png(request: Request) -> Response:
@@ -414,6 +415,7 @@ ROUTES = [
     Route("/api/teacher/roster", teacher_roster, middleware=SAME_SITE),
     Route("/api/teacher/games.csv", teacher_games_csv, middleware=SAME_SITE),
     Route("/api/teacher/lab.csv", teacher_lab_csv, middleware=SAME_SITE),
+    Route("/api/teacher/students.csv", teacher_students_csv, middleware=SAME_SITE),
     Route("/api/teacher/lab.png", teacher_lab_png, middleware=SAME_SITE),
 ]
 
