@@ -119,17 +119,51 @@ def lab_curve(clerk: Clerk) -> dict[str, object]:
     curve, members = curve_and_members(clerk)
     if not curve.students:
         return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
-                "metric": None, "trials": [], "stats": None}
+                "metric": None, "trials": [], "stats": None, "groups": groups_view(clerk)}
     scale, unit = display_unit(curve.metric)  # type: ignore[arg-type]
     trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
                "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
               for row in curve.trials]
     stats = class_stats(curve.protocol, [(clerk.shown_name(run.player), run.rows) for run in members], curve.metric)
     return {"protocol": protocol.name, "students": curve.students, "programs": curve.programs,
-            "metric": curve.metric, "unit": unit, "trials": trials,
+            "metric": curve.metric, "unit": unit, "trials": trials, "groups": groups_view(clerk),
             "stats": {**stats.as_dict(scale, probe_scale(curve.protocol, curve.metric)),
                       "probe_unit": probe_unit(curve.protocol, curve.metric),
                       "answer": answer_line(stats, scale, unit)}}
+
+
+def experiment_groups(clerk: Clerk) -> Any:
+    """A classroom experiment's two groups (``lab.classstats.two_groups``) over the class's runs, or None."""
+    from ..lab.analysis import ClassRun, curve_protocol
+    from ..lab.classstats import two_groups
+
+    experiment = clerk.roster.experiment
+    if experiment is None:
+        return None
+    runs = [run for run in clerk.lab_runs if run.program or (run.first and not clerk.roster.is_hidden(run.player))]
+    # By the name each run was handed in under: the split keeps the name a student joined with, renamed or not.
+    return two_groups([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                      (curve_protocol(experiment.a), curve_protocol(experiment.b)),
+                      lambda name: experiment.condition_of(name))
+
+
+def groups_view(clerk: Clerk) -> dict[str, object] | None:
+    """The two groups as ``/lab`` draws them side by side, and their difference in one line."""
+    from ..lab.analysis import display_unit
+    from ..lab.classstats import difference_words
+
+    groups = experiment_groups(clerk)
+    if groups is None:
+        return None
+    scale, unit = display_unit(groups.metric)
+    counts = clerk.roster.experiment.counts()  # type: ignore[union-attr]
+    out: dict[str, object] = {}
+    for c, curve, stats in zip(("a", "b"), groups.curves, groups.stats, strict=True):
+        out[c] = {"name": f"group {c.upper()}", "protocol": curve.protocol.name, "assigned": counts[c],  # type: ignore[attr-defined]
+                  "students": curve.students, "stats": None if stats is None else stats.as_dict(scale)}  # type: ignore[attr-defined]
+    return {**out, "metric": groups.metric, "unit": unit,
+            "difference": None if groups.difference is None else groups.difference.as_dict(scale),
+            "difference_words": difference_words(groups, scale, unit)}
 
 
 def probe_scale(protocol: Any, metric: str) -> float:

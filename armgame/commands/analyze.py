@@ -466,8 +466,13 @@ def _class(args: argparse.Namespace) -> int:
                            people_only=roster is not None)
     shared = None if protocol is None else \
         f"{protocol.name!r}, shared by {sum(run[2].protocol == protocol for run in runs)} replays"
+    second = None
+    if roster is not None and roster.experiment is not None:
+        second = curve_protocol(roster.experiment.b)  # the experiment's group B: its own curve, never left out
     for i, why in curve.left_out:
         other = runs[i][2].protocol
+        if second is not None and other == second and why.startswith("another protocol"):
+            continue
         if why.startswith("another protocol") and protocol is not None:
             why = (f"its protocol is also named {other.name!r} but differs from the class's ({shared})"
                    if other.name == protocol.name
@@ -511,6 +516,19 @@ def _class(args: argparse.Namespace) -> int:
     print(f"class curve of {plural(curve.students, 'student')} ({skipped} left out), "
           f"{plural(len(curve.trials), 'trial')}, {metric}")
     print(f"  the class's answer: {answer_line(class_stats(curve.protocol, members, metric), scale, unit)}")
+    if roster is not None and roster.experiment is not None:  # the projector's two groups, from the same runs
+        from ..lab.analysis import curve_protocol
+        from ..lab.classstats import difference_words, two_groups
+
+        experiment = roster.experiment
+        groups = two_groups([ClassRun(r.player, r.driven != "keyboard", run[2].protocol, run[1])
+                             for run, r in zip(runs, replays, strict=True)],
+                            (curve_protocol(experiment.a), curve_protocol(experiment.b)), experiment.condition_of)
+        g_scale, g_unit = display_unit(groups.metric)
+        for c, g_curve, g_stats in zip("AB", groups.curves, groups.stats, strict=True):
+            said = "no run" if g_stats is None else answer_line(g_stats, g_scale, g_unit)
+            print(f"  group {c} ({g_curve.protocol.name}, {plural(g_curve.students, 'student')}): {said}")
+        print(f"  the experiment's answer: {difference_words(groups, g_scale, g_unit)}")
     if curve.programs:
         print(f"  {plural(curve.programs, 'run')} of programs kept apart (never in a class's curve, as on its /lab "
               "page)")

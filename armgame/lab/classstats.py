@@ -390,3 +390,55 @@ def answer_line(s: ClassStats, scale: float = 1.0, unit: str = "") -> str:
     --class`` prints it: the after-effect and late against early exposure error, each across students."""
     return (f"after-effect {estimate_words(s.after_effect, scale, unit)}; late - early exposure error "
             f"{estimate_words(s.learning, scale, unit)}")
+
+
+# ------------------------------------------------------------------ two conditions (a classroom experiment)
+@dataclass(frozen=True)
+class Groups:
+    """A classroom experiment's two groups: each group's class curve (``analysis.ClassCurve``) and statistics, in
+    one measure, and group A's after-effect less group B's with Welch's interval (None when the two protocols are
+    measured differently: a force field's against a rotation's)."""
+
+    curves: tuple[object, object]
+    stats: tuple[ClassStats | None, ClassStats | None]
+    metric: str
+    difference: Difference | None
+
+
+def two_groups(runs: Sequence[object], protocols: tuple[object, object], condition_of,
+               people_only: bool = True) -> Groups:
+    """The two groups of ``runs`` (``analysis.ClassRun``): a run is group A's if its player's condition
+    (``condition_of(name)``: "a", "b" or None) is "a" and it runs A's protocol, likewise B's; each group's curve is
+    ``analysis.class_curve_of`` (each person's first run, programs apart), as the live class's ``/lab`` shows it
+    and ``armgame analyze --class`` rebuilds it from the class's folder."""
+    from .analysis import class_curve_of, figure_metric
+
+    metric = figure_metric(protocols[0])
+    same = figure_metric(protocols[1]) == metric
+    curves, out = [], []
+    for c, protocol in zip(("a", "b"), protocols, strict=True):
+        mine = [r for r in runs if getattr(r, "program", False) or condition_of(getattr(r, "player", None) or "") == c]
+        curve = class_curve_of(mine, protocol, metric if same or c == "a" else None, people_only=people_only)
+        curves.append(curve)
+        out.append(class_stats(protocol, [(mine[i].player or f"run {i + 1}", mine[i].rows) for i in curve.members],
+                               curve.metric) if curve.students else None)
+    difference = None
+    if same:
+        difference = welch([m.after_effect for m in out[0].students] if out[0] else [],
+                           [m.after_effect for m in out[1].students] if out[1] else [])
+    return Groups((curves[0], curves[1]), (out[0], out[1]), metric, difference)
+
+
+def difference_words(groups: Groups, scale: float = 1.0, unit: str = "") -> str:
+    """The experiment's answer in one line, as the projector shows it and ``armgame analyze --class`` prints it."""
+    d = groups.difference
+    if d is None:
+        return "the two conditions are measured differently (a force field's error against a display's): no difference"
+    per = f" {unit}" if unit else ""
+    n = f"n = {d.a.n} and {d.b.n}"
+    if not math.isfinite(d.difference):
+        return f"after-effect, group A - group B: not yet ({n})"
+    if not math.isfinite(d.low):
+        return f"after-effect, group A - group B: {d.difference * scale:+.2f}{per} ({n}: too few for an interval)"
+    return (f"after-effect, group A - group B: {d.difference * scale:+.2f}{per} (Welch's 95 % CI "
+            f"{d.low * scale:+.2f} to {d.high * scale:+.2f}, {n})")

@@ -155,6 +155,21 @@ function draw(lab) {
   const answer = document.getElementById("answer");
   const general = document.getElementById("general");
   const groups = document.getElementById("groups");
+  const curve = document.getElementById("curve");
+  // A classroom experiment: the two groups side by side take the curve's place (group A's alone would mislead).
+  const split = Boolean(lab.groups && (lab.groups.a.stats || lab.groups.b.stats));
+  groups.hidden = !split;
+  curve.parentElement.hidden = split;
+  if (split) {
+    document.getElementById("title").textContent = "A classroom experiment: two groups";
+    facts.textContent = (MEASURES[lab.groups.metric] || "error") + ", each group's mean and 95 % interval " +
+      "across its students; assigned at random: " + lab.groups.a.assigned + " and " + lab.groups.b.assigned;
+    answer.textContent = "The class's answer: " + lab.groups.difference_words;
+    general.hidden = true;
+    drawGroups(lab);
+    document.body.dataset.students = String(lab.groups.a.students + lab.groups.b.students);
+    return;
+  }
   if (!lab.protocol || lab.trials.length === 0 || !lab.stats) {
     facts.textContent = "waiting for the first volunteer's run" +
       (lab.programs ? " (" + lab.programs + " program runs are not in the curve)" : "");
@@ -177,8 +192,6 @@ function draw(lab) {
   if (!general.hidden) {
     drawGeneral(document.getElementById("general-plot"), stats.generalization, stats.probe_unit);
   }
-  groups.hidden = !lab.groups;
-  if (lab.groups) drawGroups(lab);
   document.body.dataset.students = String(lab.students);
 }
 
@@ -186,14 +199,20 @@ function draw(lab) {
 // the difference with Welch's interval under them.
 function drawGroups(lab) {
   const g = lab.groups;
-  const both = [seriesOf(g.a.stats, "a"), seriesOf(g.b.stats, "b")];
+  const both = [g.a.stats ? seriesOf(g.a.stats, "a") : [], g.b.stats ? seriesOf(g.b.stats, "b") : []];
   const range = rangeOf(both.flat());
   for (const [key, s] of [["a", both[0]], ["b", both[1]]]) {
     const side = g[key];
-    document.getElementById("group-" + key + "-title").textContent =
-      side.name + ": " + side.protocol + " · " + side.stats.curve.length + " trials · " +
-      (side.stats.own.length ? side.students + " students' own curves" : nWords(side.stats));
-    drawCurve(document.getElementById("group-" + key), side.stats.curve, s, lab.unit, range);
+    const svg = document.getElementById("group-" + key);
+    const title = document.getElementById("group-" + key + "-title");
+    if (!side.stats) {
+      title.textContent = side.name + ": " + side.protocol + " · no run yet";
+      svg.replaceChildren();
+      continue;
+    }
+    title.textContent = side.name + ": " + side.protocol + " · " + side.students + " students · " +
+      (side.stats.own.length ? "their own curves" : nWords(side.stats));
+    drawCurve(svg, side.stats.curve, s, g.unit, range);
   }
   document.getElementById("difference").textContent = g.difference_words;
 }
