@@ -195,7 +195,7 @@ def test_the_projector_the_teachers_table_and_analyze_say_the_same(tmp_path, run
     mean, low, high = t_interval([by_hand(table(runs, "mini", s))["after_effect"] * 100 for s in STUDENTS])
     assert stats["after_effect"] == {"mean": pytest.approx(mean, abs=1e-5), "low": pytest.approx(low, abs=1e-3),
                                      "high": pytest.approx(high, abs=1e-3), "n": 5}
-    assert stats["answer"].startswith(f"after-effect {mean:+.2f} cm (95 % CI ") and "n = 5" in stats["answer"]
+    assert stats["answer"].startswith(f"after-effect: {mean:+.2f} cm (95 % CI ") and "n = 5" in stats["answer"]
     assert [p["n"] for p in stats["curve"]] == [5] * 15 and stats["own"] == [] and stats["generalization"] == []
     rows = list(csv.DictReader(io.StringIO(teacher)))
     assert [r["name"] for r in rows] == list(STUDENTS)
@@ -210,3 +210,45 @@ def test_the_projector_the_teachers_table_and_analyze_say_the_same(tmp_path, run
                  "--students", str(tmp_path / "students.csv")]) == 0
     assert f"the class's answer: {stats['answer']}" in capsys.readouterr().out
     assert (tmp_path / "students.csv").read_text(encoding="utf-8-sig") == teacher
+
+
+def inside(page, selector: str) -> bool:
+    """Whether every element ``selector`` finds lies inside the viewport (CSS laid it out; nothing spills)."""
+    return page.evaluate("""(sel) => [...document.querySelectorAll(sel)].every((e) => {
+        const r = e.getBoundingClientRect();
+        return r.width > 0 && r.left >= 0 && r.top >= 0 && r.right <= innerWidth + 0.5 && r.bottom <= innerHeight + 0.5;
+    })""", selector)
+
+
+@pytest.mark.slow  # in chromium
+@pytest.mark.parametrize("protocol", ["mini", "minigen"])
+def test_the_projectors_lab_page_draws_the_band_the_answer_n_and_the_generalization(tmp_path, runs, monkeypatch,
+                                                                                       protocol):
+    from browser import browser_page
+
+    with running_class(tmp_path / "class", lab=str(runs / f"{protocol}.toml")) as opened, \
+            browser_page(1024, 768) as page:
+        page.goto(f"http://127.0.0.1:{opened.port}/lab")
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        for i, name in enumerate(STUDENTS):
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            member = client.join(address, opened.clerk.roster.code, name)
+            client.hand_in(member, (runs / f"{protocol}-{name}.json").read_bytes())
+            if i == 1:  # two students: their own curves, no band
+                page.wait_for_selector("body[data-students='2']", state="attached", timeout=10_000)
+                assert page.locator("#curve path.own").count() == 2 and page.locator("#curve polygon.band").count() == 0
+                assert "too few for an interval" in page.text_content("#facts")
+        page.wait_for_selector("body[data-students='5']", state="attached", timeout=10_000)
+        lab = json.loads(get(opened, "/api/lab"))
+        assert page.locator("#curve polygon.band").count() == 1 and page.locator("#curve path.mean").count() == 1
+        assert "n = 5 per trial" in page.text_content("#facts")
+        assert page.text_content("#answer") == "The class's answer: " + lab["stats"]["answer"]
+        general = page.locator("#general")
+        if protocol == "minigen":
+            assert general.is_visible() and page.locator("#general-plot circle.dot").count() == 4
+            assert page.locator("#general-plot line.bar").count() == 4  # an interval per direction
+            assert inside(page, "#general-plot")
+        else:
+            assert not general.is_visible()
+        assert inside(page, "#curve") and inside(page, "#answer") and page.dialogs == []
+        page.screenshot(path=str(tmp_path.parent / f"lab-{protocol}.png"))

@@ -379,7 +379,7 @@ def estimate_words(e: Estimate, scale: float = 1.0, unit: str = "") -> str:
     """"+1.13 cm (95 % CI 0.90 to 1.37, n = 24)", or without an interval "(n = 2, too few for an interval)"."""
     per = f" {unit}" if unit else ""
     if e.n == 0:
-        return "no student has it"
+        return "none measured"
     if not math.isfinite(e.low):
         return f"{e.mean * scale:+.2f}{per} (n = {e.n}, too few for an interval)"
     return f"{e.mean * scale:+.2f}{per} (95 % CI {e.low * scale:+.2f} to {e.high * scale:+.2f}, n = {e.n})"
@@ -388,7 +388,7 @@ def estimate_words(e: Estimate, scale: float = 1.0, unit: str = "") -> str:
 def answer_line(s: ClassStats, scale: float = 1.0, unit: str = "") -> str:
     """The class's answer to the lesson's question in one line, as the projector shows it and ``armgame analyze
     --class`` prints it: the after-effect and late against early exposure error, each across students."""
-    return (f"after-effect {estimate_words(s.after_effect, scale, unit)}; late - early exposure error "
+    return (f"after-effect: {estimate_words(s.after_effect, scale, unit)}; late - early exposure error: "
             f"{estimate_words(s.learning, scale, unit)}")
 
 

@@ -27,13 +27,14 @@ function el(name, attrs, text) {
 
 function fixed(v) { return v.toFixed(Math.abs(v) < 10 ? 1 : 0); }
 
-// The SVG's own size, as CSS laid it out.
-function frame(svg) {
+// The SVG's own size, as CSS laid it out; the plot inside it leaves room for its labels (`margin`: each side's
+// share of the width, left and right).
+function frame(svg, margin = [0.1, 0.02]) {
   svg.replaceChildren();
   const box = svg.getBoundingClientRect();
   const W = Math.max(box.width, 200), H = Math.max(box.height, 150);
   svg.setAttribute("viewBox", "0 0 " + W + " " + H);
-  return {W, H, left: W * 0.1, right: W * 0.98, top: H * 0.12, bottom: H * 0.84};
+  return {W, H, left: W * margin[0], right: W * (1 - margin[1]), top: H * 0.12, bottom: H * 0.84};
 }
 
 // One learning-curve panel: `blocks` (the trials' block and perturbation, for the shading), `series` (each
@@ -120,7 +121,7 @@ function nWords(stats) {
 // The generalization by direction: one point per probed direction (its angle from the trained one) with its
 // interval across students.
 function drawGeneral(svg, points, unit) {
-  const {W, H, left, right, top, bottom} = frame(svg);
+  const {W, H, left, right, top, bottom} = frame(svg, [0.16, 0.06]);
   const values = [0];
   for (const p of points) for (const v of [p.mean, p.low, p.high]) if (v !== null) values.push(v);
   let lo = Math.min(...values), hi = Math.max(...values);
@@ -140,10 +141,10 @@ function drawGeneral(svg, points, unit) {
   }
   svg.appendChild(el("path", {class: "mean", d: path}));
   for (const a of [-180, -90, 0, 90, 180]) {
-    svg.appendChild(el("text", {x: x(a), y: bottom + 24, "text-anchor": "middle"}, String(a)));
+    keepInside(svg.appendChild(el("text", {x: x(a), y: bottom + 24, "text-anchor": "middle"}, String(a))), W);
   }
-  svg.appendChild(el("text", {x: (left + right) / 2, y: H - 8, "text-anchor": "middle"},
-                      "degrees from the trained direction"));
+  keepInside(svg.appendChild(el("text", {x: (left + right) / 2, y: H - 8, "text-anchor": "middle"},
+                                 "degrees from the trained direction")), W);
   svg.appendChild(el("text", {x: left - 8, y: y(hi), "text-anchor": "end"}, fixed(hi)));
   svg.appendChild(el("text", {x: left - 8, y: y(lo), "text-anchor": "end"}, fixed(lo)));
   svg.appendChild(el("text", {x: left, y: top - 8}, unit || "adaptation index"));
