@@ -175,3 +175,41 @@ def test_the_lab_client_runs_the_protocol_its_class_hands_it_and_nothing_else(tm
         client._class_protocol({"name": "x", "blocks": "all of them"})
     with pytest.raises(ValueError):
         client._class_protocol(["lesson"])
+
+
+@pytest.mark.slow  # in chromium
+def test_the_projector_shows_the_two_groups_side_by_side_and_their_difference(tmp_path, runs, monkeypatch):
+    import urllib.request
+
+    from browser import browser_page
+    from class_server import running_class
+
+    from armgame.classroom import client
+
+    with running_class(tmp_path / "class", lab=str(runs / "strong.toml"), lab_b=str(runs / "weak.toml"),
+                       split_seed=5) as opened, browser_page(1024, 768) as page:
+        page.goto(f"http://127.0.0.1:{opened.port}/lab")
+        address = client.ClassAddress.parse(f"127.0.0.1:{opened.port}")
+        used = {"a": iter(BOTS), "b": iter(BOTS)}
+        for i in range(8):
+            name = f"S{i}"
+            monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
+            member = client.join(address, opened.clerk.roster.code, name, lab=True)
+            c = opened.clerk.roster.experiment.condition_of(name)
+            run = runs / f"{'strong' if c == 'a' else 'weak'}{next(used[c])[0]}.json"
+            assert "in the class curve" in client.hand_in(member, as_person(run, name)).message
+        page.wait_for_selector("body[data-students='8']", state="attached", timeout=10_000)
+        with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}/api/lab", timeout=10) as r:
+            groups = json.loads(r.read())["groups"]
+        assert page.locator("#groups").is_visible() and not page.locator("figure.curve").is_visible()
+        assert page.locator("#group-a polygon.band.a").count() == 1
+        assert page.locator("#group-b polygon.band.b").count() == 1
+        assert page.text_content("#difference") == groups["difference_words"]
+        assert "group A: strong" in page.text_content("#group-a-title")
+        boxes = page.evaluate("""() => ['#group-a', '#group-b', '#difference'].map((s) => {
+            const r = document.querySelector(s).getBoundingClientRect();
+            return [r.left, r.top, r.right, r.bottom]; })""")
+        assert all(left >= 0 and top >= 0 and right <= 1024.5 and bottom <= 768.5
+                   for left, top, right, bottom in boxes), boxes
+        assert boxes[0][2] <= boxes[1][0]  # side by side, not overlapping
+        page.screenshot(path=str(tmp_path.parent / "lab-groups.png"))
