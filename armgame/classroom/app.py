@@ -273,7 +273,14 @@ async def join(request: Request) -> Response:
             raise RefusedError(503, "many names are joining at once: try again in a moment")
     # A join for the lab says so (``armgame lab --join``): a closed class still takes it (``Clerk.join``).
     lab = body.get("for") == "lab"
-    player, new_token = await state.run(lambda: clerk.join(body.get("name"), token, address, lab=lab))
+    def joined() -> tuple[Any, str | None, Any]:
+        player, new_token = clerk.join(body.get("name"), token, address, lab=lab)
+        # In a classroom experiment, the lab's client is handed the protocol of the student's condition to run (as
+        # plain data: the client checks it as any protocol file); never the condition's name or its group.
+        protocol = clerk.assign(player.name) if lab else None
+        return player, new_token, protocol
+
+    player, new_token, protocol = await state.run(joined)
     if new_token is not None and not own:
         state.joins.add(address)
         state.class_joins.add("class")
@@ -282,8 +289,17 @@ async def join(request: Request) -> Response:
     return json_answer({"ok": True, "name": player.name, "token": new_token or token, "seed": clerk.roster.seed,
                         "rules": clerk.game.name, "duration": clerk.game.config.time_limit,
                         "rehearsal": clerk.rehearsal, "closed": clerk.roster.closed,
+                        **({} if protocol is None else {"lab": lab_as_data(protocol)}),
                         "message": f"joined the class as {player.name}" if new_token is None
                         else f"joined the class as {player.name} (the name is now this machine's)"})
+
+
+def lab_as_data(protocol: str | dict) -> dict:
+    """A class's protocol choice (a preset's name, or a protocol as data) as the data a lab client runs."""
+    from ..lab.analysis import curve_protocol
+    from ..lab.protocol_file import protocol_as_dict
+
+    return protocol if isinstance(protocol, dict) else protocol_as_dict(curve_protocol(protocol))
 
 
 async def hand_in(request: Request) -> Response:
@@ -361,6 +377,7 @@ def csv_download(make: Callable[[Clerk], str], filename: str) -> Endpoint:
 
 teacher_games_csv = csv_download(views.games_csv, "class-games.csv")
 teacher_lab_csv = csv_download(views.lab_csv, "class-lab-reaches.csv")
+teacher_students_csv = csv_download(views.students_table, "class-lab-students.csv")
 
 
 async def teacher_lab_png(request: Request) -> Response:
@@ -414,6 +431,7 @@ ROUTES = [
     Route("/api/teacher/roster", teacher_roster, middleware=SAME_SITE),
     Route("/api/teacher/games.csv", teacher_games_csv, middleware=SAME_SITE),
     Route("/api/teacher/lab.csv", teacher_lab_csv, middleware=SAME_SITE),
+    Route("/api/teacher/students.csv", teacher_students_csv, middleware=SAME_SITE),
     Route("/api/teacher/lab.png", teacher_lab_png, middleware=SAME_SITE),
 ]
 

@@ -215,6 +215,9 @@ class Membership:
     duration: float = 60.0
     #: The class is a rehearsal (``armgame class serve --rehearse``): nothing it takes is kept.
     rehearsal: bool = False
+    #: In a classroom experiment, the protocol the class hands this machine's lab to run (checked as any protocol
+    #: file is, ``lab.protocol_file.protocol_from_dict``), or None: run the one typed.
+    protocol: object = None
 
     @property
     def key(self) -> str:
@@ -271,11 +274,23 @@ def join(address: ClassAddress, code: str, name: str | None, lab: bool = False) 
         membership = Membership(address, code, check_name(answer["name"], "name"),
                                 check_pattern("token", answer["token"], memberships.TOKEN), int(answer["seed"]),
                                 answer.get("closed") is True, _duration(answer.get("duration", 60.0)),
-                                answer.get("rehearsal") is True)
+                                answer.get("rehearsal") is True, _class_protocol(answer.get("lab")) if lab else None)
     except (KeyError, TypeError, ValueError):  # what is kept is what a later read takes
         raise BadAnswerError("the class's answer is not armgame's (is that address an armgame class?)") from None
     _remember(membership)
     return membership
+
+
+def _class_protocol(value: object):
+    """The protocol a class's join answer hands the lab (None: none), checked as a protocol file's is: ValueError
+    otherwise (a hostile class's answer is no protocol)."""
+    if value is None:
+        return None
+    if not isinstance(value, dict):
+        raise ValueError("the class's lab protocol must be an object")
+    from ..lab.protocol_file import protocol_from_dict
+
+    return protocol_from_dict(value, "the class's lab protocol")
 
 
 def offline(address: ClassAddress, code: str, name: str | None) -> Membership | None:

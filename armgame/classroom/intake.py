@@ -195,6 +195,8 @@ class Clerk:
         player = self.roster.players.get(key)
         if player is not None:
             if token is not None and hmac.compare_digest(token_digest(token), player.token_sha256):
+                if lab:
+                    self.assign(player.name)
                 return player, None
             raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
                                f"name (or join from the machine that took it)")
@@ -219,7 +221,27 @@ class Clerk:
         player = Player(name, token_digest(new_token), now_iso(), address[:64])
         self.roster.add(key, player)
         self.version += 1
+        if lab:
+            self.assign(player.name)
         return player, new_token
+
+    def assign(self, name: str) -> str | dict | None:
+        """In a classroom experiment, ``name``'s protocol (a preset's name or a protocol as data): their condition's,
+        assigned at their first join for the lab and kept in the class's record before the join is answered;
+        None in a class of one protocol."""
+        experiment = self.roster.experiment
+        if experiment is None:
+            return None
+        before = list(experiment.assigned)
+        condition, new = experiment.assign(name)
+        if new:
+            try:
+                self.roster.save()
+            except BaseException:
+                experiment.assigned = before  # memory never disagrees with disk
+                raise
+            self.lab_version += 1
+        return experiment.protocol_of(condition)
 
     def player(self, token: str | None) -> Player:
         player = self.roster.player_of(token) if token else None
@@ -461,7 +483,7 @@ class Clerk:
         self.lab_version += 1
         if not person:
             counted = "a program's run: kept apart, never in the class curve"
-        elif first and self.curve_protocol() == protocol:
+        elif first and self.curve_protocol_of(player.name) == protocol:
             counted = "in the class curve"
         elif first:
             counted = "kept (the class curve shows the protocol the teacher chose)"
@@ -478,6 +500,17 @@ class Clerk:
             self.version += 1
             self.lab_version += 1
         return problems
+
+    def curve_protocol_of(self, name: str) -> Any:
+        """The protocol whose run of ``name``'s is in the class's curve: their condition's in an experiment (a student
+        never assigned: neither), else the teacher's choice."""
+        from ..lab.analysis import curve_protocol
+
+        experiment = self.roster.experiment
+        if experiment is None:
+            return self.curve_protocol()
+        condition = experiment.condition_of(name)
+        return None if condition is None else curve_protocol(experiment.protocol_of(condition))
 
     def curve_protocol(self) -> Any:
         """The protocol the teacher chose for the class curve (``Roster.lab``), or None."""
@@ -578,6 +611,9 @@ class Clerk:
 
         if protocol is not None and (not isinstance(protocol, str) or protocol not in PRESETS):
             raise RefusedError(400, f"the class curve shows one of the presets: {', '.join(sorted(PRESETS))}")
+        if self.roster.experiment is not None:  # the groups' protocols are the experiment: changing one ends it
+            raise RefusedError(409, "this class is an experiment of two conditions, fixed when it began: its curves "
+                                    "are the two groups'")
         self.roster.changed(lab=protocol)
         self.version += 1
         self.lab_version += 1

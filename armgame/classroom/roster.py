@@ -3,12 +3,13 @@
 Kept in the class's folder beside its table, written only by the server (one writer: the clerk
 thread), atomically and fsynced before a join is acknowledged::
 
-    class.json        {"format": "armgame-class", "format_version": 2, "code": "FROG", "seed": 10,
+    class.json        {"format": "armgame-class", "format_version": 3, "code": "FROG", "seed": 10,
                        "closed": false, "locked": false, "lab": "lesson", a protocol or null,
                        "round": {"number", "start", "minutes", "after"} or null,
                        "renamed": {old name's key: the name shown now},
                        "players": {key: {"name", "token_sha256", "joined", "address"}},
-                       "hidden": [key, ...]}
+                       "hidden": [key, ...],
+                       "experiment": {"a", "b", "seed", "assigned": [[key, "a" or "b"], ...]} or null}
     teacher.secret    the teacher's secret, created once with owner-only permissions
 
 A student's name is theirs: the first client to take it receives a random token, and only the
@@ -18,8 +19,9 @@ and a new name is refused if a reader would take it for one already in (``lookal
 skeletons of ``records.lookalikes``) or if it hides part of itself (``records.lookalikes.name_problem``).
 The address each name joined from is kept for the teacher (which names came from one machine).
 A ``locked`` roster takes no new names; ``lab`` is the protocol the class curve shows, the
-teacher's choice (``--lab``), never the one most names happened to run. Format 1 (before these)
-is read as it is and written back as 2.
+teacher's choice (``--lab``), never the one most names happened to run; ``experiment``, a split of the
+class into two conditions (``experiment.Experiment``). Formats 1 and 2 (before these) are read as they are
+and written back as 3.
 
 The join code is four letters from an alphabet with nothing a projector font confuses (no O/0,
 I/l/1, S/5, Z/2, B/8): short to type from the back row, and read case-insensitively.
@@ -45,11 +47,12 @@ from ..records.replay import now_iso
 from ..records.standings import legacy_player_key, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, dump_json, parse_json, read_limited
 from ..valid import HEX64, INT64_MAX, check_date, check_int, check_keys, check_name, check_str
+from .experiment import Experiment
 
 ROSTER_NAME = "class.json"
 SECRET_NAME = "teacher.secret"
 FORMAT = "armgame-class"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 CODE_ALPHABET = "ACDEFGHJKMNPQRTUVWXY"
 CODE_LENGTH = 4
 #: Names one class holds: a lecture hall of students, each with a program or two, with room.
@@ -109,6 +112,8 @@ class Roster:
     round: dict | None = None
     #: Names the teacher changed: the old name's ``player_key`` to the name the class shows now.
     renamed: dict[str, str] = field(default_factory=dict)
+    #: A classroom experiment: two conditions and who is in which (``experiment.Experiment``), or None.
+    experiment: Experiment | None = None
 
     def __post_init__(self) -> None:
         self.reindex()
@@ -193,7 +198,8 @@ class Roster:
             version = check_int("format_version", d.get("format_version"), 1, 10**6)
             if version > FORMAT_VERSION:
                 raise ValueError(f"class record format {version} is newer than this armgame reads: update armgame")
-            later = {"locked", "lab", "round", "renamed"} if version >= 2 else set()
+            later = ({"locked", "lab", "round", "renamed"} if version >= 2 else set()) | \
+                ({"experiment"} if version >= 3 else set())
             d = check_keys("class record", d, {"format", "format_version", "code", "seed", "closed", "players",
                                                "hidden", "created", *later})
             code = check_str("code", d["code"], CODE_LENGTH)
@@ -241,11 +247,14 @@ class Roster:
                 from .rounds import Round
 
                 rnd = Round.from_dict(rnd).as_dict()
+            experiment = d.get("experiment")
+            if experiment is not None:
+                experiment = Experiment.from_dict(experiment, MAX_PLAYERS)
         except ValueError as exc:
             raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
         hidden = {player_key(k) for k in d["hidden"]}  # player_key of an older key is today's key
         return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab, rnd,
-                   renamed)
+                   renamed, experiment)
 
     def save(self) -> None:
         """The record written whole (``dump_json``'s bytes): each player's lines made once and kept, since a
@@ -254,6 +263,7 @@ class Roster:
             "format": FORMAT, "format_version": FORMAT_VERSION, "code": self.code, "seed": self.seed,
             "closed": self.closed, "locked": self.locked, "lab": self.lab, "round": self.round,
             "renamed": dict(sorted(self.renamed.items())),
+            "experiment": None if self.experiment is None else self.experiment.as_dict(),
             "created": self.created,
             "hidden": sorted(self.hidden),
             "players": {},

@@ -134,13 +134,16 @@ class ClassServer:
 
 def open_class(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
                on_ready: Callable[[ClassServer], None] | None = None, lab: str | None = None,
-               proxy: str | None = None, rehearse: bool = False) -> ClassServer:
+               proxy: str | None = None, rehearse: bool = False, lab_b: str | None = None,
+               split_seed: int | None = None) -> ClassServer:
     """The class in ``folder`` (gone on with, or new) bound to ``host:port`` (0: a free port), not yet serving.
 
     ``say`` gets the teacher's lines: the banner once the server takes requests, notices after. ``lab``:
     the preset the class curve shows (a new class: ``lesson`` unless given; a class gone on with keeps its
     own unless given). ``proxy``: the address of a reverse proxy whose ``X-Forwarded-For`` is believed.
-    ``rehearse``: a rehearsal (``folder`` None), in a temporary folder removed when ``run`` ends."""
+    ``rehearse``: a rehearsal (``folder`` None), in a temporary folder removed when ``run`` ends. ``lab_b``: a
+    classroom experiment's second condition beside ``lab`` (``experiment``), split by ``split_seed`` (None: drawn
+    at random, and kept in the class's record)."""
     import uvicorn
 
     from ..lab.record import register
@@ -150,6 +153,9 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
     from .roster import SECRET_NAME, Roster
 
     curve = _curve_protocol(lab)
+    second = _curve_protocol(lab_b)
+    if second is not None and second == curve:
+        raise UserError("--lab-b names the same protocol as --lab: an experiment needs two conditions")
     register()  # lab runs are read as replays with their task section
     temporary = records = None
     if rehearse:
@@ -167,7 +173,23 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
         try:
             roster, new = Roster.open(folder, seed)
             if (new and roster.lab is None) or (curve is not None and curve != roster.lab):
+                if roster.experiment is not None:
+                    raise UserError(f"the class in {folder} is an experiment of its own two conditions: go on "
+                                    "with it without --lab, or start a new class in another --folder")
                 roster.changed(lab=curve or "lesson")
+            if second is not None and roster.experiment is None:
+                if not new:
+                    raise UserError(f"--lab-b: the class in {folder} has begun without an experiment; a split "
+                                    "starts with a new class (another --folder)")
+                import secrets
+
+                from .experiment import Experiment
+
+                seed_of_split = secrets.randbits(63) if split_seed is None else split_seed
+                roster.changed(experiment=Experiment(roster.lab, second, seed_of_split))  # type: ignore[arg-type]
+            elif second is not None and second != roster.experiment.b:  # type: ignore[union-attr]
+                raise UserError(f"--lab-b: the class in {folder} splits between its own two conditions: go on "
+                                "with it without --lab-b")
             clerk = Clerk(folder, roster, rehearsal=rehearse, records=records)
             sock = _bind(host, port)
         except BaseException:
@@ -297,10 +319,10 @@ class _QuietWhenFull(logging.Filter):
 
 def serve(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
           lab: str | None = None, proxy: str | None = None, rehearse: bool = False,
-          on_ready: Callable[[ClassServer], None] | None = None) -> int:
+          on_ready: Callable[[ClassServer], None] | None = None, lab_b: str | None = None) -> int:
     """Run the class in ``folder`` (a rehearsal: None) on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit
     status. ``on_ready``: as ``open_class``'s."""
-    opened = open_class(folder, host, port, seed, say, on_ready, lab=lab, proxy=proxy, rehearse=rehearse)
+    opened = open_class(folder, host, port, seed, say, on_ready, lab=lab, proxy=proxy, rehearse=rehearse, lab_b=lab_b)
     opened.run()
     if opened.temporary is not None:
         played = f"{plural(len(opened.clerk.entries), 'game')} and {plural(len(opened.clerk.lab_runs), 'lab run')}"

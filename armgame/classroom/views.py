@@ -95,11 +95,17 @@ def round_shown(clerk: Clerk, now: datetime | None = None) -> dict[str, object] 
 def class_curve(clerk: Clerk) -> Any:
     """``lab.analysis.class_curve_of`` the teacher's protocol over the class's runs (in SI units): hidden
     names left out, programs' runs counted apart."""
+    return curve_and_members(clerk)[0]
+
+
+def curve_and_members(clerk: Clerk) -> tuple[Any, list[Any]]:
+    """``class_curve`` and the runs in it (``classroom.labruns.LabRun``), in the curve's order."""
     from ..lab.analysis import ClassRun, class_curve_of
 
     runs = [run for run in clerk.lab_runs if run.program or (run.first and not clerk.roster.is_hidden(run.player))]
-    return class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
-                          clerk.curve_protocol())
+    curve = class_curve_of([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                           clerk.curve_protocol())
+    return curve, [runs[i] for i in curve.members]
 
 
 def lab_curve(clerk: Clerk) -> dict[str, object]:
@@ -107,18 +113,116 @@ def lab_curve(clerk: Clerk) -> dict[str, object]:
     and hidden names never in it; the programs counted apart). Built by ``lab.analysis.class_curve_of``,
     as ``armgame analyze --class`` builds it from the folder afterwards."""
     from ..lab.analysis import display_unit
+    from ..lab.classstats import answer_line, class_stats
 
     protocol = clerk.curve_protocol()
-    curve = class_curve(clerk)
+    curve, members = curve_and_members(clerk)
     if not curve.students:
         return {"protocol": None if protocol is None else protocol.name, "students": 0, "programs": curve.programs,
-                "metric": None, "trials": []}
+                "metric": None, "trials": [], "stats": None, "groups": groups_view(clerk)}
     scale, unit = display_unit(curve.metric)  # type: ignore[arg-type]
     trials = [{"trial": int(row["trial"]), "block": str(row["block"]), "perturbation": str(row["perturbation"]),
                "mean": _finite(row["mean"], scale), "sem": _finite(row["sem"], scale), "n": int(row["n"])}
               for row in curve.trials]
+    stats = class_stats(curve.protocol, [(clerk.shown_name(run.player), run.rows) for run in members], curve.metric)
     return {"protocol": protocol.name, "students": curve.students, "programs": curve.programs,
-            "metric": curve.metric, "unit": unit, "trials": trials}
+            "metric": curve.metric, "unit": unit, "trials": trials, "groups": groups_view(clerk),
+            "stats": {**stats.as_dict(scale, probe_scale(curve.protocol, curve.metric)),
+                      "probe_unit": probe_unit(curve.protocol, curve.metric),
+                      "answer": answer_line(stats, scale, unit)}}
+
+
+def experiment_groups(clerk: Clerk) -> Any:
+    """A classroom experiment's two groups (``lab.classstats.two_groups``) over the class's runs, or None."""
+    from ..lab.analysis import ClassRun, curve_protocol
+    from ..lab.classstats import two_groups
+
+    experiment = clerk.roster.experiment
+    if experiment is None:
+        return None
+    runs = [run for run in clerk.lab_runs if run.program or (run.first and not clerk.roster.is_hidden(run.player))]
+    # By the name each run was handed in under: the split keeps the name a student joined with, renamed or not.
+    return two_groups([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
+                      (curve_protocol(experiment.a), curve_protocol(experiment.b)),
+                      lambda name: experiment.condition_of(name))
+
+
+def groups_view(clerk: Clerk) -> dict[str, object] | None:
+    """The two groups as ``/lab`` draws them side by side, and their difference in one line."""
+    from ..lab.analysis import display_unit
+    from ..lab.classstats import difference_words
+
+    groups = experiment_groups(clerk)
+    if groups is None:
+        return None
+    scale, unit = display_unit(groups.metric)
+    counts = clerk.roster.experiment.counts()  # type: ignore[union-attr]
+    out: dict[str, object] = {}
+    for c, curve, stats in zip(("a", "b"), groups.curves, groups.stats, strict=True):
+        out[c] = {"name": f"group {c.upper()}", "protocol": curve.protocol.name, "assigned": counts[c],  # type: ignore[attr-defined]
+                  "students": curve.students, "stats": None if stats is None else stats.as_dict(scale)}  # type: ignore[attr-defined]
+    return {**out, "metric": groups.metric, "unit": unit,
+            "difference": None if groups.difference is None else groups.difference.as_dict(scale),
+            "difference_words": difference_words(groups, scale, unit)}
+
+
+def probe_scale(protocol: Any, metric: str) -> float:
+    """The factor the generalization panel shows probes in: an adaptation index as it is, a probe's error in the
+    curve's unit."""
+    from ..lab.analysis import display_unit
+
+    return 1.0 if probe_unit(protocol, metric) == "" else display_unit(metric)[0]
+
+
+def probe_unit(protocol: Any, metric: str) -> str:
+    """The generalization panel's unit: "" for the channel trials' adaptation index, else the curve's."""
+    from ..lab.analysis import display_unit
+    from ..lab.classstats import generalization_blocks
+
+    blocks = generalization_blocks(protocol)
+    channels = any(protocol.blocks[b].channel_trials for b in blocks)
+    return "" if channels else display_unit(metric)[1]
+
+
+#: Each run's two-rate fit, made once (a fit costs a tenth of a second; a run's rows never change), by its file.
+_FITS: dict[tuple[str, str], dict[str, float]] = {}
+
+
+def students_table(clerk: Clerk) -> str:
+    """The teacher's table of the class curve's students, one row each (``lab.classstats.student_table``), as
+    ``armgame analyze --class --students`` writes it from the folder (``students_csv``)."""
+    curve, members = curve_and_members(clerk)
+    if not curve.students:
+        return students_csv(None, None, [], [])
+    fits = []
+    from ..lab.classstats import student_fit
+
+    for run in members:
+        key = (str(run.path), curve.metric)
+        if key not in _FITS:
+            if len(_FITS) > 10_000:  # a server that ran many classes: the cache is a cache, not a record
+                _FITS.clear()
+            _FITS[key] = student_fit(run.rows, curve.metric)
+        fits.append(_FITS[key])
+    return students_csv(curve.protocol, curve.metric, [(clerk.shown_name(run.player), run.rows) for run in members],
+                        fits)
+
+
+def students_csv(protocol: Any, metric: str | None, students: Sequence[tuple[str, Any]],
+                 fits: Sequence[Any] | None = None) -> str:
+    """The students' table as CSV text (the teacher's download and ``armgame analyze --class --students``): a
+    student a row, each measure in the unit the page shows it (cm or deg: the column names it), the fitted rates
+    as they are; an empty cell where a measure is undefined or the fit did not converge."""
+    from ..lab.analysis import display_unit
+    from ..lab.classstats import FIT_NAMES, STUDENT_COLUMNS, student_table
+
+    if protocol is None or metric is None:
+        return _csv(STUDENT_COLUMNS, [])
+    scale, unit = display_unit(metric)
+    table = student_table(protocol, students, metric, fits)
+    columns = [c if c == "name" or c in FIT_NAMES else f"{c}_{unit}" for c in STUDENT_COLUMNS]
+    return _csv(columns, ([row["name"], *(float(row[c]) * (1.0 if c in FIT_NAMES else scale)  # type: ignore[arg-type]
+                                           for c in STUDENT_COLUMNS[1:])] for row in table))
 
 
 def roster_view(clerk: Clerk) -> dict[str, object]:

@@ -67,6 +67,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="also write each run's channel trials' force over time, one row per physics step: "
                    "REPLAY.channel_traces.csv beside the tables (trial, block, target_deg, time_s, channel_force_n, "
                    "cancelling_force_n, hand_speed_m_per_s)")
+    p.add_argument("--students", metavar="FILE.csv", default=None,
+                   help="with --class: also write the class's students, one row each (name, early and late exposure "
+                   "error, late - early, late baseline, after-effect, in cm or deg as the column says, and the "
+                   "two-rate learner's rates where a fit converges): the table the live class's teacher's page "
+                   "downloads")
     p.add_argument("--protocol", metavar="NAME", default=None,
                    help="with --class: the protocol (its name) whose replays make the curve (default: the one most "
                    "replays share)")
@@ -90,7 +95,11 @@ def _run(args: argparse.Namespace) -> int:
             raise UserError("--subtract-baseline and --channel-traces apply to replays, not --class")
         if args.out is None:
             raise UserError("--class needs --out DIR: the folder for class_curve.csv and class_curve.png")
+        if args.students is not None and not args.students.lower().endswith(".csv"):
+            raise UserError(f"--students {args.students}: give a .csv file for the students' table")
         return _class(args)
+    if args.students is not None:
+        raise UserError("--students applies with --class only")
     if not args.replays:
         raise UserError("no replay given: armgame analyze REPLAY... --out trials.csv (or --class DIR)")
     if args.out is None and not args.fit:  # a fit alone is printed; the table has nowhere else to go
@@ -457,8 +466,13 @@ def _class(args: argparse.Namespace) -> int:
                            people_only=roster is not None)
     shared = None if protocol is None else \
         f"{protocol.name!r}, shared by {sum(run[2].protocol == protocol for run in runs)} replays"
+    second = None
+    if roster is not None and roster.experiment is not None:
+        second = curve_protocol(roster.experiment.b)  # the experiment's group B: its own curve, never left out
     for i, why in curve.left_out:
         other = runs[i][2].protocol
+        if second is not None and other == second and why.startswith("another protocol"):
+            continue
         if why.startswith("another protocol") and protocol is not None:
             why = (f"its protocol is also named {other.name!r} but differs from the class's ({shared})"
                    if other.name == protocol.name
@@ -487,8 +501,34 @@ def _class(args: argparse.Namespace) -> int:
 
         class_figure(curve.trials, out / "class_curve.png", metric=metric)  # type: ignore[arg-type]
         written.append(out / "class_curve.png")
+    from ..lab.analysis import display_unit
+    from ..lab.classstats import answer_line, class_stats
+
+    members = [(replays[i].player or runs[i][0].stem, runs[i][1]) for i in curve.members]
+    scale, unit = display_unit(metric)  # type: ignore[arg-type]
+    if args.students is not None:
+        from ..classroom.views import students_csv
+        from ..lab.metrics import _write_text
+
+        table = user_path(args.students, "--students")
+        _write_text(table, students_csv(curve.protocol, metric, members))
+        written.append(table)
     print(f"class curve of {plural(curve.students, 'student')} ({skipped} left out), "
           f"{plural(len(curve.trials), 'trial')}, {metric}")
+    print(f"  the class's answer: {answer_line(class_stats(curve.protocol, members, metric), scale, unit)}")
+    if roster is not None and roster.experiment is not None:  # the projector's two groups, from the same runs
+        from ..lab.analysis import curve_protocol
+        from ..lab.classstats import difference_words, two_groups
+
+        experiment = roster.experiment
+        groups = two_groups([ClassRun(r.player, r.driven != "keyboard", run[2].protocol, run[1])
+                             for run, r in zip(runs, replays, strict=True)],
+                            (curve_protocol(experiment.a), curve_protocol(experiment.b)), experiment.condition_of)
+        g_scale, g_unit = display_unit(groups.metric)
+        for c, g_curve, g_stats in zip("AB", groups.curves, groups.stats, strict=True):
+            said = "no run" if g_stats is None else answer_line(g_stats, g_scale, g_unit)
+            print(f"  group {c} ({g_curve.protocol.name}, {plural(g_curve.students, 'student')}): {said}")
+        print(f"  the experiment's answer: {difference_words(groups, g_scale, g_unit)}")
     if curve.programs:
         print(f"  {plural(curve.programs, 'run')} of programs kept apart (never in a class's curve, as on its /lab "
               "page)")
@@ -510,7 +550,8 @@ def _fresh_outputs(args: argparse.Namespace):
     out = user_path(args.out, "--out")
     figures = not args.no_figures
     if args.class_dir is not None:
-        return fresh_outputs([out / "class_curve.csv", *([out / "class_curve.png"] if figures else [])],
+        students = [] if args.students is None else [user_path(args.students, "--students")]
+        return fresh_outputs([out / "class_curve.csv", *([out / "class_curve.png"] if figures else []), *students],
                              args.force, folder=out)
     one_table = out.suffix.lower() == ".csv"
     folder = out.parent if one_table else out

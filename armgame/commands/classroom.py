@@ -50,6 +50,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     serve.add_argument("--seed", type=_seed, default=None, help="the seed the class ranks (a new class: default 10)")
     serve.add_argument("--lab", metavar="PRESET", help="the lab preset the class curve shows (a new class: lesson; "
                        "the teacher's page can change it)")
+    serve.add_argument("--lab-b", metavar="PRESET", help="a classroom experiment: the second condition (a preset or a "
+                       "protocol's .toml file) beside --lab's; each student is assigned one of the two at their first "
+                       "join for the lab, at random in blocks of two (the groups stay within one of equal size), "
+                       "and their lab is handed its protocol to run. Fixed for the class's life: only a new class "
+                       "starts an experiment")
     serve.add_argument("--proxy", metavar="ADDRESS", help="believe X-Forwarded-For from this address only (a reverse "
                        "proxy in front of the class; default: none, a client's address is its socket's)")
     serve.add_argument("--rehearse", action="store_true", help="a rehearsal of the lesson: 15 s games and 30 s "
@@ -86,8 +91,10 @@ def run_serve(args: argparse.Namespace) -> int:
     if folder is not None and folder.exists() and not folder.is_dir():
         raise UserError(f"--folder {folder}: not a folder")
     host = args.host or lan_address()
+    if args.lab_b is not None and args.lab is None:
+        raise UserError("--lab-b is the experiment's second condition: name the first with --lab")
     return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True), lab=args.lab,
-                 proxy=args.proxy, rehearse=args.rehearse)
+                 proxy=args.proxy, rehearse=args.rehearse, lab_b=args.lab_b)
 
 
 def run_submit(args: argparse.Namespace) -> int:

@@ -221,6 +221,8 @@ def run(args: argparse.Namespace) -> int:
 
     args.membership = join_class(args, lab=True)  # before the run: a wrong code is said now, not after ten minutes
     args.refused = False
+    if args.membership is not None and args.membership.protocol is not None:
+        protocol = args.membership.protocol  # a classroom experiment: the class says which protocol this student runs
     config = check_recordable(lab_config(protocol, args.seed, remap_keys(DEFAULT_MUSCLES, args.keys),
                                          person=not args.bot), str(args.protocol))
     session = LabSession(config, protocol)

@@ -194,6 +194,7 @@ $("rename").addEventListener("click", async () => {
 });
 $("games-csv").addEventListener("click", () => download("/api/teacher/games.csv", "class-games.csv"));
 $("lab-csv").addEventListener("click", () => download("/api/teacher/lab.csv", "class-lab-reaches.csv"));
+$("students-csv").addEventListener("click", () => download("/api/teacher/students.csv", "class-lab-students.csv"));
 $("lab-png").addEventListener("click", () => download("/api/teacher/lab.png", "class-lab-curve.png"));
 refresh();
 
