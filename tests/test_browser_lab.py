@@ -295,6 +295,46 @@ def test_a_replay_without_the_sine_is_the_c_librarys_as_before(played):
     assert read.verify(config, library.timeline, library.result())[0]
 
 
+def test_the_class_serves_its_plan_and_takes_the_browsers_run_into_its_curve(tmp_path, monkeypatch):
+    """``/api/labplan``: the teacher's protocol (the lesson's until one is chosen) resolved for the class's seed; the
+    run the browser plays on it, handed in, is verified by the class and enters its curve."""
+    import urllib.request
+
+    from class_server import running_class
+
+    from armgame.classroom import client
+    from armgame.lab.plan import class_plan_json
+
+    def get(opened, path: str) -> dict:
+        with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}{path}", timeout=10) as r:
+            return json.loads(r.read())
+
+    with running_class(tmp_path / "class", seed=2**63 - 5) as opened:
+        plan = get(opened, "/api/labplan")
+        protocol = preset("lesson")
+        config = lab_config(protocol, 2**63 - 5, person=True)
+        assert plan == lab_plan(config, protocol) and plan["config"]["seed"] == str(2**63 - 5)
+        assert class_plan_json(protocol, 2**63 - 5) == class_plan_json(protocol, 2**63 - 5)  # made once
+        bot = LabSession(config, protocol, sine="arm")
+        Autopilot(bot, make_lab_bot("adaptive")).play()
+        events = [[e.step, e.key, e.action] for e in bot.timeline]
+        answer = run_node({"plans": [plan], "runs": [{"plan": 0, "events": events, "stop": config.total_steps,
+                                                      "frame": 4, "replay": "Ann"}]})
+        monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann"))
+        ann = client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Ann",
+                          lab=True)
+        handed = client.hand_in(ann, answer["runs"][0]["replay"].encode())
+        assert handed.message == "lab run handed in: in the class curve"
+        assert get(opened, "/api/lab")["students"] == 1
+        # The teacher chooses another protocol (from the teacher's own machine): the plan follows.
+        req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/lab",
+                                     data=json.dumps({"protocol": "curl"}).encode(),
+                                     headers={"Content-Type": "application/json"})
+        urllib.request.urlopen(req, timeout=10).close()
+        assert get(opened, "/api/labplan")["protocol"]["name"] == "curl"
+    assert [run.player for run in opened.clerk.lab_runs] == ["Ann"]
+
+
 def test_plans_it_cannot_play_are_refused_in_one_line(played):
     plan = played["plans"][0]
     bad = [{**plan, "format": "x"}, {**plan, "sine": "library"}, {**plan, "trials": []},

@@ -12,15 +12,21 @@ number the run depends on and that Python computes once with the C library (a ta
 
 from __future__ import annotations
 
+import functools
+import json
+
+from ..errors import UserError
 from ..game.rules import GameConfig
 from ..physics.loads import ChannelField, ConstantForce, CurlField, Loads, SpringField, ViscousField
 from ..records.replay import config_to_dict
 from .protocol import STILL_SPEED, Protocol
 from .protocol_file import protocol_as_dict
-from .session import LabSession, TrialPlan
+from .session import LabSession, TrialPlan, lab_config
 
 PLAN_FORMAT = "armgame-lab-plan"
 PLAN_VERSION = 1
+#: The most trials a class's plan holds (about 0.4 kB a trial: 0.8 MB); every preset has at most 216.
+MAX_PLAN_TRIALS = 2000
 
 
 def _pair(values: tuple[float, float]) -> list[float]:
@@ -98,3 +104,13 @@ def lab_plan(config: GameConfig, protocol: Protocol) -> dict[str, object]:
         "mixed": mixed, "trials": trials,
     }
 
+
+
+@functools.lru_cache(maxsize=8)
+def class_plan_json(protocol: Protocol, seed: int) -> bytes:
+    """The plan of a class's lab run as the class serves it (``/api/labplan``): ``protocol`` on the class's
+    ``seed``, on a person's clock (``lab_config(person=True)``), as JSON text; made once a protocol and seed."""
+    if protocol.trials > MAX_PLAN_TRIALS:
+        raise UserError(f"the lab protocol {protocol.name} has {protocol.trials} trials, more than a browser's run "
+                        f"plays ({MAX_PLAN_TRIALS})")
+    return json.dumps(lab_plan(lab_config(protocol, seed, person=True), protocol)).encode()
