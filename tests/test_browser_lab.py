@@ -20,18 +20,22 @@ import dataclasses
 import json
 import os
 import random
+import re
 import shutil
 import struct
 import subprocess
+import urllib.request
 from pathlib import Path
 
 import pytest
+from class_server import running_class
 
+from armgame.classroom import client
 from armgame.game.bots import Autopilot
 from armgame.game.session import InputEvent
 from armgame.lab.bots import make_lab_bot
 from armgame.lab.perturbations import NONE, Constant, Curl, JointSpace, JointViscous, Mirror, Rotation, Spring, Viscous
-from armgame.lab.plan import lab_plan
+from armgame.lab.plan import class_plan_json, lab_plan
 from armgame.lab.presets import PRESETS, preset
 from armgame.lab.protocol import Block, Protocol
 from armgame.lab.record import LabTask, paths_digest
@@ -298,13 +302,6 @@ def test_a_replay_without_the_sine_is_the_c_librarys_as_before(played):
 def test_the_class_serves_its_plan_and_takes_the_browsers_run_into_its_curve(tmp_path, monkeypatch):
     """``/api/labplan``: the teacher's protocol (the lesson's until one is chosen) resolved for the class's seed; the
     run the browser plays on it, handed in, is verified by the class and enters its curve."""
-    import urllib.request
-
-    from class_server import running_class
-
-    from armgame.classroom import client
-    from armgame.lab.plan import class_plan_json
-
     def get(opened, path: str) -> dict:
         with urllib.request.urlopen(f"http://127.0.0.1:{opened.port}{path}", timeout=10) as r:
             return json.loads(r.read())
@@ -342,3 +339,14 @@ def test_plans_it_cannot_play_are_refused_in_one_line(played):
     answer = run_node({"plans": bad, "runs": [{"plan": i, "events": [], "stop": 10, "frame": 1} for i in range(4)]})
     errors = [r.get("error", "") for r in answer["runs"]]
     assert all(e and "\n" not in e for e in errors), errors
+
+
+def test_the_lab_engine_needs_nothing_a_strict_page_refuses():
+    """An ES module importing only the game's engine; no eval, no WebAssembly, no C library trig, no randomness."""
+    source = (ROOT / "armgame" / "classroom" / "static" / "labengine.js").read_text(encoding="utf-8")
+    code = "\n".join(line.split("//")[0] for line in source.splitlines())
+    assert len(re.findall(r"^import ", code, re.MULTILINE)) == 1
+    assert re.findall(r'from "([^"]*)"', code) == ["./engine.js"]
+    for banned in ("eval(", "new Function", "import(", "Math.sin", "Math.cos", "Math.random", "WebAssembly",
+                   "require(", "crypto."):
+        assert banned not in code, banned

@@ -108,7 +108,7 @@ const K256 = new Uint32Array([
   0xc67178f2]);
 
 /** SHA-256 of bytes, as hex: the lab's paths digest (record.paths_digest). A page served over plain HTTP on
- * the class's network is no secure context, so crypto.subtle is not there to ask. */
+ * the class's network is no secure context, so the browser's own digest (SubtleCrypto) is not there to ask. */
 export function sha256Hex(bytes) {
   const length = bytes.length;
   const padded = new Uint8Array(((length + 9 + 63) >> 6) << 6);
