@@ -218,6 +218,21 @@ async def lab(request: Request) -> Response:
     return Response(_state(request).lab, 200, media_type="application/json")
 
 
+async def lab_plan(request: Request) -> Response:
+    """The class's lab for a browser's run (``lab.plan``): the teacher's protocol (the lesson's until one is chosen)
+    with every trial resolved for the class's seed, made once (off the event loop) and kept."""
+    from ..lab.plan import class_plan_json
+    from ..lab.presets import preset
+
+    clerk = _state(request).clerk
+    protocol = clerk.curve_protocol() or preset("lesson")
+    try:
+        data = await asyncio.to_thread(class_plan_json, protocol, clerk.roster.seed)
+    except UserError as exc:
+        raise RefusedError(409, str(exc)) from None
+    return Response(data, 200, media_type="application/json")
+
+
 async def events(request: Request) -> Response:
     """The projector's live page: the latest standings and class curve at every change, never a backlog."""
     state = _state(request)
@@ -416,6 +431,7 @@ ROUTES = [
     Route("/static/{name}", asset, middleware=SAME_SITE),
     Route("/api/standings", standings, middleware=SAME_SITE),
     Route("/api/lab", lab, middleware=SAME_SITE),
+    Route("/api/labplan", lab_plan, middleware=SAME_SITE),
     Route("/events", events, middleware=SAME_SITE),
     Route("/api/join", join, methods=POST, middleware=SAME_SITE),
     Route("/api/handin", hand_in, methods=POST, middleware=SAME_SITE),

@@ -376,6 +376,9 @@ def rotation(angle_deg: float, centre: tuple[float, float]) -> Display:
         dx, dy = x - cx, y - cy
         return cx + c * dx - s * dy, cy + s * dx + c * dy
 
+    # Its numbers, for the browser's lab (``lab.plan``): (cx + m11 dx) + m12 dy, (cy + m21 dx) + m22 dy is the same
+    # arithmetic, a - b being a + (-b) in IEEE doubles.
+    show.plan = ("linear", cx, cy, c, -s, s, c)  # type: ignore[attr-defined]
     return show
 
 
@@ -389,6 +392,7 @@ def mirror(axis_deg: float, centre: tuple[float, float]) -> Display:
         dx, dy = x - cx, y - cy
         return cx + c * dx + s * dy, cy + s * dx - c * dy
 
+    show.plan = ("linear", cx, cy, c, s, s, -c)  # type: ignore[attr-defined]
     return show
 
 
@@ -399,4 +403,5 @@ def joint_space(gain: float, centre: tuple[float, float], home_q: tuple[float, f
     def show(x: float, y: float, q1: float, q2: float) -> tuple[float, float]:
         return cx + gain * (q1 - h1), cy + gain * (q2 - h2)
 
+    show.plan = ("joint", cx, cy, gain, h1, h2)  # type: ignore[attr-defined]
     return show

@@ -26,7 +26,7 @@ from ..records.replay import register_task, same_outcome
 from ..valid import HEX64, INT64_MAX, check_int, check_keys, check_str
 from .protocol import Protocol
 from .protocol_file import protocol_as_dict, protocol_from_dict
-from .session import LAB_SCENE, LabSession
+from .session import LAB_SCENE, SINES, LabSession
 
 TASK_KIND = "centre-out"
 
@@ -47,23 +47,28 @@ class LabTask:
     @classmethod
     def of(cls, session: LabSession, motor_noise: MotorNoise | None = None) -> LabTask:
         return cls(session.protocol, tuple((t, g, e, h) for t, g, e, h in session.trial_records()),  # type: ignore[misc]
-                   paths_digest(session), motor_noise, trial_fields(session))
+                   paths_digest(session), motor_noise, trial_fields(session), session.sine)
 
     #: A protocol with mixed blocks (issue 41): each finished trial's perturbation as it ran (``Perturbation.label``),
     #: for the reader and checked by verify; None otherwise (and absent from the file).
     fields: tuple[str, ...] | None = None
+    #: Which sine the run's hand took (``session.SINES``): written only when it is the arm's own (the browser's lab
+    #: runs), so a replay without the key is one of the C library's, as every run recorded before.
+    sine: str = "library"
 
     def as_dict(self) -> dict[str, object]:
         noise = {} if self.motor_noise is None else {"motor_noise": self.motor_noise.as_dict()}
         fields = {} if self.fields is None else {"fields": list(self.fields)}
+        sine = {} if self.sine == "library" else {"sine": self.sine}
         return {"kind": TASK_KIND, "protocol": protocol_as_dict(self.protocol),
-                "trials": [list(t) for t in self.trials], "paths_sha256": self.paths_sha256, **noise, **fields}
+                "trials": [list(t) for t in self.trials], "paths_sha256": self.paths_sha256, **noise, **fields,
+                **sine}
 
     @classmethod
     def from_dict(cls, data: object, config: GameConfig, last_step: int) -> LabTask:
         """Rebuild and check a task section; raises ValueError naming the bad field."""
         d = check_keys("task", data, {"kind", "protocol", "trials", "paths_sha256"},
-                       frozenset({"motor_noise", "fields"}))
+                       frozenset({"motor_noise", "fields", "sine"}))
         kind = check_str("task.kind", d["kind"], 40)
         if kind != TASK_KIND:
             raise ValueError(f"task.kind must be {TASK_KIND!r}, got {kind!r}")
@@ -93,12 +98,15 @@ class LabTask:
             if not isinstance(d["fields"], list) or len(d["fields"]) != len(trials):
                 raise ValueError("task.fields must be a list of one perturbation per trial")
             fields = tuple(check_str(f"task.fields[{i}]", v, 120) for i, v in enumerate(d["fields"]))
+        sine = check_str("task.sine", d["sine"], 20) if "sine" in d else "library"
+        if sine not in SINES:
+            raise ValueError(f"task.sine must be one of {', '.join(SINES)}, got {sine!r}")
         return cls(protocol, tuple(trials), digest, _motor_noise(d["motor_noise"]) if "motor_noise" in d else None,
-                   fields)
+                   fields, sine)
 
     def new_session(self, config: GameConfig) -> LabSession:
         """A fresh session of this task, at its start (for a window to replay the timeline into)."""
-        return LabSession(config, self.protocol)
+        return LabSession(config, self.protocol, sine=self.sine)
 
     def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> LabSession:
         """The run re-simulated from its timeline: the session, with every trial's hand path."""

@@ -36,13 +36,18 @@ from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
 from ..game.rules import MAX_CONFIG_SECONDS, GameConfig, Target
 from ..game.session import GameResult, GameSession
 from ..limits import MAX_GAME_SECONDS
-from ..physics.hand import hand_from_trig, hand_xy
+from ..physics.hand import hand_from_trig, hand_xy, hand_xy_arm_sine
 from ..physics.integrators import Integrator
 from ..physics.loads import ChannelField, Loads, loaded_arm
+from ..physics.trig import sin_cos
 from .perturbations import NONE, Display, Perturbation
 from .protocol import MAX_CHANNEL_LAMBDA_DT, STILL_SPEED, Block, Protocol
 
 HOLD, REACH = "hold", "reach"
+#: Which sine a run's hand takes, every step (its cursor, its path, the hand a field pushes): ``library``, the C
+#: library's (``math``: every run recorded before the browser's lab, and the envs'), or ``arm``, the arm's own
+#: (``physics.trig``: the same bits on every machine and in the browser's lab, ``classroom/static/labengine.js``).
+SINES = ("library", "arm")
 _WENT, _ENDED = 1, 2
 LAB_SCENE = "lab"
 
@@ -247,8 +252,13 @@ class LabSession(GameSession):
     """A centre-out experiment on the game's session: see the module's docstring."""
 
     def __init__(self, config: GameConfig, protocol: Protocol, hold_at_home: bool = True, *,
-                 compiled: bool = True) -> None:
+                 compiled: bool = True, sine: str = "library") -> None:
         super().__init__(config, compiled=compiled)
+        if sine not in SINES:
+            raise UserError(f"a lab run's sine is one of {', '.join(SINES)}, got {sine!r}")
+        self.sine = sine
+        self._arm_sine = sine == "arm"
+        self._hand_xy = hand_xy_arm_sine if self._arm_sine else hand_xy
         #: True (the lab's rule): the go cue waits for the cursor to stay in home for the trial's delay.
         #: False (for agents, ``armgame/CenterOut-v1``): it comes that delay after the trial began, wherever
         #: the cursor is, so a policy that cannot yet hold still still starts trials.
@@ -300,9 +310,13 @@ class LabSession(GameSession):
         if (q1, q2) == tuple(self.home_q):
             return self.home, self.home_q
         p = self.config.arm
-        return hand_xy(p.l1, p.l2, q1, q2), (q1, q2)
+        return self._hand_xy(p.l1, p.l2, q1, q2), (q1, q2)
 
     # ------------------------------------------------------------------ queries
+    def hand(self) -> tuple[float, float]:
+        p = self.config.arm
+        return self._hand_xy(p.l1, p.l2, self.state[0], self.state[1])
+
     @property
     def cursor_visible(self) -> bool:
         """Whether the player sees the cursor now: always at home, and in a reach unless the trial hides it."""
@@ -370,7 +384,7 @@ class LabSession(GameSession):
         if key not in self._physics:
             loads = perturbation.loads(self.home)
             step = self.unloaded_step() if loads is None else \
-                Integrator(self.config.integrator, loaded_arm(self.model, loads)).step_components
+                Integrator(self.config.integrator, loaded_arm(self.model, loads, self._arm_sine)).step_components
             self._physics[key] = (step, perturbation.display(self.home, self.home_q))
         return self._physics[key]
 
@@ -383,7 +397,8 @@ class LabSession(GameSession):
             length = math.hypot(tx - hx, ty - hy)
             channel = ChannelField(self.protocol.channel_stiffness, self.protocol.channel_damping, self.home,
                                    ((tx - hx) / length, (ty - hy) / length))
-            step = Integrator(self.config.integrator, loaded_arm(self.model, Loads(hand=channel))).step_components
+            step = Integrator(self.config.integrator,
+                              loaded_arm(self.model, Loads(hand=channel), self._arm_sine)).step_components
             self._channels[key] = (step, channel)
         return self._channels[key]
 
@@ -420,7 +435,10 @@ class LabSession(GameSession):
         channel = self._channel
         assert channel is not None
         l1, l2 = self.config.arm.l1, self.config.arm.l2
-        s1, c1, s12, c12 = math.sin(q1), math.cos(q1), math.sin(q1 + q2), math.cos(q1 + q2)
+        if self._arm_sine:
+            (s1, c1), (s12, c12) = sin_cos(q1), sin_cos(q1 + q2)
+        else:
+            s1, c1, s12, c12 = math.sin(q1), math.cos(q1), math.sin(q1 + q2), math.cos(q1 + q2)
         x, y = hand_from_trig(l1, l2, c1, s1, c12, s12)
         vx = (-l1 * s1 - l2 * s12) * w1 - l2 * s12 * w2
         vy = (l1 * c1 + l2 * c12) * w1 + l2 * c12 * w2
@@ -467,6 +485,7 @@ class LabSession(GameSession):
         previous = self.state
         step, show = self._step, self._show
         channel = self._channel
+        hand_at = self._hand_xy
         ran = 0
         while ran < n:
             t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
@@ -479,7 +498,7 @@ class LabSession(GameSession):
             q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
             self.steps += 1
             ran += 1
-            hx, hy = hand_xy(l1, l2, q1, q2)
+            hx, hy = hand_at(l1, l2, q1, q2)
             if show is not None:
                 hx, hy = show(hx, hy, q1, q2)
             if channel is not None:

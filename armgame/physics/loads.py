@@ -40,6 +40,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from . import trig
 from .twojoint import ComponentDynamics, TwoJointArm
 
 
@@ -159,12 +160,17 @@ def hand_force_torque(model: TwoJointArm, force: HandForce, q: Any, qd: Any, t: 
 
 class LoadedArm:
     """A ``TwoJointArm`` with loads: ``component_dynamics(backend)`` includes them; everything else
-    (kinematics, energy, the unloaded dynamics) is the arm's own."""
+    (kinematics, energy, the unloaded dynamics) is the arm's own.
 
-    def __init__(self, model: TwoJointArm, loads: Loads) -> None:
+    ``arm_sine``: the hand and the Jacobian a hand force acts through take the arm's own sine (``physics.trig``,
+    the same bits on every machine and in the browser's lab) instead of the C library's (the float backend's
+    default, which the compiled fields of ``_ckernel.c`` match)."""
+
+    def __init__(self, model: TwoJointArm, loads: Loads, arm_sine: bool = False) -> None:
         self.model = model
         self.params = model.params
         self.loads = loads
+        self.arm_sine = arm_sine
         self._components: dict[str, ComponentDynamics] = {}
 
     def __getattr__(self, name: str) -> Any:
@@ -173,7 +179,9 @@ class LoadedArm:
     def component_dynamics(self, backend: str = "float") -> ComponentDynamics:
         if backend not in self._components:
             base = self.model.component_dynamics(backend)
-            if backend == "float":
+            if backend == "float" and self.arm_sine:
+                built = _with_loads(base, self.model, self.loads, trig.cos, trig.sin)
+            elif backend == "float":
                 built = _with_loads(base, self.model, self.loads, math.cos, math.sin)
             else:
                 built = _with_loads(base, self.model, self.loads, np.cos, np.sin)
@@ -181,11 +189,11 @@ class LoadedArm:
         return self._components[backend]
 
 
-def loaded_arm(model: TwoJointArm, loads: Loads | None) -> TwoJointArm | LoadedArm:
+def loaded_arm(model: TwoJointArm, loads: Loads | None, arm_sine: bool = False) -> TwoJointArm | LoadedArm:
     """The arm itself when nothing loads it (today's closures, untouched), else a ``LoadedArm``."""
     if loads is None or loads.empty:
         return model
-    return LoadedArm(model, loads)
+    return LoadedArm(model, loads, arm_sine)
 
 
 def _with_loads(base: ComponentDynamics, model: TwoJointArm, loads: Loads, cos: Callable,

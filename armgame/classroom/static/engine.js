@@ -16,11 +16,11 @@ export const ENGINE_VERSION = "1";
 /** The armgame (Python package) version whose GameSession this engine reproduces; replays name it. */
 export const ARMGAME_VERSION = "0.5.0";
 
-const MAX_EVENTS = 200000; // armgame.limits.MAX_EVENTS
+export const MAX_EVENTS = 200000; // armgame.limits.MAX_EVENTS
 const MAX_GAME_STEPS = 900000; // armgame.limits.MAX_GAME_STEPS
 const MAX_TRIES = 1000; // game/rules.py
-const RESET_KEY = "space";
-const TOGGLE_ARM_KEY = "tab";
+export const RESET_KEY = "space";
+export const TOGGLE_ARM_KEY = "tab";
 const DEG_TO_RAD = Math.PI / 180.0; // CPython's math.radians: x * degToRad, degToRad = pi / 180
 const SIXTH = 1.0 / 6.0;
 
@@ -228,7 +228,7 @@ export function expm1(x) {
   return withHighWord(y, highWord(y) + (k << 20));
 }
 
-function fail(message) {
+export function fail(message) {
   throw new Error(message);
 }
 
@@ -257,7 +257,7 @@ function seedOf(seed) {
 
 /** A BigInt seed as JSON data: a Number where it is exact, else the BigInt (JSON.stringify refuses it:
  * use replayJSON, which writes its digits). */
-function seedValue(big) {
+export function seedValue(big) {
   return big <= BigInt(Number.MAX_SAFE_INTEGER) ? Number(big) : big;
 }
 
@@ -303,92 +303,118 @@ export function standardConfig(seed, duration = 60.0) {
 }
 
 /** An ISO 8601 date as records.replay.now_iso writes it: UTC, microseconds, "+00:00". */
-function nowIso() {
+export function nowIso() {
   return new Date().toISOString().replace(/\.(\d{3})Z$/, ".$1000+00:00");
+}
+
+// ------------------------------------------------------------------------------------ the arm's physics
+/** A replay config's arm and muscles, checked as the game checks them: the seed (a BigInt), dt, the clock in
+ * steps, the arm's accel (TwoJointArm._build_components, its operations in its order), the muscles' keys,
+ * moments and rise and decay rates. The game and the lab (labengine.js) both step the arm on these. */
+export function armPhysics(config) {
+  if (config === null || typeof config !== "object") fail("the game's config must be an object");
+  const known = ["arm", "start_posture", "time_limit", "target_radius", "target_shoulder_range",
+    "target_elbow_range", "seed", "muscles", "integrator", "dt", "reset_cost", "view", "scene"];
+  for (const name of known) if (!(name in config)) fail(`config.${name} is missing`);
+  if (config.integrator !== "rk4") {
+    fail(`the browser plays only RK4 games, this one uses ${JSON.stringify(config.integrator)}`);
+  }
+  const arm = config.arm ?? {};
+  const p = {};
+  for (const k of ["l1", "l2", "r1", "r2", "m1", "m2", "i1", "i2", "gravity", "damping1", "damping2"]) {
+    p[k] = number(arm[k], `arm.${k}`);
+  }
+  const dt = number(config.dt, "dt", 1e-4, 0.02);
+  const timeLimit = number(config.time_limit, "time_limit", 0, 3600);
+  const totalSteps = roundHalfEven(timeLimit / dt);
+  if (!(timeLimit > 0) || totalSteps > MAX_GAME_STEPS) fail(`config.time_limit ${timeLimit} s is not a game's`);
+  if (!Array.isArray(config.muscles) || config.muscles.length !== 4) fail("config.muscles must be 4 muscles");
+  const keys = config.muscles.map((m, i) => {
+    if (typeof m.key !== "string") fail(`config.muscles[${i}].key must be text`);
+    return m.key;
+  });
+  if (new Set(keys).size !== 4 || keys.includes(RESET_KEY) || keys.includes(TOGGLE_ARM_KEY)) {
+    fail(`config.muscles keys must differ from each other and from space and tab, got ${keys.join(" ")}`);
+  }
+
+  // TwoJointArm's constants and kernel_params' (the ** 2 are the C library's pow: see square()).
+  const a = p.i1 + p.i2 + p.m1 * square(p.r1, "r1") + p.m2 * (square(p.l1, "l1") + square(p.r2, "r2"));
+  const b = p.m2 * p.l1 * p.r2;
+  const d = p.i2 + p.m2 * square(p.r2, "r2");
+  const g1 = p.gravity * (p.m1 * p.r1 + p.m2 * p.l1);
+  const g2 = p.gravity * p.m2 * p.r2;
+  const k1 = p.damping1, k2 = p.damping2;
+  const det0 = a * d - d * d;
+  const aMinusD = a - d;
+  // TwoJointArm._build_components: which accel, with its operations in its order.
+  let accel;
+  if (p.gravity !== 0.0) {
+    accel = (q1, q2, w1, w2, t1, t2) => {
+      const gc12 = g2 * sinCos(q1 + q2)[1];
+      const [sn, cs] = sinCos(q2);
+      const bc = b * cs, h = b * sn, m12 = d + bc;
+      const f1 = t1 + h * (w1 + w1 + w2) * w2 - g1 * sinCos(q1)[1] - gc12 - k1 * w1;
+      const f2 = t2 - h * w1 * w1 - gc12 - k2 * w2;
+      const r = 1.0 / (det0 - bc * bc);
+      return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+    };
+  } else if (k1 !== 0.0 || k2 !== 0.0) {
+    accel = (q1, q2, w1, w2, t1, t2) => {
+      const [sn, cs] = sinCos(q2);
+      const bc = b * cs, h = b * sn, m12 = d + bc;
+      const f1 = t1 + h * (w1 + w1 + w2) * w2 - k1 * w1;
+      const f2 = t2 - h * w1 * w1 - k2 * w2;
+      const r = 1.0 / (det0 - bc * bc);
+      return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+    };
+  } else {
+    accel = (q1, q2, w1, w2, t1, t2) => {
+      const [sn, cs] = sinCos(q2);
+      const bc = b * cs, h = b * sn, m12 = d + bc;
+      const f1 = t1 + h * (w1 + w1 + w2) * w2;
+      const f2 = t2 - h * w1 * w1;
+      const r = 1.0 / (det0 - bc * bc);
+      return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+    };
+  }
+  // MuscleSet's moments and rates.
+  const moments = config.muscles.map((m, i) => numbers(m.moment, `muscles[${i}].moment`, 2, -50, 50));
+  const rise = config.muscles.map((m, i) => -expm1(-dt / number(m.rise_time, `muscles[${i}].rise_time`, dt, 10)));
+  const decay = config.muscles.map((m, i) => -expm1(-dt / number(m.decay_time, `muscles[${i}].decay_time`, dt, 10)));
+  return { seed: seedOf(config.seed), dt, totalSteps, l1: p.l1, l2: p.l2, accel, keys, moments, rise, decay };
+}
+
+/** integrators._rk4: one RK4 step of the arm under the held torques (t1, t2), as [q1, q2, w1, w2]. */
+export function rk4(accel, q1, q2, w1, w2, t1, t2, dt) {
+  const h = 0.5 * dt;
+  const [ka1, ka2] = accel(q1, q2, w1, w2, t1, t2);
+  const v1 = w1 + h * ka1, v2 = w2 + h * ka2;
+  const [kb1, kb2] = accel(q1 + h * w1, q2 + h * w2, v1, v2, t1, t2);
+  const u1 = w1 + h * kb1, u2 = w2 + h * kb2;
+  const [kc1, kc2] = accel(q1 + h * v1, q2 + h * v2, u1, u2, t1, t2);
+  const z1 = w1 + dt * kc1, z2 = w2 + dt * kc2;
+  const [kd1, kd2] = accel(q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2);
+  const k = dt * SIXTH;
+  return [q1 + k * (w1 + z1 + 2.0 * (v1 + u1)), q2 + k * (w2 + z2 + 2.0 * (v2 + u2)),
+    w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1)), w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2))];
 }
 
 // ------------------------------------------------------------------------------------------- the game
 /** One game: GameSession's input, steps and rules, and the replay the server verifies. */
 export class Game {
   constructor(config) {
-    if (config === null || typeof config !== "object") fail("the game's config must be an object");
-    const known = ["arm", "start_posture", "time_limit", "target_radius", "target_shoulder_range",
-      "target_elbow_range", "seed", "muscles", "integrator", "dt", "reset_cost", "view", "scene"];
-    for (const name of known) if (!(name in config)) fail(`config.${name} is missing`);
-    if (config.integrator !== "rk4") {
-      fail(`the browser plays only RK4 games, this one uses ${JSON.stringify(config.integrator)}`);
-    }
-    const arm = config.arm ?? {};
-    const p = {};
-    for (const k of ["l1", "l2", "r1", "r2", "m1", "m2", "i1", "i2", "gravity", "damping1", "damping2"]) {
-      p[k] = number(arm[k], `arm.${k}`);
-    }
-    const dt = number(config.dt, "dt", 1e-4, 0.02);
-    const timeLimit = number(config.time_limit, "time_limit", 0, 3600);
-    const totalSteps = roundHalfEven(timeLimit / dt);
-    if (!(timeLimit > 0) || totalSteps > MAX_GAME_STEPS) fail(`config.time_limit ${timeLimit} s is not a game's`);
-    if (!Array.isArray(config.muscles) || config.muscles.length !== 4) fail("config.muscles must be 4 muscles");
-    const keys = config.muscles.map((m, i) => {
-      if (typeof m.key !== "string") fail(`config.muscles[${i}].key must be text`);
-      return m.key;
-    });
-    if (new Set(keys).size !== 4 || keys.includes(RESET_KEY) || keys.includes(TOGGLE_ARM_KEY)) {
-      fail(`config.muscles keys must differ from each other and from space and tab, got ${keys.join(" ")}`);
-    }
+    const physics = armPhysics(config);
     this._config = config;
-    this._seed = seedOf(config.seed);
-    this._dt = dt;
-    this._totalSteps = totalSteps;
-    this._l1 = p.l1;
-    this._l2 = p.l2;
-
-    // TwoJointArm's constants and kernel_params' (the ** 2 are the C library's pow: see square()).
-    const a = p.i1 + p.i2 + p.m1 * square(p.r1, "r1") + p.m2 * (square(p.l1, "l1") + square(p.r2, "r2"));
-    const b = p.m2 * p.l1 * p.r2;
-    const d = p.i2 + p.m2 * square(p.r2, "r2");
-    const g1 = p.gravity * (p.m1 * p.r1 + p.m2 * p.l1);
-    const g2 = p.gravity * p.m2 * p.r2;
-    const k1 = p.damping1, k2 = p.damping2;
-    const det0 = a * d - d * d;
-    const aMinusD = a - d;
-    // TwoJointArm._build_components: which accel, with its operations in its order.
-    let accel;
-    if (p.gravity !== 0.0) {
-      accel = (q1, q2, w1, w2, t1, t2) => {
-        const gc12 = g2 * sinCos(q1 + q2)[1];
-        const [sn, cs] = sinCos(q2);
-        const bc = b * cs, h = b * sn, m12 = d + bc;
-        const f1 = t1 + h * (w1 + w1 + w2) * w2 - g1 * sinCos(q1)[1] - gc12 - k1 * w1;
-        const f2 = t2 - h * w1 * w1 - gc12 - k2 * w2;
-        const r = 1.0 / (det0 - bc * bc);
-        return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
-      };
-    } else if (k1 !== 0.0 || k2 !== 0.0) {
-      accel = (q1, q2, w1, w2, t1, t2) => {
-        const [sn, cs] = sinCos(q2);
-        const bc = b * cs, h = b * sn, m12 = d + bc;
-        const f1 = t1 + h * (w1 + w1 + w2) * w2 - k1 * w1;
-        const f2 = t2 - h * w1 * w1 - k2 * w2;
-        const r = 1.0 / (det0 - bc * bc);
-        return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
-      };
-    } else {
-      accel = (q1, q2, w1, w2, t1, t2) => {
-        const [sn, cs] = sinCos(q2);
-        const bc = b * cs, h = b * sn, m12 = d + bc;
-        const f1 = t1 + h * (w1 + w1 + w2) * w2;
-        const f2 = t2 - h * w1 * w1;
-        const r = 1.0 / (det0 - bc * bc);
-        return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
-      };
-    }
-    this._accel = accel;
-
-    // MuscleSet.
-    this._muscleKeys = keys;
-    this._moments = config.muscles.map((m, i) => numbers(m.moment, `muscles[${i}].moment`, 2, -50, 50));
-    this._rise = config.muscles.map((m, i) => -expm1(-dt / number(m.rise_time, `muscles[${i}].rise_time`, dt, 10)));
-    this._decay = config.muscles.map((m, i) => -expm1(-dt / number(m.decay_time, `muscles[${i}].decay_time`, dt, 10)));
+    this._seed = physics.seed;
+    this._dt = physics.dt;
+    this._totalSteps = physics.totalSteps;
+    this._l1 = physics.l1;
+    this._l2 = physics.l2;
+    this._accel = physics.accel;
+    this._muscleKeys = physics.keys;
+    this._moments = physics.moments;
+    this._rise = physics.rise;
+    this._decay = physics.decay;
     this._activation = [0.0, 0.0, 0.0, 0.0];
     this._goal = [0.0, 0.0, 0.0, 0.0];
     this._rate = [...this._decay];
@@ -509,7 +535,6 @@ export class Game {
     n = Math.min(n, this._totalSteps - this._steps);
     if (n <= 0) return 0;
     const accel = this._accel, dt = this._dt, l1 = this._l1, l2 = this._l2;
-    const h = 0.5 * dt, k = dt * SIXTH;
     let [a0, a1, a2, a3] = this._activation;
     const [g0, g1, g2, g3] = this._goal;
     const [r0, r1, r2, r3] = this._rate;
@@ -527,19 +552,7 @@ export class Game {
       a2 += (g2 - a2) * r2;
       a3 += (g3 - a3) * r3;
       previous = [q1, q2, w1, w2];
-      // integrators._rk4
-      const [ka1, ka2] = accel(q1, q2, w1, w2, t1, t2);
-      const v1 = w1 + h * ka1, v2 = w2 + h * ka2;
-      const [kb1, kb2] = accel(q1 + h * w1, q2 + h * w2, v1, v2, t1, t2);
-      const u1 = w1 + h * kb1, u2 = w2 + h * kb2;
-      const [kc1, kc2] = accel(q1 + h * v1, q2 + h * v2, u1, u2, t1, t2);
-      const z1 = w1 + dt * kc1, z2 = w2 + dt * kc2;
-      const [kd1, kd2] = accel(q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2);
-      const n1 = q1 + k * (w1 + z1 + 2.0 * (v1 + u1));
-      const n2 = q2 + k * (w2 + z2 + 2.0 * (v2 + u2));
-      const m1 = w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1));
-      const m2 = w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
-      q1 = n1; q2 = n2; w1 = m1; w2 = m2;
+      [q1, q2, w1, w2] = rk4(accel, q1, q2, w1, w2, t1, t2, dt);
       const [hx, hy] = this._handAt(q1, q2);
       const dx = hx - tx, dy = hy - ty;
       if (dx * dx + dy * dy <= rr) {
