@@ -177,6 +177,77 @@ def test_the_lab_client_runs_the_protocol_its_class_hands_it_and_nothing_else(tm
         client._class_protocol(["lesson"])
 
 
+def _call(port: int, path: str, body: dict | None = None, headers: dict | None = None) -> tuple[int, dict]:
+    import urllib.error
+    import urllib.request
+
+    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", headers={**(headers or {}), **(
+        {"Content-Type": "application/json"} if body is not None else {})},
+        data=None if body is None else json.dumps(body).encode())
+    try:
+        with urllib.request.urlopen(req, timeout=20) as r:
+            return r.status, json.loads(r.read())
+    except urllib.error.HTTPError as exc:
+        with exc:
+            return exc.code, json.loads(exc.read())
+
+
+def test_each_browser_is_handed_its_students_conditions_plan_assigned_at_its_first_request(tmp_path):
+    """``/api/labplan`` with a student's code and token: their condition's plan, the condition assigned at the first
+    request as a lab join assigns it (in the split's order, balanced, in class.json); nothing in the plan names it.
+    Without the headers, the class's default plan; a wrong token or code is refused in one line and counted."""
+    from class_server import running_class
+
+    from armgame.classroom.state import FREE_GUESSES
+    from armgame.lab.plan import lab_plan
+    from armgame.lab.session import lab_config
+    from armgame.records.standings import player_key
+
+    for name, text in (("strong", STRONG), ("weak", WEAK)):
+        (tmp_path / f"{name}.toml").write_text(text)
+    protocols = {"a": load_protocol(tmp_path / "strong.toml"), "b": load_protocol(tmp_path / "weak.toml")}
+    names = [f"Student {i}" for i in range(6)]
+    with running_class(tmp_path / "class", lab=str(tmp_path / "strong.toml"), lab_b=str(tmp_path / "weak.toml"),
+                       split_seed=11) as opened:
+        port, code, seed = opened.port, opened.clerk.roster.code, opened.clerk.roster.seed
+        tokens = {}
+        for name in names:  # as the browser joins: for its game, which assigns nobody
+            status, answer = _call(port, "/api/join", {"code": code, "name": name})
+            assert status == 200 and "lab" not in answer
+            tokens[name] = answer["token"]
+        assert opened.clerk.roster.experiment.assigned == []
+        plans = {}
+        for name in names:
+            status, plans[name] = _call(port, "/api/labplan", headers={"Authorization": f"Bearer {tokens[name]}",
+                                                                       "X-Armgame-Code": code})
+            assert status == 200
+        # Asked again (a reload), the same plan; a lab join afterwards hands the Python client the same protocol.
+        assert _call(port, "/api/labplan", headers={"Authorization": f"Bearer {tokens[names[0]]}",
+                                                    "X-Armgame-Code": code})[1] == plans[names[0]]
+        joined = _call(port, "/api/join", {"code": code, "name": names[1], "token": tokens[names[1]], "for": "lab"})[1]
+        assert joined["lab"] == plans[names[1]]["protocol"]
+        status, default = _call(port, "/api/labplan")
+        assert status == 200
+        status, refused = _call(port, "/api/labplan", headers={"Authorization": f"Bearer {tokens[names[0]]}",
+                                                               "X-Armgame-Code": "ZZZZ" if code != "ZZZZ" else "YYYY"})
+        assert status == 403 and "\n" not in refused["error"] and "code" in refused["error"]
+        wrong = [_call(port, "/api/labplan", headers={"Authorization": "Bearer not-a-token", "X-Armgame-Code": code})
+                 for _ in range(FREE_GUESSES + 1)]
+        assert [s for s, _ in wrong] == [401] * FREE_GUESSES + [429]  # counted as wrong tokens are everywhere
+        assert all("\n" not in answer["error"] for _, answer in wrong)
+        record = json.loads((tmp_path / "class" / "class.json").read_text())["experiment"]
+    # Assigned in the order the browsers asked, as the split draws (blocks of two): three in each condition.
+    assert [key for key, _ in record["assigned"]] == [player_key(n) for n in names]
+    assert [c for _, c in record["assigned"]] == [condition_at(11, i) for i in range(6)]
+    conditions = dict(record["assigned"])
+    assert sorted(conditions.values()) == ["a"] * 3 + ["b"] * 3
+    for name, plan in plans.items():
+        protocol = protocols[conditions[player_key(name)]]
+        assert plan == lab_plan(lab_config(protocol, seed, person=True), protocol)
+        assert not {"condition", "group"} & set(plan)
+    assert default == lab_plan(lab_config(protocols["a"], seed, person=True), protocols["a"])  # the teacher's --lab
+
+
 @pytest.mark.slow  # in chromium
 def test_the_projector_shows_the_two_groups_side_by_side_and_their_difference(tmp_path, runs, monkeypatch):
     import urllib.request

@@ -219,13 +219,24 @@ async def lab(request: Request) -> Response:
 
 
 async def lab_plan(request: Request) -> Response:
-    """The class's lab for a browser's run (``lab.plan``): the teacher's protocol (the lesson's until one is chosen)
-    with every trial resolved for the class's seed, made once (off the event loop) and kept."""
+    """The lab a browser runs (``lab.plan``), every trial resolved for the class's seed. With a joined student's code
+    and token (the headers ``/api/handin`` takes, checked as it checks them), their protocol: in a classroom
+    experiment their condition's, assigned at this request if it is their first for the lab, exactly as a lab join
+    assigns it (``Clerk.lab_protocol``); without them, or in a class of one protocol, the teacher's (the lesson's
+    until one is chosen). The answer is the plan alone: nothing says which condition it is. Each plan is made once a
+    protocol (off the event loop) and kept (``class_plan_json``'s bounded cache)."""
     from ..lab.plan import class_plan_json
-    from ..lab.presets import preset
 
-    clerk = _state(request).clerk
-    protocol = clerk.curve_protocol() or preset("lesson")
+    state = _state(request)
+    clerk = state.clerk
+    if "authorization" in request.headers or "x-armgame-code" in request.headers:
+        _check_code(state, request, request.headers.get("x-armgame-code"))
+        name = clerk.player(_check_token(state, request)).name
+        # An assignment is a write to the class's record: the clerk's thread makes it, as it makes a join's.
+        protocol = clerk.lab_protocol(name) if clerk.roster.experiment is None else \
+            await state.run(lambda: clerk.lab_protocol(name))
+    else:
+        protocol = clerk.lab_protocol(None)
     try:
         data = await asyncio.to_thread(class_plan_json, protocol, clerk.roster.seed)
     except UserError as exc:

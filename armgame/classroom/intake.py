@@ -243,6 +243,16 @@ class Clerk:
             self.lab_version += 1
         return experiment.protocol_of(condition)
 
+    def lab_protocol(self, name: str | None) -> Any:
+        """The protocol a student's lab runs (a ``Protocol``): for ``name`` in a classroom experiment, their
+        condition's (``assign``: theirs from their first lab request on, a join's or a browser's plan's, kept in the
+        class's record); else, and without a name, the teacher's choice, the lesson's until one is chosen."""
+        from ..lab.analysis import curve_protocol
+        from ..lab.presets import preset
+
+        choice = None if name is None else self.assign(name)
+        return curve_protocol(choice) if choice is not None else self.curve_protocol() or preset("lesson")
+
     def player(self, token: str | None) -> Player:
         player = self.roster.player_of(token) if token else None
         if player is None:
