@@ -118,10 +118,11 @@ def test_the_curve_is_the_teachers_protocol_not_the_one_most_names_ran(tmp_path,
         assert json.loads(get(opened, "/api/lab"))["protocol"] == "curl"
 
 
-def post(opened, path: str, body: dict) -> tuple[int, dict]:
-    """A JSON POST from this machine (the teacher's own: its routes need no secret), and the class's answer."""
+def post(opened, path: str, body: dict, headers: dict | None = None) -> tuple[int, dict]:
+    """A JSON POST from this machine (the teacher's own: its routes need no secret), as a browser's page posts it
+    (``headers``: a hand-in's token and code), and the class's answer."""
     req = urllib.request.Request(f"http://127.0.0.1:{opened.port}{path}", data=json.dumps(body).encode(),
-                                 headers={"Content-Type": "application/json"})
+                                 headers={"Content-Type": "application/json", **(headers or {})})
     try:
         with urllib.request.urlopen(req, timeout=10) as r:
             return r.status, json.loads(r.read())
@@ -219,3 +220,46 @@ def test_a_lab_run_the_class_refuses_exits_non_zero_with_its_reason(tmp_path, ru
                        f"127.0.0.1:{opened.port}", "--code", opened.clerk.roster.code, "--name", "Bot"])
     err = capsys.readouterr().err
     assert status == 1 and "armgame lab: not handed in: the lab run does not reproduce" in err
+
+
+def browser_run(seed: int, name: str) -> dict:
+    """A browser's lab run as its page writes it (``LabSession(sine="arm")`` of the class's lesson on a person's
+    clock: ``labengine.js`` plays it bit for bit, ``tests/test_browser_lab.py``), made here by the adapting bot and
+    relabelled as the student's: the replay as JSON data."""
+    from armgame.game.bots import Autopilot
+    from armgame.lab.bots import make_lab_bot
+    from armgame.lab.presets import preset
+    from armgame.lab.record import LabTask
+    from armgame.lab.session import LabSession, lab_config
+    from armgame.records.replay import now_iso
+
+    protocol = preset("lesson")
+    session = LabSession(lab_config(protocol, seed, person=True), protocol, sine="arm")
+    Autopilot(session, make_lab_bot("adaptive")).play()
+    replay = Replay(session.config, tuple(session.timeline), session.result(), "keyboard", None, name, now_iso(),
+                    task=LabTask.of(session))
+    return json.loads(replay.to_bytes())
+
+
+def test_a_browsers_lab_run_is_verified_as_any_other_and_a_tampered_trial_is_refused_in_one_line(tmp_path):
+    """Handed in through ``/api/handin`` as the page posts it: a run on the arm's sine (``"sine": "arm"``) is
+    re-simulated on that sine and enters the class curve; the same kind of run with one trial's record changed (a
+    miss made a hit) is refused in one line and stays out of the curve and the folder."""
+    honest, tampered = browser_run(21, "Ann"), browser_run(22, "Bo")
+    assert honest["task"]["sine"] == tampered["task"]["sine"] == "arm"
+    trials = tampered["task"]["trials"]
+    i = next((k for k, t in enumerate(trials) if not t[3]), 5)
+    trials[i][3] = not trials[i][3]
+    with running_class(tmp_path / "class") as opened:  # a new class's curve: the lesson's
+        code = opened.clerk.roster.code
+        answers = {}
+        for name, run in (("Ann", honest), ("Bo", tampered)):
+            token = post(opened, "/api/join", {"code": code, "name": name})[1]["token"]
+            answers[name] = post(opened, "/api/handin", run, {"Authorization": f"Bearer {token}",
+                                                              "X-Armgame-Code": code})
+        lab = json.loads(get(opened, "/api/lab"))
+    assert answers["Ann"] == (200, {"ok": True, "already": False, "message": "lab run handed in: in the class curve"})
+    assert answers["Bo"] == (422, {"ok": False, "error": "the lab run does not reproduce its trials: not taken"})
+    assert (lab["protocol"], lab["students"]) == ("lesson", 1) and all(t["n"] == 1 for t in lab["trials"])
+    assert [run.player for run in opened.clerk.lab_runs] == ["Ann"]
+    assert len(list((tmp_path / "class" / "lab").glob("*.json"))) == 1
