@@ -54,3 +54,18 @@ def test_the_timeline_passes_benchmark_runs_and_checks_its_twins():
     for figures in report["games"].values():
         assert set(figures["passes"]) == {"reading", "its identities", "the batch's columns", "writing it again"}
         assert all(row["with_c_ms"][0] > 0 and row["python_ms"][0] > 0 for row in figures["passes"].values())
+
+
+@pytest.mark.slow  # a server and two browser lab runs (about 4 s)
+def test_the_lab_handin_benchmark_runs():
+    """benchmarks/lab_handin.py (docs/performance.md's 30 lab runs at once) on two students: every run taken into the
+    class curve (the benchmark fails otherwise), each figure there."""
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "lab_handin.py"
+    spec = importlib.util.spec_from_file_location("lab_handin_benchmark", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    report = bench.measure(students=2, repeats=1)
+    s = report["summary"]
+    assert 0 < s["after_last_sent_s"]["median"] <= s["after_first_sent_s"]["median"]
+    assert s["verify_ms"]["median"] > 0 and s["batch_ms"]["median"] > 0
+    assert report["classes"][0]["server_cpu_s"] is None or report["classes"][0]["server_cpu_s"] > 0
