@@ -284,3 +284,19 @@ def test_the_projector_shows_the_two_groups_side_by_side_and_their_difference(tm
                    for left, top, right, bottom in boxes), boxes
         assert boxes[0][2] <= boxes[1][0]  # side by side, not overlapping
         page.screenshot(path=str(tmp_path.parent / "lab-groups.png"))
+
+
+def test_a_renamed_student_keeps_the_condition_their_first_name_drew(tmp_path):
+    """The teacher fixes a typo after the split: the student's next lab request, under the new name, is handed the
+    same condition (it drew a new one: a second assignment, the split unbalanced), and the groups count them once."""
+    roster, clerk = experiment_class(tmp_path / "class", seed=5)
+    students = ("Anm", "Bo", "Cy", "Di")
+    for name in students:
+        clerk.join(name, None, "127.0.0.1")
+    drawn = {name: clerk.assign(name) for name in students}
+    clerk.rename("Anm", "Ann")
+    assert clerk.assign("Ann") == drawn["Anm"] and len(roster.experiment.assigned) == len(students)
+    assert roster.experiment.condition_of("Ann", roster.renamed) == roster.experiment.condition_of("Anm")
+    assert roster.experiment.counts() == {"a": 2, "b": 2}
+    again = Roster.open(tmp_path / "class", None)[0]  # the record as a restart, or analyze after class, reads it
+    assert again.experiment.condition_of("Ann", again.renamed) == roster.experiment.condition_of("Anm")

@@ -12,6 +12,7 @@ told nothing: their lab client is handed the protocol to run, never its conditio
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,13 +42,18 @@ class Experiment:
     seed: int
     assigned: list[tuple[str, str]] = field(default_factory=list)
 
-    def condition_of(self, name: str) -> str | None:
-        key = player_key(name)
-        return next((c for k, c in self.assigned if k == key), None)
+    def condition_of(self, name: str, renamed: Mapping[str, str] | None = None) -> str | None:
+        """``name``'s condition, or None. ``renamed`` (``Roster.renamed``: an old name's key -> the name shown now):
+        a student the teacher renamed keeps the condition their first name drew, under either name."""
+        keys = {player_key(name)}
+        if renamed:
+            shown = player_key(renamed.get(player_key(name), name))
+            keys |= {shown} | {old for old, now in renamed.items() if player_key(now) == shown}
+        return next((c for k, c in self.assigned if k in keys), None)
 
-    def assign(self, name: str) -> tuple[str, bool]:
+    def assign(self, name: str, renamed: Mapping[str, str] | None = None) -> tuple[str, bool]:
         """``name``'s condition, and whether it is new (then the caller saves the class's record)."""
-        known = self.condition_of(name)
+        known = self.condition_of(name, renamed)
         if known is not None:
             return known, False
         c = condition_at(self.seed, len(self.assigned))

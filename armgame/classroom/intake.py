@@ -233,7 +233,7 @@ class Clerk:
         if experiment is None:
             return None
         before = list(experiment.assigned)
-        condition, new = experiment.assign(name)
+        condition, new = experiment.assign(name, self.roster.renamed)
         if new:
             try:
                 self.roster.save()
@@ -519,7 +519,7 @@ class Clerk:
         experiment = self.roster.experiment
         if experiment is None:
             return self.curve_protocol()
-        condition = experiment.condition_of(name)
+        condition = experiment.condition_of(name, self.roster.renamed)
         return None if condition is None else curve_protocol(experiment.protocol_of(condition))
 
     def curve_protocol(self) -> Any:

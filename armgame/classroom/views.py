@@ -141,10 +141,10 @@ def experiment_groups(clerk: Clerk) -> Any:
     if experiment is None:
         return None
     runs = [run for run in clerk.lab_runs if run.program or (run.first and not clerk.roster.is_hidden(run.player))]
-    # By the name each run was handed in under: the split keeps the name a student joined with, renamed or not.
+    # By the name each run was handed in under: the split keeps the condition a student drew, renamed or not.
     return two_groups([ClassRun(run.player, run.program, run.protocol, run.rows) for run in runs],
                       (curve_protocol(experiment.a), curve_protocol(experiment.b)),
-                      lambda name: experiment.condition_of(name))
+                      lambda name: experiment.condition_of(name, clerk.roster.renamed))
 
 
 def groups_view(clerk: Clerk) -> dict[str, object] | None:

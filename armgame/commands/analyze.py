@@ -523,7 +523,8 @@ def _class(args: argparse.Namespace) -> int:
         experiment = roster.experiment
         groups = two_groups([ClassRun(r.player, r.driven != "keyboard", run[2].protocol, run[1])
                              for run, r in zip(runs, replays, strict=True)],
-                            (curve_protocol(experiment.a), curve_protocol(experiment.b)), experiment.condition_of)
+                            (curve_protocol(experiment.a), curve_protocol(experiment.b)),
+                            lambda name: experiment.condition_of(name, roster.renamed))
         g_scale, g_unit = display_unit(groups.metric)
         for c, g_curve, g_stats in zip("AB", groups.curves, groups.stats, strict=True):
             said = "no run" if g_stats is None else answer_line(g_stats, g_scale, g_unit)
