@@ -18,9 +18,11 @@ Every request is hostile until checked, and what it can cost is bounded before a
   at once, and can lock the roster;
 * a body over its limit is refused from its declared length, or cut off as it arrives (413);
   a body slower than ``BODY_SECONDS`` is cut off (408); at most ``UPLOADS`` bodies are read at
-  once, ``UPLOADS_PER_ADDRESS`` from one address, and a hand-in's code and token are checked
-  from its headers before its body is read, so memory stays under ``UPLOADS * MAX_HANDIN_BYTES``
-  (and the queued bodies under ``QUEUE_BYTES``) whatever arrives;
+  once and, apart, ``SMALL_UPLOADS`` declared no longer than ``SMALL_UPLOAD_BYTES`` (a student's
+  game: a few machines trickling bodies cannot hold every place), ``UPLOADS_PER_ADDRESS`` from one
+  address, and a hand-in's code and token are checked from its headers before its body is read, so
+  memory stays under ``UPLOADS * MAX_HANDIN_BYTES + SMALL_UPLOADS * SMALL_UPLOAD_BYTES`` (and the
+  queued bodies under ``QUEUE_BYTES``) whatever arrives;
 * changes go to one worker thread (the ``Clerk``'s, ``worker``), never the event loop; at most ``QUEUE_LIMIT``
   jobs and ``HANDIN_QUEUE`` hand-ins wait for it, one hand-in a player (``TOKEN_SHARE``, checked
   before the body is read, with the token), and past that a client is told to
@@ -66,7 +68,7 @@ from . import page, views
 from .guard import Guard
 from .intake import MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
 from .middleware import EXCEPTION_HANDLERS, OneLineErrors, SameSite, SecurityHeaders, json_answer
-from .state import BUSY, JOINS_PER_MINUTE, ClassState, Guesses, client_address
+from .state import BUSY, JOINS_PER_MINUTE, SMALL_UPLOAD_BYTES, ClassState, Guesses, client_address
 from .worker import ClerkThread
 
 #: Seconds a hand-in waits for one of the ``UPLOADS`` slots before it is told the class is busy.
@@ -338,15 +340,18 @@ async def hand_in(request: Request) -> Response:
     with state.hand_in_share(token), _share(state.uploading, address, UPLOADS_PER_ADDRESS,
                                              state.guard.is_own(address), BUSY):
         # the token's and the machine's places taken before the body is read: a flooder's next costs nothing
+        declared = request.headers.get("content-length", "")
+        small = declared.isdigit() and int(declared) <= SMALL_UPLOAD_BYTES  # a student's game: its own slots
+        slots = state.small_uploads if small else state.uploads
         try:
             async with asyncio.timeout(UPLOAD_WAIT):
-                await state.uploads.acquire()
+                await slots.acquire()
         except TimeoutError:
             raise RefusedError(503, BUSY) from None
         try:
-            data = await _body(request, MAX_HANDIN_BYTES)
+            data = await _body(request, SMALL_UPLOAD_BYTES if small else MAX_HANDIN_BYTES)
         finally:
-            state.uploads.release()
+            slots.release()
         return json_answer(await state.hand_in(token, data))
 
 

@@ -6,7 +6,7 @@ found without sending a packet; ``--host 127.0.0.1`` keeps a trial on one machin
 server: requests in flight get ``GRACE_SECONDS`` to finish, a hand-in being written is finished,
 the projector's stream is closed, and nothing is half-written.
 
-uvicorn runs with the class's guard on its h11 protocol (``guard``: deadlines and a share of the
+uvicorn runs with the class's guard on its httptools protocol (``guard``: deadlines and a share of the
 connections per address), and without proxy headers: a client's address is its socket's, never an
 ``X-Forwarded-For`` it wrote, unless the teacher names a proxy (``--proxy ADDRESS``). One server at
 a time serves a folder: it holds ``server.lock`` (owner-only) for its life, and a second one says so
@@ -229,7 +229,7 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
         if on_ready is not None:
             on_ready(opened)
 
-    guard = Guard(own=frozenset(own))
+    guard = Guard(own=frozenset(own), key=roster.projector_key())
     app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), guard=guard,
                     play_url=play_url)
     _more_files(CONCURRENCY + 256)

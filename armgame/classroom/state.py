@@ -48,8 +48,14 @@ TOKEN_SHARE = 1
 COOL_DOWN = 2.0
 #: What a student is told when the class cannot take their game yet (their client hands it in again).
 BUSY = "the class is busy: your game is kept and will be handed in in a moment"
-#: Hand-in bodies read at once (from one address: ``app.UPLOADS_PER_ADDRESS``).
+#: Hand-in bodies of any size (up to ``intake.MAX_HANDIN_BYTES``: a bot's game, a lab run) read at once (from one
+#: address: ``app.UPLOADS_PER_ADDRESS``).
 UPLOADS = 16
+#: Hand-in bodies of at most ``SMALL_UPLOAD_BYTES`` (declared: a student's game is 9 KB) read at once, apart from
+#: ``UPLOADS``: 40 machines holding both of their places with bodies trickled a byte a second leave most of them
+#: free for an honest student's game (``tests/test_class_memory.py``), and all of them together hold 16 MiB.
+SMALL_UPLOADS = 256
+SMALL_UPLOAD_BYTES = 64 * 1024
 #: Wrong answers of one kind an address may give before it waits; then ``GUESS_WAIT`` seconds, doubled
 #: for every further wrong one (at most ``MAX_GUESS_WAIT``).
 FREE_GUESSES = 5
@@ -144,6 +150,7 @@ class ClassState:
     joins: Window = field(default_factory=lambda: Window(JOINS_PER_MINUTE))
     class_joins: Window = field(default_factory=lambda: Window(CLASS_JOINS_PER_MINUTE))
     uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(UPLOADS))
+    small_uploads: asyncio.Semaphore = field(default_factory=lambda: asyncio.Semaphore(SMALL_UPLOADS))
     uploading: Counter[str] = field(default_factory=Counter)
     streams: int = 0
     streaming: Counter[str] = field(default_factory=Counter)
