@@ -23,13 +23,14 @@ from armgame.records.replay import Replay
 
 @contextlib.contextmanager
 def running_class(folder: Path | None, seed: int | None = None, lines: list[str] | None = None,
-                  lab: str | None = None, rehearse: bool = False) -> Iterator[ClassServer]:
+                  lab: str | None = None, rehearse: bool = False, **options: object) -> Iterator[ClassServer]:
     """The class in ``folder`` served on 127.0.0.1 (a free port) until the block ends (``lab``: its curve's
-    protocol, as ``--lab``; ``rehearse``: a rehearsal, ``folder`` None, as ``--rehearse``)."""
+    protocol, as ``--lab``; ``rehearse``: a rehearsal, ``folder`` None, as ``--rehearse``; ``options``: more of
+    ``open_class``'s, as ``proxy``)."""
     ready = threading.Event()
     said = lines if lines is not None else []
     opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set(), lab=lab,
-                        rehearse=rehearse)
+                        rehearse=rehearse, **options)
     thread = threading.Thread(target=opened.run, daemon=True)
     thread.start()
     try:

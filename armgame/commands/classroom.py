@@ -50,8 +50,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     serve.add_argument("--seed", type=_seed, default=None, help="the seed the class ranks (a new class: default 10)")
     serve.add_argument("--lab", metavar="PRESET", help="the lab preset the class curve shows (a new class: lesson; "
                        "the teacher's page can change it)")
-    serve.add_argument("--proxy", metavar="ADDRESS", help="believe X-Forwarded-For from this address only (a reverse "
-                       "proxy in front of the class; default: none, a client's address is its socket's)")
+    serve.add_argument("--proxy", metavar="ADDRESS", help="a reverse proxy in front of the class connects from this "
+                       "IP address: a request from it is the last address its X-Forwarded-For names, never the "
+                       "teacher's machine (default: none, a client's address is its socket's)")
+    serve.add_argument("--teacher-secret-always", action="store_true", help="the teacher's page asks for the secret "
+                       "on this machine too (a shared lab PC: otherwise anyone using it is the teacher)")
     serve.add_argument("--rehearse", action="store_true", help="a rehearsal of the lesson: 15 s games and 30 s "
                        "rounds, in a temporary folder removed at Ctrl-C (nothing is kept; not with --folder)")
     serve.set_defaults(run=run_serve)
@@ -87,7 +90,7 @@ def run_serve(args: argparse.Namespace) -> int:
         raise UserError(f"--folder {folder}: not a folder")
     host = args.host or lan_address()
     return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True), lab=args.lab,
-                 proxy=args.proxy, rehearse=args.rehearse)
+                 proxy=args.proxy, rehearse=args.rehearse, secret_always=args.teacher_secret_always)
 
 
 def run_submit(args: argparse.Namespace) -> int:
