@@ -29,7 +29,7 @@ import os
 import secrets
 import stat
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -133,15 +133,18 @@ def ordinal(n: int) -> str:
 class Clerk:
     """The class's state and its one writer. Not thread-safe by design: call it from one thread."""
 
-    def __init__(self, folder: Path, roster: Roster, rehearsal: bool = False, records: Path | None = None) -> None:
+    def __init__(self, folder: Path, roster: Roster, rehearsal: bool = False, records: Path | None = None,
+                 warn: Callable[[str], None] | None = None) -> None:
         """``rehearsal``: the class plays the rehearsal's 15 s game and short rounds (``serve --rehearse``);
-        ``records``: where the table's record is kept (``records.teacher``; None: the teacher's own records)."""
+        ``records``: where the table's record is kept (``records.teacher``; None: the teacher's own records);
+        ``warn``: the teacher's terminal, told of anything wrong with the table's files (a damaged journal line,
+        rebuilt from its replay or named; None: standard error)."""
         self.folder = Path(folder)
         self.roster = roster
         self.rehearsal = rehearsal
         #: The one game this class takes: a game of other rules is refused, whatever its score.
         self.game: Ruleset = CLASS_GAMES["rehearsal" if rehearsal else "standard"]
-        self.table = ScoreTable(self.folder, warn=lambda message: None, records=records)
+        self.table = ScoreTable(self.folder, warn=warn, records=records)
         self.table.lock_mode = 0o600  # only the server writes a class's table: nobody else may open its lock
         with contextlib.suppress(OSError):
             if stat.S_ISREG(os.lstat(self.table.lock_path).st_mode):

@@ -171,7 +171,8 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
             roster, new = Roster.open(folder, seed)
             if (new and roster.lab is None) or (curve is not None and curve != roster.lab):
                 roster.changed(lab=curve or "lesson")
-            clerk = Clerk(folder, roster, rehearsal=rehearse, records=records)
+            clerk = Clerk(folder, roster, rehearsal=rehearse, records=records,
+                          warn=lambda line: say(f"armgame class: {line}"))
             sock = _bind(host, port)
         except BaseException:
             held.release()
