@@ -155,8 +155,8 @@ class Clerk:
             raise DataFileError(f"{self.table.path} ranks seed {self.table.seed}, the class seed {roster.seed}: "
                                 f"this folder's table is not the class's (nothing was changed)")
         self._sweep()
-        with contextlib.suppress(DataFileError):  # a journal a killed server left, taken into the table (or read)
-            self.table.compact()
+        with contextlib.suppress(DataFileError):  # a journal a killed server left, mended and taken into the table
+            self.table.compact(mend=True)
         self.entries: list[ScoreEntry] = self.table.all_entries()
         # The two lists' rows, one a player, kept as games are entered: an answer's rank and the standings
         # cost a lookup, not a pass over the whole table (which grew with every hand-in).
