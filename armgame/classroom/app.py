@@ -67,7 +67,7 @@ from ..errors import UserError
 from . import page, views
 from .guard import Guard
 from .intake import MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
-from .middleware import EXCEPTION_HANDLERS, OneLineErrors, SameSite, SecurityHeaders, json_answer
+from .middleware import EXCEPTION_HANDLERS, ForwardedFor, OneLineErrors, SameSite, SecurityHeaders, json_answer
 from .state import BUSY, JOINS_PER_MINUTE, SMALL_UPLOAD_BYTES, ClassState, Guesses, client_address
 from .worker import ClerkThread
 
@@ -144,9 +144,9 @@ def _check_secret(state: ClassState, request: Request) -> None:
     """The teacher's routes: the teacher's own machine is the teacher (no secret to type, so none is ever shown
     where the room can read it; never made to wait); any other machine needs the secret, from the Authorization
     header, its wrong guesses counted apart."""
-    address = client_address(request)
-    if state.guard.is_own(address):
+    if state.teachers_machine(request):
         return
+    address = client_address(request)
     _waiting(state.secrets, address, "secrets")
     secret = _bearer(request)
     if secret is None or not state.clerk.roster.secret_matches(secret):
@@ -251,7 +251,7 @@ async def events(request: Request) -> Response:
     state = _state(request)
     address = client_address(request)
     projector = state.projector(request)
-    own = state.guard.is_own(address)
+    own = state.teachers_machine(request)
     if state.streams >= MAX_STREAMS and not projector:
         raise RefusedError(503, "too many pages are open on this class")
     if not own and state.streaming[address] >= STREAMS_PER_ADDRESS:
@@ -291,7 +291,7 @@ async def join(request: Request) -> Response:
     token = body.get("token")
     if token is not None and (not isinstance(token, str) or len(token) > 200):
         raise RefusedError(400, "token must be a string")
-    own = state.guard.is_own(address)
+    own = state.teachers_machine(request)
     known = token is not None and clerk.roster.player_of(token) is not None
     if not known and not own:
         if state.joins.full(address):
@@ -338,7 +338,7 @@ async def hand_in(request: Request) -> Response:
     _check_code(state, request, request.headers.get("x-armgame-code"))
     token = _check_token(state, request)
     with state.hand_in_share(token), _share(state.uploading, address, UPLOADS_PER_ADDRESS,
-                                             state.guard.is_own(address), BUSY):
+                                             state.teachers_machine(request), BUSY):
         # the token's and the machine's places taken before the body is read: a flooder's next costs nothing
         declared = request.headers.get("content-length", "")
         small = declared.isdigit() and int(declared) <= SMALL_UPLOAD_BYTES  # a student's game: its own slots
@@ -511,11 +511,15 @@ async def lifespan(app: Starlette) -> AsyncIterator[None]:
 
 def build_app(clerk: Clerk, join_line: str, on_ready: Callable[[], None] | None = None,
               say: Callable[[str], None] = lambda line: None, guard: Guard | None = None,
-              play_url: str = "") -> Starlette:
+              play_url: str = "", proxy: str | None = None, secret_always: bool = False) -> Starlette:
     """The class's app over ``clerk`` (already open on its folder); ``join_line`` is what students type;
     ``on_ready`` is called once the server takes requests; ``say`` gets one-line notices for the teacher;
     ``guard`` knows the teacher's own machine's addresses (``guard.Guard``); ``play_url`` is the browser
-    game's address (``/play``) as students reach it, for the projector's QR code."""
-    app = Starlette(routes=ROUTES, middleware=MIDDLEWARE, exception_handlers=EXCEPTION_HANDLERS, lifespan=lifespan)
-    app.state.armgame = ClassState(clerk, join_line, guard or Guard(), play_url, on_ready, say)
+    game's address (``/play``) as students reach it, for the projector's QR code; ``proxy``: the address of the
+    reverse proxy whose ``X-Forwarded-For`` names its clients (``middleware.ForwardedFor``); ``secret_always``: even
+    this machine types the teacher's secret (``ClassState.secret_always``)."""
+    middleware = [MIDDLEWARE[0], Middleware(ForwardedFor, proxy=proxy, say=say), *MIDDLEWARE[1:]]
+    app = Starlette(routes=ROUTES, middleware=middleware, exception_handlers=EXCEPTION_HANDLERS, lifespan=lifespan)
+    app.state.armgame = ClassState(clerk, join_line, guard or Guard(), play_url, secret_always=secret_always,
+                                   on_ready=on_ready, say=say)
     return app

@@ -29,7 +29,7 @@ import os
 import secrets
 import stat
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -133,15 +133,18 @@ def ordinal(n: int) -> str:
 class Clerk:
     """The class's state and its one writer. Not thread-safe by design: call it from one thread."""
 
-    def __init__(self, folder: Path, roster: Roster, rehearsal: bool = False, records: Path | None = None) -> None:
+    def __init__(self, folder: Path, roster: Roster, rehearsal: bool = False, records: Path | None = None,
+                 warn: Callable[[str], None] | None = None) -> None:
         """``rehearsal``: the class plays the rehearsal's 15 s game and short rounds (``serve --rehearse``);
-        ``records``: where the table's record is kept (``records.teacher``; None: the teacher's own records)."""
+        ``records``: where the table's record is kept (``records.teacher``; None: the teacher's own records);
+        ``warn``: the teacher's terminal, told of anything wrong with the table's files (a damaged journal line,
+        rebuilt from its replay or named; None: standard error)."""
         self.folder = Path(folder)
         self.roster = roster
         self.rehearsal = rehearsal
         #: The one game this class takes: a game of other rules is refused, whatever its score.
         self.game: Ruleset = CLASS_GAMES["rehearsal" if rehearsal else "standard"]
-        self.table = ScoreTable(self.folder, warn=lambda message: None, records=records)
+        self.table = ScoreTable(self.folder, warn=warn, records=records)
         self.table.lock_mode = 0o600  # only the server writes a class's table: nobody else may open its lock
         with contextlib.suppress(OSError):
             if stat.S_ISREG(os.lstat(self.table.lock_path).st_mode):
@@ -152,8 +155,8 @@ class Clerk:
             raise DataFileError(f"{self.table.path} ranks seed {self.table.seed}, the class seed {roster.seed}: "
                                 f"this folder's table is not the class's (nothing was changed)")
         self._sweep()
-        with contextlib.suppress(DataFileError):  # a journal a killed server left, taken into the table (or read)
-            self.table.compact()
+        with contextlib.suppress(DataFileError):  # a journal a killed server left, mended and taken into the table
+            self.table.compact(mend=True)
         self.entries: list[ScoreEntry] = self.table.all_entries()
         # The two lists' rows, one a player, kept as games are entered: an answer's rank and the standings
         # cost a lookup, not a pass over the whole table (which grew with every hand-in).

@@ -9,7 +9,9 @@
 * ``EXCEPTION_HANDLERS`` (Starlette's ``exception_handlers``): a ``RefusedError`` from any endpoint,
   check or job is its JSON answer (``refusal``); a ``UserError`` (a file the clerk could not write) is
   a 503 in one line with no path of the teacher's machine, and one line in the teacher's terminal;
-* ``OneLineErrors`` (inside ``SecurityHeaders``): any other exception is a bug, answered 500 in one
+* ``ForwardedFor`` (inside ``SecurityHeaders``, with ``serve --proxy ADDRESS``): a request whose connection is the
+  proxy's is the client the proxy named, the rightmost ``X-Forwarded-For`` entry (see ``forwarded_client``);
+* ``OneLineErrors`` (inside ``ForwardedFor``): any other exception is a bug, answered 500 in one
   line, with one line in the teacher's terminal, and the class goes on. Starlette's own handler for
   ``Exception`` (``ServerErrorMiddleware``) would raise it again for the server to print a traceback
   into the terminal the teacher reads the class's code from.
@@ -34,6 +36,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ..errors import UserError
 from .intake import RefusedError
+from .state import FORWARDED
 
 SECURITY_HEADERS = {
     "Content-Security-Policy": "default-src 'none'; script-src 'self'; style-src 'self'; connect-src 'self'; "
@@ -108,6 +111,64 @@ class SecurityHeaders(_HTTPMiddleware):
             await send(message)
 
         await self.app(scope, receive, send_with_headers)
+
+
+#: What a client is told when the proxy named nobody: the teacher's proxy is set up wrong, no machine told apart.
+NO_FORWARDED_FOR = ("the proxy in front of the class sent no X-Forwarded-For, so the class cannot tell its machines "
+                    "apart: the teacher's proxy must set it (docs/teaching.md, Behind a proxy)")
+
+
+def forwarded_client(headers: Headers) -> str | None:
+    """The client the proxy names: the rightmost entry of ``X-Forwarded-For`` (of the last such header), the one
+    the proxy itself wrote, with nginx's ``$proxy_add_x_forwarded_for`` (which appends) or ``$remote_addr``
+    (which replaces); None if there is none or it is not an address. Entries to its left are whatever the client
+    sent, and a client can send anything ("127.0.0.1"), so none of them is ever read, and with a proxy that passes
+    the client's header on unchanged, the rightmost is the client's word too: the class never takes a forwarded
+    address for the teacher's machine (``state.ClassState.teachers_machine``)."""
+    values = headers.getlist("x-forwarded-for")
+    if not values:
+        return None
+    last = values[-1].rsplit(",", 1)[-1].strip()
+    try:
+        return str(ipaddress.ip_address(last))
+    except ValueError:
+        return None
+
+
+def _same_address(a: str, b: str) -> bool:
+    try:
+        return ipaddress.ip_address(a) == ipaddress.ip_address(b)
+    except ValueError:
+        return False
+
+
+class ForwardedFor(_HTTPMiddleware):
+    """Pure ASGI middleware under ``serve --proxy ADDRESS``: a request whose connection comes from the proxy is the
+    client it names (``forwarded_client``), marked ``FORWARDED`` in its scope, so it is never the teacher's machine,
+    whatever the header says; one that names nobody is refused in one line (and said once in the teacher's
+    terminal), since every machine behind the proxy would share one address's counts. A connection from any other
+    address is its socket's address, as without a proxy."""
+
+    def __init__(self, app: ASGIApp, proxy: str | None = None, say: Any = None) -> None:
+        super().__init__(app)
+        self.proxy = proxy
+        self.say = say
+        self.said = False
+
+    async def http(self, scope: Scope, receive: Receive, send: Send) -> None:
+        client = scope.get("client")
+        if self.proxy is None or not client or not _same_address(client[0], self.proxy):
+            await self.app(scope, receive, send)
+            return
+        named = forwarded_client(Headers(scope=scope))
+        if named is None:
+            if not self.said and self.say is not None:
+                self.said = True
+                self.say(f"a request came through the proxy {self.proxy} with no X-Forwarded-For: refused (set it "
+                         f"in the proxy, e.g. nginx: proxy_set_header X-Forwarded-For $remote_addr;)")
+            await refusal(RefusedError(400, NO_FORWARDED_FOR))(scope, receive, send)
+            return
+        await self.app({**scope, "client": (named, 0), FORWARDED: True}, receive, send)
 
 
 class OneLineErrors(_HTTPMiddleware):

@@ -7,8 +7,9 @@ server: requests in flight get ``GRACE_SECONDS`` to finish, a hand-in being writ
 the projector's stream is closed, and nothing is half-written.
 
 uvicorn runs with the class's guard on its httptools protocol (``guard``: deadlines and a share of the
-connections per address), and without proxy headers: a client's address is its socket's, never an
-``X-Forwarded-For`` it wrote, unless the teacher names a proxy (``--proxy ADDRESS``). One server at
+connections per address), and without uvicorn's proxy headers: a client's address is its socket's, never an
+``X-Forwarded-For`` it wrote, unless the teacher names a proxy (``--proxy ADDRESS``); then a connection from that
+address is the client the proxy appended, and never the teacher's machine (``middleware.ForwardedFor``). One server at
 a time serves a folder: it holds ``server.lock`` (owner-only) for its life, and a second one says so
 in one line and stops.
 
@@ -135,15 +136,16 @@ class ClassServer:
 def open_class(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
                on_ready: Callable[[ClassServer], None] | None = None, lab: str | None = None,
                proxy: str | None = None, rehearse: bool = False, lab_b: str | None = None,
-               split_seed: int | None = None) -> ClassServer:
+               split_seed: int | None = None, secret_always: bool = False) -> ClassServer:
     """The class in ``folder`` (gone on with, or new) bound to ``host:port`` (0: a free port), not yet serving.
 
     ``say`` gets the teacher's lines: the banner once the server takes requests, notices after. ``lab``:
     the preset the class curve shows (a new class: ``lesson`` unless given; a class gone on with keeps its
-    own unless given). ``proxy``: the address of a reverse proxy whose ``X-Forwarded-For`` is believed.
-    ``rehearse``: a rehearsal (``folder`` None), in a temporary folder removed when ``run`` ends. ``lab_b``: a
-    classroom experiment's second condition beside ``lab`` (``experiment``), split by ``split_seed`` (None: drawn
-    at random, and kept in the class's record)."""
+    own unless given). ``proxy``: the address of a reverse proxy whose ``X-Forwarded-For`` is believed (its rightmost
+    entry; UserError unless an IP address). ``rehearse``: a rehearsal (``folder`` None), in a temporary folder removed
+    when ``run`` ends. ``lab_b``: a classroom experiment's second condition beside ``lab`` (``experiment``), split by
+    ``split_seed`` (None: drawn at random, and kept in the class's record). ``secret_always``: the teacher's page
+    asks for the secret on this machine too."""
     import uvicorn
 
     from ..lab.record import register
@@ -156,6 +158,7 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
     second = _curve_protocol(lab_b)
     if second is not None and second == curve:
         raise UserError("--lab-b names the same protocol as --lab: an experiment needs two conditions")
+    proxy = proxy_address(proxy)
     register()  # lab runs are read as replays with their task section
     temporary = records = None
     if rehearse:
@@ -190,7 +193,8 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
             elif second is not None and second != roster.experiment.b:  # type: ignore[union-attr]
                 raise UserError(f"--lab-b: the class in {folder} splits between its own two conditions: go on "
                                 "with it without --lab-b")
-            clerk = Clerk(folder, roster, rehearsal=rehearse, records=records)
+            clerk = Clerk(folder, roster, rehearsal=rehearse, records=records,
+                          warn=lambda line: say(f"armgame class: {line}"))
             sock = _bind(host, port)
         except BaseException:
             held.release()
@@ -216,8 +220,15 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
         say(f"  browser:        {play_url}   (Chromebooks, tablets: nothing to install)")
         say(f"  projector:      http://{_label(host)}:{port}/?key={roster.projector_key()}   (shows the code; "
             f"the lab's class curve: /lab)")
-        say(f"  teacher only:   http://{_label(host)}:{port}/teacher   (open it in a browser on this laptop: it asks "
-            f"no secret here; another machine needs the one in {SECRET_NAME})")
+        if secret_always:
+            say(f"  teacher only:   http://{_label(host)}:{port}/teacher   (it asks for the secret in {SECRET_NAME}, "
+                f"on this machine too: --teacher-secret-always)")
+        else:
+            say(f"  teacher only:   http://{_label(host)}:{port}/teacher   (open it in a browser on this laptop: it "
+                f"asks no secret here; another machine needs the one in {SECRET_NAME})")
+        if proxy is not None:
+            say(f"  behind the proxy {proxy}: a machine is the last address its X-Forwarded-For names, and nothing "
+                f"that comes through the proxy is this machine (the teacher's page asks for the secret there)")
         if others:
             say(f"  this machine also answers at {', '.join(others)}, if students are on that network")
         say("  the first time, Windows or macOS may ask to allow incoming connections for Python: allow it on "
@@ -231,19 +242,37 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
 
     guard = Guard(own=frozenset(own), key=roster.projector_key())
     app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), guard=guard,
-                    play_url=play_url)
+                    play_url=play_url, proxy=proxy, secret_always=secret_always)
     _more_files(CONCURRENCY + 256)
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="on",
                             timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5,
                             limit_concurrency=CONCURRENCY, h11_max_incomplete_event_size=16 * 1024,
-                            http=guarded_protocol(guard), proxy_headers=proxy is not None,
-                            forwarded_allow_ips=proxy or "")
+                            http=guarded_protocol(guard), proxy_headers=False)
     errors = logging.getLogger("uvicorn.error")  # configured by uvicorn.Config, just above
     if not any(isinstance(f, _QuietWhenFull) for f in errors.filters):
         errors.addFilter(_QuietWhenFull())
     opened = ClassServer(clerk, sock, _class_uvicorn(config, app.state.armgame.end_streams), join_line, new, held,
                          temporary)
     return opened
+
+
+def proxy_address(proxy: str | None) -> str | None:
+    """``--proxy``'s address as the class compares it, or None; UserError in one line unless it is one IP address
+    (uvicorn's own list, "*" or a network, would believe a header from anyone in it).
+
+    A proxy on this machine (127.0.0.1) is allowed: it is how a teacher puts TLS in front of the class. It is made
+    safe rather than refused, since whatever comes through a proxy is never the teacher's machine
+    (``middleware.ForwardedFor``): on such a laptop the teacher's page asks for the secret from the proxy's address,
+    and a student's own ``X-Forwarded-For: 127.0.0.1`` is a student's."""
+    if proxy is None:
+        return None
+    import ipaddress
+
+    try:
+        return str(ipaddress.ip_address(proxy.strip().strip("[]")))
+    except ValueError:
+        raise UserError(f"--proxy {proxy}: not an IP address; name the one address the reverse proxy connects from "
+                        f"(e.g. --proxy 127.0.0.1 for a proxy on this laptop)") from None
 
 
 def _class_uvicorn(config: Any, end_streams: Callable[[], None]) -> Any:
@@ -319,10 +348,12 @@ class _QuietWhenFull(logging.Filter):
 
 def serve(folder: Path | None, host: str, port: int, seed: int | None, say: Callable[[str], None] = print,
           lab: str | None = None, proxy: str | None = None, rehearse: bool = False,
-          on_ready: Callable[[ClassServer], None] | None = None, lab_b: str | None = None) -> int:
+          on_ready: Callable[[ClassServer], None] | None = None, lab_b: str | None = None,
+          secret_always: bool = False) -> int:
     """Run the class in ``folder`` (a rehearsal: None) on ``host:port`` until Ctrl-C (or SIGTERM); returns an exit
     status. ``on_ready``: as ``open_class``'s."""
-    opened = open_class(folder, host, port, seed, say, on_ready, lab=lab, proxy=proxy, rehearse=rehearse, lab_b=lab_b)
+    opened = open_class(folder, host, port, seed, say, on_ready, lab=lab, proxy=proxy, rehearse=rehearse, lab_b=lab_b,
+                        secret_always=secret_always)
     opened.run()
     if opened.temporary is not None:
         played = f"{plural(len(opened.clerk.entries), 'game')} and {plural(len(opened.clerk.lab_runs), 'lab run')}"

@@ -64,6 +64,9 @@ MAX_GUESS_WAIT = 3600.0
 MAX_TRACKED_ADDRESSES = 10_000
 JOINS_PER_MINUTE = 3
 CLASS_JOINS_PER_MINUTE = 120
+#: The key of an ASGI scope whose request came through the teacher's proxy (``middleware.ForwardedFor``): its
+#: client is the address the proxy named, and it is never the teacher's machine (``ClassState.teachers_machine``).
+FORWARDED = "armgame.forwarded"
 
 
 class Guesses:
@@ -133,6 +136,9 @@ class ClassState:
     join_line: str
     guard: Guard = field(default_factory=Guard)
     play_url: str = ""
+    #: ``serve --teacher-secret-always``: no machine is the teacher's without the secret, this one neither (a lab
+    #: PC that others use: whoever else is on it would be the teacher).
+    secret_always: bool = False
     #: Called once the server takes requests; ``say`` gets one-line notices for the teacher.
     on_ready: Callable[[], None] | None = None
     say: Callable[[str], None] = lambda line: None
@@ -181,10 +187,18 @@ class ClassState:
         self.stopping.set()
         self.changed.set()
 
+    def teachers_machine(self, request: Request) -> bool:
+        """Whether ``request`` is the teacher's machine's: its connection comes from one of this machine's own
+        addresses (``Guard.own``), and not through the proxy, whose word is never the teacher's (a header can
+        be the client's, passed on); never under ``secret_always``. Anything on this machine is the teacher:
+        every user and program on it, which is why a shared PC serves with ``--teacher-secret-always``."""
+        return not self.secret_always and not request.scope.get(FORWARDED) \
+            and self.guard.is_own(client_address(request))
+
     def projector(self, request: Request) -> bool:
         """Whether ``request`` is the projector's (its link's key) or the teacher's machine's."""
         key = request.query_params.get("key", "")
-        return self.guard.is_own(client_address(request)) or (
+        return self.teachers_machine(request) or (
             len(key) <= 64 and hmac.compare_digest(key.encode(), self.clerk.roster.projector_key().encode()))
 
     async def run(self, job: Callable[[], T]) -> T:

@@ -55,8 +55,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        "join for the lab, at random in blocks of two (the groups stay within one of equal size), "
                        "and their lab is handed its protocol to run. Fixed for the class's life: only a new class "
                        "starts an experiment")
-    serve.add_argument("--proxy", metavar="ADDRESS", help="believe X-Forwarded-For from this address only (a reverse "
-                       "proxy in front of the class; default: none, a client's address is its socket's)")
+    serve.add_argument("--proxy", metavar="ADDRESS", help="a reverse proxy in front of the class connects from this "
+                       "IP address: a request from it is the last address its X-Forwarded-For names, never the "
+                       "teacher's machine (default: none, a client's address is its socket's)")
+    serve.add_argument("--teacher-secret-always", action="store_true", help="the teacher's page asks for the secret "
+                       "on this machine too (a shared lab PC: otherwise anyone using it is the teacher)")
     serve.add_argument("--rehearse", action="store_true", help="a rehearsal of the lesson: 15 s games and 30 s "
                        "rounds, in a temporary folder removed at Ctrl-C (nothing is kept; not with --folder)")
     serve.set_defaults(run=run_serve)
@@ -94,7 +97,8 @@ def run_serve(args: argparse.Namespace) -> int:
     if args.lab_b is not None and args.lab is None:
         raise UserError("--lab-b is the experiment's second condition: name the first with --lab")
     return serve(folder, host, args.port, args.seed, say=lambda line: print(line, flush=True), lab=args.lab,
-                 proxy=args.proxy, rehearse=args.rehearse, lab_b=args.lab_b)
+                 proxy=args.proxy, rehearse=args.rehearse, lab_b=args.lab_b,
+                 secret_always=args.teacher_secret_always)
 
 
 def run_submit(args: argparse.Namespace) -> int:

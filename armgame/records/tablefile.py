@@ -28,7 +28,8 @@ table (another ``add``, or ``compact``, which the class server runs at its start
 journal's entries into ``scores.json``, and only then removes the journal: a kill in between leaves entries
 in both, which are one entry (one id) to every reader. The journal is only appended to a clean table
 (no damage, no planted counter or seed, every entry numbered); otherwise the whole table is written, which
-repairs or sets aside what it must, as before.
+repairs or sets aside what it must, as before. A class's server, as it starts, first mends a damaged journal line
+from the replay it names (``ScoreTable.compact(mend=True)``, ``journalmend``), or names it to the teacher.
 
 Trust: the table's bytes are parsed as data (``records.tableformat``). A damaged table is never overwritten
 silently: the next write first copies its bytes to ``scores.json.corrupt-<UTC time>``, then writes the new table
