@@ -68,12 +68,25 @@ def _self_reads(node: ast.AST, name: str = "self") -> dict[str, set[str]]:
     return reads
 
 
-def _assigned(cls: type) -> set[str]:
-    """The ``self.x = ...`` names of ``cls.__init__``."""
-    tree = ast.parse(textwrap.dedent(inspect.getsource(cls.__init__)))
+def _assigned(cls: type, method: str | None = "__init__") -> set[str]:
+    """The ``self.x = ...`` names of ``cls.__init__`` (``method`` None: of any of its methods, e.g. ``self.url``,
+    which uvicorn's protocol sets as each request begins)."""
+    tree = ast.parse(textwrap.dedent(inspect.getsource(cls if method is None else getattr(cls, method))))
     return {t.attr for node in ast.walk(tree) if isinstance(node, (ast.Assign, ast.AnnAssign))
             for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
             if isinstance(t, ast.Attribute) and isinstance(t.value, ast.Name) and t.value.id == "self"}
+
+
+def _super_calls(node: ast.ClassDef) -> set[str]:
+    """The names of the guard's methods that call ``super().<their own name>``."""
+    found = set()
+    for method in node.body:
+        if isinstance(method, ast.FunctionDef | ast.AsyncFunctionDef):
+            for sub in ast.walk(method):
+                if (isinstance(sub, ast.Attribute) and sub.attr == method.name and isinstance(sub.value, ast.Call)
+                        and isinstance(sub.value.func, ast.Name) and sub.value.func.id == "super"):
+                    found.add(method.name)
+    return found
 
 
 def internals_problems(base: type = HttpToolsProtocol, cycle: type = RequestResponseCycle) -> list[str]:
@@ -82,9 +95,10 @@ def internals_problems(base: type = HttpToolsProtocol, cycle: type = RequestResp
     guarded, node = _guard_class()
     problems = []
     own = {k for k in vars(guarded) if not (k.startswith("__") and k.endswith("__"))}
+    extended = _super_calls(node)  # a method that calls uvicorn's own of its name is an override, on purpose
     for name in sorted(own):
         theirs = getattr(base, name, None)
-        if name.startswith("_"):
+        if name.startswith("_") and name not in extended:
             if theirs is not None:
                 problems.append(f"uvicorn's {base.__name__} now has its own {name}, which the guard's hides")
             continue
@@ -104,10 +118,11 @@ def internals_problems(base: type = HttpToolsProtocol, cycle: type = RequestResp
     finally:
         loop.close()
     cycle_fields = _assigned(cycle)
+    set_later = _assigned(base, None)
     for name, reads in sorted(_self_reads(node).items()):
         if name in own:
             continue
-        if not hasattr(protocol, name):
+        if not hasattr(protocol, name) and name not in set_later:
             problems.append(f"the guard reads self.{name}, which uvicorn's {base.__name__} no longer sets")
         if name == "cycle":
             problems += [f"the guard reads self.cycle.{attr}, which uvicorn's {cycle.__name__} no longer sets"
