@@ -120,3 +120,13 @@ def test_proxy_must_be_one_address(tmp_path, capsys, proxy):
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and f"--proxy {proxy}: not an IP address" in err
     assert not folder.exists()
+
+
+def test_behind_a_proxy_the_students_are_not_one_address_with_one_share():
+    """Every student's connection arrives from the proxy: its address has no share of 16 to exceed (the proxy's own
+    per-client limits are the share), while any other machine keeps its share."""
+    from armgame.classroom.guard import Guard
+
+    guard = Guard(own=frozenset({"127.0.0.1"}), proxy="10.0.0.5", per_address=4)
+    assert all(guard.admit("10.0.0.5") for _ in range(40))
+    assert [guard.admit("10.0.0.9") for _ in range(5)] == [True] * 4 + [False]

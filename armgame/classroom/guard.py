@@ -85,6 +85,9 @@ class Guard:
     own: frozenset[str] = frozenset({"127.0.0.1", "::1"})
     #: The projector's link's key (``Roster.projector_key``): a connection on probation that asks with it stays.
     key: str = ""
+    #: The reverse proxy's address (``--proxy``): every student's connections arrive from it, so it has no share of
+    #: ``per_address`` to exceed (the proxy's own per-client limits are the share then: nginx's ``limit_conn``).
+    proxy: str = ""
     per_address: int = PER_ADDRESS
     header_seconds: float = HEADER_SECONDS
     request_seconds: float = REQUEST_SECONDS
@@ -110,7 +113,7 @@ class Guard:
 
     def admit(self, address: str) -> bool:
         """Count a new connection from ``address``, or refuse it (False) when the address has its share."""
-        if not self.is_own(address) and self.open[address] >= self.per_address:
+        if not self.is_own(address) and address != self.proxy and self.open[address] >= self.per_address:
             self.refused += 1
             return False
         self.open[address] += 1

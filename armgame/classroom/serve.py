@@ -240,7 +240,7 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
         if on_ready is not None:
             on_ready(opened)
 
-    guard = Guard(own=frozenset(own), key=roster.projector_key())
+    guard = Guard(own=frozenset(own), key=roster.projector_key(), proxy=proxy or "")
     app = build_app(clerk, join_line, on_ready=ready, say=lambda line: say(f"armgame class: {line}"), guard=guard,
                     play_url=play_url, proxy=proxy, secret_always=secret_always)
     _more_files(CONCURRENCY + 256)
