@@ -72,6 +72,12 @@ export class LabView {
       circle(g, ...px(...run.cursor), Math.max(3, CURSOR_RADIUS * k), INK);
     }
     if (s.phase !== "end") this._bars(g, w, h, line, run.muscleActivation);
+    else if (this._curve) {  // the end screen's curve follows its box (a phone turned, a window resized)
+      const root = $("lab-curve"), b = root.getBoundingClientRect();
+      if (root.dataset.size !== Math.max(Math.round(b.width), 120) + "x" + Math.max(Math.round(b.height), 60)) {
+        drawCurve(root, this._curve);
+      }
+    }
     // The scene's box in CSS px of the canvas: the tests hold it whole inside the screen, clear of every control.
     this.canvas.workspace = { x: view.left, y: view.top, width: view.width, height: view.height };
   }
@@ -140,8 +146,9 @@ export class LabView {
     $("lab-end-summary").textContent = summary;
     $("lab-means").textContent = means;
     this.answer(answer, kind);
-    drawCurve($("lab-curve"), curve);
+    this._curve = curve;
     $("lab-end").hidden = false;
+    drawCurve($("lab-curve"), curve);  // once laid out: its box is the page's
   }
 
   answer(line, kind) {
@@ -169,10 +176,16 @@ function svg(parent, name, attributes, text) {
   return e;
 }
 
-/** The learning curve (lab_panels.draw_curve) as SVG in a fixed frame of 1000 x 420 units the page scales. */
+/** The learning curve (lab_panels.draw_curve) as SVG, in the CSS px of the box play.css gives it, so its words are
+ * the page's size on any screen (redrawn when the box changes: LabView.draw). */
 export function drawCurve(root, curve) {
   root.replaceChildren();
-  const W = 1000, H = 420, left = 90, top = 44, bottom = 54, right = 12;
+  const box = root.getBoundingClientRect();
+  const W = Math.max(Math.round(box.width), 120), H = Math.max(Math.round(box.height), 60);
+  root.dataset.size = W + "x" + H;
+  const text = Math.max(14, Math.min(22, Math.round(Math.min(W / 28, H / 10))));
+  root.style.setProperty("--text", text + "px");
+  const left = 3.4 * text, top = 1.8 * text, bottom = 2.2 * text, right = 0.5 * text;
   root.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const points = curve.points;
   if (points.length === 0) return;
@@ -188,19 +201,21 @@ export function drawCurve(root, curve) {
     const x0 = x(b.first - 0.5), x1 = x(b.last + 0.5);
     svg(root, "rect", { x: x0, y: top, width: x1 - x0, height: plotH,
       fill: b.perturbed ? "rgb(246,214,214)" : i % 2 ? "rgb(226,226,226)" : "rgb(238,238,238)" });
-    svg(root, "text", { x: (x0 + x1) / 2, y: top - 10, "text-anchor": "middle", class: "block" }, b.name);
+    if (x1 - x0 > 0.6 * text * b.name.length) {  // a block too narrow for its name goes unnamed, as in the window
+      svg(root, "text", { x: (x0 + x1) / 2, y: top - 0.4 * text, "text-anchor": "middle", class: "block" }, b.name);
+    }
     if (Number.isFinite(b.mean) && b.mean >= low && b.mean <= high) {
-      svg(root, "line", { x1: x0 + 4, x2: x1 - 4, y1: y(b.mean), y2: y(b.mean), stroke: WARN, "stroke-width": 4 });
+      svg(root, "line", { x1: x0 + 3, x2: x1 - 3, y1: y(b.mean), y2: y(b.mean), stroke: WARN, "stroke-width": 3 });
     }
   });
   for (const t of ticks(low, high)) {
-    svg(root, "line", { x1: left - 8, x2: left, y1: y(t), y2: y(t), stroke: INK, "stroke-width": 2 });
-    svg(root, "text", { x: left - 12, y: y(t), "text-anchor": "end", "dominant-baseline": "middle" },
+    svg(root, "line", { x1: left - 0.4 * text, x2: left, y1: y(t), y2: y(t), stroke: INK, "stroke-width": 2 });
+    svg(root, "text", { x: left - 0.6 * text, y: y(t), "text-anchor": "end", "dominant-baseline": "middle" },
       String(Number(t.toPrecision(6))));
   }
   svg(root, "line", { x1: left, x2: W - right, y1: y(0), y2: y(0), stroke: INK, "stroke-width": 2 });
   svg(root, "rect", { x: left, y: top, width: plotW, height: plotH, fill: "none", stroke: INK, "stroke-width": 2 });
-  const r = Math.max(3, Math.min(8, plotW / span / 2.2));
+  const r = Math.max(3, Math.min(text / 3, plotW / span / 2.2));
   for (const p of points) {
     if (!Number.isFinite(p.value)) continue;
     if (p.catch) svg(root, "circle", { cx: x(p.trial), cy: y(p.value), r: r + 1, fill: "none", stroke: WARN, "stroke-width": 2 });
@@ -208,10 +223,10 @@ export function drawCurve(root, curve) {
   }
   if (curve.afterEffect !== null) {
     const cx = x(curve.afterEffect.trial), cy = y(curve.afterEffect.value);
-    svg(root, "circle", { cx, cy, r: r + 7, fill: "none", stroke: WARN, "stroke-width": 4 });
-    const onLeft = cx - r - 16 - 130 >= left;
-    svg(root, "text", { x: onLeft ? cx - r - 16 : cx + r + 16, y: cy, "text-anchor": onLeft ? "end" : "start",
+    svg(root, "circle", { cx, cy, r: r + 5, fill: "none", stroke: WARN, "stroke-width": 3 });
+    const onLeft = cx - r - text - 7 * text >= left;
+    svg(root, "text", { x: onLeft ? cx - r - text : cx + r + text, y: cy, "text-anchor": onLeft ? "end" : "start",
       "dominant-baseline": "middle", fill: WARN }, "after-effect");
   }
-  svg(root, "text", { x: left, y: H - 14 }, `${curve.label} (${curve.unit}) by trial`);
+  svg(root, "text", { x: left, y: H - 0.5 * text }, `${curve.label} (${curve.unit}) by trial`);
 }

@@ -263,6 +263,7 @@ async function startLab() {
 
 async function finishLab() {
   phase = "lab-over";
+  document.body.classList.add("lab-over");
   held.clear();
   fingers.clear();
   document.getElementById("lab-again").textContent = "Run the lab again";
@@ -274,7 +275,7 @@ async function finishLab() {
 
 function leaveLab() {
   lab = null;
-  document.body.classList.remove("lab");
+  document.body.classList.remove("lab", "lab-over");
   document.getElementById("lab-head").hidden = true;
   document.getElementById("lab-card").hidden = true;
   document.getElementById("lab-end").hidden = true;
