@@ -4,7 +4,6 @@
 import { blend, circle, drawArm, drawTorso, rgb } from "./body.js";
 import { Game, standardConfig } from "./engine.js";
 import { dropGame, forgetMember, keepGame, loadMember, outbox, saveMember, tokenFor } from "./kept.js";
-import { LabScreen } from "./labpage.js";
 
 const RETRY_MS = 5000;
 
@@ -245,6 +244,14 @@ async function startLab() {
     phase = "closed";  // asked again in a few seconds
     statusLine.textContent = answer.status === 200 ? "the lab could not be loaded: trying again in a few seconds"
       : "the class could not be reached for the lab: trying again in a few seconds";
+    labTimer = setTimeout(() => nextRun(), RETRY_MS);
+    return;
+  }
+  // The lab's modules are loaded when a lab starts: a class that only plays the game never fetches them.
+  let LabScreen;
+  try { ({ LabScreen } = await import("./labpage.js")); } catch {
+    phase = "closed";
+    statusLine.textContent = "the lab could not be loaded: trying again in a few seconds";
     labTimer = setTimeout(() => nextRun(), RETRY_MS);
     return;
   }
