@@ -296,3 +296,17 @@ def test_a_whole_lesson_with_keys_at_1024x768_is_handed_in_and_in_the_class_curv
 @pytest.mark.slow  # a whole lesson in chromium (about 5 s)
 def test_a_whole_lesson_with_the_touch_buttons_on_a_phone_is_handed_in_and_in_the_class_curve(tmp_path):
     _a_whole_lesson(tmp_path, (390, 844), touch=True)
+
+
+def test_what_teaching_md_says_the_switch_and_the_page_say_is_what_they_say():
+    """docs/teaching.md's words for the teacher's page, the projector and the student's screen are the pages' own."""
+    guide = " ".join((ROOT / "docs" / "teaching.md").read_text(encoding="utf-8").split())
+    static = ROOT / "armgame" / "classroom" / "static"
+    pages = " ".join(" ".join((static / name).read_text(encoding="utf-8").split()) for name in (
+        "teacher.html", "standings.html", "play.js", "labpage.js", "play.html"))
+    for words in ("Everyone's browser runs the lab", "Back to the game", "LAB in every browser",
+                  "the teacher has started the lab", "Play again", "Run the lab again"):
+        assert words in guide and words in pages, words
+    # The class's answer and the measure's words, as the tests above see them said.
+    assert "lab run handed in: in the class curve" in guide
+    assert "cm off the line (right)" in guide

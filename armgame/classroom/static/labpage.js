@@ -205,6 +205,6 @@ export class LabScreen {
   get debug() {
     return { lab: true, phase: this.phase, trial: this.run.trialIndex, trials: this.plan.trials.length,
       done: this.run.outcomes.length, held: [...this.held], activation: this.run.muscleActivation,
-      resets: this.run.resets, steps: this.run.steps };
+      resets: this.run.resets, steps: this.run.steps, go: this.run.phase === "reach" ? this.run.goStep : null };
   }
 }
