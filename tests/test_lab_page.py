@@ -5,7 +5,7 @@ and what it tells the student.
   the teacher's alone, and the projector's facts and /play's public standings say it.
 - What the page tells a student of each reach (``labmeasure.js``: the outcome word, the result's words) and the
   learning curve its end screen draws are Python's (``analysis.outcome_word``, ``result_words``,
-  ``learning_curve`` on ``trial_rows``), on the adaptive bot's whole lesson, a rotation lesson and quick protocols
+  ``learning_curve`` on ``trial_rows``), on the adaptive bot's whole lesson and quick protocols
   with catch trials, channel trials and no-vision probes, played through ``labengine.js`` in ``node``.
 - In chromium: the lab's first card and its go cue (default tier); a whole ``lesson`` at 1024x768 with keys and
   one on a phone (390x844) with the touch buttons, each handed in and in /lab's curve and n (slow tier).
@@ -116,13 +116,13 @@ def test_the_switch_is_the_teachers_alone(tmp_path, monkeypatch):
 
 # ------------------------------------------------------------------------------ what the page tells
 def _runs() -> list[tuple[object, object, list]]:
-    """(config, protocol, events): the adaptive bot's lesson and rotation lesson, and quick protocols at random keys
-    (catch and channel trials, endpoint feedback and no-vision probes, postures)."""
+    """(config, protocol, events): the adaptive bot's lesson, and quick protocols at random keys (catch and channel
+    trials, endpoint feedback and no-vision probes, mixes, postures and displays)."""
     import random
 
     rng = random.Random(5)
     out = []
-    for name in ("lesson", "rotation"):
+    for name in ("lesson",):  # a changed display's measure (the direction) is the postures protocol's, below
         protocol = preset(name)
         config = lab_config(protocol, 31, person=True)
         bot = LabSession(config, protocol, sine="arm")
@@ -138,7 +138,7 @@ def _runs() -> list[tuple[object, object, list]]:
 @pytest.mark.skipif(NODE is None and not os.environ.get("ARMGAME_REQUIRE_BROWSER"), reason="no node")
 def test_the_page_tells_each_reach_and_draws_the_curve_as_python_measures_them():
     runs = _runs()
-    stops = [c.total_steps if i < 2 else 6000 for i, (c, _, _) in enumerate(runs)]
+    stops = [c.total_steps if i == 0 else 6000 for i, (c, _, _) in enumerate(runs)]
     request = {"runs": [{"plan": lab_plan(c, p), "events": e, "stop": stop}
                         for (c, p, e), stop in zip(runs, stops, strict=True)]}
     done = subprocess.run([NODE, str(RUNNER)], input=json.dumps(request), capture_output=True, text=True,
@@ -185,8 +185,9 @@ def test_the_page_tells_each_reach_and_draws_the_curve_as_python_measures_them()
         else:
             assert mine["afterEffect"]["trial"] == curve.after_effect[0]
             assert close(mine["afterEffect"]["value"], curve.after_effect[1])
-    # The runs told every kind of outcome: hits and time-outs, a miss without a cursor, and nothing at all.
+    # The runs told every kind of outcome (hits and time-outs, nothing at all) in both measures.
     assert {("full", "hit"), ("full", "time out"), ("none", None)} <= told, told
+    assert {got["metric"] for got in answers} == {"max_perpendicular_error_m", "initial_direction_error_deg"}
 
 
 # ------------------------------------------------------------------------------------------ in chromium
@@ -221,6 +222,12 @@ def test_a_joined_student_gets_the_labs_first_card_and_its_go_cue(tmp_path):
         page.keyboard.press(" ")
         assert page.is_hidden("#lab-card")
         run_for(page, 1100)  # the hold at home (0.5 to 1 s) brings the go cue
+        # The words over the scene, never on it: the head above the scene's box, both inside the window.
+        head = page.eval_on_selector("#lab-head",
+                                     "e => { const b = e.getBoundingClientRect(); return [b.top, b.bottom]; }")
+        scene = page.evaluate("(() => { const c = document.getElementById('game'), b = c.getBoundingClientRect(),"
+                              " w = c.workspace; return [b.top + w.y, b.top + w.y + w.height, b.bottom]; })()")
+        assert 0 <= head[0] < head[1] <= scene[0] < scene[1] <= scene[2] <= 768, (head, scene)
         debug = page.evaluate("document.getElementById('game').debug")
         assert debug["lab"] and debug["phase"] == "reach" and debug["steps"] > 0
         assert page.evaluate("(() => { const c = document.getElementById('game'); const g = c.getContext('2d');"

@@ -60,11 +60,13 @@ function refusal(answer) {
   return answer.data && typeof answer.data.error === "string" ? answer.data.error : "the class refused (" + answer.status + ")";
 }
 
-async function join(code, name, token) {
+// ``state``: the class's state asked before a new name joins. With the teacher's switch on, the join says it is for
+// the lab (a closed class takes a new name for it). A name this browser has is known to the class: it rejoins as
+// it always did, and the lab's own join follows if the switch is on (startLab).
+async function join(code, name, token, state) {
   const body = { code, name };
   if (token) body.token = token;
-  // A class whose teacher has every browser run the lab: the join says it is for the lab (a closed class takes it).
-  if ((await classState()).lab) body.for = "lab";
+  if (state && state.lab) body.for = "lab";
   return post("/api/join", JSON.stringify(body));
 }
 
@@ -150,7 +152,8 @@ joinForm.addEventListener("submit", async (event) => {
   const button = document.getElementById("join-button");
   button.disabled = true;
   // A name this browser joined under before keeps its token (the class knows it); a new one starts afresh.
-  const answer = await join(code, name, tokenFor(code, name));
+  const state = await classState();
+  const answer = await join(code, name, tokenFor(code, name), state);
   button.disabled = false;
   if (answer.status === 0) {
     document.getElementById("join-error").textContent = "the class could not be reached: is this the address on the projector?";
@@ -160,16 +163,23 @@ joinForm.addEventListener("submit", async (event) => {
     document.getElementById("join-error").textContent = refusal(answer);
     return;
   }
-  joined(code, answer.data);
+  joined(code, answer.data, state);
 });
 
-function joined(code, data) {
+// ``state``: the class's state asked just before (the next run chosen at once), or null: the game starts at once
+// (a tap just after the page loads starts it), and the lab replaces it if the teacher's switch is on.
+function joined(code, data, state = null) {
   // The class's game: its seed and its clock (a rehearsal's games are 15 s; a class that does not say: 60 s).
   member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60 };
   saveMember(member);
   joinForm.hidden = true;
   statusLine.textContent = "";
-  nextRun();
+  if (state !== null) nextRun(state);
+  else if (data.closed) nextRun();
+  else {
+    newGame();
+    classState().then((s) => { if (s.lab && phase === "countdown") startLab(); });
+  }
   flushOutbox().then(showAnswers);
 }
 
@@ -198,9 +208,9 @@ function waitWhileClosed() {
 }
 
 // What a student does next: the lab when the teacher has switched it on (a closed class takes lab runs), else the
-// game, or a wait while the class is closed.
-async function nextRun() {
-  const state = await classState();
+// game, or a wait while the class is closed. ``known``: the class's state just asked (else it is asked now).
+async function nextRun(known) {
+  const state = known ?? await classState();
   if (state.lab) { startLab(); return; }
   if (state.closed) { waitWhileClosed(); return; }
   newGame();
