@@ -1,7 +1,10 @@
 """Draw the live class's pages as a projector shows them: docs/img/class_page.png (thirty students) and
 class_lab.png, and a round's end, class_round.png; the browser game (/play) as a student's laptop shows
 it, mid-game and at its end: class_play.png, class_play_end.png; and mid-game on a phone and a tablet, played
-with fingers on the touch buttons: class_play_phone.png (390x844), class_play_tablet.png (820x1180).
+with fingers on the touch buttons: class_play_phone.png (390x844), class_play_tablet.png (820x1180); and the
+lab in the browser (the teacher's switch "Everyone's browser runs the lab" on), a reach's path just after it and
+the end screen at 1024x768, class_lab_play.png and class_lab_play_end.png, and a reach on a phone with the
+touch buttons, class_lab_phone.png (390x844).
 
     python docs/make_class_screenshots.py             # writes docs/img/class_*.png
     python docs/make_class_screenshots.py --out DIR   # somewhere else, at 1024x768 and 1920x1080 both
@@ -45,7 +48,8 @@ QUICK_LAB = ('name = "quick"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "fi
              'perturbation = "curl"\nb = -2.0\n[[blocks]]\nname = "washout"\ntrials = 1\n')
 #: What the script draws, by name: docs/img holds these (tests/test_docs.py checks the rest of docs/img).
 PICTURES = ("class_page.png", "class_lab.png", "class_round.png", "class_play.png", "class_play_end.png",
-            "class_play_phone.png", "class_play_tablet.png")
+            "class_play_phone.png", "class_play_tablet.png", "class_lab_play.png", "class_lab_play_end.png",
+            "class_lab_phone.png")
 #: The touch screens drawn (each once, whatever the laptops' sizes): name, size, student.
 TOUCH = (("class_play_phone.png", (390, 844), "Léa"), ("class_play_tablet.png", (820, 1180), "Sofía"))
 
@@ -122,6 +126,103 @@ def touch_play(browser, opened, size: tuple[int, int], path: Path, name: str) ->
         raise SystemExit(f"the browser game at {size[0]}x{size[1]} with touch logged {errors}")
 
 
+def lab_reach(page, key: str, press, touch: bool = False) -> None:
+    """One trial of the lab in the browser: past a card if one is up, the hold at home to the go cue, a muscle pulled
+    for a moment (``press(key, ms)``), the hand brought home, and the trial left to end (its path then shown)."""
+    if page.is_visible("#lab-card"):
+        if touch:
+            page.tap("#lab-go")
+        else:
+            page.keyboard.press(" ")
+    run_for(page, 1100)
+    press(key, 260)
+    for _ in range(40):  # the time-out at the latest
+        if page.evaluate("document.getElementById('game').debug.phase") != "reach":
+            return
+        run_for(page, 100)
+
+
+def bot_reaches(opened) -> list[list[tuple[int, str, str]]]:
+    """The adapting bot's keys on the class's lab (the class's protocol on the class's seed), each trial's as (steps
+    after its go cue, key, action): the pictures show reaches a student makes, not keys pressed at random."""
+    from armgame.game.bots import Autopilot
+    from armgame.lab.bots import make_lab_bot
+    from armgame.lab.presets import preset
+    from armgame.lab.session import LabSession, lab_config
+
+    protocol = opened.clerk.curve_protocol() or preset("lesson")
+    bot = LabSession(lab_config(protocol, opened.clerk.roster.seed, person=True), protocol, sine="arm")
+    Autopilot(bot, make_lab_bot("adaptive")).play()
+    return [[(e.step - o.go_step, e.key, e.action) for e in bot.timeline
+             if o.go_step <= e.step < o.end_step and e.key in "dfjk"] for o in bot.outcomes]
+
+
+def lab_play(browser, opened, size: tuple[int, int], out: Path, suffix: str) -> None:
+    """A student on a Chromebook runs the class's lab in the browser, each trial's keys the adapting bot's at its steps
+    after the go cue (the page's clock moved to each): a reach's path just after it, then the end screen."""
+    page = browser.new_page(viewport={"width": size[0], "height": size[1]})
+    errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+    join(page, opened.clerk.roster.code, "Paula" if size[0] < 1500 else "Quirin")  # names of their own
+    page.wait_for_selector("#lab-card", state="visible")
+    state = "document.getElementById('game').debug"
+    for trial, keys in enumerate(bot_reaches(opened)):
+        d = page.evaluate(state)
+        while d["phase"] != "end" and not (d["phase"] == "reach" and d["done"] == trial and d["go"] is not None):
+            if page.is_visible("#lab-card"):
+                page.keyboard.press("Enter")
+            page.clock.fast_forward(16)
+            d = page.evaluate(state)
+        if d["phase"] == "end":
+            break
+        for offset, key, action in keys:
+            while d["phase"] == "reach" and d["steps"] < d["go"] + offset:
+                page.clock.fast_forward(16)
+                d = page.evaluate(state)
+            if d["phase"] != "reach":
+                break
+            (page.keyboard.down if action == "down" else page.keyboard.up)(key)
+        for key in "dfjk":
+            page.keyboard.up(key)
+        if trial == 2:
+            while page.evaluate(state)["phase"] == "reach":
+                run_for(page, 50)
+            run_for(page, 100)
+            page.screenshot(path=str(out / f"class_lab_play{suffix}.png"))
+    while not page.is_visible("#lab-end"):
+        if page.is_visible("#lab-card"):
+            page.keyboard.press("Enter")
+        run_for(page, 260)
+    page.wait_for_selector("#lab-answer:has-text('handed in')")
+    page.screenshot(path=str(out / f"class_lab_play_end{suffix}.png"))
+    page.close()
+    if errors:
+        raise SystemExit(f"the browser's lab at {size[0]}x{size[1]} logged {errors}")
+
+
+def touch_lab(browser, opened, size: tuple[int, int], path: Path, name: str) -> None:
+    """A student on a phone runs the lab with the touch buttons: a reach's path just after it."""
+    context = browser.new_context(viewport={"width": size[0], "height": size[1]}, has_touch=True, is_mobile=True)
+    page = context.new_page()
+    errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+    join(page, opened.clerk.roster.code, name)
+    page.wait_for_selector("#lab-card", state="visible")
+    fingers = iter(range(2, 1000))
+
+    def press(key: str, ms: int) -> None:
+        button = "#reset" if key == " " else f"#touch button[data-key='{key}']"
+        finger = next(fingers)
+        page.dispatch_event(button, "pointerdown", {"pointerId": finger, "pointerType": "touch"})
+        run_for(page, ms)
+        page.dispatch_event(button, "pointerup", {"pointerId": finger, "pointerType": "touch"})
+
+    lab_reach(page, "j", press, touch=True)
+    run_for(page, 200)
+    page.screenshot(path=str(path))
+    context.close()
+    if errors:
+        raise SystemExit(f"the browser's lab at {size[0]}x{size[1]} with touch logged {errors}")
+
+
 def teacher(opened, path: str, body: dict) -> None:
     """A teacher's action, from the teacher's machine (which needs no secret)."""
     import json
@@ -195,6 +296,13 @@ def main_(argv: list[str] | None = None) -> int:
             for name, size, student in TOUCH:
                 touch_play(browser, opened, size, out / name, student)
                 print(f"wrote {out / name}")
+            teacher(opened, "/api/teacher/browserlab", {"on": True})  # every browser runs the lab from here on
+            for width, height in sizes:
+                suffix = "" if args.out is None or args.quick else f"-{width}x{height}"
+                lab_play(browser, opened, (width, height), out, suffix)
+                print(f"wrote {out / f'class_lab_play{suffix}.png'} and class_lab_play_end{suffix}.png")
+            touch_lab(browser, opened, (390, 844), out / "class_lab_phone.png", "Lina")
+            print(f"wrote {out / 'class_lab_phone.png'}")
             browser.close()
     return 0
 

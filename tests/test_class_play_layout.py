@@ -25,7 +25,7 @@ LOOK = """() => {
   const shown = (e) => e !== null && e.getClientRects().length > 0 && getComputedStyle(e).visibility !== "hidden";
   const box = (e) => { const b = e.getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; };
   const controls = [...document.querySelectorAll(
-      "#touch button, #not-me, #again, #join input, #join button")].filter(shown).map((e) => {
+      "#touch button, #not-me, #again, #join input, #join button, #lab-go, #lab-again")].filter(shown).map((e) => {
     const [l, t, r, b] = box(e);
     const hit = document.elementFromPoint((l + r) / 2, (t + b) / 2);
     return { name: e.id || e.dataset.key || e.textContent, box: [l, t, r, b], onTop: hit !== null && e.contains(hit),
@@ -33,7 +33,8 @@ LOOK = """() => {
         cls: s.className, text: s.textContent })) };
   });
   const canvas = document.getElementById("game"), c = box(canvas), w = canvas.workspace;
-  return { controls, status: box(document.getElementById("status")), canvas: c,
+  const head = document.getElementById("lab-head");
+  return { controls, status: box(document.getElementById("status")), canvas: c, head: shown(head) ? box(head) : null,
     reach: w ? [c[0] + w.x, c[1] + w.y, c[0] + w.x + w.width, c[1] + w.y + w.height] : null,
     view: [window.innerWidth, window.innerHeight], scroll: [document.documentElement.scrollWidth,
       document.documentElement.scrollHeight] };
@@ -90,6 +91,11 @@ def _check(page, size: tuple[int, int], phase: str) -> dict:
         for c in controls:
             assert not _overlap(reach, c["box"]), f"{where}: {c['name']!r} lies over the arm's reach"
         assert not _overlap(reach, look["status"]), f"{where}: the status line lies over the arm's reach"
+        if look["head"] is not None:  # the lab's head: the trial, the instruction, what was said of the last reach
+            assert _inside(look["head"], screen), f"{where}: the lab's head is cut: {look['head']}"
+            assert not _overlap(reach, look["head"]), f"{where}: the lab's head lies over the scene"
+            for c in controls:
+                assert not _overlap(look["head"], c["box"]), f"{where}: {c['name']!r} lies over the lab's head"
         _arranged(look, size, {c["name"]: c["box"] for c in touch}, where)
     return look
 
@@ -166,6 +172,58 @@ def _every_size(tmp_path, sizes: list[tuple[int, int]], end: bool = True, **devi
             look = _check(page, size, "over")
             assert {c["name"] for c in look["controls"]} >= {"again", "not-me"}, look["controls"]
         assert errors == [] and page.dialogs == []
+
+
+def _lab_every_size(tmp_path, sizes: list[tuple[int, int]], end: bool = True, **device: object) -> None:
+    """The lab's screen (the teacher's switch on) at each of ``sizes``: its first card, the trials (the whole scene
+    on the screen, under no control and under no words), each muscle's button pulling its muscle, home bringing the
+    hand home, and (``end``) the end screen with its learning curve."""
+    import json
+    import urllib.request
+
+    with running_class(tmp_path / "class") as opened, \
+            browser_page(*sizes[0], has_touch=True, is_mobile=True, **device) as page:
+        req = urllib.request.Request(f"http://127.0.0.1:{opened.port}/api/teacher/browserlab",
+                                     data=json.dumps({"on": True}).encode(),
+                                     headers={"Content-Type": "application/json"})
+        urllib.request.urlopen(req, timeout=10).close()
+        errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+        page.wait_for_selector("#touch", state="visible")
+        join(page, opened.clerk.roster.code, "Aleksandra Nowakowska")
+        page.wait_for_selector("#lab-card", state="visible")
+        for size in sizes:
+            _resize(page, size)
+            look = _check(page, size, "lab card")
+            assert "lab-go" in {c["name"] for c in look["controls"]}, f"{size}: the card's button is not on the screen"
+        page.tap("#lab-go")
+        finger = [1]
+        for i, size in enumerate(sizes):
+            _resize(page, size)
+            _check(page, size, "playing")
+            assert _debug(page)["phase"] in ("reach", "feedback"), _debug(page)
+            if end or i == 0:  # the suite's cheap part drives the muscles at its first size only
+                _fingers_drive_their_muscles(page, f"{size[0]}x{size[1]} (lab)", finger)
+        if end:
+            for _ in range(3000):
+                if page.is_visible("#lab-end"):
+                    break
+                if page.is_visible("#lab-card"):
+                    page.tap("#lab-go")
+                run_for(page, 260)
+            page.wait_for_selector("#lab-answer:has-text('handed in: ')")
+            for size in sizes:
+                _resize(page, size)
+                look = _check(page, size, "lab over")
+                assert "lab-again" in {c["name"] for c in look["controls"]}, look["controls"]
+                curve = page.evaluate("(() => { const b = document.getElementById('lab-curve').getBoundingClientRect();"
+                                      " return [b.left, b.top, b.right, b.bottom]; })()")
+                assert _inside(curve, [0, 0, *size]) and curve[3] - curve[1] > 40, f"{size}: the curve {curve}"
+        assert errors == [] and page.dialogs == []
+
+
+@pytest.mark.slow  # a whole lesson in chromium at every size (about 6 s); the suite's look is test_lab_page's
+def test_the_labs_screen_on_every_phone_and_tablet_to_its_end(tmp_path):
+    _lab_every_size(tmp_path, PHONES + TABLETS, device_scale_factor=2)
 
 
 def test_a_phone_upright_and_sideways_has_every_control_and_the_whole_reach_on_its_screen(tmp_path):

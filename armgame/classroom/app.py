@@ -380,6 +380,7 @@ teacher_remove = teacher_action(lambda clerk, b: clerk.remove(b.get("names")))
 teacher_close = teacher_action(lambda clerk, b: clerk.close(bool(b.get("closed", True))))
 teacher_lock = teacher_action(lambda clerk, b: clerk.lock(bool(b.get("locked", True))))
 teacher_lab = teacher_action(lambda clerk, b: clerk.choose_lab(b.get("protocol")))
+teacher_browser_lab = teacher_action(lambda clerk, b: clerk.browser_lab(b.get("on") is True))
 teacher_round = teacher_action(_start_or_stop_round)
 
 
@@ -458,6 +459,7 @@ ROUTES = [
     Route("/api/teacher/close", teacher_close, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/lock", teacher_lock, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/lab", teacher_lab, methods=POST, middleware=SAME_SITE),
+    Route("/api/teacher/browserlab", teacher_browser_lab, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/round", teacher_round, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/standings", teacher_standings, middleware=SAME_SITE),
     Route("/api/teacher/roster", teacher_roster, middleware=SAME_SITE),

@@ -611,6 +611,21 @@ class Clerk:
         return ("the class is closed to new games (the lab's volunteers still join, and their runs count)" if closed
                 else "the class takes games again")
 
+    def browser_lab(self, on: bool) -> str:
+        """The teacher's switch: every browser at /play runs the class's lab (a game under way is finished first),
+        or plays the game again. The lab's protocol is the class curve's (``choose_lab``)."""
+        self.roster.changed(browser_lab=bool(on))
+        self.version += 1
+        if on:
+            return (f"every browser runs the lab ({self.lab_protocol_name()}) once its game is over; their runs enter "
+                    f"the class curve")
+        return "the browsers play the game again"
+
+    def lab_protocol_name(self) -> str:
+        """The protocol a browser's lab runs, by name: the teacher's, or the lesson's until one is chosen."""
+        lab = self.roster.lab
+        return str(lab.get("name", "the class's own")) if isinstance(lab, dict) else (lab or "lesson")
+
     def lock(self, locked: bool) -> str:
         """No new names (the students already in play on), the lab's volunteers' neither; or new names again."""
         self.roster.changed(locked=bool(locked))

@@ -8,6 +8,8 @@ follow the window (CSS viewport units, 19 px at the least at 1024x768) in the hi
 of the game's windows (``ui.render.PALETTES["high-contrast"]``): black on white, red for news.
 ``play.html`` is the game itself for a browser (``/play``): ``engine.js`` plays it, ``play.js`` draws it
 (``body.js``: the arm and torso), ``kept.js`` keeps what the browser keeps (names, tokens, games not yet taken).
+When the teacher has every browser run the lab, ``labpage.js`` runs it there: ``labengine.js`` plays the server's
+plan, ``labmeasure.js`` measures each reach for the student, ``labview.js`` draws the scene and sets the words.
 """
 
 from __future__ import annotations
@@ -33,6 +35,10 @@ PAGES = {
     "engine.js": "text/javascript; charset=utf-8",
     "body.js": "text/javascript; charset=utf-8",
     "kept.js": "text/javascript; charset=utf-8",
+    "labengine.js": "text/javascript; charset=utf-8",
+    "labmeasure.js": "text/javascript; charset=utf-8",
+    "labview.js": "text/javascript; charset=utf-8",
+    "labpage.js": "text/javascript; charset=utf-8",
     "icon.svg": "image/svg+xml",
 }
 

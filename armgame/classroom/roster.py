@@ -3,8 +3,9 @@
 Kept in the class's folder beside its table, written only by the server (one writer: the clerk
 thread), atomically and fsynced before a join is acknowledged::
 
-    class.json        {"format": "armgame-class", "format_version": 3, "code": "FROG", "seed": 10,
+    class.json        {"format": "armgame-class", "format_version": 4, "code": "FROG", "seed": 10,
                        "closed": false, "locked": false, "lab": "lesson", a protocol or null,
+                       "browser_lab": false,
                        "round": {"number", "start", "minutes", "after"} or null,
                        "renamed": {old name's key: the name shown now},
                        "players": {key: {"name", "token_sha256", "joined", "address"}},
@@ -20,8 +21,9 @@ skeletons of ``records.lookalikes``) or if it hides part of itself (``records.lo
 The address each name joined from is kept for the teacher (which names came from one machine).
 A ``locked`` roster takes no new names; ``lab`` is the protocol the class curve shows, the
 teacher's choice (``--lab``), never the one most names happened to run; ``experiment``, a split of the
-class into two conditions (``experiment.Experiment``). Formats 1 and 2 (before these) are read as they are
-and written back as 3.
+class into two conditions (``experiment.Experiment``); ``browser_lab``, the teacher's switch that has every
+browser at ``/play`` run the class's lab in place of the game. Formats 1 to 3 (before these) are read as they are
+(no switch: off) and written back as 4.
 
 The join code is four letters from an alphabet with nothing a projector font confuses (no O/0,
 I/l/1, S/5, Z/2, B/8): short to type from the back row, and read case-insensitively.
@@ -52,7 +54,7 @@ from .experiment import Experiment
 ROSTER_NAME = "class.json"
 SECRET_NAME = "teacher.secret"
 FORMAT = "armgame-class"
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
 CODE_ALPHABET = "ACDEFGHJKMNPQRTUVWXY"
 CODE_LENGTH = 4
 #: Names one class holds: a lecture hall of students, each with a program or two, with room.
@@ -114,6 +116,8 @@ class Roster:
     renamed: dict[str, str] = field(default_factory=dict)
     #: A classroom experiment: two conditions and who is in which (``experiment.Experiment``), or None.
     experiment: Experiment | None = None
+    #: The teacher's switch: every browser at /play runs the class's lab (the game's students too), not the game.
+    browser_lab: bool = False
 
     def __post_init__(self) -> None:
         self.reindex()
@@ -199,7 +203,7 @@ class Roster:
             if version > FORMAT_VERSION:
                 raise ValueError(f"class record format {version} is newer than this armgame reads: update armgame")
             later = ({"locked", "lab", "round", "renamed"} if version >= 2 else set()) | \
-                ({"experiment"} if version >= 3 else set())
+                ({"experiment"} if version >= 3 else set()) | ({"browser_lab"} if version >= 4 else set())
             d = check_keys("class record", d, {"format", "format_version", "code", "seed", "closed", "players",
                                                "hidden", "created", *later})
             code = check_str("code", d["code"], CODE_LENGTH)
@@ -250,11 +254,14 @@ class Roster:
             experiment = d.get("experiment")
             if experiment is not None:
                 experiment = Experiment.from_dict(experiment, MAX_PLAYERS)
+            browser_lab = d.get("browser_lab", False)
+            if not isinstance(browser_lab, bool):
+                raise ValueError("browser_lab must be true or false")
         except ValueError as exc:
             raise DataFileError(f"{path}: {exc}; the class cannot go on from it (nothing was changed)") from None
         hidden = {player_key(k) for k in d["hidden"]}  # player_key of an older key is today's key
         return cls(folder, code, seed, _read_secret(folder), d["closed"], players, hidden, created, locked, lab, rnd,
-                   renamed, experiment)
+                   renamed, experiment, browser_lab)
 
     def save(self) -> None:
         """The record written whole (``dump_json``'s bytes): each player's lines made once and kept, since a
@@ -264,6 +271,7 @@ class Roster:
             "closed": self.closed, "locked": self.locked, "lab": self.lab, "round": self.round,
             "renamed": dict(sorted(self.renamed.items())),
             "experiment": None if self.experiment is None else self.experiment.as_dict(),
+            "browser_lab": self.browser_lab,
             "created": self.created,
             "hidden": sorted(self.hidden),
             "players": {},

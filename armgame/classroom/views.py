@@ -52,6 +52,7 @@ def standings(clerk: Clerk, teacher: bool = False) -> dict[str, object]:
     if arrival is not None and roster.is_hidden(arrival.name):
         arrival = None
     return {"version": clerk.version, "seed": roster.seed, "closed": roster.closed, "rehearsal": clerk.rehearsal,
+            "browser_lab": roster.browser_lab and clerk.lab_protocol_name(),
             "joined": len(roster.players), "people": who_joined(clerk), "games": len(clerk.entries),
             "round": None if teacher else round_shown(clerk),
             "students": rows(False), "programs": rows(True),
@@ -248,7 +249,7 @@ def roster_view(clerk: Clerk) -> dict[str, object]:
     chosen = roster.lab
     return {"machines": groups, "joined": len(roster.players), "people": who_joined(clerk),
             "waiting": sum(1 for k in roster.players if not played.get(k) and not lab.get(k)),
-            "locked": roster.locked, "closed": roster.closed,
+            "locked": roster.locked, "closed": roster.closed, "browser_lab": roster.browser_lab,
             "lab": chosen.get("name") if isinstance(chosen, dict) else chosen, "presets": list(PRESETS)}
 
 

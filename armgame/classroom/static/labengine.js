@@ -402,6 +402,8 @@ export class LabRun {
   get finished() { return this._finished; }
   get over() { return this._finished || this._steps >= this._totalSteps; }
   get phase() { return this._phase; }
+  /** The step of the current trial's go cue (its last one while holding at home). */
+  get goStep() { return this._goStep; }
   get trialIndex() { return this._trialIndex; }
   get trials() { return this._trials.length; }
   /** The current trial's plan (null once finished). */

@@ -34,7 +34,8 @@ canvas.frameTimes = [];
 
 let member = loadMember();  // {code, name, token, seed, duration}: the name playing now
 let config = null, game = null, names = [], keys = [];
-let phase = "join";  // join, countdown, playing, over
+let phase = "join";  // join, countdown, playing, over, closed; lab-loading, lab, lab-over (the teacher's switch)
+let lab = null;  // the lab's screen (labpage.js) while the class runs the lab in every browser
 let countdownLeft = 0, clock = 0, taken = 0, last = null, alpha = 1;
 const held = new Set();  // keys this page has pressed in the game and not yet released
 const fingers = new Map();  // pointer id -> the key its button holds
@@ -59,9 +60,13 @@ function refusal(answer) {
   return answer.data && typeof answer.data.error === "string" ? answer.data.error : "the class refused (" + answer.status + ")";
 }
 
-async function join(code, name, token) {
+// ``state``: the class's state asked before a new name joins. With the teacher's switch on, the join says it is for
+// the lab (a closed class takes a new name for it). A name this browser has is known to the class: it rejoins as
+// it always did, and the lab's own join follows if the switch is on (startLab).
+async function join(code, name, token, state) {
   const body = { code, name };
   if (token) body.token = token;
+  if (state && state.lab) body.for = "lab";
   return post("/api/join", JSON.stringify(body));
 }
 
@@ -107,9 +112,9 @@ function showOutbox() {
   const kept = outbox().length;
   statusLine.replaceChildren();
   if (phase === "closed") statusLine.append(CLOSED + " · ");
-  if (member) statusLine.append("playing as " + member.name + " ");
+  if (member) statusLine.append((lab !== null ? "in the lab as " : "playing as ") + member.name + " ");
   if (kept > 0) statusLine.append("· " + (kept === 1 ? "1 game" : kept + " games") + " kept, to hand in ");
-  if (member && phase !== "playing") {
+  if (member && phase !== "playing" && phase !== "lab" && phase !== "lab-loading") {
     const change = document.createElement("button");
     change.type = "button";
     change.id = "not-me";
@@ -147,7 +152,8 @@ joinForm.addEventListener("submit", async (event) => {
   const button = document.getElementById("join-button");
   button.disabled = true;
   // A name this browser joined under before keeps its token (the class knows it); a new one starts afresh.
-  const answer = await join(code, name, tokenFor(code, name));
+  const state = await classState();
+  const answer = await join(code, name, tokenFor(code, name), state);
   button.disabled = false;
   if (answer.status === 0) {
     document.getElementById("join-error").textContent = "the class could not be reached: is this the address on the projector?";
@@ -157,16 +163,23 @@ joinForm.addEventListener("submit", async (event) => {
     document.getElementById("join-error").textContent = refusal(answer);
     return;
   }
-  joined(code, answer.data);
+  joined(code, answer.data, state);
 });
 
-function joined(code, data) {
+// ``state``: the class's state asked just before (the next run chosen at once), or null: the game starts at once
+// (a tap just after the page loads starts it), and the lab replaces it if the teacher's switch is on.
+function joined(code, data, state = null) {
   // The class's game: its seed and its clock (a rehearsal's games are 15 s; a class that does not say: 60 s).
   member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60 };
   saveMember(member);
   joinForm.hidden = true;
   statusLine.textContent = "";
-  if (data.closed) waitWhileClosed(); else newGame();
+  if (state !== null) nextRun(state);
+  else if (data.closed) nextRun();
+  else {
+    newGame();
+    classState().then((s) => { if (s.lab && phase === "countdown") startLab(); });
+  }
   flushOutbox().then(showAnswers);
 }
 
@@ -174,12 +187,15 @@ function joined(code, data) {
 // seconds and starts one once the teacher opens the class.
 let closedTimer = null;
 const CLOSED = "the class is closed: it takes no more games (the game starts if the teacher opens it)";
-async function classClosed() {
+// What the class says of itself now (public: the projector's standings): closed, and whether the teacher has every
+// browser run the lab. Not reached: {closed: false, lab: false}, and the game is played, kept, handed in later.
+async function classState() {
   try {
     const r = await fetch("/api/standings", { cache: "no-store" });
-    return r.ok && (await r.json()).closed === true;
+    const s = r.ok ? await r.json() : {};
+    return { closed: s.closed === true, lab: typeof s.browser_lab === "string" && s.browser_lab !== "" };
   } catch (e) {
-    return false;  // not reached: the game is played, kept and handed in later
+    return { closed: false, lab: false };
   }
 }
 
@@ -188,21 +204,111 @@ function waitWhileClosed() {
   endCard.hidden = true;
   showOutbox();
   clearTimeout(closedTimer);
-  closedTimer = setTimeout(async () => { if (await classClosed()) waitWhileClosed(); else playAgain(); }, 5000);
+  closedTimer = setTimeout(() => nextRun(), 5000);
 }
 
-async function playAgain() {
-  if (await classClosed()) { waitWhileClosed(); return; }
+// What a student does next: the lab when the teacher has switched it on (a closed class takes lab runs), else the
+// game, or a wait while the class is closed. ``known``: the class's state just asked (else it is asked now).
+async function nextRun(known) {
+  const state = known ?? await classState();
+  if (state.lab) { startLab(); return; }
+  if (state.closed) { waitWhileClosed(); return; }
   newGame();
 }
 
+async function playAgain() { await nextRun(); }
+
+// The teacher's switch, looked for every few seconds while no game is under way: a student at the countdown goes to
+// the lab at once; one looking at their score is told, and "Play again" starts it. A game under way is finished.
+setInterval(async () => {
+  if (member === null || (phase !== "countdown" && phase !== "over")) return;
+  const state = await classState();
+  if (!state.lab) return;
+  if (phase === "countdown") startLab();
+  else if (phase === "over") statusLine.textContent = "the teacher has started the lab: Play again starts it";
+}, 5000);
+
+// ------------------------------------------------------------------ the lab (the teacher's switch)
+let labTimer = null;
+// The lab's join says it is for the lab (a closed class takes it; in a classroom experiment it assigns the student's
+// condition), then the plan of the student's run (/api/labplan, asked as the student: the plan of their condition).
+async function startLab() {
+  if (phase === "lab-loading" || phase === "lab") return;
+  phase = "lab-loading";
+  clearTimeout(closedTimer);
+  clearTimeout(labTimer);
+  endCard.hidden = true;
+  document.getElementById("lab-end").hidden = true;
+  statusLine.textContent = "the teacher has started the lab: loading it…";
+  const answer = await post("/api/join", JSON.stringify({ code: member.code, name: member.name, token: member.token,
+    for: "lab" }));
+  let plan = null;
+  if (answer.status === 200 && answer.data && answer.data.ok) {
+    try {
+      const r = await fetch("/api/labplan", { cache: "no-store", credentials: "omit",
+        headers: { Authorization: "Bearer " + member.token, "X-Armgame-Code": member.code } });
+      plan = r.ok ? await r.json() : null;
+    } catch { plan = null; }
+  }
+  if (plan === null) {
+    phase = "closed";  // asked again in a few seconds
+    statusLine.textContent = answer.status === 200 ? "the lab could not be loaded: trying again in a few seconds"
+      : "the class could not be reached for the lab: trying again in a few seconds";
+    labTimer = setTimeout(() => nextRun(), RETRY_MS);
+    return;
+  }
+  // The lab's modules are loaded when a lab starts: a class that only plays the game never fetches them.
+  let LabScreen;
+  try { ({ LabScreen } = await import("./labpage.js")); } catch {
+    phase = "closed";
+    statusLine.textContent = "the lab could not be loaded: trying again in a few seconds";
+    labTimer = setTimeout(() => nextRun(), RETRY_MS);
+    return;
+  }
+  game = null;
+  lab = new LabScreen(plan, canvas, member.name, touchMode);
+  keys = lab.keys;
+  names = plan.config.muscles.map((m) => m.name);
+  labelButtons("home", "");
+  document.body.classList.add("lab");
+  document.getElementById("lab-head").hidden = false;
+  phase = "lab";
+  held.clear();
+  fingers.clear();
+  showOutbox();
+}
+
+async function finishLab() {
+  phase = "lab-over";
+  document.body.classList.add("lab-over");
+  held.clear();
+  fingers.clear();
+  document.getElementById("lab-again").textContent = "Run the lab again";
+  const answer = await handIn(lab.replayJSON(), "run");
+  lab.answer(answer.line, answer.kind);
+  showOutbox();
+  document.getElementById("lab-again").focus();
+}
+
+function leaveLab() {
+  lab = null;
+  document.body.classList.remove("lab", "lab-over");
+  document.getElementById("lab-head").hidden = true;
+  document.getElementById("lab-card").hidden = true;
+  document.getElementById("lab-end").hidden = true;
+}
+
+document.getElementById("lab-go").addEventListener("click", () => { if (phase === "lab") lab.goOn(); });
+document.getElementById("lab-again").addEventListener("click", () => { if (phase === "lab-over") { leaveLab(); nextRun(); } });
+
 // ------------------------------------------------------------------ a game
 function newGame() {
+  leaveLab();
   config = standardConfig(member.seed, member.duration ?? 60);
   game = new Game(config);
   names = config.muscles.map((m) => m.name);
   keys = game.muscleKeys;
-  labelButtons();
+  labelButtons("reset", "-" + config.reset_cost);
   phase = "countdown";
   countdownLeft = COUNTDOWN;
   clock = 0; taken = 0; alpha = 1; hits = []; seenHits = 0; lastTarget = game.target;
@@ -213,6 +319,7 @@ function newGame() {
 }
 
 function press(key) {
+  if (phase === "lab") { lab.press(key); return; }
   if (phase === "countdown") { start(); return; }  // any key starts, and is not the game's input
   if (phase !== "playing" || held.has(key)) return;
   held.add(key);
@@ -220,12 +327,14 @@ function press(key) {
 }
 
 function lift(key) {
+  if (phase === "lab" || phase === "lab-over") { lab.lift(key); return; }
   if (!held.delete(key)) return;
   if (phase === "playing") game.keyEvent(key, "up");
 }
 
 // Every held key let go, into the game as key-ups (the tab lost focus; a finger left the screen unseen).
 function releaseAll() {
+  if (lab !== null) lab.releaseAll();
   for (const key of [...held]) lift(key);
   fingers.clear();
   touch.querySelectorAll("button.held").forEach((b) => b.classList.remove("held"));
@@ -240,31 +349,37 @@ async function finish() {
   phase = "over";
   held.clear();
   fingers.clear();
+  showEnd("handing in…", "");
   const body = game.replayJSON(member.name);  // any seed's digits exact (a seed past 2^53 is a BigInt)
+  const answer = await handIn(body, "game", (line) => showEnd(line, ""));
+  if (answer.data) showEnd(answer.line, answer.kind, answer.data); else showEnd(answer.line, answer.kind);
+}
+
+// A game's or a lab run's replay kept first, then sent: a page closed while the answer is on its way hands it in
+// next time. Returns the line to show ({line, kind, data}); ``showing`` is told the line while it is on its way.
+async function handIn(body, what, showing) {
   const id = Date.now().toString(36) + Math.random().toString(36).slice(2, 8);
-  // Kept first, then sent: a page closed while the answer is on its way hands the game in next time.
   const kept = keepGame({ id, code: member.code, token: member.token, body });
-  showEnd(kept ? "handing in…" : "handing in (this browser keeps nothing: stay on the page)…", "");
+  if (!kept && showing) showing("handing in (this browser keeps nothing: stay on the page)…");
   const results = await flushOutbox();
   const mine = results.find((r) => r.id === id);
   showAnswers(results.filter((r) => r.id !== id));
-  if (mine === undefined) {
-    showEnd("the class is busy, your game is kept and will be handed in", "kept");
-  } else {
-    showHandIn(mine.answer);
+  if (mine === undefined) return { line: `the class is busy, your ${what} is kept and will be handed in`, kind: "kept" };
+  return handInLine(mine.answer, what);
+}
+
+function handInLine(answer, what) {
+  if (answer.status === 200 && answer.data && answer.data.ok) return { line: answer.data.message, kind: "", data: answer.data };
+  if (answer.status === 0) return { line: `the class could not be reached: your ${what} is kept and will be handed in`, kind: "kept" };
+  if (answer.status === 503 || answer.status === 429 || answer.status === 408 || answer.status >= 500) {
+    return { line: `the class is busy, your ${what} is kept and will be handed in`, kind: "kept" };
   }
+  return { line: "not handed in: " + refusal(answer), kind: "kept" };
 }
 
 function showHandIn(answer) {
-  if (answer.status === 200 && answer.data && answer.data.ok) {
-    showEnd(answer.data.message, "", answer.data);
-  } else if (answer.status === 0) {
-    showEnd("the class could not be reached: your game is kept and will be handed in", "kept");
-  } else if (answer.status === 503 || answer.status === 429 || answer.status === 408 || answer.status >= 500) {
-    showEnd("the class is busy, your game is kept and will be handed in", "kept");
-  } else {
-    showEnd("not handed in: " + refusal(answer), "kept");
-  }
+  const said = handInLine(answer, "game");
+  if (said.data) showEnd(said.line, said.kind, said.data); else showEnd(said.line, said.kind);
 }
 
 // Games from before (the outbox) handed in now: one line for the student, under whatever is on screen.
@@ -274,6 +389,10 @@ function showAnswers(results) {
     const last = taken[taken.length - 1].answer.data;
     statusLine.textContent = (taken.length === 1 ? "a kept game was " : taken.length + " kept games were ") +
       last.message;
+  }
+  if (phase === "lab-over" && outbox().length === 0 && taken.length > 0 &&
+      document.getElementById("lab-answer").className === "kept") {
+    lab.answer(taken[taken.length - 1].answer.data.message, "");
   }
   if (phase === "over" && endCard.dataset.kept === "kept" && outbox().length === 0 && taken.length > 0) {
     const mine = taken[taken.length - 1];
@@ -321,6 +440,7 @@ function gameKey(event) {
 
 window.addEventListener("keydown", (event) => {
   if (phase === "join") return;
+  if (phase === "lab" || phase === "lab-over") { labKey(event); return; }
   if (phase === "over") {
     if (event.key === "Enter") { event.preventDefault(); playAgain(); }
     return;
@@ -335,7 +455,30 @@ window.addEventListener("keydown", (event) => {
   event.preventDefault();  // tab must not leave the page, space must not scroll it
   if (!event.repeat) press(key);
 });
+// The lab's keys, as the lab window's: the muscles' and space (the hand home; a card's "go on", as Enter is).
+function labKey(event) {
+  if (event.ctrlKey || event.metaKey || event.altKey) return;
+  if (phase === "lab-over") {
+    if (event.key === "Enter" && document.activeElement !== document.getElementById("lab-again")) {
+      event.preventDefault();
+      leaveLab();
+      nextRun();
+    }
+    return;
+  }
+  const key = gameKey(event);
+  if (event.key === "Enter" && lab.phase === "card") { event.preventDefault(); lab.goOn(); return; }
+  if (key === null || key === "tab") { if (key === "tab") event.preventDefault(); return; }
+  event.preventDefault();  // space must not scroll the page, nor press the card's button
+  if (!event.repeat) lab.press(key);
+}
+
 window.addEventListener("keyup", (event) => {
+  if (phase === "lab" || phase === "lab-over") {
+    const key = gameKey(event);
+    if (key !== null) { event.preventDefault(); lab.lift(key); }
+    return;
+  }
   const key = gameKey(event);
   if (key !== null && held.has(key)) { event.preventDefault(); lift(key); }
 });
@@ -351,7 +494,7 @@ function fingerDown(event) {
   touchMode = true;
   if (button.setPointerCapture) { try { button.setPointerCapture(event.pointerId); } catch { /* synthetic */ } }
   if (phase === "countdown") { start(); }
-  if (phase !== "playing") return;
+  if (phase !== "playing" && phase !== "lab") return;
   fingers.set(event.pointerId, key);
   button.classList.add("held");
   press(key);
@@ -373,7 +516,7 @@ for (const button of touch.querySelectorAll("button")) {
   button.addEventListener("contextmenu", (e) => e.preventDefault());
 }
 // Each muscle's button: its key's letter, large, and its muscle's name under it; reset says what it costs.
-function labelButtons() {
+function labelButtons(reset, cost) {
   touch.querySelectorAll("button.muscle").forEach((b) => {
     const i = Number(b.dataset.index);
     const letter = document.createElement("span"), name = document.createElement("span");
@@ -383,18 +526,21 @@ function labelButtons() {
     b.setAttribute("aria-label", keys[i] + " " + names[i]);
     b.dataset.key = keys[i];
   });
-  touch.querySelector("#reset .name").textContent = "-" + config.reset_cost;
+  touch.querySelector("#reset .key").textContent = reset;
+  touch.querySelector("#reset .name").textContent = cost;
 }
 // What the tests read of the page as it is played: the keys held, each muscle's activation, the resets, and the
 // canvas's box as the last resize saw it.
-Object.defineProperty(canvas, "debug", { get: () => ({ phase, held: [...held],
-  activation: game ? game.muscleActivation : [], resets: game ? game.resets : 0, box: [box.w, box.h] }) });
+Object.defineProperty(canvas, "debug", { get: () => (lab !== null ? { ...lab.debug, page: phase, box: [box.w, box.h] }
+  : { phase, held: [...held], activation: game ? game.muscleActivation : [], resets: game ? game.resets : 0,
+    box: [box.w, box.h] }) });
 // A touch anywhere shows the buttons (a laptop with a touch screen too); so does a coarse pointer at load.
 function showTouch() {
   if (!touch.hidden) return;
   touch.hidden = false;
   document.body.classList.add("touch");  // play.css gives the buttons their cells
   touchMode = true;
+  if (lab !== null) lab.touched();
 }
 window.addEventListener("pointerdown", (e) => { if (e.pointerType === "touch") showTouch(); }, true);
 canvas.addEventListener("pointerdown", () => { if (phase === "countdown") start(); });
@@ -406,7 +552,10 @@ function frame() {
   const began = performance.now();
   const elapsed = last === null ? 0 : (began - last) / 1000;
   last = began;
-  if (phase === "countdown") {
+  if (phase === "lab") {
+    lab.frame(elapsed);
+    if (lab.over) finishLab();
+  } else if (phase === "countdown") {
     countdownLeft -= Math.max(elapsed, 0);
     if (countdownLeft <= 0) start();
   } else if (phase === "playing") {
@@ -423,7 +572,7 @@ function frame() {
     noteHits();
     if (game.over) { alpha = 1; finish(); }
   }
-  if (game !== null && member !== null) draw();  // "not me?" forgets the name while the last game is on screen
+  paint();
   const times = canvas.frameTimes;
   times.push(performance.now() - began);
   if (times.length > 600) times.splice(0, times.length - 600);
@@ -536,7 +685,7 @@ const resized = new ResizeObserver(([entry]) => {
   box = { w: entry.contentRect.width, h: entry.contentRect.height };
   const w = device ? device.inlineSize : Math.round(box.w * dpr), h = device ? device.blockSize : Math.round(box.h * dpr);
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; backgroundKey = ""; }
-  if (game !== null && member !== null) { draw(); return; }  // before the page is painted: never blank
+  if (paint()) return;  // before the page is painted: never blank
   ctx.setTransform(1, 0, 0, 1, 0, 0);  // no game yet (the join form over it): the window's colour, not black
   ctx.fillStyle = PALETTE.window;
   ctx.fillRect(0, 0, canvas.width, canvas.height);
@@ -544,6 +693,16 @@ const resized = new ResizeObserver(([entry]) => {
 // Its device pixels watched too, where the browser can (a window moved to a screen of another density); Safari
 // watches the CSS box only.
 try { resized.observe(canvas, { box: "device-pixel-content-box" }); } catch { resized.observe(canvas); }
+
+// The lab's scene or the game's, whichever is on: false when neither is.
+function paint() {
+  if (lab !== null && member !== null) {
+    lab.draw(box.w, box.h, canvas.width / Math.max(box.w, 1), canvas.height / Math.max(box.h, 1));
+    return true;
+  }
+  if (game !== null && member !== null) { draw(); return true; }  // "not me?" forgets the name while the last game is on screen
+  return false;
+}
 
 function draw() {
   const { w, h } = box;

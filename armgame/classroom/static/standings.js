@@ -247,6 +247,8 @@ function render(s) {
   document.getElementById("games").textContent = String(s.games);
   document.getElementById("seed").textContent = String(s.seed);
   document.getElementById("closed").hidden = !s.closed;
+  document.getElementById("browser-lab").hidden = !s.browser_lab;
+  document.getElementById("browser-lab-protocol").textContent = s.browser_lab || "";
   document.getElementById("rehearsal").hidden = !s.rehearsal;
   const a = s.arrival;
   const isNew = a && lastArrival !== null && a.seq > lastArrival;

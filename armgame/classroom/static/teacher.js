@@ -83,6 +83,9 @@ function machines(view) {
   $("waiting").textContent = joinedWords(view.people) + "; " + view.waiting +
     (view.waiting === 1 ? " name has" : " names have") + " handed nothing in yet (no game, no lab run).";
   $("list-state").textContent = view.locked ? "The list is locked: no new names." : "New names can join.";
+  // The switch for the whole class: a game under way is finished first, then the page at /play runs the lab.
+  $("browser-lab-state").textContent = view.browser_lab
+    ? "On: every browser at /play runs the lab of the curve's protocol, and hands it in." : "Off: the browsers play the game.";
   const select = $("lab-protocol");
   if (select.options.length === 0) {
     for (const name of view.presets) {
@@ -178,6 +181,12 @@ $("lab-protocol").addEventListener("change", async () => {
   catch (e) { say(e.message, true); }
   refresh();
 });
+for (const [id, on] of [["browser-lab-on", true], ["browser-lab-off", false]]) {
+  $(id).addEventListener("click", async () => {
+    try { say((await (await call("/api/teacher/browserlab", {on})).json()).message); } catch (e) { say(e.message, true); }
+    refresh();
+  });
+}
 $("round-start").addEventListener("click", async () => {
   try { say((await (await call("/api/teacher/round", {minutes: Number($("round-minutes").value)})).json()).message); }
   catch (e) { say(e.message, true); }
