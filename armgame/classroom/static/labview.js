@@ -226,7 +226,8 @@ export function drawCurve(root, curve) {
     svg(root, "circle", { cx, cy, r: r + 5, fill: "none", stroke: WARN, "stroke-width": 3 });
     const onLeft = cx - r - text - 7 * text >= left;
     svg(root, "text", { x: onLeft ? cx - r - text : cx + r + text, y: cy, "text-anchor": onLeft ? "end" : "start",
-      "dominant-baseline": "middle", fill: WARN }, "after-effect");
+      "dominant-baseline": "middle", fill: WARN, stroke: "#fff", "stroke-width": Math.max(3, text / 4),
+      "paint-order": "stroke" }, "after-effect");  // a white edge: the label reads over the dots it lies on
   }
   svg(root, "text", { x: left, y: H - 0.5 * text }, `${curve.label} (${curve.unit}) by trial`);
 }
