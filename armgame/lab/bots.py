@@ -385,6 +385,21 @@ def curl_unit_torque(l1: float, l2: float, q1: float, q2: float, fx: float, fy: 
     return (-l1 * s1 - l2 * s12) * fx + (l1 * c1 + l2 * c12) * fy, -l2 * s12 * fx + l2 * c12 * fy
 
 
+#: The rates of a learner that learns nothing more: what it holds stays as it was set (``holding_bot``).
+FROZEN = LearningRates(0.0, 1.0, 0.0, 0.0)
+
+
+def holding_bot(frame: str, matrix: np.ndarray) -> LabBot:
+    """The adaptive bot whose learned field in ``frame`` is ``matrix`` (``B^``, N s/m, at the hand; ``W^``, N m s/rad,
+    at the joints), learning nothing more: with the true field, a learner that compensates it exactly (issue 50: the
+    frames index is calibrated against it, ``designs.held_field_indices``)."""
+    bot = make_lab_bot("adaptive", FROZEN, frame=frame)
+    r = FROZEN
+    bot.matrix_learner = TwoRateLearner(r.retention_fast, r.retention_slow, r.rate_fast, r.rate_slow,
+                                        fast=np.zeros(4), slow=np.asarray(matrix, dtype=float).reshape(4))
+    return bot
+
+
 def make_lab_bot(name: str, rates: LearningRates | None = None, representation: str = "global",
                  width_deg: float = TUNING_WIDTH_DEG, noise: MotorNoise | None = None, frame: str = "hand") -> LabBot:
     """``model``, ``naive`` (the game's bots) or ``adaptive`` (the model bot learning the perturbation, with a

@@ -9,6 +9,17 @@ symmetric part (Shadmehr & Mussa-Ivaldi's) is not. ``frame_indices`` regresses a
 candidate would need cancelled at that trial's states (sample by sample, at its own joint angles and velocities):
 ``adaptation_index_hand`` and ``adaptation_index_joint``, 1 when that frame's field is fully compensated.
 
+A channel trial takes the whole field away, its push along the path too, and the index regresses only the push across
+it. A learner that holds the field still pushes against the part along the path; nothing meets that push in the
+channel, so the reach runs slower or faster than the learner planned, and what it presses across the channel changes
+with it. Where a field pushes along the path, the index of a learner that compensates it exactly is off, by a different
+amount at each posture: the lab's model bot holding exactly the viscous preset's field read 1.03 at the posture it
+learned at and 1.39 with the shoulder turned 90 deg, over 8 directions from 0 deg (issue 50). ``across_path_deg``
+finds the directions where a field pushes along the path only by its isotropic part (``tr B / 2``); for the viscous
+preset's field that is 0.06 N s/m against 1.93 across, and a full compensator there reads 1 in its own frame at both
+postures (``tests/test_lab_frames_calibration.py``). A shoulder turned by a multiple of 90 deg keeps those directions
+(the joint twin ``R B R^T`` swaps the field's axes), so one set of targets serves both frames.
+
 **Probes without vision** (Krakauer et al. 2000). ``probe_generalization``: per probed direction, the initial
 direction error of the no-cursor catch trials in a train-on-one block, less that direction's no-cursor baseline, as a
 fraction of the rotation (1: the trained rotation fully expressed there, 0: nothing).
@@ -18,12 +29,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from .perturbations import Perturbation
-from .protocol import Protocol
-from .session import LabSession, TrialOutcome
+from .protocol import Block, Protocol
+from .session import LabSession, TrialOutcome, lab_config
 
 Matrix = tuple[tuple[float, float], tuple[float, float]]
 
@@ -46,6 +58,19 @@ def hand_twin(joint: Matrix, l1: float, l2: float, posture: tuple[float, float])
     """``B = J^-T W J^-1`` (N s/m): the hand field that is the joint field ``W`` at ``posture`` (rad)."""
     inverse = np.linalg.inv(jacobian(l1, l2, *posture))
     return inverse.T @ np.asarray(joint, dtype=float) @ inverse
+
+
+def across_path_deg(hand: Matrix) -> float:
+    """The direction (deg, 0 to 90) of the first of four, 90 deg apart, in which the hand field ``F = B v`` pushes a
+    reach along its path only by ``tr B / 2`` (``u . B u`` for the unit direction ``u``): 45 deg from the principal
+    axes of ``B``'s symmetric part, where the field pushes most across the path. 0 for a field with no such axes (a
+    curl, or the same push along every direction)."""
+    b = np.asarray(hand, dtype=float)
+    a, c = 0.5 * (b[0, 0] - b[1, 1]), 0.5 * (b[0, 1] + b[1, 0])
+    if math.hypot(a, c) < 1e-12:
+        return 0.0
+    # u . B u = tr B / 2 + a cos 2t + c sin 2t, which is tr B / 2 where a cos 2t + c sin 2t = 0.
+    return math.degrees(0.5 * math.atan2(-a, c)) % 90.0
 
 
 def candidate_fields(protocol: Protocol, field: Perturbation, l1: float, l2: float) -> tuple[np.ndarray, np.ndarray]:
@@ -87,6 +112,42 @@ def frame_indices(session: LabSession, outcome: TrialOutcome) -> tuple[float, fl
     torque = qdot @ w.T
     hand_force = np.linalg.solve(np.swapaxes(jac, -1, -2), torque[..., None])[..., 0]
     return _slope(f, -(v @ b.T) @ n), _slope(f, -hand_force @ n)
+
+
+def calibration_protocol(protocol: Protocol) -> Protocol:
+    """A frames protocol's calibration: its targets and reference field, a cycle of channel trials in the field at the
+    posture it is learned at (block ``trained``) and one at the posture of its first frames test (block ``test``)."""
+    field = next(b.perturbation for b in protocol.blocks if b.perturbation.is_velocity_field)
+    learned = protocol.field_posture_deg(field)
+    test = next(b.posture_of(protocol) for b in protocol.blocks
+                if b.channel_trials and b.posture_of(protocol) != learned)
+    n = protocol.targets
+    return replace(protocol, blocks=(Block("trained", n, field, channel_trials=n, home_posture_deg=learned),
+                                     Block("test", n, field, channel_trials=n, home_posture_deg=test)))
+
+
+def held_field_indices(protocol: Protocol, frame: str, matrix: Matrix | np.ndarray, seed: int = 10,
+                       ) -> dict[tuple[str, str], float]:
+    """What a learner that holds ``matrix`` in ``frame`` (``bots.holding_bot``: the adaptive bot's learned field set
+    to it) reads on ``calibration_protocol(protocol)``: per (block, index frame), the mean over the block's channel
+    trials of its index less the field-free model bot's on the same trial (the same seed, so the same trials). With
+    the true field in either frame it is the frames index's calibration: 1 in that frame at both postures."""
+    from ..game.bots import Autopilot
+    from .bots import holding_bot, make_lab_bot
+
+    calibration = calibration_protocol(protocol)
+    readings: dict[tuple[str, str], list[float]] = {}
+    runs = []
+    for bot in (holding_bot(frame, np.asarray(matrix, dtype=float)), make_lab_bot("model")):
+        session = LabSession(lab_config(calibration, seed), calibration)
+        Autopilot(session, bot).play()
+        runs.append(session)
+    held, free = runs
+    for o, f in zip(held.outcomes, free.outcomes, strict=True):
+        (h1, j1), (h0, j0) = frame_indices(held, o), frame_indices(free, f)
+        readings.setdefault((o.plan.block_name, "hand"), []).append(h1 - h0)
+        readings.setdefault((o.plan.block_name, "joint"), []).append(j1 - j0)
+    return {k: float(np.mean(v)) for k, v in readings.items()}
 
 
 def frames_table(session: LabSession, rows: Sequence[Mapping[str, object]]) -> list[dict[str, object]]:
