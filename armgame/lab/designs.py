@@ -14,8 +14,8 @@ it. A learner that holds the field still pushes against the part along the path;
 channel, so the reach runs slower or faster than the learner planned, and what it presses across the channel changes
 with it. Where a field pushes along the path, the index of a learner that compensates it exactly is off, by a different
 amount at each posture: the lab's model bot holding exactly the viscous preset's field read 1.03 at the posture it
-learned at and 1.39 with the shoulder turned 90 deg, over 8 directions from 0 deg (issue 50). ``across_path_deg``
-finds the directions where a field pushes along the path only by its isotropic part (``tr B / 2``); for the viscous
+learned at and 1.39 with the shoulder turned 90 deg, over 8 directions from 0 deg (issue 50).
+``perturbations.across_path_deg`` finds the directions where a field pushes along the path only by its isotropic part (``tr B / 2``); for the viscous
 preset's field that is 0.06 N s/m against 1.93 across, and a full compensator there reads 1 in its own frame at both
 postures (``tests/test_lab_frames_calibration.py``). A shoulder turned by a multiple of 90 deg keeps those directions
 (the joint twin ``R B R^T`` swaps the field's axes), so one set of targets serves both frames.
@@ -58,19 +58,6 @@ def hand_twin(joint: Matrix, l1: float, l2: float, posture: tuple[float, float])
     """``B = J^-T W J^-1`` (N s/m): the hand field that is the joint field ``W`` at ``posture`` (rad)."""
     inverse = np.linalg.inv(jacobian(l1, l2, *posture))
     return inverse.T @ np.asarray(joint, dtype=float) @ inverse
-
-
-def across_path_deg(hand: Matrix) -> float:
-    """The direction (deg, 0 to 90) of the first of four, 90 deg apart, in which the hand field ``F = B v`` pushes a
-    reach along its path only by ``tr B / 2`` (``u . B u`` for the unit direction ``u``): 45 deg from the principal
-    axes of ``B``'s symmetric part, where the field pushes most across the path. 0 for a field with no such axes (a
-    curl, or the same push along every direction)."""
-    b = np.asarray(hand, dtype=float)
-    a, c = 0.5 * (b[0, 0] - b[1, 1]), 0.5 * (b[0, 1] + b[1, 0])
-    if math.hypot(a, c) < 1e-12:
-        return 0.0
-    # u . B u = tr B / 2 + a cos 2t + c sin 2t, which is tr B / 2 where a cos 2t + c sin 2t = 0.
-    return math.degrees(0.5 * math.atan2(-a, c)) % 90.0
 
 
 def candidate_fields(protocol: Protocol, field: Perturbation, l1: float, l2: float) -> tuple[np.ndarray, np.ndarray]:

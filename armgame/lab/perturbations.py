@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
@@ -405,3 +405,16 @@ def joint_space(gain: float, centre: tuple[float, float], home_q: tuple[float, f
 
     show.plan = ("joint", cx, cy, gain, h1, h2)  # type: ignore[attr-defined]
     return show
+
+
+def across_path_deg(hand: Sequence[Sequence[float]]) -> float:
+    """The direction (deg, 0 to 90) of the first of four, 90 deg apart, in which the hand field ``F = B v`` pushes a
+    reach along its path only by ``tr B / 2`` (``u . B u`` for the unit direction ``u``): 45 deg from the principal
+    axes of ``B``'s symmetric part, where the field pushes most across the path. 0 for a field with no such axes (a
+    curl, or the same push along every direction). Plain math, no numpy: the presets import it (``armgame --help``
+    loads them and no heavy package)."""
+    a, c = 0.5 * (hand[0][0] - hand[1][1]), 0.5 * (hand[0][1] + hand[1][0])
+    if math.hypot(a, c) < 1e-12:
+        return 0.0
+    # u . B u = tr B / 2 + a cos 2t + c sin 2t, which is tr B / 2 where a cos 2t + c sin 2t = 0.
+    return math.degrees(0.5 * math.atan2(-a, c)) % 90.0

@@ -12,8 +12,7 @@ from collections.abc import Callable
 
 from ..errors import UserError
 from ..words import unknown_name
-from .designs import across_path_deg
-from .perturbations import NONE, Curl, JointSpace, Mirror, Perturbation, Rotation, Viscous
+from .perturbations import NONE, Curl, JointSpace, Mirror, Perturbation, Rotation, Viscous, across_path_deg
 from .protocol import DEFAULT_INSTRUCTIONS, Block, Protocol
 
 #: The curl preset's field. Chosen by measurement (docs/lab.md, ``tests/test_lab.py``): the model
@@ -58,7 +57,7 @@ LESSON_BLOCKS = (4, 16, 4)
 FRAMES_TEST_POSTURE = (135.0, 90.0)
 FRAMES_BLOCKS = (16, 24, 160, 16)
 #: Its targets: the four directions in which the field pushes a reach along its path only by ``tr B / 2`` (0.06 N s/m,
-#: against 1.93 across it), in both frames at both postures (``designs.across_path_deg``; the 90 deg turn keeps
+#: against 1.93 across it), in both frames at both postures (``perturbations.across_path_deg``; the 90 deg turn keeps
 #: them). A channel trial takes away the field's push along the path, which a learner's compensation then meets
 #: nowhere: with the 8 targets from 0 deg a bot holding exactly the field read 1.03 at the training posture and 1.39
 #: at the test posture (issue 50); here it reads 1 at both (``tests/test_lab_frames_calibration.py``).
