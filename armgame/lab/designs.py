@@ -12,13 +12,14 @@ candidate would need cancelled at that trial's states (sample by sample, at its 
 A channel trial takes the whole field away, its push along the path too, and the index regresses only the push across
 it. A learner that holds the field still pushes against the part along the path; nothing meets that push in the
 channel, so the reach runs slower or faster than the learner planned, and what it presses across the channel changes
-with it. Where a field pushes along the path, the index of a learner that compensates it exactly is off, by a different
-amount at each posture: the lab's model bot holding exactly the viscous preset's field read 1.03 at the posture it
-learned at and 1.39 with the shoulder turned 90 deg, over 8 directions from 0 deg (issue 50).
-``perturbations.across_path_deg`` finds the directions where a field pushes along the path only by its isotropic part (``tr B / 2``); for the viscous
-preset's field that is 0.06 N s/m against 1.93 across, and a full compensator there reads 1 in its own frame at both
-postures (``tests/test_lab_frames_calibration.py``). A shoulder turned by a multiple of 90 deg keeps those directions
-(the joint twin ``R B R^T`` swaps the field's axes), so one set of targets serves both frames.
+with it. Where a field pushes along the path, the index of a learner that compensates it exactly is off, by a
+different amount at each posture: the lab's model bot holding exactly the viscous preset's field read 1.03 at the
+posture it learned at and 1.39 with the shoulder turned 90 deg, over 8 directions from 0 deg (issue 50).
+``perturbations.across_path_deg`` finds the directions where a field pushes along the path only by its isotropic part
+(``tr B / 2``); for the viscous preset's field that is 0.06 N s/m against 1.93 across, and a full compensator there
+reads 1 in its own frame at both postures (``tests/test_lab_frames_calibration.py``). A shoulder turned by a multiple
+of 90 deg keeps those directions (the joint twin ``R B R^T`` swaps the field's axes), so one set of targets serves
+both frames.
 
 **Probes without vision** (Krakauer et al. 2000). ``probe_generalization``: per probed direction, the initial
 direction error of the no-cursor catch trials in a train-on-one block, less that direction's no-cursor baseline, as a
