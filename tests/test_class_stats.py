@@ -181,6 +181,7 @@ def get(opened, path: str, secret: str | None = None) -> bytes:
         return r.read()
 
 
+@pytest.mark.slow  # a class served and analyze run (2.6 s): one function builds the three, CI runs it after the suite
 def test_the_projector_the_teachers_table_and_analyze_say_the_same(tmp_path, runs, monkeypatch, capsys):
     folder = tmp_path / "class"
     with running_class(folder, lab=str(runs / "mini.toml")) as opened:

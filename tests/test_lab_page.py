@@ -200,6 +200,7 @@ def _switch_on(port: int) -> None:
     assert status == 200, answer
 
 
+@pytest.mark.slow  # chromium (1.6 s); the whole lesson in chromium, keys and touch, is in the slow tier beside it
 def test_a_joined_student_gets_the_labs_first_card_and_its_go_cue(tmp_path):
     """The default tier's look: with the switch on (and the class closed to games), /play joins for the lab, shows
     the first card (what to do and the keys, never what will happen), and space brings the go cue: a target."""
