@@ -401,7 +401,9 @@ export function rk4(accel, q1, q2, w1, w2, t1, t2, dt) {
 
 // ------------------------------------------------------------------------------------------- the game
 /** One game: GameSession's input, steps and rules, and the replay the server verifies. */
-export class Game {
+/** GameSession's arm, muscles, keys, clock and record, which the game (Game) and the lab's run (labengine.js's
+ * LabRun) share, as LabSession is a GameSession in Python: each adds its rules, its advance and its reset. */
+export class ArmSession {
   constructor(config) {
     const physics = armPhysics(config);
     this._config = config;
@@ -419,33 +421,20 @@ export class Game {
     this._goal = [0.0, 0.0, 0.0, 0.0];
     this._rate = [...this._decay];
     this._held = [false, false, false, false];
-
-    // GameRules.
     this._start = numbers(config.start_posture, "start_posture", 2, -7, 7);
-    this._radius = number(config.target_radius, "target_radius", 0.005, 0.5);
-    this._shoulderRange = numbers(config.target_shoulder_range, "target_shoulder_range", 2, -360, 360);
-    this._elbowRange = numbers(config.target_elbow_range, "target_elbow_range", 2, -360, 360);
-    this._view = numbers(config.view, "view", 4, -20, 20);
     this._resetCost = config.reset_cost;
     if (!Number.isInteger(this._resetCost) || this._resetCost < 0) fail("config.reset_cost must be a whole number");
-    this._rng = new PythonRandom(this._seed);
     this._score = 0;
     this._hits = 0;
     this._resets = 0;
-    this._hitTimes = [];
     this._armVisible = true;
-    this.tries = 0;
-
-    // GameSession.
     this._steps = 0;
     const [q1, q2] = this._start;
     this._state = [q1, q2, 0.0, 0.0];
     this._previous = this._state;
     this._timeline = [];
-    this._target = this._drawTarget(this._handAt(q1, q2));
   }
 
-  // ------------------------------------------------------------------------------------ the rules
   /** rules.hand_position: the arm's own sine, the same bits as Python's. */
   _handAt(q1, q2) {
     const [s1, c1] = sinCos(q1);
@@ -453,6 +442,116 @@ export class Game {
     return [this._l1 * c1 + this._l2 * c12, this._l1 * s1 + this._l2 * s12];
   }
 
+  /** The reset key's common part: the arm at (q1, q2) at rest, the muscles relaxed, the reset counted and paid. */
+  _resetTo(q1, q2) {
+    this._state = this._previous = [q1, q2, 0.0, 0.0];
+    this._activation = [0.0, 0.0, 0.0, 0.0];
+    this._resets += 1;
+    this._score = Math.max(0, this._score - this._resetCost);
+  }
+
+  /** GameSession.key_event: a key ("d", "space", "tab"...) going "down" or "up" before the next step. Returns
+   * whether it acted (only those enter the timeline). The reset key is each session's own ``_reset``. */
+  keyEvent(key, action) {
+    if (this.over) return false;
+    if (this._timeline.length >= MAX_EVENTS) {
+      this._totalSteps = this._steps; // the game stops here, as the Python's does
+      return false;
+    }
+    const i = this._muscleKeys.indexOf(key);
+    if (i >= 0) {
+      const down = action === "down";
+      if (this._held[i] === down) return false;
+      this._held[i] = down;
+      this._goal[i] = down ? 1.0 : 0.0;
+      this._rate[i] = down ? this._rise[i] : this._decay[i];
+    } else if (key === RESET_KEY && action === "down") {
+      this._reset();
+    } else if (key === TOGGLE_ARM_KEY && action === "down") {
+      this._armVisible = !this._armVisible;
+    } else {
+      return false;
+    }
+    this._timeline.push([this._steps, key, action]);
+    return true;
+  }
+
+  // ---------------------------------------------------------------------------------- queries
+  get steps() { return this._steps; }
+  get totalSteps() { return this._totalSteps; }
+  get dt() { return this._dt; }
+  get over() { return this._steps >= this._totalSteps; }
+  get state() { return [...this._state]; }
+  get target() { return { ...this._target }; }
+  get score() { return this._score; }
+  get hits() { return this._hits; }
+  get resets() { return this._resets; }
+  get armVisible() { return this._armVisible; }
+  get muscleActivation() { return [...this._activation]; }
+  get muscleKeys() { return [...this._muscleKeys]; }
+  get timeline() { return this._timeline.map((e) => [...e]); }
+
+  /** GameSession.interpolated_angles: the joint angles a fraction alpha of a step past the previous state. */
+  interpolatedAngles(alpha) {
+    const [p1, p2] = this._previous, [c1, c2] = this._state;
+    return [p1 + alpha * (c1 - p1), p2 + alpha * (c2 - p2)];
+  }
+
+  /** The hand [x, y] in metres (world coordinates), where the rules see it. */
+  hand() {
+    return this._handAt(this._state[0], this._state[1]);
+  }
+
+  /** GameSession.result() as JSON data. */
+  result() {
+    const c = this._config;
+    return { score: this._score, hits: this._hits, resets: this._resets, seed: seedValue(this._seed),
+      duration: c.time_limit, steps: this._steps, scene: c.scene, integrator: c.integrator, dt: c.dt,
+      version: ARMGAME_VERSION };
+  }
+
+  /** The replay as records.replay.Replay.as_dict writes a keyboard game's, its driver the device a person
+   * played it on ("browser", one of records.replay.KEYBOARD_DEVICES: still a person's game, not a program's).
+   * A seed above 2^53 is a BigInt, which JSON.stringify refuses: replayJSON writes it. */
+  replay(player) {
+    const config = { ...this._config, seed: seedValue(this._seed) };
+    return {
+      format: "armgame-replay",
+      format_version: 1,
+      armgame_version: ARMGAME_VERSION,
+      date: nowIso(),
+      player: player ?? null,
+      driven: "keyboard",
+      driver: "browser",
+      scene: this._config.scene,
+      config,
+      timeline: this.timeline,
+      result: this.result(),
+    };
+  }
+
+  /** The replay as JSON text, any seed's digits exact: what the page hands in. */
+  replayJSON(player) {
+    return toJSON(this.replay(player));
+  }
+}
+
+export class Game extends ArmSession {
+  constructor(config) {
+    super(config);
+    // GameRules.
+    this._radius = number(config.target_radius, "target_radius", 0.005, 0.5);
+    this._shoulderRange = numbers(config.target_shoulder_range, "target_shoulder_range", 2, -360, 360);
+    this._elbowRange = numbers(config.target_elbow_range, "target_elbow_range", 2, -360, 360);
+    this._view = numbers(config.view, "view", 4, -20, 20);
+    this._rng = new PythonRandom(this._seed);
+    this._hitTimes = [];
+    this.tries = 0;
+    const [q1, q2] = this._start;
+    this._target = this._drawTarget(this._handAt(q1, q2));
+  }
+
+  // ------------------------------------------------------------------------------------ the rules
   /** GameRules._draw_target. */
   _drawTarget(hand) {
     const [xmin, xmax, ymin, ymax] = this._view;
@@ -499,33 +598,9 @@ export class Game {
   }
 
   // ------------------------------------------------------------------------------------ input
-  /** GameSession.key_event: a key ("d", "space", "tab"...) going "down" or "up" before the next step. */
-  keyEvent(key, action) {
-    if (this.over) return false;
-    if (this._timeline.length >= MAX_EVENTS) {
-      this._totalSteps = this._steps; // the game stops here, as the Python's does
-      return false;
-    }
-    const i = this._muscleKeys.indexOf(key);
-    if (i >= 0) {
-      const down = action === "down";
-      if (this._held[i] === down) return false;
-      this._held[i] = down;
-      this._goal[i] = down ? 1.0 : 0.0;
-      this._rate[i] = down ? this._rise[i] : this._decay[i];
-    } else if (key === RESET_KEY && action === "down") {
-      const [q1, q2] = this._start;
-      this._state = this._previous = [q1, q2, 0.0, 0.0];
-      this._activation = [0.0, 0.0, 0.0, 0.0];
-      this._resets += 1;
-      this._score = Math.max(0, this._score - this._resetCost);
-    } else if (key === TOGGLE_ARM_KEY && action === "down") {
-      this._armVisible = !this._armVisible;
-    } else {
-      return false;
-    }
-    this._timeline.push([this._steps, key, action]);
-    return true;
+  /** The reset key: the arm back at its start posture (GameRules.reset). */
+  _reset() {
+    this._resetTo(...this._start);
   }
 
   // ---------------------------------------------------------------------------------- physics
@@ -572,64 +647,7 @@ export class Game {
   }
 
   // ---------------------------------------------------------------------------------- queries
-  get steps() { return this._steps; }
-  get totalSteps() { return this._totalSteps; }
-  get dt() { return this._dt; }
-  get over() { return this._steps >= this._totalSteps; }
   get timeLeft() { return Math.max(0.0, (this._totalSteps - this._steps) * this._dt); }
-  get state() { return [...this._state]; }
-  get target() { return { ...this._target }; }
-  get score() { return this._score; }
-  get hits() { return this._hits; }
-  get resets() { return this._resets; }
   get hitTimes() { return [...this._hitTimes]; }
-  get armVisible() { return this._armVisible; }
-  get muscleActivation() { return [...this._activation]; }
-  get muscleKeys() { return [...this._muscleKeys]; }
   get view() { return [...this._view]; }
-  get timeline() { return this._timeline.map((e) => [...e]); }
-
-  /** GameSession.interpolated_angles: the joint angles a fraction alpha of a step past the previous state. */
-  interpolatedAngles(alpha) {
-    const [p1, p2] = this._previous, [c1, c2] = this._state;
-    return [p1 + alpha * (c1 - p1), p2 + alpha * (c2 - p2)];
-  }
-
-  /** The hand [x, y] in metres (world coordinates), where the rules see it. */
-  hand() {
-    return this._handAt(this._state[0], this._state[1]);
-  }
-
-  /** GameSession.result() as JSON data. */
-  result() {
-    const c = this._config;
-    return { score: this._score, hits: this._hits, resets: this._resets, seed: seedValue(this._seed),
-      duration: c.time_limit, steps: this._steps, scene: c.scene, integrator: c.integrator, dt: c.dt,
-      version: ARMGAME_VERSION };
-  }
-
-  /** The replay as records.replay.Replay.as_dict writes a keyboard game's, its driver the device a person
-   * played it on ("browser", one of records.replay.KEYBOARD_DEVICES: still a person's game, not a program's).
-   * A seed above 2^53 is a BigInt, which JSON.stringify refuses: replayJSON writes it. */
-  replay(player) {
-    const config = { ...this._config, seed: seedValue(this._seed) };
-    return {
-      format: "armgame-replay",
-      format_version: 1,
-      armgame_version: ARMGAME_VERSION,
-      date: nowIso(),
-      player: player ?? null,
-      driven: "keyboard",
-      driver: "browser",
-      scene: this._config.scene,
-      config,
-      timeline: this.timeline,
-      result: this.result(),
-    };
-  }
-
-  /** The replay as JSON text, any seed's digits exact: what the page hands in. */
-  replayJSON(player) {
-    return toJSON(this.replay(player));
-  }
 }

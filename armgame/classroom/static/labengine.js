@@ -8,8 +8,7 @@
 // RK4, the muscles and the arm's own sine are engine.js's, the game's: one definition of the physics.
 // tests/test_browser_lab.py holds it to LabSession in Node; the server re-simulates every hand-in anyway.
 
-import { ARMGAME_VERSION, MAX_EVENTS, RESET_KEY, TOGGLE_ARM_KEY, armPhysics, fail, nowIso, rk4, seedValue, sinCos,
-  toJSON } from "./engine.js";
+import { ArmSession, fail, rk4, sinCos } from "./engine.js";
 
 export const PLAN_FORMAT = "armgame-lab-plan";
 export const PLAN_VERSION = 1;
@@ -141,32 +140,16 @@ export function sha256Hex(bytes) {
 
 // -------------------------------------------------------------------------------------------- the run
 /** One lab run: LabSession's input, steps and rules on the server's plan, and the replay the server verifies. */
-export class LabRun {
+export class LabRun extends ArmSession {
   constructor(plan) {
     if (plan === null || typeof plan !== "object" || plan.format !== PLAN_FORMAT) fail("this is not a lab plan");
     if (plan.format_version !== PLAN_VERSION) fail(`the lab plan's version ${plan.format_version} is not ${PLAN_VERSION}`);
     if (plan.sine !== "arm") fail("the browser's lab plays runs on the arm's own sine only");
     if (!Array.isArray(plan.trials) || plan.trials.length === 0) fail("the lab plan has no trials");
     const config = plan.config;
-    const physics = armPhysics(config);
+    super(config);
     if (config.scene !== "lab") fail(`a lab run's scene is "lab", got ${JSON.stringify(config.scene)}`);
     this._plan = plan;
-    this._config = config;
-    this._seed = physics.seed;
-    this._dt = physics.dt;
-    this._totalSteps = physics.totalSteps;
-    this._l1 = physics.l1;
-    this._l2 = physics.l2;
-    this._base = physics.accel;
-    this._muscleKeys = physics.keys;
-    this._moments = physics.moments;
-    this._rise = physics.rise;
-    this._decay = physics.decay;
-    this._activation = [0.0, 0.0, 0.0, 0.0];
-    this._goal = [0.0, 0.0, 0.0, 0.0];
-    this._rate = [...this._decay];
-    this._held = [false, false, false, false];
-    this._resetCost = config.reset_cost;
     this._holdSteps = plan.hold_steps;
     this._timeoutSteps = plan.timeout_steps;
     this._targetRadius = plan.target_radius;
@@ -174,16 +157,7 @@ export class LabRun {
     this._distance = plan.distance;
     this._stillSpeed = plan.still_speed;
     this._trials = plan.trials;
-    this._unloaded = (q1, q2, w1, w2, t1, t2, dt) => rk4(this._base, q1, q2, w1, w2, t1, t2, dt);
-    this._steps = 0;
-    this._score = 0;
-    this._hits = 0;
-    this._resets = 0;
-    this._armVisible = true;
-    this._timeline = [];
-    const [q1, q2] = config.start_posture;
-    this._state = [q1, q2, 0.0, 0.0];
-    this._previous = this._state;
+    this._unloaded = (q1, q2, w1, w2, t1, t2, dt) => rk4(this._accel, q1, q2, w1, w2, t1, t2, dt);
     this._home = [...plan.home];
     this._homeQ = [...plan.home_q];
     this._homeTarget = { x: this._home[0], y: this._home[1], radius: this._homeRadius };
@@ -209,10 +183,10 @@ export class LabRun {
     const l1 = this._l1, l2 = this._l2;
     let accel = null;
     if (trial.channel) {
-      accel = loadedAccel(this._base, l1, l2, channelForce(trial.channel_field), null);
+      accel = loadedAccel(this._accel, l1, l2, channelForce(trial.channel_field), null);
     } else if (trial.load !== null) {
       const force = trial.load.hand ? handForce(trial.load.hand) : null;
-      accel = loadedAccel(this._base, l1, l2, force, trial.load.joint ?? null);
+      accel = loadedAccel(this._accel, l1, l2, force, trial.load.joint ?? null);
     }
     const step = accel === null ? this._unloaded : (q1, q2, w1, w2, t1, t2, dt) => rk4(accel, q1, q2, w1, w2, t1, t2, dt);
     return [step, trial.channel ? null : display(trial.display)];
@@ -295,45 +269,12 @@ export class LabRun {
     return this._still >= this._holdSteps || this._steps - this._goStep >= this._timeoutSteps;
   }
 
-  /** The hand with the arm's own sine (hand.hand_xy_arm_sine). */
-  _handAt(q1, q2) {
-    const [s1, c1] = sinCos(q1);
-    const [s12, c12] = sinCos(q1 + q2);
-    return [this._l1 * c1 + this._l2 * c12, this._l1 * s1 + this._l2 * s12];
-  }
-
   // ------------------------------------------------------------------------------------ input
-  /** GameSession.key_event with LabSession's reset: a key ("d", "space", "tab"...) "down" or "up" before the
-   * next step. Returns whether it acted (only those enter the timeline). */
-  keyEvent(key, action) {
-    if (this.over) return false;
-    if (this._timeline.length >= MAX_EVENTS) {
-      this._totalSteps = this._steps;
-      return false;
-    }
-    const i = this._muscleKeys.indexOf(key);
-    if (i >= 0) {
-      const down = action === "down";
-      if (this._held[i] === down) return false;
-      this._held[i] = down;
-      this._goal[i] = down ? 1.0 : 0.0;
-      this._rate[i] = down ? this._rise[i] : this._decay[i];
-    } else if (key === RESET_KEY && action === "down") {
-      // The hand home (its block's), at rest, counted; the trial's clock runs on.
-      const [q1, q2] = this._homeQ;
-      this._state = this._previous = [q1, q2, 0.0, 0.0];
-      this._activation = [0.0, 0.0, 0.0, 0.0];
-      this._resets += 1;
-      this._score = Math.max(0, this._score - this._resetCost);
-      this._cursor = this.shownHand();
-      if (this._phase === REACH && this._homeAt === null && !this.over) this._homeAt = this._xs.length;
-    } else if (key === TOGGLE_ARM_KEY && action === "down") {
-      this._armVisible = !this._armVisible;
-    } else {
-      return false;
-    }
-    this._timeline.push([this._steps, key, action]);
-    return true;
+  /** LabSession's reset: the hand home (its block's), at rest, counted; the trial's clock runs on. */
+  _reset() {
+    this._resetTo(...this._homeQ);
+    this._cursor = this.shownHand();
+    if (this._phase === REACH && this._homeAt === null && !this.over) this._homeAt = this._xs.length;
   }
 
   // ---------------------------------------------------------------------------------- physics
@@ -396,9 +337,6 @@ export class LabRun {
   }
 
   // ---------------------------------------------------------------------------------- queries
-  get steps() { return this._steps; }
-  get totalSteps() { return this._totalSteps; }
-  get dt() { return this._dt; }
   get finished() { return this._finished; }
   get over() { return this._finished || this._steps >= this._totalSteps; }
   get phase() { return this._phase; }
@@ -408,7 +346,6 @@ export class LabRun {
   get trials() { return this._trials.length; }
   /** The current trial's plan (null once finished). */
   get trial() { return this._trials[this._trialIndex] ?? null; }
-  get target() { return { ...this._target }; }
   get home() { return [...this._home]; }
   get cursor() { return [...this._cursor]; }
   /** LabSession.cursor_visible: always at home, and in a reach unless the trial hides it. */
@@ -416,26 +353,9 @@ export class LabRun {
     const trial = this.trial;
     return this._phase === HOLD || trial === null || trial.feedback === "full";
   }
-  get score() { return this._score; }
-  get hits() { return this._hits; }
-  get resets() { return this._resets; }
-  get armVisible() { return this._armVisible; }
-  get state() { return [...this._state]; }
-  get muscleActivation() { return [...this._activation]; }
-  get muscleKeys() { return [...this._muscleKeys]; }
-  get timeline() { return this._timeline.map((e) => [...e]); }
   /** Each finished trial: its index, target, go and end steps, hit, the shown hand's path and where space sent
    * the hand home (null: never). */
   get outcomes() { return this._outcomes.map((o) => ({ ...o, xs: [...o.xs], ys: [...o.ys] })); }
-
-  interpolatedAngles(alpha) {
-    const [p1, p2] = this._previous, [c1, c2] = this._state;
-    return [p1 + alpha * (c1 - p1), p2 + alpha * (c2 - p2)];
-  }
-
-  hand() {
-    return this._handAt(this._state[0], this._state[1]);
-  }
 
   /** The hand as the player is shown it (the trial's display transform applied). */
   shownHand() {
@@ -466,13 +386,6 @@ export class LabRun {
     return sha256Hex(bytes);
   }
 
-  result() {
-    const c = this._config;
-    return { score: this._score, hits: this._hits, resets: this._resets, seed: seedValue(this._seed),
-      duration: c.time_limit, steps: this._steps, scene: c.scene, integrator: c.integrator, dt: c.dt,
-      version: ARMGAME_VERSION };
-  }
-
   /** The lab's task section (record.LabTask.as_dict). */
   task() {
     const task = { kind: TASK_KIND, protocol: this._plan.protocol, trials: this.trialRecords(),
@@ -482,26 +395,8 @@ export class LabRun {
     return task;
   }
 
-  /** The replay as records.replay.Replay.as_dict writes a lab run's, played in a browser. */
+  /** The replay as records.replay.Replay.as_dict writes a lab run's, played in a browser: the game's, with its task. */
   replay(player) {
-    return {
-      format: "armgame-replay",
-      format_version: 1,
-      armgame_version: ARMGAME_VERSION,
-      date: nowIso(),
-      player: player ?? null,
-      driven: "keyboard",
-      driver: "browser",
-      scene: this._config.scene,
-      config: { ...this._config, seed: seedValue(this._seed) },
-      timeline: this.timeline,
-      result: this.result(),
-      task: this.task(),
-    };
-  }
-
-  /** The replay as JSON text, any seed's digits exact: what the page hands in. */
-  replayJSON(player) {
-    return toJSON(this.replay(player));
+    return { ...super.replay(player), task: this.task() };
   }
 }
