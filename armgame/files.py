@@ -54,6 +54,15 @@ def show_path(path: object) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
+def user_data_dir() -> Path:
+    """armgame's per-user data folder by each platform's convention (``platformdirs``): the table's,
+    the lab's runs and the class client's live in it, so they are found side by side on every platform.
+    Here, below every layer, so the student's client finds its folder without loading the table."""
+    import platformdirs
+
+    return Path(platformdirs.user_data_dir("armgame", appauthor=False))
+
+
 def user_path(text: str | os.PathLike[str], what: str = "path") -> Path:
     """A path the user typed, ``~`` expanded; a ``~user`` that names nobody, or a path too long for the
     file system (``check_path_length``), is a ``UserError``."""

@@ -27,6 +27,9 @@ which the projector's page shows live, one row per student. What each module own
 * ``serve``: starting the server (uvicorn) on the address the students can reach, and stopping it.
 * ``client``: the student's side: joining, handing in, the token and the outbox kept in the user's
   folder, so a game played while the server was unreachable is handed in at the next join.
+  ``memberships``: the names this machine joined under. ``wire``: what both sides hold to (the join
+  code's letters, the largest hand-in), with no imports: the student's side imports none of the server's
+  modules, and this package's ``__init__`` imports nothing (``tests/test_thin_client.py``).
 
 Above ``records``, ``lab`` and ``game``; below ``commands``; ``records`` never imports it and it
 imports pygame only through ``ui`` (``armgame class show``). Headless clients never load pygame.

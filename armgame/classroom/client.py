@@ -38,8 +38,7 @@ from pathlib import Path
 from ..errors import UserError
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited, user_path
 from . import memberships
-from .intake import MAX_HANDIN_BYTES
-from .roster import CODE_ALPHABET, CODE_LENGTH, normal_code
+from .wire import CODE_ALPHABET, CODE_LENGTH, MAX_HANDIN_BYTES, normal_code
 
 CLIENT_ENV = "ARMGAME_CLASS_CLIENT"
 DEFAULT_PORT = 8765
@@ -61,7 +60,7 @@ def client_folder() -> Path:
     env = os.environ.get(CLIENT_ENV)
     if env:
         return user_path(env, f"${CLIENT_ENV}")
-    from ..records.scores import user_data_dir
+    from ..files import user_data_dir
 
     return user_data_dir() / "class"
 

@@ -51,10 +51,8 @@ from .board import Board
 from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
 from .roster import MAX_PLAYERS, Player, Roster, token_digest
 from .rounds import Round, new_round
+from .wire import MAX_HANDIN_BYTES
 
-#: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
-#: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
-MAX_HANDIN_BYTES = 4 * 1024 * 1024
 #: The most re-simulation one hand-in may ask for, in physics steps (``records.scores.replay_work``).
 #: A standard game costs 15,000 steps and its hits and events; a lab run, its protocol's steps.
 #: A game claiming more (a "hit storm") is refused before anything is replayed.

@@ -34,7 +34,7 @@ from ..limits import MAX_GAME_SECONDS
 from ..records.standings import player_key
 from ..records.storage import atomic_write_bytes, parse_json
 from ..valid import INT64_MAX, check_float, check_int, check_keys, check_name, check_pattern, check_str
-from .roster import CODE_ALPHABET, CODE_LENGTH
+from .wire import CODE_ALPHABET, CODE_LENGTH
 
 FORMAT = 2
 #: The names one class keeps on one machine: a student, their bots and a spelling or two, with room.

@@ -50,13 +50,12 @@ from ..records.standings import legacy_player_key, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, dump_json, parse_json, read_limited
 from ..valid import HEX64, INT64_MAX, check_date, check_int, check_keys, check_name, check_str
 from .experiment import Experiment
+from .wire import CODE_ALPHABET, CODE_LENGTH, normal_code
 
 ROSTER_NAME = "class.json"
 SECRET_NAME = "teacher.secret"
 FORMAT = "armgame-class"
 FORMAT_VERSION = 4
-CODE_ALPHABET = "ACDEFGHJKMNPQRTUVWXY"
-CODE_LENGTH = 4
 #: Names one class holds: a lecture hall of students, each with a program or two, with room.
 MAX_PLAYERS = 2000
 MAX_ROSTER_BYTES = 2 * 1024 * 1024
@@ -65,11 +64,6 @@ _SECRET = re.compile(r"[A-Za-z0-9_-]{20,100}")
 
 def new_code() -> str:
     return "".join(secrets.choice(CODE_ALPHABET) for _ in range(CODE_LENGTH))
-
-
-def normal_code(text: str) -> str:
-    """A typed join code as the class compares it: case and surrounding spaces do not matter."""
-    return text.strip().upper()
 
 
 def token_digest(token: str) -> str:

@@ -48,7 +48,7 @@ TOKEN_SHARE = 1
 COOL_DOWN = 2.0
 #: What a student is told when the class cannot take their game yet (their client hands it in again).
 BUSY = "the class is busy: your game is kept and will be handed in in a moment"
-#: Hand-in bodies of any size (up to ``intake.MAX_HANDIN_BYTES``: a bot's game, a lab run) read at once (from one
+#: Hand-in bodies of any size (up to ``wire.MAX_HANDIN_BYTES``: a bot's game, a lab run) read at once (from one
 #: address: ``app.UPLOADS_PER_ADDRESS``).
 UPLOADS = 16
 #: Hand-in bodies of at most ``SMALL_UPLOAD_BYTES`` (declared: a student's game is 9 KB) read at once, apart from

@@ -39,6 +39,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
+from ..files import user_data_dir
 from ..limits import DEFAULT_SEED, MAX_REPLAY_BYTES
 from .cache import VerificationCache, default_cache_dir, file_signature  # noqa: F401 (the cache's old home)
 from .checking import (  # noqa: F401 (imported from here by the commands and tests)
@@ -106,14 +107,6 @@ def default_scores_dir() -> Path:
     if (root / "pyproject.toml").is_file() and (root / "scores").is_dir():
         return root / "scores"
     return user_data_dir() / "scores"
-
-
-def user_data_dir() -> Path:
-    """armgame's per-user data folder by each platform's convention (``platformdirs``): the table's
-    and the lab's runs live in it, so they are found side by side on every platform."""
-    import platformdirs
-
-    return Path(platformdirs.user_data_dir("armgame", appauthor=False))
 
 
 class ScoreTable(TableFile, TableChecks):
