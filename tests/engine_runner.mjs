@@ -2,8 +2,8 @@
 // on stdin, one JSON answer on stdout. Doubles go out as their 64 bits in hex, so nothing (not even a zero's
 // sign) is lost between the two languages.
 import { readFileSync } from "node:fs";
-import { Game, PythonRandom, expm1, sinCos, standardConfig, toJSON, ENGINE_VERSION, ARMGAME_VERSION }
-  from "../armgame/classroom/static/engine.js";
+import { Game, PythonRandom, sinCos, standardConfig, toJSON } from "../armgame/classroom/static/engine.js";
+import { ARMGAME_VERSION } from "../armgame/classroom/static/constants.js";
 
 const view = new DataView(new ArrayBuffer(8));
 function bits(x) {
@@ -48,14 +48,13 @@ function play(job) {
 
 const request = JSON.parse(readFileSync(0, "utf8"));
 const answer = {
-  engine_version: ENGINE_VERSION, armgame_version: ARMGAME_VERSION,
+  armgame_version: ARMGAME_VERSION,
   games: (request.games ?? []).map(play),
   random: (request.random ?? []).map(([seed, count]) => {
     const rng = new PythonRandom(BigInt(seed));
     return Array.from({ length: count }, () => bits(rng.random()));
   }),
   sin_cos: (request.sin_cos ?? []).map((x) => sinCos(x).map(bits)),
-  expm1: (request.expm1 ?? []).map((x) => bits(expm1(x))),
   // a seed, or [seed, duration] (a rehearsal's clock)
   standard: (request.standard ?? []).map((s) => toJSON(Array.isArray(s) ? standardConfig(...s) : standardConfig(s))),
 };

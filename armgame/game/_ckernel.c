@@ -143,10 +143,6 @@ static int one_game_args(const char *name, PyObject *const *args, Py_ssize_t nar
     return 0;
 }
 
-/* The relative margin of game_steps' "near" test over the exact one (which Python makes): far above
- * the round-off of squaring by multiplication instead of ``**``. */
-#define NEAR_MARGIN 1e-9
-
 PyDoc_STRVAR(game_steps_doc,
 "game_steps(params, mode, n, q1, q2, w1, w2, a0, a1, a2, a3, g0, g1, g2, g3, r0, r1, r2, r3, tx, ty, rr)\n"
 "    -> (ran, near, q1, q2, w1, w2, p1, p2, p3, p4, a0, a1, a2, a3, hx, hy)\n\n"
@@ -178,57 +174,17 @@ static PyObject *game_steps(PyObject *self, PyObject *const *args, Py_ssize_t na
         PyErr_SetString(PyExc_ValueError, message);
         return NULL;
     }
-    double x[4] = {v[0], v[1], v[2], v[3]};
-    double a0 = v[4], a1 = v[5], a2 = v[6], a3 = v[7];
-    const double g0 = v[8], g1 = v[9], g2 = v[10], g3 = v[11];
-    const double r0 = v[12], r1 = v[13], r2 = v[14], r3 = v[15];
-    const double x0 = v[16], y0 = v[17], rr = v[18];
-    const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
-    const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
-    const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
-    const double near = rr * (1.0 + NEAR_MARGIN);
-    double previous[4] = {x[0], x[1], x[2], x[3]}, hx = 0.0, hy = 0.0;
-    /* |the hand's move| <= reach1 |dq1| + reach2 |dq2| (numpy_kernel.hand_move_bounds, a hair over). */
-    const double reach1 = (l1 + l2) * (1.0 + 1e-9), reach2 = l2 * (1.0 + 1e-9);
-    const double radius = rr > 0.0 ? sqrt(rr) : 0.0;
-    double slack = -1.0;  /* measured after the first step */
-    Py_ssize_t ran = 0;
+    /* GameSession._advance's loop: _cstep.h's game_loop, which any build of the game compiles. */
+    Game game = {{v[0], v[1], v[2], v[3]}, {v[4], v[5], v[6], v[7]}, {v[0], v[1], v[2], v[3]}, 0.0, 0.0};
     int flagged = 0;
-    while (ran < n) {
-        /* GameSession._advance: torque from the activations, then the muscles step, then RK4. */
-        const double t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
-        const double t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
-        a0 += (g0 - a0) * r0;
-        a1 += (g1 - a1) * r1;
-        a2 += (g2 - a2) * r2;
-        a3 += (g3 - a3) * r3;
-        memcpy(previous, x, sizeof previous);
-        rk4_exact(&arm, NULL, t1, t2, dt, x);
-        ran++;
-        /* The hand's four cos and sin cost a third of a step: it is measured only when a lower bound on its
-         * distance from the disc, lowered by a bound on each step's move, runs out (the batch's slack, see
-         * ``run``), which no hand outside the disc by 1e-9 m can skip past. */
-        slack -= fabs(x[0] - previous[0]) * reach1 + fabs(x[1] - previous[1]) * reach2;
-        if (slack < 0.0) {
-            double sa, ca, sb, cb;
-            arm_sin_cos(x[0], &sa, &ca);  /* the rules' hand (rules.hand_position): the caller decides on it */
-            arm_sin_cos(x[0] + x[1], &sb, &cb);
-            hx = l1 * ca + l2 * cb;
-            hy = l1 * sa + l2 * sb;
-            const double dx = hx - x0, dy = hy - y0;
-            const double d2h = dx * dx + dy * dy;
-            if (d2h <= near) {
-                flagged = 1;
-                break;
-            }
-            slack = sqrt(d2h) - radius - 1e-9;
-        }
-    }
+    const Py_ssize_t ran = (Py_ssize_t)game_loop(&arm, p, v + 8, v + 12, v[16], v[17], v[18], (int64_t)n, &game,
+                                                 &flagged);
     PyObject *out = PyTuple_New(16);
     if (out == NULL)
         return NULL;
+    const double *x = game.x, *previous = game.previous, *a = game.a;
     const double values[14] = {x[0], x[1], x[2], x[3], previous[0], previous[1], previous[2], previous[3],
-                               a0, a1, a2, a3, hx, hy};
+                               a[0], a[1], a[2], a[3], game.hx, game.hy};
     PyObject *item = PyLong_FromSsize_t(ran);
     if (item == NULL)
         goto fail;

@@ -9,18 +9,16 @@
 // The server re-simulates every hand-in anyway (records.replay.Replay.verify): this engine only has to
 // show the student the game the server will find.
 //
-// No dependencies, no build step, no eval: it runs as it is under a CSP of script-src 'self', and in Node.
+// It plays one game, the class's (the standard arm, muscles and step; a seed, a clock and a target size of its own):
+// the numbers that game's physics needs come computed by the Python in constants.js, generated from armgame's own
+// definitions (armgame/classroom/jsconstants.py), so nothing here copies a parameter by hand.
+//
+// No build step, no eval, one import (constants.js): it runs as it is under a CSP of script-src 'self', and in Node.
 
-/** The arithmetic's version: bumped whenever a result could change. */
-export const ENGINE_VERSION = "1";
-/** The armgame (Python package) version whose GameSession this engine reproduces; replays name it. */
-export const ARMGAME_VERSION = "0.5.0";
+import { ARM, ARMGAME_VERSION, DECAY, MAX_EVENTS, MAX_GAME_STEPS, MAX_TRIES, MOMENTS, MUSCLE_KEYS, RESET_KEY, RISE,
+  STANDARD_CONFIG, TOGGLE_ARM_KEY } from "./constants.js";
 
-export const MAX_EVENTS = 200000; // armgame.limits.MAX_EVENTS
-const MAX_GAME_STEPS = 900000; // armgame.limits.MAX_GAME_STEPS
-const MAX_TRIES = 1000; // game/rules.py
-export const RESET_KEY = "space";
-export const TOGGLE_ARM_KEY = "tab";
+export { ARMGAME_VERSION };
 const DEG_TO_RAD = Math.PI / 180.0; // CPython's math.radians: x * degToRad, degToRad = pi / 180
 const SIXTH = 1.0 / 6.0;
 
@@ -55,8 +53,6 @@ export function sinCos(x) {
 }
 
 // ---------------------------------------------- Python's random.Random(seed): MT19937, CPython's seeding
-const MASK64 = (1n << 64n) - 1n;
-
 /** Python's random.Random seeded from a whole number 0 <= seed < 2^63 (a BigInt). */
 export class PythonRandom {
   constructor(seed) {
@@ -131,103 +127,6 @@ function roundHalfEven(x) {
   return (r - x === 0.5 && r % 2 !== 0) ? r - 1 : r;
 }
 
-function ulpOf(x) {
-  const view = new DataView(new ArrayBuffer(8));
-  view.setFloat64(0, Math.abs(x));
-  const exponent = (view.getUint16(0) >>> 4) & 0x7ff;
-  return Math.pow(2, Math.max(exponent, 1) - 1075);
-}
-
-/** x * x, which is what Python's x ** 2 (the C library's pow) gives unless x * x lies within 0.02 ulp of a
- * rounding tie: glibc's pow is within 0.52 ulp, so farther from a tie it returns the correctly rounded
- * square. Nearer, the browser cannot know which way the server's pow rounds: refused. */
-function square(x, name) {
-  const p = x * x;
-  const c = 134217729.0 * x; // Veltkamp's split: x = hi + lo exactly, each half 26 bits
-  const hi = c - (c - x), lo = x - hi;
-  const err = ((hi * hi - p) + 2.0 * hi * lo) + lo * lo; // exact(x^2) - p (Dekker)
-  if (Math.abs(err) > 0.48 * ulpOf(p)) {
-    throw new Error(`the arm's ${name} ${x} has a square too near a rounding tie to reproduce in the browser`);
-  }
-  return p;
-}
-
-// fdlibm's expm1 (Sun, 1993), the C library's method: the muscles' rates are -expm1(-dt / T).
-const O_THRESHOLD = 7.09782712893383973096e+02, LN2_HI = 6.93147180369123816490e-01;
-const LN2_LO = 1.90821492927058770002e-10, INVLN2 = 1.44269504088896338700e+00;
-const Q1 = -3.33333333333331316428e-02, Q2 = 1.58730158725481460165e-03, Q3 = -7.93650757867487942473e-05;
-const Q4 = 4.00821782732936239552e-06, Q5 = -2.01099218183624371326e-07;
-
-function highWord(x) {
-  const view = new DataView(new ArrayBuffer(8));
-  view.setFloat64(0, x);
-  return view.getInt32(0);
-}
-
-function withHighWord(x, high) {
-  const view = new DataView(new ArrayBuffer(8));
-  view.setFloat64(0, x);
-  view.setInt32(0, high);
-  return view.getFloat64(0);
-}
-
-export function expm1(x) {
-  let hx = highWord(x);
-  const xsb = hx & 0x80000000;
-  hx &= 0x7fffffff;
-  let y, hi, lo, c = 0, k, t;
-  if (hx >= 0x4043687A) { // |x| >= 56 ln 2
-    if (hx >= 0x40862E42) {
-      if (hx >= 0x7ff00000) return Number.isNaN(x) ? x + x : (xsb === 0 ? x : -1.0);
-      if (x > O_THRESHOLD) return Infinity;
-    }
-    if (xsb !== 0) return -1.0;
-  }
-  if (hx > 0x3fd62e42) { // |x| > 0.5 ln 2
-    if (hx < 0x3FF0A2B2) { // and < 1.5 ln 2
-      if (xsb === 0) { hi = x - LN2_HI; lo = LN2_LO; k = 1; } else { hi = x + LN2_HI; lo = -LN2_LO; k = -1; }
-    } else {
-      k = Math.trunc(INVLN2 * x + ((xsb === 0) ? 0.5 : -0.5));
-      t = k;
-      hi = x - t * LN2_HI;
-      lo = t * LN2_LO;
-    }
-    x = hi - lo;
-    c = (hi - x) - lo;
-  } else if (hx < 0x3c900000) { // |x| < 2^-54
-    return x;
-  } else {
-    k = 0;
-  }
-  const hfx = 0.5 * x;
-  const hxs = x * hfx;
-  const r1 = 1.0 + hxs * (Q1 + hxs * (Q2 + hxs * (Q3 + hxs * (Q4 + hxs * Q5))));
-  t = 3.0 - r1 * hfx;
-  let e = hxs * ((r1 - t) / (6.0 - x * t));
-  if (k === 0) return x - (x * e - hxs);
-  e = (x * (e - c) - c);
-  e -= hxs;
-  if (k === -1) return 0.5 * (x - e) - 0.5;
-  if (k === 1) {
-    if (x < -0.25) return -2.0 * (e - (x + 0.5));
-    return 1.0 + 2.0 * (x - e);
-  }
-  if (k <= -2 || k > 56) {
-    y = 1.0 - (e - x);
-    y = k === 1024 ? y * 2.0 * 8.98846567431158e307 : withHighWord(y, highWord(y) + (k << 20));
-    return y - 1.0;
-  }
-  if (k < 20) {
-    t = withHighWord(0, 0x3ff00000 - (0x200000 >> k)); // 1 - 2^-k
-    y = t - (e - x);
-    return withHighWord(y, highWord(y) + (k << 20));
-  }
-  t = withHighWord(0, (0x3ff - k) << 20); // 2^-k
-  y = x - (e + t);
-  y += 1.0;
-  return withHighWord(y, highWord(y) + (k << 20));
-}
-
 export function fail(message) {
   throw new Error(message);
 }
@@ -272,34 +171,25 @@ export function toJSON(value) {
 }
 
 // ---------------------------------------------------------------------------- the standard game
-const STANDARD_MUSCLES = [
-  ["pectoralis", "d", [1.5, 0.0]],
-  ["posterior deltoid", "f", [-1.5, 0.0]],
-  ["biceps", "j", [0.0, 1.125]],
-  ["triceps", "k", [0.0, -1.125]],
-];
+/** Whether two pieces of JSON data are equal: numbers and text by ===, lists and objects item by item. */
+function same(a, b) {
+  if (Array.isArray(a)) return Array.isArray(b) && a.length === b.length && a.every((v, i) => same(v, b[i]));
+  if (a !== null && typeof a === "object") {
+    if (b === null || typeof b !== "object" || Array.isArray(b)) return false;
+    const keys = Object.keys(a);
+    return keys.length === Object.keys(b).length && keys.every((k) => k in b && same(a[k], b[k]));
+  }
+  return a === b;
+}
 
 /** The replay "config" of the class's standard game (records.replay.config_to_dict(GameConfig(seed=seed))), on
  * a clock of `duration` seconds: 60, or a rehearsal's 15 (records.rulesets.REHEARSAL), as the class's join answer
  * says. The replay records it (config.time_limit, result.duration), so the class verifies the game it names. */
 export function standardConfig(seed, duration = 60.0) {
-  return {
-    arm: { l1: 0.34, l2: 0.46, r1: 0.17, r2: 0.23, m1: 2.1, m2: 1.65, i1: 0.025, i2: 0.075, gravity: 0.0,
-      damping1: 0.36, damping2: 0.27 },
-    start_posture: [45.0 * DEG_TO_RAD, 90.0 * DEG_TO_RAD],
-    time_limit: duration,
-    target_radius: 0.05,
-    target_shoulder_range: [15.0, 90.0],
-    target_elbow_range: [45.0, 90.0],
-    seed: seedValue(seedOf(seed)),
-    muscles: STANDARD_MUSCLES.map(([name, key, moment]) => (
-      { name, key, moment: [...moment], rise_time: 0.08, decay_time: 0.1 })),
-    integrator: "rk4",
-    dt: 0.004,
-    reset_cost: 1,
-    view: [-0.8, 0.8, -0.4, 1.2],
-    scene: "game",
-  };
+  const config = structuredClone(STANDARD_CONFIG);
+  config.time_limit = duration;
+  config.seed = seedValue(seedOf(seed));
+  return config;
 }
 
 /** An ISO 8601 date as records.replay.now_iso writes it: UTC, microseconds, "+00:00". */
@@ -308,80 +198,38 @@ export function nowIso() {
 }
 
 // ------------------------------------------------------------------------------------ the arm's physics
-/** A replay config's arm and muscles, checked as the game checks them: the seed (a BigInt), dt, the clock in
- * steps, the arm's accel (TwoJointArm._build_components, its operations in its order), the muscles' keys,
- * moments and rise and decay rates. The game and the lab (labengine.js) both step the arm on these. */
+/** TwoJointArm's accel_with_damping (twojoint._build_components, its operations in its order) for the class's arm,
+ * whose constants (constants.js's ARM) Python computed: a damped arm without gravity. */
+function accel(q1, q2, w1, w2, t1, t2) {
+  const { b, d, det0, aMinusD, k1, k2 } = ARM;
+  const [sn, cs] = sinCos(q2);
+  const bc = b * cs, h = b * sn, m12 = d + bc;
+  const f1 = t1 + h * (w1 + w1 + w2) * w2 - k1 * w1;
+  const f2 = t2 - h * w1 * w1 - k2 * w2;
+  const r = 1.0 / (det0 - bc * bc);
+  return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
+}
+
+/** A replay config's physics, checked: the class's arm, muscles, step and integrator (anything else is refused in
+ * one line naming what differs), a seed (a BigInt) and a clock in steps. The game and the lab (labengine.js) both
+ * step the arm on these. */
 export function armPhysics(config) {
   if (config === null || typeof config !== "object") fail("the game's config must be an object");
-  const known = ["arm", "start_posture", "time_limit", "target_radius", "target_shoulder_range",
-    "target_elbow_range", "seed", "muscles", "integrator", "dt", "reset_cost", "view", "scene"];
-  for (const name of known) if (!(name in config)) fail(`config.${name} is missing`);
-  if (config.integrator !== "rk4") {
+  for (const name of Object.keys(STANDARD_CONFIG)) if (!(name in config)) fail(`config.${name} is missing`);
+  if (config.integrator !== STANDARD_CONFIG.integrator) {
     fail(`the browser plays only RK4 games, this one uses ${JSON.stringify(config.integrator)}`);
   }
-  const arm = config.arm ?? {};
-  const p = {};
-  for (const k of ["l1", "l2", "r1", "r2", "m1", "m2", "i1", "i2", "gravity", "damping1", "damping2"]) {
-    p[k] = number(arm[k], `arm.${k}`);
+  for (const name of ["arm", "muscles", "dt"]) {
+    if (!same(config[name], STANDARD_CONFIG[name])) {
+      fail(`the browser plays only the class's game: this config's ${name} is not the class's`);
+    }
   }
-  const dt = number(config.dt, "dt", 1e-4, 0.02);
+  const dt = STANDARD_CONFIG.dt;
   const timeLimit = number(config.time_limit, "time_limit", 0, 3600);
   const totalSteps = roundHalfEven(timeLimit / dt);
   if (!(timeLimit > 0) || totalSteps > MAX_GAME_STEPS) fail(`config.time_limit ${timeLimit} s is not a game's`);
-  if (!Array.isArray(config.muscles) || config.muscles.length !== 4) fail("config.muscles must be 4 muscles");
-  const keys = config.muscles.map((m, i) => {
-    if (typeof m.key !== "string") fail(`config.muscles[${i}].key must be text`);
-    return m.key;
-  });
-  if (new Set(keys).size !== 4 || keys.includes(RESET_KEY) || keys.includes(TOGGLE_ARM_KEY)) {
-    fail(`config.muscles keys must differ from each other and from space and tab, got ${keys.join(" ")}`);
-  }
-
-  // TwoJointArm's constants and kernel_params' (the ** 2 are the C library's pow: see square()).
-  const a = p.i1 + p.i2 + p.m1 * square(p.r1, "r1") + p.m2 * (square(p.l1, "l1") + square(p.r2, "r2"));
-  const b = p.m2 * p.l1 * p.r2;
-  const d = p.i2 + p.m2 * square(p.r2, "r2");
-  const g1 = p.gravity * (p.m1 * p.r1 + p.m2 * p.l1);
-  const g2 = p.gravity * p.m2 * p.r2;
-  const k1 = p.damping1, k2 = p.damping2;
-  const det0 = a * d - d * d;
-  const aMinusD = a - d;
-  // TwoJointArm._build_components: which accel, with its operations in its order.
-  let accel;
-  if (p.gravity !== 0.0) {
-    accel = (q1, q2, w1, w2, t1, t2) => {
-      const gc12 = g2 * sinCos(q1 + q2)[1];
-      const [sn, cs] = sinCos(q2);
-      const bc = b * cs, h = b * sn, m12 = d + bc;
-      const f1 = t1 + h * (w1 + w1 + w2) * w2 - g1 * sinCos(q1)[1] - gc12 - k1 * w1;
-      const f2 = t2 - h * w1 * w1 - gc12 - k2 * w2;
-      const r = 1.0 / (det0 - bc * bc);
-      return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
-    };
-  } else if (k1 !== 0.0 || k2 !== 0.0) {
-    accel = (q1, q2, w1, w2, t1, t2) => {
-      const [sn, cs] = sinCos(q2);
-      const bc = b * cs, h = b * sn, m12 = d + bc;
-      const f1 = t1 + h * (w1 + w1 + w2) * w2 - k1 * w1;
-      const f2 = t2 - h * w1 * w1 - k2 * w2;
-      const r = 1.0 / (det0 - bc * bc);
-      return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
-    };
-  } else {
-    accel = (q1, q2, w1, w2, t1, t2) => {
-      const [sn, cs] = sinCos(q2);
-      const bc = b * cs, h = b * sn, m12 = d + bc;
-      const f1 = t1 + h * (w1 + w1 + w2) * w2;
-      const f2 = t2 - h * w1 * w1;
-      const r = 1.0 / (det0 - bc * bc);
-      return [(d * f1 - m12 * f2) * r, ((m12 + aMinusD + bc) * f2 - m12 * f1) * r];
-    };
-  }
-  // MuscleSet's moments and rates.
-  const moments = config.muscles.map((m, i) => numbers(m.moment, `muscles[${i}].moment`, 2, -50, 50));
-  const rise = config.muscles.map((m, i) => -expm1(-dt / number(m.rise_time, `muscles[${i}].rise_time`, dt, 10)));
-  const decay = config.muscles.map((m, i) => -expm1(-dt / number(m.decay_time, `muscles[${i}].decay_time`, dt, 10)));
-  return { seed: seedOf(config.seed), dt, totalSteps, l1: p.l1, l2: p.l2, accel, keys, moments, rise, decay };
+  return { seed: seedOf(config.seed), dt, totalSteps, l1: ARM.l1, l2: ARM.l2, accel, keys: [...MUSCLE_KEYS],
+    moments: MOMENTS.map((m) => [...m]), rise: [...RISE], decay: [...DECAY] };
 }
 
 /** integrators._rk4: one RK4 step of the arm under the held torques (t1, t2), as [q1, q2, w1, w2]. */
@@ -539,11 +387,17 @@ export class ArmSession {
 export class Game extends ArmSession {
   constructor(config) {
     super(config);
-    // GameRules.
+    // GameRules, the class's: its target ranges and view. The target's size is the config's, which the class's game
+    // fixes (its ruleset) and the engine's tests vary by an ulp to put a hit on the target's very edge.
+    for (const name of ["target_shoulder_range", "target_elbow_range", "view", "scene"]) {
+      if (!same(config[name], STANDARD_CONFIG[name])) {
+        fail(`the browser plays only the class's game: this config's ${name} is not the class's`);
+      }
+    }
     this._radius = number(config.target_radius, "target_radius", 0.005, 0.5);
-    this._shoulderRange = numbers(config.target_shoulder_range, "target_shoulder_range", 2, -360, 360);
-    this._elbowRange = numbers(config.target_elbow_range, "target_elbow_range", 2, -360, 360);
-    this._view = numbers(config.view, "view", 4, -20, 20);
+    this._shoulderRange = [...STANDARD_CONFIG.target_shoulder_range];
+    this._elbowRange = [...STANDARD_CONFIG.target_elbow_range];
+    this._view = [...STANDARD_CONFIG.view];
     this._rng = new PythonRandom(this._seed);
     this._hitTimes = [];
     this.tries = 0;
