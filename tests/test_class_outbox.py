@@ -4,6 +4,7 @@ and cost today's student no wait; whatever is in the store, the page plays and h
 
 from __future__ import annotations
 
+import http.client
 import json
 
 import pytest
@@ -54,6 +55,36 @@ def test_tabs_finishing_games_at_the_same_moment_lose_none(tabs):
         every = {f"r{r}t{t}" for r in range(rounds) for t in range(tabs)}
         assert every - acked - kept == set()  # each game acknowledged by the class, or still kept
         assert acked & kept == set() and len(acked) == len(every) // 2
+
+
+def _ask(port: int, path: str, body: bytes, headers: dict[str, str] | None = None) -> tuple[int, dict]:
+    """A POST from a student's machine of its own (127.0.0.9, not the teacher's)."""
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10, source_address=("127.0.0.9", 0))
+    try:
+        connection.request("POST", path, body, {"Content-Type": "application/json", **(headers or {})})
+        answer = connection.getresponse()
+        return answer.status, json.loads(answer.read())
+    finally:
+        connection.close()
+
+
+def test_a_join_or_a_game_that_names_another_class_is_refused_and_is_no_guess(tmp_path):
+    """A request naming another class (last week's, at this address) is refused before its code is looked at: it
+    learns nothing of the code, so it is not counted, however many come. The right code is taken at once after."""
+    with running_class(tmp_path / "class") as opened:
+        roster = opened.clerk.roster
+        for n in range(12):
+            status, said = _ask(opened.port, "/api/join", json.dumps(
+                {"code": "ZZZZ", "name": "Ama", "class": "0123456789abcdef"[: 1 + n]}).encode())
+            assert (status, said["ok"]) == (410, False) and "another class" in said["error"]
+            status, said = _ask(opened.port, "/api/handin", b"{}", {"Authorization": "Bearer x", "X-Armgame-Code":
+                                                                    "ZZZZ", "X-Armgame-Class": "5" * 16})
+            assert status == 410 and "another class" in said["error"]
+        status, said = _ask(opened.port, "/api/join", json.dumps({"code": roster.code, "name": "Ama"}).encode())
+        assert status == 200 and said["class"] == roster.class_id()
+        status, said = _ask(opened.port, "/api/join", json.dumps(
+            {"code": roster.code, "name": "Ama", "token": said["token"], "class": said["class"]}).encode())
+        assert status == 200 and said["name"] == "Ama"
 
 
 def _member(page) -> dict:
