@@ -23,14 +23,15 @@ from armgame.records.replay import Replay
 
 @contextlib.contextmanager
 def running_class(folder: Path | None, seed: int | None = None, lines: list[str] | None = None,
-                  lab: str | None = None, rehearse: bool = False, **options: object) -> Iterator[ClassServer]:
-    """The class in ``folder`` served on 127.0.0.1 (a free port) until the block ends (``lab``: its curve's
-    protocol, as ``--lab``; ``rehearse``: a rehearsal, ``folder`` None, as ``--rehearse``; ``options``: more of
+                  lab: str | None = None, rehearse: bool = False, port: int = 0,
+                  **options: object) -> Iterator[ClassServer]:
+    """The class in ``folder`` served on 127.0.0.1 (``port``, else a free one) until the block ends (``lab``: its
+    curve's protocol, as ``--lab``; ``rehearse``: a rehearsal, ``folder`` None, as ``--rehearse``; ``options``: more of
     ``open_class``'s, as ``proxy``, ``lab_b`` and ``split_seed`` (a classroom experiment's second condition, as
     ``--lab-b``, and the seed of its split))."""
     ready = threading.Event()
     said = lines if lines is not None else []
-    opened = open_class(folder, "127.0.0.1", 0, seed, say=said.append, on_ready=lambda _: ready.set(), lab=lab,
+    opened = open_class(folder, "127.0.0.1", port, seed, say=said.append, on_ready=lambda _: ready.set(), lab=lab,
                         rehearse=rehearse, **options)
     thread = threading.Thread(target=opened.run, daemon=True)
     thread.start()

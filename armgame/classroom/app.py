@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import hmac
 import json
 import math
 from collections import Counter
@@ -138,6 +139,17 @@ def _check_code(state: ClassState, request: Request, typed: object) -> None:
         state.codes.failed(address)
         raise RefusedError(403, "wrong class code: check the code on the projector")
     state.codes.succeeded(address)
+
+
+#: A join or a hand-in that names another class (a browser's game kept from last week's class at this address):
+#: refused before its code is looked at, so it is no guess and not counted as one (it learns nothing of the code).
+OTHER_CLASS = 410
+
+
+def _check_class(state: ClassState, named: object, what: str) -> None:
+    if named is not None and not (isinstance(named, str) and hmac.compare_digest(
+            named.encode("utf-8", "surrogatepass"), state.clerk.roster.class_id().encode())):
+        raise RefusedError(OTHER_CLASS, what)
 
 
 def _check_secret(state: ClassState, request: Request) -> None:
@@ -287,6 +299,8 @@ async def join(request: Request) -> Response:
     clerk = state.clerk
     address = client_address(request)
     body = await _json_body(request)
+    _check_class(state, body.get("class"), "this browser joined another class at this address before: type the code "
+                                           "on the projector")
     _check_code(state, request, body.get("code"))
     token = body.get("token")
     if token is not None and (not isinstance(token, str) or len(token) > 200):
@@ -315,6 +329,7 @@ async def join(request: Request) -> Response:
     # The class's game: its seed, its rules and their clock (a rehearsal's games are 15 s), which the student's
     # machine plays; a game of other rules is refused at hand-in.
     return json_answer({"ok": True, "name": player.name, "token": new_token or token, "seed": clerk.roster.seed,
+                        "class": clerk.roster.class_id(),
                         "rules": clerk.game.name, "duration": clerk.game.config.time_limit,
                         "rehearsal": clerk.rehearsal, "closed": clerk.roster.closed,
                         **({} if protocol is None else {"lab": lab_as_data(protocol)}),
@@ -335,6 +350,8 @@ async def hand_in(request: Request) -> Response:
     the body read (bounded), then checked and entered by the clerk; answered once it is durably written."""
     state = _state(request)
     address = client_address(request)
+    _check_class(state, request.headers.get("x-armgame-class"), "this game was played in another class: it is kept "
+                                                                 "on your machine, not handed in to this one")
     _check_code(state, request, request.headers.get("x-armgame-code"))
     token = _check_token(state, request)
     with state.hand_in_share(token), _share(state.uploading, address, UPLOADS_PER_ADDRESS,

@@ -49,7 +49,7 @@ SECURITY_HEADERS = {
 _RAW_SECURITY_HEADERS = [(name.lower().encode("latin-1"), value.encode("latin-1"))
                          for name, value in SECURITY_HEADERS.items()]
 #: Statuses after which a request's body may be left unread: the connection is closed after the answer.
-_BODY_LEFT = (400, 401, 403, 408, 413, 415, 429, 503)
+_BODY_LEFT = (400, 401, 403, 408, 410, 413, 415, 429, 503)
 
 
 def json_answer(data: object, status: int = 200, headers: Mapping[str, str] | None = None) -> Response:

@@ -300,6 +300,12 @@ class Roster:
         """The key in the projector's link: it shows the join code; derived from the secret, never the secret."""
         return hmac.new(self.secret.encode(), b"armgame projector", hashlib.sha256).hexdigest()[:20]
 
+    def class_id(self) -> str:
+        """What tells this class from another served at the same address (last week's, whose code may differ): a
+        browser tags its kept games with it, so a game is never handed in to another class. Derived from the
+        secret, never the secret; not a proof of anything, so a stranger may read it."""
+        return hmac.new(self.secret.encode(), b"armgame class", hashlib.sha256).hexdigest()[:16]
+
     def is_hidden(self, name: str) -> bool:
         return player_key(name) in self.hidden
 

@@ -5,8 +5,12 @@
 
 // The name playing now and its class: a reload, or the next game, plays under the same name.
 const MEMBER = "armgame.play.member";
-// Games finished but not yet taken by the class, oldest first: handed in at the next chance (the next page load,
+// Each game finished but not yet taken by the class, under a key of its own (GAME + its id): two tabs finishing at
+// once each write their own key, and a game taken is one key removed, so no tab writes back a list of games another
+// tab has just changed (a shared list lost a game so: issue 54). Handed in at the next chance (the next page load,
 // the next game's end, a timer while the page is open).
+const GAME = "armgame.play.game.";
+// Before, every kept game was in one list under this key: moved to keys of their own when the outbox is read.
 const OUTBOX = "armgame.play.outbox";
 // Every name this browser joined a class under, each with its token, by the class's code, the newest first:
 // {CODE: [{name, token, at}]}. A token is what proves a name is this browser's, and the class gives it once,
@@ -16,7 +20,7 @@ const NAMES = "armgame.play.names";
 const MAX_NAMES = 8, MAX_CLASSES = 40;
 // A kept game's replay: far larger than any 60 s game's (about 20 KB), far smaller than a browser's store.
 const MAX_GAME_BYTES = 1 << 20, MAX_KEPT_GAMES = 50;
-const CODE = /^[A-Z]{4}$/, TOKEN = /^[A-Za-z0-9_-]{1,200}$/, ID = /^[a-z0-9]{1,40}$/;
+const CODE = /^[A-Z]{4}$/, TOKEN = /^[A-Za-z0-9_-]{1,200}$/, ID = /^[a-z0-9]{1,40}$/, CLASS = /^[0-9a-f]{1,64}$/;
 
 function load(key, fallback) {
   try { return JSON.parse(localStorage.getItem(key)) ?? fallback; } catch { return fallback; }
@@ -26,7 +30,7 @@ function save(key, value) {
 }
 
 // ------------------------------------------------------------------ the name playing now
-// {code, name, token, seed, duration}, or null. The seed is a number or a decimal string (a seed past 2^53).
+// {code, name, token, seed, duration, class}, or null (class: the class's id, null when joined before it said it). The seed is a number or a decimal string (a seed past 2^53).
 export function loadMember() {
   const m = load(MEMBER, null);
   if (m === null || typeof m !== "object" || typeof m.code !== "string" || !CODE.test(m.code.toUpperCase()) ||
@@ -37,7 +41,8 @@ export function loadMember() {
   if (tokenFor(m.code, m.name) === null) keepName(m.code, m.name, m.token);  // kept before every name was
   // A class from before it said its clock, or a damaged one: the standard game's (the class checks the game).
   const duration = Number.isFinite(m.duration) && m.duration > 0 && m.duration <= 3600 ? m.duration : 60;
-  return { code: m.code, name: m.name, token: m.token, seed: m.seed, duration };
+  const cls = typeof m.class === "string" && CLASS.test(m.class) ? m.class : null;
+  return { code: m.code, name: m.name, token: m.token, seed: m.seed, duration, class: cls };
 }
 
 export function saveMember(member) {
@@ -84,31 +89,80 @@ export function keepName(code, name, token) {
 }
 
 // ------------------------------------------------------------------ the games not yet taken
-// A browser that refuses to store (private browsing, a full store) keeps its games here while the page is open.
-let unstored = null;
+// A kept game: {id, code, token, class, body, at}. ``class`` is what the class said of itself at the join (the
+// server's class id; null for a game kept before classes said it): a game is handed in only to its own class.
+// Games the browser would not store (private browsing, a full store): kept here while the page is open.
+const unstored = new Map();
 
 function keptGame(g) {
-  return g !== null && typeof g === "object" && typeof g.id === "string" && ID.test(g.id) &&
+  return g !== null && typeof g === "object" && !Array.isArray(g) && typeof g.id === "string" && ID.test(g.id) &&
     typeof g.code === "string" && CODE.test(g.code.toUpperCase()) && typeof g.token === "string" &&
-    TOKEN.test(g.token) && typeof g.body === "string" && g.body.length <= MAX_GAME_BYTES;
+    TOKEN.test(g.token) && typeof g.body === "string" && g.body.length <= MAX_GAME_BYTES &&
+    (g.class === undefined || g.class === null || (typeof g.class === "string" && CLASS.test(g.class)));
 }
 
-// The kept games, oldest first: a store that is not a list of games ({}, 5, [null]) reads as the games in it.
+function asGame(g, at) {
+  return { id: g.id, code: g.code, token: g.token, class: g.class ?? null, body: g.body,
+    at: Number.isFinite(g.at) ? g.at : at };
+}
+
+function store(game) {
+  try { localStorage.setItem(GAME + game.id, JSON.stringify(game)); return true; } catch { return false; }
+}
+
+// The old list's games moved to keys of their own (the same ids: two tabs moving them at once write the same keys),
+// and the list removed once every game in it is stored; what is not a game ({}, 5, [null]) is left out.
+function moveOldOutbox() {
+  let raw = null;
+  try { raw = localStorage.getItem(OUTBOX); } catch { return; }
+  if (raw === null) return;
+  let box = null;
+  try { box = JSON.parse(raw); } catch { box = null; }
+  let stored = true;
+  if (Array.isArray(box)) {
+    box.slice(0, MAX_KEPT_GAMES).filter(keptGame).forEach((g, i) => {
+      const game = asGame(g, i);  // older than any game kept since: handed in first, as before
+      if (!store(game)) { unstored.set(game.id, game); stored = false; }
+    });
+  }
+  if (stored) { try { localStorage.removeItem(OUTBOX); } catch { /* read again next time */ } }
+}
+
+// The kept games, oldest first. A key of the outbox's that is not a game (another page's, a damaged store) is left
+// out, never thrown: it can cost that game at worst, never the next one.
 export function outbox() {
-  if (unstored !== null) return unstored.slice();
-  const box = load(OUTBOX, []);
-  return Array.isArray(box) ? box.slice(0, MAX_KEPT_GAMES).filter(keptGame) : [];
+  moveOldOutbox();
+  const games = new Map(unstored);
+  let keys = [];
+  try {
+    for (let i = 0; i < localStorage.length; i++) {
+      const key = localStorage.key(i);
+      if (typeof key === "string" && key.startsWith(GAME)) keys.push(key);
+    }
+  } catch { keys = []; }
+  for (const key of keys) {
+    let raw = null;
+    try { raw = localStorage.getItem(key); } catch { raw = null; }
+    if (typeof raw !== "string" || raw.length > 2 * MAX_GAME_BYTES + 4096) continue;  // not parsed: no game is
+    let g = null;
+    try { g = JSON.parse(raw); } catch { g = null; }
+    if (keptGame(g) && key === GAME + g.id) games.set(g.id, asGame(g, 0));
+  }
+  return [...games.values()].sort((a, b) => a.at - b.at || (a.id < b.id ? -1 : a.id > b.id ? 1 : 0));
 }
 
 // Kept before it is sent; false when the browser would not store it (it is kept for as long as the page is open).
+// Past MAX_KEPT_GAMES the oldest go.
 export function keepGame(game) {
-  const box = [...outbox(), game].slice(-MAX_KEPT_GAMES);
-  if (unstored === null && save(OUTBOX, box)) return true;
-  unstored = box;
-  return false;
+  const kept = { ...asGame(game, 0), at: Date.now() };
+  const stored = store(kept);
+  if (!stored) unstored.set(kept.id, kept);
+  const box = outbox();
+  for (const old of box.slice(0, Math.max(box.length - MAX_KEPT_GAMES, 0))) dropGame(old.id);
+  return stored;
 }
 
 export function dropGame(id) {
-  const box = outbox().filter((g) => g.id !== id);
-  if (unstored !== null) unstored = box; else save(OUTBOX, box);
+  unstored.delete(id);
+  try { localStorage.removeItem(GAME + id); } catch { /* the browser stores nothing: it kept nothing */ }
 }

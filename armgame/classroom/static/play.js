@@ -32,7 +32,10 @@ const statusLine = document.getElementById("status");
 // The last frames' times (ms of script and drawing each): benchmarks/browser_page.py and the tests read them.
 canvas.frameTimes = [];
 
-let member = loadMember();  // {code, name, token, seed, duration}: the name playing now
+let member = loadMember();  // {code, name, token, seed, duration, class}: the name playing now
+// The class this page's last join reached: {class: its id, code: the code it took}. Only its games are handed in,
+// with that code; null until a join answers, and nothing kept is sent before (a game from another class never is).
+let here = null;
 let config = null, game = null, names = [], keys = [];
 let phase = "join";  // join, countdown, playing, over, closed; lab-loading, lab, lab-over (the teacher's switch)
 let lab = null;  // the lab's screen (labpage.js) while the class runs the lab in every browser
@@ -63,15 +66,37 @@ function refusal(answer) {
 // ``state``: the class's state asked before a new name joins. With the teacher's switch on, the join says it is for
 // the lab (a closed class takes a new name for it). A name this browser has is known to the class: it rejoins as
 // it always did, and the lab's own join follows if the switch is on (startLab).
-async function join(code, name, token, state) {
+async function join(code, name, token, state, cls = null) {
   const body = { code, name };
   if (token) body.token = token;
+  if (cls) body.class = cls;  // a name kept from another class at this address is refused, and no guess counted
   if (state && state.lab) body.for = "lab";
   return post("/api/join", JSON.stringify(body));
 }
 
 // A refusal that will be the same every time (a game the class does not take): dropped from the outbox.
-function final(status) { return status >= 400 && status < 500 && status !== 408 && status !== 429; }
+function final(status) {
+  return status >= 400 && status < 500 && status !== 408 && status !== 429 && status !== ANOTHER_CLASS;
+}
+// The class's answer to a join or a game that names another class (app.py's OTHER_CLASS): the game stays kept.
+const ANOTHER_CLASS = 410;
+
+function classOf(data) { return typeof data.class === "string" && /^[0-9a-f]{1,64}$/.test(data.class) ? data.class : null; }
+
+// A kept game is the class's here by the class's id; one kept before classes said it, by its code.
+function belongsHere(game) {
+  if (here === null) return false;
+  if (game.class !== null && here.class !== null) return game.class === here.class;
+  return game.code.toUpperCase() === here.code.toUpperCase();
+}
+function toHandIn() { return outbox().filter(belongsHere); }
+
+// A kept game sent with the code the class here took at the join (its own class's, whatever code it was kept with).
+function send(game) {
+  const headers = { Authorization: "Bearer " + game.token, "X-Armgame-Code": here.code };
+  if (game.class !== null) headers["X-Armgame-Class"] = game.class;
+  return post("/api/handin", game.body, headers);
+}
 
 let flushing = null;
 // Every kept game handed in, oldest first; returns the answers ({game, answer}) to show.
@@ -82,17 +107,13 @@ function flushOutbox() {
 async function doFlush() {
   const results = [];
   for (;;) {
-    const box = outbox();
+    const box = toHandIn();
     if (box.length === 0) break;
     const item = box[0];
-    const answer = await post("/api/handin", item.body,
-      { Authorization: "Bearer " + item.token, "X-Armgame-Code": item.code });
-    if (answer.status === 200 && answer.data && answer.data.ok) {
-      results.push({ id: item.id, answer });
-    } else if (final(answer.status)) {
-      results.push({ id: item.id, answer });
-    } else {
-      results.push({ id: item.id, answer });
+    const answer = await send(item);
+    results.push({ id: item.id, answer });
+    if (answer.status === ANOTHER_CLASS) { here = null; break; }  // another class is here now: it is sent nothing
+    if (!(answer.status === 200 && answer.data && answer.data.ok) && !final(answer.status)) {
       scheduleRetry();
       break;  // busy or unreachable: the rest wait with it
     }
@@ -105,16 +126,42 @@ async function doFlush() {
 let retryTimer = null;
 function scheduleRetry() {
   if (retryTimer !== null) return;
-  retryTimer = setTimeout(() => { retryTimer = null; flushOutbox().then(showAnswers); }, RETRY_MS);
+  retryTimer = setTimeout(async () => {
+    retryTimer = null;
+    if (here === null) await rejoin();
+    if (here !== null) flushOutbox().then(showAnswers);
+  }, RETRY_MS);
+}
+
+// The name playing now joined again, to learn which class is here (the page played on while the class was away).
+// It names its class: another class at this address refuses it without counting a guess. Returns the answer.
+async function rejoin() {
+  if (member === null) return { status: 0, data: null };
+  const answer = await join(member.code, member.name, member.token, null, member.class);
+  if (answer.status === 200 && answer.data && answer.data.ok) {
+    here = { class: classOf(answer.data), code: member.code };
+    if (member.class === null && here.class !== null) { member.class = here.class; saveMember(member); }
+  } else if (answer.status === 0 || answer.status === 408 || answer.status === 429 || answer.status >= 500) {
+    scheduleRetry();
+  }
+  showOutbox();
+  return answer;
 }
 
 function showOutbox() {
-  const kept = outbox().length;
+  const box = outbox(), mine = here === null ? box : box.filter(belongsHere);
+  const elsewhere = box.filter((g) => !mine.includes(g));
+  const between = phase !== "playing" && phase !== "lab" && phase !== "lab-loading";
   statusLine.replaceChildren();
   if (phase === "closed") statusLine.append(CLOSED + " · ");
   if (member) statusLine.append((lab !== null ? "in the lab as " : "playing as ") + member.name + " ");
-  if (kept > 0) statusLine.append("· " + (kept === 1 ? "1 game" : kept + " games") + " kept, to hand in ");
-  if (member && phase !== "playing" && phase !== "lab" && phase !== "lab-loading") {
+  if (mine.length > 0) statusLine.append("· " + games(mine.length) + (here === null ? " kept " : " kept, to hand in "));
+  if (elsewhere.length > 0) {
+    // Games played for another class at this address (last week's): never handed in here; the student may let go.
+    statusLine.append("· " + games(elsewhere.length) + " kept from another class, not handed in here ");
+    if (between) statusLine.append(discardButton(elsewhere), " ");
+  }
+  if (member && between) {
     const change = document.createElement("button");
     change.type = "button";
     change.id = "not-me";
@@ -122,6 +169,26 @@ function showOutbox() {
     change.addEventListener("click", forget);
     statusLine.append(change);
   }
+}
+
+function games(n) { return n === 1 ? "1 game" : n + " games"; }
+
+// Two clicks: the first asks, the second lets the games go.
+function discardButton(elsewhere) {
+  const button = document.createElement("button");
+  button.type = "button";
+  button.id = "discard";
+  button.textContent = "discard " + (elsewhere.length === 1 ? "it" : "them");
+  button.addEventListener("click", () => {
+    if (button.dataset.sure !== "yes") {
+      button.dataset.sure = "yes";
+      button.textContent = "discard " + games(elsewhere.length) + " for good?";
+      return;
+    }
+    for (const game of elsewhere) dropGame(game.id);
+    showOutbox();
+  });
+  return button;
 }
 
 // ------------------------------------------------------------------ joining
@@ -170,7 +237,9 @@ joinForm.addEventListener("submit", async (event) => {
 // (a tap just after the page loads starts it), and the lab replaces it if the teacher's switch is on.
 function joined(code, data, state = null) {
   // The class's game: its seed and its clock (a rehearsal's games are 15 s; a class that does not say: 60 s).
-  member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60 };
+  member = { code, name: data.name, token: data.token, seed: data.seed, duration: data.duration ?? 60,
+    class: classOf(data) };
+  here = { class: member.class, code };
   saveMember(member);
   joinForm.hidden = true;
   statusLine.textContent = "";
@@ -241,9 +310,10 @@ async function startLab() {
   document.getElementById("lab-end").hidden = true;
   statusLine.textContent = "the teacher has started the lab: loading it…";
   const answer = await post("/api/join", JSON.stringify({ code: member.code, name: member.name, token: member.token,
-    for: "lab" }));
+    for: "lab", ...(member.class ? { class: member.class } : {}) }));
   let plan = null;
   if (answer.status === 200 && answer.data && answer.data.ok) {
+    here = { class: classOf(answer.data), code: member.code };
     try {
       const r = await fetch("/api/labplan", { cache: "no-store", credentials: "omit",
         headers: { Authorization: "Bearer " + member.token, "X-Armgame-Code": member.code } });
@@ -359,18 +429,28 @@ async function finish() {
 // next time. Returns the line to show ({line, kind, data}); ``showing`` is told the line while it is on its way.
 async function handIn(body, what, showing) {
   const id = Date.now().toString(36) + Math.random().toString(36).slice(2, 8);
-  const kept = keepGame({ id, code: member.code, token: member.token, body });
+  const game = { id, code: member.code, token: member.token, class: member.class, body };
+  const kept = keepGame(game);
   if (!kept && showing) showing("handing in (this browser keeps nothing: stay on the page)…");
-  const results = await flushOutbox();
-  const mine = results.find((r) => r.id === id);
-  showAnswers(results.filter((r) => r.id !== id));
-  if (mine === undefined) return { line: `the class is busy, your ${what} is kept and will be handed in`, kind: "kept" };
-  return handInLine(mine.answer, what);
+  // This game first, by itself: another tab's hand-in may send it too, and the class takes a game once.
+  const answer = here === null ? await rejoin() : null;
+  if (here === null) return handInLine(answer, what);
+  if (!belongsHere(game)) return handInLine({ status: ANOTHER_CLASS, data: null }, what);
+  const mine = await send(game);
+  if (mine.status === ANOTHER_CLASS) here = null;
+  else if ((mine.status === 200 && mine.data && mine.data.ok) || final(mine.status)) dropGame(id);
+  else scheduleRetry();
+  showAnswers(here !== null && mine.status === 200 ? await flushOutbox() : []);
+  showOutbox();
+  return handInLine(mine, what);
 }
 
 function handInLine(answer, what) {
   if (answer.status === 200 && answer.data && answer.data.ok) return { line: answer.data.message, kind: "", data: answer.data };
   if (answer.status === 0) return { line: `the class could not be reached: your ${what} is kept and will be handed in`, kind: "kept" };
+  if (answer.status === ANOTHER_CLASS) {
+    return { line: `kept, not handed in: the class here is not the one your ${what} was played for`, kind: "kept" };
+  }
   if (answer.status === 503 || answer.status === 429 || answer.status === 408 || answer.status >= 500) {
     return { line: `the class is busy, your ${what} is kept and will be handed in`, kind: "kept" };
   }
@@ -390,11 +470,11 @@ function showAnswers(results) {
     statusLine.textContent = (taken.length === 1 ? "a kept game was " : taken.length + " kept games were ") +
       last.message;
   }
-  if (phase === "lab-over" && outbox().length === 0 && taken.length > 0 &&
+  if (phase === "lab-over" && toHandIn().length === 0 && taken.length > 0 &&
       document.getElementById("lab-answer").className === "kept") {
     lab.answer(taken[taken.length - 1].answer.data.message, "");
   }
-  if (phase === "over" && endCard.dataset.kept === "kept" && outbox().length === 0 && taken.length > 0) {
+  if (phase === "over" && endCard.dataset.kept === "kept" && toHandIn().length === 0 && taken.length > 0) {
     const mine = taken[taken.length - 1];
     showHandIn(mine.answer);
   }
@@ -859,7 +939,7 @@ async function begin() {
   showOutbox();
   requestAnimationFrame(frame);
   if (member === null) { askToJoin(""); flushOutbox().then(showAnswers); return; }
-  const answer = await join(member.code, member.name, member.token);
+  const answer = await join(member.code, member.name, member.token, null, member.class);
   if (answer.status === 200 && answer.data && answer.data.ok) {
     joined(member.code, answer.data);
   } else if (answer.status === 0 || answer.status === 503 || answer.status === 429) {
@@ -872,6 +952,10 @@ async function begin() {
     scheduleRetry();
   } else {
     askToJoin(refusal(answer));
+    if (answer.status === ANOTHER_CLASS) {  // last week's code is no use here: today's is typed afresh
+      document.getElementById("code").value = "";
+      document.getElementById("code").focus();
+    }
   }
 }
 
