@@ -85,22 +85,20 @@ def test_the_projector_counts_a_round_down_and_shows_its_winners(tmp_path, monke
         for name in ("Ann", "Bo"):
             monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / name))
             members[name] = client.join(address, opened.clerk.roster.code, name)
+        clock = opened.clerk.clock = FrozenClock()
         client.hand_in(members["Bo"], keyboard_game(40, player="Bo").to_bytes())  # before the round
         assert teacher(opened, "/api/teacher/round", {"minutes": 3})["message"] == "round 1: 3 min, from now"
-        client.hand_in(members["Ann"], keyboard_game(12, player="Ann").to_bytes())  # during it
+        rnd = opened.clerk.current_round()
+        ticket = client.start_ticket(members["Ann"])  # Ann begins a game during it
+        clock.now += timedelta(seconds=61)
+        client.hand_in(members["Ann"], keyboard_game(12, player="Ann").to_bytes(), ticket=ticket)
         page.goto(f"http://127.0.0.1:{opened.port}/")
         page.wait_for_selector("body[data-round='on']", state="attached")
         assert page.inner_text("#round-title") == "Round 1: play now!"
         assert page.inner_text("#round-clock").startswith(("3:00", "2:5")) and "left" in page.inner_text("#round-clock")
         names = page.eval_on_selector_all("#students td.name", "cells => cells.map(c => c.textContent)")
         assert names == ["Ann"]  # the round's own standings: Bo's game came before it
-        # The round's clock run out: moved back in the roster's record (as a restart would read it) so that Ann's
-        # game came just within its grace, which has run out a second later.
-        ann = datetime.fromisoformat(next(e.entered_at for e in opened.clerk.entries if e.name == "Ann"))
-        start = ann - timedelta(minutes=1, seconds=GRACE_SECONDS - 1)
-        after = opened.clerk.current_round().after
-        opened.clerk.roster.changed(round={"number": 1, "start": start.isoformat(timespec="seconds"), "minutes": 1,
-                                           "after": after})
+        clock.now = rnd.closes  # the round's clock and grace run out: the class says so at once
         page.wait_for_selector("body[data-round='over']", state="attached", timeout=10_000)
         assert page.inner_text("#winners-title") == "Round 1: the winners"
         assert page.eval_on_selector_all("#winners li .name", "cells => cells.map(c => c.textContent)") == ["Ann"]

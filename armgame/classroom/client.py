@@ -341,6 +341,9 @@ def start_ticket(m: Membership) -> str | None:
     try:
         with urllib.request.urlopen(req, timeout=TICKET_TIMEOUT) as response:
             ticket = _answer(response.read(4096), quiet=True).get("ticket")
+    except urllib.error.HTTPError as exc:  # an older class (404), or this name is no longer this machine's
+        exc.close()
+        return None
     except (OSError, http.client.HTTPException, ValueError):
         return None
     return ticket if isinstance(ticket, str) and 0 < len(ticket) <= 64 and ticket.isascii() else None
