@@ -284,3 +284,52 @@ def test_start_tickets_are_used_once_and_bounded_per_player_and_for_the_class():
     assert len(tickets) == 3 and tickets.take(third, "ann") is None  # the class's oldest made room
     assert [tickets.take(t, name) for t, name in zip(others, ("bo", "cy", "di"), strict=True)] == [START] * 3
     assert len(tickets) == 0 and tickets.take(None, "ann") is None
+
+
+@pytest.mark.slow  # in chromium: CI's slow tier runs every page after the suite
+def test_the_browser_game_asks_for_its_start_ticket_and_its_game_counts_in_the_round(tmp_path):
+    from play_page import join, open_page, play_keys, to_the_end
+
+    with running_class(tmp_path / "class") as opened, browser_page(1024, 768) as page:
+        clock = opened.clerk.clock = FrozenClock()
+        base = f"http://127.0.0.1:{opened.port}"
+        errors = open_page(page, base)
+        join(page, opened.clerk.roster.code, "Zoë")
+        teacher(opened, "/api/teacher/round", {"minutes": 3})
+        sent = []
+        page.on("request", lambda r: sent.append(r.headers.get("x-armgame-start")) if r.url.endswith("/api/handin")
+                else None)
+        play_keys(page)  # the game begins: its ticket asked for
+        for _ in range(200):  # the ticket given (asked for as the game began, beside it)
+            if len(opened.clerk.tickets):
+                break
+            time.sleep(0.01)
+        clock.now += timedelta(seconds=61)  # the page's own clock runs the game in a moment; the class's, a minute
+        to_the_end(page)
+        page.wait_for_selector("#end-answer:has-text('; in round 1')")
+        assert len(sent) == 1 and sent[0] and errors == []
+        assert [s["name"] for s in round_now(opened)["students"]] == ["Zoë"]
+
+
+def test_the_python_games_window_asks_for_its_start_ticket_and_its_game_counts_in_the_round(tmp_path, monkeypatch,
+                                                                                             capsys):
+    """``armgame play --join``'s window: the ticket asked for as each game is set up (on a thread), sent with it."""
+    import argparse
+
+    from class_server import final_answer, keyboard_session
+
+    from armgame.commands.play import _class_standing
+
+    with running_class(tmp_path / "class") as opened:
+        clock = opened.clerk.clock = FrozenClock()
+        ann = students(tmp_path, monkeypatch, opened, "Ann")["Ann"]
+        teacher(opened, "/api/teacher/round", {"minutes": 3})
+        standing = _class_standing(keyboard_session(20), argparse.Namespace(bot=None, record=None), ann)
+        for _ in range(500):  # the game begins: its ticket given
+            if len(opened.clerk.tickets):
+                break
+            time.sleep(0.01)
+        clock.now += timedelta(seconds=61)
+        final_answer(standing(None))
+        assert "; in round 1" in capsys.readouterr().out
+        assert [s["name"] for s in round_now(opened)["students"]] == ["Ann"]
