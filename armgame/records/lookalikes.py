@@ -65,6 +65,12 @@ ALLOWED_MIXES = (
 _NEUTRAL_SCRIPTS = frozenset({"COMMON", "INHERITED", "Unknown"})
 
 
+def mix_partners(script: str) -> frozenset[str]:
+    """The scripts a name may mix with ``script`` (``ALLOWED_MIXES``; none for most): the refused mixes are every
+    other pair, and a name mixes well only if each pair of its scripts does (the mixes are the largest such sets)."""
+    return frozenset().union(*(mix for mix in ALLOWED_MIXES if script in mix)) - {script}
+
+
 def _ignorable(code: int) -> bool:
     return any(low <= code <= high for low, high in DEFAULT_IGNORABLE)
 
