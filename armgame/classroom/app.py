@@ -306,7 +306,9 @@ async def join(request: Request) -> Response:
     if token is not None and (not isinstance(token, str) or len(token) > 200):
         raise RefusedError(400, "token must be a string")
     own = state.teachers_machine(request)
-    known = token is not None and clerk.roster.player_of(token) is not None
+    # Only a join again under a name the token already holds is free: any other is a new name, whatever token it
+    # carries (a joined name's token once let one machine join as many names as it liked).
+    known = clerk.roster.rejoins(body.get("name"), token) is not None
     if not known and not own:
         if state.joins.full(address):
             raise RefusedError(429, f"this machine has joined {JOINS_PER_MINUTE} names in the last minute: one "

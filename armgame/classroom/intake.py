@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import bisect
 import contextlib
-import hmac
 import os
 import secrets
 import stat
@@ -199,30 +198,13 @@ class Clerk:
         ``lab``: the join says it is for the lab (``armgame lab --join``). A closed class is closed to new
         games, and the teacher's lab is not one: its volunteers join a closed class (their games stay refused,
         ``_read``). A locked list is the teacher's "nobody new", and refuses them like any new name."""
-        try:
-            name = check_name(name)
-        except ValueError as exc:
-            raise RefusedError(400, str(exc)) from None
+        player = self.roster.rejoins(name, token)
+        if player is not None:  # the name, or its old one the teacher changed, is this machine's already
+            if lab:
+                self.assign(player.name)
+            return player, None
+        name = self.check_new_name(name)
         key = player_key(name)
-        player = self.roster.players.get(key)
-        if player is not None:
-            if token is not None and hmac.compare_digest(token_digest(token), player.token_sha256):
-                if lab:
-                    self.assign(player.name)
-                return player, None
-            raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
-                               f"name (or join from the machine that took it)")
-        if name.strip().upper() == "NAME":
-            raise RefusedError(400, "type your own name in place of NAME (in quotes if it has a space: "
-                                    "--name \"Ann B\")")
-        problem = name_problem(name)
-        if problem is not None:
-            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "
-                               f"letters")
-        alike = self.roster.lookalike_of(name)
-        if alike is not None:
-            raise RefusedError(409, f"that name reads like {alike.name}, who is in this class already: choose a name "
-                               f"nobody could mistake for a classmate's")
         if self.roster.closed and not lab:
             raise RefusedError(403, CLOSED_TO_PLAYERS)
         if self.roster.locked:
@@ -236,6 +218,36 @@ class Clerk:
         if lab:
             self.assign(player.name)
         return player, new_token
+
+    def check_new_name(self, name: object, owner: Player | None = None, what: str = "player name") -> str:
+        """The one check of a name a player takes: a machine's new name (``join``), or the one the teacher gives a
+        student (``rename``, ``owner`` the student). The name, trimmed; RefusedError if it is no name
+        (``valid.check_name``), hides part of itself (``records.lookalikes.name_problem``), or is another
+        player's: taken, read like theirs, or a name of theirs the teacher changed (``Roster``'s questions)."""
+        try:
+            name = check_name(name, what)
+        except ValueError as exc:
+            raise RefusedError(400, str(exc)) from None
+        taken = self.roster.players.get(player_key(name))
+        if taken is not None and taken is not owner:
+            raise RefusedError(409, f"the name {taken.name} is taken in this class by another machine: choose another "
+                               f"name (or join from the machine that took it)")
+        if name.strip().upper() == "NAME":
+            raise RefusedError(400, "type your own name in place of NAME (in quotes if it has a space: "
+                                    "--name \"Ann B\")")
+        problem = name_problem(name)
+        if problem is not None:
+            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "
+                               f"letters")
+        alike = self.roster.lookalike_of(name)
+        if alike is not None and alike is not owner:
+            raise RefusedError(409, f"that name reads like {alike.name}, who is in this class already: choose a name "
+                               f"nobody could mistake for a classmate's: add the first letter of your surname "
+                               f"(\"{name} K\", say)")
+        now = self.roster.renamed_from(name)
+        if now is not None and (owner is None or player_key(now) != player_key(owner.name)):
+            raise RefusedError(409, f"that name is {now}'s, whom the teacher renamed: choose another name")
+        return name
 
     def assign(self, name: str) -> str | dict | None:
         """In a classroom experiment, ``name``'s protocol (a preset's name or a protocol as data): their condition's,
@@ -631,18 +643,9 @@ class Clerk:
         part of itself, or that a reader would take for another student's."""
         if not isinstance(name, str) or player_key(name) not in self.roster.players:
             raise RefusedError(404, "no machine has joined under that name")
-        try:
-            new = check_name(to, "the new name")
-        except ValueError as exc:
-            raise RefusedError(400, str(exc)) from None
+        player = self.roster.players[player_key(name)]
+        new = self.check_new_name(to, player, "the new name")
         old_key, new_key = player_key(name), player_key(new)
-        player = self.roster.players[old_key]
-        problem = name_problem(new)
-        if problem is not None:
-            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem})")
-        taken = self.roster.players.get(new_key) or self.roster.lookalike_of(new)
-        if new_key != old_key and taken is not None and taken is not player:
-            raise RefusedError(409, f"that name is taken or reads like {taken.name}: choose another")
         players = {k: p for k, p in self.roster.players.items() if k != old_key}
         players[new_key] = Player(new, player.token_sha256, player.joined, player.address)
         renamed = {k: (new if player_key(v) == old_key else v) for k, v in self.roster.renamed.items()}
