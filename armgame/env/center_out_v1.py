@@ -40,7 +40,7 @@ def observation_bounds_v1(protocol: Protocol, trial_start: str) -> tuple[np.ndar
     kinds = {p.kind for p in protocol.perturbations}
     config = lab_config(protocol, 0)
     reach = config.arm.l1 + config.arm.l2
-    w = math.inf if kinds & {"constant", "spring"} else speed_bound(config)
+    w = speed_bound(config)  # held by the run's speed guard under any field (``center_out.observation_bounds``)
     v = (config.arm.l1 + 2.0 * config.arm.l2) * w
     # The cursor is the hand, or the hand rotated or mirrored about home: within 2 reaches of home and
     # 3 of the shoulder; a shown target (home or a target) lies within reach of the shoulder.
@@ -92,7 +92,8 @@ class CenterOutV1Env(CenterOutBaseEnv):
     | 15    | time since the phase began                       | 0      | 3.004 | s     |
 
     The shown target is home during a hold. A protocol with a ``jointspace`` display leaves the
-    cursor unbounded, and a constant force or a spring the speeds, as in v0; with
+    cursor unbounded, as in v0, and a field's runaway stops the run at the speed bound, terminated,
+    ``info["stopped"]`` saying why (v0's guard); with
     ``trial_start="hold"`` a hold has no end, so time in phase is bounded by a day.
 
     ## Rewards
@@ -158,7 +159,8 @@ class CenterOutV1Env(CenterOutBaseEnv):
       seed starts a new run, ``continue_run=True`` continues the run over episodes (checkouts of
       the v1 env before armgame 0.2.0, which still called themselves 0.1.0, always continued the
       run, and a reset mid-episode changed nothing); ``armgame/CenterOutHold-v1`` and its
-      ``Continuous`` twin registered, ``trial_start="hold"`` fixed (armgame 0.2).
+      ``Continuous`` twin registered, ``trial_start="hold"`` fixed (armgame 0.2). Since issue 52 a
+      field's runaway stops the run (v0's note); an unseeded reset draws its seed below 10^9.
     * v0: Initial version (armgame 0.1).
     """
 

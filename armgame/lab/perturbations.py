@@ -205,7 +205,7 @@ class Spring(Perturbation):
 
     kind: ClassVar[str] = "spring"
     is_force: ClassVar[bool] = True
-    stiffness: float = _param(0.0, 500.0, "N/m")
+    stiffness: float = _param(0.0, 250.0, "N/m")
 
     def loads(self, home: tuple[float, float]) -> Loads | None:
         from ..physics.loads import Loads, SpringField

@@ -1,0 +1,133 @@
+"""Issue 52, items 3 and 4: CenterOut as physical as Reach under every lab field, and the protocol's holes
+(training seeds, stateful and recurrent policies in ``evaluate``, ``verify``'s hit steps)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import armgame.env  # noqa: F401  (registers the ids)
+from armgame.env import suite
+from armgame.env.center_out import CenterOutEnv
+from armgame.env.center_out_v1 import CenterOutV1Env
+from armgame.env.reach import drawn_seed
+from armgame.lab.perturbations import KINDS, Perturbation
+from armgame.lab.protocol import Block, Protocol
+
+#: The issue's runaways: energy-feeding and non-symmetric matrices at the lab's range's extremes.
+ISSUE_FIELDS = (Perturbation.make("viscous", b11=50.0, b22=50.0),
+                Perturbation.make("viscous", b11=50.0, b12=50.0, b21=50.0, b22=50.0),
+                Perturbation.make("joint_viscous", w11=5.0, w12=5.0, w21=5.0, w22=5.0))
+
+
+def pump(observation: np.ndarray) -> np.ndarray:
+    """Each joint's muscle that pushes the way it turns: all the energy the muscles can feed (resonant)."""
+    return np.array([observation[2] > 0, observation[2] <= 0, observation[3] > 0, observation[3] <= 0], dtype=np.int8)
+
+
+def bang(step: int) -> np.ndarray:
+    flex = (step // 5) % 2 == 0
+    return np.array([flex, not flex, flex, not flex], dtype=np.int8)
+
+
+def extremes() -> list[Perturbation]:
+    """Every force field the lab offers at its range's extremes: each parameter alone at either end, all of them
+    at either end together, and the matrices' feeding, damping and non-symmetric shapes."""
+    out: list[Perturbation] = []
+    for cls in KINDS.values():
+        if not cls.is_force:
+            continue
+        params = cls.parameters()
+        for end in ("low", "high"):
+            out.append(cls(**{p.name: getattr(p, end) for p in params}))
+            for p in params:
+                out.append(cls(**{p.name: getattr(p, end)}))
+        if len(params) == 4:  # a matrix field: [[m, m], [-m, m]], [[m, -m], [m, -m]]
+            m = params[0].high
+            out.append(cls(m, m, -m, m))
+            out.append(cls(m, -m, m, -m))
+    return list(dict.fromkeys(out))
+
+
+def play_whole(env: gym.Env, policy: str, seed: int) -> dict:
+    """An episode to its end; every observation inside the declared Box (``step`` raising fails the test)."""
+    observation, info = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    space = env.observation_space
+    assert space.contains(observation)
+    step, done = 0, False
+    while not done:
+        action = env.action_space.sample() if policy == "random" else bang(step) if policy == "bang" \
+            else pump(observation)
+        observation, _, terminated, truncated, info = env.step(action)
+        assert space.contains(observation), (step, observation, info)
+        assert np.isfinite(observation).all()
+        done, step = terminated or truncated, step + 1
+    if "stopped" in info:
+        assert terminated and not truncated
+    return info
+
+
+def one_block(perturbation: Perturbation, trials: int) -> Protocol:
+    return Protocol("fields", (Block("exposure", trials, perturbation),))
+
+
+@pytest.mark.parametrize("perturbation", ISSUE_FIELDS, ids=lambda p: p.label())
+def test_the_issues_runaway_fields_stay_in_the_box_and_stop_in_one_line(perturbation):
+    # Before the guard these ran to 546-5.3e15 rad/s against a bound of 34.4 and raised NonFiniteStateError.
+    env = gym.make("armgame/CenterOut-v1", protocol=one_block(perturbation, 2), episode_trials=2,
+                   observation_dtype="float64")
+    info = play_whole(env, "pump", 0)
+    assert info["stopped"].startswith("the force field drove a joint past 34.4 rad/s")
+    # v0 runs a person's task: its go cue waits for the hand to rest at home, as a person's would.
+    v0 = CenterOutEnv(protocol=one_block(perturbation, 1), time_cost=0.0)
+    observation, _ = v0.reset(seed=0)
+    for _ in range(60):
+        observation, *_ = v0.step(np.zeros(4, dtype=np.int8))
+    assert v0.session.phase == "reach"
+    done = False
+    while not done:
+        observation, _, terminated, truncated, info = v0.step(pump(observation))
+        assert v0.observation_space.contains(observation)
+        done = terminated or truncated
+    assert terminated and "stopped" in info
+
+
+def test_every_center_out_field_declares_finite_speeds():
+    for perturbation in extremes():
+        env = CenterOutV1Env(protocol=one_block(perturbation, 1))
+        assert np.isfinite(env.observation_space.high[2:4]).all(), perturbation.label()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("policy", ["random", "bang", "pump"])
+def test_every_lab_field_at_its_extremes_plays_whole_episodes_inside_the_box(policy):
+    stopped = []
+    for perturbation in extremes():
+        for dtype in ("float32", "float64"):
+            env = gym.make("armgame/CenterOut-v1", protocol=one_block(perturbation, 8), episode_trials=8,
+                           observation_dtype=dtype)
+            for seed in range(2):
+                stopped.append("stopped" in play_whole(env, policy, seed))
+            env.close()
+    assert len(stopped) > 100
+
+
+# ------------------------------------------------------------------ item 4: the protocol's holes
+def test_unseeded_resets_draw_training_seeds_only():
+    for env_id in ("armgame/Reach-v0", "armgame/Reach-v1", "armgame/ReachHard-v1", "armgame/CenterOut-v0",
+                   "armgame/CenterOut-v1"):
+        env = gym.make(env_id)
+        env.reset(seed=3)
+        seeds = []
+        for _ in range(40):
+            env.reset()
+            seeds.append(env.unwrapped.session.config.seed)
+        assert all(0 <= s < suite.TRAINING_SEED_LIMIT for s in seeds), (env_id, max(seeds))
+        assert len(set(seeds)) == 40
+    envs = gym.make_vec("armgame/Reach-v1", num_envs=4, vectorization_mode="vector_entry_point")
+    envs.reset(seed=5)
+    assert all(envs.unwrapped._game_seed(i, None) < suite.TRAINING_SEED_LIMIT for i in range(4) for _ in range(50))
+    generator = np.random.default_rng(0)
+    assert max(drawn_seed(generator) for _ in range(1000)) < suite.TRAINING_SEED_LIMIT
