@@ -7,7 +7,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import armgame.env  # noqa: F401  (registers the ids)
+import armgame.env
 from armgame.env import suite
 from armgame.env.center_out import CenterOutEnv
 from armgame.env.center_out_v1 import CenterOutV1Env
@@ -131,3 +131,51 @@ def test_unseeded_resets_draw_training_seeds_only():
     assert all(envs.unwrapped._game_seed(i, None) < suite.TRAINING_SEED_LIMIT for i in range(4) for _ in range(50))
     generator = np.random.default_rng(0)
     assert max(drawn_seed(generator) for _ in range(1000)) < suite.TRAINING_SEED_LIMIT
+
+
+class CarriedBot:
+    """A stand-in for a recurrent SB3 model (``predict(obs, state=None, episode_start=None, deterministic=...)``): it
+    plays the model bot only while its state comes back as it gave it, starting afresh at each ``episode_start``;
+    with its state lost it holds no key, and hits nothing."""
+
+    def __init__(self) -> None:
+        self.env = gym.make("armgame/Reach-v1", time_limit=2.0, observation_dtype="float64")
+        self.bots: dict[int, object] = {}
+        self.resets = 0
+
+    def reset(self) -> None:
+        self.resets += 1
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=False):
+        from armgame.env.policies import BotPolicy
+
+        batch = np.atleast_2d(observation)
+        if episode_start is None:
+            return np.zeros((len(batch), 4), dtype=np.int8).reshape((*np.shape(observation)[:-1], 4)), None
+        state = np.zeros(len(batch), dtype=np.int64) if state is None else np.array(state)
+        actions = []
+        for i, obs in enumerate(batch):
+            if episode_start[i]:
+                self.bots[i] = BotPolicy("model", self.env)
+                state[i] = 0
+            elif state[i] == 0:  # a state lost: this game's bot is forgotten
+                self.bots.pop(i, None)
+            bot = self.bots.get(i)
+            actions.append(bot(obs) if bot is not None else np.zeros(4, dtype=np.int8))
+            state[i] += 1
+        actions = np.array(actions)
+        return (actions if np.ndim(observation) == 2 else actions[0]), state
+
+
+@pytest.mark.parametrize("with_reset", [False, True])
+def test_evaluate_carries_a_recurrent_state_through_each_game_and_resets_it(with_reset):
+    model = CarriedBot()
+    if not with_reset:  # the batched path (no reset()): the state goes through SB3's signature
+        model.reset = None
+    seeds = [armgame.env.suite.EVALUATION_SEED_START + i for i in range(3)]
+    result = armgame.env.evaluate(model, "armgame/Reach-v1", seeds=seeds, time_limit=2.0,
+                                  observation_dtype="float64")
+    bot = armgame.env.evaluate("model", "armgame/Reach-v1", seeds=seeds, time_limit=2.0, observation_dtype="float64")
+    assert sum(bot.hits) > 0 and result.hits == bot.hits
+    if with_reset:
+        assert model.resets == 3
