@@ -179,3 +179,56 @@ def test_evaluate_carries_a_recurrent_state_through_each_game_and_resets_it(with
     assert sum(bot.hits) > 0 and result.hits == bot.hits
     if with_reset:
         assert model.resets == 3
+
+
+# ------------------------------------------------------------------ item 4: verify compares every hit's step
+def a_dwell_game(tmp_path):
+    """A ReachHold-v1 game (dwell 50 steps) whose replay, edited to a dwell of 1, scores the same 2 hits earlier."""
+    from armgame.env.policies import bot_policy
+    from armgame.env.record import replay_of
+
+    env = gym.make("armgame/ReachHold-v1", time_limit=3.0)
+    policy = bot_policy("model", env)
+    observation, info = env.reset(seed=0)
+    done = False
+    while not done:
+        observation, _, terminated, truncated, info = env.step(policy(observation))
+        done = terminated or truncated
+    assert info["hits"] == 2
+    path = tmp_path / "game.json"
+    replay_of(env, driver="model bot").save(path)
+    return path
+
+
+def test_a_dwell_edited_to_the_same_count_is_refused_in_one_line(tmp_path, capsys):
+    import json
+
+    from armgame.cli import main
+
+    path = a_dwell_game(tmp_path)
+    assert main(["verify", str(path)]) == 0
+    capsys.readouterr()
+    data = json.loads(path.read_text())
+    data["task"]["hold_steps"] = 1  # an easier ruleset: the bot's two hits come sooner, and still two
+    path.write_text(json.dumps(data))
+    assert main(["verify", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1 and "DIFFERS" in out and "dwell 1 steps" in out
+    assert "the same score, hits, resets and steps, but hit 1 recorded at step" in out
+
+
+def test_a_counts_only_section_is_refused_in_one_line(tmp_path, capsys):
+    import json
+
+    from armgame.cli import main
+
+    path = a_dwell_game(tmp_path)
+    data = json.loads(path.read_text())
+    data["task"]["version"] = 1  # what 0.5 wrote: no hit steps, so the edit above would pass
+    del data["task"]["hit_steps"]
+    data["task"]["hold_steps"] = 1
+    path.write_text(json.dumps(data))
+    assert main(["verify", str(path)]) == 2
+    captured = capsys.readouterr()
+    line = (captured.out + captured.err).strip()
+    assert "\n" not in line and "task.version 1" in line and "records no hit steps" in line
