@@ -19,6 +19,16 @@ game, if it has one (``armgame.env.policies``' bots have one), or pass ``policy_
 game. (Until this was so, CenterOutHold-v1's naive bot scored 0 on seed 7,000,002 after another game and
 1 hit alone: its clock ran on from one game into the next.)
 
+**Stateful and recurrent models.** A model with SB3's ``predict`` and no ``reset()`` plays ``BATCH`` games at a
+time, one ``predict`` call a step for all of them. Where its ``predict`` takes ``state`` and ``episode_start``
+(``takes_state``: every SB3 model's does, and sb3-contrib's ``RecurrentPPO`` needs them), its recurrent state is
+carried from step to step for every game, ``episode_start`` true at each game's first step only, so each game
+starts from a fresh state. A model with a ``reset()`` (an SB3 model given one included) keeps a state of its own
+that games played together would share, so its games are played one at a time: ``reset()`` is called before
+each, and its recurrent state, where ``predict`` takes one, starts afresh with ``episode_start`` true at the
+game's first step. (Before issue 52 a model's ``reset()`` was never called and no recurrent state was passed, so
+a stateful model scored a seed differently alone and after other games.)
+
 Several training seeds of one algorithm are summarised with ``aggregate_runs``: the interquartile mean
 of their scores over the ids, with a stratified bootstrap interval (``armgame.env.statistics``).
 
