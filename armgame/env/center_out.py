@@ -367,11 +367,13 @@ class CenterOutEnv(CenterOutBaseEnv):
       target, trial counter, muscle bars) by ``armgame.ui.lab_window.LabRenderer``; ``render_size``
       ``(width, height)`` pixels (default ``(600, 600)``).
 
+    Since issue 52 a field's runaway stops the run (terminated, ``info["stopped"]``) where it raised
+    ``NonFiniteStateError`` or left the observation space, and a constant force or a spring no longer leaves the
+    speeds unbounded: games that did neither are unchanged, so the version is too.
+
     ## Version History
 
-    * v0: Initial version (armgame 0.1). Since issue 52 a field's runaway stops the run (terminated,
-      ``info["stopped"]``) where it raised ``NonFiniteStateError`` or left the observation space, and a
-      constant force or a spring no longer leaves the speeds unbounded: games that did neither are unchanged.
+    * v0: Initial version (armgame 0.1).
     """
 
     version = 0

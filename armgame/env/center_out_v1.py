@@ -151,6 +151,9 @@ class CenterOutV1Env(CenterOutBaseEnv):
       ``observation_dtype`` (``"float32"`` or ``"float64"``): as ``armgame/Reach-v1``; ``time_cost``:
       reward lost per second, 0 to 10 (default 0).
 
+    Since issue 52 a field's runaway stops the run (v0's note) and an unseeded reset draws its seed below 10^9
+    (the training seeds): games that did neither are unchanged, so the version is too.
+
     ## Version History
 
     * v1: trials start after their delay; episodes of a few trials or a block; the cursor, the
@@ -159,8 +162,7 @@ class CenterOutV1Env(CenterOutBaseEnv):
       seed starts a new run, ``continue_run=True`` continues the run over episodes (checkouts of
       the v1 env before armgame 0.2.0, which still called themselves 0.1.0, always continued the
       run, and a reset mid-episode changed nothing); ``armgame/CenterOutHold-v1`` and its
-      ``Continuous`` twin registered, ``trial_start="hold"`` fixed (armgame 0.2). Since issue 52 a
-      field's runaway stops the run (v0's note); an unseeded reset draws its seed below 10^9.
+      ``Continuous`` twin registered, ``trial_start="hold"`` fixed (armgame 0.2).
     * v0: Initial version (armgame 0.1).
     """
 
