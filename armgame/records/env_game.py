@@ -117,7 +117,7 @@ class EnvGameTask:
         if old and not legacy:
             raise ValueError(f"task.version {COUNTS_ONLY_VERSION}: a Reach env's section of version "
                              f"{COUNTS_ONLY_VERSION} records no hit steps, so a ruleset edited to the same count "
-                             f"would pass; this armgame verifies version {SECTION_VERSION} (record the game again, "
+                             f"would pass; this armgame reads version {SECTION_VERSION} (record the game again, "
                              f"or move a file you trust with benchmarks/env_game_hit_steps.py)")
         d = check_keys("task", data, fields if old else fields | {"hit_steps"})
         env_id = section_head(d, TASK_KIND, COUNTS_ONLY_VERSION if old else SECTION_VERSION, "a Reach env's")
