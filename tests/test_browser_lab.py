@@ -80,9 +80,9 @@ def own_protocols() -> list[Protocol]:
     return [
         Protocol("joint-viscous", (
             Block("baseline", 4),
-            Block("exposure", 12, JointViscous(0.5, -1.0, 1.5, 0.8), catch_trials=2, channel_trials=2,
+            Block("exposure", 12, JointViscous(0.06, -1.0, 1.1, 0.05), catch_trials=2, channel_trials=2,
                   probe_feedback="endpoint"),
-            Block("test", 8, JointViscous(0.5, -1.0, 1.5, 0.8), home_posture_deg=(100.0, 70.0), channel_trials=8),
+            Block("test", 8, JointViscous(0.06, -1.0, 1.1, 0.05), home_posture_deg=(100.0, 70.0), channel_trials=8),
         ), targets=4, **timing),
         Protocol("loads", (
             Block("constant", 6, Constant(1.5, -2.0), feedback="endpoint"),

@@ -169,7 +169,11 @@ def test_each_kind_refuses_its_own_bad_values(kind, bad):
 @pytest.mark.parametrize("kind", list(KINDS))
 def test_each_kind_writes_and_reads_itself(kind):
     cls = KINDS[kind]
-    record = cls(**{p.name: p.low + (p.high - p.low) / 3.0 for p in cls.parameters()})
+    values = [p.low + (p.high - p.low) / 3.0 for p in cls.parameters()]
+    if hasattr(cls, "max_feeding"):  # a matrix field whose opposite feeds within the limit too: a saddle and a curl
+        half = cls.max_feeding / 2
+        values = [half, values[1], -values[1], -half]
+    record = cls(*values)
     written = record.as_dict()
     assert written["perturbation"] == kind and set(written) - {"perturbation"} == cls.file_keys()
     assert cls.read(written) == record and Perturbation.make(kind, **dict(record.items())) == record

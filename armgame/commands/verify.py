@@ -140,6 +140,7 @@ def _verify_folder(folder, limit: int | None = None) -> int:
 def _report(path, replay, ok: bool, got) -> int:
     """One line on a recomputed replay; 0 if it matches, else 1."""
     from .. import __version__
+    from ..records.replay import same_outcome
     from ..records.rulesets import ruleset_name
 
     r = replay.result
@@ -156,6 +157,11 @@ def _report(path, replay, ok: bool, got) -> int:
         return 0
     note = f" (recorded with armgame {replay.version}, checked with {__version__})" \
         if replay.version != __version__ else ""
+    apart = getattr(replay.task, "hit_difference", None)  # a Reach env's game: the steps of its hits
+    detail = apart(replay.config, replay.timeline, r) if apart is not None and same_outcome(got, r) else None
+    if detail is not None:  # the same counts under another ruleset: where the hits part is what differs
+        print(f"{path}: DIFFERS: {about}: the same score, hits, resets and steps, but {detail}{note}")
+        return 1
     print(f"{path}: DIFFERS: {about}: recorded score {r.score}, {plural(r.hits, 'hit')}, "
           f"{plural(r.resets, 'reset')}, {plural(r.steps, 'step')}; the replay gives score {got.score}, "
           f"{plural(got.hits, 'hit')}, {plural(got.resets, 'reset')}, {plural(got.steps, 'step')}{note}")

@@ -12,6 +12,7 @@ frames): ``CenterOutEnv`` (v0) and ``center_out_v1.CenterOutV1Env`` derive from 
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Mapping
 from dataclasses import replace
@@ -25,6 +26,7 @@ from ..errors import UserError
 from ..game.muscles import MuscleSet
 from ..game.rules import MAX_CONFIG_SECONDS, Target
 from ..game.session import DOWN
+from ..game.variant import RunawayError
 from ..lab.analysis import trial_row
 from ..lab.bots import LAB_BOT_NAMES, make_lab_bot
 from ..lab.perturbations import KINDS, NONE, Perturbation
@@ -38,9 +40,9 @@ from .base import EnvArgumentError, SessionEnv
 from .reach import (
     DEFAULT_DECISION_STEPS,
     MAX_DECISION_STEPS,
-    SEED_LIMIT,
     _check_size,
     check_seed,
+    drawn_seed,
     speed_bound,
     wrap_angle,
 )
@@ -172,15 +174,19 @@ class CenterOutBaseEnv(SessionEnv):
             self._set_levels(action, 4)
         else:
             self._press_keys(action, 4)
-        done, hits = len(session.outcomes), session.rules.board.hits
-        ran = session.advance(self.decision_steps)
+        done, hits, steps = len(session.outcomes), session.rules.board.hits, session.steps
+        with contextlib.suppress(RunawayError):  # the run ends at its last allowed state (LabSession's guard)
+            session.advance(self.decision_steps)
+        ran = session.steps - steps
         reward = self._reward(session.rules.board.hits - hits) - self.time_cost * ran * session.config.dt
         info = self._info()
         if len(session.outcomes) > done:
             info["reaches"] = [trial_row(session, o) for o in session.outcomes[done:]]
+        if session.stopped is not None:
+            info["stopped"] = session.stopped
         if self.render_mode == "human":
             self.render()
-        truncated = session.over and not session.finished  # the run's clock ran out
+        truncated = session.over and not session.finished and session.stopped is None  # the run's clock ran out
         return self._observation(), reward, self._episode_over() and not truncated, truncated, info
 
     # ------------------------------------------------------- each version's own
@@ -212,10 +218,11 @@ class CenterOutBaseEnv(SessionEnv):
         if options:
             self._take_options(options)
         super().reset(seed=seed)
-        lab_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
+        lab_seed = seed if seed is not None else drawn_seed(self.np_random)
         try:
-            self.session = LabSession(lab_config(self.protocol, lab_seed), self.protocol,
-                                      hold_at_home=self.hold_at_home)
+            config = lab_config(self.protocol, lab_seed)
+            self.session = LabSession(config, self.protocol, hold_at_home=self.hold_at_home,
+                                      speed_limit=speed_bound(config))
         except UserError as exc:  # a target out of the arm's reach, in the lab's words
             raise EnvArgumentError(str(exc)) from None
 
@@ -231,9 +238,9 @@ class CenterOutBaseEnv(SessionEnv):
         low, high = self._bounds(protocol)
         space = self.observation_space
         if np.any(low.astype(space.dtype) < space.low) or np.any(high.astype(space.dtype) > space.high):
-            raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) or a constant or "
-                                   "spring force (unbounded speeds) needs an env made with it, e.g. "
-                                   "gym.make(id, protocol='jointspace'): this env's observation space bounds them")
+            raise EnvArgumentError("a protocol with a jointspace display (an unbounded cursor) needs an env made "
+                                   "with it, e.g. gym.make(id, protocol='jointspace'): this env's observation space "
+                                   "bounds the cursor")
         self.protocol = protocol
 
     def _new_view(self) -> Any:
@@ -297,10 +304,12 @@ class CenterOutEnv(CenterOutBaseEnv):
     within the arm's reach (0.8 m). The cursor is the hand, or the hand rotated or mirrored about home,
     so within three arm's lengths (2.4 m) of the shoulder; the ``jointspace`` display shows it at
     ``home + gain (q - q_home)`` for joint angles that nothing bounds, so an env whose protocol (or
-    perturbation) at ``make`` has that display observes the cursor in (-inf, inf) instead. Likewise a
-    constant force or a spring at the hand feeds the arm energy the speed bound does not count (a curl
-    field does no work), so an env made with one observes unbounded velocities. An env made without
-    them refuses a reset option that brings them in. The angles are wrapped as in
+    perturbation) at ``make`` has that display observes the cursor in (-inf, inf) instead; an env made
+    without it refuses a reset option that brings it in. The speed bound is proven for the arm and a
+    curl field (which does no work); any other field (a constant force, a spring, a viscous or joint
+    field, a channel) can feed the arm more energy, so a run whose joint speed would pass the bound
+    stops at its last state within it, **terminated**, ``info["stopped"]`` saying why in one line, as
+    ``armgame/Reach-v1``'s fields do. The angles are wrapped as in
     ``armgame/Reach-v0``. The run's clock is the lab's (``lab_config``: 1.5 times the slowest run's
     length plus 60 s, at most a day); a run that fidgets at home past it is truncated.
 
@@ -358,6 +367,10 @@ class CenterOutEnv(CenterOutBaseEnv):
       target, trial counter, muscle bars) by ``armgame.ui.lab_window.LabRenderer``; ``render_size``
       ``(width, height)`` pixels (default ``(600, 600)``).
 
+    Since issue 52 a field's runaway stops the run (terminated, ``info["stopped"]``) where it raised
+    ``NonFiniteStateError`` or left the observation space, and a constant force or a spring no longer leaves the
+    speeds unbounded: games that did neither are unchanged, so the version is too.
+
     ## Version History
 
     * v0: Initial version (armgame 0.1).
@@ -412,13 +425,15 @@ def observation_bounds(protocol: Protocol) -> tuple[np.ndarray, np.ndarray]:
 
     The speed bound is the game's (``reach.speed_bound``: the energy the muscles can feed against the
     damping), which a curl field keeps (its force is perpendicular to the hand's velocity: it does no
-    work); a constant force or a spring feeds the arm energy of its own, so with either the speeds are
-    left unbounded. The joint-space display's cursor follows unbounded joint angles."""
+    work). Every other field (a constant force, a spring, a viscous matrix, a joint field, a channel) can
+    feed the arm energy of its own, so the run's speed guard holds the bound instead: a run whose joint
+    speed would pass it stops there, terminated, ``info["stopped"]`` saying why (``LabSession.speed_limit``,
+    as Reach-v1's fields). The joint-space display's cursor follows unbounded joint angles."""
     kinds = {p.kind for p in protocol.perturbations}
     config = lab_config(protocol, 0)
     reach = config.arm.l1 + config.arm.l2
     pi, day = math.pi, MAX_RUN_SECONDS
-    speed = math.inf if kinds & {"constant", "spring"} else speed_bound(config)
+    speed = speed_bound(config)
     # |cursor - home| = |hand - home| <= |hand| + |home| under a rotation or mirror about home, both within reach.
     c = math.inf if "jointspace" in kinds else 3.0 * reach
     low = np.array([-pi, -pi, -speed, -speed, 0, 0, 0, 0, -c, -c, -reach, -reach, -reach, -reach, 0, 0, 0, 0])

@@ -40,7 +40,7 @@ def observation_bounds_v1(protocol: Protocol, trial_start: str) -> tuple[np.ndar
     kinds = {p.kind for p in protocol.perturbations}
     config = lab_config(protocol, 0)
     reach = config.arm.l1 + config.arm.l2
-    w = math.inf if kinds & {"constant", "spring"} else speed_bound(config)
+    w = speed_bound(config)  # held by the run's speed guard under any field (``center_out.observation_bounds``)
     v = (config.arm.l1 + 2.0 * config.arm.l2) * w
     # The cursor is the hand, or the hand rotated or mirrored about home: within 2 reaches of home and
     # 3 of the shoulder; a shown target (home or a target) lies within reach of the shoulder.
@@ -92,7 +92,8 @@ class CenterOutV1Env(CenterOutBaseEnv):
     | 15    | time since the phase began                       | 0      | 3.004 | s     |
 
     The shown target is home during a hold. A protocol with a ``jointspace`` display leaves the
-    cursor unbounded, and a constant force or a spring the speeds, as in v0; with
+    cursor unbounded, as in v0, and a field's runaway stops the run at the speed bound, terminated,
+    ``info["stopped"]`` saying why (v0's guard); with
     ``trial_start="hold"`` a hold has no end, so time in phase is bounded by a day.
 
     ## Rewards
@@ -149,6 +150,9 @@ class CenterOutV1Env(CenterOutBaseEnv):
     * ``reward`` (``"dense"`` or ``"sparse"``), ``progress_weight``, ``hit_bonus``,
       ``observation_dtype`` (``"float32"`` or ``"float64"``): as ``armgame/Reach-v1``; ``time_cost``:
       reward lost per second, 0 to 10 (default 0).
+
+    Since issue 52 a field's runaway stops the run (v0's note) and an unseeded reset draws its seed below 10^9
+    (the training seeds): games that did neither are unchanged, so the version is too.
 
     ## Version History
 

@@ -19,6 +19,16 @@ game, if it has one (``armgame.env.policies``' bots have one), or pass ``policy_
 game. (Until this was so, CenterOutHold-v1's naive bot scored 0 on seed 7,000,002 after another game and
 1 hit alone: its clock ran on from one game into the next.)
 
+**Stateful and recurrent models.** A model with SB3's ``predict`` and no ``reset()`` plays ``BATCH`` games at a
+time, one ``predict`` call a step for all of them. Where its ``predict`` takes ``state`` and ``episode_start``
+(``takes_state``: every SB3 model's does, and sb3-contrib's ``RecurrentPPO`` needs them), its recurrent state is
+carried from step to step for every game, ``episode_start`` true at each game's first step only, so each game
+starts from a fresh state. A model with a ``reset()`` (an SB3 model given one included) keeps a state of its own
+that games played together would share, so its games are played one at a time: ``reset()`` is called before
+each, and its recurrent state, where ``predict`` takes one, starts afresh with ``episode_start`` true at the
+game's first step. (Before issue 52 a model's ``reset()`` was never called and no recurrent state was passed, so
+a stateful model scored a seed differently alone and after other games.)
+
 Several training seeds of one algorithm are summarised with ``aggregate_runs``: the interquartile mean
 of their scores over the ids, with a stratified bootstrap interval (``armgame.env.statistics``).
 
@@ -31,6 +41,7 @@ of their scores over the ids, with a stratified bootstrap interval (``armgame.en
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
@@ -132,7 +143,9 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
         raise EnvArgumentError(f"seeds must hold 1 to {MAX_GAMES} game seeds, got {len(seeds)}")
     if policy_factory is not None and not callable(policy_factory):
         raise EnvArgumentError(f"policy_factory must be a callable env -> policy, got {policy_factory!r}")
-    if policy_factory is None and not isinstance(policy, str) and hasattr(policy, "predict"):
+    # A model with a reset() keeps a state of its own, so its games are played one at a time.
+    if policy_factory is None and not isinstance(policy, str) and hasattr(policy, "predict") \
+            and not callable(getattr(policy, "reset", None)):
         name = type(policy).__name__
         hits, scores, minutes = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
     else:
@@ -161,8 +174,11 @@ def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], determini
                 act = _policy(policy_factory(env), env, deterministic)[0]
             elif isinstance(policy, str) and policy in ("naive", "model"):
                 act = _policy(policy, env, deterministic)[0]  # a new bot: nothing of the last game in it
-            elif callable(getattr(policy, "reset", None)):
-                policy.reset()
+            else:
+                if callable(getattr(policy, "reset", None)):
+                    policy.reset()
+                if not isinstance(policy, str) and hasattr(policy, "predict"):
+                    act = _policy(policy, env, deterministic)[0]  # a recurrent state of its own starts afresh
             observation, info = env.reset(seed=seed)
             if name == "random":
                 env.action_space.seed(seed)
@@ -202,10 +218,17 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
             final_hits = np.zeros(len(part), dtype=np.int64)
             final_scores = np.zeros(len(part), dtype=np.int64)
             final_minutes = np.zeros(len(part))
+            recurrent = takes_state(model)
+            state, starts = None, np.ones(len(part), dtype=bool)
             while not done.all():
-                action, _ = model.predict(observation, deterministic=deterministic)
+                if recurrent:
+                    action, state = model.predict(observation, state=state, episode_start=starts,
+                                                  deterministic=deterministic)
+                else:
+                    action, _ = model.predict(observation, deterministic=deterministic)
                 observation, _, terminated, truncated, info = envs.step(action)
                 over = terminated | truncated
+                starts = over.copy()  # a game that ended starts again: its recurrent state with it
                 ended = over & ~done
                 final_hits[ended] = info["hits"][ended]
                 final_scores[ended] = info["score"][ended] if "score" in info else info["hits"][ended]
@@ -240,12 +263,37 @@ def _policy(policy: Any, env: gym.Env, deterministic: bool) -> tuple[Policy, str
         except ValueError as exc:  # an env the game's bots do not play
             raise EnvArgumentError(str(exc)) from None
     if hasattr(policy, "predict"):
-        return (lambda observation: policy.predict(observation, deterministic=deterministic)[0]), \
-            type(policy).__name__
+        return _predictor(policy, deterministic), type(policy).__name__
     if callable(policy):
         return policy, getattr(policy, "__name__", type(policy).__name__)
     raise EnvArgumentError(f"policy must be 'random', 'naive', 'model', a callable or a model with predict(), "
                            f"got {type(policy).__name__}")
+
+
+def takes_state(model: Any) -> bool:
+    """Whether ``model.predict`` takes SB3's recurrent arguments, ``state`` and ``episode_start`` (every SB3 model
+    does; a recurrent one, sb3-contrib's ``RecurrentPPO``, needs them carried through a game)."""
+    try:
+        names = inspect.signature(model.predict).parameters
+    except (TypeError, ValueError):
+        return False
+    return "state" in names and "episode_start" in names
+
+
+def _predictor(model: Any, deterministic: bool) -> Policy:
+    """A model's ``predict`` as ``observation -> action`` for one game: its recurrent state carried from step to
+    step, with ``episode_start`` true at the game's first step only."""
+    if not takes_state(model):
+        return lambda observation: model.predict(observation, deterministic=deterministic)[0]
+    carried: list[Any] = [None, True]
+
+    def act(observation: np.ndarray) -> Any:
+        action, carried[0] = model.predict(observation, state=carried[0], episode_start=np.array([carried[1]]),
+                                           deterministic=deterministic)
+        carried[1] = False
+        return action
+
+    return act
 
 
 def _game_minutes(env: gym.Env) -> float:

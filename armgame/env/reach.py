@@ -27,6 +27,7 @@ from ..game.session import GameSession
 from ..valid import INT64_MAX
 from .base import EnvArgumentError, SessionEnv
 from .features import REACH_REWARDS, check_dtype, check_reward, reach_bounds_v1
+from .suite import TRAINING_SEED_LIMIT
 from .variants import ReachVariant
 
 #: Decision step of the standard envs in physics steps: 5 x 4 ms = 20 ms, a 50 Hz controller.
@@ -185,6 +186,13 @@ def check_seed(seed: object) -> int:
     return int(seed)
 
 
+def drawn_seed(generator: np.random.Generator) -> int:
+    """The game seed of a reset without one, from the env's generator: below ``suite.TRAINING_SEED_LIMIT``, so that
+    an autoreset (every training game after the first) is a training game by construction, never a validation or
+    test game (before issue 52 it took any 63-bit seed, and missed those ranges only by chance)."""
+    return int(generator.integers(TRAINING_SEED_LIMIT))
+
+
 class ReachBaseEnv(SessionEnv):
     """What the Reach envs' versions share: a ``GameSession`` made at each reset and driven a decision step
     at a time (``reset``, ``step``, ``info``, frames). Each version is its own sibling subclass (as
@@ -215,7 +223,7 @@ class ReachBaseEnv(SessionEnv):
         if seed is not None:
             seed = check_seed(seed)
         super().reset(seed=seed)
-        game_seed = seed if seed is not None else int(self.np_random.integers(SEED_LIMIT))
+        game_seed = seed if seed is not None else drawn_seed(self.np_random)
         self.session = self._new_session(self.settings.game(game_seed))
         return self._first_view()
 

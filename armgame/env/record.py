@@ -4,8 +4,8 @@ A game of ``armgame/Reach-v0`` or ``Reach-v1`` with keys is the game itself, and
 game's (``Replay.from_session``), which the high-score table can read. Every other Reach game (a
 continuous id's muscle levels; the suite's dwell, noise, delay, field or target size) gets the
 ``"reach-env"`` task section (``armgame.records.env_game``): the variant's rules and physics, the
-levels commanded, the id, and whether a runaway stopped it. ``armgame verify`` replays it with all of
-that and compares the score, hits, resets and steps.
+levels commanded, the id, whether a runaway stopped it, and the step of every hit. ``armgame verify`` replays
+it with all of that and compares the score, hits, resets, steps and each hit's step.
 
 A CenterOut episode (v0, v1, CenterOutHold, keys or levels) is a lab run from its start to the episode's
 end: its replay carries ``"centre-out-env"`` (``CenterOutEnvTask``): the lab's own section (the
@@ -42,7 +42,7 @@ from ..game.session import GameResult, InputEvent, LevelEvent
 from ..game.variant import play_inputs
 from ..lab.record import LabTask, paths_digest, trial_fields
 from ..lab.session import LabSession
-from ..records.env_game import EnvGameTask, levels_from_list, register, section_head
+from ..records.env_game import EnvGameTask, hit_steps, levels_from_list, register, section_head
 from ..records.replay import Replay, now_iso, register_task, same_outcome
 from ..valid import check_bool, check_keys
 from .errors import EnvArgumentError
@@ -89,7 +89,7 @@ def replay_of(env: Any, driver: str = "program", player: str | None = None, driv
     from ..game.variant import GameVariant
 
     task = EnvGameTask(variant or GameVariant(decision_steps=settings.decision_steps), levels, stopped, env_id,
-                       base.variant.observation_delay if version else 0)
+                       base.variant.observation_delay if version else 0, hit_steps(session))
     return Replay(session.config, tuple(session.timeline), session.result(), driven, driver, player, now_iso(),
                   task=task)
 

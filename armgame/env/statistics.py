@@ -6,7 +6,8 @@ the runs' scores, pooled over tasks), robust to one run that failed or one that 
 **stratified bootstrap** confidence interval (each bootstrap sample redraws, with replacement, the runs
 of every task separately, so each task keeps its number of runs), by the percentile method. Their
 library ``rliable`` computes these; it installs from PyPI (1.2.0, a source package) but brings arch,
-statsmodels, pandas, seaborn and absl-py with it, ten packages for two functions, so the same statistics
+statsmodels, pandas, seaborn and absl-py with it, ten packages for two functions, and imports only beside
+pandas 2 (``pip install rliable==1.2.0 "pandas<3"``), so the same statistics
 are here in numpy. ``tests/test_env_statistics.py`` holds them to a brute-force computation: every one
 of the bootstrap's resamples of a small table enumerated.
 

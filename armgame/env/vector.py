@@ -46,11 +46,11 @@ from .features import (
 )
 from .reach import (
     DEFAULT_DECISION_STEPS,
-    SEED_LIMIT,
     EnvArgumentError,
     ReachSettings,
     _check_size,
     check_seed,
+    drawn_seed,
 )
 from .variants import ReachVariant, with_target_radius
 from .vector_common import AutoresetBook, SingleEnvsVectorEnv, check_reset_mask
@@ -290,7 +290,7 @@ class ReachVectorEnv(VectorEnv):
         generator = self._generators[i]
         if generator is None:
             generator = self._generators[i] = seeding.np_random()[0]
-        return int(generator.integers(SEED_LIMIT))
+        return drawn_seed(generator)
 
     def _check(self, actions: Any) -> np.ndarray:
         shape = (self.num_envs, self._width)

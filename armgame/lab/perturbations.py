@@ -34,6 +34,11 @@ if TYPE_CHECKING:  # the physics (and numpy) are imported when a run builds its 
 Display = Callable[[float, float, float, float], tuple[float, float]]
 Matrix = tuple[tuple[float, float], tuple[float, float]]
 
+#: The most a viscous (N s/m) or joint (N m s/rad) matrix may feed the arm (``feeding``): 0.85 of the largest that
+#: held whole episodes under the pump, rounded down (``benchmarks/results/center_out_fields.json``, "feeding").
+VISCOUS_MAX_FEEDING = 2.0
+JOINT_MAX_FEEDING = 0.15
+
 
 class ProtocolError(UserError, ValueError):
     """A protocol or perturbation that cannot be run, in one line naming the value as a protocol file names it."""
@@ -205,7 +210,7 @@ class Spring(Perturbation):
 
     kind: ClassVar[str] = "spring"
     is_force: ClassVar[bool] = True
-    stiffness: float = _param(0.0, 500.0, "N/m")
+    stiffness: float = _param(0.0, 250.0, "N/m")
 
     def loads(self, home: tuple[float, float]) -> Loads | None:
         from ..physics.loads import Loads, SpringField
@@ -213,17 +218,45 @@ class Spring(Perturbation):
         return Loads(hand=SpringField(self.stiffness, home)) if self.stiffness != 0.0 else None
 
 
+def feeding(matrix: Matrix) -> float:
+    """The most energy a velocity field ``F = M v`` (or ``tau = M qdot``) feeds the arm per squared speed: the sum of
+    the positive eigenvalues of ``M``'s symmetric part, which alone does work (``v . M v``; the antisymmetric part,
+    a curl, pushes across the motion). Where only one eigenvalue is positive (the viscous preset's, 1.99 and -1.86
+    N s/m) it is the largest eigenvalue; where both are, they add up: the largest eigenvalue alone does not bound
+    what the arm takes, since twice the identity (both 2 N s/m) runs away under the pump where every shape that
+    feeds 2.4 in all holds (``benchmarks/center_out_fields.py``)."""
+    (a, b), (c, d) = matrix
+    mean, radius = (a + d) / 2, math.hypot((a - d) / 2, (b + c) / 2)
+    return max(mean + radius, 0.0) + max(mean - radius, 0.0)
+
+
 @dataclass(frozen=True)
 class _MatrixField(Perturbation):
     """A field given by a 2 x 2 matrix, its four entries the parameters, row by row: a protocol file writes it
-    ``matrix = [[.., ..], [.., ..]]`` and names an entry ``matrix[i][j]``."""
+    ``matrix = [[.., ..], [.., ..]]`` and names an entry ``matrix[i][j]``.
+
+    Each entry has its range, and the matrix as a whole feeds the arm at most ``max_feeding`` (``feeding``): more
+    outweighs the joints' own damping and a reach runs away, which the entries' ranges alone allowed (issue 52). The
+    limit is measured by ``benchmarks/center_out_fields.py`` (its pump policy, with a margin), and
+    ``tests/test_env_fields_protocol.py`` holds it to the committed measurement."""
 
     #: The matrix's letter in the label, and its entries' format there.
     symbol: ClassVar[str]
     number_format: ClassVar[str]
+    #: The most its symmetric part's positive eigenvalues may sum to, in the entries' unit.
+    max_feeding: ClassVar[float]
     is_force: ClassVar[bool] = True
     is_velocity_field: ClassVar[bool] = True
     has_opposite: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        fed = feeding(self.entries)
+        if fed > self.max_feeding + 1e-12:  # the eigenvalues' round-off: a matrix at the limit is within it
+            unit = self.parameters()[0].unit
+            raise ProtocolError(f"matrix: a {self.kind} field may feed the arm at most {self.max_feeding:g} {unit} "
+                                f"(its symmetric part's positive eigenvalues summed; more runs a reach away), "
+                                f"this one feeds {fed:.3g}")
 
     @classmethod
     def from_matrix(cls, matrix: Matrix) -> _MatrixField:
@@ -274,6 +307,7 @@ class Viscous(_MatrixField):
     kind: ClassVar[str] = "viscous"
     symbol: ClassVar[str] = "B"
     number_format: ClassVar[str] = "g"
+    max_feeding: ClassVar[float] = VISCOUS_MAX_FEEDING
     b11: float = _param(-50.0, 50.0, "N s/m")
     b12: float = _param(-50.0, 50.0, "N s/m")
     b21: float = _param(-50.0, 50.0, "N s/m")
@@ -299,6 +333,7 @@ class JointViscous(_MatrixField):
     kind: ClassVar[str] = "joint_viscous"
     symbol: ClassVar[str] = "W"
     number_format: ClassVar[str] = ".4g"
+    max_feeding: ClassVar[float] = JOINT_MAX_FEEDING
     w11: float = _param(-5.0, 5.0, "N m s/rad")
     w12: float = _param(-5.0, 5.0, "N m s/rad")
     w21: float = _param(-5.0, 5.0, "N m s/rad")

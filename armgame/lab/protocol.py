@@ -345,6 +345,12 @@ def _check(p: Protocol) -> None:
             if b.catch_trials:
                 raise ValueError(f"blocks[{i}].mix: a mixed block's off trials are its catch trials: give no "
                                  "catch_trials")
+            if "opposite" in b.mix:  # a damping matrix's opposite feeds the arm: it must be a field the lab runs
+                try:
+                    b.perturbation.opposite()
+                except ValueError as exc:
+                    raise ValueError(f"blocks[{i}].mix: \"opposite\" runs every parameter negated, which the lab "
+                                     f"refuses: {exc}") from None
         if b.channel_trials > b.trials:
             raise ValueError(f"blocks[{i}].channel_trials must be at most the block's trials ({b.trials})")
         if b.channel_block:

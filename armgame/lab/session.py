@@ -35,6 +35,7 @@ from ..errors import UserError
 from ..game.muscles import DEFAULT_MUSCLES, MuscleSpec
 from ..game.rules import MAX_CONFIG_SECONDS, GameConfig, Target
 from ..game.session import GameResult, GameSession
+from ..game.variant import RunawayError, guarded
 from ..limits import MAX_GAME_SECONDS
 from ..physics.hand import hand_from_trig, hand_xy, hand_xy_arm_sine
 from ..physics.integrators import Integrator
@@ -252,11 +253,17 @@ class LabSession(GameSession):
     """A centre-out experiment on the game's session: see the module's docstring."""
 
     def __init__(self, config: GameConfig, protocol: Protocol, hold_at_home: bool = True, *,
-                 compiled: bool = True, sine: str = "library") -> None:
+                 compiled: bool = True, sine: str = "library", speed_limit: float = math.inf) -> None:
         super().__init__(config, compiled=compiled)
+        #: A force field's or a channel's joint speed past this (rad/s) stops the run where it is, as the Reach envs'
+        #: games stop (``armgame.game.variant.guarded``): the envs set it to the speed bound they declare, since a
+        #: field that feeds the arm energy can break any bound. Infinite (the lab's own runs): no guard.
+        self.speed_limit = float(speed_limit)
+        #: Why the guard stopped the run (one line), or None.
         if sine not in SINES:
             raise UserError(f"a lab run's sine is one of {', '.join(SINES)}, got {sine!r}")
         self.sine = sine
+        self.stopped: str | None = None
         self._arm_sine = sine == "arm"
         self._hand_xy = hand_xy_arm_sine if self._arm_sine else hand_xy
         #: True (the lab's rule): the go cue waits for the cursor to stay in home for the trial's delay.
@@ -384,7 +391,8 @@ class LabSession(GameSession):
         if key not in self._physics:
             loads = perturbation.loads(self.home)
             step = self.unloaded_step() if loads is None else \
-                Integrator(self.config.integrator, loaded_arm(self.model, loads, self._arm_sine)).step_components
+                self._guarded(Integrator(self.config.integrator,
+                                         loaded_arm(self.model, loads, self._arm_sine)).step_components)
             self._physics[key] = (step, perturbation.display(self.home, self.home_q))
         return self._physics[key]
 
@@ -397,10 +405,15 @@ class LabSession(GameSession):
             length = math.hypot(tx - hx, ty - hy)
             channel = ChannelField(self.protocol.channel_stiffness, self.protocol.channel_damping, self.home,
                                    ((tx - hx) / length, (ty - hy) / length))
-            step = Integrator(self.config.integrator,
-                              loaded_arm(self.model, Loads(hand=channel), self._arm_sine)).step_components
+            arm = loaded_arm(self.model, Loads(hand=channel), self._arm_sine)
+            step = self._guarded(Integrator(self.config.integrator, arm).step_components)
             self._channels[key] = (step, channel)
         return self._channels[key]
+
+    def _guarded(self, step: object) -> object:
+        """A loaded step under the run's speed guard, if it has one. The arm's own step needs none: every hold starts
+        at rest, and from rest the muscles cannot pass the game's speed bound (``env.reach.speed_bound``)."""
+        return guarded(step, self.speed_limit) if math.isfinite(self.speed_limit) else step  # type: ignore[arg-type]
 
     def _check_channel(self) -> None:
         """Refuse a channel too stiff for the fixed physics step (as MotorNet checks delays against dt).
@@ -487,40 +500,47 @@ class LabSession(GameSession):
         channel = self._channel
         hand_at = self._hand_xy
         ran = 0
-        while ran < n:
-            t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
-            t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
-            a0 += (g0 - a0) * r0
-            a1 += (g1 - a1) * r1
-            a2 += (g2 - a2) * r2
-            a3 += (g3 - a3) * r3
-            previous = (q1, q2, w1, w2)
-            q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
-            self.steps += 1
-            ran += 1
-            hx, hy = hand_at(l1, l2, q1, q2)
-            if show is not None:
-                hx, hy = show(hx, hy, q1, q2)
-            if channel is not None:
-                self._record_channel(q1, q2, w1, w2)
-            event = self._task_step(hx, hy)
-            if event:
-                step, show = self._step, self._show  # the go cue switched the perturbation on, or the end off
-                channel = self._channel
-                if channel is not None:  # a channel trial's go cue: its first sample
+        try:
+            while ran < n:
+                t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3
+                t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3
+                a0 += (g0 - a0) * r0
+                a1 += (g1 - a1) * r1
+                a2 += (g2 - a2) * r2
+                a3 += (g3 - a3) * r3
+                previous = (q1, q2, w1, w2)
+                q1, q2, w1, w2 = step(q1, q2, w1, w2, t1, t2, dt)
+                self.steps += 1
+                ran += 1
+                hx, hy = hand_at(l1, l2, q1, q2)
+                if show is not None:
+                    hx, hy = show(hx, hy, q1, q2)
+                if channel is not None:
                     self._record_channel(q1, q2, w1, w2)
-                if event == _ENDED:
-                    # The arm goes home at rest and the muscles relax.
-                    q1, q2 = self.home_q
-                    w1 = w2 = 0.0
-                    previous = (q1, q2, w1, w2)
-                    a0 = a1 = a2 = a3 = 0.0
-                    self.cursor = self.home
-                    if self.finished:
-                        break
-        muscles.activation = [a0, a1, a2, a3]
-        self.state = (q1, q2, w1, w2)
-        self.previous_state = previous
+                event = self._task_step(hx, hy)
+                if event:
+                    step, show = self._step, self._show  # the go cue switched the perturbation on, or the end off
+                    channel = self._channel
+                    if channel is not None:  # a channel trial's go cue: its first sample
+                        self._record_channel(q1, q2, w1, w2)
+                    if event == _ENDED:
+                        # The arm goes home at rest and the muscles relax.
+                        q1, q2 = self.home_q
+                        w1 = w2 = 0.0
+                        previous = (q1, q2, w1, w2)
+                        a0 = a1 = a2 = a3 = 0.0
+                        self.cursor = self.home
+                        if self.finished:
+                            break
+        except RunawayError as exc:
+            # The guard refused the step's state: the run keeps the last state it allowed and ends there.
+            self.stopped = str(exc)
+            self.total_steps = self.steps
+            raise
+        finally:
+            muscles.activation = [a0, a1, a2, a3]
+            self.state = (q1, q2, w1, w2)
+            self.previous_state = previous
         return ran
 
     def _task_step(self, x: float, y: float) -> int:

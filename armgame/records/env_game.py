@@ -5,13 +5,20 @@ a dwell, motor noise drawn each decision, a force field at the hand, the speed g
 continuous ids, the muscle levels it commanded (``GameSession.level_events``), which the key timeline does
 not hold. Before this section a replay of such a game held only the key timeline, and ``armgame verify``
 replayed the plain game: 19 hits recorded, 0 replayed (issue 40). The section, ``"kind": "reach-env"``,
-carries all of it, versioned (``"version": 1``); a replay without it is the game itself and verifies as
-before. ``armgame.env.record.replay_of`` writes it; the commands that verify replays register its reader
+carries all of it, versioned; a replay without it is the game itself and verifies as before.
+``armgame.env.record.replay_of`` writes it; the commands that verify replays register its reader
 (``register``), records' own readers never need it (the table ranks no replay with a task section).
 
-    {"kind": "reach-env", "version": 1, "env_id": "armgame/ReachHard-v1", "decision_steps": 5,
+    {"kind": "reach-env", "version": 2, "env_id": "armgame/ReachHard-v1", "decision_steps": 5,
      "hold_steps": 50, "motor_noise": 0.3, "field": {"kind": "curl", "b": 2.0}, "speed_limit": 68.9,
-     "observation_delay": 5, "levels": [[0, 1.0, 0.0, 0.5, 0.0], ...], "stopped": false}
+     "observation_delay": 5, "levels": [[0, 1.0, 0.0, 0.5, 0.0], ...], "stopped": false,
+     "hit_steps": [412, 787, ...]}
+
+``hit_steps`` (version 2, issue 52) is the physics step of every hit, which verification compares one by one: a
+count can come out the same under another ruleset (a dwell edited from 50 steps to 1 scores its hits earlier), the
+steps of the hits do not. Version 1 carried counts only, so a reader of it could not tell such an edit; this armgame
+refuses it in one line. ``benchmarks/env_game_hit_steps.py`` moves a version-1 file one trusts (the repository's
+committed games) to version 2: it replays each, keeps only those whose counts match, and writes the steps.
 
 ``env_id`` and ``observation_delay`` are what the agent played, for the reader: neither changes the game
 (a delay changes only what the agent saw), so verification does not depend on them.
@@ -32,7 +39,9 @@ from ..valid import check_bool, check_float, check_int, check_keys, check_str
 from .replay import TRY_WORK, register_task, same_outcome
 
 TASK_KIND = "reach-env"
-SECTION_VERSION = 1
+SECTION_VERSION = 2
+#: The version that recorded counts but not the hits' steps: read only by the migration (``legacy=True``).
+COUNTS_ONLY_VERSION = 1
 #: Bounds on what a section may claim (a reader refuses more before replaying anything).
 MAX_HOLD_STEPS = 10_000
 MAX_DECISION_STEPS = 1_000
@@ -61,6 +70,8 @@ class EnvGameTask:
     stopped: bool = False
     env_id: str | None = None
     observation_delay: int = 0
+    #: The physics step of every hit, in order; None only for a version-1 section read by the migration.
+    hit_steps: tuple[int, ...] | None = None
 
     def about(self) -> str:
         """The variant in words, for ``armgame verify``'s line."""
@@ -85,18 +96,31 @@ class EnvGameTask:
             field = {"kind": "curl", "b": v.field_parameter}
         elif v.field == "viscous":
             field = {"kind": "viscous", "matrix": [list(row) for row in v.field_parameter]}  # type: ignore[union-attr]
-        return {"kind": TASK_KIND, "version": SECTION_VERSION, "env_id": self.env_id,
-                "decision_steps": v.decision_steps, "hold_steps": v.hold_steps, "motor_noise": v.motor_noise,
-                "field": field, "speed_limit": None if math.isinf(v.speed_limit) else v.speed_limit,
-                "observation_delay": self.observation_delay,
-                "levels": [[e.step, *e.levels] for e in self.levels], "stopped": self.stopped}
+        d: dict[str, object] = {
+            "kind": TASK_KIND, "version": SECTION_VERSION if self.hit_steps is not None else COUNTS_ONLY_VERSION,
+            "env_id": self.env_id, "decision_steps": v.decision_steps, "hold_steps": v.hold_steps,
+            "motor_noise": v.motor_noise, "field": field,
+            "speed_limit": None if math.isinf(v.speed_limit) else v.speed_limit,
+            "observation_delay": self.observation_delay, "levels": [[e.step, *e.levels] for e in self.levels],
+            "stopped": self.stopped}
+        if self.hit_steps is not None:
+            d["hit_steps"] = list(self.hit_steps)
+        return d
 
     @classmethod
-    def from_dict(cls, data: object, config: GameConfig, last_step: int) -> EnvGameTask:
-        """Rebuild and check a section; raises ValueError naming the bad field."""
-        d = check_keys("task", data, {"kind", "version", "env_id", "decision_steps", "hold_steps", "motor_noise",
-                                      "field", "speed_limit", "observation_delay", "levels", "stopped"})
-        env_id = section_head(d, TASK_KIND, SECTION_VERSION, "a Reach env's")
+    def from_dict(cls, data: object, config: GameConfig, last_step: int, legacy: bool = False) -> EnvGameTask:
+        """Rebuild and check a section; raises ValueError naming the bad field. ``legacy``: read a version-1
+        section too (its ``hit_steps`` None), as the migration to version 2 does and nothing else."""
+        fields = {"kind", "version", "env_id", "decision_steps", "hold_steps", "motor_noise", "field",
+                  "speed_limit", "observation_delay", "levels", "stopped"}
+        old = isinstance(data, dict) and data.get("version") == COUNTS_ONLY_VERSION and data.get("kind") == TASK_KIND
+        if old and not legacy:
+            raise ValueError(f"task.version {COUNTS_ONLY_VERSION}: a Reach env's section of version "
+                             f"{COUNTS_ONLY_VERSION} records no hit steps, so a ruleset edited to the same count "
+                             f"would pass; this armgame reads version {SECTION_VERSION} (record the game again, "
+                             f"or move a file you trust with benchmarks/env_game_hit_steps.py)")
+        d = check_keys("task", data, fields if old else fields | {"hit_steps"})
+        env_id = section_head(d, TASK_KIND, COUNTS_ONLY_VERSION if old else SECTION_VERSION, "a Reach env's")
         decision_steps = check_int("task.decision_steps", d["decision_steps"], 1, MAX_DECISION_STEPS)
         hold_steps = check_int("task.hold_steps", d["hold_steps"], 0, MAX_HOLD_STEPS)
         noise = check_float("task.motor_noise", d["motor_noise"], 0.0, 1.0)
@@ -106,11 +130,13 @@ class EnvGameTask:
         delay = check_int("task.observation_delay", d["observation_delay"], 0, 10**6)
         stopped = check_bool("task.stopped", d["stopped"])
         levels = levels_from_list(d["levels"], last_step)
+        # A runaway's decision is played past the last step, and the hits it scored on the way count.
+        hits = None if old else _hit_steps(d["hit_steps"], last_step + decision_steps * stopped)
         try:
             variant = GameVariant(hold_steps, noise, decision_steps, field, parameter, limit)
         except UserError as exc:
             raise ValueError(f"task: {exc}") from None
-        return cls(variant, levels, stopped, env_id, delay)
+        return cls(variant, levels, stopped, env_id, delay, hits)
 
     def session(self, config: GameConfig, timeline: Sequence[InputEvent], steps: int) -> GameSession:
         """The game replayed from its timeline and levels to ``steps`` (and its runaway, if it stopped at one)."""
@@ -118,7 +144,8 @@ class EnvGameTask:
 
     def verify(self, config: GameConfig, timeline: Sequence[InputEvent], result: GameResult,
                max_work: int | None = MAX_VERIFY_WORK) -> tuple[bool, GameResult, GameSession]:
-        """Replay and compare. Stops early, as ``Replay.verify`` does, once the game has scored more hits or
+        """Replay and compare the result and the step of every hit (a version-1 section, read by the migration:
+        the result alone). Stops early, as ``Replay.verify`` does, once the game has scored more hits or
         resets than recorded, or spent ``max_work`` (steps, and ``TRY_WORK`` a target posture tried)."""
 
         def going_on(session: GameSession) -> bool:
@@ -129,7 +156,39 @@ class EnvGameTask:
 
         session = VariantPlay(config, self.variant).play(timeline, self.levels, result.steps, self.stopped, going_on)
         recomputed = session.result()
-        return same_outcome(recomputed, result), recomputed, session
+        same_hits = self.hit_steps is None or hit_steps(session) == self.hit_steps
+        return same_outcome(recomputed, result) and same_hits, recomputed, session
+
+    def hit_difference(self, config: GameConfig, timeline: Sequence[InputEvent], result: GameResult) -> str | None:
+        """Where the replayed hits part from the recorded steps, in words (``armgame verify``'s line when the counts
+        agree but the steps do not), or None where they do not part."""
+        if self.hit_steps is None:
+            return None
+        replayed = hit_steps(self.session(config, timeline, result.steps))
+        for k, (recorded, got) in enumerate(zip(self.hit_steps, replayed, strict=False)):
+            if recorded != got:
+                return f"hit {k + 1} recorded at step {recorded:,}, replayed at step {got:,}"
+        if len(replayed) != len(self.hit_steps):
+            return f"{len(self.hit_steps):,} hit steps recorded, {len(replayed):,} hits replayed"
+        return None
+
+
+def hit_steps(session: GameSession) -> tuple[int, ...]:
+    """The physics step of each of a game's hits (the rules keep their times: ``t = step * dt`` exactly)."""
+    dt = session.config.dt
+    return tuple(round(t / dt) for t in session.rules.board.hit_times)
+
+
+def _hit_steps(data: object, last_step: int) -> tuple[int, ...]:
+    if not isinstance(data, list):
+        raise ValueError("task.hit_steps must be a list of physics steps")
+    if len(data) > last_step:  # at most one hit a step
+        raise ValueError(f"task.hit_steps has {len(data):,} steps, more than the game's {last_step:,}")
+    steps, previous = [], 0
+    for i, item in enumerate(data):
+        previous = check_int(f"task.hit_steps[{i}]", item, previous + 1, last_step)
+        steps.append(previous)
+    return tuple(steps)
 
 
 def _field(data: object) -> tuple[str | None, object]:
