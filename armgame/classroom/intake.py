@@ -48,34 +48,17 @@ from ..records.standings import player_key, shared_rank
 from ..records.storage import DataFileError
 from ..valid import check_name
 from .board import Board
+from .bounds import MAX_HANDIN_BYTES, MAX_HANDIN_WORK, MAX_PLAYERS, REMEMBERED_FORGERIES
+from .errors import RefusedError
 from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
-from .roster import MAX_PLAYERS, Player, Roster, token_digest
+from .roster import Player, Roster, token_digest
 from .rounds import Round, new_round
-from .wire import MAX_HANDIN_BYTES
 
-#: The most re-simulation one hand-in may ask for, in physics steps (``records.scores.replay_work``).
-#: A standard game costs 15,000 steps and its hits and events; a lab run, its protocol's steps.
-#: A game claiming more (a "hit storm") is refused before anything is replayed.
-MAX_HANDIN_WORK = 1_500_000
 NOT_JOINED = ("this machine has not joined the class under that name: join first "
               "(armgame play --join HOST:PORT --code CODE --name NAME)")
 CLOSED = "the class is closed to new games: this game is not taken (your replay stays on your machine)"
 #: A new name refused by a closed class (a join for a game: the lab's volunteers still join, ``Clerk.join``).
 CLOSED_TO_PLAYERS = "the class is closed to new games, so it takes no new players (the teacher can open it again)"
-#: Forged games whose re-simulated result is kept (by identity), so one sent again is not played again:
-#: a result is about 200 bytes.
-REMEMBERED_FORGERIES = 4096
-
-
-class RefusedError(Exception):
-    """A request the class turns down: an HTTP status and one line saying why (sent as it is); for 429 and 503,
-    the seconds after which to ask again (``Retry-After``)."""
-
-    def __init__(self, status: int, message: str, retry_after: int = 2) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
-        self.retry_after = retry_after
 
 
 @dataclass(frozen=True)
