@@ -109,13 +109,15 @@ def check_word(name: str, value: object, max_len: int = 40) -> str:
 
 
 def check_name(name: object, what: str = "player name") -> str:
-    """A player's name: 1 to 40 printable characters, surrounding spaces trimmed."""
-    name = check_str(what, name, 10**6).strip()
+    """A player's name: 1 to 40 printable characters, surrounding spaces trimmed. The two joiners (ZWJ, ZWNJ) are
+    printable here: Sinhala, Persian and other scripts spell names with them (where a name may hold one is
+    ``records.lookalikes.name_problem``'s question, for a class's names)."""
+    name = check_str(what, name, 10**6, printable=False).strip()
     if not name:
         raise ValueError(f"{what} is empty")
     if len(name) > MAX_NAME:
         raise ValueError(f"{what} must be at most {MAX_NAME} characters, got {len(name)}")
-    if not name.isprintable():
+    if not name.replace("\u200c", "").replace("\u200d", "").isprintable():
         raise ValueError(f"{what} must not contain control characters, got {name!r}")
     return name
 

@@ -18,7 +18,8 @@ from class_server import keyboard_game, running_class, tapped_game
 
 from armgame.classroom import client
 from armgame.classroom import state as class_state
-from armgame.classroom.intake import Clerk, RefusedError
+from armgame.classroom.errors import RefusedError
+from armgame.classroom.intake import Clerk
 from armgame.classroom.roster import Roster, token_digest
 from armgame.classroom.worker import ClerkThread, HandIn
 from armgame.game.session import DOWN, InputEvent

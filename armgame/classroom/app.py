@@ -312,7 +312,9 @@ async def join(request: Request) -> Response:
     if token is not None and (not isinstance(token, str) or len(token) > 200):
         raise RefusedError(400, "token must be a string")
     own = state.teachers_machine(request)
-    known = token is not None and clerk.roster.player_of(token) is not None
+    # Only a join again under a name the token already holds is free: any other is a new name, whatever token it
+    # carries (a joined name's token once let one machine join as many names as it liked).
+    known = clerk.roster.rejoins(body.get("name"), token) is not None
     if not known and not own:
         if state.joins.full(address):
             raise RefusedError(429, f"this machine has joined {JOINS_PER_MINUTE} names in the last minute: one "
@@ -351,6 +353,22 @@ def lab_as_data(protocol: str | dict) -> dict:
     return protocol if isinstance(protocol, dict) else protocol_as_dict(curve_protocol(protocol))
 
 
+async def start(request: Request) -> Response:
+    """A game begins on a joined student's machine: its start ticket (``Clerk.start_ticket``), which its hand-in
+    sends back (``X-Armgame-Start``) so a round knows the game was played during it. The code and token are
+    checked as a hand-in's; the class keeps a few tickets a player, so asking often costs nothing."""
+    state = _state(request)
+    _check_code(state, request, request.headers.get("x-armgame-code"))
+    token = _check_token(state, request)
+    return json_answer({"ok": True, "ticket": state.clerk.start_ticket(token)})
+
+
+def _ticket(request: Request) -> str | None:
+    """The hand-in's start ticket, as ``start`` gave it (anything else is no ticket: the game is not in a round)."""
+    ticket = request.headers.get("x-armgame-start", "")
+    return ticket if 0 < len(ticket) <= 64 and ticket.isascii() else None
+
+
 async def hand_in(request: Request) -> Response:
     """A game or a lab run handed in: the code, the token and the player's place checked from the headers, then
     the body read (bounded), then checked and entered by the clerk; answered once it is durably written."""
@@ -375,7 +393,7 @@ async def hand_in(request: Request) -> Response:
             data = await _body(request, SMALL_UPLOAD_BYTES if small else MAX_HANDIN_BYTES)
         finally:
             slots.release()
-        return json_answer(await state.hand_in(token, data))
+        return json_answer(await state.hand_in(token, data, _ticket(request)))
 
 
 Endpoint = Callable[[Request], Awaitable[Response]]
@@ -475,6 +493,7 @@ ROUTES = [
     Route("/events", events, middleware=SAME_SITE),
     Route("/api/join", join, methods=POST, middleware=SAME_SITE),
     Route("/api/handin", hand_in, methods=POST, middleware=SAME_SITE),
+    Route("/api/start", start, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/hide", teacher_hide, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/release", teacher_release, methods=POST, middleware=SAME_SITE),
     Route("/api/teacher/remove", teacher_remove, methods=POST, middleware=SAME_SITE),
@@ -503,10 +522,12 @@ async def _load_lab(state: ClassState) -> None:
 
 
 async def _round_clock(state: ClassState) -> None:
-    """A round's end is a change no request makes: looked for every second while a round is on, so the
-    projector shows its winners as its clock runs out."""
+    """A round's end is a change no request makes: looked for every second while a round is on, and at the
+    moment it closes (``Round.closes``), so the projector shows its winners as its clock and grace run out."""
     while not state.stopping.is_set():
-        await asyncio.sleep(1.0)
+        rnd = None if state.clerk.roster.round is None or state.clerk.round_over else state.clerk.current_round()
+        left = 1.0 if rnd is None else (rnd.closes - state.clerk.clock()).total_seconds()
+        await asyncio.sleep(min(1.0, max(0.0, left)))
         if state.clerk.roster.round is not None and not state.clerk.round_over:
             with contextlib.suppress(RefusedError):
                 await state.run(state.clerk.round_ended)

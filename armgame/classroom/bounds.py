@@ -133,6 +133,9 @@ REMEMBERED_FORGERIES = 4096
 MAX_PLAYERS = 2000
 #: Bytes of the class's record (class.json): ``MAX_PLAYERS`` names, their tokens' hashes and renames fit.
 MAX_ROSTER_BYTES = 2 * 1024 * 1024
+#: Bytes of the current round's games (``intake.ROUND_GAMES``, read at a restart): a lecture hall's round, each
+#: game's entry id, with room.
+MAX_ROUND_GAMES_BYTES = 4 * 1024 * 1024
 
 # ---------------------------------------------------------------------- the pages (app, views)
 #: Rows of each list the standings carry: the projector shows the top, the CSV has everything.
@@ -148,6 +151,8 @@ HEARTBEAT_SECONDS = 15.0
 #: Seconds the client waits for one answer: a hand-in's body and the clerk's durable write under a lecture hall's
 #: load.
 CLIENT_TIMEOUT = 15.0
+#: Seconds a game's start ticket is waited for: the game starts anyway (it is then not in a round).
+TICKET_TIMEOUT = 3.0
 #: Seconds a hand-in keeps asking a busy class, in all.
 BUSY_PATIENCE = 60.0
 #: Seconds before asking again when the class took a request but its answer never came.

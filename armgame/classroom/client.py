@@ -38,7 +38,7 @@ from pathlib import Path
 from ..errors import UserError
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited, user_path
 from . import memberships
-from .bounds import BUSY_PATIENCE, CLIENT_TIMEOUT, LOST_ANSWER_PAUSE, MAX_HANDIN_BYTES, MAX_OUTBOX
+from .bounds import BUSY_PATIENCE, CLIENT_TIMEOUT, LOST_ANSWER_PAUSE, MAX_HANDIN_BYTES, MAX_OUTBOX, TICKET_TIMEOUT
 from .wire import BUSY, CODE_ALPHABET, CODE_LENGTH, normal_code
 
 CLIENT_ENV = "ARMGAME_CLASS_CLIENT"
@@ -322,12 +322,32 @@ def outbox(m: Membership) -> Path:
     return client_folder() / "outbox" / slug
 
 
-def hand_in(m: Membership, data: bytes, keep: bool = True) -> HandIn:
-    """Hand ``data`` (a replay's bytes) in. UnreachableError: kept in the outbox (``keep``) for the next join."""
+def start_ticket(m: Membership) -> str | None:
+    """The class's start ticket for a game beginning now (a round counts a game begun during it: the hand-in sends
+    it back), or None if the class did not give one at once (an older class; unreachable): never a wait longer
+    than ``TICKET_TIMEOUT``, never an error. The game is played either way."""
+    req = urllib.request.Request(m.address.url("/api/start"), data=b"{}", method="POST", headers={
+        "Content-Type": "application/json", "Authorization": f"Bearer {m.token}", "X-Armgame-Code": m.code})
+    try:
+        with urllib.request.urlopen(req, timeout=TICKET_TIMEOUT) as response:
+            ticket = _answer(response.read(4096), quiet=True).get("ticket")
+    except urllib.error.HTTPError as exc:  # an older class (404), or this name is no longer this machine's
+        exc.close()
+        return None
+    except (OSError, http.client.HTTPException, ValueError):
+        return None
+    return ticket if isinstance(ticket, str) and 0 < len(ticket) <= 64 and ticket.isascii() else None
+
+
+def hand_in(m: Membership, data: bytes, keep: bool = True, ticket: str | None = None) -> HandIn:
+    """Hand ``data`` (a replay's bytes) in, with the start ``ticket`` of its game if it has one (``start_ticket``).
+    UnreachableError: kept in the outbox (``keep``) for the next join (without its ticket: a kept game counts on the
+    board, never in a round)."""
     if len(data) > MAX_HANDIN_BYTES:
         return HandIn(f"not handed in: the replay is larger than a class takes ({MAX_HANDIN_BYTES:,} bytes)",
                       refused=True)
-    headers = {"Content-Type": "application/json", "Authorization": f"Bearer {m.token}", "X-Armgame-Code": m.code}
+    headers = {"Content-Type": "application/json", "Authorization": f"Bearer {m.token}", "X-Armgame-Code": m.code,
+               **({"X-Armgame-Start": ticket} if ticket else {})}
     try:
         answer = _request(m.address, "/api/handin", data, headers)
     except RefusalError as exc:

@@ -18,20 +18,21 @@ The class's folder::
     scores.json, replays/        an ordinary armgame table: ``armgame scores --scores DIR`` reads it
     lab/                         each student's first lab run of each protocol (``analyze --class``)
     lab-more/                    their later runs, kept, not in the class curve (``labruns``)
+    round.json                   the current round's games (``ROUND_GAMES``: which games it took)
 """
 
 from __future__ import annotations
 
 import bisect
 import contextlib
-import hmac
 import os
 import secrets
 import stat
+import sys
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import Any
 
@@ -45,20 +46,23 @@ from ..records.replay import Replay, now_iso, same_outcome
 from ..records.rulesets import CLASS_GAMES, Ruleset, class_game_name, config_digest
 from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
 from ..records.standings import player_key, shared_rank
-from ..records.storage import DataFileError
+from ..records.storage import DataFileError, atomic_write_bytes, dump_json, parse_json, read_limited
 from ..valid import check_name
 from .board import Board
-from .bounds import MAX_HANDIN_BYTES, MAX_HANDIN_WORK, MAX_PLAYERS, REMEMBERED_FORGERIES
+from .bounds import MAX_HANDIN_BYTES, MAX_HANDIN_WORK, MAX_PLAYERS, MAX_ROUND_GAMES_BYTES, REMEMBERED_FORGERIES
 from .errors import RefusedError
 from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
 from .roster import Player, Roster, token_digest
-from .rounds import Round, new_round
+from .rounds import Round, Tickets, new_round
 
 NOT_JOINED = ("this machine has not joined the class under that name: join first "
               "(armgame play --join HOST:PORT --code CODE --name NAME)")
 CLOSED = "the class is closed to new games: this game is not taken (your replay stays on your machine)"
 #: A new name refused by a closed class (a join for a game: the lab's volunteers still join, ``Clerk.join``).
 CLOSED_TO_PLAYERS = "the class is closed to new games, so it takes no new players (the teacher can open it again)"
+#: The current round's games, by entry id, as the clerk took them into it (``rounds.Round.refusal``): the round's
+#: standings survive a restart. Its number and start say which round; another round's file counts nothing.
+ROUND_GAMES = "round.json"
 
 
 @dataclass(frozen=True)
@@ -126,6 +130,7 @@ class Clerk:
         #: The one game this class takes: a game of other rules is refused, whatever its score.
         self.game: Ruleset = CLASS_GAMES["rehearsal" if rehearsal else "standard"]
         self.table = ScoreTable(self.folder, warn=warn, records=records)
+        self._warn = warn or (lambda message: print(f"armgame class: {message}", file=sys.stderr))
         self.table.lock_mode = 0o600  # only the server writes a class's table: nobody else may open its lock
         with contextlib.suppress(OSError):
             if stat.S_ISREG(os.lstat(self.table.lock_path).st_mode):
@@ -150,6 +155,10 @@ class Clerk:
         self.version = 0  # bumped at every change the projector should see
         self.lab_version = 0  # and at every change of the class curve (a lab run, a name hidden)
         self._recomputed: OrderedDict[str, GameResult] = OrderedDict()  # forged games' results, by identity
+        #: The class's one clock for rounds: start tickets, a game's entry into a round and the round's end.
+        self.clock: Callable[[], datetime] = lambda: datetime.now(UTC)
+        self.tickets = Tickets()
+        self.round_games: set[str] = self._read_round_games()
 
     def _sweep(self) -> None:
         """Temporary files a server killed mid-write left (never renamed: nothing refers to them). Only
@@ -171,30 +180,13 @@ class Clerk:
         ``lab``: the join says it is for the lab (``armgame lab --join``). A closed class is closed to new
         games, and the teacher's lab is not one: its volunteers join a closed class (their games stay refused,
         ``_read``). A locked list is the teacher's "nobody new", and refuses them like any new name."""
-        try:
-            name = check_name(name)
-        except ValueError as exc:
-            raise RefusedError(400, str(exc)) from None
+        player = self.roster.rejoins(name, token)
+        if player is not None:  # the name, or its old one the teacher changed, is this machine's already
+            if lab:
+                self.assign(player.name)
+            return player, None
+        name = self.check_new_name(name)
         key = player_key(name)
-        player = self.roster.players.get(key)
-        if player is not None:
-            if token is not None and hmac.compare_digest(token_digest(token), player.token_sha256):
-                if lab:
-                    self.assign(player.name)
-                return player, None
-            raise RefusedError(409, f"the name {player.name} is taken in this class by another machine: choose another "
-                               f"name (or join from the machine that took it)")
-        if name.strip().upper() == "NAME":
-            raise RefusedError(400, "type your own name in place of NAME (in quotes if it has a space: "
-                                    "--name \"Ann B\")")
-        problem = name_problem(name)
-        if problem is not None:
-            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "
-                               f"letters")
-        alike = self.roster.lookalike_of(name)
-        if alike is not None:
-            raise RefusedError(409, f"that name reads like {alike.name}, who is in this class already: choose a name "
-                               f"nobody could mistake for a classmate's")
         if self.roster.closed and not lab:
             raise RefusedError(403, CLOSED_TO_PLAYERS)
         if self.roster.locked:
@@ -208,6 +200,36 @@ class Clerk:
         if lab:
             self.assign(player.name)
         return player, new_token
+
+    def check_new_name(self, name: object, owner: Player | None = None, what: str = "player name") -> str:
+        """The one check of a name a player takes: a machine's new name (``join``), or the one the teacher gives a
+        student (``rename``, ``owner`` the student). The name, trimmed; RefusedError if it is no name
+        (``valid.check_name``), hides part of itself (``records.lookalikes.name_problem``), or is another
+        player's: taken, read like theirs, or a name of theirs the teacher changed (``Roster``'s questions)."""
+        try:
+            name = check_name(name, what)
+        except ValueError as exc:
+            raise RefusedError(400, str(exc)) from None
+        taken = self.roster.players.get(player_key(name))
+        if taken is not None and taken is not owner:
+            raise RefusedError(409, f"the name {taken.name} is taken in this class by another machine: choose another "
+                               f"name (or join from the machine that took it)")
+        if name.strip().upper() == "NAME":
+            raise RefusedError(400, "type your own name in place of NAME (in quotes if it has a space: "
+                                    "--name \"Ann B\")")
+        problem = name_problem(name)
+        if problem is not None:
+            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem}): type it with plain "
+                               f"letters")
+        alike = self.roster.lookalike_of(name)
+        if alike is not None and alike is not owner:
+            raise RefusedError(409, f"that name reads like {alike.name}, who is in this class already: choose a name "
+                               f"nobody could mistake for a classmate's: add the first letter of your surname "
+                               f"(\"{name} K\", say)")
+        now = self.roster.renamed_from(name)
+        if now is not None and (owner is None or player_key(now) != player_key(owner.name)):
+            raise RefusedError(409, f"that name is {now}'s, whom the teacher renamed: choose another name")
+        return name
 
     def assign(self, name: str) -> str | dict | None:
         """In a classroom experiment, ``name``'s protocol (a preset's name or a protocol as data): their condition's,
@@ -242,6 +264,11 @@ class Clerk:
         if player is None:
             raise RefusedError(401, NOT_JOINED)
         return player
+
+    def start_ticket(self, token: str | None) -> str:
+        """A start ticket for the game ``token``'s player begins now (``rounds.Tickets``): what the class knows of
+        when it was played. Thread-safe (the event loop gives them, stamped as the request comes)."""
+        return self.tickets.give(self.player(token).token_sha256, self.clock())
 
     # ------------------------------------------------------------------ handing in
     def hand_in(self, token: str | None, data: bytes) -> Answer:
@@ -382,9 +409,12 @@ class Clerk:
         while len(self._recomputed) > REMEMBERED_FORGERIES:
             self._recomputed.popitem(last=False)
 
-    def enter(self, checked: Sequence[Checked]) -> list[Answer | RefusedError]:
+    def enter(self, checked: Sequence[Checked], tickets: Sequence[str | None] | None = None
+              ) -> list[Answer | RefusedError]:
         """Enter checked games together (one table write for all: a burst of a class costs one write, not
-        thirty); each game's answer, or why it was not entered. Durable on disk before this returns."""
+        thirty); each game's answer, or why it was not entered. Durable on disk before this returns.
+        ``tickets``: each game's start ticket (``start_ticket``), for the round: a game is in it if the round
+        takes it at the moment it is entered (``rounds.Round.refusal``)."""
         try:
             results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked], journal=True)
         except (ValueError, UserError) as exc:  # the table could not be written: none was entered
@@ -398,10 +428,14 @@ class Clerk:
         for c, result in zip(checked, results, strict=True):
             if isinstance(result, ScoreEntry):
                 self.games[c.digests[0]] = result
-        for c, result in zip(checked, results, strict=True):
+        rounds = self._into_round(checked, results, tickets or [None] * len(checked))
+        for c, result, in_round in zip(checked, results, rounds, strict=True):
             twin = next((self.games[d] for d in c.digests if d in self.games), None)
             if isinstance(result, ScoreEntry):
                 answer = self._answer(result)
+                if in_round:
+                    answer["round"] = in_round
+                    answer["message"] = f"{answer['message']}; {in_round}"
                 self.version += 1
                 self.arrival = Arrival(self.version, self.shown_name(result.name), result.score, str(answer["note"]),
                                        result.program)
@@ -414,6 +448,53 @@ class Clerk:
             else:
                 answers.append(RefusedError(400, f"not entered: {result}"))
         return answers
+
+    def _into_round(self, checked: Sequence[Checked], results: Sequence[object],
+                    tickets: Sequence[str | None]) -> list[str]:
+        """The games just entered taken into the round that is on (their start tickets used up), kept in
+        ``ROUND_GAMES`` before any is answered; for each game, the line its student is told of the round (empty
+        when no round is on, or for a program's game, which no round shows)."""
+        rnd = self.current_round()
+        now = self.clock()  # after the table's write: the moment the game is taken, as the projector's end is
+        lines, taken = [], []
+        for c, result, ticket in zip(checked, results, tickets, strict=True):
+            if not isinstance(result, ScoreEntry) or rnd is None or result.program or \
+                    now >= rnd.end + timedelta(seconds=rnd.hold):
+                lines.append("")
+                continue
+            started = self.tickets.take(ticket, c.player.token_sha256)
+            why = rnd.refusal(started, self.game.config.time_limit, now)
+            if why is None:
+                taken.append(result.id)
+                lines.append(f"in round {rnd.number}")
+            else:
+                lines.append(f"on the board, not in round {rnd.number}: {why}")
+        if taken:
+            self.round_games.update(taken)
+            try:
+                atomic_write_bytes(self.folder / ROUND_GAMES, dump_json(
+                    {"number": rnd.number, "start": rnd.as_dict()["start"], "games": sorted(self.round_games)}),
+                    "round's games")
+            except (OSError, DataFileError) as exc:  # the round goes on; only a restart would lose them
+                self._warn(f"the round's games could not be kept ({exc}): a restart would leave them out of it")
+        return lines
+
+    def _read_round_games(self) -> set[str]:
+        """The current round's games as ``ROUND_GAMES`` keeps them (none if it is another round's, or unreadable:
+        the teacher is told)."""
+        rnd = self.current_round()
+        path = self.folder / ROUND_GAMES
+        if rnd is None or not path.exists():
+            return set()
+        try:
+            data = parse_json(read_limited(path, MAX_ROUND_GAMES_BYTES, "round's games", follow=False))
+        except (DataFileError, ValueError) as exc:
+            self._warn(f"{path}: {exc}: round {rnd.number} counts only the games from now on")
+            return set()
+        if not isinstance(data, dict) or data.get("number") != rnd.number or \
+                data.get("start") != rnd.as_dict()["start"] or not isinstance(data.get("games"), list):
+            return set()
+        return {g for g in data["games"] if isinstance(g, str)}
 
     def _answer(self, entry: ScoreEntry, already: bool = False) -> Answer:
         """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""
@@ -544,18 +625,9 @@ class Clerk:
         part of itself, or that a reader would take for another student's."""
         if not isinstance(name, str) or player_key(name) not in self.roster.players:
             raise RefusedError(404, "no machine has joined under that name")
-        try:
-            new = check_name(to, "the new name")
-        except ValueError as exc:
-            raise RefusedError(400, str(exc)) from None
+        player = self.roster.players[player_key(name)]
+        new = self.check_new_name(to, player, "the new name")
         old_key, new_key = player_key(name), player_key(new)
-        player = self.roster.players[old_key]
-        problem = name_problem(new)
-        if problem is not None:
-            raise RefusedError(400, f"that name cannot be shown as it is typed ({problem})")
-        taken = self.roster.players.get(new_key) or self.roster.lookalike_of(new)
-        if new_key != old_key and taken is not None and taken is not player:
-            raise RefusedError(409, f"that name is taken or reads like {taken.name}: choose another")
         players = {k: p for k, p in self.roster.players.items() if k != old_key}
         players[new_key] = Player(new, player.token_sha256, player.joined, player.address)
         renamed = {k: (new if player_key(v) == old_key else v) for k, v in self.roster.renamed.items()}
@@ -636,10 +708,11 @@ class Clerk:
         """A new round of ``minutes``, from now (the last one ends here if it was still on)."""
         try:
             rnd = new_round(self.current_round(), minutes, max((e.entered or 0 for e in self.entries), default=0),
-                            rehearsal=self.rehearsal)
+                            self.clock(), rehearsal=self.rehearsal)
         except ValueError as exc:
             raise RefusedError(400, str(exc)) from None
         self.roster.changed(round=rnd.as_dict())
+        self.round_games = set()  # the file's games are the last round's: this one's own replace them
         self.version += 1
         self.round_over = False
         length = f"{rnd.seconds} s (a rehearsal's round)" if rnd.seconds else f"{rnd.minutes} min"
@@ -657,7 +730,7 @@ class Clerk:
         """Whether the round's results just became final (its clock and grace run out): the projector is told
         once, and shows its winners."""
         rnd = self.current_round()
-        if rnd is None or self.round_over or not rnd.over(now or datetime.now(UTC)):
+        if rnd is None or self.round_over or not rnd.over(now or self.clock()):
             return False
         self.round_over = True
         self.version += 1

@@ -16,8 +16,9 @@ thread), atomically and fsynced before a join is acknowledged::
 A student's name is theirs: the first client to take it receives a random token, and only the
 token's SHA-256 is kept here, so the folder itself never holds what would let someone else hand
 in under that name. Names are compared by ``records.standings.player_key`` ("alice" is "Alice"),
-and a new name is refused if a reader would take it for one already in (``lookalike_of``: the
-skeletons of ``records.lookalikes``) or if it hides part of itself (``records.lookalikes.name_problem``).
+and a name is the one player's a reader would take it for (``holder_of``: the same key, one of the
+skeletons of ``records.lookalikes``, or a name the teacher changed, which stays the renamed student's);
+``intake.Clerk.check_new_name`` refuses a new name that has a holder or that hides part of itself.
 The address each name joined from is kept for the teacher (which names came from one machine).
 A ``locked`` roster takes no new names; ``lab`` is the protocol the class curve shows, the
 teacher's choice (``--lab``), never the one most names happened to run; ``experiment``, a split of the
@@ -120,6 +121,9 @@ class Roster:
         change through ``add``, ``remove`` and ``changed`` does it; call it after filling ``players`` directly."""
         self.by_token = {p.token_sha256: key for key, p in self.players.items()}
         self.by_skeleton = {s: key for key, p in self.players.items() for s in skeletons(p.name)}
+        # A name the teacher changed stays its student's: nobody else joins under it, or one that reads like it,
+        # and has their games shown under the new name (``renamed`` maps the old key to it).
+        self.by_old_skeleton = {s: now for old, now in self.renamed.items() for s in skeletons(old)}
 
     def add(self, key: str, player: Player) -> None:
         """``player`` under ``key``, saved; nothing changed if the save fails."""
@@ -293,6 +297,22 @@ class Roster:
         index = self.by_skeleton
         return next((self.players[k] for s in skeletons(name) if (k := index.get(s)) not in (None, key)
                      and k in self.players), None)
+
+    def renamed_from(self, name: str) -> str | None:
+        """The name shown now for a student the teacher renamed from ``name``, or from one that reads like it;
+        None if ``name`` is no old name."""
+        index = self.by_old_skeleton
+        return self.renamed.get(player_key(name)) or next((now for s in skeletons(name) if (now := index.get(s))), None)
+
+    def rejoins(self, name: object, token: str | None) -> Player | None:
+        """The player ``token`` proves ``name`` is already (a join again, not a new name): its name, or its old
+        one the teacher changed; else None. Safe from another thread (the swapped-in indexes), cheap (no
+        skeletons): the event loop asks it before a join counts against a machine's new names."""
+        player = self.player_of(token) if token else None
+        if player is None or not isinstance(name, str):
+            return None
+        key, own = player_key(name), player_key(player.name)
+        return player if key == own or player_key(self.renamed.get(key, "")) == own else None
 
     def projector_key(self) -> str:
         """The key in the projector's link: it shows the join code; derived from the secret, never the secret."""

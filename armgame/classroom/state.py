@@ -195,17 +195,17 @@ class ClassState:
             self.waiting -= 1
             self._tell_pages()
 
-    async def hand_in(self, token: str, body: bytes) -> Answer:
+    async def hand_in(self, token: str, body: bytes, ticket: str | None = None) -> Answer:
         """The replay ``body`` checked and entered on the clerk's thread (``ClerkThread.hand_in``), if the queue
         has room (``HANDIN_QUEUE`` hand-ins and ``QUEUE_BYTES`` of their bodies); the pages are told of any
-        change."""
+        change. ``ticket``: the game's start ticket (``Clerk.start_ticket``), if its client sent one."""
         if self.handins >= HANDIN_QUEUE or self.queued_bytes + len(body) > QUEUE_BYTES:
             raise RefusedError(503, BUSY)
         assert self.worker is not None, "the class is not serving"
         self.handins += 1
         self.queued_bytes += len(body)
         try:
-            return await asyncio.wrap_future(self.worker.hand_in(token, body))
+            return await asyncio.wrap_future(self.worker.hand_in(token, body, ticket))
         finally:
             self.handins -= 1
             self.queued_bytes -= len(body)

@@ -19,7 +19,7 @@ import csv
 import io
 import math
 from collections.abc import Iterable, Sequence
-from datetime import UTC, datetime
+from datetime import datetime
 from typing import Any
 
 from ..records.standings import player_key, shared_rank
@@ -86,9 +86,10 @@ def lab_runs_by_name(clerk: Clerk) -> dict[str, list[str]]:
 
 
 def round_shown(clerk: Clerk, now: datetime | None = None) -> dict[str, object] | None:
-    """The round on the projector (``rounds.round_view``): its clock, and its winners once it is over."""
-    return round_view(clerk.current_round(), clerk.entries, clerk.roster.hidden, now or datetime.now(UTC),
-                      STANDINGS_ROWS, name_of=clerk.shown_name)
+    """The round on the projector (``rounds.round_view``): its clock, and its winners once it is over (by the
+    clerk's clock, the one that takes games into it)."""
+    return round_view(clerk.current_round(), clerk.entries, clerk.roster.hidden, now or clerk.clock(),
+                      STANDINGS_ROWS, name_of=clerk.shown_name, counted=clerk.round_games)
 
 
 def class_curve(clerk: Clerk) -> Any:

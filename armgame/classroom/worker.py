@@ -47,6 +47,8 @@ class HandIn:
 
     token: str
     body: bytes
+    #: The game's start ticket (``Clerk.start_ticket``), for the round; None if its client sent none.
+    ticket: str | None = None
     future: Future[Answer] = field(default_factory=Future)
 
 
@@ -67,9 +69,10 @@ class ClerkThread:
         self.work.put(job)
         return job.future
 
-    def hand_in(self, token: str, body: bytes) -> Future[Answer]:
-        """The replay ``body`` handed in under ``token``, checked and entered on the clerk's thread."""
-        hand_in = HandIn(token, body)
+    def hand_in(self, token: str, body: bytes, ticket: str | None = None) -> Future[Answer]:
+        """The replay ``body`` handed in under ``token`` (with its start ``ticket``), checked and entered on the
+        clerk's thread."""
+        hand_in = HandIn(token, body, ticket)
         self.work.put(hand_in)
         return hand_in.future
 
@@ -134,7 +137,7 @@ class ClerkThread:
         outcomes: list[tuple[Future, Outcome]] = []
         while batch:
             again = []
-            checked: list[tuple[Checked, Future]] = []
+            checked: list[tuple[Checked, HandIn]] = []
             found_all = _outcome(lambda batch=batch: self.clerk.check_many([(h.token, h.body) for h in batch]))
             if isinstance(found_all, BaseException):
                 found_all = [found_all] * len(batch)
@@ -146,12 +149,13 @@ class ClerkThread:
                 elif found.answer is not None:  # answered without entering anything
                     outcomes.append((hand_in.future, found.answer))
                 else:
-                    checked.append((found, hand_in.future))
+                    checked.append((found, hand_in))
             if checked:
-                answers = _outcome(lambda checked=checked: self.clerk.enter([c for c, _ in checked]))
+                answers = _outcome(lambda checked=checked: self.clerk.enter([c for c, _ in checked],
+                                                                            [h.ticket for _, h in checked]))
                 if isinstance(answers, BaseException):
                     answers = [answers] * len(checked)
-                outcomes += [(future, answer) for (_, future), answer in zip(checked, answers, strict=True)]
+                outcomes += [(h.future, answer) for (_, h), answer in zip(checked, answers, strict=True)]
             batch = again
         return outcomes
 

@@ -155,16 +155,16 @@ def _join(args: argparse.Namespace):
     return membership
 
 
-def _hand_in(replay, membership, args: argparse.Namespace, out=None) -> object:
+def _hand_in(replay, membership, args: argparse.Namespace, out=None, ticket: str | None = None) -> object:
     """Hand a finished game in to the class; one line on what became of it (kept in the outbox if the
     class could not be reached), on ``out`` (stdout), or for a refusal on stderr (and ``args.refused``
     set: the command exits 1). The window's games are handed in on a thread, and say so here too: the
-    terminal's scrollback keeps the record of every game."""
+    terminal's scrollback keeps the record of every game. ``ticket``: the game's start ticket, for a round."""
     import sys
 
     from ..classroom.client import hand_in
 
-    result = hand_in(membership, replay.to_bytes())
+    result = hand_in(membership, replay.to_bytes(), ticket=ticket)
     if result.refused:
         args.refused = True
         print(f"armgame play: {result.message}", file=sys.stderr, flush=True)
@@ -432,12 +432,24 @@ def _saved_line(args: argparse.Namespace) -> str | None:
 
 def _class_standing(session, args: argparse.Namespace, membership):
     """The end screen in a live class: the game is handed in on a thread (the window never waits for
-    the network), and the screen shows what became of it, and the class's top, when the answer comes."""
+    the network), and the screen shows what became of it, and the class's top, when the answer comes. The game's
+    start ticket is asked for as it is set up, on a thread too, and goes with it (a round counts games begun
+    during it)."""
     import sys
     import threading
 
+    from ..classroom.bounds import TICKET_TIMEOUT
+    from ..classroom.client import start_ticket
     from ..records.replay import Replay
     from ..ui.render import Standing
+
+    ticket: list[str | None] = []
+    asking = threading.Thread(target=lambda: ticket.append(start_ticket(membership)), daemon=True)
+    asking.start()
+
+    def handed_in(replay) -> object:
+        asking.join(TICKET_TIMEOUT)
+        return _hand_in(replay, membership, args, ticket=ticket[0] if ticket else None)
 
     def standing(name: str | None) -> Standing | None:
         args.kept = True
@@ -452,7 +464,7 @@ def _class_standing(session, args: argparse.Namespace, membership):
                 print(f"armgame play: error: {exc}", file=sys.stderr)
         saved = _saved_line(args)
         done: list = []
-        thread = threading.Thread(target=lambda: done.append(_hand_in(replay, membership, args)), daemon=True)
+        thread = threading.Thread(target=lambda: done.append(handed_in(replay)), daemon=True)
         thread.start()
         args.handing_in = [*(t for t in getattr(args, "handing_in", ()) if t.is_alive()), thread]
 

@@ -21,6 +21,8 @@ const MAX_NAMES = 8, MAX_CLASSES = 40;
 // A kept game's replay: far larger than any 60 s game's (about 20 KB), far smaller than a browser's store.
 const MAX_GAME_BYTES = 1 << 20, MAX_KEPT_GAMES = 50;
 const CODE = /^[A-Z]{4}$/, TOKEN = /^[A-Za-z0-9_-]{1,200}$/, ID = /^[a-z0-9]{1,40}$/, CLASS = /^[0-9a-f]{1,64}$/;
+// A start ticket (the class's answer to POST /api/start): a game handed in with it may count in a round.
+const TICKET = /^[A-Za-z0-9_-]{1,64}$/;
 
 function load(key, fallback) {
   try { return JSON.parse(localStorage.getItem(key)) ?? fallback; } catch { return fallback; }
@@ -89,7 +91,7 @@ export function keepName(code, name, token) {
 }
 
 // ------------------------------------------------------------------ the games not yet taken
-// A kept game: {id, code, token, class, body, at}. ``class`` is what the class said of itself at the join (the
+// A kept game: {id, code, token, class, body, at, start}. ``class`` is what the class said of itself at the join (the
 // server's class id; null for a game kept before classes said it): a game is handed in only to its own class.
 // Games the browser would not store (private browsing, a full store): kept here while the page is open.
 const unstored = new Map();
@@ -103,7 +105,7 @@ function keptGame(g) {
 
 function asGame(g, at) {
   return { id: g.id, code: g.code, token: g.token, class: g.class ?? null, body: g.body,
-    at: Number.isFinite(g.at) ? g.at : at };
+    at: Number.isFinite(g.at) ? g.at : at, start: typeof g.start === "string" && TICKET.test(g.start) ? g.start : null };
 }
 
 function store(game) {

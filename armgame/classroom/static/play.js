@@ -95,7 +95,7 @@ function toHandIn() { return outbox().filter(belongsHere); }
 function send(game) {
   const headers = { Authorization: "Bearer " + game.token, "X-Armgame-Code": here.code };
   if (game.class !== null) headers["X-Armgame-Class"] = game.class;
-  return post("/api/handin", game.body, headers);
+  return post("/api/handin", game.body, { ...headers, ...startHeader(game.start) });
 }
 
 let flushing = null;
@@ -412,8 +412,21 @@ function releaseAll() {
 
 function start() {
   phase = "playing";
+  ticket = startTicket(member);
   showOutbox();
 }
+
+// The class's start ticket for the game beginning now: its hand-in sends it back, and a round counts only games
+// begun during it. Never waited for by the game; no ticket (an older class, no answer) is a game kept on the board
+// but not in a round.
+let ticket = null;
+const TICKET = /^[A-Za-z0-9_-]{1,64}$/;
+async function startTicket(m) {
+  const answer = await post("/api/start", "{}", { Authorization: "Bearer " + m.token, "X-Armgame-Code": m.code });
+  const t = answer.status === 200 && answer.data ? answer.data.ticket : null;
+  return typeof t === "string" && TICKET.test(t) ? t : null;
+}
+function startHeader(t) { return typeof t === "string" && TICKET.test(t) ? { "X-Armgame-Start": t } : {}; }
 
 async function finish() {
   phase = "over";
@@ -421,15 +434,17 @@ async function finish() {
   fingers.clear();
   showEnd("handing in…", "");
   const body = game.replayJSON(member.name);  // any seed's digits exact (a seed past 2^53 is a BigInt)
-  const answer = await handIn(body, "game", (line) => showEnd(line, ""));
+  const start = ticket === null ? null : await ticket;
+  ticket = null;
+  const answer = await handIn(body, "game", (line) => showEnd(line, ""), start);
   if (answer.data) showEnd(answer.line, answer.kind, answer.data); else showEnd(answer.line, answer.kind);
 }
 
 // A game's or a lab run's replay kept first, then sent: a page closed while the answer is on its way hands it in
 // next time. Returns the line to show ({line, kind, data}); ``showing`` is told the line while it is on its way.
-async function handIn(body, what, showing) {
+async function handIn(body, what, showing, start = null) {
   const id = Date.now().toString(36) + Math.random().toString(36).slice(2, 8);
-  const game = { id, code: member.code, token: member.token, class: member.class, body };
+  const game = { id, code: member.code, token: member.token, class: member.class, body, ...(start ? { start } : {}) };
   const kept = keepGame(game);
   if (!kept && showing) showing("handing in (this browser keeps nothing: stay on the page)…");
   // This game first, by itself: another tab's hand-in may send it too, and the class takes a game once.
