@@ -16,7 +16,7 @@ import urllib.request
 import pytest
 from class_server import keyboard_game, running_class, tapped_game
 
-from armgame.classroom import client
+from armgame.classroom import client, handins
 from armgame.classroom import state as class_state
 from armgame.classroom.errors import RefusedError
 from armgame.classroom.intake import Clerk
@@ -104,7 +104,7 @@ def test_batch_verification_gives_exactly_the_single_verdicts(tmp_path):
     games = [Replay.from_bytes(d) for _, d in mix if d.startswith(b"{\n")]
     games = [g for g in games if g.config.seed == 10]
     fresh, _ = _clerk(tmp_path / "fresh")
-    assert fresh._verify_games([(g, identity.game_digest(g)) for g in games]) == [g.verify() for g in games]
+    assert fresh.handins._verify_games([(g, identity.game_digest(g)) for g in games]) == [g.verify() for g in games]
 
 
 def test_a_forgery_that_hides_a_reset_is_refused_with_the_single_sessions_score(tmp_path):
@@ -127,7 +127,7 @@ def test_each_games_identity_is_computed_once(tmp_path, monkeypatch):
         calls.append(replay.timeline)
         return real(replay)
 
-    for module in (identity, scores_module, entry_module, __import__("armgame.classroom.intake").classroom.intake):
+    for module in (identity, scores_module, entry_module, handins):
         if hasattr(module, "game_digests"):
             monkeypatch.setattr(module, "game_digests", counted)
     clerk, tokens = _clerk(tmp_path / "class")

@@ -65,8 +65,8 @@ COMPILED = {"armgame.game._ckernel", "armgame.game._cbots", "armgame.physics._ct
 #: What only the server runs: none of it may reach a student's machine.
 SERVER_PACKAGES = ("starlette", "uvicorn", "anyio", "h11")
 SERVER_MODULES = {f"armgame.classroom.{name}" for name in (
-    "app", "board", "errors", "experiment", "guard", "intake", "labruns", "middleware", "page", "roster", "rounds",
-    "serve", "state", "views", "worker")}
+    "app", "board", "errors", "experiment", "guard", "handins", "intake", "labruns", "middleware", "page", "roster",
+    "rounds", "serve", "state", "views", "worker")}
 
 #: Run in a fresh process: armgame's command line with sys.argv, the user's data folder in a temporary one (the
 #: student's own path to it, as no $ARMGAME_CLASS_CLIENT is set), ``class show``'s window cut to a few frames; then

@@ -6,9 +6,10 @@ which the projector's page shows live, one row per student. What each module own
 
 * ``roster``: the class's own record (``class.json``): its join code, the teacher's secret, the seed
   it ranks, each student's name and the hash of the token that proves it, what the teacher hid.
-* ``intake``: the ``Clerk``, the class's one writer: a join, one hand-in from arrival to answer
-  (checked, verified, entered once by its content, durably on disk before it is acknowledged), the
-  teacher's changes. ``board``: the two lists' rows, kept as games are entered; ``labruns``: the lab
+* ``intake``: the ``Clerk``, the class's one writer: a join, the lab runs, the teacher's changes and
+  rounds, and the facade of ``handins``, the hand-in pipeline: hand-ins from arrival to answer
+  (checked, verified, entered once by its content, durably on disk before it is acknowledged).
+  ``board``: the two lists' rows, kept as games are entered; ``labruns``: the lab
   runs' files, written and read again.
 * ``views``: what the pages show, read from the clerk's state: the standings, the class curve, the
   teacher's roster and CSVs.

@@ -121,7 +121,7 @@ JOINS_PER_MINUTE = 3
 #: addresses is slowed.
 CLASS_JOINS_PER_MINUTE = 120
 
-# ---------------------------------------------------------------------- the clerk's work (intake, roster)
+# ---------------------------------------------------------------------- the clerk's work (handins, intake, roster)
 #: The most re-simulation one hand-in may ask for, in physics steps (``records.scores.replay_work``): a standard
 #: game costs 15,000 steps and its hits and events, a lab run its protocol's steps. A game claiming more (a "hit
 #: storm") is refused before anything is replayed.
@@ -133,7 +133,7 @@ REMEMBERED_FORGERIES = 4096
 MAX_PLAYERS = 2000
 #: Bytes of the class's record (class.json): ``MAX_PLAYERS`` names, their tokens' hashes and renames fit.
 MAX_ROSTER_BYTES = 2 * 1024 * 1024
-#: Bytes of the current round's games (``intake.ROUND_GAMES``, read at a restart): a lecture hall's round, each
+#: Bytes of the current round's games (``handins.ROUND_GAMES``, read at a restart): a lecture hall's round, each
 #: game's entry id, with room.
 MAX_ROUND_GAMES_BYTES = 4 * 1024 * 1024
 

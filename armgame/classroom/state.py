@@ -40,7 +40,8 @@ from .bounds import (
 )
 from .errors import RefusedError
 from .guard import Guard
-from .intake import Answer, Clerk
+from .handins import Answer
+from .intake import Clerk
 from .roster import token_digest
 from .wire import BUSY
 from .worker import ClerkThread

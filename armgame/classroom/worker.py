@@ -26,7 +26,8 @@ from dataclasses import dataclass, field
 from typing import Generic, TypeVar
 
 from .bounds import BATCH
-from .intake import AGAIN, Answer, Checked, Clerk
+from .handins import AGAIN, Answer, Checked
+from .intake import Clerk
 
 T = TypeVar("T")
 #: What a request is sent back: the value its work returned, or the exception it raised (raised in the request).
