@@ -136,6 +136,26 @@ def test_each_games_identity_is_computed_once(tmp_path, monkeypatch):
     assert len(calls) == 3
 
 
+def test_each_stored_replays_bytes_are_hashed_once(tmp_path, monkeypatch):
+    """The bytes a hand-in's replay is stored as are hashed once: for its file's name and its entry's digest."""
+    import hashlib
+
+    stored, real = [], hashlib.sha256
+
+    def counted(data=b"", *args, **kwargs):
+        stored.append(bytes(data))
+        return real(data, *args, **kwargs)
+
+    clerk, tokens = _clerk(tmp_path / "class")
+    replays = [keyboard_game(s, player="Ann") for s in (5, 9)]
+    monkeypatch.setattr(hashlib, "sha256", counted)
+    assert all(isinstance(o, dict) and o["ok"] for o in _batch(clerk, [(tokens["Ann"], r.to_bytes()) for r in replays]))
+    monkeypatch.undo()
+    for replay in replays:
+        data = replay.with_player("Ann").to_bytes()
+        assert stored.count(data) == 1, f"the stored bytes were hashed {stored.count(data)} times"
+
+
 def test_the_journal_is_durable_without_rewriting_the_table(tmp_path):
     table = ScoreTable(tmp_path / "t", warn=lambda line: None)
     table.new(10)
