@@ -7,7 +7,8 @@ the replay reader refuses files over ``MAX_REPLAY_BYTES``, timelines over ``MAX_
 games over ``MAX_GAME_STEPS`` before replaying anything. A ranked game costs exactly its
 ruleset (15,000 steps for ``standard``); these bounds are for everything else.
 
-No imports: every layer may read these numbers. The README's "Limits" section states them.
+No imports: every layer may read these numbers. The README's "Limits" section states them. The live
+class's own bounds (the largest hand-in, its deadlines, queues and shares) are ``armgame.classroom.bounds``.
 """
 
 from __future__ import annotations

@@ -262,9 +262,10 @@ def flood_class(flooders: int, honest: int, seconds: float, games: list[dict[str
 def clerk_rate(games: list[dict[str, Any]], forged: list[str], count: int) -> dict[str, Any]:
     """The clerk alone, in this process (no HTTP): ``count`` distinct honest hand-ins, then ``count`` forged ones,
     in the server's batches (``ClerkThread.hand_in_batch``, ``BATCH`` at a time); CPU and wall time per hand-in."""
+    from armgame.classroom.bounds import BATCH
     from armgame.classroom.intake import Clerk
     from armgame.classroom.roster import Player, Roster, token_digest
-    from armgame.classroom.worker import BATCH, ClerkThread, HandIn
+    from armgame.classroom.worker import ClerkThread, HandIn
 
     out: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="armgame-class-clerk-") as tmp:

@@ -18,7 +18,7 @@ must be ``lab run handed in: in the class curve`` and ``/api/lab`` must then cou
 fails otherwise). The students' threads are in this process and share the machine with the server.
 
 Then, in this process and without HTTP, the clerk's work on the same runs is timed piece by piece, as
-``Clerk._lab_run`` does it: reading the replay, its identity, the re-simulation (``LabTask.verify``), the trial
+``Clerk.lab_run`` does it: reading the replay, its identity, the re-simulation (``LabTask.verify``), the trial
 rows for the curve (``trial_rows``), the durable write (``write_run``), and once per batch the class curve the
 pages read (``views.lab_curve``); and the clerk's whole batch (``ClerkThread.hand_in_batch``). Figures are medians
 over ``--repeats`` with [min-max]; the machine and its load average are printed beside them.
@@ -143,7 +143,7 @@ def one_class(runs: list[tuple[str, bytes]]) -> dict[str, Any]:
 
 
 def clerk_pieces(runs: list[tuple[str, bytes]]) -> dict[str, Any]:
-    """The clerk's work on ``runs`` in this process, piece by piece as ``Clerk._lab_run`` does it (ms, all runs
+    """The clerk's work on ``runs`` in this process, piece by piece as ``Clerk.lab_run`` does it (ms, all runs
     together), and the clerk's whole batch of them (``ClerkThread.hand_in_batch``)."""
     from armgame.classroom import views
     from armgame.classroom.intake import Clerk

@@ -65,7 +65,8 @@ def font_stack() -> str:
 def accepted(codes: range | list[int]) -> list[int]:
     """The code points c a class that has "Ann B" takes as the new name "Ann B" + c, with ``DRAWN_AS_NOTHING`` (this
     scan's own findings) left out of the check."""
-    from armgame.classroom.intake import Clerk, RefusedError
+    from armgame.classroom.errors import RefusedError
+    from armgame.classroom.intake import Clerk
     from armgame.classroom.roster import Roster
     from armgame.records import lookalikes
 

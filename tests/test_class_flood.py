@@ -16,9 +16,10 @@ import urllib.request
 import pytest
 from class_server import keyboard_game, running_class, tapped_game
 
-from armgame.classroom import client
+from armgame.classroom import client, handins
 from armgame.classroom import state as class_state
-from armgame.classroom.intake import Clerk, RefusedError
+from armgame.classroom.errors import RefusedError
+from armgame.classroom.intake import Clerk
 from armgame.classroom.roster import Roster, token_digest
 from armgame.classroom.worker import ClerkThread, HandIn
 from armgame.game.session import DOWN, InputEvent
@@ -103,7 +104,7 @@ def test_batch_verification_gives_exactly_the_single_verdicts(tmp_path):
     games = [Replay.from_bytes(d) for _, d in mix if d.startswith(b"{\n")]
     games = [g for g in games if g.config.seed == 10]
     fresh, _ = _clerk(tmp_path / "fresh")
-    assert fresh._verify_games([(g, identity.game_digest(g)) for g in games]) == [g.verify() for g in games]
+    assert fresh.handins._verify_games([(g, identity.game_digest(g)) for g in games]) == [g.verify() for g in games]
 
 
 def test_a_forgery_that_hides_a_reset_is_refused_with_the_single_sessions_score(tmp_path):
@@ -126,13 +127,33 @@ def test_each_games_identity_is_computed_once(tmp_path, monkeypatch):
         calls.append(replay.timeline)
         return real(replay)
 
-    for module in (identity, scores_module, entry_module, __import__("armgame.classroom.intake").classroom.intake):
+    for module in (identity, scores_module, entry_module, handins):
         if hasattr(module, "game_digests"):
             monkeypatch.setattr(module, "game_digests", counted)
     clerk, tokens = _clerk(tmp_path / "class")
     games = [keyboard_game(s, player="Ann").to_bytes() for s in (5, 9, 14)]
     assert all(isinstance(o, dict) and o["ok"] for o in _batch(clerk, [(tokens["Ann"], d) for d in games]))
     assert len(calls) == 3
+
+
+def test_each_stored_replays_bytes_are_hashed_once(tmp_path, monkeypatch):
+    """The bytes a hand-in's replay is stored as are hashed once: for its file's name and its entry's digest."""
+    import hashlib
+
+    stored, real = [], hashlib.sha256
+
+    def counted(data=b"", *args, **kwargs):
+        stored.append(bytes(data))
+        return real(data, *args, **kwargs)
+
+    clerk, tokens = _clerk(tmp_path / "class")
+    replays = [keyboard_game(s, player="Ann") for s in (5, 9)]
+    monkeypatch.setattr(hashlib, "sha256", counted)
+    assert all(isinstance(o, dict) and o["ok"] for o in _batch(clerk, [(tokens["Ann"], r.to_bytes()) for r in replays]))
+    monkeypatch.undo()
+    for replay in replays:
+        data = replay.with_player("Ann").to_bytes()
+        assert stored.count(data) == 1, f"the stored bytes were hashed {stored.count(data)} times"
 
 
 def test_the_journal_is_durable_without_rewriting_the_table(tmp_path):

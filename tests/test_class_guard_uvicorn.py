@@ -28,8 +28,8 @@ from armgame.classroom.guard import Guard, guarded_protocol
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The uvicorn.Config options the class's server passes (``serve.open_class``).
-CONFIG_OPTIONS = ("http", "limit_concurrency", "h11_max_incomplete_event_size", "timeout_keep_alive",
-                  "timeout_graceful_shutdown", "proxy_headers", "lifespan", "access_log", "log_level")
+CONFIG_OPTIONS = ("http", "limit_concurrency", "timeout_keep_alive", "timeout_graceful_shutdown", "proxy_headers",
+                  "lifespan", "access_log", "log_level")
 
 
 def uvicorn_requirement() -> Requirement:

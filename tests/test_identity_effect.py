@@ -290,7 +290,8 @@ def test_a_forged_entry_naming_an_honest_replay_file_never_pushes_it_out(tmp_pat
 
 def test_a_live_class_knows_a_game_entered_before_the_bump(tmp_path):
     """The class's clerk looks a hand-in up by every identity version's digest, as the table's door does."""
-    from armgame.classroom.intake import Clerk, RefusedError
+    from armgame.classroom.errors import RefusedError
+    from armgame.classroom.intake import Clerk
     from armgame.classroom.roster import Roster
 
     folder = tmp_path / "class"

@@ -11,7 +11,9 @@ import pytest
 from class_server import keyboard_game, running_class
 
 from armgame.classroom import client, memberships
-from armgame.classroom.memberships import MAX_BYTES, MAX_CLASSES, MAX_NAMES
+from armgame.classroom.bounds import MAX_MEMBERSHIP_CLASSES as MAX_CLASSES
+from armgame.classroom.bounds import MAX_MEMBERSHIP_NAMES as MAX_NAMES
+from armgame.classroom.bounds import MAX_MEMBERSHIPS_BYTES as MAX_BYTES
 from armgame.classroom.roster import CODE_ALPHABET
 from armgame.cli import main
 from armgame.files import DataFileError

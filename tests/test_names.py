@@ -15,7 +15,8 @@ import pytest
 from class_server import running_class, tapped_game
 
 from armgame.classroom import state as class_state
-from armgame.classroom.intake import Clerk, RefusedError
+from armgame.classroom.errors import RefusedError
+from armgame.classroom.intake import Clerk
 from armgame.classroom.roster import Roster
 from armgame.records.lookalikes import name_problem, skeletons
 

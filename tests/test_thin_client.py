@@ -4,7 +4,7 @@ Each command runs for real in a fresh process against a class served here, and t
 are compared with the lists below. A module added to a student's path fails the test: if it belongs there (it
 is light and the student needs it), add it to its list; if it is the server's (the clerk, the table's
 writer, the batch replays), import what the student needs from a module both sides share
-(``armgame.classroom.wire``) instead.
+(``armgame.classroom.wire``, ``armgame.classroom.bounds``) instead.
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ from class_server import keyboard_game, running_class
 CLIENT = {
     "armgame", "armgame.errors", "armgame.files", "armgame.limits", "armgame.valid",
     "armgame.records", "armgame.records.standings", "armgame.records.storage",
-    "armgame.classroom", "armgame.classroom.client", "armgame.classroom.memberships", "armgame.classroom.wire",
+    "armgame.classroom", "armgame.classroom.bounds", "armgame.classroom.client", "armgame.classroom.memberships",
+    "armgame.classroom.wire",
 }
 #: Parsing any command line: every command's ``register`` (``armgame --help`` loads these).
 COMMAND_LINE = {
@@ -64,8 +65,8 @@ COMPILED = {"armgame.game._ckernel", "armgame.game._cbots", "armgame.physics._ct
 #: What only the server runs: none of it may reach a student's machine.
 SERVER_PACKAGES = ("starlette", "uvicorn", "anyio", "h11")
 SERVER_MODULES = {f"armgame.classroom.{name}" for name in (
-    "app", "board", "experiment", "guard", "intake", "labruns", "middleware", "page", "roster", "rounds", "serve",
-    "state", "views", "worker")}
+    "app", "board", "errors", "experiment", "guard", "handins", "intake", "labruns", "middleware", "page", "roster",
+    "rounds", "serve", "state", "views", "worker")}
 
 #: Run in a fresh process: armgame's command line with sys.argv, the user's data folder in a temporary one (the
 #: student's own path to it, as no $ARMGAME_CLASS_CLIENT is set), ``class show``'s window cut to a few frames; then

@@ -34,6 +34,8 @@ Every request is hostile until checked, and what it can cost is bounded before a
 * the join code is in no answer a stranger can fetch: the standings carry it only to the projector's
   link (``?key=``, printed in the teacher's terminal) and to the teacher's machine.
 
+Every bound named here is in ``bounds``, with its reason.
+
 Responses are JSON (``{"ok": false, "error": "one line"}`` when refused) or the static pages,
 served with a content security policy that allows no inline script: names reach a page only as
 data that its script sets as text.
@@ -66,21 +68,25 @@ from starlette.routing import Route
 
 from ..errors import UserError
 from . import page, views
+from .bounds import (
+    BODY_SECONDS,
+    HEARTBEAT_SECONDS,
+    JOINS_PER_MINUTE,
+    MAX_HANDIN_BYTES,
+    MAX_JSON_BYTES,
+    MAX_STREAMS,
+    SMALL_UPLOAD_BYTES,
+    STREAMS_PER_ADDRESS,
+    UPLOAD_WAIT,
+    UPLOADS_PER_ADDRESS,
+)
+from .errors import RefusedError
 from .guard import Guard
-from .intake import MAX_HANDIN_BYTES, NOT_JOINED, Clerk, RefusedError
+from .intake import NOT_JOINED, Clerk
 from .middleware import EXCEPTION_HANDLERS, ForwardedFor, OneLineErrors, SameSite, SecurityHeaders, json_answer
-from .state import BUSY, JOINS_PER_MINUTE, SMALL_UPLOAD_BYTES, ClassState, Guesses, client_address
+from .state import ClassState, Guesses, client_address
+from .wire import BUSY
 from .worker import ClerkThread
-
-#: Seconds a hand-in waits for one of the ``UPLOADS`` slots before it is told the class is busy.
-UPLOAD_WAIT = 5.0
-UPLOADS_PER_ADDRESS = 2
-#: Within the connection's own deadline (``guard.REQUEST_SECONDS``), so the app answers 408 first.
-BODY_SECONDS = 12.0
-MAX_JSON_BYTES = 4096
-MAX_STREAMS = 64
-STREAMS_PER_ADDRESS = 4
-HEARTBEAT_SECONDS = 15.0
 
 
 # ---------------------------------------------------------------------- what the endpoints check

@@ -38,22 +38,13 @@ from pathlib import Path
 from ..errors import UserError
 from ..records.storage import DataFileError, atomic_write_bytes, read_limited, user_path
 from . import memberships
-from .wire import CODE_ALPHABET, CODE_LENGTH, MAX_HANDIN_BYTES, normal_code
+from .bounds import BUSY_PATIENCE, CLIENT_TIMEOUT, LOST_ANSWER_PAUSE, MAX_HANDIN_BYTES, MAX_OUTBOX, TICKET_TIMEOUT
+from .wire import BUSY, CODE_ALPHABET, CODE_LENGTH, normal_code
 
 CLIENT_ENV = "ARMGAME_CLASS_CLIENT"
 DEFAULT_PORT = 8765
-TIMEOUT = 15.0
-#: How long a hand-in keeps asking a busy class, in all.
-BUSY_PATIENCE = 60.0
 #: The requests asked again when the class took them but their answer never came: a game counts once.
 _ASKED_AGAIN_SAFELY = frozenset({"/api/handin"})
-#: Seconds a game's start ticket is waited for: the game starts anyway (it is then not in a round).
-TICKET_TIMEOUT = 3.0
-#: Seconds before asking again when the class took a request but its answer never came.
-LOST_ANSWER_PAUSE = 1.0
-#: What a busy class means to a student (a 503 without the class's own line: the server's connection limit).
-BUSY = "the class is busy: your game is kept and will be handed in in a moment"
-MAX_OUTBOX = 200
 _HOST = re.compile(r"[A-Za-z0-9]([A-Za-z0-9.-]{0,252})")
 
 
@@ -143,7 +134,7 @@ def _request(address: ClassAddress, path: str, body: bytes, headers: dict[str, s
     """POST ``body``; the JSON answer. Asks a busy class again (bounded); raises UnreachableError or RefusalError.
 
     Busy is a 503, and for a hand-in also a class that took the connection but whose answer did not come (cut
-    off, or later than ``TIMEOUT`` under a lecture hall's load): that is not a network problem, and asking
+    off, or later than ``CLIENT_TIMEOUT`` under a lecture hall's load): that is not a network problem, and asking
     again is safe (a game handed in twice counts once; a join asked again would find its name taken, so a
     join is not). Only a connection that could not be made is unreachable, with the hint about school
     networks."""
@@ -151,7 +142,7 @@ def _request(address: ClassAddress, path: str, body: bytes, headers: dict[str, s
     while True:
         req = urllib.request.Request(address.url(path), data=body, method="POST", headers=headers)
         try:
-            with urllib.request.urlopen(req, timeout=TIMEOUT) as response:
+            with urllib.request.urlopen(req, timeout=CLIENT_TIMEOUT) as response:
                 return _answer(response.read(1 << 20))
         except urllib.error.HTTPError as exc:
             answer = _answer(exc.read(1 << 20), quiet=True)

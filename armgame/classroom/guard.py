@@ -48,33 +48,19 @@ import httptools
 from uvicorn.protocols.http.flow_control import HIGH_WATER_LIMIT, FlowControl
 from uvicorn.protocols.http.httptools_impl import STATUS_LINE, HttpToolsProtocol
 
-#: Seconds for a request's headers to arrive (a browser or the client sends them in one packet).
-HEADER_SECONDS = 5.0
-#: Seconds for a whole request once its headers are in: a 4 MB hand-in over slow school Wi-Fi (1 MB/s).
-REQUEST_SECONDS = 15.0
-#: Connections one client address may hold at once (a browser opens six per server; the client one).
-PER_ADDRESS = 16
-#: Requests one connection may have waiting behind the one being answered (no browser pipelines; a script may).
-PIPELINE = 8
-#: Headers in one request: a browser sends about 15 (Apache's LimitRequestFields is 100).
-MAX_HEADERS = 100
-#: Bytes of one request's head, its line and headers together (nginx's default is 4 x 8 KiB, Go's 1 MB).
-MAX_HEADER_BYTES = 16 * 1024
-#: Connections from other machines than the teacher's at once: uvicorn's limit (``serve.CONCURRENCY``, 2,500)
-#: less a reserve of 100 for the teacher's machine and the connections on probation.
-CONNECTIONS = 2400
-#: Connections past ``CONNECTIONS`` that wait to show they are the projector's (its link's key), the oldest
-#: closed for a newer: a flood of new connections cannot keep the projector out for longer than its first
-#: request takes to arrive.
-PROBATION = 32
-#: Bytes fed to the parser at a time while a request's head is read or requests wait: the head is counted, and
-#: reading stops when the queue is full, to within this.
-SLICE = 1024
-#: Seconds a refused connection's input is still read (and dropped) after its answer, so that the client reads
-#: the answer instead of a reset.
-LINGER_SECONDS = 1.0
-#: Input held back past which a connection is closed (asyncio reads 256 KiB at a time: one read is held at most).
-HELD_BYTES = 1024 * 1024
+from .bounds import (
+    CONNECTIONS,
+    HEADER_SECONDS,
+    HELD_BYTES,
+    LINGER_SECONDS,
+    MAX_HEADER_BYTES,
+    MAX_HEADERS,
+    PER_ADDRESS,
+    PIPELINE,
+    PROBATION,
+    REQUEST_SECONDS,
+    SLICE,
+)
 
 
 @dataclass

@@ -3,10 +3,10 @@
 The server runs every change (a join, a hand-in, the teacher's hide and close) through the clerk on
 a single worker thread (``worker.ClerkThread``), so the table, the roster and the lab folder never
 see two writers, and a hand-in is answered only once it is durably on disk (the table's own atomic,
-fsynced write). Everything a request carries is checked here before it costs anything: the replay
-is parsed with the replay reader's schema, its work bounded before it is re-simulated, its player
-taken from the token (never from the file), its game identified by its content
-(``records.identity``), so the same game from two machines is one game.
+fsynced write). A hand-in goes through the hand-in pipeline (``handins``), which the clerk calls: everything
+it carries is checked before it costs anything, its replay parsed with the replay reader's schema, its work
+bounded before it is re-simulated, its player taken from the token (never from the file), its game identified
+by its content (``records.identity``), so the same game from two machines is one game.
 
 The clerk keeps the class's state and answers each hand-in (its rank, from ``board``); what the
 pages show (the standings, the class curve, the teacher's roster and CSVs) is built from that state
@@ -18,119 +18,40 @@ The class's folder::
     scores.json, replays/        an ordinary armgame table: ``armgame scores --scores DIR`` reads it
     lab/                         each student's first lab run of each protocol (``analyze --class``)
     lab-more/                    their later runs, kept, not in the class curve (``labruns``)
-    round.json                   the current round's games (``ROUND_GAMES``: which games it took)
+    round.json                   the current round's games (``handins.ROUND_GAMES``: which games it took)
 """
 
 from __future__ import annotations
 
-import bisect
 import contextlib
 import os
 import secrets
 import stat
 import sys
-from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from datetime import UTC, datetime, timedelta
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ..errors import UserError
-from ..game.batch import replay_many
-from ..game.session import GameResult
-from ..records.batch_verify import batchable
-from ..records.identity import game_digests
 from ..records.lookalikes import name_problem
-from ..records.replay import Replay, now_iso, same_outcome
-from ..records.rulesets import CLASS_GAMES, Ruleset, class_game_name, config_digest
-from ..records.scores import ScoreEntry, ScoreTable, replay_work, sort_key
-from ..records.standings import player_key, shared_rank
-from ..records.storage import DataFileError, atomic_write_bytes, dump_json, parse_json, read_limited
+from ..records.replay import Replay, now_iso
+from ..records.rulesets import CLASS_GAMES, Ruleset
+from ..records.scores import ScoreEntry, ScoreTable
+from ..records.standings import player_key
+from ..records.storage import DataFileError
 from ..valid import check_name
 from .board import Board
+from .bounds import MAX_HANDIN_BYTES, MAX_PLAYERS
+from .errors import RefusedError
+from .handins import AGAIN, Again, Answer, Arrival, Checked, HandInPipeline, read_round_games
 from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
-from .roster import MAX_PLAYERS, Player, Roster, token_digest
+from .roster import Player, Roster, token_digest
 from .rounds import Round, Tickets, new_round
-from .wire import MAX_HANDIN_BYTES
 
-#: The most re-simulation one hand-in may ask for, in physics steps (``records.scores.replay_work``).
-#: A standard game costs 15,000 steps and its hits and events; a lab run, its protocol's steps.
-#: A game claiming more (a "hit storm") is refused before anything is replayed.
-MAX_HANDIN_WORK = 1_500_000
 NOT_JOINED = ("this machine has not joined the class under that name: join first "
               "(armgame play --join HOST:PORT --code CODE --name NAME)")
-CLOSED = "the class is closed to new games: this game is not taken (your replay stays on your machine)"
 #: A new name refused by a closed class (a join for a game: the lab's volunteers still join, ``Clerk.join``).
 CLOSED_TO_PLAYERS = "the class is closed to new games, so it takes no new players (the teacher can open it again)"
-#: Forged games whose re-simulated result is kept (by identity), so one sent again is not played again:
-#: a result is about 200 bytes.
-REMEMBERED_FORGERIES = 4096
-#: The current round's games, by entry id, as the clerk took them into it (``rounds.Round.refusal``): the round's
-#: standings survive a restart. Its number and start say which round; another round's file counts nothing.
-ROUND_GAMES = "round.json"
-MAX_ROUND_GAMES_BYTES = 4 * 1024 * 1024
-
-
-class RefusedError(Exception):
-    """A request the class turns down: an HTTP status and one line saying why (sent as it is); for 429 and 503,
-    the seconds after which to ask again (``Retry-After``)."""
-
-    def __init__(self, status: int, message: str, retry_after: int = 2) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
-        self.retry_after = retry_after
-
-
-@dataclass(frozen=True)
-class Arrival:
-    """A game just entered, as the projector announces it."""
-
-    seq: int
-    name: str
-    score: int
-    note: str
-    program: bool
-
-
-#: What the student's machine is told of a hand-in taken: a JSON object (``ok``, ``already``, ``message``; for a
-#: game, its rank and the top of its list).
-Answer = dict[str, object]
-
-
-@dataclass(frozen=True)
-class Checked:
-    """A hand-in through every check, nothing of it entered yet: a game verified for ``enter`` (its player,
-    its replay under their name, its identity: ``identity.game_digests``, the current version's first), or,
-    when ``answer`` is set, a hand-in answered already (the player's own game handed in before; a lab run,
-    kept at once), which ``enter`` never sees."""
-
-    player: Player
-    replay: Replay
-    digests: tuple[str, ...] = ()
-    answer: Answer | None = None
-
-
-class _Again:
-    """``Clerk.check_many``'s answer for a game that came twice in one batch: check it again after the batch."""
-
-
-AGAIN = _Again()
-
-
-@dataclass(frozen=True)
-class _Pending:
-    """A game through every check but its re-simulation (``Clerk.check_many`` verifies them together)."""
-
-    player: Player
-    replay: Replay
-    digests: tuple[str, ...]
-
-
-def ordinal(n: int) -> str:
-    suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
-    return f"{n}{suffix}"
 
 
 class Clerk:
@@ -148,7 +69,7 @@ class Clerk:
         #: The one game this class takes: a game of other rules is refused, whatever its score.
         self.game: Ruleset = CLASS_GAMES["rehearsal" if rehearsal else "standard"]
         self.table = ScoreTable(self.folder, warn=warn, records=records)
-        self._warn = warn or (lambda message: print(f"armgame class: {message}", file=sys.stderr))
+        self.warn = warn or (lambda message: print(f"armgame class: {message}", file=sys.stderr))
         self.table.lock_mode = 0o600  # only the server writes a class's table: nobody else may open its lock
         with contextlib.suppress(OSError):
             if stat.S_ISREG(os.lstat(self.table.lock_path).st_mode):
@@ -165,18 +86,18 @@ class Clerk:
         # The two lists' rows, one a player, kept as games are entered: an answer's rank and the standings
         # cost a lookup, not a pass over the whole table (which grew with every hand-in).
         self._build_boards()
-        self.games: dict[str, ScoreEntry] = {e.game_sha256: e for e in self.entries if e.game_sha256}
         self.lab_runs: list[LabRun] = []
         self.lab_digests: set[str] = set()
         self.arrival: Arrival | None = None
         self.round_over = False  # the current round's winners have been shown
         self.version = 0  # bumped at every change the projector should see
         self.lab_version = 0  # and at every change of the class curve (a lab run, a name hidden)
-        self._recomputed: OrderedDict[str, GameResult] = OrderedDict()  # forged games' results, by identity
         #: The class's one clock for rounds: start tickets, a game's entry into a round and the round's end.
         self.clock: Callable[[], datetime] = lambda: datetime.now(UTC)
         self.tickets = Tickets()
-        self.round_games: set[str] = self._read_round_games()
+        self.round_games: set[str] = read_round_games(self.folder, self.current_round(), self.warn)
+        #: The hand-in pipeline (``handins``): ``check_many`` and ``enter`` are its.
+        self.handins = HandInPipeline(self)
 
     def _sweep(self) -> None:
         """Temporary files a server killed mid-write left (never renamed: nothing refers to them). Only
@@ -306,243 +227,18 @@ class Clerk:
         found = self.check_many([(token, data)])[0]
         if isinstance(found, BaseException):
             raise found
-        assert not isinstance(found, _Again), "one hand-in cannot come twice"
+        assert found is not AGAIN, "one hand-in cannot come twice"
         return found
 
-    def check_many(self, hand_ins: Sequence[tuple[str | None, bytes]]
-                   ) -> list[Checked | BaseException | _Again]:
-        """``check`` of hand-ins that arrived together, each outcome (the exception ``check`` would raise,
-        returned) in order: the cheap refusals first, then the games still to verify re-simulated together
-        (``records.batch_verify``'s lanes, each verdict the single session's, bit for bit). ``AGAIN``: a game the
-        batch holds earlier, to check again once the batch is entered (``check`` never returns it)."""
-        outcomes: list[Checked | BaseException | _Pending | _Again] = []
-        for token, data in hand_ins:
-            try:
-                outcomes.append(self._read(token, data))
-            except Exception as exc:  # one hand-in's failure is its own answer, never the batch's
-                outcomes.append(exc)
-        # A game a batch holds twice (whatever each claims) is answered as one after the other: the later one
-        # once the first is entered or refused, as if it had come in the next batch (``AGAIN``).
-        seen: set[str] = set()
-        for i, p in enumerate(outcomes):
-            if isinstance(p, _Pending):
-                if seen.intersection(p.digests):
-                    outcomes[i] = AGAIN
-                seen.update(p.digests)
-        pending = [p for p in outcomes if isinstance(p, _Pending)]
-        verdicts = self._verify_games([(p.replay, p.digests[0]) for p in pending])
-        judged: dict[int, Checked | BaseException] = {}
-        for p, verdict in zip(pending, verdicts, strict=True):
-            if isinstance(verdict, BaseException):
-                judged[id(p)] = verdict
-                continue
-            ok, recomputed = verdict
-            r = p.replay.result
-            judged[id(p)] = Checked(p.player, p.replay.with_player(p.player.name), p.digests) if ok else \
-                RefusedError(422, f"the replay does not reproduce its score (recorded {r.score}, it replays to "
-                                  f"{recomputed.score}): not entered")
-        return [judged[id(o)] if isinstance(o, _Pending) else o for o in outcomes]
-
-    def _read(self, token: str | None, data: bytes) -> Checked | _Pending:
-        """One hand-in up to its verification: the token first (it costs nothing), then the replay read once
-        (a closed class refuses a game, and takes a lab run: the lab is not a new game), its work bounded, its
-        rules and seed, its identity computed once and looked up; a lab run is kept here (its own
-        verification). Raises RefusedError."""
-        player = self.player(token)
-        try:
-            replay = Replay.from_bytes(data, "the replay")
-        except DataFileError as exc:
-            raise RefusedError(400, str(exc)) from None
-        if self.roster.closed and replay.task is None:
-            raise RefusedError(403, CLOSED)
-        work = replay_work(replay)
-        if work > MAX_HANDIN_WORK:
-            raise RefusedError(413, f"the replay claims {replay.result.hits} hits in {replay.result.steps} steps, more "
-                               f"to check ({work:,}) than a class checks for one hand-in ({MAX_HANDIN_WORK:,})")
-        if replay.task is not None:
-            return Checked(player, replay, answer=self._lab_run(player, replay))
-        return self._game(player, replay)
-
-    def _game(self, player: Player, replay: Replay) -> Checked | _Pending:
-        r = replay.result
-        if not replay.complete:
-            raise RefusedError(400, "the game stopped before its clock ran out: only a whole game is handed in")
-        if config_digest(replay.config) != self.game.digest or r.seed != self.roster.seed:
-            raise RefusedError(400, f"this class plays the {self.game.name} game ({self.game.config.time_limit:g} s) "
-                               f"of seed {self.roster.seed}; this game is {class_game_name(replay.config)} rules "
-                               f"({r.duration:g} s), seed {r.seed} (play it with --join to get the class's game)")
-        # An entry keeps the digest of the identity version that entered it: the game is looked up by each.
-        # Computed here once and carried to the table's entry (``Checked.digests``).
-        digests = game_digests(replay)
-        twin = next((self.games[d] for d in digests if d in self.games), None)
-        if twin is not None:  # known: answered without re-simulating it
-            if player_key(self.shown_name(twin.name)) == player_key(player.name):
-                return Checked(player, replay, digests, answer=self._answer(twin, already=True))
-            raise RefusedError(409, f"this game was already handed in by {twin.name}: a game counts once, whoever "
-                               f"hands it in")
-        return _Pending(player, replay, digests)
-
-    def _verify_games(self, games: Sequence[tuple[Replay, str]]) -> list[tuple[bool, GameResult] | BaseException]:
-        """``replay.verify()`` of each game, or the exception it raised: the games together in the batch's
-        lanes where they can share them, the rest (and any game whose batch failed) one at a time.
-
-        The batch plays every game to its end; ``verify`` stops once the game has scored more hits or resets
-        than claimed, and its refusal names the score there. A game the batch finds past its claim is
-        therefore verified again alone (rare: a forgery that hides hits or resets), so every verdict and
-        every message is the single session's. A forged game seen before is not played again: its result
-        is remembered by its identity (``_recomputed``, bounded)."""
-        replays = [replay for replay, _ in games]
-        results: list[GameResult | None] = [None] * len(replays)
-        todo: list[int] = []
-        for i, (replay, digest) in enumerate(games):
-            known = self._recomputed.get(digest)
-            if known is not None:
-                results[i] = known
-            elif batchable(replay):
-                todo.append(i)
-        if todo:
-            with contextlib.suppress(Exception):  # e.g. one game's blow-up stopped the batch: each alone below
-                got = replay_many([replays[i].config for i in todo], [replays[i].timeline for i in todo],
-                                  [replays[i].result.steps for i in todo], exact=True)
-                for i, result in zip(todo, got, strict=True):
-                    results[i] = result
-        verdicts: list[tuple[bool, GameResult] | BaseException] = []
-        for (replay, digest), result in zip(games, results, strict=True):
-            claimed = result is not None and same_outcome(result, replay.result)
-            if result is None or (not claimed and (result.hits > replay.result.hits
-                                                   or result.resets > replay.result.resets)):
-                try:
-                    verdicts.append(replay.verify())
-                except Exception as exc:  # the single session's exception is this game's answer
-                    verdicts.append(exc)
-                continue
-            if not claimed:
-                self._remember(digest, result)
-            verdicts.append((claimed, result))
-        return verdicts
-
-    def _remember(self, digest: str, result: GameResult) -> None:
-        self._recomputed[digest] = result
-        self._recomputed.move_to_end(digest)
-        while len(self._recomputed) > REMEMBERED_FORGERIES:
-            self._recomputed.popitem(last=False)
+    def check_many(self, hand_ins: Sequence[tuple[str | None, bytes]]) -> list[Checked | BaseException | Again]:
+        """``check`` of hand-ins that arrived together (``HandInPipeline.check_many``)."""
+        return self.handins.check_many(hand_ins)
 
     def enter(self, checked: Sequence[Checked], tickets: Sequence[str | None] | None = None
               ) -> list[Answer | RefusedError]:
-        """Enter checked games together (one table write for all: a burst of a class costs one write, not
-        thirty); each game's answer, or why it was not entered. Durable on disk before this returns.
-        ``tickets``: each game's start ticket (``start_ticket``), for the round: a game is in it if the round
-        takes it at the moment it is entered (``rounds.Round.refusal``)."""
-        try:
-            results = self.table.add_many([c.replay for c in checked], [c.digests for c in checked], journal=True)
-        except (ValueError, UserError) as exc:  # the table could not be written: none was entered
-            refusal = RefusedError(503, f"the class's table could not take the game: {exc}")
-            return [refusal for _ in checked]
-        answers: list[Answer | RefusedError] = []
-        fresh = [r for r in results if isinstance(r, ScoreEntry)]
-        for entry in fresh:
-            bisect.insort(self.entries, entry, key=sort_key)
-            self.boards[entry.program].add(entry)
-        for c, result in zip(checked, results, strict=True):
-            if isinstance(result, ScoreEntry):
-                self.games[c.digests[0]] = result
-        rounds = self._into_round(checked, results, tickets or [None] * len(checked))
-        for c, result, in_round in zip(checked, results, rounds, strict=True):
-            twin = next((self.games[d] for d in c.digests if d in self.games), None)
-            if isinstance(result, ScoreEntry):
-                answer = self._answer(result)
-                if in_round:
-                    answer["round"] = in_round
-                    answer["message"] = f"{answer['message']}; {in_round}"
-                self.version += 1
-                self.arrival = Arrival(self.version, self.shown_name(result.name), result.score, str(answer["note"]),
-                                       result.program)
-                answers.append(answer)
-            elif twin is not None and player_key(self.shown_name(twin.name)) == player_key(c.player.name):
-                answers.append(self._answer(twin, already=True))  # the same game twice in one burst
-            elif twin is not None:
-                answers.append(RefusedError(409, f"this game was already handed in by {twin.name}: a game counts "
-                                                 f"once, whoever hands it in"))
-            else:
-                answers.append(RefusedError(400, f"not entered: {result}"))
-        return answers
-
-    def _into_round(self, checked: Sequence[Checked], results: Sequence[object],
-                    tickets: Sequence[str | None]) -> list[str]:
-        """The games just entered taken into the round that is on (their start tickets used up), kept in
-        ``ROUND_GAMES`` before any is answered; for each game, the line its student is told of the round (empty
-        when no round is on, or for a program's game, which no round shows)."""
-        rnd = self.current_round()
-        now = self.clock()  # after the table's write: the moment the game is taken, as the projector's end is
-        lines, taken = [], []
-        for c, result, ticket in zip(checked, results, tickets, strict=True):
-            if not isinstance(result, ScoreEntry) or rnd is None or result.program or \
-                    now >= rnd.end + timedelta(seconds=rnd.hold):
-                lines.append("")
-                continue
-            started = self.tickets.take(ticket, c.player.token_sha256)
-            why = rnd.refusal(started, self.game.config.time_limit, now)
-            if why is None:
-                taken.append(result.id)
-                lines.append(f"in round {rnd.number}")
-            else:
-                lines.append(f"on the board, not in round {rnd.number}: {why}")
-        if taken:
-            self.round_games.update(taken)
-            try:
-                atomic_write_bytes(self.folder / ROUND_GAMES, dump_json(
-                    {"number": rnd.number, "start": rnd.as_dict()["start"], "games": sorted(self.round_games)}),
-                    "round's games")
-            except (OSError, DataFileError) as exc:  # the round goes on; only a restart would lose them
-                self._warn(f"the round's games could not be kept ({exc}): a restart would leave them out of it")
-        return lines
-
-    def _read_round_games(self) -> set[str]:
-        """The current round's games as ``ROUND_GAMES`` keeps them (none if it is another round's, or unreadable:
-        the teacher is told)."""
-        rnd = self.current_round()
-        path = self.folder / ROUND_GAMES
-        if rnd is None or not path.exists():
-            return set()
-        try:
-            data = parse_json(read_limited(path, MAX_ROUND_GAMES_BYTES, "round's games", follow=False))
-        except (DataFileError, ValueError) as exc:
-            self._warn(f"{path}: {exc}: round {rnd.number} counts only the games from now on")
-            return set()
-        if not isinstance(data, dict) or data.get("number") != rnd.number or \
-                data.get("start") != rnd.as_dict()["start"] or not isinstance(data.get("games"), list):
-            return set()
-        return {g for g in data["games"] if isinstance(g, str)}
-
-    def _answer(self, entry: ScoreEntry, already: bool = False) -> Answer:
-        """Where ``entry`` leaves its player: their rank among students (or programs), and their best."""
-        board = self.boards[entry.program]
-        rank = board.rank(player_key(self.shown_name(entry.name)))
-        row = board.row(rank)
-        best = row.best
-        position = rank  # the row's position; its place is shared with every row of an equal score above it
-        while rank > 1 and board.row(rank - 1).best.score == best.score:
-            rank -= 1
-        where = "in the class" if not entry.program else "among the programs"
-        if best.id == entry.id:
-            note = "first game" if row.games == 1 else "new personal best"
-            line = f"{ordinal(rank)} of {len(board)} {where} (your best so far)"
-        else:
-            note = f"best {best.score}"
-            line = f"score {entry.score}; your best, {best.score}, is {ordinal(rank)} of {len(board)} {where}"
-        placed: list[dict[str, object]] = []
-        for r in board.rows(10):
-            placed.append({"rank": shared_rank(placed, r.best.score), "score": r.best.score, "name": r.name})
-        shown = [(i, p) for i, p in enumerate(placed, 1) if not self.roster.is_hidden(str(p["name"])) or i == position]
-        top = [[p["rank"], p["name"], p["score"]] for _, p in shown]
-        # The player's own row, by its index in top: rows of an equal score share the place, so it cannot say.
-        yours = next((j for j, (i, _) in enumerate(shown) if i == position), len(top))
-        if position > 10:
-            top.append([rank, row.name, best.score])
-        return {"ok": True, "already": already, "name": entry.name, "score": entry.score, "rank": rank,
-                "of": len(board), "best": best.score, "list": "programs" if entry.program else "students",
-                "note": note, "top": top, "yours": yours,
-                "message": ("already handed in: " if already else "handed in: ") + line}
+        """Enter checked games together, each one's answer (``HandInPipeline.enter``). Durable on disk before this
+        returns."""
+        return self.handins.enter(checked, tickets)
 
     def _build_boards(self) -> None:
         self.boards = {programs: Board((e for e in self.entries if e.program == programs), self.roster.renamed)
@@ -553,7 +249,8 @@ class Clerk:
         return self.roster.renamed.get(player_key(name), name)
 
     # ------------------------------------------------------------------ the lab
-    def _lab_run(self, player: Player, replay: Replay) -> Answer:
+    def lab_run(self, player: Player, replay: Replay) -> Answer:
+        """A lab run handed in (``HandInPipeline._read``): verified, kept, and where it counts."""
         from ..lab.analysis import trial_rows
 
         game = lab_identity(replay)

@@ -9,15 +9,15 @@ Format 2 (written since 0.5)::
 A name's token is what proves to the class that the name is this machine's, and the class gives it once:
 a token lost is a name lost (the teacher can let the machine take it again). So every name a machine
 joined a class under keeps its token, most recent first: a student who joins their bot as "Kofi's robot"
-is still "Kofi A" on the next join. Bounded: ``MAX_NAMES`` names a class and ``MAX_CLASSES`` classes, the
-ones joined longest ago dropped first.
+is still "Kofi A" on the next join. Bounded (``bounds``): ``MAX_MEMBERSHIP_NAMES`` names a class and
+``MAX_MEMBERSHIP_CLASSES`` classes, the ones joined longest ago dropped first.
 
 Format 1 (before 0.5) kept one name a class, ``{CODE: {"name", "token", "seed", "address", "at"}}``; it is
 read as format 2 with that one name, and written as format 2 at the next join.
 
 The file is read as hostile (it is only ever the user's own, but a damaged or planted file must not cost
-more than its bound or send a token into a request's header unchecked): at most ``MAX_BYTES``, a regular
-file (never a symlink), every field checked. One that fails is one ``DataFileError`` line naming it, and
+more than its bound or send a token into a request's header unchecked): at most ``MAX_MEMBERSHIPS_BYTES``, a
+regular file (never a symlink), every field checked. One that fails is one ``DataFileError`` line naming it, and
 nothing is written over it. It is written atomically and private (0600): the tokens are the user's alone.
 """
 
@@ -34,16 +34,10 @@ from ..limits import MAX_GAME_SECONDS
 from ..records.standings import player_key
 from ..records.storage import atomic_write_bytes, parse_json
 from ..valid import INT64_MAX, check_float, check_int, check_keys, check_name, check_pattern, check_str
+from .bounds import MAX_MEMBERSHIP_CLASSES, MAX_MEMBERSHIP_NAMES, MAX_MEMBERSHIPS_BYTES
 from .wire import CODE_ALPHABET, CODE_LENGTH
 
 FORMAT = 2
-#: The names one class keeps on one machine: a student, their bots and a spelling or two, with room.
-MAX_NAMES = 8
-#: The classes one machine keeps: a school year of lessons, each its own class.
-MAX_CLASSES = 40
-#: The file's largest size: the caps filled with the longest names (40 characters of 4 bytes each), tokens
-#: and addresses take 150 KB of it (tests/test_memberships.py).
-MAX_BYTES = 1 << 18
 #: A token as a class writes it (``secrets.token_urlsafe``), at most as long as a class takes one.
 TOKEN = re.compile(r"[A-Za-z0-9_-]{1,200}")
 _WHAT = "class memberships file"
@@ -88,7 +82,7 @@ def read(path: Path) -> dict[str, Joined]:
         return {}
     except OSError:
         pass  # read_limited says what is wrong, in its line
-    data = read_limited(path, MAX_BYTES, _WHAT, follow=False)
+    data = read_limited(path, MAX_MEMBERSHIPS_BYTES, _WHAT, follow=False)
     try:
         return _checked(parse_json(data))
     except (ValueError, UnicodeDecodeError) as exc:
@@ -117,7 +111,7 @@ def _checked(data: object) -> dict[str, Joined]:
         if not isinstance(names, list) or not names:
             raise ValueError(f"class {code}: names must be a list of at least one name")
         kept: dict[str, Name] = {}
-        for item in names[:10 * MAX_NAMES]:  # a planted list costs no more than its bound
+        for item in names[:10 * MAX_MEMBERSHIP_NAMES]:  # a planted list costs no more than its bound
             n = check_keys(f"class {code}: a name", item, {"name", "token", "at"})
             name = Name(check_name(n["name"], f"class {code}: a name"),
                         check_pattern("token", n["token"], TOKEN), check_float("at", n["at"], 0, _LATEST))
@@ -125,7 +119,7 @@ def _checked(data: object) -> dict[str, Joined]:
         out[code] = Joined(check_str(f"class {code}: address", c["address"], 300),
                            check_int(f"class {code}: seed", c["seed"], 0, INT64_MAX),
                            check_float(f"class {code}: at", c["at"], 0, _LATEST),
-                           _newest(kept.values(), MAX_NAMES),
+                           _newest(kept.values(), MAX_MEMBERSHIP_NAMES),
                            check_float(f"class {code}: duration", c.get("duration", 60.0), 0.0, MAX_GAME_SECONDS,
                                        low_open=True))
     return dict(_newest_classes(out))
@@ -148,7 +142,7 @@ def _newest(names, cap: int) -> tuple[Name, ...]:
 
 
 def _newest_classes(classes: Mapping[str, Joined]) -> list[tuple[str, Joined]]:
-    return sorted(classes.items(), key=lambda kv: -kv[1].at)[:MAX_CLASSES]
+    return sorted(classes.items(), key=lambda kv: -kv[1].at)[:MAX_MEMBERSHIP_CLASSES]
 
 
 def joined(classes: Mapping[str, Joined], code: str, address: str, seed: int, name: str, token: str,
@@ -157,7 +151,7 @@ def joined(classes: Mapping[str, Joined], code: str, address: str, seed: int, na
     the class's other names stay, the oldest past the caps go."""
     before = classes.get(code)
     others = () if before is None else tuple(n for n in before.names if player_key(n.name) != player_key(name))
-    names = (Name(name, token, now), *others)[:MAX_NAMES]
+    names = (Name(name, token, now), *others)[:MAX_MEMBERSHIP_NAMES]
     return dict(_newest_classes({**classes, code: Joined(address, seed, now, names, duration)}))
 
 

@@ -35,7 +35,7 @@ from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ..errors import UserError
-from .intake import RefusedError
+from .errors import RefusedError
 from .state import FORWARDED
 
 SECURITY_HEADERS = {

@@ -20,7 +20,7 @@ from importlib import resources
 
 from starlette.responses import Response
 
-from .intake import RefusedError
+from .errors import RefusedError
 
 PAGES = {
     "standings.html": "text/html; charset=utf-8",

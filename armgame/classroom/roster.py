@@ -50,6 +50,7 @@ from ..records.replay import now_iso
 from ..records.standings import legacy_player_key, player_key
 from ..records.storage import DataFileError, atomic_write_bytes, dump_json, parse_json, read_limited
 from ..valid import HEX64, INT64_MAX, check_date, check_int, check_keys, check_name, check_str
+from .bounds import MAX_PLAYERS, MAX_ROSTER_BYTES
 from .experiment import Experiment
 from .wire import CODE_ALPHABET, CODE_LENGTH, normal_code
 
@@ -57,9 +58,6 @@ ROSTER_NAME = "class.json"
 SECRET_NAME = "teacher.secret"
 FORMAT = "armgame-class"
 FORMAT_VERSION = 4
-#: Names one class holds: a lecture hall of students, each with a program or two, with room.
-MAX_PLAYERS = 2000
-MAX_ROSTER_BYTES = 2 * 1024 * 1024
 _SECRET = re.compile(r"[A-Za-z0-9_-]{20,100}")
 
 

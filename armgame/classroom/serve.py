@@ -3,7 +3,7 @@
 uvicorn serves the app (``app.build_app``) on one address: by default the address of the network
 interface that holds the default route (the one the students' laptops share with the teacher's),
 found without sending a packet; ``--host 127.0.0.1`` keeps a trial on one machine. Ctrl-C stops the
-server: requests in flight get ``GRACE_SECONDS`` to finish, a hand-in being written is finished,
+server: requests in flight get ``SHUTDOWN_SECONDS`` to finish, a hand-in being written is finished,
 the projector's stream is closed, and nothing is half-written.
 
 uvicorn runs with the class's guard on its httptools protocol (``guard``: deadlines and a share of the
@@ -40,20 +40,10 @@ from typing import Any
 
 from ..errors import UserError
 from ..words import plural
+from .bounds import BACKLOG, CONCURRENCY, KEEP_ALIVE_SECONDS, SHUTDOWN_SECONDS
 from .rounds import REHEARSAL_ROUND_SECONDS
 
-GRACE_SECONDS = 3
 SERVER_LOCK = "server.lock"
-#: Connections served at once; past it uvicorn answers 503 itself. A lecture hall's round's end is 1,000
-#: students at the same moment: at 400, six in ten were sent away for 2 s, again and again (the clerk's own
-#: queue, bounded in bytes and one hand-in a player, is what keeps memory bounded). The process's limit of
-#: open files is raised to fit where the system allows (``_more_files``).
-CONCURRENCY = 2500
-#: Connections the system holds for the server to accept (capped by the system's own, 4,096 on Linux, 128 on
-#: macOS unless raised). Past it a new connection's first packet is dropped and its client sends it again a
-#: second later, then three: at 128, a round's end of 1,000 students at once, or a flood of clients, cost an
-#: honest student seconds before the server even saw their game.
-BACKLOG = 2048
 #: Why a rehearsal takes no folder, in one line.
 REHEARSE_NO_FOLDER = ("--rehearse keeps nothing: it plays in a temporary folder removed at Ctrl-C, so it takes no "
                       "--folder (leave out --rehearse to serve the class in that folder)")
@@ -245,8 +235,8 @@ def open_class(folder: Path | None, host: str, port: int, seed: int | None, say:
                     play_url=play_url, proxy=proxy, secret_always=secret_always)
     _more_files(CONCURRENCY + 256)
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="on",
-                            timeout_graceful_shutdown=GRACE_SECONDS, timeout_keep_alive=5,
-                            limit_concurrency=CONCURRENCY, h11_max_incomplete_event_size=16 * 1024,
+                            timeout_graceful_shutdown=SHUTDOWN_SECONDS, timeout_keep_alive=KEEP_ALIVE_SECONDS,
+                            limit_concurrency=CONCURRENCY,
                             http=guarded_protocol(guard), proxy_headers=False)
     errors = logging.getLogger("uvicorn.error")  # configured by uvicorn.Config, just above
     if not any(isinstance(f, _QuietWhenFull) for f in errors.filters):

@@ -5,7 +5,7 @@ The clerk and its thread (``worker.ClerkThread``), and the bounds on what may wa
 ``BUSY``: the client comes back), one hand-in a player (``TOKEN_SHARE``), a forger's next one after
 ``COOL_DOWN``; the wrong codes, secrets and tokens counted per address (``Guesses``) and the joins per
 address and for the class (``Window``); the pages' data, rebuilt on the clerk's thread after every change
-(``publish``), and the event streams told of it. The bounds are listed together in ``app``'s docstring.
+(``publish``), and the event streams told of it. The bounds are ``bounds``'s, each with its reason.
 """
 
 from __future__ import annotations
@@ -23,47 +23,29 @@ from typing import TypeVar
 from starlette.requests import Request
 
 from . import views
+from .bounds import (
+    CLASS_JOINS_PER_MINUTE,
+    COOL_DOWN,
+    FREE_GUESSES,
+    GUESS_WAIT,
+    HANDIN_QUEUE,
+    JOINS_PER_MINUTE,
+    MAX_GUESS_WAIT,
+    MAX_TRACKED_ADDRESSES,
+    QUEUE_BYTES,
+    QUEUE_LIMIT,
+    SMALL_UPLOADS,
+    TOKEN_SHARE,
+    UPLOADS,
+)
+from .errors import RefusedError
 from .guard import Guard
-from .intake import Answer, Clerk, RefusedError
+from .handins import Answer
+from .intake import Clerk
 from .roster import token_digest
+from .wire import BUSY
 from .worker import ClerkThread
 
-#: Jobs (a join, the teacher's requests) waiting for the clerk at once; past it, 503 and the client comes back.
-#: A join rewrites the roster, so a lecture hall's joins are let in a few at a time.
-QUEUE_LIMIT = 64
-#: Hand-ins waiting for the clerk at once. One checked and entered in a batch costs the clerk 2.5 ms (a bot's
-#: game 60 ms): room for a lecture hall's round's end (``benchmarks/class_server.py``), where a queue of 64
-#: sent nine students in ten away for 2 s, again and again.
-HANDIN_QUEUE = 1024
-#: The bodies those waiting hand-ins hold, in bytes at the most (a bot's game is 0.5 MB, a student's 9 KB).
-QUEUE_BYTES = 64 * 1024 * 1024
-#: Hand-ins of one player (one token) waiting at once: a client that floods the class has one in the queue,
-#: and its next is told the class is busy before its body is read, so a flooder's backlog never sits in
-#: front of an honest student's game.
-TOKEN_SHARE = 1
-#: Seconds a player's next hand-in is told the class is busy after one of theirs did not reproduce its score
-#: (422, found only by re-simulating it): a forger's next game waits its turn behind the honest students'
-#: instead of taking the clerk's time at once. An honest student's game is never refused so. A body that is
-#: not a class's game (400, 413) is refused before any re-simulation, cheaply, and does not count.
-COOL_DOWN = 2.0
-#: What a student is told when the class cannot take their game yet (their client hands it in again).
-BUSY = "the class is busy: your game is kept and will be handed in in a moment"
-#: Hand-in bodies of any size (up to ``wire.MAX_HANDIN_BYTES``: a bot's game, a lab run) read at once (from one
-#: address: ``app.UPLOADS_PER_ADDRESS``).
-UPLOADS = 16
-#: Hand-in bodies of at most ``SMALL_UPLOAD_BYTES`` (declared: a student's game is 9 KB) read at once, apart from
-#: ``UPLOADS``: 40 machines holding both of their places with bodies trickled a byte a second leave most of them
-#: free for an honest student's game (``tests/test_class_memory.py``), and all of them together hold 16 MiB.
-SMALL_UPLOADS = 256
-SMALL_UPLOAD_BYTES = 64 * 1024
-#: Wrong answers of one kind an address may give before it waits; then ``GUESS_WAIT`` seconds, doubled
-#: for every further wrong one (at most ``MAX_GUESS_WAIT``).
-FREE_GUESSES = 5
-GUESS_WAIT = 60.0
-MAX_GUESS_WAIT = 3600.0
-MAX_TRACKED_ADDRESSES = 10_000
-JOINS_PER_MINUTE = 3
-CLASS_JOINS_PER_MINUTE = 120
 #: The key of an ASGI scope whose request came through the teacher's proxy (``middleware.ForwardedFor``): its
 #: client is the address the proxy named, and it is never the teacher's machine (``ClassState.teachers_machine``).
 FORWARDED = "armgame.forwarded"

@@ -23,11 +23,9 @@ from datetime import datetime
 from typing import Any
 
 from ..records.standings import player_key, shared_rank
+from .bounds import STANDINGS_ROWS
 from .intake import Clerk
 from .rounds import round_view
-
-#: Rows of each list the standings carry: the projector shows the top, the CSV has everything.
-STANDINGS_ROWS = 60
 
 
 def standings(clerk: Clerk, teacher: bool = False) -> dict[str, object]:

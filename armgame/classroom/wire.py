@@ -1,8 +1,9 @@
-"""What the class and a student's machine both hold to: the join code's form and the largest hand-in.
+"""What the class and a student's machine both hold to: the join code's form and the busy class's line.
 
 No imports, so the student's client (``client``, ``memberships``) reads these without loading any of
 the server (``roster``, ``intake``, the clerk and what they import: numpy's batch replays, the table).
-A rule either side checks, and the other must agree with, belongs here.
+A rule either side checks, and the other must agree with, belongs here; a bound both sides hold to (the
+largest hand-in) is in ``bounds`` with the class's others, which imports nothing either.
 """
 
 from __future__ import annotations
@@ -11,10 +12,9 @@ from __future__ import annotations
 CODE_ALPHABET = "ACDEFGHJKMNPQRTUVWXY"
 #: Four letters: short to type from the back row.
 CODE_LENGTH = 4
-#: The largest hand-in a class reads: a 60 s bot game that acts every control period is about
-#: 0.55 MB and a lab run on a preset about 0.5 MB; eight times that, and no more, is read at once.
-#: The client keeps a bigger replay rather than send what the class would cut off.
-MAX_HANDIN_BYTES = 4 * 1024 * 1024
+#: What a student is told when the class cannot take their game yet: the class's 503, and the client's own line for
+#: a 503 without one (the server's connection limit). The client hands the game in again.
+BUSY = "the class is busy: your game is kept and will be handed in in a moment"
 
 
 def normal_code(text: str) -> str:

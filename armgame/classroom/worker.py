@@ -25,10 +25,9 @@ from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Generic, TypeVar
 
-from .intake import AGAIN, Answer, Checked, Clerk
-
-#: Hand-ins checked, re-simulated (one batch) and entered (one table write) together at the most.
-BATCH = 64
+from .bounds import BATCH
+from .handins import AGAIN, Answer, Checked
+from .intake import Clerk
 
 T = TypeVar("T")
 #: What a request is sent back: the value its work returned, or the exception it raised (raised in the request).

@@ -438,7 +438,8 @@ def _class_standing(session, args: argparse.Namespace, membership):
     import sys
     import threading
 
-    from ..classroom.client import TICKET_TIMEOUT, start_ticket
+    from ..classroom.bounds import TICKET_TIMEOUT
+    from ..classroom.client import start_ticket
     from ..records.replay import Replay
     from ..ui.render import Standing
 

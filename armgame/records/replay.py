@@ -312,8 +312,7 @@ class Replay:
         return cls(session.config, tuple(session.timeline), session.result(), driven, driver, player, now_iso())
 
     def with_player(self, player: str) -> Replay:
-        return Replay(self.config, self.timeline, self.result, self.driven, self.driver, check_name(player),
-                      self.date, self.version, self.task, self.timeline_text)
+        return replace(self, player=check_name(player))
 
     def replay(self, max_work: int | None = None) -> GameResult:
         """Recompute the result: the timeline replayed on a fresh session, no clock. With ``max_work``, a game

@@ -262,9 +262,10 @@ class ScoreTable(TableFile, TableChecks):
             try:
                 _enterable(replay)
                 data = replay.to_bytes()
-                name = self._replay_name(replay, data)
+                sha256 = hashlib.sha256(data).hexdigest()  # once: the file's name and the entry's replay_sha256
+                name = self._replay_name(replay, sha256)
                 known = game_digests(replay) if digests is None else tuple(digests[i])
-                results.append((_new_entry(replay, name, data, known), frozenset(known)))
+                results.append((_new_entry(replay, name, data, known, sha256), frozenset(known)))
                 files[name] = data
             except ValueError as exc:
                 results.append(exc)
@@ -322,14 +323,16 @@ def _enterable(replay: Replay) -> None:
         raise ValueError("only a game played to the end enters the table")
 
 
-def _new_entry(replay: Replay, replay_name: str, data: bytes, digests: Sequence[str] | None = None) -> ScoreEntry:
-    """The entry of ``replay``, whose file ``replay_name`` in replays/ holds ``data`` (not yet entered)."""
+def _new_entry(replay: Replay, replay_name: str, data: bytes, digests: Sequence[str] | None = None,
+               sha256: str | None = None) -> ScoreEntry:
+    """The entry of ``replay``, whose file ``replay_name`` in replays/ holds ``data`` (not yet entered); ``sha256``:
+    the digest of ``data``, where the caller has it already."""
     claims = replay_claims(replay, digests)
     r = replay.result
     return ScoreEntry.from_dict(dict(
         id=uuid.uuid4().hex, name=replay.player, driven=replay.driven, driver=replay.driver, score=r.score,
         hits=r.hits, resets=r.resets, seed=r.seed, scene=r.scene, duration=r.duration,
         date=replay.date or now_iso(), version=replay.version, replay=replay_name,
-        replay_sha256=hashlib.sha256(data).hexdigest(), ruleset=claims["ruleset"],
+        replay_sha256=sha256 or hashlib.sha256(data).hexdigest(), ruleset=claims["ruleset"],
         config_sha256=claims["config_sha256"], game_sha256=claims["game_sha256"], complete=True,
     ))

@@ -209,7 +209,7 @@ class TableFile:
         """Save the replay in replays/ (before the table is touched); returns its path."""
         self._safe_folder()
         data = replay.to_bytes()
-        path = self.replays / self._replay_name(replay, data)
+        path = self.replays / self._replay_name(replay, hashlib.sha256(data).hexdigest())
         try:
             if read_limited(path, MAX_REPLAY_BYTES, "replay file", follow=False) == data:
                 return path  # already there, byte for byte
@@ -219,13 +219,13 @@ class TableFile:
         return path
 
     @staticmethod
-    def _replay_name(replay: Replay, data: bytes) -> str:
-        """A replay's file name in replays/: its date, its player and its bytes' digest (never a name a
-        file or a client gave)."""
+    def _replay_name(replay: Replay, sha256: str) -> str:
+        """A replay's file name in replays/: its date, its player and its bytes' digest (``sha256``, hex; never a
+        name a file or a client gave)."""
         stamp = replay.date or now_iso()
         slug = name_slug(replay.player or "")
         when = datetime.fromisoformat(stamp).strftime("%Y%m%dT%H%M%S")
-        return f"{when}-{slug}-{hashlib.sha256(data).hexdigest()[:8]}.json"
+        return f"{when}-{slug}-{sha256[:8]}.json"
 
     def _enter_many(self, new_entries: Sequence[tuple[ScoreEntry, frozenset[str]]], seed: int | None = None
                     ) -> list[ScoreEntry | TableError]:
