@@ -47,6 +47,7 @@ GAME = {
 REPLAYS = {
     "armgame.records._ctimeline", "armgame.records.replay", "armgame.game._cbots", "armgame.game.bots",
     "armgame.lab.protocol_file", "armgame.lab.record", "armgame.lab.session", "armgame.physics.loads",
+    "armgame.game.variant",  # the lab session's speed guard (``variant.guarded``), Reach's own
 }
 #: ``play``'s own, with or without a class: the local table it keeps the game in, a bot to play it.
 PLAY = {
