@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from armgame.lab.learner import TwoRateLearner, simulate
+from armgame.lab.perturbations import VISCOUS_MAX_FEEDING
 from armgame.lab.presets import SAVINGS_WASHOUT, preset
 from armgame.lab.protocol import CHANNEL_DAMPING, CHANNEL_STIFFNESS
 from armgame.lab.session import LabSession, lab_config
@@ -149,7 +150,8 @@ def test_the_task_protocol_and_option_numbers():
     program, person = (lab_config(lesson, 10, person=who).time_limit for who in (False, True))
     _says(LAB, f"(`lesson`: {program:.0f} s and {person:.0f} s)")
     low, high = Viscous.parameters()[0][1:3]
-    _says(LAB, f"each entry from {low:.0f} to {high:.0f})",
+    _says(LAB, f"each entry from {low:.0f} to {high:.0f}, and the matrix may feed the arm at most "
+               f"{VISCOUS_MAX_FEEDING:g} N s/m",
           f"`channel_stiffness` (N/m, default {CHANNEL_STIFFNESS:.0f}, above 0 and at most "
           f"{MAX_CHANNEL_STIFFNESS:,.0f})",
           f"`channel_damping` (N s/m, default {CHANNEL_DAMPING:.0f}, 0 to {MAX_CHANNEL_DAMPING:.0f})",
