@@ -41,9 +41,10 @@ try:
 except ImportError:  # no C compiler at install: the SyncVectorEnv of single envs runs
     _ccenter = None  # type: ignore[assignment]
 
-#: From this many envs the batch is faster than ``SyncVectorEnv`` (benchmarks/env_speed.py; below it the two
-#: are within noise of each other, and SyncVectorEnv runs every protocol).
-BATCH_FROM = 1
+#: From this many envs the batch is faster than ``SyncVectorEnv`` (benchmarks/results/env_speed_center_out.json:
+#: 1.25 and 1.86 times at 4 envs, 0.44 and 0.67 times at 1, where its per-step numpy and C calls cost more than
+#: one lab session's step).
+BATCH_FROM = 4
 #: The most runs one batched vector env holds: a run's arrays and its path buffer take about 13 KB.
 MAX_BATCH_ENVS = 65536
 
@@ -166,12 +167,12 @@ class CenterOutBatchVectorEnv(VectorEnv):
 
     >>> import gymnasium as gym
     >>> import armgame.env
-    >>> envs = gym.make_vec("armgame/CenterOut-v1", num_envs=3)
+    >>> envs = gym.make_vec("armgame/CenterOut-v1", num_envs=4)
     >>> type(envs).__name__
     'CenterOutBatchVectorEnv'
     >>> obs, info = envs.reset(seed=0)
     >>> obs.shape, info["trial"].tolist()
-    ((3, 16), [0, 0, 0])
+    ((4, 16), [0, 0, 0, 0])
     """
 
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}  # noqa: RUF012
