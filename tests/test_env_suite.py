@@ -14,7 +14,7 @@ from gymnasium.utils.env_checker import check_env
 
 import armgame.env
 from armgame.env.base import EnvArgumentError
-from armgame.env.center_out_v1 import CenterOutVectorEnv
+from armgame.env.center_out_batch import MAX_BATCH_ENVS, CenterOutBatchVectorEnv
 from armgame.env.evaluation import evaluate, mean_interval, normalised_score
 from armgame.env.policies import BotPolicy, bot_policy
 from armgame.env.references import CEILINGS, REFERENCE_HITS
@@ -57,7 +57,7 @@ def test_gymnasiums_checker_passes_on_every_suite_id(env_id):
     assert env.unwrapped.continuous == ("Continuous" in env_id)
     name = env_id.split("/")[1].removesuffix("-v1").removesuffix("Continuous")
     if name in CENTER_OUT_SUITE:
-        assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, CenterOutVectorEnv)
+        assert isinstance(gym.make_vec(env_id, num_envs=8).unwrapped, CenterOutBatchVectorEnv)
         assert env.unwrapped.trial_start == CENTER_OUT_SUITE[name]["trial_start"]
         return
     vector = type(gym.make_vec(env_id, num_envs=8).unwrapped)
@@ -476,6 +476,12 @@ def test_the_size_cap_of_each_suite_ids_vector_env_is_the_one_the_docs_state():
             most = armgame.env.vector.MAX_ENV_MEMORY // (armgame.env.vector.BYTES_PER_ENV + ring + noise)
             assert f"`{name}-v1` and its twin at most {most:,} envs" in guide
             with pytest.raises(EnvArgumentError, match=f"at most {most:,} games"):
+                gym.make_vec(env_id, num_envs=most + 1, vectorization_mode="vector_entry_point")
+            continue
+        if name in CENTER_OUT_SUITE:  # the CenterOut batch (issue 52): its own cap, past SyncVectorEnv's
+            most = MAX_BATCH_ENVS
+            assert f"It holds up to {most:,} envs" in guide
+            with pytest.raises(EnvArgumentError, match=f"from 1 to {most:,}, got {most + 1}"):
                 gym.make_vec(env_id, num_envs=most + 1, vectorization_mode="vector_entry_point")
             continue
         with pytest.raises(EnvArgumentError, match=f"from 1 to {cap}, got {cap + 1}"):

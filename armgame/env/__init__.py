@@ -27,7 +27,7 @@ num_envs=N)`` gives one vector env: for Reach, from 4 games (2 with noise or a f
 ``vector.batch_min_envs``), ``vector.ReachVectorEnv`` stepping N games as numpy arrays on
 ``BatchGameSession`` (below that, for the score reward, and for noise and fields without the compiled kernel,
 ``vector_common.SingleEnvsVectorEnv``, Gymnasium's ``SyncVectorEnv`` of single envs); for
-CenterOut-v1, ``center_out_v1.CenterOutVectorEnv``. ``sb3`` adapts
+CenterOut-v1, ``center_out_batch.center_out_vector_env`` (the batch in C, else ``SyncVectorEnv``). ``sb3`` adapts
 them to Stable-Baselines3 (and is the only module that imports it). ``import armgame`` imports neither
 gymnasium nor this package, and nothing here imports pygame until an env renders::
 
@@ -83,11 +83,11 @@ def _register() -> None:
         if env_id not in gymnasium.registry:
             # An episode is a few trials or a block: it ends itself (terminated).
             gymnasium.register(id=env_id, entry_point="armgame.env.center_out_v1:CenterOutV1Env",
-                               vector_entry_point="armgame.env.center_out_v1:CenterOutVectorEnv",
+                               vector_entry_point="armgame.env.center_out_batch:center_out_vector_env",
                                kwargs={"continuous": continuous}, max_episode_steps=None, nondeterministic=False)
     suites = ((SUITE, "armgame.env.reach_v1:ReachV1Env", "armgame.env.vector:reach_v1_vector_env"),
               (CENTER_OUT_SUITE, "armgame.env.center_out_v1:CenterOutV1Env",
-               "armgame.env.center_out_v1:CenterOutVectorEnv"))
+               "armgame.env.center_out_batch:center_out_vector_env"))
     for suite, entry_point, vector_entry_point in suites:
         for name, arguments in suite.items():
             for continuous in (False, True):

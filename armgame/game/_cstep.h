@@ -124,10 +124,13 @@ static inline void elbow(const Arm *arm, int fast, double q2, double delta, doub
 /* Steps between full cos and sin of the elbow in the fast kernel (turned ones gather round-off). */
 #define REANCHOR 32
 
-/* A field at the hand (loads.CurlField, loads.ViscousField) and the flag of a game the guard stopped. */
-enum { FIELD_NONE = 0, FIELD_CURL = 1, FIELD_VISCOUS = 2 };
+/* A field at the hand (loads.CurlField, loads.ViscousField, loads.ConstantForce, loads.SpringField) or at the
+ * joints (a loads.JointLoad of viscosity alone, the lab's ``joint_viscous``), and the flag of a game the guard
+ * stopped. */
+enum { FIELD_NONE = 0, FIELD_CURL = 1, FIELD_VISCOUS = 2, FIELD_CONSTANT = 3, FIELD_SPRING = 4, FIELD_JOINT = 5 };
 
-/* A field at the hand: its kind, parameters (curl b; viscous b11 b12 b21 b22) and the arm's lengths. */
+/* A field: its kind, parameters (curl b; viscous b11 b12 b21 b22; constant fx fy; spring stiffness, anchor x y;
+ * joint w11 w12 w21 w22) and the arm's lengths. */
 typedef struct {
     int kind;
     double p[4], l1, l2;
@@ -138,6 +141,11 @@ typedef struct {
 static inline void field_torque(const Field *f, double s1, double c1, double s12, double c12, double w1, double w2,
                                 double *e1, double *e2)
 {
+    if (f->kind == FIELD_JOINT) {  /* torque (0, 0) + W w, no hand force: Python's c1 + v11 * w1 + v12 * w2 */
+        *e1 = 0.0 + f->p[0] * w1 + f->p[1] * w2;
+        *e2 = 0.0 + f->p[2] * w1 + f->p[3] * w2;
+        return;
+    }
     const double j12 = -f->l2 * s12, j22 = f->l2 * c12;
     const double j11 = -f->l1 * s1 + j12, j21 = f->l1 * c1 + j22;
     const double vx = j11 * w1 + j12 * w2, vy = j21 * w1 + j22 * w2;
@@ -145,6 +153,16 @@ static inline void field_torque(const Field *f, double s1, double c1, double s12
     if (f->kind == FIELD_CURL) {
         fx = f->p[0] * vy;
         fy = -f->p[0] * vx;
+    } else if (f->kind == FIELD_CONSTANT || f->kind == FIELD_SPRING) {
+        /* The hand as _with_loads passes it: l1 cos q1 + l2 cos(q1 + q2), l1 sin q1 + l2 sin(q1 + q2). */
+        const double x = f->l1 * c1 + f->l2 * c12, y = f->l1 * s1 + f->l2 * s12;
+        if (f->kind == FIELD_CONSTANT) {
+            fx = f->p[0] + 0.0 * x;
+            fy = f->p[1] + 0.0 * y;
+        } else {
+            fx = -f->p[0] * (x - f->p[1]);
+            fy = -f->p[0] * (y - f->p[2]);
+        }
     } else {
         fx = f->p[0] * vx + f->p[1] * vy;
         fy = f->p[2] * vx + f->p[3] * vy;

@@ -1,0 +1,452 @@
+"""CenterOut-v1's batched vector env: N lab runs stepped together in C (``_ccenter.c``).
+
+``CenterOutBatchVectorEnv`` is what ``gymnasium.make_vec`` returns for the CenterOut-v1 ids from
+``BATCH_FROM`` envs on, where the C extension was built and the protocol is one it runs; otherwise
+``center_out_v1.CenterOutVectorEnv`` (``SyncVectorEnv`` of single envs) runs. The C loop owns each run's
+physics and the task's hold and reach; this module keeps, per run, what the lab keeps per trial: the
+trials (``lab.session.schedule``, drawn from the run's seed as ``LabSession`` draws them), the outcomes,
+their rows of the lab's table (``info["reaches"]``), the hits, and the next trial's description.
+
+Sub-env ``i`` is the single env seeded as ``SyncVectorEnv`` seeds it, bit for bit: observations,
+rewards, flags and infos (``tests/test_env_center_out_batch.py``). What it does not run, ``batch_refusal``
+says in one line: a protocol with channel trials, a hidden cursor, or blocks at another posture, the
+``SameStep`` autoreset, and frames (``render_mode``).
+"""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+from gymnasium.error import ResetNeeded
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from ..game.variant import runaway_message
+from ..lab.analysis import trial_row
+from ..lab.perturbations import Perturbation
+from ..lab.protocol import Protocol
+from ..lab.session import LabSession, TrialOutcome, TrialPlan, lab_config, schedule
+from ..physics.loads import ConstantForce, CurlField, SpringField, ViscousField
+from .base import EnvArgumentError
+from .center_out_v1 import CenterOutV1Env
+from .reach import check_seed, drawn_seed, speed_bound
+from .vector_common import AutoresetBook, check_reset_mask
+
+try:
+    from . import _ccenter
+except ImportError:  # no C compiler at install: the SyncVectorEnv of single envs runs
+    _ccenter = None  # type: ignore[assignment]
+
+#: From this many envs the batch is faster than ``SyncVectorEnv`` (benchmarks/results/env_speed_center_out.json:
+#: 1.25 and 1.86 times at 4 envs, 0.44 and 0.67 times at 1, where its per-step numpy and C calls cost more than
+#: one lab session's step).
+BATCH_FROM = 4
+#: The most runs one batched vector env holds: a run's arrays and its path buffer take about 13 KB.
+MAX_BATCH_ENVS = 65536
+
+# The columns of the C loop's arrays (``_ccenter.c``'s enums).
+S_X, S_A, S_G, S_R, S_CX, S_CY, S_FW1, S_FW2, S_COUNT = 0, 4, 8, 12, 16, 17, 18, 19, 20
+I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_COUNT = range(10)
+T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP = range(11)
+T_SHOW, T_SP = T_FP + 4, T_FP + 5
+T_HOLD_AT_HOME, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT = T_SP + 6, T_SP + 7, T_SP + 8, T_SP + 9, T_SP + 10
+EVENT_HIT, EVENT_MISS, EVENT_STOPPED = 1, 2, 3
+
+
+def batch_refusal(protocol: Protocol) -> str | None:
+    """Why the batch cannot run ``protocol`` (one line), or None when it can."""
+    if _ccenter is None:
+        return "the C extension armgame.env._ccenter was not built"
+    if protocol.has_channels:
+        return "the protocol has channel trials"
+    if len(protocol.postures_deg) > 1:
+        return "the protocol has blocks at another posture"
+    if any(b.feedback != "full" or b.probes_feedback != "full" for b in protocol.blocks):
+        return "the protocol hides the cursor on some trials"
+    return None
+
+
+def field_row(perturbation: Perturbation, home: tuple[float, float]) -> tuple[int, tuple[float, ...]]:
+    """The C loop's field (kind, parameters) for a perturbation's loads: kind 0 where the arm's own step runs."""
+    loads = perturbation.loads(home)
+    if loads is None:
+        return 0, ()
+    if loads.joint is not None:
+        (a, b), (c, d) = loads.joint.viscosity
+        assert loads.hand is None and loads.joint.torque == (0.0, 0.0)
+        return 5, (a, b, c, d)
+    hand = loads.hand
+    if isinstance(hand, CurlField):
+        return 1, (hand.b,)
+    if isinstance(hand, ViscousField):
+        (a, b), (c, d) = hand.matrix
+        return 2, (a, b, c, d)
+    if isinstance(hand, ConstantForce):
+        return 3, (hand.fx, hand.fy)
+    if isinstance(hand, SpringField):
+        return 4, (hand.stiffness, *hand.anchor)
+    raise EnvArgumentError(f"the batch has no field for {perturbation.kind}")
+
+
+def show_row(perturbation: Perturbation, home: tuple[float, float],
+             home_q: tuple[float, float]) -> tuple[int, tuple[float, ...]]:
+    """The C loop's display (kind, numbers) from the transform's ``plan``: 0 for the hand as it is."""
+    show = perturbation.display(home, home_q)
+    if show is None:
+        return 0, ()
+    kind, *numbers = show.plan  # type: ignore[attr-defined]
+    return (1 if kind == "linear" else 2), tuple(numbers)
+
+
+class _Task:
+    """What every run of one protocol shares: its session's constants, from one ``LabSession``."""
+
+    def __init__(self, protocol: Protocol, hold_at_home: bool) -> None:
+        config = lab_config(protocol, 0)
+        session = LabSession(config, protocol, hold_at_home=hold_at_home, speed_limit=speed_bound(config))
+        self.protocol, self.config, self.dt = protocol, config, config.dt
+        self.home, self.home_q = session.home, tuple(session.home_q)
+        self.total_steps = session.total_steps
+        compiled = session._compiled
+        if compiled is None:
+            raise EnvArgumentError("the batch needs the game's compiled kernel (armgame.game._ckernel)")
+        self.params = np.frombuffer(compiled[0], dtype=np.float64).copy()
+        self.mode = int(compiled[1])
+        self.rise = np.array(session.muscles._rise)
+        self.decay = np.array(session.muscles._decay)
+        base = np.zeros(T_COUNT)
+        base[[T_HX, T_HY, T_HR, T_HQ1, T_HQ2]] = (*self.home, protocol.home_radius, *self.home_q)
+        base[T_TR] = protocol.target_radius
+        base[[T_HOLD_AT_HOME, T_HOLD, T_TIMEOUT, T_LIMIT]] = (float(hold_at_home), session.hold_steps,
+                                                             session.timeout_steps, session.speed_limit)
+        self.base = base
+        self.cap = session.timeout_steps + 2
+        self._rows: dict[Perturbation, np.ndarray] = {}
+        self.stub = SimpleNamespace(config=SimpleNamespace(dt=self.dt), protocol=protocol)
+
+    def trial(self, plan: TrialPlan) -> np.ndarray:
+        """A trial's row of the C loop's ``trials``."""
+        perturbation = plan.active
+        row = self._rows.get(perturbation)
+        if row is None:
+            row = self.base.copy()
+            kind, numbers = field_row(perturbation, self.home)
+            row[T_FIELD], row[T_FP:T_FP + len(numbers)] = kind, numbers
+            kind, numbers = show_row(perturbation, self.home, self.home_q)  # type: ignore[arg-type]
+            row[T_SHOW], row[T_SP:T_SP + len(numbers)] = kind, numbers
+            self._rows[perturbation] = row
+        row = row.copy()
+        row[[T_DELAY, T_TX, T_TY]] = (plan.delay_steps, *plan.position)
+        return row
+
+
+class _Run:
+    """One sub-env's run: its trials and what the lab counts of them."""
+
+    __slots__ = ("finished", "first_block", "first_trial", "hits", "plans", "stopped", "task", "trial_index")
+
+    def __init__(self, task: _Task, seed: int) -> None:
+        self.task = task
+        self.plans = schedule(task.protocol, seed, task.dt, task.home)
+        self.trial_index = self.hits = self.first_trial = 0
+        self.first_block = self.plans[0].block
+        self.finished = False
+        self.stopped: str | None = None
+
+    def block_name(self) -> str:
+        return self.plans[min(self.trial_index, len(self.plans) - 1)].block_name
+
+
+class CenterOutBatchVectorEnv(VectorEnv):
+    """``num_envs`` CenterOut-v1 envs stepped together in C; the arguments are the single env's
+    (``CenterOutV1Env``), with ``autoreset_mode`` ``"NextStep"`` (default) or ``"Disabled"``.
+
+    >>> import gymnasium as gym
+    >>> import armgame.env
+    >>> envs = gym.make_vec("armgame/CenterOut-v1", num_envs=4)
+    >>> type(envs).__name__
+    'CenterOutBatchVectorEnv'
+    >>> obs, info = envs.reset(seed=0)
+    >>> obs.shape, info["trial"].tolist()
+    ((4, 16), [0, 0, 0, 0])
+    """
+
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}  # noqa: RUF012
+
+    def __init__(self, num_envs: int = 1, *, autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
+                 **kwargs: Any) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, int | np.integer) \
+                or not 1 <= num_envs <= MAX_BATCH_ENVS:
+            raise EnvArgumentError(f"num_envs must be a whole number from 1 to {MAX_BATCH_ENVS:,}, got {num_envs!r}")
+        self.template = env = CenterOutV1Env(**kwargs)  # checks the arguments, one line for a bad one
+        self._book = AutoresetBook(int(num_envs), autoreset_mode)
+        if self._book.mode is AutoresetMode.SAME_STEP:
+            raise EnvArgumentError("the batched CenterOut vector env autoresets NextStep or Disabled")
+        refusal = batch_refusal(env.protocol)
+        if refusal is not None:
+            raise EnvArgumentError(f"no batched CenterOut env for this protocol: {refusal}")
+        self.num_envs = n = int(num_envs)
+        self.metadata = {**self.metadata, "autoreset_mode": self._book.mode, "render_fps": 1.0 / env.decision_time}
+        self.render_mode = None
+        self.single_action_space = env.action_space
+        self.single_observation_space = env.observation_space
+        self.action_space = batch_space(env.action_space, n)
+        self.observation_space = batch_space(env.observation_space, n)
+        self._tasks: dict[Protocol, _Task] = {}
+        task = self._task(env.protocol)
+        self.state = np.zeros((n, S_COUNT))
+        self.ints = np.zeros((n, I_COUNT), dtype=np.int64)
+        self.trials = np.zeros((n, T_COUNT))
+        self.xs = np.zeros((n, task.cap))
+        self.ys = np.zeros((n, task.cap))
+        self._obs = np.zeros((n, 16))
+        self.held = np.zeros((n, 4), dtype=bool)
+        self.runs: list[_Run | None] = [None] * n
+        self._generators: list[np.random.Generator | None] = [None] * n
+        self._edge = np.zeros(n)
+        self._shown = np.zeros((n, 2), dtype=np.int64)
+
+    # ----------------------------------------------------------------- the API
+    def reset(self, *, seed: int | list[int | None] | None = None,
+              options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+        n = self.num_envs
+        options = dict(options or {})
+        mask = check_reset_mask(options.pop("reset_mask", None), n, have_games=self.runs[0] is not None)
+        if seed is None or isinstance(seed, int | np.integer):
+            seeds: list[int | None] = [None] * n if seed is None else [int(check_seed(seed)) + i for i in range(n)]
+        elif isinstance(seed, list | tuple) and len(seed) == n:
+            seeds = list(seed)
+        else:
+            raise EnvArgumentError(f"seed must be None, a whole number or a list of {n} seeds, got {seed!r}")
+        chosen = np.ones(n, dtype=bool) if mask is None else mask
+        for i in np.flatnonzero(chosen):
+            self._start_episode(int(i), seeds[i], options)
+        self._advance()
+        self._book.reset(chosen)
+        return self._observations(), self._infos(np.ones(n, dtype=bool) if mask is None else chosen)
+
+    def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        if self.runs[0] is None:
+            raise ResetNeeded("call reset() before step()")
+        book = self._book
+        book.before_step()
+        n = self.num_envs
+        restart = book.restart_now.copy()
+        stepping = ~restart
+        self._act(actions, stepping)
+        ints = self.ints
+        steps_before = ints[:, I_STEPS].copy()
+        hits_before = np.array([r.hits for r in self.runs])  # type: ignore[union-attr]
+        ints[:, I_TODO] = np.where(stepping, self.template.decision_steps, 0)
+        reaches = self._advance()
+        hits = np.array([r.hits for r in self.runs]) - hits_before  # type: ignore[union-attr]
+        ran = ints[:, I_STEPS] - steps_before
+        rewards = self._rewards(hits, stepping) - self.template.time_cost * ran * self.task_dt
+        over = np.array([self._over(i) for i in range(n)])
+        finished = np.array([r.finished for r in self.runs])  # type: ignore[union-attr]
+        stopped = np.array([r.stopped is not None for r in self.runs])  # type: ignore[union-attr]
+        truncated = (ints[:, I_STEPS] >= ints[:, I_TOTAL]) & ~finished & ~stopped & stepping
+        terminated = over & ~truncated & stepping
+        infos = self._infos(np.ones(n, dtype=bool))
+        if reaches:
+            infos["reaches"] = np.full(n, None, dtype=object)
+            infos["_reaches"] = np.zeros(n, dtype=bool)
+            for i, rows in reaches.items():
+                infos["reaches"][i] = rows
+                infos["_reaches"][i] = True
+        where = stopped & stepping
+        if where.any():
+            infos["stopped"] = np.full(n, None, dtype=object)
+            for i in np.flatnonzero(where):
+                infos["stopped"][i] = self.runs[i].stopped  # type: ignore[union-attr]
+            infos["_stopped"] = where
+        if restart.any():
+            for i in np.flatnonzero(restart):
+                self._start_episode(int(i), None, {})
+            self._advance()
+            rewards[restart] = 0.0
+            restarted = self._infos(restart)
+            for key in ("trial", "trials_done", "hits", "block"):
+                infos[key][restart] = restarted[key][restart]
+        book.after_step(terminated | truncated)
+        return self._observations(), rewards, terminated, truncated, infos
+
+    # --------------------------------------------------------------- internals
+    @property
+    def task_dt(self) -> float:
+        return self._task(self.template.protocol).dt
+
+    def _task(self, protocol: Protocol) -> _Task:
+        task = self._tasks.get(protocol)
+        if task is None:
+            task = self._tasks[protocol] = _Task(protocol, self.template.hold_at_home)
+        return task
+
+    def _start_episode(self, i: int, seed: int | None, options: dict[str, Any]) -> None:
+        """CenterOutV1Env._start_episode for sub-env ``i``."""
+        env, run = self.template, self.runs[i]
+        if env.continue_run and seed is None and not options and run is not None \
+                and not self._run_over(i) and self._over(i):
+            run.first_trial = run.trial_index
+            run.first_block = run.plans[run.trial_index].block
+        else:
+            if seed is not None:
+                seed = check_seed(seed)
+            protocol = env.protocol if run is None else run.task.protocol
+            if options:
+                env.protocol = protocol
+                env._take_options(options)  # one line for a bad option, as the single env's reset
+                protocol = env.protocol
+                refusal = batch_refusal(protocol)
+                if refusal is not None:
+                    raise EnvArgumentError(f"no batched CenterOut env for this protocol: {refusal}")
+            if seed is not None or self._generators[i] is None:
+                self._generators[i], _ = seeding.np_random(seed)
+            lab_seed = seed if seed is not None else drawn_seed(self._generators[i])  # type: ignore[arg-type]
+            task = self._task(protocol)
+            run = self.runs[i] = _Run(task, lab_seed)
+            self.state[i] = 0.0
+            self.state[i, S_X:S_X + 2] = task.home_q
+            self.state[i, S_R:S_R + 4] = task.decay
+            self.state[i, S_CX:S_CY + 1] = task.home
+            self.ints[i] = 0
+            self.ints[i, I_TOTAL] = task.total_steps
+            self.trials[i] = task.trial(run.plans[0])
+            self.held[i] = False
+        self._shown[i] = (run.trial_index, self.ints[i, I_PHASE])
+        self._edge[i] = math.nan  # measured after the C loop's observation (``_advance``)
+
+    def _run_over(self, i: int) -> bool:
+        run = self.runs[i]
+        assert run is not None
+        return run.finished or self.ints[i, I_STEPS] >= self.ints[i, I_TOTAL]
+
+    def _over(self, i: int) -> bool:
+        run = self.runs[i]
+        assert run is not None
+        if self._run_over(i):
+            return True
+        if self.template.episode_trials == "block":
+            return run.plans[run.trial_index].block != run.first_block
+        return run.trial_index - run.first_trial >= self.template.episode_trials  # type: ignore[operator]
+
+    def _act(self, actions: Any, stepping: np.ndarray) -> None:
+        """The single env's ``_press_keys`` or ``_set_levels`` on every stepping run that is not over."""
+        n = self.num_envs
+        live = stepping & (self.ints[:, I_STEPS] < self.ints[:, I_TOTAL])
+        live &= ~np.array([r.finished for r in self.runs])  # type: ignore[union-attr]
+        rise = np.stack([r.task.rise for r in self.runs]) if len(self._tasks) > 1 else \
+            next(iter(self._tasks.values())).rise  # type: ignore[union-attr]
+        decay = np.stack([r.task.decay for r in self.runs]) if len(self._tasks) > 1 else \
+            next(iter(self._tasks.values())).decay  # type: ignore[union-attr]
+        goal, rate = self.state[:, S_G:S_G + 4], self.state[:, S_R:S_R + 4]
+        if self.template.continuous:
+            levels = np.asarray(actions, dtype=np.float64)
+            if levels.shape != (n, 4) or not np.isfinite(levels[stepping]).all():
+                raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) finite numbers in [-1, 1], got "
+                                 f"shape {levels.shape}")
+            levels = np.clip((levels + 1.0) * 0.5, 0.0, 1.0)
+            up = levels > self.state[:, S_A:S_A + 4]
+            where = live[:, None]
+            goal[...] = np.where(where, levels, goal)
+            rate[...] = np.where(where, np.where(up, rise, decay), rate)
+            return
+        pressed = np.asarray(actions)
+        if pressed.shape != (n, 4) or not np.isin(pressed[stepping], (0, 1)).all():
+            raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) zeros or ones (keys held), got shape "
+                             f"{pressed.shape}")
+        down = pressed == 1
+        change = (down != self.held) & live[:, None]
+        self.held ^= change
+        goal[...] = np.where(change, down.astype(np.float64), goal)
+        rate[...] = np.where(change, np.where(down, rise, decay), rate)
+
+    def _advance(self) -> dict[int, list[dict[str, object]]]:
+        """Run the C loop until every run has run its steps, ending trials as ``LabSession._task_step`` does."""
+        reaches: dict[int, list[dict[str, object]]] = {}
+        task = self._task(self.template.protocol)
+        ints, state, trials = self.ints, self.state, self.trials
+        while _ccenter.advance(task.params, task.mode, state, ints, trials, self.xs, self.ys, self._obs):
+            for i in np.flatnonzero(ints[:, I_EVENT]):
+                run = self.runs[i]
+                assert run is not None
+                event = int(ints[i, I_EVENT])
+                ints[i, I_EVENT] = 0
+                if event == EVENT_STOPPED:
+                    run.stopped = runaway_message(trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
+                    ints[i, I_TODO] = 0
+                    continue
+                path = int(ints[i, I_PATH])
+                plan = run.plans[run.trial_index]
+                outcome = TrialOutcome(plan, int(ints[i, I_GO]), int(ints[i, I_STEPS]), event == EVENT_HIT,
+                                       self.xs[i, :path].tolist(), self.ys[i, :path].tolist())
+                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome))  # type: ignore[arg-type]
+                run.hits += event == EVENT_HIT
+                run.trial_index += 1
+                if run.trial_index >= len(run.plans):
+                    run.finished = True
+                    ints[i, I_TODO] = 0
+                else:
+                    trials[i] = run.task.trial(run.plans[run.trial_index])
+        self._measure_new()
+        return reaches
+
+    def _measure_new(self) -> None:
+        fresh = np.isnan(self._edge)
+        if fresh.any():
+            self._edge[fresh] = self._edges()[fresh]
+
+    def _edges(self) -> np.ndarray:
+        """Each cursor's distance to its shown target's edge, by ``math.hypot`` as the single env measures it."""
+        obs = self._obs
+        radius = np.where(self.ints[:, I_PHASE] == 1, self.trials[:, T_TR], self.trials[:, T_HR])
+        d = np.fromiter(map(math.hypot, obs[:, 12].tolist(), obs[:, 13].tolist()), float, self.num_envs)
+        return np.maximum(0.0, d - radius)
+
+    def _rewards(self, hits: np.ndarray, stepping: np.ndarray) -> np.ndarray:
+        env = self.template
+        if env.reward_kind == "sparse":
+            return hits.astype(np.float64)
+        shown = np.stack([np.array([r.trial_index for r in self.runs]), self.ints[:, I_PHASE]], axis=1)  # type: ignore[union-attr]
+        edge = self._edges()
+        same = (shown == self._shown).all(axis=1)
+        progress = np.where(same, self._edge - edge, 0.0)
+        self._edge = np.where(stepping, edge, self._edge)
+        self._shown = np.where(stepping[:, None], shown, self._shown)
+        return env.progress_weight * progress + env.hit_bonus * hits
+
+    def _observations(self) -> np.ndarray:
+        return self._obs.astype(self.template.observation_dtype)
+
+    def _infos(self, games: np.ndarray) -> dict[str, Any]:
+        runs = self.runs
+        trial = np.array([r.trial_index for r in runs])  # type: ignore[union-attr]
+        hits = np.array([r.hits for r in runs])  # type: ignore[union-attr]
+        block = np.empty(self.num_envs, dtype=object)
+        block[:] = [r.block_name() for r in runs]  # type: ignore[union-attr]
+        infos: dict[str, Any] = {}
+        for key, value in (("trial", trial), ("trials_done", trial.copy()), ("hits", hits), ("block", block)):
+            infos[key] = np.where(games, value, np.zeros_like(value) if value.dtype != object else None)
+            infos[f"_{key}"] = games.copy()
+        return infos
+
+
+def center_out_vector_env(num_envs: int = 1, *, autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
+                          render_mode: str | None = None, **kwargs: Any) -> VectorEnv:
+    """The CenterOut-v1 ids' vector entry point: the batch where it runs (``batch_refusal``, from ``BATCH_FROM``
+    envs, without frames or the ``SameStep`` autoreset), else ``SyncVectorEnv`` of single envs (at most 4,096)."""
+    from .center_out import run_protocol
+    from .center_out_v1 import CenterOutVectorEnv
+
+    mode = AutoresetBook(1, autoreset_mode).mode  # checked in one line
+    protocol = kwargs.get("protocol", "null")
+    batched = render_mode is None and mode is not AutoresetMode.SAME_STEP \
+        and isinstance(num_envs, int | np.integer) and not isinstance(num_envs, bool) and num_envs >= BATCH_FROM \
+        and batch_refusal(run_protocol(protocol, kwargs.get("perturbation"))) is None
+    if batched:
+        return CenterOutBatchVectorEnv(num_envs, autoreset_mode=mode, **kwargs)
+    return CenterOutVectorEnv(num_envs, autoreset_mode=mode, render_mode=render_mode, **kwargs)
