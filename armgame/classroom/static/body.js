@@ -105,7 +105,7 @@ export function limbOutline(start, end, [w0, w1]) {
     [end[0] - w1 * nx, end[1] - w1 * ny], [start[0] - w0 * nx, start[1] - w0 * ny]];
 }
 
-function palm(wrist, hand, grow) {
+export function palm(wrist, hand, grow) {
   const dx = hand[0] - wrist[0], dy = hand[1] - wrist[1], length = Math.hypot(dx, dy) || 1e-9;
   const ux = dx / length, uy = dy / length, nx = -uy, ny = ux;
   const halfL = HAND[0] * 1.1 + grow, halfW = HAND[1] + grow;
