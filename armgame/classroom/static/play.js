@@ -278,9 +278,9 @@ async function finish() {
   fingers.clear();
   showEnd("handing in…", "");
   const body = game.replayJSON(link.member.name);  // any seed's digits exact (a seed past 2^53 is a BigInt)
-  const start = ticket === null ? null : await ticket;
+  const given = ticket === null ? null : await ticket;
   ticket = null;
-  const answer = await link.handIn(body, "game", (line) => showEnd(line, ""), start);
+  const answer = await link.handIn(body, "game", (line) => showEnd(line, ""), given);
   if (answer.data) showEnd(answer.line, answer.kind, answer.data); else showEnd(answer.line, answer.kind);
 }
 
@@ -323,9 +323,9 @@ function showEnd(line, kind, data) {
     for (const [i, [rank, name, score]] of data.top.entries()) {
       const row = table.insertRow();
       if (i === data.yours) row.className = "mine";
-      for (const [text, kind] of [[rank + ".", "rank"], [name, "name"], [String(score), "score"]]) {
+      for (const [text, column] of [[rank + ".", "rank"], [name, "name"], [String(score), "score"]]) {
         const cell = row.insertCell();
-        cell.className = kind;
+        cell.className = column;
         cell.textContent = text;
       }
     }
