@@ -21,7 +21,7 @@ globalThis.localStorage = new FakeStorage();
 const kept = await import(new URL("kept.js", STATIC));
 const { ANOTHER_CLASS, ClassLink, handInLine } = await import(new URL("outbox.js", STATIC));
 const { COUNTDOWN, MAX_FRAME, PlayedGame } = await import(new URL("model.js", STATIC));
-const { MIN_TEXT_AT_720, MIN_TEXT_FRACTION, clockText, layout, textSizes } = await import(new URL("view.js", STATIC));
+const { WARN_SECONDS, clockText, hudWords, layout } = await import(new URL("view.js", STATIC));
 
 const CLASS = "c1a55", CODE = "ABCD";
 const MEMBER = { code: CODE, name: "Ann", token: "tok-ann", seed: 7, duration: 60, class: CLASS };
@@ -163,46 +163,43 @@ describe("model.js", () => {
 });
 
 describe("view.js", () => {
-  const measure = (text, size, bold) => text.length * size * (bold ? 0.62 : 0.55);
+  const arm = { l1: 0.34, l2: 0.46 };
   const hud = { seed: 7, name: "Ann", score: 12, timeLeft: 42.25, keys: ["d", "f", "j", "k"],
-    names: ["pectoralis major", "posterior deltoid", "biceps", "triceps"], activation: [0, 0.5, 2, -1],
-    touchMode: false, resetCost: 2, arm: { l1: 0.34, l2: 0.46 } };
+    names: ["pectoralis", "posterior deltoid", "biceps", "triceps"], activation: [0, 0.5, 2, -1],
+    touchMode: false, resetCost: 2, phase: "playing", countdownLeft: 0 };
   const inside = (a, b) => a.x >= b.x - 1e-9 && a.y >= b.y - 1e-9 && a.x + a.w <= b.x + b.w + 1e-9 &&
     a.y + a.h <= b.y + b.h + 1e-9;
-  const reachBox = (lay) => ({ x: lay.reach.x, y: lay.reach.y, w: lay.reach.width, h: lay.reach.height });
 
-  // The HUD beside the scene from 1.15 times as wide as high (a laptop, a phone held sideways), above it otherwise.
-  for (const [w, h, beside] of [[1280, 720, true], [844, 390, true], [1000, 820, true], [390, 844, false],
-    [768, 1024, false], [1000, 900, false]]) {
-    test(`at ${w}x${h} the reach is whole in the scene, the scene in the canvas, and no text over the scene`, () => {
-      const lay = layout(w, h, hud, measure);
-      assert.equal(lay.landscape, beside);
+  for (const [w, h] of [[1280, 720], [844, 390], [390, 500], [300, 260], [2560, 1440]]) {
+    test(`at ${w}x${h} the arm's whole reach is in the scene, the scene in the canvas, and as large as fits`, () => {
+      const lay = layout(w, h, arm);
+      const reach = { x: lay.reach.x, y: lay.reach.y, w: lay.reach.width, h: lay.reach.height };
       assert.ok(inside(lay.scene, { x: 0, y: 0, w, h }), JSON.stringify(lay.scene));
-      assert.ok(inside(reachBox(lay), lay.scene), JSON.stringify([lay.reach, lay.scene]));
-      for (const [text, x, y, size] of lay.labels) {
-        const box = { x, y, w: measure(text, size, false), h: size * 1.2 };
-        assert.ok(inside(box, { x: 0, y: 0, w, h }), `${text} at ${x},${y}`);
-        const over = box.x < lay.scene.x + lay.scene.w && lay.scene.x < box.x + box.w &&
-          box.y < lay.scene.y + lay.scene.h && lay.scene.y < box.y + box.h;
-        assert.ok(!over, `${text} lies over the scene`);
-      }
-      const floor = Math.max(Math.round(MIN_TEXT_AT_720 * Math.min(w, h) / 720), Math.round(MIN_TEXT_FRACTION * h));
-      assert.ok(textSizes(w, h).small >= floor);
-      assert.deepEqual(lay.bars.map((b) => b[5]), [0, 0.5, 1, 0], "activations shown between 0 and 1");
+      assert.ok(inside(reach, lay.scene), JSON.stringify([lay.reach, lay.scene]));
+      // The scene's shorter side holds the reach and its margin: no more room is left unused.
+      const side = Math.min(lay.scene.w, lay.scene.h);
+      assert.ok(Math.abs(lay.view.scale * 2 * (arm.l1 + arm.l2 + 0.04) - side) < 1e-9, String(lay.view.scale));
+      assert.ok(Math.abs(lay.view.ox - (lay.scene.x + lay.scene.w / 2)) < 1e-9, "the shoulder in the middle");
     });
   }
 
-  test("the clock's words and its warning, and a long name fitted on a line of its own", () => {
-    assert.equal(clockText(42.25), "42.3");
+  test("the HUD's words: the clock and its warning, the bars' levels, the help, the countdown", () => {
+    const words = hudWords(hud);
+    assert.deepEqual([words.seed, words.name, words.score, words.clock], ["seed 7", "Ann", "Score 12", "Time 42.3"]);
+    assert.equal(words.warn, false);
+    assert.equal(hudWords({ ...hud, timeLeft: WARN_SECONDS - 0.5 }).warn, true);
+    assert.equal(hudWords({ ...hud, timeLeft: 0 }).warn, false, "a clock run out is not a warning");
+    assert.deepEqual(words.bars.map((b) => b.level), [0, 0.5, 1, 0], "activations shown between 0 and 1");
+    assert.deepEqual(words.bars.map((b) => b.key + " " + b.name), ["d pectoralis", "f posterior deltoid", "j biceps",
+      "k triceps"]);
+    assert.deepEqual(words.help, ["d/f shoulder", "j/k elbow", "space reset (-2)", "tab hide arm"]);
+    assert.deepEqual(hudWords({ ...hud, touchMode: true }).help, ["the buttons pull the muscles", "reset costs 2"]);
+    assert.equal(words.countdown, null);
+    assert.deepEqual(hudWords({ ...hud, phase: "countdown", countdownLeft: 2.2 }).countdown,
+      { number: "3", hint: "any key starts" });
+    assert.deepEqual(hudWords({ ...hud, phase: "countdown", countdownLeft: 0.01, touchMode: true }).countdown,
+      { number: "1", hint: "a tap starts" });
     assert.equal(clockText(5), " 5.0");
     assert.equal(clockText(100.2), "1:41");
-    const texts = (s) => layout(1280, 720, s, measure).labels;
-    assert.equal(texts(hud).find((l) => l[0].startsWith("Time"))[4], "ink");
-    assert.equal(texts({ ...hud, timeLeft: 9.5 }).find((l) => l[0].startsWith("Time"))[4], "warn");
-    const long = texts({ ...hud, name: "Aleksandra Nowakowska-Wiśniewska von Brzęczyszczykiewicz" });
-    assert.equal(long[0][0], "PLAY   seed 7");
-    assert.ok(long[1][0].endsWith("…"), long[1][0]);
-    const help = texts({ ...hud, touchMode: true }).filter((l) => l[4] === "faint").map((l) => l[0]).join(" ");
-    assert.match(help, /reset costs 2/);
   });
 });

@@ -1,8 +1,9 @@
 """The browser game's modules in Node, in the default tier: tests/play_logic.test.mjs (``node --test``, no npm
 packages) runs the class's API and the outbox (outbox.js, with a fake class and a fake store), the game on the
-page's clock (model.js) and the frame's layout (view.js) without a browser; and what the page draws with is held to
-the Python's: view.js's palette to ``ui/palette.py``'s high-contrast one and the buttons' colours in play.css, its
-sizes and times to ``ui/render.py``'s, body.js's sizes and outlines to ``ui/body.py``'s.
+page's clock (model.js) and the scene's layout and the HUD's words (view.js) without a browser; and what the page
+draws with is held to the Python's: view.js's palette to ``ui/palette.py``'s high-contrast one, as are the buttons'
+and the HUD's bars' colours in play.css; its line, clock and hit times to ``ui/render.py``'s; body.js's sizes and
+outlines to ``ui/body.py``'s.
 
 Skipped only where ``node`` is missing and ``ARMGAME_REQUIRE_BROWSER`` is unset (CI sets it)."""
 
@@ -47,9 +48,8 @@ import * as body from './body.js';
 const poses = %s, l1 = 0.34, l2 = 0.46;
 process.stdout.write(JSON.stringify({
   palette: view.PALETTE,
-  render: {MIN_TEXT_AT_720: view.MIN_TEXT_AT_720, MIN_TEXT_FRACTION: view.MIN_TEXT_FRACTION, MIN_LINE: view.MIN_LINE,
-    WARN_SECONDS: view.WARN_SECONDS, FLASH_TIME: model.FLASH_TIME, PLUS_ONE_TIME: model.PLUS_ONE_TIME,
-    FADE_IN: model.FADE_IN},
+  render: {MIN_LINE: view.MIN_LINE, WARN_SECONDS: view.WARN_SECONDS, FLASH_TIME: model.FLASH_TIME,
+    PLUS_ONE_TIME: model.PLUS_ONE_TIME, FADE_IN: model.FADE_IN},
   body: {UPPER_ARM: body.UPPER_ARM, FOREARM: body.FOREARM, HAND: body.HAND, MUSCLE_REST: body.MUSCLE_REST,
     MUSCLE_GAIN: body.MUSCLE_GAIN, BREADTH: body.BREADTH, MUSCLE_TINT: body.MUSCLE_TINT, TORSO: body.TORSO,
     HEAD: body.HEAD},
@@ -82,10 +82,14 @@ def test_the_pages_looks_are_the_pythons():
     for name, colour in looks["palette"].items():
         python = getattr(high, name)
         assert colour == ([list(c) for c in python] if name == "muscles" else list(python)), name
-    # The touch buttons' colours and the warning's, in play.css, are the palette's too.
+    # The touch buttons' colours, the HUD's bars' and the warning's, in play.css, are the palette's too.
     css = (STATIC / "play.css").read_text(encoding="utf-8")
-    buttons = re.findall(r'#touch button\[data-index="(\d)"\] \{[^}]*background: rgb\((\d+), (\d+), (\d+)\)', css)
-    assert {int(i): [int(c) for c in rgb] for i, *rgb in buttons} == dict(enumerate(map(list, high.muscles)))
+    muscles = dict(enumerate(map(list, high.muscles)))
+    for where in (r"#touch button", r"#hud \.bar"):
+        found = re.findall(where + r'\[data-index="(\d)"\][^{]*\{[^}]*background: rgb\((\d+), (\d+), (\d+)\)', css)
+        assert {int(i): [int(c) for c in rgb] for i, *rgb in found} == muscles, where
+    track = re.search(r"#hud \.track \{[^}]*background: rgb\((\d+), (\d+), (\d+)\)", css)
+    assert [int(c) for c in track.groups()] == list(high.bar_back)
     warn = re.search(r"--warn: #([0-9a-f]{6})", css).group(1)
     assert [int(warn[k:k + 2], 16) for k in (0, 2, 4)] == list(high.warn)
     for name, value in looks["render"].items():

@@ -6,7 +6,7 @@
 // (textContent, fillText), never as HTML.
 import { PlayedGame } from "./model.js";
 import { ANOTHER_CLASS, ClassLink, RETRY_MS, accepted, handInLine, refusal } from "./outbox.js";
-import { View } from "./view.js";
+import { Hud, View } from "./view.js";
 
 // ------------------------------------------------------------------ the page's parts
 const canvas = document.getElementById("game");
@@ -18,6 +18,7 @@ const statusLine = document.getElementById("status");
 canvas.frameTimes = [];
 
 const view = new View(canvas);
+const hud = new Hud(document);
 const link = new ClassLink({ onChange: () => showOutbox(), onAnswers: (results) => showAnswers(results) });
 let phase = "join";  // join, countdown, playing, over, closed; lab-loading, lab, lab-over (the teacher's switch)
 let played = null;  // the game on screen (model.js), or null
@@ -482,25 +483,34 @@ const resized = new ResizeObserver(([entry]) => {
 // watches the CSS box only.
 try { resized.observe(canvas, { box: "device-pixel-content-box" }); } catch { resized.observe(canvas); }
 
-// The lab's scene or the game's, whichever is on: false when neither is.
+// The lab's scene or the game's, whichever is on: false when neither is. The HUD is shown with the game's alone.
 function paint() {
   const box = view.box;
+  // "not me?" forgets the name while the last game is on screen
+  const playing = lab === null && played !== null && link.member !== null;
+  hud.show(playing ? hudState() : null);
   if (lab !== null && link.member !== null) {
     lab.draw(box.w, box.h, canvas.width / Math.max(box.w, 1), canvas.height / Math.max(box.h, 1));
     return true;
   }
-  // "not me?" forgets the name while the last game is on screen
-  if (played !== null && link.member !== null) { view.draw(frameState()); return true; }
+  if (playing) { view.draw(sceneState()); return true; }
   return false;
 }
 
-// What view.js draws of the game now: the HUD's words and bars, and the scene's moving parts.
-function frameState() {
+// What the HUD says of the game now (view.js's hudWords).
+function hudState() {
   const member = link.member, game = played.game;
   return { seed: member.seed, name: member.name, score: game.score, timeLeft: game.timeLeft, keys, names,
-    activation: game.muscleActivation, touchMode, resetCost: played.config.reset_cost, arm: played.config.arm, phase,
-    now: played.now, target: game.target, angles: game.interpolatedAngles(played.alpha), armVisible: game.armVisible,
-    hits: played.hits, countdownLeft: played.countdownLeft };
+    activation: game.muscleActivation, touchMode, resetCost: played.config.reset_cost, phase,
+    countdownLeft: played.countdownLeft };
+}
+
+// What view.js draws of the scene now: its moving parts.
+function sceneState() {
+  const game = played.game;
+  return { arm: played.config.arm, phase, now: played.now, target: game.target,
+    angles: game.interpolatedAngles(played.alpha), armVisible: game.armVisible, activation: game.muscleActivation,
+    hits: played.hits };
 }
 
 // ------------------------------------------------------------------ the start

@@ -1,7 +1,9 @@
-// The browser game's view (/play), as ui/render.py's GameRenderer: layout() returns where everything goes as data
-// (the HUD's lines and bars, the scene, the metres-to-pixels view, the arm's reach), which tests/play_logic.test.mjs
-// checks without a canvas; View.draw() paints one frame of it on the canvas. The text is set with fillText, never
-// as HTML. Its looks are ui/palette.py's and ui/render.py's: tests/test_play_logic.py ties them to the Python.
+// The browser game's view (/play), as ui/render.py's GameRenderer: layout() returns where the scene goes as data
+// (its box, the metres-to-pixels view, the arm's reach) and hudWords() what the HUD says, which
+// tests/play_logic.test.mjs checks without a page; View.draw() paints the scene on the canvas, and Hud sets the
+// HUD's words (the mode, the score, the clock, the muscle bars, the help, the countdown) as HTML that play.css lays
+// out, with textContent only. Its looks are ui/palette.py's and ui/render.py's: tests/test_play_logic.py ties them
+// to the Python.
 import { blend, circle, drawArm, drawTorso, rgb } from "./body.js";
 import { FADE_IN, FLASH_TIME, PLUS_ONE_TIME } from "./model.js";
 
@@ -14,19 +16,12 @@ export const PALETTE = {
   panel: [255, 255, 255], skin: [225, 225, 225],
 };
 const FONT = '"DejaVu Sans", "Segoe UI", Helvetica, Arial, sans-serif';
-// ui/render.py's: the smallest text at 720 lines and as a fraction of the height; the narrowest line a student must
-// see; the clock turns to the warning colour in its last WARN_SECONDS.
-export const MIN_TEXT_AT_720 = 14, MIN_TEXT_FRACTION = 0.025, MIN_LINE = 3, WARN_SECONDS = 10;
+// ui/render.py's: the narrowest line a student must see; the clock turns to the warning colour in its last
+// WARN_SECONDS.
+export const MIN_LINE = 3, WARN_SECONDS = 10;
 // The scene shows the arm's whole reach, every target in it, and a margin for the palm and a target's flash at its
 // edge. The game's view (ui/render.py's) runs 0.4 m above the reach, where nothing is drawn, and cuts its bottom.
 export const REACH_MARGIN = 0.04;
-
-export function textSizes(w, h) {
-  const m = Math.min(w, h), u = m / 720;
-  const minText = Math.max(Math.round(MIN_TEXT_AT_720 * m / 720), Math.round(MIN_TEXT_FRACTION * h));
-  const small = Math.max(12, Math.round(18 * u), minText);
-  return { small, normal: Math.max(Math.max(13, Math.round(22 * u)), small + 2), big: Math.max(18, Math.round(40 * u)) };
-}
 
 export function font(size, bold) { return (bold ? "bold " : "") + size + "px " + FONT; }
 
@@ -34,13 +29,6 @@ export function clockText(seconds) {
   if (seconds < 100) return seconds.toFixed(1).padStart(4, " ");
   const whole = Math.ceil(seconds);
   return Math.floor(whole / 60) + ":" + String(whole % 60).padStart(2, "0");
-}
-
-// ``text`` cut to ``room`` px with an ellipsis; ``measure(text, size, bold)`` is its width.
-function fit(text, size, room, measure) {
-  if (measure(text, size) <= room) return text;
-  while (text && measure(text + "…", size) > room) text = text.slice(0, -1);
-  return text + "…";
 }
 
 export function sceneWorld(arm) {
@@ -56,98 +44,87 @@ export function viewport(scene, world) {
   return { scale, ox: left - xmin * scale, oy: top + ymax * scale };
 }
 
-// Where a frame's parts go in a canvas box of w x h CSS px (the canvas is its own cell: the buttons and the status
-// line have cells of their own, play.css). ``s``: what the HUD shows ({seed, name, score, timeLeft, keys, names,
-// activation, touchMode, resetCost, arm: {l1, l2}}); ``measure(text, size, bold)``: a text's width in px.
-// Returns the sizes, the HUD's and the scene's boxes, the view, the reach's box (``reach``), the labels
-// ([text, x, y, size, colour: a PALETTE name, bold]), the muscle bars ([x, y, w, h, muscle, activation]).
-export function layout(w, h, s, measure) {
+// Where a frame's parts go in a canvas box of w x h CSS px: the canvas is the scene's cell alone (the HUD, the
+// buttons and the status line have cells of their own, play.css). Returns the sizes, the scene's box, the view
+// (metres to px) and the box of the arm's reach (``reach``: x, y, width, height).
+export function layout(w, h, arm) {
   const u = Math.min(w, h) / 720;
   const pad = Math.max(6, Math.round(16 * u)), gap = Math.max(4, Math.round(8 * u));
-  const { small, normal, big } = textSizes(w, h);
-  const landscape = w >= 1.15 * h;
-  let hud, scene;
-  if (landscape) {
-    const needed = measure("Time 00.0", big, true) + 2 * pad;
-    const side = Math.min(Math.max(Math.round(w * 0.27), 200, needed), Math.max(480, needed), w - Math.round(h * 0.55));
-    hud = { x: pad, y: pad, w: side - 2 * pad, h: h - 2 * pad };
-    scene = { x: side, y: pad, w: w - side - pad, h: h - 2 * pad };
-  } else {
-    hud = { x: pad, y: pad, w: w - 2 * pad, h: h - 2 * pad };
-    scene = { x: pad, y: 0, w: w - 2 * pad, h: 0 };
-  }
-  // The HUD's top: the mode, the score and the clock.
-  const labels = [];
-  let y = hud.y;
-  // The mode's parts share a line where they fit (a long name goes on a line of its own), as in the window.
-  const modeLines = [];
-  for (const part of ["PLAY", "seed " + s.seed, s.name]) {
-    const line = modeLines.length ? modeLines[modeLines.length - 1] + "   " + part : null;
-    if (line !== null && measure(line, normal) <= hud.w) modeLines[modeLines.length - 1] = line;
-    else modeLines.push(fit(part, normal, hud.w, measure));
-  }
-  for (const line of modeLines) {
-    labels.push([line, hud.x, y, normal, "ink", false]);
-    y += Math.round(normal * 1.2) + gap / 2;
-  }
-  y += gap / 2;
-  let head = big;
-  const score = "Score " + s.score, clockLine = "Time " + clockText(s.timeLeft);
-  const clockColour = s.timeLeft > 0 && s.timeLeft <= WARN_SECONDS ? "warn" : "ink";
-  if (landscape) {
-    labels.push([score, hud.x, y, head, "ink", true]);
-    y += Math.round(head * 1.2) + gap;
-    labels.push([clockLine, hud.x, y, head, clockColour, true]);
-  } else {
-    while (head > normal && measure("Score 000", head, true) + 2 * gap + measure("Time 00.0", head, true) > hud.w) head -= 1;
-    labels.push([score, hud.x, y, head, "ink", true]);
-    labels.push([clockLine, hud.x + hud.w - measure("Time 00.0", head, true), y, head, clockColour, true]);
-  }
-  y += Math.round(head * 1.2) + 2 * gap;
-  // The muscle bars: one column beside the scene, two above it on a tall window.
-  const columns = landscape ? 1 : 2;
-  const colW = (hud.w - (columns - 1) * 2 * pad) / columns;
-  const barH = Math.max(5, Math.round(10 * u));
-  const rowH = Math.round(small * 1.2) + gap / 2 + barH + gap;
-  const short = s.names.some((n, i) => measure(s.keys[i] + "  " + n, small) > colW);
-  const bars = [];
-  for (let i = 0; i < 4; i++) {
-    const cx = hud.x + (i % columns) * (colW + 2 * pad), ry = y + Math.floor(i / columns) * rowH;
-    const name = short ? s.names[i].split(" ").pop() : s.names[i];
-    labels.push([fit(s.keys[i] + "  " + name, small, colW, measure), cx, ry, small, "ink", false]);
-    bars.push([cx, ry + Math.round(small * 1.2) + gap / 2, colW, barH, i, Math.min(Math.max(s.activation[i], 0), 1)]);
-  }
-  y += rowH * (4 / columns) + gap;
-  // The help line(s), at the bottom of the HUD (the touch buttons say what they do themselves).
-  const items = s.touchMode ? ["the buttons pull the muscles", "reset costs " + s.resetCost]
-    : [s.keys[0] + "/" + s.keys[1] + " shoulder", s.keys[2] + "/" + s.keys[3] + " elbow", "space reset (-" + s.resetCost + ")",
-      "tab hide arm"];
-  const lines = [];
-  for (const item of items) {
-    if (lines.length && measure(lines[lines.length - 1] + "    " + item, small) <= hud.w) lines[lines.length - 1] += "    " + item;
-    else lines.push(fit(item, small, hud.w, measure));
-  }
-  const lineH = Math.round(small * 1.2);
-  const helpTop = hud.y + hud.h - lines.length * (lineH + gap / 2);
-  lines.forEach((line, i) => {
-    const ly = helpTop + i * (lineH + gap / 2);
-    labels.push([line, landscape ? hud.x : (w - measure(line, small)) / 2, ly, small, "faint", false]);
-  });
-  if (!landscape) { scene.y = y; scene.h = Math.max(helpTop - gap - y, 10); }
-  const view = viewport(scene, sceneWorld(s.arm));
-  const r = (s.arm.l1 + s.arm.l2) * view.scale;
+  const big = Math.max(18, Math.round(40 * u));  // a hit's "+1"
+  const scene = { x: pad, y: pad, w: Math.max(w - 2 * pad, 10), h: Math.max(h - 2 * pad, 10) };
+  const view = viewport(scene, sceneWorld(arm));
+  const r = (arm.l1 + arm.l2) * view.scale;
   const reach = { x: view.ox - r, y: view.oy - r, width: 2 * r, height: 2 * r };
-  return { w, h, u, pad, gap, small, normal, big, landscape, hud, scene, view, reach, labels, bars };
+  return { w, h, u, pad, gap, big, scene, view, reach };
 }
 
-// The countdown's panel in the middle of the scene: {x, y, w, h, size, number, hint}.
-export function countdownPanel(lay, countdownLeft, touchMode, measure) {
-  const s = lay.scene, size = Math.max(lay.big, Math.round(s.h * 0.2));
-  const number = String(Math.max(1, Math.ceil(countdownLeft)));
-  const hint = touchMode ? "a tap starts" : "any key starts";
-  const w = Math.max(measure(number, size, true), measure(hint, lay.normal)) + 6 * lay.gap;
-  const h = size * 1.2 + lay.normal * 1.2 + 4 * lay.gap;
-  return { x: s.x + s.w / 2 - w / 2, y: s.y + s.h / 2 - h / 2, w, h, size, number, hint };
+// The HUD's words (view.js's Hud sets them as text; play.css lays them out): ``s`` is {seed, name, score, timeLeft,
+// keys, names, activation, touchMode, resetCost, phase, countdownLeft}. The clock is "warn" in its last
+// WARN_SECONDS; each bar's level is its muscle's activation between 0 and 1; the countdown's words while it runs.
+export function hudWords(s) {
+  return {
+    seed: "seed " + s.seed, name: s.name, score: "Score " + s.score, clock: "Time " + clockText(s.timeLeft),
+    warn: s.timeLeft > 0 && s.timeLeft <= WARN_SECONDS,
+    bars: s.keys.map((key, i) => ({ key, name: s.names[i], level: Math.min(Math.max(s.activation[i], 0), 1) })),
+    // The touch buttons say what they do themselves.
+    help: s.touchMode ? ["the buttons pull the muscles", "reset costs " + s.resetCost]
+      : [s.keys[0] + "/" + s.keys[1] + " shoulder", s.keys[2] + "/" + s.keys[3] + " elbow",
+        "space reset (-" + s.resetCost + ")", "tab hide arm"],
+    countdown: s.phase === "countdown" ? { number: String(Math.max(1, Math.ceil(s.countdownLeft))),
+      hint: s.touchMode ? "a tap starts" : "any key starts" } : null,
+  };
+}
+
+// The HUD and the countdown as HTML (play.html's #hud and #countdown): words set with textContent only when they
+// change, the bars' levels as a transform (no layout a frame).
+export class Hud {
+  constructor(doc) {
+    const $ = (id) => doc.getElementById(id);
+    this.body = doc.body;
+    this.root = $("hud");
+    this.parts = { seed: $("hud-seed"), name: $("hud-name"), score: $("hud-score"), clock: $("hud-clock") };
+    this.bars = [...this.root.querySelectorAll(".bar")].map((bar) => ({ key: bar.querySelector(".key"),
+      name: bar.querySelector(".name"), fill: bar.querySelector(".fill") }));
+    this.help = $("hud-help");
+    this.countdownBox = $("countdown");
+    this.number = $("countdown-number");
+    this.hint = $("countdown-hint");
+    this.said = new Map();
+    this.helpSaid = "";
+  }
+
+  text(element, text) {
+    if (this.said.get(element) !== text) { element.textContent = text; this.said.set(element, text); }
+  }
+
+  // ``s``: hudWords's argument, or null when no game is on screen (the HUD's cell goes: the join form and the lab
+  // have the screen).
+  show(s) {
+    const on = s !== null;
+    if (this.root.hidden === on) { this.root.hidden = !on; this.body.classList.toggle("hud", on); }
+    if (!on) { this.countdownBox.hidden = true; return; }
+    const w = hudWords(s);
+    this.root.classList.toggle("veiled", s.phase === "over");  // as the canvas is, under the end card
+    for (const part of ["seed", "name", "score", "clock"]) this.text(this.parts[part], w[part]);
+    this.parts.clock.classList.toggle("warn", w.warn);
+    w.bars.forEach((bar, i) => {
+      const shown = this.bars[i];
+      this.text(shown.key, bar.key);
+      this.text(shown.name, bar.name);
+      const level = "scaleX(" + bar.level + ")";
+      if (shown.fill.style.transform !== level) shown.fill.style.transform = level;
+    });
+    if (w.help.join("\n") !== this.helpSaid) {
+      this.helpSaid = w.help.join("\n");
+      this.help.replaceChildren(...w.help.map((item) => {
+        const span = this.help.ownerDocument.createElement("span");
+        span.textContent = item;
+        return span;
+      }));
+    }
+    this.countdownBox.hidden = w.countdown === null;
+    if (w.countdown !== null) { this.text(this.number, w.countdown.number); this.text(this.hint, w.countdown.hint); }
+  }
 }
 
 export class View {
@@ -157,7 +134,6 @@ export class View {
     this.box = { w: 0, h: 0 };  // the canvas's box (CSS px), as play.css's grid sizes its cell
     this.background = null;
     this.backgroundKey = "";
-    this.measure = (text, size, bold) => { this.ctx.font = font(size, bold); return this.ctx.measureText(text).width; };
   }
 
   // The canvas's box as a ResizeObserver saw it: its bitmap follows it in device pixels.
@@ -202,24 +178,22 @@ export class View {
     return off;
   }
 
-  // One frame: ``s`` is layout()'s HUD and the scene's moving parts ({phase, now, target, angles, armVisible, hits,
-  // countdownLeft}). Sets the canvas's ``workspace``: the reach's box, which the tests hold inside the screen.
+  // One frame of the scene: ``s`` is {arm: {l1, l2}, phase, now, target, angles, armVisible, activation, hits}. Sets
+  // the canvas's ``workspace``: the reach's box, which the tests hold inside the screen.
   draw(s) {
     const { w, h } = this.box;
     if (w < 1 || h < 1) return;
-    const canvas = this.canvas, ctx = this.ctx, p = PALETTE;
+    const canvas = this.canvas, ctx = this.ctx;
     const sx = canvas.width / w, sy = canvas.height / h;  // the device pixels a CSS px has, as the bitmap has them
-    const lay = layout(w, h, s, this.measure);
-    const view = lay.view, gap = lay.gap, big = lay.big;
-    const key = [w, h, canvas.width, canvas.height, lay.scene.x, lay.scene.y, lay.scene.w, lay.scene.h].join(",");
+    const lay = layout(w, h, s.arm);
+    const view = lay.view;
+    const key = [w, h, canvas.width, canvas.height].join(",");
     if (key !== this.backgroundKey) { this.background = this.drawBackground(lay, s.arm, sx, sy); this.backgroundKey = key; }
     canvas.workspace = lay.reach;
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.drawImage(this.background, 0, 0);
     ctx.setTransform(sx, 0, 0, sy, 0, 0);
-    ctx.textBaseline = "top";
-    ctx.textAlign = "left";
-    // The scene: target, arm, hand, clipped to it.
+    // The scene: target, arm, hand, a hit's "+1", clipped to it.
     const sc = lay.scene;
     ctx.save();
     ctx.beginPath();
@@ -231,14 +205,17 @@ export class View {
     const elbow = [l1 * Math.cos(q1), l1 * Math.sin(q1)];
     const hand = [elbow[0] + l2 * Math.cos(q1 + q2), elbow[1] + l2 * Math.sin(q1 + q2)];
     if (s.armVisible) drawArm(ctx, view, q1, q2, l1, l2, s.activation, PALETTE);
-    circle(ctx, view.ox + hand[0] * view.scale, view.oy - hand[1] * view.scale, Math.max(1, 0.02 * view.scale), rgb(p.hand));
-    const labels = lay.labels.slice();
-    for (const [x, yy, t] of s.hits) {
+    circle(ctx, view.ox + hand[0] * view.scale, view.oy - hand[1] * view.scale, Math.max(1, 0.02 * view.scale), rgb(PALETTE.hand));
+    ctx.textBaseline = "top";
+    ctx.textAlign = "left";
+    ctx.font = font(lay.big, true);
+    ctx.fillStyle = rgb(PALETTE.ink);
+    for (const [x, y, t] of s.hits) {
       const age = s.now - t;
       if (age < PLUS_ONE_TIME) {
         const r = s.target.radius * view.scale;
-        labels.push(["+1", view.ox + x * view.scale + r + gap, view.oy - yy * view.scale - age / PLUS_ONE_TIME * 2 * r - big / 2,
-          big, "ink", true]);
+        ctx.fillText("+1", view.ox + x * view.scale + r + lay.gap,
+          view.oy - y * view.scale - age / PLUS_ONE_TIME * 2 * r - lay.big / 2);
       }
     }
     ctx.restore();
@@ -246,24 +223,6 @@ export class View {
       ctx.fillStyle = "rgba(255,255,255,0.67)";
       ctx.fillRect(0, 0, w, h);
     }
-    for (const [x, by, bw, bh, i, a] of lay.bars) {
-      this.roundRect(x, by, bw, bh, bh / 2, rgb(p.bar_back));
-      if (a > 0.002) this.roundRect(x, by, Math.max(bh, Math.round(bw * a)), bh, bh / 2, rgb(p.muscles[i]));
-    }
-    for (const [text, x, ly, size, colour, bold] of labels) {
-      ctx.font = font(size, bold);
-      ctx.fillStyle = rgb(p[colour]);
-      ctx.fillText(text, x, ly);
-    }
-    if (s.phase === "countdown") this.drawCountdown(lay, s);
-  }
-
-  roundRect(x, y, w, h, r, fill, stroke, line) {
-    const ctx = this.ctx;
-    ctx.beginPath();
-    ctx.roundRect(x, y, w, h, r);
-    if (fill) { ctx.fillStyle = fill; ctx.fill(); }
-    if (stroke) { ctx.lineWidth = line; ctx.strokeStyle = stroke; ctx.stroke(); }
   }
 
   drawTarget(view, s) {
@@ -281,19 +240,5 @@ export class View {
         circle(ctx, view.ox + hx * k, view.oy - hy * k, rr, rgb(PALETTE.flash), rgb(PALETTE.target), Math.max(2, r / 5));
       }
     }
-  }
-
-  drawCountdown(lay, s) {
-    const ctx = this.ctx, sc = lay.scene;
-    const c = countdownPanel(lay, s.countdownLeft, s.touchMode, this.measure);
-    this.roundRect(c.x, c.y, c.w, c.h, Math.max(4, Math.round(12 * lay.u)), rgb(PALETTE.panel), rgb(PALETTE.edge),
-      Math.max(MIN_LINE, Math.round(2 * lay.u)));
-    ctx.textAlign = "center";
-    ctx.fillStyle = rgb(PALETTE.ink);
-    ctx.font = font(c.size, true);
-    ctx.fillText(c.number, sc.x + sc.w / 2, c.y + 1.5 * lay.gap);
-    ctx.font = font(lay.normal, false);
-    ctx.fillText(c.hint, sc.x + sc.w / 2, c.y + 1.5 * lay.gap + c.size * 1.2 + lay.gap);
-    ctx.textAlign = "left";
   }
 }
