@@ -93,8 +93,14 @@ export class Hud {
     this.helpSaid = "";
   }
 
+  // The page is written only where it changes: a frame that changes nothing costs no style or layout.
   text(element, text) {
     if (this.said.get(element) !== text) { element.textContent = text; this.said.set(element, text); }
+  }
+
+  mark(element, name, on) {
+    const key = name + on;
+    if (this.said.get(element) !== key) { element.classList.toggle(name, on); this.said.set(element, key); }
   }
 
   // ``s``: hudWords's argument, or null when no game is on screen (the HUD's cell goes: the join form and the lab
@@ -104,15 +110,15 @@ export class Hud {
     if (this.root.hidden === on) { this.root.hidden = !on; this.body.classList.toggle("hud", on); }
     if (!on) { this.countdownBox.hidden = true; return; }
     const w = hudWords(s);
-    this.root.classList.toggle("veiled", s.phase === "over");  // as the canvas is, under the end card
+    this.mark(this.root, "veiled", s.phase === "over");  // as the canvas is, under the end card
     for (const part of ["seed", "name", "score", "clock"]) this.text(this.parts[part], w[part]);
-    this.parts.clock.classList.toggle("warn", w.warn);
+    this.mark(this.parts.clock, "warn", w.warn);
     w.bars.forEach((bar, i) => {
       const shown = this.bars[i];
       this.text(shown.key, bar.key);
       this.text(shown.name, bar.name);
       const level = "scaleX(" + bar.level + ")";
-      if (shown.fill.style.transform !== level) shown.fill.style.transform = level;
+      if (this.said.get(shown.fill) !== level) { shown.fill.style.transform = level; this.said.set(shown.fill, level); }
     });
     if (w.help.join("\n") !== this.helpSaid) {
       this.helpSaid = w.help.join("\n");
