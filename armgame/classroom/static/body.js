@@ -1,12 +1,13 @@
 // The body in the browser's game (ui/body.py): the torso and head behind the scene, and the arm, its limbs and
 // joints outlined, the palm, the four muscles swelling with their activation in their keys' colours. Pure
-// drawing on a 2D context, given the view (metres to pixels: scale, ox, oy) and the palette; play.js owns the page.
+// drawing on a 2D context, given the view (metres to pixels: scale, ox, oy) and the palette (view.js's PALETTE: RGB
+// triples); view.js draws with it. tests/test_play_logic.py ties its sizes and outlines to ui/body.py's.
 
 // In metres, as ui/body.py's.
-const UPPER_ARM = [0.048, 0.034], FOREARM = [0.034, 0.022], HAND = [0.036, 0.030];
-const MUSCLE_REST = 0.011, MUSCLE_GAIN = 0.02, BREADTH = [1.4, 1.4, 1.0, 1.0], MUSCLE_TINT = 0.45;
-const TORSO = [[-0.19, -0.035], [0.23, 0.11]], HEAD = [[-0.19, -0.02], 0.085];
-const SPINDLE = Array.from({ length: 9 }, (_, k) => [k / 8, Math.sin(Math.PI * k / 8) ** 1.2]);
+export const UPPER_ARM = [0.048, 0.034], FOREARM = [0.034, 0.022], HAND = [0.036, 0.030];
+export const MUSCLE_REST = 0.011, MUSCLE_GAIN = 0.02, BREADTH = [1.4, 1.4, 1.0, 1.0], MUSCLE_TINT = 0.45;
+export const TORSO = [[-0.19, -0.035], [0.23, 0.11]], HEAD = [[-0.19, -0.02], 0.085];
+export const SPINDLE = Array.from({ length: 9 }, (_, k) => [k / 8, Math.sin(Math.PI * k / 8) ** 1.2]);
 const PALM = Array.from({ length: 14 }, (_, j) => {
   const t = 2 * Math.PI * j / 14;
   return [Math.sign(Math.cos(t)) * Math.abs(Math.cos(t)) ** 0.6, Math.sign(Math.sin(t)) * Math.abs(Math.sin(t)) ** 0.6];
@@ -22,7 +23,7 @@ export function circle(g, x, y, r, fill, stroke, line) {
   if (stroke) { g.lineWidth = line; g.strokeStyle = stroke; g.stroke(); }
 }
 
-// The torso, the head and the other shoulder, which never move: play.js draws them once per size.
+// The torso, the head and the other shoulder, which never move: view.js draws them once per size.
 export function drawTorso(g, view, palette) {
   const k = view.scale, body = Math.max(3, Math.round(k * 0.005));
   const px = (x, y) => [view.ox + x * k, view.oy - y * k];
@@ -32,11 +33,12 @@ export function drawTorso(g, view, palette) {
   g.roundRect(left, top, 2 * hw * k, 2 * hh * k, hh * k);
   g.fillStyle = rgb(palette.skin);
   g.fill();
-  g.lineWidth = body; g.strokeStyle = palette.link; g.stroke();
+  const edge = rgb(palette.link);
+  g.lineWidth = body; g.strokeStyle = edge; g.stroke();
   const [[hx, hy], r] = HEAD;
-  circle(g, ...px(hx, hy + r * 0.95), 0.022 * k, rgb(palette.skin), palette.link, body);
-  circle(g, ...px(hx, hy), r * k, rgb(palette.skin), palette.link, body);
-  circle(g, ...px(-0.38, 0), 0.03 * k, rgb(palette.skin), palette.link, body);
+  circle(g, ...px(hx, hy + r * 0.95), 0.022 * k, rgb(palette.skin), edge, body);
+  circle(g, ...px(hx, hy), r * k, rgb(palette.skin), edge, body);
+  circle(g, ...px(-0.38, 0), 0.03 * k, rgb(palette.skin), edge, body);
 }
 
 // The arm (ui/body.py's draw_arm): limbs and joints outlined, the palm, the four muscles swelling with
@@ -55,7 +57,7 @@ export function drawArm(ctx, view, q1, q2, l1, l2, activation, palette) {
     if (stroke) { ctx.lineWidth = 1; ctx.strokeStyle = stroke; ctx.stroke(); }
   };
   const joints = [[shoulder, UPPER_ARM[0]], [elbow, UPPER_ARM[1]], [wrist, FOREARM[1]]];
-  const skin = rgb(palette.skin), edge = palette.link;
+  const skin = rgb(palette.skin), edge = rgb(palette.link);
   const limbs = [[shoulder, elbow, UPPER_ARM], [elbow, wrist, FOREARM]];
   for (const [a, b, wd] of limbs) poly(limbOutline(a, b, [wd[0] + grow, wd[1] + grow]), edge);
   for (const [c, r] of joints) circle(ctx, view.ox + c[0] * k, view.oy - c[1] * k, r * k + line, edge);
@@ -83,7 +85,7 @@ function muscleEnds(i, q1, q2, l1, l2) {
   return [along(s, u, n, 0.12 * l1, -0.55 * UPPER_ARM[0]), along(elbow, u, n, 0.02, -0.5 * UPPER_ARM[1])];
 }
 
-function muscleOutline(i, q1, q2, l1, l2, a) {
+export function muscleOutline(i, q1, q2, l1, l2, a) {
   const [[x0, y0], [x1, y1]] = muscleEnds(i, q1, q2, l1, l2);
   const dx = x1 - x0, dy = y1 - y0, length = Math.hypot(dx, dy) || 1e-9;
   const nx = -dy / length, ny = dx / length, belly = (MUSCLE_REST + MUSCLE_GAIN * a) * BREADTH[i];
@@ -96,14 +98,14 @@ function muscleOutline(i, q1, q2, l1, l2, a) {
   return side.concat(other.reverse());
 }
 
-function limbOutline(start, end, [w0, w1]) {
+export function limbOutline(start, end, [w0, w1]) {
   const dx = end[0] - start[0], dy = end[1] - start[1], length = Math.hypot(dx, dy) || 1e-9;
   const nx = -dy / length, ny = dx / length;
   return [[start[0] + w0 * nx, start[1] + w0 * ny], [end[0] + w1 * nx, end[1] + w1 * ny],
     [end[0] - w1 * nx, end[1] - w1 * ny], [start[0] - w0 * nx, start[1] - w0 * ny]];
 }
 
-function palm(wrist, hand, grow) {
+export function palm(wrist, hand, grow) {
   const dx = hand[0] - wrist[0], dy = hand[1] - wrist[1], length = Math.hypot(dx, dy) || 1e-9;
   const ux = dx / length, uy = dy / length, nx = -uy, ny = ux;
   const halfL = HAND[0] * 1.1 + grow, halfW = HAND[1] + grow;

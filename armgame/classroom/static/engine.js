@@ -233,15 +233,15 @@ export function armPhysics(config) {
 }
 
 /** integrators._rk4: one RK4 step of the arm under the held torques (t1, t2), as [q1, q2, w1, w2]. */
-export function rk4(accel, q1, q2, w1, w2, t1, t2, dt) {
+export function rk4(f, q1, q2, w1, w2, t1, t2, dt) {
   const h = 0.5 * dt;
-  const [ka1, ka2] = accel(q1, q2, w1, w2, t1, t2);
+  const [ka1, ka2] = f(q1, q2, w1, w2, t1, t2);
   const v1 = w1 + h * ka1, v2 = w2 + h * ka2;
-  const [kb1, kb2] = accel(q1 + h * w1, q2 + h * w2, v1, v2, t1, t2);
+  const [kb1, kb2] = f(q1 + h * w1, q2 + h * w2, v1, v2, t1, t2);
   const u1 = w1 + h * kb1, u2 = w2 + h * kb2;
-  const [kc1, kc2] = accel(q1 + h * v1, q2 + h * v2, u1, u2, t1, t2);
+  const [kc1, kc2] = f(q1 + h * v1, q2 + h * v2, u1, u2, t1, t2);
   const z1 = w1 + dt * kc1, z2 = w2 + dt * kc2;
-  const [kd1, kd2] = accel(q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2);
+  const [kd1, kd2] = f(q1 + dt * u1, q2 + dt * u2, z1, z2, t1, t2);
   const k = dt * SIXTH;
   return [q1 + k * (w1 + z1 + 2.0 * (v1 + u1)), q2 + k * (w2 + z2 + 2.0 * (v2 + u2)),
     w1 + k * (ka1 + kd1 + 2.0 * (kb1 + kc1)), w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2))];
@@ -463,7 +463,7 @@ export class Game extends ArmSession {
     if (!Number.isInteger(n)) fail(`advance takes a whole number of steps, got ${n}`);
     n = Math.min(n, this._totalSteps - this._steps);
     if (n <= 0) return 0;
-    const accel = this._accel, dt = this._dt, l1 = this._l1, l2 = this._l2;
+    const armAccel = this._accel, dt = this._dt;
     let [a0, a1, a2, a3] = this._activation;
     const [g0, g1, g2, g3] = this._goal;
     const [r0, r1, r2, r3] = this._rate;
@@ -481,7 +481,7 @@ export class Game extends ArmSession {
       a2 += (g2 - a2) * r2;
       a3 += (g3 - a3) * r3;
       previous = [q1, q2, w1, w2];
-      [q1, q2, w1, w2] = rk4(accel, q1, q2, w1, w2, t1, t2, dt);
+      [q1, q2, w1, w2] = rk4(armAccel, q1, q2, w1, w2, t1, t2, dt);
       const [hx, hy] = this._handAt(q1, q2);
       const dx = hx - tx, dy = hy - ty;
       if (dx * dx + dy * dy <= rr) {

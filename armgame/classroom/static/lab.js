@@ -98,7 +98,8 @@ function rangeOf(seriesList) {
   for (const s of seriesList) for (const p of s.points) {
     for (const v of [p.mean, p.low, p.high]) if (v !== null && v !== undefined) values.push(v);
   }
-  let lo = Math.min(...values), hi = Math.max(...values);
+  const lo = Math.min(...values);
+  let hi = Math.max(...values);
   if (hi - lo < 1e-9) hi = lo + 1;
   return [lo, hi];
 }
@@ -124,7 +125,8 @@ function drawGeneral(svg, points, unit) {
   const {W, H, left, right, top, bottom} = frame(svg, [0.16, 0.06]);
   const values = [0];
   for (const p of points) for (const v of [p.mean, p.low, p.high]) if (v !== null) values.push(v);
-  let lo = Math.min(...values), hi = Math.max(...values);
+  const lo = Math.min(...values);
+  let hi = Math.max(...values);
   if (hi - lo < 1e-9) hi = lo + 1;
   const x = (a) => left + (right - left) * (a + 180) / 360;
   const y = (v) => bottom - (bottom - top) * (v - lo) / (hi - lo);

@@ -36,14 +36,14 @@ function row(table, r, kind) {
     tr.appendChild(td);
   }
   const td = document.createElement("td");
-  const button = document.createElement("button");
-  button.textContent = r.hidden ? "Show" : "Hide";
-  button.addEventListener("click", async () => {
+  const hide = document.createElement("button");
+  hide.textContent = r.hidden ? "Show" : "Hide";
+  hide.addEventListener("click", async () => {
     try { say((await (await call("/api/teacher/hide", {name: r.name, hidden: !r.hidden})).json()).message); }
     catch (e) { say(e.message, true); }
     refresh();
   });
-  td.appendChild(button);
+  td.appendChild(hide);
   tr.appendChild(td);
   table.appendChild(tr);
 }

@@ -1,0 +1,108 @@
+"""The browser game's modules in Node, in the default tier: tests/play_logic.test.mjs (``node --test``, no npm
+packages) runs the class's API and the outbox (outbox.js, with a fake class and a fake store), the game on the
+page's clock (model.js) and the scene's layout and the HUD's words (view.js) without a browser; and what the page
+draws with is held to the Python's: view.js's palette to ``ui/palette.py``'s high-contrast one, as are the buttons'
+and the HUD's bars' colours in play.css; its line, clock and hit times to ``ui/render.py``'s; body.js's sizes and
+outlines to ``ui/body.py``'s.
+
+Skipped only where ``node`` is missing and ``ARMGAME_REQUIRE_BROWSER`` is unset (CI sets it)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+STATIC = ROOT / "armgame" / "classroom" / "static"
+NODE = shutil.which("node")
+if NODE is None and not os.environ.get("ARMGAME_REQUIRE_BROWSER"):
+    pytest.skip("node (Node.js) is not installed, and ARMGAME_REQUIRE_BROWSER is unset: the browser game's modules "
+                "are not checked here (CI sets it)", allow_module_level=True)
+
+
+def _node(*args: str) -> subprocess.CompletedProcess:
+    assert NODE is not None, "ARMGAME_REQUIRE_BROWSER is set but node is not installed"
+    return subprocess.run([NODE, *args], cwd=STATIC, capture_output=True, text=True, timeout=60, check=False)
+
+
+def test_the_pages_modules_pass_their_node_tests():
+    done = _node("--test", str(ROOT / "tests" / "play_logic.test.mjs"))
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
+    assert re.search(r"^# fail 0$", done.stdout, re.M) and not re.search(r"^# pass 0$", done.stdout, re.M), done.stdout
+
+
+#: Poses and activations the outlines are compared at: (muscle, q1, q2, activation).
+POSES = [(0, 0.785, 1.571, 0.0), (1, -0.3, 2.4, 0.5), (2, 1.9, 0.2, 1.0), (3, 0.1, 2.9, 0.25)]
+
+LOOKS = """
+import * as view from './view.js';
+import * as model from './model.js';
+import * as body from './body.js';
+const poses = %s, l1 = 0.34, l2 = 0.46;
+process.stdout.write(JSON.stringify({
+  palette: view.PALETTE,
+  render: {MIN_LINE: view.MIN_LINE, WARN_SECONDS: view.WARN_SECONDS, FLASH_TIME: model.FLASH_TIME,
+    PLUS_ONE_TIME: model.PLUS_ONE_TIME, FADE_IN: model.FADE_IN},
+  body: {UPPER_ARM: body.UPPER_ARM, FOREARM: body.FOREARM, HAND: body.HAND, MUSCLE_REST: body.MUSCLE_REST,
+    MUSCLE_GAIN: body.MUSCLE_GAIN, BREADTH: body.BREADTH, MUSCLE_TINT: body.MUSCLE_TINT, TORSO: body.TORSO,
+    HEAD: body.HEAD},
+  spindle: body.SPINDLE,
+  muscles: poses.map(([i, q1, q2, a]) => body.muscleOutline(i, q1, q2, l1, l2, a)),
+  limbs: poses.map(([, q1]) => body.limbOutline([0, 0], [l1 * Math.cos(q1), l1 * Math.sin(q1)], body.UPPER_ARM)),
+  palms: poses.map(([, q1, q2, a]) => body.palm([0.1, 0.2],
+    [0.1 + 0.2 * Math.cos(q1 + q2), 0.2 + 0.2 * Math.sin(q1 + q2)], a)),
+}));
+"""
+
+
+def _close(js, py, where: str) -> None:
+    """Outlines to within a few ulps: JavaScript's ``**`` and sine need not round as the C library's do."""
+    assert len(js) == len(py), where
+    for a, b in zip(js, py, strict=True):
+        assert a == pytest.approx(list(b), rel=1e-12, abs=1e-15), where
+
+
+def test_the_pages_looks_are_the_pythons():
+    pytest.importorskip("pygame")
+    from armgame.ui import body, render
+    from armgame.ui.palette import PALETTES
+
+    done = _node("--input-type=module", "-e", LOOKS % json.dumps(POSES))
+    assert done.returncode == 0, done.stderr
+    looks = json.loads(done.stdout)
+    high = PALETTES["high-contrast"]
+    assert looks["palette"], "view.js has no palette"
+    for name, colour in looks["palette"].items():
+        python = getattr(high, name)
+        assert colour == ([list(c) for c in python] if name == "muscles" else list(python)), name
+    # The touch buttons' colours, the HUD's bars' and the warning's, in play.css, are the palette's too.
+    css = (STATIC / "play.css").read_text(encoding="utf-8")
+    muscles = dict(enumerate(map(list, high.muscles)))
+    for where in (r"#touch button", r"#hud \.bar"):
+        found = re.findall(where + r'\[data-index="(\d)"\][^{]*\{[^}]*background: rgb\((\d+), (\d+), (\d+)\)', css)
+        assert {int(i): [int(c) for c in rgb] for i, *rgb in found} == muscles, where
+    track = re.search(r"#hud \.track \{[^}]*background: rgb\((\d+), (\d+), (\d+)\)", css)
+    assert [int(c) for c in track.groups()] == list(high.bar_back)
+    warn = re.search(r"--warn: #([0-9a-f]{6})", css).group(1)
+    assert [int(warn[k:k + 2], 16) for k in (0, 2, 4)] == list(high.warn)
+    for name, value in looks["render"].items():
+        assert value == getattr(render, name), name
+    for name, value in looks["body"].items():
+        assert value == json.loads(json.dumps(getattr(body, name))), name
+    assert len(looks["spindle"]) == body.SPINDLE_POINTS
+    _close(looks["spindle"], body._SPINDLE, "the spindle")
+    l1, l2 = 0.34, 0.46
+    for (i, q1, q2, a), js in zip(POSES, looks["muscles"], strict=True):
+        _close(js, body.muscle_outline(i, q1, q2, l1, l2, a), f"muscle {i}")
+    for (_, q1, _, _), js in zip(POSES, looks["limbs"], strict=True):
+        _close(js, body.limb_outline((0.0, 0.0), (l1 * math.cos(q1), l1 * math.sin(q1)), body.UPPER_ARM), "limb")
+    for (_, q1, q2, a), js in zip(POSES, looks["palms"], strict=True):
+        hand = (0.1 + 0.2 * math.cos(q1 + q2), 0.2 + 0.2 * math.sin(q1 + q2))
+        _close(js, body._palm((0.1, 0.2), hand, a), "palm")
