@@ -27,6 +27,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..game.variant import runaway_message
 from ..lab.analysis import trial_row
+from ..lab.metrics import Reach
 from ..lab.perturbations import Perturbation
 from ..lab.protocol import Protocol
 from ..lab.session import LabSession, TrialOutcome, TrialPlan, lab_config, schedule
@@ -371,31 +372,36 @@ class CenterOutBatchVectorEnv(VectorEnv):
         n = self.num_envs
         live = stepping & (self.ints[:, I_STEPS] < self.ints[:, I_TOTAL])
         live &= ~self._finished
-        rise = np.stack([r.task.rise for r in self.runs]) if len(self._tasks) > 1 else \
-            next(iter(self._tasks.values())).rise  # type: ignore[union-attr]
-        decay = np.stack([r.task.decay for r in self.runs]) if len(self._tasks) > 1 else \
-            next(iter(self._tasks.values())).decay  # type: ignore[union-attr]
+        if len(self._task_list) > 1:
+            rise = np.stack([t.rise for t in self._task_list])[self._task_of]
+            decay = np.stack([t.decay for t in self._task_list])[self._task_of]
+        else:
+            rise, decay = self._task_list[0].rise, self._task_list[0].decay
         goal, rate = self.state[:, S_G:S_G + 4], self.state[:, S_R:S_R + 4]
+        everyone = stepping.all()
         if self.template.continuous:
             levels = np.asarray(actions, dtype=np.float64)
-            if levels.shape != (n, 4) or not np.isfinite(levels[stepping]).all():
+            if levels.shape != (n, 4) or not np.isfinite(levels if everyone else levels[stepping]).all():
                 raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) finite numbers in [-1, 1], got "
                                  f"shape {levels.shape}")
             levels = np.clip((levels + 1.0) * 0.5, 0.0, 1.0)
             up = levels > self.state[:, S_A:S_A + 4]
-            where = live[:, None]
-            goal[...] = np.where(where, levels, goal)
-            rate[...] = np.where(where, np.where(up, rise, decay), rate)
+            where = np.broadcast_to(live[:, None], up.shape)
+            np.copyto(goal, levels, where=where)
+            np.copyto(rate, rise, where=where & up)
+            np.copyto(rate, decay, where=where & ~up)
             return
         pressed = np.asarray(actions)
-        if pressed.shape != (n, 4) or not np.isin(pressed[stepping], (0, 1)).all():
+        keys = pressed if everyone else pressed[stepping]
+        if pressed.shape != (n, 4) or not ((keys == 0) | (keys == 1)).all():
             raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) zeros or ones (keys held), got shape "
                              f"{pressed.shape}")
         down = pressed == 1
         change = (down != self.held) & live[:, None]
         self.held ^= change
-        goal[...] = np.where(change, down.astype(np.float64), goal)
-        rate[...] = np.where(change, np.where(down, rise, decay), rate)
+        np.copyto(goal, down, where=change)
+        np.copyto(rate, rise, where=change & down)
+        np.copyto(rate, decay, where=change & ~down)
 
     def _advance(self) -> dict[int, list[dict[str, object]]]:
         """Run the C loop until every run has run its steps, ending trials as ``LabSession._task_step`` does."""
@@ -415,9 +421,16 @@ class CenterOutBatchVectorEnv(VectorEnv):
                     continue
                 path = int(ints[i, I_PATH])
                 index = int(self._trial[i])
-                outcome = TrialOutcome(run.plans[index], int(ints[i, I_GO]), int(ints[i, I_STEPS]),
-                                       event == EVENT_HIT, self.xs[i, :path].tolist(), self.ys[i, :path].tolist())
-                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome))  # type: ignore[arg-type]
+                plan, go = run.plans[index], int(ints[i, I_GO])
+                # The outcome's path stays empty: no trial the batch runs is a channel trial or one space sent
+                # home, so the row reads the path only as the reach, given here as the arrays reach_of would
+                # build from it (the same numbers), without the C loop's rows going through lists.
+                hand = np.column_stack((self.xs[i, :path], self.ys[i, :path]))
+                reach = Reach(t=(go + np.arange(len(hand))) * run.task.dt, hand=hand, start=plan.home,
+                              target=plan.position, go_time=go * run.task.dt, hit=event == EVENT_HIT)
+                outcome = TrialOutcome(plan, go, int(ints[i, I_STEPS]), event == EVENT_HIT)
+                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome,  # type: ignore[arg-type]
+                                                                reach=reach))
                 self._hits[i] += event == EVENT_HIT
                 self._trial[i] = index = index + 1
                 if index >= len(run.plans):
