@@ -43,8 +43,8 @@ except ImportError:  # no C compiler at install: the SyncVectorEnv of single env
     _ccenter = None  # type: ignore[assignment]
 
 #: From this many envs the batch is faster than ``SyncVectorEnv`` (benchmarks/results/env_speed_center_out.json:
-#: 1.25 and 1.86 times at 4 envs, 0.44 and 0.67 times at 1, where its per-step numpy and C calls cost more than
-#: one lab session's step).
+#: 1.69 and 1.95 times at 4 envs; an earlier run with the batch from 1 env measured it 0.44 and 0.67 times as fast
+#: at 1, where its per-step numpy and C calls cost more than one lab session's step).
 BATCH_FROM = 4
 #: The most runs one batched vector env holds: a run's arrays and its path buffer take about 13 KB.
 MAX_BATCH_ENVS = 65536
