@@ -4,7 +4,9 @@ autoreset modes the batch runs, and the speed guard's stop."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -18,7 +20,7 @@ from armgame.env.center_out_batch import CenterOutBatchVectorEnv, center_out_vec
 from armgame.env.center_out_v1 import CenterOutVectorEnv
 from armgame.lab.presets import preset
 
-pytestmark = pytest.mark.skipif(center_out_batch._ccenter is None, reason="armgame.env._ccenter was not built")
+compiled = pytest.mark.skipif(center_out_batch._ccenter is None, reason="armgame.env._ccenter was not built")
 
 IDS = ("armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1", "armgame/CenterOutHold-v1",
        "armgame/CenterOutHoldContinuous-v1")
@@ -70,23 +72,27 @@ def played(env_id: str, n: int, steps: int, seed: int = 3, **kwargs: object) -> 
     return seen
 
 
+@compiled
 @pytest.mark.parametrize("env_id", IDS)
 def test_each_id_equals_sync(env_id: str) -> None:
     seen = played(env_id, 2, 220, episode_trials=1)
     assert seen["reaches"] > 0 or "Hold" in env_id  # random keys rarely hold still at home
 
 
+@compiled
 @pytest.mark.parametrize("kind", KINDS, ids=lambda k: k if isinstance(k, str) else k["perturbation"])
 def test_each_field_kind_equals_sync(kind: object) -> None:
     played("armgame/CenterOutContinuous-v1", 2, 200, episode_trials=1, protocol=EXPOSED, perturbation=kind)
 
 
+@compiled
 def test_jointspace_continue_run_sparse_and_float64() -> None:
     played("armgame/CenterOut-v1", 2, 200, protocol="jointspace", episode_trials=1, continue_run=True)
     played("armgame/CenterOut-v1", 2, 150, episode_trials=1, reward="sparse", time_cost=0.5,
            observation_dtype="float64")
 
 
+@compiled
 def test_the_guards_stop_equals_sync(monkeypatch: pytest.MonkeyPatch) -> None:
     # A bound the field breaks within a reach: both stop the run there, terminated, info["stopped"] the same.
     monkeypatch.setattr(center_out_module, "speed_bound", lambda config: 0.5)
@@ -96,6 +102,7 @@ def test_the_guards_stop_equals_sync(monkeypatch: pytest.MonkeyPatch) -> None:
     assert seen["stopped"] > 0
 
 
+@compiled
 def test_disabled_autoreset_and_masks_equal_sync() -> None:
     args = {"continuous": False, "episode_trials": 1}
     sync = CenterOutVectorEnv(2, autoreset_mode="Disabled", **args)
@@ -112,6 +119,7 @@ def test_disabled_autoreset_and_masks_equal_sync() -> None:
             same(sync.reset(options={"reset_mask": ended}), batch.reset(options={"reset_mask": ended}), "mask")
 
 
+@compiled
 def test_make_vec_takes_the_batch_where_it_runs() -> None:
     assert isinstance(gym.make_vec("armgame/CenterOut-v1", num_envs=8192), CenterOutBatchVectorEnv)
     assert isinstance(center_out_vector_env(2, protocol="null", autoreset_mode="SameStep"), CenterOutVectorEnv)
@@ -119,9 +127,35 @@ def test_make_vec_takes_the_batch_where_it_runs() -> None:
         center_out_vector_env(5000, autoreset_mode="SameStep")
 
 
+@compiled
 @pytest.mark.slow
 @pytest.mark.parametrize("env_id", IDS)
 def test_longer_runs_of_every_kind_equal_sync(env_id: str) -> None:
     for kind in KINDS:
         played(env_id, 4, 1500, seed=11, perturbation=kind, protocol=EXPOSED, episode_trials=3)
     played(env_id, 4, 1500, seed=12, protocol="curl", episode_trials="block", continue_run=True)
+
+
+def test_the_docs_batch_figures_are_the_committed_run() -> None:
+    """docs/programs.md's figures for CenterOut's batch are the committed run's
+    (benchmarks/results/env_speed_center_out.json): its load, each id's rate and ratio at 8,192 envs, CenterOut-v1's
+    range there, and the ratios at 4 envs; and the docs say MotorNet was not measured beside it."""
+    root = Path(__file__).resolve().parent.parent
+    run = json.loads((root / "benchmarks" / "results" / "env_speed_center_out.json").read_text(encoding="utf-8"))
+    prose = " ".join((root / "docs" / "programs.md").read_text(encoding="utf-8").split())
+    ids = ("armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1")
+    assert run["peer"] == "sync" and run["motornet"] is None and set(run["ids"]) == set(ids)
+    top = [run["ids"][i]["sizes"]["8192"] for i in ids]
+    at4 = [run["ids"][i]["sizes"]["4"] for i in ids]
+    spread = min(top[0]["make_vec"]["cpu_rates"]), max(top[0]["make_vec"]["cpu_rates"])
+    assert f"1 M for `CenterOut-v1` (its repeats: {spread[0] / 1e6:.2f} to {spread[1] / 1e6:.2f} M)" in prose
+    load = run["load_average"]
+    assert f"measured on 2 cores under a load average of {load[0]:.1f} to {load[1]:.1f}" in prose
+    assert (f"the batch makes {top[0]['make_vec']['cpu']['median'] / 1e6:.2f} M (`CenterOut-v1`) and "
+            f"{top[1]['make_vec']['cpu']['median'] / 1e6:.2f} M (`CenterOutContinuous-v1`) env steps at 8,192 envs, "
+            f"{top[0]['ratio']['median']:.2f} and {top[1]['ratio']['median']:.2f} times Gymnasium's `SyncVectorEnv` of "
+            f"single envs ({top[0]['sync']['cpu']['median'] / 1e3:.0f} k and "
+            f"{top[1]['sync']['cpu']['median'] / 1e3:.0f} k;") in prose
+    assert (f"and {at4[0]['ratio']['median']:.2f} and {at4[1]['ratio']['median']:.2f} times it at 4 envs") in prose
+    assert all(run["ids"][i]["batch_from"] == center_out_batch.BATCH_FROM for i in ids)
+    assert "MotorNet's matched env (20 ms of RK4 a step) was not measured here" in prose

@@ -6,9 +6,10 @@
  *
  * Why it equals the single env bit for bit: the step is _cstep.h's ``rk4_exact`` (the game's step; with a field,
  * ``loads``' accel, operation for operation), the shown hand is ``physics.hand.hand_xy`` (the C library's sin and
- * cos, as Python's ``math``; glibc's sincos is not used here), the displays are ``lab.perturbations``' transforms
+ * cos, as Python's ``math``), the displays are ``lab.perturbations``' transforms
  * as their ``plan`` numbers write them, and the rules' tests are ``Target.contains`` and ``_task_step``'s, in the
- * same order. setup.py builds this file with floating-point contraction off. tests/test_env_center_out_batch.py
+ * same order. The hand's sin and cos come in pairs from glibc's sincos only where this module's start found it
+ * equal to sin and cos, bit for bit (_ckernel.c's check). setup.py builds this file with floating-point contraction off. tests/test_env_center_out_batch.py
  * compares every observation, reward, flag and info with Gymnasium's ``SyncVectorEnv`` of single envs. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -17,10 +18,33 @@
 #include <string.h>
 
 #if defined(__GLIBC__)
-/* _cstep.h's sin_cos reads this: 0, the C library's sin and cos apart (no check of sincos in this module). */
+/* _cstep.h's sin_cos reads this: 1 where sincos_agrees found glibc's sincos equal to its sin and cos. */
 int armgame_use_sincos = 0;
 #endif
 #include "../game/_cstep.h"
+
+/* _ckernel.c's check: whether sincos gives sin's and cos's bits on a spread of angles (small, game-sized and
+ * huge). A pair from sincos costs about two thirds of sin and cos apart, and the hand's four run every step. */
+static int sincos_agrees(void)
+{
+#if defined(__GLIBC__)
+    uint64_t r = UINT64_C(88172645463325252);
+    for (int i = 0; i < 3000; i++) {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        const double scale = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 40.0 : 2e6);
+        const double x = ((double)(r >> 11) / 9007199254740992.0 - 0.5) * scale;
+        double s, c;
+        sincos(x, &s, &c);
+        if (s != sin(x) || c != cos(x))
+            return 0;
+    }
+    return 1;
+#else
+    return 0;
+#endif
+}
 
 /* Columns of a run's float state, int state and trial (the Python side names them the same). */
 enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_COUNT = 20 };
@@ -118,8 +142,10 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
         }
         steps++;
         ran++;
-        const double q12 = x[0] + x[1];
-        double hx = l1 * cos(x[0]) + l2 * cos(q12), hy = l1 * sin(x[0]) + l2 * sin(q12);
+        double s1, c1, s12, c12;
+        sin_cos(x[0], &s1, &c1);
+        sin_cos(x[0] + x[1], &s12, &c12);
+        double hx = l1 * c1 + l2 * c12, hy = l1 * s1 + l2 * s12;
         shown(t, phase, x[0], x[1], &hx, &hy);
         s[S_CX] = hx;
         s[S_CY] = hy;
@@ -241,7 +267,9 @@ static PyObject *advance(PyObject *self, PyObject *args)
             /* center_out_v1.CenterOutV1Env._observation, in its order. */
             const double q1 = s[0], q2 = s[1], w1 = s[2], w2 = s[3];
             const double q12 = q1 + q2, w12 = w1 + w2;
-            const double c1 = cos(q1), s1 = sin(q1), c12 = cos(q12), s12 = sin(q12);
+            double c1, s1, c12, s12;
+            sin_cos(q1, &s1, &c1);
+            sin_cos(q12, &s12, &c12);
             const int reach = it[I_PHASE] == 1;
             const double cx = s[S_CX], cy = s[S_CY];
             double *o = obs + 16 * i;
@@ -280,8 +308,10 @@ static struct PyModuleDef module = {
 
 PyMODINIT_FUNC PyInit__ccenter(void)
 {
+    armgame_use_sincos = sincos_agrees();
     PyObject *m = PyModule_Create(&module);
-    if (m != NULL && PyModule_AddIntConstant(m, "VERSION", 1) < 0) {
+    if (m != NULL && (PyModule_AddIntConstant(m, "VERSION", 1) < 0
+                      || PyModule_AddIntConstant(m, "SINCOS", armgame_use_sincos) < 0)) {
         Py_DECREF(m);
         return NULL;
     }

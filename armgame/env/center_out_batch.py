@@ -27,6 +27,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..game.variant import runaway_message
 from ..lab.analysis import trial_row
+from ..lab.metrics import Reach
 from ..lab.perturbations import Perturbation
 from ..lab.protocol import Protocol
 from ..lab.session import LabSession, TrialOutcome, TrialPlan, lab_config, schedule
@@ -42,8 +43,8 @@ except ImportError:  # no C compiler at install: the SyncVectorEnv of single env
     _ccenter = None  # type: ignore[assignment]
 
 #: From this many envs the batch is faster than ``SyncVectorEnv`` (benchmarks/results/env_speed_center_out.json:
-#: 1.25 and 1.86 times at 4 envs, 0.44 and 0.67 times at 1, where its per-step numpy and C calls cost more than
-#: one lab session's step).
+#: 1.69 and 1.95 times at 4 envs; an earlier run with the batch from 1 env measured it 0.44 and 0.67 times as fast
+#: at 1, where its per-step numpy and C calls cost more than one lab session's step).
 BATCH_FROM = 4
 #: The most runs one batched vector env holds: a run's arrays and its path buffer take about 13 KB.
 MAX_BATCH_ENVS = 65536
@@ -127,6 +128,11 @@ class _Task:
         self.cap = session.timeout_steps + 2
         self._rows: dict[Perturbation, np.ndarray] = {}
         self.stub = SimpleNamespace(config=SimpleNamespace(dt=self.dt), protocol=protocol)
+        # A trial's block follows from its index alone (``schedule`` runs the blocks in order, each its own
+        # count of trials), so every run of the protocol shares these; the seed draws only targets and delays.
+        plans = schedule(protocol, 0, self.dt, self.home)
+        self.blocks = np.array([p.block for p in plans], dtype=np.int64)
+        self.block_names = np.array([p.block_name for p in plans], dtype=object)
 
     def trial(self, plan: TrialPlan) -> np.ndarray:
         """A trial's row of the C loop's ``trials``."""
@@ -145,20 +151,14 @@ class _Task:
 
 
 class _Run:
-    """One sub-env's run: its trials and what the lab counts of them."""
+    """One sub-env's run: its trials and, if the guard stopped it, why (its counts are the env's arrays)."""
 
-    __slots__ = ("finished", "first_block", "first_trial", "hits", "plans", "stopped", "task", "trial_index")
+    __slots__ = ("plans", "stopped", "task")
 
     def __init__(self, task: _Task, seed: int) -> None:
         self.task = task
         self.plans = schedule(task.protocol, seed, task.dt, task.home)
-        self.trial_index = self.hits = self.first_trial = 0
-        self.first_block = self.plans[0].block
-        self.finished = False
         self.stopped: str | None = None
-
-    def block_name(self) -> str:
-        return self.plans[min(self.trial_index, len(self.plans) - 1)].block_name
 
 
 class CenterOutBatchVectorEnv(VectorEnv):
@@ -209,6 +209,17 @@ class CenterOutBatchVectorEnv(VectorEnv):
         self._generators: list[np.random.Generator | None] = [None] * n
         self._edge = np.zeros(n)
         self._shown = np.zeros((n, 2), dtype=np.int64)
+        # What the lab counts per run, as arrays so that a step reads them without a loop over the runs: the
+        # trial under way (the trials done), the hits, where the episode began, and how the run ended.
+        self._trial = np.zeros(n, dtype=np.int64)
+        self._hits = np.zeros(n, dtype=np.int64)
+        self._first_trial = np.zeros(n, dtype=np.int64)
+        self._first_block = np.zeros(n, dtype=np.int64)
+        self._finished = np.zeros(n, dtype=bool)
+        self._stopped = np.zeros(n, dtype=bool)
+        self._task_of = np.zeros(n, dtype=np.int64)
+        self._task_list: list[_Task] = [task]
+        self._tables()
 
     # ----------------------------------------------------------------- the API
     def reset(self, *, seed: int | list[int | None] | None = None,
@@ -240,15 +251,14 @@ class CenterOutBatchVectorEnv(VectorEnv):
         self._act(actions, stepping)
         ints = self.ints
         steps_before = ints[:, I_STEPS].copy()
-        hits_before = np.array([r.hits for r in self.runs])  # type: ignore[union-attr]
+        hits_before = self._hits.copy()
         ints[:, I_TODO] = np.where(stepping, self.template.decision_steps, 0)
         reaches = self._advance()
-        hits = np.array([r.hits for r in self.runs]) - hits_before  # type: ignore[union-attr]
+        hits = self._hits - hits_before
         ran = ints[:, I_STEPS] - steps_before
         rewards = self._rewards(hits, stepping) - self.template.time_cost * ran * self.task_dt
-        over = np.array([self._over(i) for i in range(n)])
-        finished = np.array([r.finished for r in self.runs])  # type: ignore[union-attr]
-        stopped = np.array([r.stopped is not None for r in self.runs])  # type: ignore[union-attr]
+        over = self._overs()
+        finished, stopped = self._finished.copy(), self._stopped.copy()
         truncated = (ints[:, I_STEPS] >= ints[:, I_TOTAL]) & ~finished & ~stopped & stepping
         terminated = over & ~truncated & stepping
         infos = self._infos(np.ones(n, dtype=bool))
@@ -284,15 +294,30 @@ class CenterOutBatchVectorEnv(VectorEnv):
         task = self._tasks.get(protocol)
         if task is None:
             task = self._tasks[protocol] = _Task(protocol, self.template.hold_at_home)
+            if hasattr(self, "_task_list"):
+                self._task_list.append(task)
+                self._tables()
         return task
+
+    def _tables(self) -> None:
+        """Each task's trials' blocks and block names as one table's row, padded with its last trial's: indexed by
+        (the run's task, its trial index clipped to the table) it is the block of the trial under way, or of the
+        last trial once the run is done (as ``LabSession.block_name`` reads it)."""
+        width = max(len(t.blocks) for t in self._task_list)
+        self._blocks = np.stack([np.pad(t.blocks, (0, width - len(t.blocks)), mode="edge") for t in self._task_list])
+        self._names = np.stack([np.concatenate([t.block_names, [t.block_names[-1]] * (width - len(t.block_names))])
+                                for t in self._task_list])
+
+    def _block_at(self, trial: np.ndarray) -> np.ndarray:
+        return self._blocks[self._task_of, np.minimum(trial, self._blocks.shape[1] - 1)]
 
     def _start_episode(self, i: int, seed: int | None, options: dict[str, Any]) -> None:
         """CenterOutV1Env._start_episode for sub-env ``i``."""
         env, run = self.template, self.runs[i]
         if env.continue_run and seed is None and not options and run is not None \
                 and not self._run_over(i) and self._over(i):
-            run.first_trial = run.trial_index
-            run.first_block = run.plans[run.trial_index].block
+            self._first_trial[i] = self._trial[i]
+            self._first_block[i] = run.plans[self._trial[i]].block
         else:
             if seed is not None:
                 seed = check_seed(seed)
@@ -317,53 +342,66 @@ class CenterOutBatchVectorEnv(VectorEnv):
             self.ints[i, I_TOTAL] = task.total_steps
             self.trials[i] = task.trial(run.plans[0])
             self.held[i] = False
-        self._shown[i] = (run.trial_index, self.ints[i, I_PHASE])
+            self._trial[i] = self._hits[i] = self._first_trial[i] = 0
+            self._first_block[i] = run.plans[0].block
+            self._finished[i] = self._stopped[i] = False
+            self._task_of[i] = self._task_list.index(task)
+        self._shown[i] = (self._trial[i], self.ints[i, I_PHASE])
         self._edge[i] = math.nan  # measured after the C loop's observation (``_advance``)
 
     def _run_over(self, i: int) -> bool:
-        run = self.runs[i]
-        assert run is not None
-        return run.finished or self.ints[i, I_STEPS] >= self.ints[i, I_TOTAL]
+        return bool(self._finished[i] or self.ints[i, I_STEPS] >= self.ints[i, I_TOTAL])
 
     def _over(self, i: int) -> bool:
-        run = self.runs[i]
-        assert run is not None
         if self._run_over(i):
             return True
         if self.template.episode_trials == "block":
-            return run.plans[run.trial_index].block != run.first_block
-        return run.trial_index - run.first_trial >= self.template.episode_trials  # type: ignore[operator]
+            trial = min(int(self._trial[i]), self._blocks.shape[1] - 1)
+            return bool(self._blocks[self._task_of[i], trial] != self._first_block[i])
+        return bool(self._trial[i] - self._first_trial[i] >= self.template.episode_trials)
+
+    def _overs(self) -> np.ndarray:
+        """CenterOutV1Env's episode end for every run: its run over, or its episode's trials done."""
+        over = self._finished | (self.ints[:, I_STEPS] >= self.ints[:, I_TOTAL])
+        if self.template.episode_trials == "block":
+            return over | (self._block_at(self._trial) != self._first_block)
+        return over | (self._trial - self._first_trial >= self.template.episode_trials)
 
     def _act(self, actions: Any, stepping: np.ndarray) -> None:
         """The single env's ``_press_keys`` or ``_set_levels`` on every stepping run that is not over."""
         n = self.num_envs
         live = stepping & (self.ints[:, I_STEPS] < self.ints[:, I_TOTAL])
-        live &= ~np.array([r.finished for r in self.runs])  # type: ignore[union-attr]
-        rise = np.stack([r.task.rise for r in self.runs]) if len(self._tasks) > 1 else \
-            next(iter(self._tasks.values())).rise  # type: ignore[union-attr]
-        decay = np.stack([r.task.decay for r in self.runs]) if len(self._tasks) > 1 else \
-            next(iter(self._tasks.values())).decay  # type: ignore[union-attr]
+        live &= ~self._finished
+        if len(self._task_list) > 1:
+            rise = np.stack([t.rise for t in self._task_list])[self._task_of]
+            decay = np.stack([t.decay for t in self._task_list])[self._task_of]
+        else:
+            rise, decay = self._task_list[0].rise, self._task_list[0].decay
         goal, rate = self.state[:, S_G:S_G + 4], self.state[:, S_R:S_R + 4]
+        everyone = stepping.all()
         if self.template.continuous:
             levels = np.asarray(actions, dtype=np.float64)
-            if levels.shape != (n, 4) or not np.isfinite(levels[stepping]).all():
+            if levels.shape != (n, 4) or not np.isfinite(levels if everyone else levels[stepping]).all():
                 raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) finite numbers in [-1, 1], got "
                                  f"shape {levels.shape}")
             levels = np.clip((levels + 1.0) * 0.5, 0.0, 1.0)
             up = levels > self.state[:, S_A:S_A + 4]
-            where = live[:, None]
-            goal[...] = np.where(where, levels, goal)
-            rate[...] = np.where(where, np.where(up, rise, decay), rate)
+            where = np.broadcast_to(live[:, None], up.shape)
+            np.copyto(goal, levels, where=where)
+            np.copyto(rate, rise, where=where & up)
+            np.copyto(rate, decay, where=where & ~up)
             return
         pressed = np.asarray(actions)
-        if pressed.shape != (n, 4) or not np.isin(pressed[stepping], (0, 1)).all():
+        keys = pressed if everyone else pressed[stepping]
+        if pressed.shape != (n, 4) or not ((keys == 0) | (keys == 1)).all():
             raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) zeros or ones (keys held), got shape "
                              f"{pressed.shape}")
         down = pressed == 1
         change = (down != self.held) & live[:, None]
         self.held ^= change
-        goal[...] = np.where(change, down.astype(np.float64), goal)
-        rate[...] = np.where(change, np.where(down, rise, decay), rate)
+        np.copyto(goal, down, where=change)
+        np.copyto(rate, rise, where=change & down)
+        np.copyto(rate, decay, where=change & ~down)
 
     def _advance(self) -> dict[int, list[dict[str, object]]]:
         """Run the C loop until every run has run its steps, ending trials as ``LabSession._task_step`` does."""
@@ -378,20 +416,28 @@ class CenterOutBatchVectorEnv(VectorEnv):
                 ints[i, I_EVENT] = 0
                 if event == EVENT_STOPPED:
                     run.stopped = runaway_message(trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
+                    self._stopped[i] = True
                     ints[i, I_TODO] = 0
                     continue
                 path = int(ints[i, I_PATH])
-                plan = run.plans[run.trial_index]
-                outcome = TrialOutcome(plan, int(ints[i, I_GO]), int(ints[i, I_STEPS]), event == EVENT_HIT,
-                                       self.xs[i, :path].tolist(), self.ys[i, :path].tolist())
-                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome))  # type: ignore[arg-type]
-                run.hits += event == EVENT_HIT
-                run.trial_index += 1
-                if run.trial_index >= len(run.plans):
-                    run.finished = True
+                index = int(self._trial[i])
+                plan, go = run.plans[index], int(ints[i, I_GO])
+                # The outcome's path stays empty: no trial the batch runs is a channel trial or one space sent
+                # home, so the row reads the path only as the reach, given here as the arrays reach_of would
+                # build from it (the same numbers), without the C loop's rows going through lists.
+                hand = np.column_stack((self.xs[i, :path], self.ys[i, :path]))
+                reach = Reach(t=(go + np.arange(len(hand))) * run.task.dt, hand=hand, start=plan.home,
+                              target=plan.position, go_time=go * run.task.dt, hit=event == EVENT_HIT)
+                outcome = TrialOutcome(plan, go, int(ints[i, I_STEPS]), event == EVENT_HIT)
+                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome,  # type: ignore[arg-type]
+                                                                reach=reach))
+                self._hits[i] += event == EVENT_HIT
+                self._trial[i] = index = index + 1
+                if index >= len(run.plans):
+                    self._finished[i] = True
                     ints[i, I_TODO] = 0
                 else:
-                    trials[i] = run.task.trial(run.plans[run.trial_index])
+                    trials[i] = run.task.trial(run.plans[index])
         self._measure_new()
         return reaches
 
@@ -411,7 +457,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
         env = self.template
         if env.reward_kind == "sparse":
             return hits.astype(np.float64)
-        shown = np.stack([np.array([r.trial_index for r in self.runs]), self.ints[:, I_PHASE]], axis=1)  # type: ignore[union-attr]
+        shown = np.stack([self._trial, self.ints[:, I_PHASE]], axis=1)
         edge = self._edges()
         same = (shown == self._shown).all(axis=1)
         progress = np.where(same, self._edge - edge, 0.0)
@@ -423,11 +469,8 @@ class CenterOutBatchVectorEnv(VectorEnv):
         return self._obs.astype(self.template.observation_dtype)
 
     def _infos(self, games: np.ndarray) -> dict[str, Any]:
-        runs = self.runs
-        trial = np.array([r.trial_index for r in runs])  # type: ignore[union-attr]
-        hits = np.array([r.hits for r in runs])  # type: ignore[union-attr]
-        block = np.empty(self.num_envs, dtype=object)
-        block[:] = [r.block_name() for r in runs]  # type: ignore[union-attr]
+        trial, hits = self._trial.copy(), self._hits.copy()
+        block = self._names[self._task_of, np.minimum(trial, self._names.shape[1] - 1)]
         infos: dict[str, Any] = {}
         for key, value in (("trial", trial), ("trials_done", trial.copy()), ("hits", hits), ("block", block)):
             infos[key] = np.where(games, value, np.zeros_like(value) if value.dtype != object else None)

@@ -70,12 +70,14 @@ def trial_rows(session: LabSession) -> list[dict[str, object]]:
     return [trial_row(session, o, d) for o, d in zip(session.outcomes, disturbance, strict=True)]
 
 
-def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.nan) -> dict[str, object]:
+def trial_row(session: LabSession, o: TrialOutcome, disturbance: float = math.nan,
+              reach: Reach | None = None) -> dict[str, object]:
     """One finished trial's row, with the columns of ``metrics.TRIAL_COLUMNS`` (``disturbance``: the trial's, in
-    units of the run's first perturbation, ``disturbance_schedule``; NaN when not given)."""
+    units of the run's first perturbation, ``disturbance_schedule``; NaN when not given). ``reach``: the trial's
+    ``reach_of``, where the caller has it as arrays already (the CenterOut batch: its paths are numpy rows)."""
     from .designs import frame_indices
 
-    m = reach_metrics(reach_of(session, o))
+    m = reach_metrics(reach_of(session, o) if reach is None else reach)
     hand, joint = frame_indices(session, o)
     shoulder, elbow = session.protocol.blocks[o.plan.block].posture_of(session.protocol)
     return {
