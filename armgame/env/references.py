@@ -124,3 +124,92 @@ CEILINGS: dict[str, dict[str, Any]] = {
     "armgame/CenterOutHoldContinuous-v1": {
         "hits": 8.0, "by": "every trial of the episode hit"},
 }
+
+
+# Protocol 3's reference (``python benchmarks/reference_scores.py references-v3``, from benchmarks/results/ceiling
+# and benchmarks/results/reference; tests/test_hit_bound.py holds it to those files): per Reach id, the shooting
+# controller at its strongest settings tried, its mean hits on the test games played so far (``games``; 95 % interval
+# over games), the code, and the CPU seconds a decision cost in that run. Not yet the headline: an id is complete at
+# 100 games, and an id whose reference run has no games yet is absent (docs/programs.md, "Protocol 3's reference").
+REFERENCES_V3: dict[str, dict[str, Any]] = {
+    'armgame/Reach-v1': {
+        'hits': 72.16,
+        'low': 71.552,
+        'high': 72.768,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00264,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/Reach-v1',
+    },
+    'armgame/ReachHold-v1': {
+        'hits': 64.57,
+        'low': 64.209,
+        'high': 64.931,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00304,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/ReachHold-v1',
+    },
+    'armgame/ReachNoisy-v1': {
+        'hits': 70.63,
+        'low': 69.957,
+        'high': 71.303,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController(replan=1)',
+        'cpu_per_decision': 0.00394,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/ReachNoisy-v1',
+    },
+    'armgame/ReachContinuous-v1': {
+        'hits': 72.16,
+        'low': 71.552,
+        'high': 72.768,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00264,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/Reach-v1',
+    },
+    'armgame/ReachDelay-v1': {
+        'hits': 72.16,
+        'low': 71.552,
+        'high': 72.768,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00264,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/Reach-v1',
+    },
+    'armgame/ReachDelayContinuous-v1': {
+        'hits': 72.16,
+        'low': 71.552,
+        'high': 72.768,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00264,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/Reach-v1',
+    },
+    'armgame/ReachHoldContinuous-v1': {
+        'hits': 64.57,
+        'low': 64.209,
+        'high': 64.931,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00304,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/ReachHold-v1',
+    },
+    'armgame/ReachNoisyContinuous-v1': {
+        'hits': 70.63,
+        'low': 69.957,
+        'high': 71.303,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController(replan=1)',
+        'cpu_per_decision': 0.00394,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/ReachNoisy-v1',
+    },
+}
