@@ -319,6 +319,40 @@ def references_v3(ceiling_folder: Path = RESULTS / "ceiling",
             for env_id in (*bench.DISTINCT, *bench.STANDS_FOR) if bench.STANDS_FOR.get(env_id, env_id) in measured}
 
 
+def references_v3_table() -> str:
+    """docs/programs.md's table of protocol 3's references (``references_v3``), every Reach id: a row without games
+    yet says so."""
+    from armgame.env.evaluation import normalised_score
+
+    bench = _ceiling_benchmark()
+    rows = references_v3()
+    runs = long_runs()
+    lines = ["| id | reference | test games so far | hits (95% CI over games) | CPU s a decision | machine "
+             "| PPO's longest runs, protocol 3 |", "|---|---|---:|---|---:|---|---:|"]
+    for env_id in (*bench.DISTINCT, *bench.STANDS_FOR):
+        name = env_id.split("/")[1]
+        row = rows.get(env_id)
+        if row is None:
+            settings = ", ".join(f"{k}={v!r}" for k, v in bench.REFERENCE.get(bench.STANDS_FOR.get(env_id, env_id),
+                                                                               {}).items())
+            lines.append(f"| `{name}` | `ShootingController({settings})` | 0 (running) | | | | |")
+            continue
+        code = row["code"].removeprefix("armgame.env.ceiling.")
+        games = f"{row['games']}" + ("" if row["games"] >= 100 else " (incomplete)")
+        same = "" if row["games_of"] == env_id else f" = {row['games_of'].split('/')[1]}"
+        ppo = runs.get(env_id, {})
+        score = normalised_score(env_id, float(np.mean(ppo[max(ppo)])), protocol=3) if ppo else None
+        shown = "" if score is None else f"{score:.2f}"
+        lines.append(f"| `{name}` | `{code}` | {games} | {row['hits']:.1f} ({row['low']:.1f}-{row['high']:.1f}){same} "
+                     f"| {row['cpu_per_decision']:.4f} | {row['machine']} | {shown} |")
+    short = [f"{env_id.split('/')[1]} {rows[env_id]['games'] if env_id in rows else 0}" for env_id in bench.DISTINCT
+             if rows.get(env_id, {}).get("games", 0) < 100]
+    head = (f"**The table is incomplete**: the test games so far of {', '.join(short)} (of 100; their twins' the "
+            "same). "
+            "An id without games is left out of `REFERENCES_V3`." if short else "Every id has its 100 test games.")
+    return head + "\n\n" + "\n".join(lines)
+
+
 def references_v3_source() -> str:
     """``armgame/env/references.py``'s ``REFERENCES_V3``, as Python source."""
     lines = ["REFERENCES_V3: dict[str, dict[str, Any]] = {"]
@@ -619,6 +653,7 @@ def _main(argv: list[str] | None = None) -> int:
     sub.add_parser("table", help="docs/programs.md's reference table, from the committed results (protocol 2)")
     sub.add_parser("ceilings", help="armgame/env/references.py's CEILINGS, from the committed results")
     sub.add_parser("references-v3", help="armgame/env/references.py's REFERENCES_V3 (protocol 3's normaliser)")
+    sub.add_parser("references-v3-table", help="docs/programs.md's table of protocol 3's references")
     sub.add_parser("runs-table", help="docs/programs.md's table of PPO's protocol runs, from the committed results")
     fig = sub.add_parser("figure", help="docs/img/ppo_curves.png: the protocol runs' validation curves (matplotlib)")
     fig.add_argument("--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "img" /
@@ -657,6 +692,8 @@ def _main(argv: list[str] | None = None) -> int:
         print(ceilings_source())
     elif args.command == "references-v3":
         print(references_v3_source())
+    elif args.command == "references-v3-table":
+        print(references_v3_table())
     elif args.command == "runs-table":
         print(runs_table())
     elif args.command == "figure":
