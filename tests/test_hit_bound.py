@@ -119,3 +119,42 @@ def test_the_reference_run_records_its_settings_decisions_and_processor(tmp_path
     result = json.loads((tmp_path / "ReachHard-v1.json").read_text(encoding="utf-8"))
     assert result["settings"] == bench.REFERENCE["armgame/ReachHard-v1"] != bench.SETTINGS["armgame/ReachHard-v1"]
     assert result["decisions"] == 50 and result["processor"] and result["cpu_seconds"] > 0
+
+
+def test_a_played_games_hand_stays_within_the_bounds_speed_and_acceleration():
+    """Random keys and a pump (each joint's muscle pushing the way it turns) on the noisy game, whose bound is the
+    widest: the hand's speed stays below ``V`` and its mean acceleration over each decision below ``A``."""
+    import gymnasium as gym
+
+    bound = _module("hit_bound")
+    row = {r["env_id"]: r for r in json.loads((RESULTS / "hit_bound.json").read_text(encoding="utf-8"))}
+    seen = {}
+    for env_id in ("armgame/Reach-v1", "armgame/ReachNoisy-v1"):
+        limit = row[env_id]
+        env = gym.make(env_id, time_limit=8.0)
+        p = env.unwrapped.settings.config.arm
+        rng = np.random.default_rng(0)
+        for pump in (False, True):
+            env.reset(seed=5)
+            before, fastest, hardest, done = None, 0.0, 0.0, False
+            while not done:
+                q1, q2, w1, w2 = env.unwrapped.session.state
+                j = bound.jacobian(p, np.array(q2))
+                c, s = np.cos(q1), np.sin(q1)
+                v = np.array([[c, -s], [s, c]]) @ j @ np.array([w1, w2])
+                fastest = max(fastest, float(np.linalg.norm(v)))
+                if before is not None:
+                    hardest = max(hardest, float(np.linalg.norm(v - before)) / 0.02)
+                before = v
+                keys = (np.array([w1 >= 0, w1 < 0, w2 >= 0, w2 < 0]) if pump else rng.integers(0, 2, 4)).astype(np.int8)
+                _, _, terminated, truncated, _ = env.step(keys)
+                done = terminated or truncated
+            assert fastest < limit["speed"] and hardest < limit["accel"], (env_id, pump, fastest, hardest)
+            seen[env_id, pump] = (fastest, hardest)
+        env.close()
+    # The docs' reading of how far the bound's V and A are from what the pump reaches.
+    guide = " ".join((ROOT / "docs" / "programs.md").read_text(encoding="utf-8").split())
+    fastest, hardest = seen["armgame/Reach-v1", True]
+    limit = row["armgame/Reach-v1"]
+    assert (f"reaches {fastest:.1f} m/s and {hardest:.0f} m/s^2 in an 8 s game of Reach-v1, against `V` "
+            f"{limit['speed']:.1f} and `A` {limit['accel']:.0f}") in guide
