@@ -2,6 +2,7 @@
 
     python benchmarks/hit_bound.py                                  # print it
     python benchmarks/hit_bound.py --out benchmarks/results/hit_bound.json
+    python benchmarks/hit_bound.py --table benchmarks/results/hit_bound.json        # docs/programs.md's table
 
 A relaxation, each step of which only makes the task easier, so its hits are at least any policy's:
 
@@ -32,7 +33,7 @@ A relaxation, each step of which only makes the task easier, so its hits are at 
 An oracle that knows the game's draws (the seeds are public) escapes step 4: for it each reach's ``v0`` points at its
 target at speed ``V``, and its bound is reported beside (``oracle``).
 
-Bad input (an unknown id) is one line and exit 1.
+Bad input (an unknown id, a result that is not one) is one line and exit 1.
 """
 
 from __future__ import annotations
@@ -195,11 +196,73 @@ def bound(env_id: str) -> dict[str, Any]:
     return out
 
 
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def committed_scores(results: Path = RESULTS) -> dict[str, float]:
+    """Each Reach id's best committed mean hits: PPO's runs (each seed), the controller's and the reference's results
+    (for every id playing their games), the bots and protocol 1's PPO (``references.py``) and protocol 2's ceiling."""
+    import importlib.util
+
+    from armgame.env.references import CEILINGS, REFERENCE_HITS
+
+    spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
+    bench = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(bench)  # type: ignore[union-attr]
+    best: dict[str, float] = {}
+
+    def seen(env_id: str, hits: float) -> None:
+        if "CenterOut" not in env_id:
+            best[env_id] = max(best.get(env_id, -math.inf), hits)
+
+    for path in results.glob("ppo*/**/result.json"):
+        result = json.loads(path.read_text(encoding="utf-8"))
+        seen(result["env_id"], float(result["mean_hits"]))
+    for folder in ("ceiling", "reference"):
+        for path in (results / folder).glob("*.json"):
+            data = bench.read_result(path)
+            for env_id in (data["env_id"], *[k for k, v in bench.STANDS_FOR.items() if v == data["env_id"]]):
+                if data["hits"]:
+                    seen(env_id, float(np.mean(data["hits"])))
+    for env_id, row in REFERENCE_HITS.items():
+        for policy in ("random", "naive", "model", "ppo"):
+            seen(env_id, row[policy])
+    for env_id, row in CEILINGS.items():
+        seen(env_id, row["hits"])
+    return best
+
+
+def table(rows: list[dict[str, Any]], results: Path = RESULTS) -> str:
+    """docs/programs.md's table of the bound, each game's best measured score over every id that plays its games."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
+    bench = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(bench)  # type: ignore[union-attr]
+    scores = committed_scores(results)
+    lines = ["| game | `E*` (J) | `V` (m/s) | `A` (m/s^2) | mean reach at least (ms) | bound: hits a game "
+             "| an oracle's | best measured | bound / best |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for row in rows:
+        best = max(v for k, v in scores.items() if bench.STANDS_FOR.get(k, k) == row["env_id"])
+        lines.append(f"| `{row['env_id'].split('/')[1]}` | {row['energy']:.1f} | {row['speed']:.1f} | "
+                     f"{row['accel']:.0f} | {row['bound_reach'] * 1000:.0f} | **{row['bound_hits']:.0f}** | "
+                     f"{row['oracle_hits']:.0f} | {best:.1f} | {row['bound_hits'] / best:.0f} |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ids", nargs="+", default=list(DISTINCT))
     parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--table", type=Path, default=None, metavar="RESULT",
+                        help="print docs/programs.md's table from a result of --out (and the committed scores)")
     args = parser.parse_args(argv)
+    if args.table is not None:
+        try:
+            print(table(json.loads(args.table.read_text(encoding="utf-8"))))
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise SystemExit(f"{args.table}: not a result of hit_bound.py --out ({type(exc).__name__})") from None
+        return 0
     for env_id in args.ids:
         if env_id not in DISTINCT:
             raise SystemExit(f"{env_id}: not one of the five distinct Reach games ({', '.join(DISTINCT)})")
