@@ -3,6 +3,7 @@
     python benchmarks/ceiling.py run --ids armgame/Reach-v1 --out benchmarks/results/ceiling     # 100 test games
     python benchmarks/ceiling.py run --ids armgame/ReachHold-v1 --games 3 --seconds 20 --out /tmp/look  # a look
     python benchmarks/ceiling.py show benchmarks/results/ceiling                                 # what is there
+    python benchmarks/ceiling.py run --reference --out benchmarks/results/reference  # protocol 3's reference
 
 ``run`` plays ``armgame.env.evaluate`` with a fresh ``ShootingController`` a game on the first ``--games`` test
 seeds of each id (the settings below, per id), ten games a call, and writes each id's hits so far to
@@ -12,6 +13,11 @@ their key ids' game for game (levels 0 and 1 act exactly as keys: ``tests/test_c
 delay never reaches a controller that reads the true state, so ``ReachDelay-v1`` is ``Reach-v1`` and
 ``ReachDelayContinuous-v1`` too: ``run`` measures the five distinct games (``DISTINCT``) and ``show`` says which
 id's result stands for which.
+
+``--reference`` plays protocol 3's reference settings (``REFERENCE``: per id, the strongest tried) instead of
+issue 40's, and each file then also holds the decisions played and the machine's processor, so the CPU a decision
+costs is measured in the run that scores it. An id whose reference settings are issue 40's needs no new run: its
+``benchmarks/results/ceiling`` file is its reference (``reference_scores.py`` reads both folders).
 
 Bad input (an unknown id, a result file that is not one) is one line and exit 1.
 """
@@ -40,6 +46,14 @@ SETTINGS: dict[str, dict[str, Any]] = {
     "armgame/ReachNoisy-v1": {"replan": 1},
     "armgame/ReachHard-v1": {"coarse": 15, "fine": 4},
 }
+
+#: Protocol 3's reference: the controller's arguments per id, the strongest tried on the first three test games
+#: (docs/programs.md, "Protocol 3's reference"). ``replan=1`` (a closed loop every decision) gained 8 hits in 3 games
+#: on ReachHard-v1 (54, 53, 58 against 52, 50, 55) and 3 on ReachField-v1 (71, 69, 72 against 70, 68, 71), 1 on
+#: ReachHold-v1 and lost 2 on Reach-v1, at two to three times the CPU, so ReachHard-v1's and ReachField-v1's
+#: settings change; ReachNoisy-v1's were already ``replan=1``.
+REFERENCE: dict[str, dict[str, Any]] = {**SETTINGS, "armgame/ReachHard-v1": {"replan": 1, "coarse": 15, "fine": 4},
+                                        "armgame/ReachField-v1": {"replan": 1}}
 
 #: The ids whose games differ for the controller; every other Reach id's games are one of these (``STANDS_FOR``).
 DISTINCT = ("armgame/Reach-v1", "armgame/ReachHold-v1", "armgame/ReachNoisy-v1", "armgame/ReachField-v1",
@@ -71,10 +85,31 @@ def read_result(path: Path) -> dict[str, Any]:
     return data
 
 
-def run(out: Path, ids: list[str], games: int, seconds: float | None) -> None:
+def processor() -> str:
+    """The machine's processor as its OS names it (Linux's /proc/cpuinfo), else ``platform``'s word for it."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text(encoding="utf-8").splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def decision_seconds(env_id: str) -> float:
+    """The game time (s) one decision of ``env_id`` lasts."""
+    import gymnasium as gym
+
+    env = gym.make(env_id)
+    settings = env.unwrapped.settings
+    env.close()
+    return settings.decision_steps * settings.config.dt
+
+
+def run(out: Path, ids: list[str], games: int, seconds: float | None, reference: bool = False) -> None:
     out.mkdir(parents=True, exist_ok=True)
     for env_id in ids:
-        settings = SETTINGS.get(env_id, {})
+        settings = (REFERENCE if reference else SETTINGS).get(env_id, {})
         path = out / f"{slug(env_id)}.json"
         hits: list[int] = []
         cpu = 0.0
@@ -95,6 +130,9 @@ def run(out: Path, ids: list[str], games: int, seconds: float | None) -> None:
             record = {"env_id": env_id, "controller": "armgame.env.ceiling.ShootingController", "settings": settings,
                       "time_limit": seconds, "first_seed": EVALUATION_SEEDS[0], "hits": hits, "cpu_seconds": cpu,
                       "machine": f"{platform.machine()}, {platform.python_version()}, armgame {armgame.__version__}"}
+            if reference:
+                record["decisions"] = round(len(hits) * part.minutes * 60.0 / decision_seconds(env_id))
+                record["processor"] = processor()
             tmp = path.with_suffix(".tmp")
             tmp.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
             tmp.replace(path)
@@ -126,6 +164,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--games", type=int, default=100)
     r.add_argument("--seconds", type=float, default=None, help="a shorter game (default: the id's 60 s)")
     r.add_argument("--out", type=Path, required=True)
+    r.add_argument("--reference", action="store_true", help="protocol 3's reference settings (REFERENCE)")
     s = sub.add_parser("show", help="each Reach id's score from a folder of results")
     s.add_argument("folder", type=Path)
     args = parser.parse_args(argv)
@@ -136,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
                 raise SystemExit(f"{env_id}: not a Reach id of the suite")
         if not 1 <= args.games <= 1000:
             raise SystemExit(f"--games {args.games}: expected 1 to 1000")
-        run(args.out, args.ids, args.games, args.seconds)
+        run(args.out, args.ids, args.games, args.seconds, args.reference)
     else:
         for env_id, (mean, low, high, games, source) in summary(args.folder).items():
             note = "" if source == env_id else f" (the games of {source})"

@@ -276,6 +276,93 @@ def table(reference: dict[str, dict[str, Any]] | None = None, controller_folder:
     return "\n".join(lines)
 
 
+def _ceiling_benchmark() -> Any:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
+    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module
+
+
+def references_v3(ceiling_folder: Path = RESULTS / "ceiling",
+                  reference_folder: Path = RESULTS / "reference") -> dict[str, dict[str, Any]]:
+    """Protocol 3's reference of every Reach id: the shooting controller at ``benchmarks/ceiling.py``'s
+    ``REFERENCE`` settings, its mean hits on the test games played so far (``games`` of them, with the 95 % interval
+    over games), the code that plays it, and the CPU seconds a decision cost in the same run, on its machine. Read
+    from ``reference_folder`` where it holds the id at those settings, else from ``ceiling_folder`` (issue 40's runs,
+    whose settings are the reference's on four ids). An id whose games are another's (``STANDS_FOR``) takes its."""
+    from armgame.env.evaluation import mean_interval
+
+    bench = _ceiling_benchmark()
+    measured: dict[str, dict[str, Any]] = {}
+    for env_id in bench.DISTINCT:
+        settings = bench.REFERENCE.get(env_id, {})
+        for folder in (reference_folder, ceiling_folder):
+            path = folder / f"{bench.slug(env_id)}.json"
+            if path.is_file() and bench.read_result(path)["settings"] == settings:
+                data = bench.read_result(path)
+                break
+        else:
+            continue
+        hits = data["hits"]
+        low, high = mean_interval(hits)
+        decisions = data.get("decisions", len(hits) * 3000)  # issue 40's runs: 60 s games of 20 ms decisions
+        arguments = ", ".join(f"{k}={v!r}" for k, v in settings.items())
+        measured[env_id] = {
+            "hits": round(float(np.mean(hits)), 3), "low": round(low, 3), "high": round(high, 3), "games": len(hits),
+            "code": f"armgame.env.ceiling.ShootingController({arguments})",
+            "cpu_per_decision": round(float(data["cpu_seconds"]) / decisions, 5),
+            "machine": f"{data.get('processor', 'processor not recorded')}; {data['machine']}",
+            "games_of": env_id}
+    return {env_id: {**measured[bench.STANDS_FOR.get(env_id, env_id)]}
+            for env_id in (*bench.DISTINCT, *bench.STANDS_FOR) if bench.STANDS_FOR.get(env_id, env_id) in measured}
+
+
+def references_v3_table() -> str:
+    """docs/programs.md's table of protocol 3's references (``references_v3``), every Reach id: a row without games
+    yet says so."""
+    from armgame.env.evaluation import normalised_score
+
+    bench = _ceiling_benchmark()
+    rows = references_v3()
+    runs = long_runs()
+    lines = ["| id | reference | test games so far | hits (95% CI over games) | CPU s a decision | machine "
+             "| PPO's longest runs, protocol 3 |", "|---|---|---:|---|---:|---|---:|"]
+    for env_id in (*bench.DISTINCT, *bench.STANDS_FOR):
+        name = env_id.split("/")[1]
+        row = rows.get(env_id)
+        if row is None:
+            settings = ", ".join(f"{k}={v!r}" for k, v in bench.REFERENCE.get(bench.STANDS_FOR.get(env_id, env_id),
+                                                                               {}).items())
+            lines.append(f"| `{name}` | `ShootingController({settings})` | 0 (running) | | | | |")
+            continue
+        code = row["code"].removeprefix("armgame.env.ceiling.")
+        games = f"{row['games']}" + ("" if row["games"] >= 100 else " (incomplete)")
+        same = "" if row["games_of"] == env_id else f" = {row['games_of'].split('/')[1]}"
+        ppo = runs.get(env_id, {})
+        score = normalised_score(env_id, float(np.mean(ppo[max(ppo)])), protocol=3) if ppo else None
+        shown = "" if score is None else f"{score:.2f}"
+        lines.append(f"| `{name}` | `{code}` | {games} | {row['hits']:.1f} ({row['low']:.1f}-{row['high']:.1f}){same} "
+                     f"| {row['cpu_per_decision']:.4f} | {row['machine']} | {shown} |")
+    short = [f"{env_id.split('/')[1]} {rows[env_id]['games'] if env_id in rows else 0}" for env_id in bench.DISTINCT
+             if rows.get(env_id, {}).get("games", 0) < 100]
+    head = (f"**The table is incomplete**: the test games so far of {', '.join(short)} (of 100; their twins' the "
+            "same). "
+            "An id without games is left out of `REFERENCES_V3`." if short else "Every id has its 100 test games.")
+    return head + "\n\n" + "\n".join(lines)
+
+
+def references_v3_source() -> str:
+    """``armgame/env/references.py``'s ``REFERENCES_V3``, as Python source."""
+    lines = ["REFERENCES_V3: dict[str, dict[str, Any]] = {"]
+    for env_id, row in references_v3().items():
+        lines.append(f"    {env_id!r}: {{")
+        lines += [f"        {key!r}: {value!r}," for key, value in row.items()]
+        lines.append("    },")
+    return "\n".join([*lines, "}"])
+
+
 def ceilings_source(reference: dict[str, dict[str, Any]] | None = None) -> str:
     """``armgame/env/references.py``'s ``CEILINGS``, as Python source."""
     lines = ["CEILINGS: dict[str, dict[str, Any]] = {"]
@@ -565,6 +652,8 @@ def _main(argv: list[str] | None = None) -> int:
     ppo.add_argument("--out", type=Path, required=True)
     sub.add_parser("table", help="docs/programs.md's reference table, from the committed results (protocol 2)")
     sub.add_parser("ceilings", help="armgame/env/references.py's CEILINGS, from the committed results")
+    sub.add_parser("references-v3", help="armgame/env/references.py's REFERENCES_V3 (protocol 3's normaliser)")
+    sub.add_parser("references-v3-table", help="docs/programs.md's table of protocol 3's references")
     sub.add_parser("runs-table", help="docs/programs.md's table of PPO's protocol runs, from the committed results")
     fig = sub.add_parser("figure", help="docs/img/ppo_curves.png: the protocol runs' validation curves (matplotlib)")
     fig.add_argument("--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "img" /
@@ -601,6 +690,10 @@ def _main(argv: list[str] | None = None) -> int:
         print(table())
     elif args.command == "ceilings":
         print(ceilings_source())
+    elif args.command == "references-v3":
+        print(references_v3_source())
+    elif args.command == "references-v3-table":
+        print(references_v3_table())
     elif args.command == "runs-table":
         print(runs_table())
     elif args.command == "figure":

@@ -305,12 +305,15 @@ def _game_minutes(env: gym.Env) -> float:
     return session.steps * session.config.dt / 60.0 if session is not None else math.nan
 
 
-def normalised_score(env_id: str, mean_hits: float) -> float | None:
+def normalised_score(env_id: str, mean_hits: float, protocol: int = 2) -> float | None:
     """``(hits - random) / (ceiling - random)`` by the id's reference scores (protocol 2: ``CEILINGS``); None for an
-    id without them."""
-    from .references import CEILINGS, REFERENCE_HITS
+    id without them. Protocol 3 divides by the id's reference controller instead (``REFERENCES_V3``: a fixed score
+    of the shooting controller, never a mean of the runs being scored), so a run above it scores above 1."""
+    from .references import CEILINGS, REFERENCE_HITS, REFERENCES_V3
 
-    reference, ceiling = REFERENCE_HITS.get(env_id), CEILINGS.get(env_id)
+    if protocol not in (2, 3):
+        raise ValueError(f"protocol must be 2 or 3, got {protocol!r}")
+    reference, ceiling = REFERENCE_HITS.get(env_id), (CEILINGS if protocol == 2 else REFERENCES_V3).get(env_id)
     if reference is None or ceiling is None:
         return None
     low, high = reference["random"], ceiling["hits"]
