@@ -19,6 +19,9 @@ Importing this package registers, with ``gymnasium.register``:
   exported here) scores a policy on the held-out evaluation seeds against the reference scores
   (``references``), ``aggregate_runs`` summarises training seeds (IQM, stratified bootstrap:
   ``statistics``), and ``record.replay_of`` writes any env's game as a replay ``armgame verify`` checks;
+* the separating tier (``suite.TIER``): ``armgame/ReachMemory-v1``, ``ReachMemoryHold-v1`` and
+  ``ReachPositions-v1``, Reach-v1's and ReachHold-v1's games with the target seen only 0.1 s after it
+  appears, or only positions observed;
 * ``armgame/Reach-v0``, ``armgame/ReachContinuous-v0``, ``armgame/CenterOut-v0``,
   ``armgame/CenterOutContinuous-v0``: the first versions, unchanged (``reach``, ``center_out``).
 
@@ -44,7 +47,7 @@ from __future__ import annotations
 import gymnasium
 
 from .evaluation import Evaluation, aggregate_runs, evaluate
-from .suite import CENTER_OUT_SUITE, SUITE
+from .suite import CENTER_OUT_SUITE, SUITE, TIER
 
 __all__ = ["CENTER_OUT_IDS", "CENTER_OUT_SUITE", "CENTER_OUT_V1_IDS", "ENV_IDS", "SUITE", "V1_IDS", "Evaluation",
            "aggregate_runs", "evaluate"]
@@ -96,5 +99,13 @@ def _register() -> None:
                     gymnasium.register(id=env_id, entry_point=entry_point, vector_entry_point=vector_entry_point,
                                        kwargs={"continuous": continuous, **arguments}, max_episode_steps=None,
                                        nondeterministic=False)
+    # The separating tier: key ids only (suite.TIER).
+    for name, arguments in TIER.items():
+        env_id = f"armgame/{name}-v1"
+        if env_id not in gymnasium.registry:
+            gymnasium.register(id=env_id, entry_point="armgame.env.reach_v1:ReachV1Env",
+                               vector_entry_point="armgame.env.vector:reach_v1_vector_env",
+                               kwargs={"continuous": False, **arguments}, max_episode_steps=None,
+                               nondeterministic=False)
 
 _register()

@@ -18,7 +18,7 @@ from ..game.session import GameSession
 from ..game.variant import GameVariant, MuscleNoise, RunawayError
 from .features import DEFAULT_HIT_BONUS, DEFAULT_PROGRESS_WEIGHT, hand_and_velocity
 from .reach import DEFAULT_DECISION_STEPS, ReachBaseEnv, ReachSettings, wrap_angle
-from .variants import DelayedObservations, ReachVariant, with_target_radius
+from .variants import DelayedObservations, HiddenObservations, ReachVariant, with_target_radius
 
 OBSERVATION_NAMES_V1 = ("q1", "q2", "w1", "w2", "a_d", "a_f", "a_j", "a_k", "hand_x", "hand_y", "hand_vx", "hand_vy",
                         "to_target_x", "to_target_y", "time_left_fraction")
@@ -141,8 +141,10 @@ class ReachV1Env(ReachBaseEnv):
                  hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
                  hold_time: float = 0.0, motor_noise: float = 0.0, observation_delay: int = 0,
                  field: str | None = None, field_strength: float | None = None, target_radius: float | None = None,
+                 target_shown: float | None = None, positions_only: bool = False,
                  config: GameConfig | None = None, render_size: tuple[int, int] = (600, 600)) -> None:
-        variant = ReachVariant.of(hold_time, motor_noise, observation_delay, field, field_strength)
+        variant = ReachVariant.of(hold_time, motor_noise, observation_delay, field, field_strength, target_shown,
+                                  positions_only)
         if target_radius is not None:
             config = with_target_radius(config or GameConfig(), target_radius)
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
@@ -155,6 +157,7 @@ class ReachV1Env(ReachBaseEnv):
         #: Why the game stopped before its clock ran out (a field's runaway), or None.
         self._stopped: str | None = None
         self._delayed = DelayedObservations(variant.observation_delay) if variant.observation_delay else None
+        self._hidden = HiddenObservations(variant, settings.config.dt) if variant.hides else None
 
     @property
     def reward_kind(self) -> str:
@@ -238,5 +241,8 @@ class ReachV1Env(ReachBaseEnv):
         target = session.rules.target
         total = self.config.total_steps
         left = (total - min(session.steps, total)) / total
-        return np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *session.muscles.activation, hx, hy, vx, vy,
-                         target.x - hx, target.y - hy, left), dtype=self.settings.observation_dtype)
+        observation = np.array((wrap_angle(q1), wrap_angle(q2), w1, w2, *session.muscles.activation, hx, hy, vx, vy,
+                                target.x - hx, target.y - hy, left), dtype=self.settings.observation_dtype)
+        if self._hidden is not None:  # before the delay: a delayed observation hides what it hid when made
+            self._hidden.apply(observation, target, session.steps)
+        return observation

@@ -38,6 +38,25 @@ SUITE: dict[str, dict[str, Any]] = {
                   "field_strength": 2.0, "target_radius": 0.03},
 }
 
+#: The separating tier (issue 52): Reach ids whose observation hides part of the game's state, which the game
+#: itself does not change, so each plays a suite game (``TIER_GAMES``) and its reference is that game's. A
+#: policy that acts on the present observation alone cannot do what the reference does, which plans from the
+#: true state, while an agent that remembers what it saw can know all the reference knows. Key ids only (no
+#: ``Continuous`` twins); not in ``suite_ids()``, so protocol 2's ids and tables stay as published.
+TIER: dict[str, dict[str, Any]] = {
+    # The target is seen for 0.1 s (5 observations) after it appears, then hidden: where to go must be remembered.
+    "ReachMemory": {"target_shown": 0.1},
+    # The same with a 0.2 s stay in the target: the stop needs the target's distance, which the hand's motion
+    # toward it does not carry.
+    "ReachMemoryHold": {"target_shown": 0.1, "hold_time": 0.2},
+    # Positions only: no velocities (joints' or hand's) and no muscle activations observed; they must be told
+    # from the positions seen over the last few decisions and the keys pressed.
+    "ReachPositions": {"positions_only": True},
+}
+
+#: Which suite game each tier id plays: the same game, hit for hit, with less of it observed.
+TIER_GAMES: dict[str, str] = {"ReachMemory": "Reach", "ReachMemoryHold": "ReachHold", "ReachPositions": "Reach"}
+
 #: The harder CenterOut ids and the ``armgame/CenterOut-v1`` arguments each fixes; each has a ``Continuous`` twin.
 CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
     # A person's rule: the go cue waits for the cursor to stay in home (0.5 to 1.0 s), so every trial
@@ -62,6 +81,11 @@ TRAINING_SEED_LIMIT = EVALUATION_SEED_START
 VALIDATION_SEED_START = EVALUATION_SEED_START + EVALUATION_SEED_COUNT
 VALIDATION_SEED_COUNT = 10**6
 VALIDATION_SEEDS = range(VALIDATION_SEED_START, VALIDATION_SEED_START + VALIDATION_SEED_COUNT)
+
+
+def tier_ids() -> tuple[str, ...]:
+    """The separating tier's ids, in ``TIER``'s order."""
+    return tuple(f"armgame/{name}-v1" for name in TIER)
 
 
 def suite_ids() -> tuple[str, ...]:

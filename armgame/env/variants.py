@@ -27,6 +27,11 @@ and ``ReachHard-v1``, all four at once. What each does to the game:
   guard keeps the declared speed bounds true beyond it: a game whose joint speed passes them stops,
   terminated, ``info["stopped"]`` saying why in one line (``armgame.game.variant.RunawayError``).
 * ``target_radius`` (m): the game's targets smaller or larger (the game's 0.05 by default).
+* ``target_shown`` (s) and ``positions_only``: what the observation hides, the game unchanged. With
+  ``target_shown`` the hand-to-target vector is seen only in the observations of that long after each target
+  appears (the first at least), then reads 0 until the next target: where to go must be remembered.
+  ``positions_only=True`` reads 0 for the joints' and the hand's velocities and the muscles' activations: a
+  policy must tell them from the positions it has seen and the keys it has pressed. The separating tier's ids fix them (``armgame.env.suite.TIER``).
 
 A variant's game is not the game of ``armgame play``, and its score is not comparable with a player's,
 but it is recorded all the same: ``armgame.env.record.replay_of(env)`` writes a replay whose task
@@ -54,11 +59,13 @@ from ..game.variant import NOISE_CORRELATION_TIME, NOISE_FACTOR_MAX, GameVariant
 from .errors import EnvArgumentError
 
 __all__ = ["FIELDS", "MAX_FIELD_STRENGTH", "MAX_VISCOUS_STRENGTH", "NOISE_CORRELATION_TIME", "NOISE_FACTOR_MAX",
-           "DelayedObservations", "MuscleNoise", "ReachVariant", "with_target_radius"]
+           "DelayedObservations", "HiddenObservations", "MuscleNoise", "ReachVariant", "with_target_radius"]
 
 FIELDS = ("curl", "viscous")
 MAX_HOLD_TIME = 5.0
 MAX_OBSERVATION_DELAY = 100
+#: ``target_shown`` at most (s): the game's longest.
+MAX_TARGET_SHOWN = 3600.0
 #: The curl field's ``b`` (N s/m) at most, either sign: it does no work, so any ``b`` keeps the speed bound.
 MAX_FIELD_STRENGTH = 50.0
 #: The viscous field's scale at most, either sign: what was measured stable, with margin (module docstring).
@@ -74,10 +81,15 @@ class ReachVariant:
     observation_delay: int = 0
     field: str | None = None
     field_strength: float = 0.0
+    #: Seconds the hand-to-target vector is observed after each target appears (None: always).
+    target_shown: float | None = None
+    #: Whether only positions are observed (the velocities and the activations read 0).
+    positions_only: bool = False
 
     @classmethod
     def of(cls, hold_time: object = 0.0, motor_noise: object = 0.0, observation_delay: object = 0,
-           field: object = None, field_strength: object = None) -> ReachVariant:
+           field: object = None, field_strength: object = None, target_shown: object = None,
+           positions_only: object = False) -> ReachVariant:
         hold = _number("hold_time", hold_time, 0.0, MAX_HOLD_TIME, "s")
         noise = _number("motor_noise", motor_noise, 0.0, 1.0, "(a coefficient of variation)")
         if isinstance(observation_delay, bool) or not isinstance(observation_delay, int | np.integer) \
@@ -96,7 +108,17 @@ class ReachVariant:
             unit = "N s/m" if field == "curl" else "(times the lab's viscous matrix; stronger runs away)"
             strength = default if field_strength is None else _number("field_strength", field_strength, -most, most,
                                                                        unit)
-        return cls(hold, noise, int(observation_delay), field if strength != 0.0 else None, strength)  # type: ignore[arg-type]
+        shown = None if target_shown is None else _number("target_shown", target_shown, 0.0, MAX_TARGET_SHOWN,
+                                                            "s (or None: always)")
+        if not isinstance(positions_only, bool | np.bool_):
+            raise EnvArgumentError(f"positions_only must be True or False, got {positions_only!r}")
+        return cls(hold, noise, int(observation_delay), field if strength != 0.0 else None, strength,  # type: ignore[arg-type]
+                   shown, bool(positions_only))
+
+    @property
+    def hides(self) -> bool:
+        """Whether the observation hides part of the state (``target_shown``, ``positions_only``)."""
+        return self.target_shown is not None or self.positions_only
 
     @property
     def plain(self) -> bool:
@@ -147,6 +169,31 @@ def _number(name: str, value: object, low: float, high: float, unit: str) -> flo
         raise EnvArgumentError(f"{name} must be a number from {low:g} to {high:g} {unit}".rstrip()
                                + f", got {value!r}")
     return float(value)
+
+
+class HiddenObservations:
+    """An observation with what the variant hides read as 0: the hand-to-target vector (entries 12 and 13) once
+    its target has been seen for ``target_shown`` seconds; with ``positions_only`` the velocities (2, 3, 10, 11) and
+    the activations (4 to 7).
+    A target's age counts from the first observation that shows it (the end of the decision it appeared in), in
+    physics steps, so it is seen in ``ceil(target_shown / decision time)`` observations, at least one."""
+
+    def __init__(self, variant: ReachVariant, dt: float) -> None:
+        self.shown_steps = None if variant.target_shown is None else max(1, round(variant.target_shown / dt))
+        self.positions_only = variant.positions_only
+        self._target: object = None
+        self._since = 0
+
+    def apply(self, observation: np.ndarray, target: object, steps: int) -> np.ndarray:
+        if self.shown_steps is not None:
+            if target is not self._target:
+                self._target, self._since = target, steps
+            if steps - self._since >= self.shown_steps:
+                observation[12:14] = 0.0
+        if self.positions_only:
+            observation[2:8] = 0.0
+            observation[10:12] = 0.0
+        return observation
 
 
 class DelayedObservations:
