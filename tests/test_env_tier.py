@@ -1,7 +1,6 @@
 """The separating tier (``armgame.env.suite.TIER``): what each id's observation hides, that its game is its suite
 game's hit for hit, that its games verify, and that docs/programs.md's tier table is the committed results."""
 
-import json
 import math
 import warnings
 from pathlib import Path
@@ -84,7 +83,7 @@ def test_with_positions_only_the_velocities_and_activations_read_zero_and_nothin
 
 
 def test_a_hidden_target_with_a_dwell_plays_reachholds_game_hit_for_hit():
-    seen, truth, infos, _ = play_both("armgame/ReachMemoryHold-v1", 5, 400)
+    seen, _, infos, _ = play_both("armgame/ReachMemoryHold-v1", 5, 400)
     assert infos[-1]["hits"] >= 3
     assert (seen[:, TARGET] == 0).all(axis=1).sum() > len(seen) // 2  # hidden most of the time
 

@@ -31,7 +31,8 @@ and ``ReachHard-v1``, all four at once. What each does to the game:
   ``target_shown`` the hand-to-target vector is seen only in the observations of that long after each target
   appears (the first at least), then reads 0 until the next target: where to go must be remembered.
   ``positions_only=True`` reads 0 for the joints' and the hand's velocities and the muscles' activations: a
-  policy must tell them from the positions it has seen and the keys it has pressed. The separating tier's ids fix them (``armgame.env.suite.TIER``).
+  policy must tell them from the positions it has seen and the keys it has pressed. The separating tier's ids
+  fix them (``armgame.env.suite.TIER``).
 
 A variant's game is not the game of ``armgame play``, and its score is not comparable with a player's,
 but it is recorded all the same: ``armgame.env.record.replay_of(env)`` writes a replay whose task
