@@ -38,7 +38,7 @@ import numpy as np
 import armgame.env
 from armgame.env.ceiling import ShootingController
 from armgame.env.evaluation import mean_interval
-from armgame.env.suite import EVALUATION_SEEDS, suite_ids
+from armgame.env.suite import EVALUATION_SEEDS, TIER_GAMES, suite_ids
 
 #: The controller's arguments per id (the defaults elsewhere): measured on three games of 20 s each
 #: (``--games 3 --seconds 20``), the cheapest setting within a hit a minute of the best tried.
@@ -63,7 +63,10 @@ DISTINCT = ("armgame/Reach-v1", "armgame/ReachHold-v1", "armgame/ReachNoisy-v1",
 STANDS_FOR = {"armgame/ReachContinuous-v1": "armgame/Reach-v1", "armgame/ReachDelay-v1": "armgame/Reach-v1",
               "armgame/ReachDelayContinuous-v1": "armgame/Reach-v1",
               **{f"armgame/{name}Continuous-v1": f"armgame/{name}-v1"
-                 for name in ("ReachHold", "ReachNoisy", "ReachField", "ReachHard")}}
+                 for name in ("ReachHold", "ReachNoisy", "ReachField", "ReachHard")},
+              # The separating tier hides part of the observation, never the game, and only what an agent that
+              # remembers can know (the target it saw; speeds and activations from the positions and its keys).
+              **{f"armgame/{name}-v1": f"armgame/{game}-v1" for name, game in TIER_GAMES.items()}}
 
 CHUNK = 10
 

@@ -6,6 +6,8 @@
     python benchmarks/reference_scores.py table                      # docs/programs.md's table, from the results
     python benchmarks/reference_scores.py ceilings                   # armgame/env/references.py's CEILINGS
     python benchmarks/reference_scores.py runs-table                 # docs/programs.md's table of the protocol runs
+    python benchmarks/reference_scores.py tier-table                 # docs/programs.md's table of the separating tier
+    python benchmarks/reference_scores.py center-out-table           # CenterOut's hits a minute and time to target
     python benchmarks/reference_scores.py figure                     # docs/img/ppo_curves.png, their curves
     python benchmarks/reference_scores.py table-v1 refs              # protocol 1's table (the model bot normalising)
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
@@ -61,7 +63,12 @@ def run_bots(out: Path, ids: tuple[str, ...], games: int,
         for policy in policies:
             start = time.perf_counter()
             result = evaluate(policy, env_id, games=games)
-            write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start)
+            # CenterOut: each game's seconds from a go cue to a hit too, which ranks policies that hit every trial.
+            timing = {"hits_per_minute": round(result.hits_per_minute, 4)} | (
+                {"reach_seconds": [None if np.isnan(t) else round(t, 4) for t in result.reach_seconds]}
+                if result.reach_seconds else {})
+            write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start,
+                  timing)
             print(result.summary(), flush=True)
 
 
@@ -317,6 +324,67 @@ def references_v3(ceiling_folder: Path = RESULTS / "ceiling",
             "games_of": env_id}
     return {env_id: {**measured[bench.STANDS_FOR.get(env_id, env_id)]}
             for env_id in (*bench.DISTINCT, *bench.STANDS_FOR) if bench.STANDS_FOR.get(env_id, env_id) in measured}
+
+
+def tier_table(root: Path = RESULTS) -> str:
+    """docs/programs.md's table of the separating tier (``armgame.env.suite.TIER``), from the committed results: each
+    id's reference (``REFERENCES_V3``, its suite game's) and that game's bound (``hit_bound.json``), the bots' 100 test
+    games (``tier-bots``), PPO's probe (one training seed at 300,000 env steps, ``tier-probe``) and PPO's protocol
+    runs at 4 M env steps (``ppo-tier``: the seeds finished so far), with PPO's protocol 3 score."""
+    from armgame.env.evaluation import mean_interval, normalised_score
+    from armgame.env.references import REFERENCES_V3
+    from armgame.env.suite import TIER, tier_ids
+
+    bounds = {row["env_id"]: row for row in json.loads((root / "hit_bound.json").read_text(encoding="utf-8"))}
+    bots = {(r["env_id"], r["policy"]): r for r in
+            (json.loads(p.read_text(encoding="utf-8")) for p in sorted((root / "tier-bots").glob("*.json")))}
+    lines = ["| id | hidden | reference: the shooting controller (95% CI, games) | bound | random | naive bot "
+             "| model bot | PPO 300 k steps, 1 seed | PPO 4 M steps: seeds done, mean (95% CI over seeds) "
+             "| PPO / reference (protocol 3) |", "|---|---|---|---:|---:|---:|---:|---:|---|---:|"]
+    for env_id, name in zip(tier_ids(), TIER, strict=True):
+        ref = REFERENCES_V3[env_id]
+        hidden = ", ".join(f"`{k}={v!r}`" for k, v in TIER[name].items() if k in ("target_shown", "positions_only"))
+        bound = bounds[ref["games_of"]]["bound_hits"]
+        cells = [f"{bots[(env_id, p)]['mean_hits']:.2f}" if (env_id, p) in bots else "" for p in
+                 ("random", "naive", "model")]
+        probe_path = root / "tier-probe" / slug(env_id) / "result.json"
+        probe = f"{json.loads(probe_path.read_text(encoding='utf-8'))['mean_hits']:.1f}" if probe_path.is_file() else ""
+        means = [json.loads(p.read_text(encoding="utf-8"))["mean_hits"]
+                 for p in sorted((root / "ppo-tier" / slug(env_id)).glob("seed*/result.json"))]
+        if means:
+            low, high = mean_interval(means)
+            runs = f"{len(means)} of 5: {np.mean(means):.1f}" + (f" ({low:.1f}-{high:.1f})" if len(means) > 1 else "")
+            score = f"{normalised_score(env_id, float(np.mean(means)), protocol=3):.2f}"
+        else:
+            runs, score = "0 of 5: running", ""
+        lines.append(f"| `{slug(env_id)}` | {hidden} | {ref['hits']:.1f} ({ref['low']:.1f}-{ref['high']:.1f}, "
+                     f"{ref['games']}; {slug(ref['games_of'])}'s) | {bound:.0f} | {' | '.join(cells)} | {probe} "
+                     f"| {runs} | {score} |")
+    return "\n".join(lines)
+
+
+def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
+    """docs/programs.md's table of the CenterOut ids' policies (``bots``' files in ``folder``): hits, hits a minute
+    and the seconds from a trial's go cue to its hit (the mean over games with a hit, 95 % interval over them),
+    which ranks policies that all hit every trial."""
+    from armgame.env.evaluation import mean_interval
+
+    lines = ["| id | policy | hits a game (95% CI) | hits a minute | s from the go cue to a hit (95% CI) "
+             "| games with a hit |", "|---|---|---|---:|---|---:|"]
+    rows = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(folder.glob("*.json"))]
+    order = {"random": 0, "naive": 1, "model": 2}
+    for r in sorted(rows, key=lambda r: (IDS.index(r["env_id"]) if r["env_id"] in IDS else len(IDS), r["env_id"],
+                                         order.get(r["policy"], 3), r["policy"])):
+        low, high = mean_interval(r["hits"])
+        times = [t for t in r.get("reach_seconds", []) if t is not None]
+        if times:
+            t_low, t_high = mean_interval(times)
+            reach = f"{np.mean(times):.2f} ({t_low:.2f}-{t_high:.2f})"
+        else:
+            reach = "no hit"
+        lines.append(f"| `{slug(r['env_id'])}` | {r['policy']} | {np.mean(r['hits']):.2f} ({low:.2f}-{high:.2f}) "
+                     f"| {r['hits_per_minute']:.1f} | {reach} | {len(times)} of {r['games']} |")
+    return "\n".join(lines)
 
 
 def references_v3_table() -> str:
@@ -654,6 +722,10 @@ def _main(argv: list[str] | None = None) -> int:
     sub.add_parser("ceilings", help="armgame/env/references.py's CEILINGS, from the committed results")
     sub.add_parser("references-v3", help="armgame/env/references.py's REFERENCES_V3 (protocol 3's normaliser)")
     sub.add_parser("references-v3-table", help="docs/programs.md's table of protocol 3's references")
+    timing = sub.add_parser("center-out-table", help="docs/programs.md's table of CenterOut's hits a minute and time "
+                            "to the target, from bots' runs")
+    timing.add_argument("folder", type=Path, nargs="?", default=RESULTS / "center-out-time")
+    sub.add_parser("tier-table", help="docs/programs.md's table of the separating tier, from the committed results")
     sub.add_parser("runs-table", help="docs/programs.md's table of PPO's protocol runs, from the committed results")
     fig = sub.add_parser("figure", help="docs/img/ppo_curves.png: the protocol runs' validation curves (matplotlib)")
     fig.add_argument("--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "img" /
@@ -696,6 +768,10 @@ def _main(argv: list[str] | None = None) -> int:
         print(references_v3_table())
     elif args.command == "runs-table":
         print(runs_table())
+    elif args.command == "tier-table":
+        print(tier_table())
+    elif args.command == "center-out-table":
+        print(center_out_timing_table(args.folder))
     elif args.command == "figure":
         print(f"wrote {args.out}: {', '.join(curves_figure(args.out))}")
     else:

@@ -132,7 +132,10 @@ def main(argv: list[str] | None = None) -> int:
         result = {"env_id": args.env, "algorithm": "PPO", "training_seed": args.seed, "env_steps": model.num_timesteps,
                   "budget_steps": args.steps, "test_seeds": [test.seeds[0], test.seeds[-1]],
                   "test_hits": list(test.hits), "mean_hits": test.mean_hits, "normalised": test.normalised,
-                  "protocol": PROTOCOL_VERSION}  # the normalised score's: a file without it is protocol 1's
+                  "protocol": PROTOCOL_VERSION,  # the normalised score's: a file without it is protocol 1's
+                  "hits_per_minute": test.hits_per_minute}
+        if test.reach_seconds:  # CenterOut: where every trial is hit, the time to the target still ranks
+            result["reach_seconds"] = [None if math.isnan(t) else round(t, 4) for t in test.reach_seconds]
         (args.out / "result.json").write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
         hits = keep_a_game(model, args.env, args.out / "game.json")
         print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")

@@ -1,6 +1,7 @@
 """The separating tier (``armgame.env.suite.TIER``): what each id's observation hides, that its game is its suite
 game's hit for hit, that its games verify, and that docs/programs.md's tier table is the committed results."""
 
+import json
 import math
 import warnings
 from pathlib import Path
@@ -9,13 +10,16 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
 
-import armgame.env  # noqa: F401  (registers the ids)
+import armgame.env
 from armgame.env.base import EnvArgumentError
 from armgame.env.policies import bot_policy
 from armgame.env.record import replay_of
 from armgame.env.suite import SUITE, TIER, TIER_GAMES, tier_ids
+from armgame.env.vector import REWARD_TOLERANCE, ReachV1VectorEnv
 from armgame.env.vector_common import SingleEnvsVectorEnv
+from armgame.game.batch import STATE_TOLERANCE
 from armgame.records.replay import Replay
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -57,8 +61,8 @@ def test_gymnasiums_checker_passes_on_every_tier_id_and_its_arguments_are_the_en
         assert getattr(env.unwrapped.variant, argument) == value
     for argument, value in SUITE.get(TIER_GAMES[name], {}).items():  # the suite game's own arguments, all kept
         assert getattr(env.unwrapped.variant, argument) == value
-    # The batch hides nothing: make_vec steps single envs, each the single env's game.
-    assert isinstance(gym.make_vec(env_id, num_envs=8).unwrapped, SingleEnvsVectorEnv)
+    assert isinstance(gym.make_vec(env_id, num_envs=8).unwrapped, ReachV1VectorEnv)  # the batch hides it too
+    assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, SingleEnvsVectorEnv)
 
 
 def test_a_hidden_target_is_seen_only_in_the_first_observations_after_it_appears():
@@ -100,6 +104,38 @@ def test_what_is_hidden_is_hidden_before_the_delay():
     assert truth[1][TARGET].any() and not truth[2][TARGET].any()  # 0.04 s: two observations
 
 
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+@pytest.mark.parametrize("env_id", tier_ids())
+def test_the_batch_hides_what_single_envs_hide_over_hits_autoresets_and_a_delay(env_id, mode):
+    """Bots play the suite game (they read the observation, which the tier id hides); the tier id's batch and its
+    single envs take the same keys and hand out the same observations, as games are hit and end twice."""
+    n, kwargs = 4, {"time_limit": 1.5, "observation_delay": 2}
+    native = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode=mode, **kwargs)
+    singles = SyncVectorEnv([lambda: gym.make(env_id, **kwargs) for _ in range(n)], autoreset_mode=mode)
+    truth = SyncVectorEnv([lambda: gym.make(game_id(env_id), time_limit=1.5) for _ in range(n)], autoreset_mode=mode)
+    assert isinstance(native.unwrapped, ReachV1VectorEnv)
+    bots = [bot_policy("model", gym.make(game_id(env_id))) for _ in range(n)]
+    a, b, (seen, _) = native.reset(seed=40), singles.reset(seed=40), truth.reset(seed=40)
+    assert np.array_equal(a[0], b[0])
+    hits = ends = hidden = 0
+    moving = False
+    for step in range(2 * 76 + 3):
+        actions = np.array([bot(row) for bot, row in zip(bots, seen, strict=True)])
+        (oa, ra, _, ua, ia), (ob, rb, _, ub, ib) = native.step(actions), singles.step(actions)
+        seen = truth.step(actions)[0]
+        assert np.abs(oa - ob).max() <= STATE_TOLERANCE and np.array_equal(oa[:, 4:], ob[:, 4:]), step
+        assert np.abs(ra - rb).max() <= REWARD_TOLERANCE, step
+        assert ua.tolist() == ub.tolist() and ia["hits"].tolist() == ib["hits"].tolist(), step
+        if mode is AutoresetMode.SAME_STEP and ua.any():
+            assert all(np.array_equal(ia["final_obs"][i], ib["final_obs"][i]) for i in np.flatnonzero(ua))
+        hits, ends = hits + int((ra > 0.5).sum()), ends + int(ua.sum())
+        hidden += int((oa[:, 12:14] == 0).all(axis=1).sum())
+        moving = moving or bool((oa[:, 2:8] != 0).any())
+    assert ends == 2 * n and hits >= 4
+    assert (hidden > n * 76) == ("Memory" in env_id)  # hidden most of the time
+    assert moving == ("Positions" not in env_id)
+
+
 @pytest.mark.parametrize("env_id", tier_ids())
 def test_a_tier_game_is_recorded_and_verifies(env_id):
     _, _, infos, env = play_both(env_id, 11, 300)
@@ -116,3 +152,71 @@ def test_bad_hiding_arguments_are_refused_in_one_line():
         with pytest.raises(EnvArgumentError, match=words) as caught:
             gym.make("armgame/Reach-v1", **kwargs)
         assert "\n" not in str(caught.value)
+
+
+@pytest.mark.slow  # about 1 s an id alone, the controller's searches
+@pytest.mark.parametrize("env_id", tier_ids())
+def test_the_reference_plays_a_tier_games_as_its_suite_games_so_their_reference_is_one(env_id):
+    """The shooting controller reads the game, not the observation (``benchmarks/ceiling.py``'s ``STANDS_FOR``): on
+    a tier id it presses the keys it presses on the suite game, step for step."""
+    from armgame.env.ceiling import ShootingController
+
+    played = []
+    for name in (env_id, game_id(env_id)):
+        env = gym.make(name, time_limit=1.5)
+        controller = ShootingController(env)
+        obs, _ = env.reset(seed=1_000_000_000)
+        keys, done = [], False
+        while not done:
+            keys.append(controller(obs))
+            obs, _, terminated, truncated, info = env.step(keys[-1])
+            done = terminated or truncated
+        played.append((np.array(keys), info["hits"]))
+    assert np.array_equal(played[0][0], played[1][0]) and played[0][1] == played[1][1] >= 1
+
+
+def _reference_scores():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("reference_scores", ROOT / "benchmarks" / "reference_scores.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_docs_tier_table_is_the_committed_results_and_ppos_probe_is_far_below_the_reference():
+    from armgame.env.evaluation import normalised_score
+    from armgame.env.references import REFERENCES_V3, TIER_HITS
+
+    scores = _reference_scores()
+    guide = (ROOT / "docs" / "programs.md").read_text(encoding="utf-8")
+    assert scores.tier_table() in guide
+    assert scores.references_of(ROOT / "benchmarks" / "results" / "tier-bots") == TIER_HITS
+    bounds = {row["env_id"]: row["bound_hits"]
+              for row in json.loads((ROOT / "benchmarks" / "results" / "hit_bound.json").read_text())}
+    for env_id in tier_ids():
+        reference = REFERENCES_V3[env_id]
+        assert reference["games"] == 100 and reference["games_of"] == game_id(env_id)
+        assert reference["hits"] < bounds[reference["games_of"]] / 3  # clearly below the bound
+        probe = json.loads((ROOT / "benchmarks" / "results" / "tier-probe" / env_id.split("/")[1] /
+                            "result.json").read_text())
+        assert probe["env_id"] == env_id and probe["env_steps"] >= 300_000
+        assert normalised_score(env_id, probe["mean_hits"], protocol=3) < 0.7
+        assert normalised_score(env_id, probe["mean_hits"]) is None  # no protocol 2 ceiling
+    # The bots' first games are evaluate's own.
+    first = armgame.env.evaluate("model", "armgame/ReachPositions-v1", games=2)
+    assert list(first.hits) == TIER_HITS["armgame/ReachPositions-v1"]["model_first"][:2]
+
+
+def test_the_docs_center_out_table_is_the_committed_results_and_evaluates_own_times():
+    scores = _reference_scores()
+    guide = (ROOT / "docs" / "programs.md").read_text(encoding="utf-8")
+    assert scores.center_out_timing_table() in guide
+    committed = json.loads((ROOT / "benchmarks" / "results" / "center-out-time" / "CenterOutHold-v1.model.json")
+                           .read_text())
+    assert committed["hits"] == [8] * 100  # every trial of every episode: hits cannot rank the model bot
+    result = armgame.env.evaluate("model", "armgame/CenterOutHold-v1", games=3)
+    assert [round(t, 4) for t in result.reach_seconds] == committed["reach_seconds"][:3]
+    assert result.mean_reach_seconds == pytest.approx(np.mean(result.reach_seconds))
+    assert f"{result.mean_reach_seconds:.2f} s from the go cue to a hit" in result.summary()
+    assert armgame.env.evaluate("model", "armgame/Reach-v1", games=1, time_limit=1.0).reach_seconds == ()

@@ -11,7 +11,7 @@ import pytest
 
 pytest.importorskip("gymnasium")
 
-from armgame.env.references import CEILINGS, REFERENCE_HITS, REFERENCES_V3
+from armgame.env.references import CEILINGS, REFERENCE_HITS, REFERENCES_V3, TIER_HITS
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results"
@@ -96,7 +96,7 @@ def test_protocol_3_divides_by_the_reference_and_a_run_above_it_scores_above_1()
     guide = (ROOT / "docs" / "programs.md").read_text(encoding="utf-8")
     assert scores.references_v3_table() in guide
     for env_id, row in REFERENCES_V3.items():
-        random = REFERENCE_HITS[env_id]["random"]
+        random = {**REFERENCE_HITS, **TIER_HITS}[env_id]["random"]
         assert normalised_score(env_id, row["hits"], protocol=3) == pytest.approx(1.0)
         assert normalised_score(env_id, row["hits"] + 1.0, protocol=3) > 1.0
         assert normalised_score(env_id, random, protocol=3) == pytest.approx(0.0)

@@ -72,6 +72,9 @@ class Evaluation:
     scores: tuple[int, ...]
     minutes: float  # of game time a game, on average (an episode of CenterOut lasts as its trials do)
     normalised: float | None
+    #: CenterOut ids: each game's mean seconds from a trial's go cue to its hit, over the trials it hit (nan: none);
+    #: empty for Reach. Where every policy hits every trial, this is what still ranks them.
+    reach_seconds: tuple[float, ...] = ()
 
     @property
     def games(self) -> int:
@@ -98,11 +101,19 @@ class Evaluation:
     def score_per_minute(self) -> float:
         return self.mean_score / self.minutes
 
+    @property
+    def mean_reach_seconds(self) -> float | None:
+        """The mean over games (those with a hit) of ``reach_seconds``; None for Reach or where nothing was hit."""
+        times = [t for t in self.reach_seconds if not math.isnan(t)]
+        return float(np.mean(times)) if times else None
+
     def summary(self) -> str:
         low, high = self.ci95
         norm = "" if self.normalised is None else f", normalised {self.normalised:.2f}"
+        reach = self.mean_reach_seconds
+        time = "" if reach is None else f", {reach:.2f} s from the go cue to a hit"
         return (f"{self.policy} on {self.env_id}: {self.mean_hits:.1f} hits a game (95% CI {low:.1f} to {high:.1f}, "
-                f"{self.games} games), {self.hits_per_minute:.1f} a minute{norm}")
+                f"{self.games} games), {self.hits_per_minute:.1f} a minute{time}{norm}")
 
 
 def mean_interval(values: Sequence[float]) -> tuple[float, float]:
@@ -147,18 +158,19 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     if policy_factory is None and not isinstance(policy, str) and hasattr(policy, "predict") \
             and not callable(getattr(policy, "reset", None)):
         name = type(policy).__name__
-        hits, scores, minutes = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
+        hits, scores, minutes, reach = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
     else:
-        name, hits, scores, minutes = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs,
-                                                       policy_factory)
+        name, hits, scores, minutes, reach = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs,
+                                                              policy_factory)
     normalised = None if env_kwargs else normalised_score(env_id, float(np.mean(hits)))
-    return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised)
+    return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised, reach)
 
 
 def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
                      env_kwargs: dict[str, Any], policy_factory: Callable[[gym.Env], Policy] | None = None,
-                     ) -> tuple[str, tuple[int, ...], tuple[int, ...], float]:
-    """The games one after another in one single env: (the policy's name, hits, scores, minutes a game).
+                     ) -> tuple[str, tuple[int, ...], tuple[int, ...], float, tuple[float, ...]]:
+    """The games one after another in one single env: (the policy's name, hits, scores, minutes a game, each
+    game's seconds from a go cue to a hit: CenterOut's).
 
     The policy is fresh for each game (``evaluate``): made anew by ``policy_factory`` or, for a bot's name,
     by ``bot_policy``; else its ``reset()``, where it has one, is called before the game."""
@@ -168,7 +180,7 @@ def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], determini
             name = policy if isinstance(policy, str) else getattr(policy_factory, "__name__", "policy")
         else:
             act, name = _policy(policy, env, deterministic)
-        hits, scores, durations = [], [], []
+        hits, scores, durations, reach = [], [], [], []
         for seed in seeds:
             if policy_factory is not None:
                 act = _policy(policy_factory(env), env, deterministic)[0]
@@ -189,9 +201,10 @@ def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], determini
             hits.append(int(info["hits"]))
             scores.append(int(info.get("score", info["hits"])))
             durations.append(_game_minutes(env))
+            reach.append(_reach_seconds(env))
     finally:
         env.close()
-    return name, tuple(hits), tuple(scores), float(np.mean(durations))
+    return name, tuple(hits), tuple(scores), float(np.mean(durations)), _kept(reach)
 
 
 #: Games a model's evaluation steps together: one ``predict`` call a step for all of them.
@@ -199,7 +212,7 @@ BATCH = 100
 
 
 def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
-                  env_kwargs: dict[str, Any]) -> tuple[tuple[int, ...], tuple[int, ...], float]:
+                  env_kwargs: dict[str, Any]) -> tuple[tuple[int, ...], tuple[int, ...], float, tuple[float, ...]]:
     """A model's games, ``BATCH`` at a time in Gymnasium's ``SyncVectorEnv`` of single envs (each game the single
     env's, seeded alike), the model asked once a step for all of them: a network's forward pass costs
     about as much for a hundred observations as for one."""
@@ -208,6 +221,7 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
     hits: list[int] = []
     scores: list[int] = []
     durations: list[float] = []
+    reach: list[float | None] = []
     for start in range(0, len(seeds), BATCH):
         part = list(seeds[start:start + BATCH])
         envs = gym.make_vec(env_id, num_envs=len(part), vectorization_mode="sync",
@@ -218,6 +232,7 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
             final_hits = np.zeros(len(part), dtype=np.int64)
             final_scores = np.zeros(len(part), dtype=np.int64)
             final_minutes = np.zeros(len(part))
+            final_reach: list[float | None] = [None] * len(part)
             recurrent = takes_state(model)
             state, starts = None, np.ones(len(part), dtype=bool)
             while not done.all():
@@ -234,6 +249,7 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
                 final_scores[ended] = info["score"][ended] if "score" in info else info["hits"][ended]
                 for i in np.flatnonzero(ended):
                     final_minutes[i] = _game_minutes(envs.envs[i])
+                    final_reach[i] = _reach_seconds(envs.envs[i])
                 done |= ended
                 if over.any() and not done.all():
                     # A finished game's place plays on, uncounted, until the others end; a game there may end
@@ -245,7 +261,8 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
         hits += final_hits.tolist()
         scores += final_scores.tolist()
         durations += final_minutes.tolist()
-    return tuple(hits), tuple(scores), float(np.mean(durations))
+        reach += final_reach
+    return tuple(hits), tuple(scores), float(np.mean(durations)), _kept(reach)
 
 
 def _policy(policy: Any, env: gym.Env, deterministic: bool) -> tuple[Policy, str]:
@@ -305,15 +322,33 @@ def _game_minutes(env: gym.Env) -> float:
     return session.steps * session.config.dt / 60.0 if session is not None else math.nan
 
 
+def _reach_seconds(env: gym.Env) -> float | None:
+    """A CenterOut episode's mean seconds from a trial's go cue to its hit (the end of the stay in the target), over
+    the trials it hit (nan: none); None for an env without trials (Reach)."""
+    session = getattr(env.unwrapped, "session", None)
+    outcomes = getattr(session, "outcomes", None)
+    if outcomes is None or not hasattr(session, "trial_index"):
+        return None
+    times = [(o.end_step - o.go_step) * session.config.dt for o in outcomes if o.hit]
+    return float(np.mean(times)) if times else math.nan
+
+
+def _kept(reach: list[float | None]) -> tuple[float, ...]:
+    """Each game's reach time, or nothing where the env has no trials."""
+    return () if any(t is None for t in reach) else tuple(t for t in reach if t is not None)
+
+
 def normalised_score(env_id: str, mean_hits: float, protocol: int = 2) -> float | None:
     """``(hits - random) / (ceiling - random)`` by the id's reference scores (protocol 2: ``CEILINGS``); None for an
     id without them. Protocol 3 divides by the id's reference controller instead (``REFERENCES_V3``: a fixed score
     of the shooting controller, never a mean of the runs being scored), so a run above it scores above 1."""
-    from .references import CEILINGS, REFERENCE_HITS, REFERENCES_V3
+    from .references import CEILINGS, REFERENCE_HITS, REFERENCES_V3, TIER_HITS
 
     if protocol not in (2, 3):
         raise ValueError(f"protocol must be 2 or 3, got {protocol!r}")
-    reference, ceiling = REFERENCE_HITS.get(env_id), (CEILINGS if protocol == 2 else REFERENCES_V3).get(env_id)
+    # The separating tier's random play is in TIER_HITS: it has no protocol 2 ceiling, only protocol 3's reference.
+    reference = REFERENCE_HITS.get(env_id) or TIER_HITS.get(env_id)
+    ceiling = (CEILINGS if protocol == 2 else REFERENCES_V3).get(env_id)
     if reference is None or ceiling is None:
         return None
     low, high = reference["random"], ceiling["hits"]

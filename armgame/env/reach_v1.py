@@ -65,6 +65,11 @@ class ReachV1Env(ReachBaseEnv):
     The speed bounds are proven, not observed (``reach.speed_bound``; the hand's from the joints':
     ``(l1 + 2 l2) w``); in play the hand moves at up to about 3 m/s. The target's radius is 0.05 m.
 
+    The separating tier's ids hide entries, which then read 0 (the game is unchanged):
+    ``armgame/ReachMemory-v1`` and ``ReachMemoryHold-v1`` entries 12-13 (m) from 0.1 s after each target appears
+    (its first 5 observations show it) to the next target; ``armgame/ReachPositions-v1`` entries 2-7 (rad/s and
+    activations) and 10-11 (m/s).
+
     ## Rewards
 
     ``reward="dense"`` (the default): ``r = w (e_prev - e) + bonus * hits - c * resets``, with ``e``
@@ -121,11 +126,20 @@ class ReachV1Env(ReachBaseEnv):
       default the game's 0.05). The suite's ids fix them: ``ReachHold-v1``, ``ReachNoisy-v1``,
       ``ReachDelay-v1``, ``ReachField-v1``, ``ReachHard-v1`` and their ``Continuous`` twins
       (``armgame.env.suite``).
+    * What the observation hides (``armgame.env.variants``; the game unchanged): ``target_shown`` (s, 0 to
+      3600; default None, always: the hand-to-target vector reads 0 once its target has been seen that long,
+      at least one observation) and ``positions_only`` (default False: True reads 0 for the velocities and
+      the activations). The separating tier's ids fix them: ``ReachMemory-v1`` (``target_shown=0.1``),
+      ``ReachMemoryHold-v1`` (the same and ``hold_time=0.2``) and ``ReachPositions-v1`` (``positions_only=True``),
+      key ids only (``armgame.env.suite.TIER``).
     * ``time_limit``, ``decision_steps`` (default 5: a 20 ms step), ``reset_key``, ``config``,
       ``render_mode`` (``"rgb_array"`` or ``"human"``), ``render_size``: as ``armgame/Reach-v0``.
 
     ## Version History
 
+    * v1, armgame 0.6: the observation's hiding arguments (``target_shown``, ``positions_only``) and the
+      separating tier's ids ``ReachMemory-v1``, ``ReachMemoryHold-v1`` and ``ReachPositions-v1``; every other
+      id's behaviour unchanged.
     * v1: hand position and velocity and the hand-to-target vector observed, float32; the
       fraction of time left instead of seconds; the target's position only relative to the hand;
       a dense reward by default; continuous actions in [-1, 1]; the score reward, the harder

@@ -129,7 +129,8 @@ CEILINGS: dict[str, dict[str, Any]] = {
 # Protocol 3's reference (``python benchmarks/reference_scores.py references-v3``, from benchmarks/results/ceiling
 # and benchmarks/results/reference; tests/test_hit_bound.py holds it to those files): per Reach id, the shooting
 # controller at its strongest settings tried, its mean hits on the test games played so far (``games``; 95 % interval
-# over games), the code, and the CPU seconds a decision cost in that run. Not yet the headline: an id is complete at
+# over games), the code, and the CPU seconds a decision cost in that run; the separating tier's ids
+# (``armgame.env.suite.TIER``) take their suite game's. Not yet the headline: an id is complete at
 # 100 games, and an id whose reference run has no games yet is absent (docs/programs.md, "Protocol 3's reference").
 REFERENCES_V3: dict[str, dict[str, Any]] = {
     'armgame/Reach-v1': {
@@ -251,5 +252,63 @@ REFERENCES_V3: dict[str, dict[str, Any]] = {
         'cpu_per_decision': 0.01091,
         'machine': 'AMD EPYC; x86_64, 3.11.7, armgame 0.5.0',
         'games_of': 'armgame/ReachHard-v1',
+    },
+    'armgame/ReachMemory-v1': {
+        'hits': 72.16,
+        'low': 71.552,
+        'high': 72.768,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00264,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/Reach-v1',
+    },
+    'armgame/ReachMemoryHold-v1': {
+        'hits': 64.57,
+        'low': 64.209,
+        'high': 64.931,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00304,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/ReachHold-v1',
+    },
+    'armgame/ReachPositions-v1': {
+        'hits': 72.16,
+        'low': 71.552,
+        'high': 72.768,
+        'games': 100,
+        'code': 'armgame.env.ceiling.ShootingController()',
+        'cpu_per_decision': 0.00264,
+        'machine': 'processor not recorded; x86_64, 3.11.7, armgame 0.4.0',
+        'games_of': 'armgame/Reach-v1',
+    },
+}
+
+
+# The separating tier's bots (``python benchmarks/reference_scores.py references benchmarks/results/tier-bots``, the
+# 100 test games; tests/test_env_tier.py holds it to those files): random play is the 0 of their protocol 3 score.
+# They have no protocol 2 ceiling. The game's bots read the observation, so they lose what it hides.
+TIER_HITS: dict[str, dict[str, Any]] = {
+    'armgame/ReachMemory-v1': {
+        'random': 0.53,
+        'naive': 0.79,
+        'model': 1.02,
+        'random_first': [0, 1, 0, 0, 1],
+        'model_first': [1, 1, 1, 0, 1],
+    },
+    'armgame/ReachMemoryHold-v1': {
+        'random': 0.46,
+        'naive': 0.78,
+        'model': 0.96,
+        'random_first': [0, 1, 0, 0, 1],
+        'model_first': [1, 1, 1, 0, 1],
+    },
+    'armgame/ReachPositions-v1': {
+        'random': 0.53,
+        'naive': 8.36,
+        'model': 10.04,
+        'random_first': [0, 1, 0, 0, 1],
+        'model_first': [10, 14, 4, 10, 16],
     },
 }

@@ -398,13 +398,15 @@ class ReachV1VectorEnv(ReachVectorEnv):
                  hit_bonus: float = DEFAULT_HIT_BONUS, observation_dtype: str = "float32",
                  hold_time: float = 0.0, motor_noise: float = 0.0, observation_delay: int = 0,
                  field: str | None = None, field_strength: float | None = None, target_radius: float | None = None,
+                 target_shown: float | None = None, positions_only: bool = False,
                  config: GameConfig | None = None, render_mode: str | None = None,
                  render_size: tuple[int, int] = (600, 600),
                  autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP) -> None:
         if reward == "score":  # its shaping needs each game's reset and end: make_vec plays it on single envs
             raise EnvArgumentError("the batched vector env has no reward='score': gymnasium.make_vec gives single "
                                    "envs for it")
-        variant = ReachVariant.of(hold_time, motor_noise, observation_delay, field, field_strength)
+        variant = ReachVariant.of(hold_time, motor_noise, observation_delay, field, field_strength, target_shown,
+                                  positions_only)
         if target_radius is not None:
             config = with_target_radius(config or GameConfig(), target_radius)
         settings = ReachSettings.of(config, time_limit, decision_steps, continuous, reset_key, 1, reward,
@@ -432,6 +434,13 @@ class ReachV1VectorEnv(ReachVectorEnv):
         #: Whether this step's observations are still to go into the ring (read twice a step in SameStep mode:
         #: once for ``final_obs``, once after the restarts).
         self._unpushed = False
+        # What the observation hides (the separating tier), as the single env's ``HiddenObservations``: each game's
+        # physics step at the first observation of its target and its hits then (a hit brings a new target).
+        self._shown_steps = None if variant.target_shown is None else max(1, round(variant.target_shown
+                                                                                   / settings.config.dt))
+        self._seen_at = np.zeros(self.num_envs, dtype=np.int64)
+        self._seen_hits = np.zeros(self.num_envs, dtype=np.int64)
+        self._new_target = np.ones(self.num_envs, dtype=bool)
 
     def reset(self, *, seed: int | list[int | None] | None = None,
               options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
@@ -458,6 +467,7 @@ class ReachV1VectorEnv(ReachVectorEnv):
     def _started(self, games: np.ndarray) -> None:
         self._measured = None  # restarted games have new states and targets
         self._fresh |= games
+        self._new_target |= games
         for part, batch in self.parts:
             self._edges[part] = np.where(games[part], self._edges_now(batch), self._edges[part])
 
@@ -484,6 +494,8 @@ class ReachV1VectorEnv(ReachVectorEnv):
 
     def _observations(self) -> np.ndarray:
         obs = self._observed()
+        if self.variant.hides:  # before the delay: a delayed observation hides what it hid when made
+            self._hide(obs)
         past = self._past
         if past is None:
             return obs
@@ -497,6 +509,21 @@ class ReachV1VectorEnv(ReachVectorEnv):
         if fresh.any():
             past[:, fresh] = obs[fresh]
         return past[(self._head + 1) % len(past)].copy()
+
+    def _hide(self, obs: np.ndarray) -> None:
+        """What the variant hides read as 0, in place (``variants.HiddenObservations``, game by game). Read twice in a
+        SameStep step (``final_obs``, then after the restarts), it marks nothing twice: a target is new once."""
+        if self._shown_steps is not None:
+            steps = np.concatenate([batch.steps for _, batch in self.parts])
+            hits = np.concatenate([batch.hits for _, batch in self.parts])
+            new = self._new_target | (hits != self._seen_hits)
+            self._seen_at[new] = steps[new]
+            self._seen_hits[...] = hits
+            self._new_target[...] = False
+            obs[steps - self._seen_at >= self._shown_steps, 12:14] = 0.0
+        if self.variant.positions_only:
+            obs[:, 2:8] = 0.0
+            obs[:, 10:12] = 0.0
 
     def _observed(self) -> np.ndarray:
         """The games' observations now, undelayed."""
