@@ -339,7 +339,7 @@ def tier_table(root: Path = RESULTS) -> str:
     bots = {(r["env_id"], r["policy"]): r for r in
             (json.loads(p.read_text(encoding="utf-8")) for p in sorted((root / "tier-bots").glob("*.json")))}
     lines = ["| id | hidden | reference: the shooting controller (95% CI, games) | bound | random | naive bot "
-             "| model bot | PPO 300 k steps, 1 seed | PPO 4 M steps: seeds done, mean (95% CI over seeds) "
+             "| model bot | PPO 300 k steps, 1 seed (protocol 3) | PPO 4 M steps: seeds done, mean (95% CI over seeds) "
              "| PPO / reference (protocol 3) |", "|---|---|---|---:|---:|---:|---:|---:|---|---:|"]
     for env_id, name in zip(tier_ids(), TIER, strict=True):
         ref = REFERENCES_V3[env_id]
@@ -348,7 +348,10 @@ def tier_table(root: Path = RESULTS) -> str:
         cells = [f"{bots[(env_id, p)]['mean_hits']:.2f}" if (env_id, p) in bots else "" for p in
                  ("random", "naive", "model")]
         probe_path = root / "tier-probe" / slug(env_id) / "result.json"
-        probe = f"{json.loads(probe_path.read_text(encoding='utf-8'))['mean_hits']:.1f}" if probe_path.is_file() else ""
+        probe = ""
+        if probe_path.is_file():  # its hits, and its protocol 3 score
+            hits = json.loads(probe_path.read_text(encoding="utf-8"))["mean_hits"]
+            probe = f"{hits:.1f} ({normalised_score(env_id, hits, protocol=3):.2f})"
         means = [json.loads(p.read_text(encoding="utf-8"))["mean_hits"]
                  for p in sorted((root / "ppo-tier" / slug(env_id)).glob("seed*/result.json"))]
         if means:

@@ -203,6 +203,17 @@ def test_the_docs_tier_table_is_the_committed_results_and_ppos_probe_is_far_belo
         assert probe["env_id"] == env_id and probe["env_steps"] >= 300_000
         assert normalised_score(env_id, probe["mean_hits"], protocol=3) < 0.7
         assert normalised_score(env_id, probe["mean_hits"]) is None  # no protocol 2 ceiling
+    # The prose's figures are the files'.
+    folder = ROOT / "benchmarks" / "results" / "tier-probe"
+    probes = {name: json.loads((folder / f"{name}-v1" / "result.json").read_text())["mean_hits"]
+              for name in ("ReachMemory", "ReachMemoryHold", "ReachPositions")}
+    assert f"{probes['ReachMemory']:.1f}" == f"{probes['ReachMemoryHold']:.1f}"
+    positions = normalised_score("armgame/ReachPositions-v1", probes["ReachPositions"], protocol=3)
+    assert (f"PPO scores {probes['ReachMemory']:.1f} hits a game on both memory\nids, below random play, and "
+            f"{probes['ReachPositions']:.1f} on `ReachPositions-v1`, {positions:.2f} of the reference") in guide
+    assert probes["ReachMemory"] < TIER_HITS["armgame/ReachMemory-v1"]["random"]
+    assert (f"fall to {TIER_HITS['armgame/ReachMemory-v1']['model']:.1f} without the target and to "
+            f"{TIER_HITS['armgame/ReachPositions-v1']['model']:.1f} without the\nvelocities") in guide
     # The bots' first games are evaluate's own.
     first = armgame.env.evaluate("model", "armgame/ReachPositions-v1", games=2)
     assert list(first.hits) == TIER_HITS["armgame/ReachPositions-v1"]["model_first"][:2]

@@ -382,7 +382,8 @@ class ReachV1VectorEnv(ReachVectorEnv):
     ``variant`` (``armgame.game.batch.variant``: each game's own noise stream, the field and the speed guard in
     the compiled kernel), and a game the guard stops is ``terminated`` with ``info["stopped"]``, as the single
     env's. Noise and fields need the compiled kernel (refused in one line without it; ``make_vec`` then gives
-    single envs).
+    single envs). ``target_shown`` and ``positions_only`` (the separating tier) hide game by game what the single env's
+    ``HiddenObservations`` hides, before the delay.
 
     >>> import gymnasium as gym
     >>> import armgame.env
