@@ -226,6 +226,7 @@ def test_the_docs_center_out_table_is_the_committed_results_and_evaluates_own_ti
     committed = json.loads((ROOT / "benchmarks" / "results" / "center-out-time" / "CenterOutHold-v1.model.json")
                            .read_text())
     assert committed["hits"] == [8] * 100  # every trial of every episode: hits cannot rank the model bot
+    assert f"every episode, {np.mean(committed['reach_seconds']):.2f} s after each go cue" in " ".join(guide.split())
     result = armgame.env.evaluate("model", "armgame/CenterOutHold-v1", games=3)
     assert [round(t, 4) for t in result.reach_seconds] == committed["reach_seconds"][:3]
     assert result.mean_reach_seconds == pytest.approx(np.mean(result.reach_seconds))
