@@ -232,3 +232,21 @@ def test_the_docs_center_out_table_is_the_committed_results_and_evaluates_own_ti
     assert result.mean_reach_seconds == pytest.approx(np.mean(result.reach_seconds))
     assert f"{result.mean_reach_seconds:.2f} s from the go cue to a hit" in result.summary()
     assert armgame.env.evaluate("model", "armgame/Reach-v1", games=1, time_limit=1.0).reach_seconds == ()
+
+
+def test_a_models_centre_out_times_are_measured_in_its_batched_games_as_one_by_one():
+    """``evaluate`` plays a model with ``predict`` and no ``reset()`` many games at a time: each game's time from a go
+    cue to a hit is read from its own env when it ends, as in the games played one by one."""
+    env_id = "armgame/CenterOut-v1"
+
+    class Bots:  # a stand-in model: one model bot a game column, asked together
+        def __init__(self, n):
+            self.bots = [bot_policy("model", gym.make(env_id)) for _ in range(n)]
+
+        def predict(self, observation, deterministic=True):
+            return np.array([bot(row) for bot, row in zip(self.bots, observation, strict=True)]), None
+
+    batched = armgame.env.evaluate(Bots(3), env_id, games=3)
+    alone = armgame.env.evaluate("model", env_id, games=3)
+    assert batched.hits == alone.hits == (8, 8, 8)
+    assert batched.reach_seconds == alone.reach_seconds and len(alone.reach_seconds) == 3
