@@ -34,7 +34,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
-from browser import FLAGS, chromium_path  # noqa: E402
+from browser import browser_page, close_shared  # noqa: E402
 
 BASE = "Ann B"
 RESULT = HERE / "results" / "name_scan.json"
@@ -108,34 +108,29 @@ def drawn_as_nothing(codes: list[int], progress: bool = False) -> tuple[list[int
     """Those of ``codes`` that Chromium draws as nothing after "Ann B"; and Chromium's version. Each name is the
     text of an element, as the class's pages show names (``textContent``), one to a cell of a grid, clipped to it;
     a batch is one screenshot, compared with the first cell, which holds "Ann B" alone."""
-    from playwright.sync_api import sync_playwright
-
     width, height = CELL
     batch = COLUMNS * ROWS - 1
     nothing: list[int] = []
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=chromium_path(), args=FLAGS)
-        try:
-            page = browser.new_page(viewport={"width": COLUMNS * width, "height": ROWS * height})
-            page.set_content(PAGE.format(size=SIZE, font=font_stack(), columns=COLUMNS, width=width, height=height,
-                                         pad=SIZE // 2))
+    # The chromium of tests/browser.py, which a test's process shares: a second Playwright cannot start in a process
+    # that runs one (its event loop stays marked running between calls), as a test worker does after a page's test.
+    with browser_page(COLUMNS * width, ROWS * height) as page:
+        page.set_content(PAGE.format(size=SIZE, font=font_stack(), columns=COLUMNS, width=width, height=height,
+                                     pad=SIZE // 2))
 
-            def draw(names: list[str]) -> list[int]:
-                page.evaluate(FILL, [BASE, *names])
-                rows = -(-(len(names) + 1) // COLUMNS)
-                shot = page.screenshot(clip={"x": 0, "y": 0, "width": COLUMNS * width, "height": rows * height})
-                return [i - 1 for i in same_as_first(shot, rows)]
+        def draw(names: list[str]) -> list[int]:
+            page.evaluate(FILL, [BASE, *names])
+            rows = -(-(len(names) + 1) // COLUMNS)
+            shot = page.screenshot(clip={"x": 0, "y": 0, "width": COLUMNS * width, "height": rows * height})
+            return [i - 1 for i in same_as_first(shot, rows)]
 
-            # The check of the check: the name alone is drawn as itself, a full stop after it is not nothing.
-            assert draw([BASE, BASE + "."]) == [0]
-            for start in range(0, len(codes), batch):
-                chunk = codes[start:start + batch]
-                nothing += [chunk[i] for i in draw([BASE + chr(c) for c in chunk])]
-                if progress and start // batch % 50 == 0:
-                    print(f"  {start + len(chunk):,} of {len(codes):,} drawn, {len(nothing)} as nothing", flush=True)
-            return nothing, browser.version
-        finally:
-            browser.close()
+        # The check of the check: the name alone is drawn as itself, a full stop after it is not nothing.
+        assert draw([BASE, BASE + "."]) == [0]
+        for start in range(0, len(codes), batch):
+            chunk = codes[start:start + batch]
+            nothing += [chunk[i] for i in draw([BASE + chr(c) for c in chunk])]
+            if progress and start // batch % 50 == 0:
+                print(f"  {start + len(chunk):,} of {len(codes):,} drawn, {len(nothing)} as nothing", flush=True)
+        return nothing, page.context.browser.version
 
 
 def fonts_installed() -> int | None:
@@ -174,7 +169,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.every < 1:
         parser.error("--every must be 1 or more")
-    result = scan(args.bmp, args.every, progress=True)
+    try:
+        result = scan(args.bmp, args.every, progress=True)
+    finally:
+        close_shared()
     out = args.out or (RESULT if not args.bmp and args.every == 1 else None)
     text = json.dumps(result, indent=1, ensure_ascii=False) + "\n"
     if out is not None:

@@ -3,6 +3,8 @@ own clock (Playwright's ``page.clock``), so a 60 s game takes about a second and
 
 from __future__ import annotations
 
+import datetime
+
 #: The page clamps a frame to 0.25 s (a stalled tab slows the game rather than jumping it): the clock is moved
 #: on in jumps just over that, each one frame.
 JUMP_MS = 260
@@ -11,12 +13,24 @@ JUMP_MS = 260
 PATTERN = (("d", 520, 260), ("j", 780, 260), ("f", 520, 0), ("k", 520, 520), ("space", 0, 260))
 
 
-def open_page(page, base: str) -> list[str]:
-    """``/play`` at ``base`` on a clock the test moves; returns the list its console errors are added to."""
+#: How far ahead of the wall clock a still page's clock is paused (``open_page``): more than any test lasts, so the
+#: pause is never a jump into the page's past however slowly the machine runs.
+STILL_AHEAD = datetime.timedelta(hours=1)
+
+
+def open_page(page, base: str, still: bool = False) -> list[str]:
+    """``/play`` at ``base`` on a clock the test moves; returns the list its console errors are added to.
+
+    Playwright's installed clock also runs on by itself with the wall clock, so the game moves on between the
+    test's steps by however long the machine took over them. ``still``: the clock paused before the page loads,
+    so the page's time moves only when the test moves it (``run_for``) and the same steps play the same game on
+    a machine under load as on an idle one."""
     errors: list[str] = []
     page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
     page.on("pageerror", lambda e: errors.append(f"uncaught: {e}"))
     page.clock.install()
+    if still:  # no page yet: the jump fires nothing
+        page.clock.pause_at(datetime.datetime.now() + STILL_AHEAD)
     page.goto(f"{base}/play")
     return errors
 

@@ -121,9 +121,24 @@ def _debug(page) -> dict:
     return page.evaluate("document.getElementById('game').debug")
 
 
-def _fingers_drive_their_muscles(page, where: str, finger: list[int]) -> None:
-    """A finger on each muscle's button holds its key and pulls that muscle alone; one on reset resets."""
+def _in_a_trial(page) -> None:
+    """The lab's page moved on (its clock, a card's button) until a trial takes keys: one ending, its result
+    shown, or a block's card ignores them."""
+    for _ in range(200):
+        if _debug(page)["phase"] == "reach":
+            return
+        if page.is_visible("#lab-go"):
+            page.tap("#lab-go")
+        run_for(page, 100)
+    raise AssertionError(f"no trial took keys: {_debug(page)}")
+
+
+def _fingers_drive_their_muscles(page, where: str, finger: list[int], lab: bool = False) -> None:
+    """A finger on each muscle's button holds its key and pulls that muscle alone; one on reset resets (``lab``:
+    each in a trial, where the lab's keys count)."""
     for i, key in enumerate(MUSCLES):
+        if lab:
+            _in_a_trial(page)
         finger[0] += 1
         button = f"#touch button[data-key='{key}']"
         page.dispatch_event(button, "pointerdown", {"pointerId": finger[0], "pointerType": "touch"})
@@ -136,6 +151,8 @@ def _fingers_drive_their_muscles(page, where: str, finger: list[int]) -> None:
         others = [a for j, a in enumerate(activation) if j != i]
         assert activation[i] > 0.5 and max(others) < 0.2, f"{where}: {key}: {held}"
         assert _debug(page)["held"] == [], where
+    if lab:
+        _in_a_trial(page)
     before = _debug(page)["resets"]
     finger[0] += 1
     page.dispatch_event("#reset", "pointerdown", {"pointerId": finger[0], "pointerType": "touch"})
@@ -148,7 +165,7 @@ def _every_size(tmp_path, sizes: list[tuple[int, int]], end: bool = True, **devi
     """Joining, playing and (``end``) the end card at each of ``sizes`` in turn, in one context of ``device``."""
     with running_class(tmp_path / "class") as opened, \
             browser_page(*sizes[0], has_touch=True, is_mobile=True, **device) as page:
-        errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+        errors = open_page(page, f"http://127.0.0.1:{opened.port}", still=True)
         page.wait_for_selector("#touch", state="visible")  # a coarse pointer at load shows the buttons
         for size in sizes:
             _resize(page, size)
@@ -187,7 +204,7 @@ def _lab_every_size(tmp_path, sizes: list[tuple[int, int]], end: bool = True, **
                                      data=json.dumps({"on": True}).encode(),
                                      headers={"Content-Type": "application/json"})
         urllib.request.urlopen(req, timeout=10).close()
-        errors = open_page(page, f"http://127.0.0.1:{opened.port}")
+        errors = open_page(page, f"http://127.0.0.1:{opened.port}", still=True)
         page.wait_for_selector("#touch", state="visible")
         join(page, opened.clerk.roster.code, "Aleksandra Nowakowska")
         page.wait_for_selector("#lab-card", state="visible")
@@ -202,7 +219,7 @@ def _lab_every_size(tmp_path, sizes: list[tuple[int, int]], end: bool = True, **
             _check(page, size, "playing")
             assert _debug(page)["phase"] in ("reach", "feedback"), _debug(page)
             if end or i == 0:  # the suite's cheap part drives the muscles at its first size only
-                _fingers_drive_their_muscles(page, f"{size[0]}x{size[1]} (lab)", finger)
+                _fingers_drive_their_muscles(page, f"{size[0]}x{size[1]} (lab)", finger, lab=True)
         if end:
             for _ in range(3000):
                 if page.is_visible("#lab-end"):

@@ -106,3 +106,55 @@ def test_the_pages_looks_are_the_pythons():
     for (_, q1, q2, a), js in zip(POSES, looks["palms"], strict=True):
         hand = (0.1 + 0.2 * math.cos(q1 + q2), 0.2 + 0.2 * math.sin(q1 + q2))
         _close(js, body._palm((0.1, 0.2), hand, a), "palm")
+
+
+LAB_LOOKS = """
+import * as labview from './labview.js';
+const named = Object.entries(labview).filter(([k]) => k === k.toUpperCase());  // its constants, not its functions
+process.stdout.write(JSON.stringify(Object.fromEntries(named)));
+"""
+#: labview.js's colours and the Python lab window's each stands for: the high-contrast palette's (``ui/palette.py``,
+#: by field) or ``ui/lab_window.py``'s own (by constant). One colour of the page draws what the window draws in
+#: several of the palette's, all alike in the high-contrast one: INK the text, the targets' rings, the ideal line,
+#: the hand and the cursor (lab_window.CURSOR); PAPER the scene and the panels.
+LAB_COLOURS = {"INK": ("ink", "edge", "hand", "CURSOR"), "PAPER": ("scene", "panel"), "TARGET": ("target",),
+               "TRAIL": ("trail",), "WARN": ("warn",), "BAR_BACK": ("bar_back",), "HOME": ("HOME",),
+               "HIT": ("HIT",)}
+#: labview.js's colours that differ from the Python's on purpose, by name, with why (none today).
+LAB_DIFFERS: dict[str, str] = {}
+
+
+def _rgb(colour) -> list[int]:
+    """[r, g, b] of a page's colour: "rgb(r,g,b)" or [r, g, b]."""
+    if isinstance(colour, str):
+        found = re.fullmatch(r"rgb\((\d+), ?(\d+), ?(\d+)\)", colour)
+        assert found, colour
+        return [int(c) for c in found.groups()]
+    return list(colour)
+
+
+def test_the_labs_colours_are_the_lab_windows():
+    """labview.js's hand-copied palette, held to the lab window's: each colour to the high-contrast palette's fields
+    or lab_window.py's constants it stands for, the muscles' bars to the palette's muscles, and the learning curve's
+    block shading to lab_panels.draw_curve's blend of the panel (a perturbed block towards the target, the others
+    towards ``link`` by turns). A colour added to labview.js must be named here."""
+    pytest.importorskip("pygame")
+    from armgame.ui import lab_window
+    from armgame.ui.body import blend
+    from armgame.ui.palette import PALETTES
+
+    done = _node("--input-type=module", "-e", LAB_LOOKS)
+    assert done.returncode == 0, done.stderr
+    looks = json.loads(done.stdout)
+    high = PALETTES["high-contrast"]
+    assert set(looks) == {*LAB_COLOURS, "MUSCLES", "BLOCK_SHADES"}, "labview.js's colours are not all named here"
+    for name, stands_for in LAB_COLOURS.items():
+        if name in LAB_DIFFERS:
+            continue
+        for python in stands_for:
+            colour = getattr(lab_window, python) if python.isupper() else getattr(high, python)
+            assert _rgb(looks[name]) == list(colour), f"labview.js's {name} is not the lab window's {python}"
+    assert [_rgb(c) for c in looks["MUSCLES"]] == [list(c) for c in high.muscles], "the muscles' colours"
+    shades = {"perturbed": blend(high.panel, high.target, 0.16), "even": blend(high.panel, high.link, 0.07),
+              "odd": blend(high.panel, high.link, 0.11)}
+    assert {k: _rgb(c) for k, c in looks["BLOCK_SHADES"].items()} == {k: list(c) for k, c in shades.items()}

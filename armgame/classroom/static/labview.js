@@ -5,12 +5,16 @@
 // set with textContent only. labpage.js holds the model and calls these; nothing here changes the run.
 import { circle, rgb } from "./body.js";
 
-// The high-contrast palette (ui/palette.py), and the lab window's own colours.
-const INK = "rgb(0,0,0)", PAPER = "rgb(255,255,255)", TARGET = [200, 0, 0], TRAIL = "rgb(90,90,90)";
-const WARN = "rgb(170,0,0)", BAR_BACK = "rgb(200,200,200)";
-const HOME = "rgb(0,114,178)";  // Okabe-Ito blue: told apart from the vermilion target by colour-blind players too
+// The high-contrast palette (ui/palette.py), and the lab window's own colours (tests/test_play_logic.py holds
+// them to the Python's).
+export const INK = "rgb(0,0,0)", PAPER = "rgb(255,255,255)", TARGET = [200, 0, 0], TRAIL = "rgb(90,90,90)";
+export const WARN = "rgb(170,0,0)", BAR_BACK = "rgb(200,200,200)";
+export const HOME = "rgb(0,114,178)";  // Okabe-Ito blue: told apart from the vermilion target by colour-blind players too
 export const HIT = "rgb(0,128,90)";
-const MUSCLES = [[0, 80, 220], [180, 90, 0], [0, 120, 60], [160, 0, 160]];
+export const MUSCLES = [[0, 80, 220], [180, 90, 0], [0, 120, 60], [160, 0, 160]];
+// The learning curve's blocks (lab_panels.draw_curve's blend of the panel): a perturbed one in the target's tint,
+// the others in two greys by turns.
+export const BLOCK_SHADES = { perturbed: "rgb(246,214,214)", odd: "rgb(227,227,227)", even: "rgb(237,237,237)" };
 const CURSOR_RADIUS = 0.006, MIN_LINE = 3;
 const SVG = "http://www.w3.org/2000/svg";
 
@@ -200,7 +204,7 @@ export function drawCurve(root, curve) {
   curve.blocks.forEach((b, i) => {
     const x0 = x(b.first - 0.5), x1 = x(b.last + 0.5);
     svg(root, "rect", { x: x0, y: top, width: x1 - x0, height: plotH,
-      fill: b.perturbed ? "rgb(246,214,214)" : i % 2 ? "rgb(226,226,226)" : "rgb(238,238,238)" });
+      fill: b.perturbed ? BLOCK_SHADES.perturbed : i % 2 ? BLOCK_SHADES.odd : BLOCK_SHADES.even });
     if (x1 - x0 > 0.6 * text * b.name.length) {  // a block too narrow for its name goes unnamed, as in the window
       svg(root, "text", { x: (x0 + x1) / 2, y: top - 0.4 * text, "text-anchor": "middle", class: "block" }, b.name);
     }
@@ -226,7 +230,7 @@ export function drawCurve(root, curve) {
     svg(root, "circle", { cx, cy, r: r + 5, fill: "none", stroke: WARN, "stroke-width": 3 });
     const onLeft = cx - r - text - 7 * text >= left;
     svg(root, "text", { x: onLeft ? cx - r - text : cx + r + text, y: cy, "text-anchor": onLeft ? "end" : "start",
-      "dominant-baseline": "middle", fill: WARN, stroke: "#fff", "stroke-width": Math.max(3, text / 4),
+      "dominant-baseline": "middle", fill: WARN, stroke: PAPER, "stroke-width": Math.max(3, text / 4),
       "paint-order": "stroke" }, "after-effect");  // a white edge: the label reads over the dots it lies on
   }
   svg(root, "text", { x: left, y: H - 0.5 * text }, `${curve.label} (${curve.unit}) by trial`);
