@@ -23,29 +23,6 @@ int armgame_use_sincos = 0;
 #endif
 #include "../game/_cstep.h"
 
-/* _ckernel.c's check: whether sincos gives sin's and cos's bits on a spread of angles (small, game-sized and
- * huge). A pair from sincos costs about two thirds of sin and cos apart, and the hand's four run every step. */
-static int sincos_agrees(void)
-{
-#if defined(__GLIBC__)
-    uint64_t r = UINT64_C(88172645463325252);
-    for (int i = 0; i < 3000; i++) {
-        r ^= r << 13;
-        r ^= r >> 7;
-        r ^= r << 17;
-        const double scale = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 40.0 : 2e6);
-        const double x = ((double)(r >> 11) / 9007199254740992.0 - 0.5) * scale;
-        double s, c;
-        sincos(x, &s, &c);
-        if (s != sin(x) || c != cos(x))
-            return 0;
-    }
-    return 1;
-#else
-    return 0;
-#endif
-}
-
 /* Columns of a run's float state, int state and trial (the Python side names them the same). */
 enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_COUNT = 20 };
 enum { I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_COUNT };

@@ -34,28 +34,6 @@
 
 int armgame_use_sincos = 0;
 
-/* Whether sincos gives sin's and cos's bits on a spread of angles (small, game-sized and huge). */
-static int sincos_agrees(void)
-{
-#if defined(__GLIBC__)
-    uint64_t r = UINT64_C(88172645463325252);
-    for (int i = 0; i < 3000; i++) {
-        r ^= r << 13;
-        r ^= r >> 7;
-        r ^= r << 17;
-        const double scale = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 40.0 : 2e6);
-        const double x = ((double)(r >> 11) / 9007199254740992.0 - 0.5) * scale;
-        double s, c;
-        sincos(x, &s, &c);
-        if (s != sin(x) || c != cos(x))
-            return 0;
-    }
-    return 1;
-#else
-    return 0;
-#endif
-}
-
 /* Nonzero if ``x`` is NaN or infinite: its exponent bits all ones. No branch, so checking a call's
  * arguments as they are read costs next to nothing. */
 static inline uint64_t not_finite(double x)
@@ -244,7 +222,6 @@ static PyObject *rk4_step_loaded(PyObject *self, PyObject *const *args, Py_ssize
     rk4_exact(&arm, &field, v[9], v[10], v[11], x);
     return Py_BuildValue("(dddd)", x[0], x[1], x[2], x[3]);
 }
-
 
 PyDoc_STRVAR(rk4_run_doc,
 "rk4_run(params, mode, dt, x, torques, steps, states, every, limit) -> int\n\n"

@@ -37,6 +37,29 @@ static inline void sin_cos(double x, double *s, double *c)
     *c = cos(x);
 }
 
+/* Whether sincos gives sin's and cos's bits on a spread of angles (small, game-sized and huge): each module
+ * that steps the hand asks it once at its start and sets armgame_use_sincos from the answer. */
+static inline int sincos_agrees(void)
+{
+#if defined(__GLIBC__)
+    uint64_t r = UINT64_C(88172645463325252);
+    for (int i = 0; i < 3000; i++) {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        const double scale = i % 3 == 0 ? 1.0 : (i % 3 == 1 ? 40.0 : 2e6);
+        const double x = ((double)(r >> 11) / 9007199254740992.0 - 0.5) * scale;
+        double s, c;
+        sincos(x, &s, &c);
+        if (s != sin(x) || c != cos(x))
+            return 0;
+    }
+    return 1;
+#else
+    return 0;
+#endif
+}
+
 /* The arm's trig (arm_sin_cos, arm_cos): armgame/physics/_trig.h. */
 #include "../physics/_trig.h"
 
