@@ -156,3 +156,18 @@ def test_a_played_games_hand_stays_within_the_bounds_speed_and_acceleration():
     limit = row["armgame/Reach-v1"]
     assert (f"reaches {fastest:.1f} m/s and {hardest:.0f} m/s^2 in an 8 s game of Reach-v1, against `V` "
             f"{limit['speed']:.1f} and `A` {limit['accel']:.0f}") in guide
+
+
+def test_a_complete_reference_is_no_weaker_than_the_controllers_earlier_settings():
+    """docs/programs.md: an id whose reference replays at new settings keeps them only if its 100 games beat the 100
+    of the settings before (``benchmarks/results/ceiling``); until then the table says "incomplete"."""
+    from armgame.env.references import REFERENCES_V3
+
+    earlier = Path(__file__).resolve().parents[1] / "benchmarks" / "results" / "ceiling"
+    for env_id, ref in REFERENCES_V3.items():
+        if ref["games_of"] != env_id or ref["games"] < 100:
+            continue
+        before = json.loads((earlier / f"{env_id.split('/')[1]}.json").read_text(encoding="utf-8"))
+        hits = before["hits"]
+        mean = sum(hits) / len(hits)
+        assert ref["hits"] >= round(mean, 2) - 1e-9, f"{env_id}: the reference {ref['hits']} is below {mean:.2f}"
