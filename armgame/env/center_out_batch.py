@@ -27,7 +27,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..game.variant import runaway_message
 from ..lab.analysis import trial_row
-from ..lab.metrics import Reach
+from ..lab.metrics import METRIC_COLUMNS, Reach
 from ..lab.perturbations import Perturbation
 from ..lab.protocol import Protocol
 from ..lab.session import LabSession, TrialOutcome, TrialPlan, lab_config, schedule
@@ -127,6 +127,7 @@ class _Task:
         self.base = base
         self.cap = session.timeout_steps + 2
         self._rows: dict[Perturbation, np.ndarray] = {}
+        self._table_rows: dict[tuple[object, ...], dict[str, object]] = {}
         self.stub = SimpleNamespace(config=SimpleNamespace(dt=self.dt), protocol=protocol)
         # A trial's block follows from its index alone (``schedule`` runs the blocks in order, each its own
         # count of trials), so every run of the protocol shares these; the seed draws only targets and delays.
@@ -146,8 +147,21 @@ class _Task:
             row[T_SHOW], row[T_SP:T_SP + len(numbers)] = kind, numbers
             self._rows[perturbation] = row
         row = row.copy()
-        row[[T_DELAY, T_TX, T_TY]] = (plan.delay_steps, *plan.position)
+        row[T_DELAY], row[T_TX], row[T_TY] = plan.delay_steps, *plan.position
         return row
+
+    def row(self, plan: TrialPlan) -> dict[str, object]:
+        """A fresh copy of ``trial_row``'s row for a trial of this kind, but for the columns that differ from trial to
+        trial (``trial``, ``target_deg``, ``hit`` and ``METRIC_COLUMNS``), which the caller sets. No trial the batch
+        runs is a channel trial or one space sent home, so the rest follows from the plan's block and perturbation."""
+        key = (plan.block, plan.block_name, plan.perturbation, plan.catch, plan.channel, plan.feedback, plan.home)
+        row = self._table_rows.get(key)
+        if row is None:
+            empty = Reach(t=np.zeros(0), hand=np.zeros((0, 2)), start=plan.home, target=plan.position, go_time=0.0,
+                          hit=False)
+            row = self._table_rows[key] = trial_row(self.stub, TrialOutcome(plan, 0, 0, False),  # type: ignore[arg-type]
+                                                    reach=empty)
+        return dict(row)
 
 
 class _Run:
@@ -409,37 +423,46 @@ class CenterOutBatchVectorEnv(VectorEnv):
         task = self._task(self.template.protocol)
         ints, state, trials = self.ints, self.state, self.trials
         while _ccenter.advance(task.params, task.mode, state, ints, trials, self.xs, self.ys, self._obs):
-            for i in np.flatnonzero(ints[:, I_EVENT]):
-                run = self.runs[i]
-                assert run is not None
-                event = int(ints[i, I_EVENT])
-                ints[i, I_EVENT] = 0
-                if event == EVENT_STOPPED:
-                    run.stopped = runaway_message(trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
-                    self._stopped[i] = True
-                    ints[i, I_TODO] = 0
-                    continue
-                path = int(ints[i, I_PATH])
-                index = int(self._trial[i])
-                plan, go = run.plans[index], int(ints[i, I_GO])
-                # The outcome's path stays empty: no trial the batch runs is a channel trial or one space sent
-                # home, so the row reads the path only as the reach, given here as the arrays reach_of would
-                # build from it (the same numbers), without the C loop's rows going through lists.
-                hand = np.column_stack((self.xs[i, :path], self.ys[i, :path]))
-                reach = Reach(t=(go + np.arange(len(hand))) * run.task.dt, hand=hand, start=plan.home,
-                              target=plan.position, go_time=go * run.task.dt, hit=event == EVENT_HIT)
-                outcome = TrialOutcome(plan, go, int(ints[i, I_STEPS]), event == EVENT_HIT)
-                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome,  # type: ignore[arg-type]
-                                                                reach=reach))
-                self._hits[i] += event == EVENT_HIT
-                self._trial[i] = index = index + 1
-                if index >= len(run.plans):
-                    self._finished[i] = True
-                    ints[i, I_TODO] = 0
-                else:
-                    trials[i] = run.task.trial(run.plans[index])
+            runs = np.flatnonzero(ints[:, I_EVENT])
+            events = ints[runs, I_EVENT]
+            ints[runs, I_EVENT] = 0
+            for i in runs[events == EVENT_STOPPED].tolist():
+                self.runs[i].stopped = runaway_message(  # type: ignore[union-attr]
+                    trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
+                self._stopped[i] = True
+                ints[i, I_TODO] = 0
+            ended = events != EVENT_STOPPED
+            if ended.any():
+                self._end_trials(runs[ended], events[ended] == EVENT_HIT, reaches)
         self._measure_new()
         return reaches
+
+    def _end_trials(self, ended: np.ndarray, hit: np.ndarray, reaches: dict[int, list[dict[str, object]]]) -> None:
+        """The trials the C loop just ended (runs ``ended``, each its first event this call): their rows of the lab's
+        table, the runs' hits and trial counts, and the next trials' rows for the C loop. The rows' reach measures
+        come from ``_ccenter.measures`` for all of them at once (``reach_metrics``, bit for bit); the rest of a row
+        is ``trial_row``'s, which the batch computes once per kind of trial (``_Task.row``)."""
+        runs, ints = self.runs, self.ints
+        indices = self._trial[ended].tolist()
+        plans = [runs[i].plans[index] for i, index in zip(ended.tolist(), indices, strict=True)]  # type: ignore[union-attr]
+        geometry = np.array([(runs[i].task.dt, *plan.home, *plan.position)  # type: ignore[union-attr]
+                             for i, plan in zip(ended.tolist(), plans, strict=True)])
+        measures = np.empty((len(plans), len(METRIC_COLUMNS)))
+        _ccenter.measures(self.xs, self.ys, ended, ints[ended, I_PATH], ints[ended, I_GO], geometry, measures)
+        for i, plan, values, won in zip(ended.tolist(), plans, measures.tolist(), hit.tolist(), strict=True):
+            row = runs[i].task.row(plan)  # type: ignore[union-attr]
+            row["trial"], row["target_deg"], row["hit"] = plan.index + 1, plan.target_deg, won
+            row.update(zip(METRIC_COLUMNS, values, strict=True))
+            reaches.setdefault(i, []).append(row)
+        self._hits[ended] += hit
+        self._trial[ended] += 1
+        for i, index in zip(ended.tolist(), self._trial[ended].tolist(), strict=True):
+            run = runs[i]
+            if index >= len(run.plans):  # type: ignore[union-attr]
+                self._finished[i] = True
+                ints[i, I_TODO] = 0
+            else:
+                self.trials[i] = run.task.trial(run.plans[index])  # type: ignore[union-attr]
 
     def _measure_new(self) -> None:
         fresh = np.isnan(self._edge)
