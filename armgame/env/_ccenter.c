@@ -25,7 +25,7 @@ int armgame_use_sincos = 0;
 
 /* Columns of a run's float state, int state and trial (the Python side names them the same). */
 enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_COUNT = 20 };
-enum { I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_COUNT };
+enum { I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_FRESH, I_COUNT };
 enum { T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP, T_SHOW = T_FP + 4, T_SP,
        T_HOLD_AT_HOME = T_SP + 6, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT };
 enum { EVENT_NONE = 0, EVENT_HIT = 1, EVENT_MISS = 2, EVENT_STOPPED = 3 };
@@ -186,8 +186,8 @@ static inline double wrap(double q)
 PyDoc_STRVAR(advance_doc,
 "advance(params, mode, state, ints, trials, xs, ys, obs) -> int\n\n"
 "Run every run of the batch its ints[:, TODO] steps (stopping at a trial's end or the guard's stop, which\n"
-"ints[:, EVENT] says, with the steps left in TODO), then fill obs (n, 16 float64) with each run's v1\n"
-"observation. Returns how many runs stopped at an event.");
+"ints[:, EVENT] says, with the steps left in TODO), then fill obs (n, 16 float64) with the v1 observation\n"
+"of each run that ran or has ints[:, FRESH] set (which it clears). Returns how many runs stopped at an event.");
 
 static PyObject *advance(PyObject *self, PyObject *args)
 {
@@ -238,9 +238,15 @@ static PyObject *advance(PyObject *self, PyObject *args)
             double *s = state + S_COUNT * i;
             int64_t *it = ints + I_COUNT * i;
             const double *t = trials + T_COUNT * i;
+            /* A run's observation changes only when it runs or the caller changed it (FRESH): called again within a
+             * step for the runs a trial's end stopped, the loop leaves the others' as they are. */
+            const int touched = it[I_TODO] > 0 || it[I_FRESH] != 0;
             if (it[I_EVENT] == EVENT_NONE && it[I_TODO] > 0)
                 run(&arm, p, s, it, t, xs + cap * i, ys + cap * i, cap);
             events += it[I_EVENT] != EVENT_NONE;
+            if (!touched)
+                continue;
+            it[I_FRESH] = 0;
             /* center_out_v1.CenterOutV1Env._observation, in its order. */
             const double q1 = s[0], q2 = s[1], w1 = s[2], w2 = s[3];
             const double q12 = q1 + q2, w12 = w1 + w2;

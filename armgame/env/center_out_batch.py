@@ -51,7 +51,7 @@ MAX_BATCH_ENVS = 65536
 
 # The columns of the C loop's arrays (``_ccenter.c``'s enums).
 S_X, S_A, S_G, S_R, S_CX, S_CY, S_FW1, S_FW2, S_COUNT = 0, 4, 8, 12, 16, 17, 18, 19, 20
-I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_COUNT = range(10)
+I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_FRESH, I_COUNT = range(11)
 T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP = range(11)
 T_SHOW, T_SP = T_FP + 4, T_FP + 5
 T_HOLD_AT_HOME, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT = T_SP + 6, T_SP + 7, T_SP + 8, T_SP + 9, T_SP + 10
@@ -167,12 +167,19 @@ class _Task:
 class _Run:
     """One sub-env's run: its trials and, if the guard stopped it, why (its counts are the env's arrays)."""
 
-    __slots__ = ("plans", "stopped", "task")
+    __slots__ = ("plans", "seed", "stopped", "task")
 
-    def __init__(self, task: _Task, seed: int) -> None:
-        self.task = task
-        self.plans = schedule(task.protocol, seed, task.dt, task.home)
+    def __init__(self, task: _Task, seed: int, first: int | None) -> None:
+        self.task, self.seed = task, seed
+        # A new run at every reset (the default) plays its first episode's trials only: those are the full schedule's
+        # first (``schedule``'s ``limit``), and the rest are drawn if the run goes on (``plan``).
+        self.plans = schedule(task.protocol, seed, task.dt, task.home, limit=first)
         self.stopped: str | None = None
+
+    def plan(self, index: int) -> TrialPlan:
+        if index >= len(self.plans):
+            self.plans = schedule(self.task.protocol, self.seed, self.task.dt, self.task.home)
+        return self.plans[index]
 
 
 class CenterOutBatchVectorEnv(VectorEnv):
@@ -331,7 +338,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
         if env.continue_run and seed is None and not options and run is not None \
                 and not self._run_over(i) and self._over(i):
             self._first_trial[i] = self._trial[i]
-            self._first_block[i] = run.plans[self._trial[i]].block
+            self._first_block[i] = run.plan(int(self._trial[i])).block
         else:
             if seed is not None:
                 seed = check_seed(seed)
@@ -347,7 +354,8 @@ class CenterOutBatchVectorEnv(VectorEnv):
                 self._generators[i], _ = seeding.np_random(seed)
             lab_seed = seed if seed is not None else drawn_seed(self._generators[i])  # type: ignore[arg-type]
             task = self._task(protocol)
-            run = self.runs[i] = _Run(task, lab_seed)
+            first = None if env.episode_trials == "block" else int(env.episode_trials) + 1  # its next trial's too
+            run = self.runs[i] = _Run(task, lab_seed, first)
             self.state[i] = 0.0
             self.state[i, S_X:S_X + 2] = task.home_q
             self.state[i, S_R:S_R + 4] = task.decay
@@ -360,6 +368,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
             self._first_block[i] = run.plans[0].block
             self._finished[i] = self._stopped[i] = False
             self._task_of[i] = self._task_list.index(task)
+        self.ints[i, I_FRESH] = 1
         self._shown[i] = (self._trial[i], self.ints[i, I_PHASE])
         self._edge[i] = math.nan  # measured after the C loop's observation (``_advance``)
 
@@ -426,6 +435,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
             runs = np.flatnonzero(ints[:, I_EVENT])
             events = ints[runs, I_EVENT]
             ints[runs, I_EVENT] = 0
+            ints[runs, I_FRESH] = 1  # their trial, or their stop, changes what they observe
             for i in runs[events == EVENT_STOPPED].tolist():
                 self.runs[i].stopped = runaway_message(  # type: ignore[union-attr]
                     trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
@@ -444,7 +454,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
         is ``trial_row``'s, which the batch computes once per kind of trial (``_Task.row``)."""
         runs, ints = self.runs, self.ints
         indices = self._trial[ended].tolist()
-        plans = [runs[i].plans[index] for i, index in zip(ended.tolist(), indices, strict=True)]  # type: ignore[union-attr]
+        plans = [runs[i].plan(index) for i, index in zip(ended.tolist(), indices, strict=True)]  # type: ignore[union-attr]
         geometry = np.array([(runs[i].task.dt, *plan.home, *plan.position)  # type: ignore[union-attr]
                              for i, plan in zip(ended.tolist(), plans, strict=True)])
         measures = np.empty((len(plans), len(METRIC_COLUMNS)))
@@ -458,22 +468,24 @@ class CenterOutBatchVectorEnv(VectorEnv):
         self._trial[ended] += 1
         for i, index in zip(ended.tolist(), self._trial[ended].tolist(), strict=True):
             run = runs[i]
-            if index >= len(run.plans):  # type: ignore[union-attr]
+            if index >= len(run.task.blocks):  # type: ignore[union-attr]
                 self._finished[i] = True
                 ints[i, I_TODO] = 0
             else:
-                self.trials[i] = run.task.trial(run.plans[index])  # type: ignore[union-attr]
+                self.trials[i] = run.task.trial(run.plan(index))  # type: ignore[union-attr]
 
     def _measure_new(self) -> None:
-        fresh = np.isnan(self._edge)
-        if fresh.any():
-            self._edge[fresh] = self._edges()[fresh]
+        fresh = np.flatnonzero(np.isnan(self._edge))
+        if fresh.size:
+            self._edge[fresh] = self._edges(fresh)
 
-    def _edges(self) -> np.ndarray:
-        """Each cursor's distance to its shown target's edge, by ``math.hypot`` as the single env measures it."""
-        obs = self._obs
-        radius = np.where(self.ints[:, I_PHASE] == 1, self.trials[:, T_TR], self.trials[:, T_HR])
-        d = np.fromiter(map(math.hypot, obs[:, 12].tolist(), obs[:, 13].tolist()), float, self.num_envs)
+    def _edges(self, runs: np.ndarray | None = None) -> np.ndarray:
+        """Each cursor's distance to its shown target's edge (of ``runs``, default all), by ``math.hypot`` as the
+        single env measures it."""
+        obs, ints, trials = (self._obs, self.ints, self.trials) if runs is None else \
+            (self._obs[runs], self.ints[runs], self.trials[runs])
+        radius = np.where(ints[:, I_PHASE] == 1, trials[:, T_TR], trials[:, T_HR])
+        d = np.fromiter(map(math.hypot, obs[:, 12].tolist(), obs[:, 13].tolist()), float, len(obs))
         return np.maximum(0.0, d - radius)
 
     def _rewards(self, hits: np.ndarray, stepping: np.ndarray) -> np.ndarray:
