@@ -18,7 +18,10 @@ reset as they end:
   (issue 28: no slower at any size; at least 4 M env-steps/s at 8,192 envs);
 * with ``--suite ID ...``, instead: each suite id's ``make_vec`` vector env (the native one where the batch
   plays the id, else single envs in ``SyncVectorEnv``) against ``SyncVectorEnv`` of its single envs, side by
-  side (issue 40, item 5: at least 1 M env-steps/s at 8,192 envs); a size past the id's cap is reported so;
+  side (issue 40, item 5: at least 1 M env-steps/s at 8,192 envs); a size past the id's cap is reported so.
+  A CenterOut id's ``make_vec`` env runs ``CENTER_OUT_WARM_STEPS`` steps before its clock starts: its trials,
+  and its 8-trial episodes, first end together after hundreds of steps, and an ended trial costs its
+  ``info["reaches"]`` row, so the figure is a step's cost once trials and episodes end on every step;
 * with ``--suite ID ... --motornet``, instead of ``SyncVectorEnv``: MotorNet's reaching env beside each id's
   ``make_vec`` vector env at 1 to 8,192 envs (issue 40, item 5: at least 20 times MotorNet's env at every size).
 
@@ -67,6 +70,9 @@ MOTORNET_SIZES = (1, 4, 16, 64, 256, 1024, 4096, 8192)  # issue 40: every size f
 MOTORNET_GOAL = 20.0  # armgame's env steps per CPU second over MotorNet's, at every size (issue 40)
 SINGLE_GOAL = 1.0  # Reach-v0 steps per second over Acrobot-v1's
 VECTOR_GOAL = 1e6  # env-steps per second at 8,192 envs (v0)
+#: Steps a CenterOut id's make_vec env runs before it is measured: past its first episodes' ends (8 trials of up to
+#: about 200 steps each), after which trials and episodes end on every step of a batch of thousands.
+CENTER_OUT_WARM_STEPS = 1500
 V1_VECTOR_GOAL = 4e6  # Reach-v1's, at 8,192 envs (issue 28)
 
 
@@ -93,13 +99,15 @@ def single_runner(env_id: str) -> Callable[[float], tuple[float, float]]:
     return run
 
 
-def vector_runner(env_id: str, num_envs: int, mode: str) -> Callable[[float], tuple[float, float]]:
-    """Env-steps per second (vector steps x num_envs) of a vector env for about ``seconds``: (wall, CPU)."""
+def vector_runner(env_id: str, num_envs: int, mode: str, warm: int = 1) -> Callable[[float], tuple[float, float]]:
+    """Env-steps per second (vector steps x num_envs) of a vector env for about ``seconds``: (wall, CPU), after
+    ``warm`` steps (the first may build what later steps reuse)."""
     envs = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode)
     envs.action_space.seed(0)
     actions = [envs.action_space.sample() for _ in range(8)]
     envs.reset(seed=0)
-    envs.step(actions[0])  # the first step may build what later steps reuse
+    for step in range(warm):
+        envs.step(actions[step % 8])
 
     def run(seconds: float) -> tuple[float, float]:
         steps, start, cpu = 0, time.perf_counter(), time.process_time()
@@ -259,9 +267,11 @@ def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, re
         physics = f"{game.decision_steps} {config.integrator.upper()} steps of {config.dt * 1e3:g} ms"
         single.close()
         rates: dict[int, object] = {}
+        center_out = env_id in CENTER_OUT_V1_IDS or "CenterOut" in env_id
+        warm = CENTER_OUT_WARM_STEPS if center_out else 1
         for n in sizes:
             try:
-                runners = {"make_vec": vector_runner(env_id, n, "vector_entry_point")}
+                runners = {"make_vec": vector_runner(env_id, n, "vector_entry_point", warm)}
             except EnvArgumentError as exc:  # past the id's cap
                 rates[n] = {"refused": str(exc)}
                 continue
@@ -277,11 +287,10 @@ def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, re
             if peer:
                 rates[n]["ratio"] = spread([a / b for a, b in zip(rates[n]["make_vec"]["cpu_rates"],  # type: ignore[index]
                                                                   rates[n][peer]["cpu_rates"], strict=True)])
-        center_out = env_id in CENTER_OUT_V1_IDS or "CenterOut" in env_id
         ids[env_id] = {"batched": True if center_out else batch_plays(env_id, {}),
                        "batch_from": BATCH_FROM if center_out else batch_min_envs(gym.spec(env_id).kwargs),
                        "sizes": rates, "step_seconds": step_seconds,
-                       "physics": physics}
+                       "physics": physics, "warm_steps": {"make_vec": warm, "peer": 1}}
     return {
         **_run_facts(load_before, seconds),
         "repeats": repeats,

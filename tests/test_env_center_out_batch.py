@@ -18,7 +18,9 @@ from armgame.env import center_out_batch
 from armgame.env.base import EnvArgumentError
 from armgame.env.center_out_batch import CenterOutBatchVectorEnv, center_out_vector_env
 from armgame.env.center_out_v1 import CenterOutVectorEnv
+from armgame.lab.metrics import METRIC_COLUMNS, Reach, reach_metrics
 from armgame.lab.presets import preset
+from armgame.lab.session import schedule
 
 compiled = pytest.mark.skipif(center_out_batch._ccenter is None, reason="armgame.env._ccenter was not built")
 
@@ -159,3 +161,49 @@ def test_the_docs_batch_figures_are_the_committed_run() -> None:
     assert (f"and {at4[0]['ratio']['median']:.2f} and {at4[1]['ratio']['median']:.2f} times it at 4 envs") in prose
     assert all(run["ids"][i]["batch_from"] == center_out_batch.BATCH_FROM for i in ids)
     assert "MotorNet's matched env (20 ms of RK4 a step) was not measured here" in prose
+
+
+@pytest.mark.parametrize("name", ("null", "curl", "savings", "random-fields", "generalization"))
+def test_a_schedules_first_trials_are_the_full_schedules(name: str) -> None:
+    # The batch draws a run's first episode's trials only (``limit``): they must be the full schedule's, probes and
+    # mixed blocks included, whatever the cut.
+    protocol = preset(name)
+    full = schedule(protocol, 7, 0.004, (0.0, 0.4))
+    for limit in (1, 2, 9, protocol.blocks[0].trials, protocol.blocks[0].trials + 3, len(full), len(full) + 5):
+        assert schedule(protocol, 7, 0.004, (0.0, 0.4), limit=limit) == full[:limit], limit
+
+
+@compiled
+def test_the_c_reach_measures_are_reach_metrics_bit_for_bit() -> None:
+    # _ccenter.measures stands for lab.metrics.reach_metrics on each ended trial: smooth, noisy, still, cut-off,
+    # random and too-short paths, targets off and on the home position, several steps and go cues.
+    rng = np.random.default_rng(52)
+    cap, count = 300, 1500
+    xs, ys = np.zeros((count, cap)), np.zeros((count, cap))
+    samples, go, geometry = np.zeros(count, np.int64), np.zeros(count, np.int64), np.zeros((count, 5))
+    for k in range(count):
+        n = int(rng.integers(0, cap + 1)) if k % 10 else int(rng.integers(0, 4))
+        home = rng.normal(0.0, 0.3, 2)
+        target = home + rng.normal(0.0, 0.1, 2) if k % 20 else home
+        s = np.clip((np.arange(n) - rng.integers(-20, 60)) / rng.integers(10, 200), 0.0, 1.0)
+        shape = 10 * s**3 - 15 * s**4 + 6 * s**5
+        x, y = home[0] + (target[0] - home[0]) * shape, home[1] + (target[1] - home[1]) * shape
+        kind = k % 4
+        if kind == 1:
+            x, y = x + rng.normal(0, 1e-4, n).cumsum(), y + rng.normal(0, 1e-4, n).cumsum()
+        elif kind == 2:
+            x, y = np.full(n, home[0]), np.full(n, home[1]) + 1e-9 * (k % 8 == 2) * np.arange(n)
+        elif kind == 3:
+            x, y = rng.normal(0.0, 0.05, n), rng.normal(0.0, 0.05, n)
+        xs[k, :n], ys[k, :n] = x, y
+        samples[k], go[k] = n, rng.integers(0, 3000)
+        geometry[k] = (float(rng.choice([0.004, 0.001, 1 / 240])), *home, *target)
+    out = np.zeros((count, len(METRIC_COLUMNS)))
+    center_out_batch._ccenter.measures(xs, ys, np.arange(count), samples, go, geometry, out)
+    for k in range(count):
+        n, dt = int(samples[k]), geometry[k, 0]
+        reach = Reach(t=(go[k] + np.arange(n)) * dt, hand=np.column_stack((xs[k, :n], ys[k, :n])),
+                      start=tuple(geometry[k, 1:3]), target=tuple(geometry[k, 3:5]), go_time=int(go[k]) * dt, hit=True)
+        want = np.array(list(reach_metrics(reach).as_dict().values()))
+        assert np.array_equal(np.isnan(want), np.isnan(out[k])), k
+        assert want[~np.isnan(want)].tobytes() == out[k][~np.isnan(out[k])].tobytes(), (k, want, out[k])

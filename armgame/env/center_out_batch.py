@@ -27,7 +27,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..game.variant import runaway_message
 from ..lab.analysis import trial_row
-from ..lab.metrics import Reach
+from ..lab.metrics import METRIC_COLUMNS, Reach
 from ..lab.perturbations import Perturbation
 from ..lab.protocol import Protocol
 from ..lab.session import LabSession, TrialOutcome, TrialPlan, lab_config, schedule
@@ -51,7 +51,7 @@ MAX_BATCH_ENVS = 65536
 
 # The columns of the C loop's arrays (``_ccenter.c``'s enums).
 S_X, S_A, S_G, S_R, S_CX, S_CY, S_FW1, S_FW2, S_COUNT = 0, 4, 8, 12, 16, 17, 18, 19, 20
-I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_COUNT = range(10)
+I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_FRESH, I_COUNT = range(11)
 T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP = range(11)
 T_SHOW, T_SP = T_FP + 4, T_FP + 5
 T_HOLD_AT_HOME, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT = T_SP + 6, T_SP + 7, T_SP + 8, T_SP + 9, T_SP + 10
@@ -127,6 +127,7 @@ class _Task:
         self.base = base
         self.cap = session.timeout_steps + 2
         self._rows: dict[Perturbation, np.ndarray] = {}
+        self._table_rows: dict[tuple[object, ...], dict[str, object]] = {}
         self.stub = SimpleNamespace(config=SimpleNamespace(dt=self.dt), protocol=protocol)
         # A trial's block follows from its index alone (``schedule`` runs the blocks in order, each its own
         # count of trials), so every run of the protocol shares these; the seed draws only targets and delays.
@@ -146,19 +147,39 @@ class _Task:
             row[T_SHOW], row[T_SP:T_SP + len(numbers)] = kind, numbers
             self._rows[perturbation] = row
         row = row.copy()
-        row[[T_DELAY, T_TX, T_TY]] = (plan.delay_steps, *plan.position)
+        row[T_DELAY], row[T_TX], row[T_TY] = plan.delay_steps, *plan.position
         return row
+
+    def row(self, plan: TrialPlan) -> dict[str, object]:
+        """A fresh copy of ``trial_row``'s row for a trial of this kind, but for the columns that differ from trial to
+        trial (``trial``, ``target_deg``, ``hit`` and ``METRIC_COLUMNS``), which the caller sets. No trial the batch
+        runs is a channel trial or one space sent home, so the rest follows from the plan's block and perturbation."""
+        key = (plan.block, plan.block_name, plan.perturbation, plan.catch, plan.channel, plan.feedback, plan.home)
+        row = self._table_rows.get(key)
+        if row is None:
+            empty = Reach(t=np.zeros(0), hand=np.zeros((0, 2)), start=plan.home, target=plan.position, go_time=0.0,
+                          hit=False)
+            row = self._table_rows[key] = trial_row(self.stub, TrialOutcome(plan, 0, 0, False),  # type: ignore[arg-type]
+                                                    reach=empty)
+        return dict(row)
 
 
 class _Run:
     """One sub-env's run: its trials and, if the guard stopped it, why (its counts are the env's arrays)."""
 
-    __slots__ = ("plans", "stopped", "task")
+    __slots__ = ("plans", "seed", "stopped", "task")
 
-    def __init__(self, task: _Task, seed: int) -> None:
-        self.task = task
-        self.plans = schedule(task.protocol, seed, task.dt, task.home)
+    def __init__(self, task: _Task, seed: int, first: int | None) -> None:
+        self.task, self.seed = task, seed
+        # A new run at every reset (the default) plays its first episode's trials only: those are the full schedule's
+        # first (``schedule``'s ``limit``), and the rest are drawn if the run goes on (``plan``).
+        self.plans = schedule(task.protocol, seed, task.dt, task.home, limit=first)
         self.stopped: str | None = None
+
+    def plan(self, index: int) -> TrialPlan:
+        if index >= len(self.plans):
+            self.plans = schedule(self.task.protocol, self.seed, self.task.dt, self.task.home)
+        return self.plans[index]
 
 
 class CenterOutBatchVectorEnv(VectorEnv):
@@ -317,7 +338,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
         if env.continue_run and seed is None and not options and run is not None \
                 and not self._run_over(i) and self._over(i):
             self._first_trial[i] = self._trial[i]
-            self._first_block[i] = run.plans[self._trial[i]].block
+            self._first_block[i] = run.plan(int(self._trial[i])).block
         else:
             if seed is not None:
                 seed = check_seed(seed)
@@ -333,7 +354,8 @@ class CenterOutBatchVectorEnv(VectorEnv):
                 self._generators[i], _ = seeding.np_random(seed)
             lab_seed = seed if seed is not None else drawn_seed(self._generators[i])  # type: ignore[arg-type]
             task = self._task(protocol)
-            run = self.runs[i] = _Run(task, lab_seed)
+            first = None if env.episode_trials == "block" else int(env.episode_trials) + 1  # its next trial's too
+            run = self.runs[i] = _Run(task, lab_seed, first)
             self.state[i] = 0.0
             self.state[i, S_X:S_X + 2] = task.home_q
             self.state[i, S_R:S_R + 4] = task.decay
@@ -346,6 +368,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
             self._first_block[i] = run.plans[0].block
             self._finished[i] = self._stopped[i] = False
             self._task_of[i] = self._task_list.index(task)
+        self.ints[i, I_FRESH] = 1
         self._shown[i] = (self._trial[i], self.ints[i, I_PHASE])
         self._edge[i] = math.nan  # measured after the C loop's observation (``_advance``)
 
@@ -409,48 +432,60 @@ class CenterOutBatchVectorEnv(VectorEnv):
         task = self._task(self.template.protocol)
         ints, state, trials = self.ints, self.state, self.trials
         while _ccenter.advance(task.params, task.mode, state, ints, trials, self.xs, self.ys, self._obs):
-            for i in np.flatnonzero(ints[:, I_EVENT]):
-                run = self.runs[i]
-                assert run is not None
-                event = int(ints[i, I_EVENT])
-                ints[i, I_EVENT] = 0
-                if event == EVENT_STOPPED:
-                    run.stopped = runaway_message(trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
-                    self._stopped[i] = True
-                    ints[i, I_TODO] = 0
-                    continue
-                path = int(ints[i, I_PATH])
-                index = int(self._trial[i])
-                plan, go = run.plans[index], int(ints[i, I_GO])
-                # The outcome's path stays empty: no trial the batch runs is a channel trial or one space sent
-                # home, so the row reads the path only as the reach, given here as the arrays reach_of would
-                # build from it (the same numbers), without the C loop's rows going through lists.
-                hand = np.column_stack((self.xs[i, :path], self.ys[i, :path]))
-                reach = Reach(t=(go + np.arange(len(hand))) * run.task.dt, hand=hand, start=plan.home,
-                              target=plan.position, go_time=go * run.task.dt, hit=event == EVENT_HIT)
-                outcome = TrialOutcome(plan, go, int(ints[i, I_STEPS]), event == EVENT_HIT)
-                reaches.setdefault(int(i), []).append(trial_row(run.task.stub, outcome,  # type: ignore[arg-type]
-                                                                reach=reach))
-                self._hits[i] += event == EVENT_HIT
-                self._trial[i] = index = index + 1
-                if index >= len(run.plans):
-                    self._finished[i] = True
-                    ints[i, I_TODO] = 0
-                else:
-                    trials[i] = run.task.trial(run.plans[index])
+            runs = np.flatnonzero(ints[:, I_EVENT])
+            events = ints[runs, I_EVENT]
+            ints[runs, I_EVENT] = 0
+            ints[runs, I_FRESH] = 1  # their trial, or their stop, changes what they observe
+            for i in runs[events == EVENT_STOPPED].tolist():
+                self.runs[i].stopped = runaway_message(  # type: ignore[union-attr]
+                    trials[i, T_LIMIT], state[i, S_FW1], state[i, S_FW2])
+                self._stopped[i] = True
+                ints[i, I_TODO] = 0
+            ended = events != EVENT_STOPPED
+            if ended.any():
+                self._end_trials(runs[ended], events[ended] == EVENT_HIT, reaches)
         self._measure_new()
         return reaches
 
-    def _measure_new(self) -> None:
-        fresh = np.isnan(self._edge)
-        if fresh.any():
-            self._edge[fresh] = self._edges()[fresh]
+    def _end_trials(self, ended: np.ndarray, hit: np.ndarray, reaches: dict[int, list[dict[str, object]]]) -> None:
+        """The trials the C loop just ended (runs ``ended``, each its first event this call): their rows of the lab's
+        table, the runs' hits and trial counts, and the next trials' rows for the C loop. The rows' reach measures
+        come from ``_ccenter.measures`` for all of them at once (``reach_metrics``, bit for bit); the rest of a row
+        is ``trial_row``'s, which the batch computes once per kind of trial (``_Task.row``)."""
+        runs, ints = self.runs, self.ints
+        indices = self._trial[ended].tolist()
+        plans = [runs[i].plan(index) for i, index in zip(ended.tolist(), indices, strict=True)]  # type: ignore[union-attr]
+        geometry = np.array([(runs[i].task.dt, *plan.home, *plan.position)  # type: ignore[union-attr]
+                             for i, plan in zip(ended.tolist(), plans, strict=True)])
+        measures = np.empty((len(plans), len(METRIC_COLUMNS)))
+        _ccenter.measures(self.xs, self.ys, ended, ints[ended, I_PATH], ints[ended, I_GO], geometry, measures)
+        for i, plan, values, won in zip(ended.tolist(), plans, measures.tolist(), hit.tolist(), strict=True):
+            row = runs[i].task.row(plan)  # type: ignore[union-attr]
+            row["trial"], row["target_deg"], row["hit"] = plan.index + 1, plan.target_deg, won
+            row.update(zip(METRIC_COLUMNS, values, strict=True))
+            reaches.setdefault(i, []).append(row)
+        self._hits[ended] += hit
+        self._trial[ended] += 1
+        for i, index in zip(ended.tolist(), self._trial[ended].tolist(), strict=True):
+            run = runs[i]
+            if index >= len(run.task.blocks):  # type: ignore[union-attr]
+                self._finished[i] = True
+                ints[i, I_TODO] = 0
+            else:
+                self.trials[i] = run.task.trial(run.plan(index))  # type: ignore[union-attr]
 
-    def _edges(self) -> np.ndarray:
-        """Each cursor's distance to its shown target's edge, by ``math.hypot`` as the single env measures it."""
-        obs = self._obs
-        radius = np.where(self.ints[:, I_PHASE] == 1, self.trials[:, T_TR], self.trials[:, T_HR])
-        d = np.fromiter(map(math.hypot, obs[:, 12].tolist(), obs[:, 13].tolist()), float, self.num_envs)
+    def _measure_new(self) -> None:
+        fresh = np.flatnonzero(np.isnan(self._edge))
+        if fresh.size:
+            self._edge[fresh] = self._edges(fresh)
+
+    def _edges(self, runs: np.ndarray | None = None) -> np.ndarray:
+        """Each cursor's distance to its shown target's edge (of ``runs``, default all), by ``math.hypot`` as the
+        single env measures it."""
+        obs, ints, trials = (self._obs, self.ints, self.trials) if runs is None else \
+            (self._obs[runs], self.ints[runs], self.trials[runs])
+        radius = np.where(ints[:, I_PHASE] == 1, trials[:, T_TR], trials[:, T_HR])
+        d = np.fromiter(map(math.hypot, obs[:, 12].tolist(), obs[:, 13].tolist()), float, len(obs))
         return np.maximum(0.0, d - radius)
 
     def _rewards(self, hits: np.ndarray, stepping: np.ndarray) -> np.ndarray:

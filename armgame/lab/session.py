@@ -112,7 +112,7 @@ class TrialOutcome:
 
 def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float],
              homes: dict[tuple[float, float], tuple[tuple[float, float], tuple[float, float]]] | None = None,
-             ) -> tuple[TrialPlan, ...]:
+             limit: int | None = None) -> tuple[TrialPlan, ...]:
     """Every trial of the protocol: targets in shuffled cycles (each of the block's targets once a cycle),
     go-cue delays, catch trials and channel trials, all drawn from one ``random.Random(seed)`` in a fixed
     order. A block without catch or channel trials draws nothing for them, so the schedules of protocols
@@ -121,12 +121,17 @@ def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]
 
     ``homes``: each posture's (home position, posture in rad), by the posture in degrees, for protocols whose blocks
     move home (``LabSession`` works them out); by default every block starts at ``home``. A mixed block (``mix``)
-    draws its trials' kinds after its targets and probes: per target, in order, shuffled cycles of the mix."""
+    draws its trials' kinds after its targets and probes: per target, in order, shuffled cycles of the mix.
+
+    ``limit``: only the first ``limit`` trials, the same as the full schedule's (every draw for a trial comes before
+    the next trial's), for a caller that may never reach the others (the CenterOut batch's short episodes)."""
     rng = random.Random(seed)
     angles = protocol.target_angles_deg()
     start_q = tuple(math.radians(a) for a in protocol.start_posture_deg)
     plans: list[TrialPlan] = []
     for b, block in enumerate(protocol.blocks):
+        if limit is not None and len(plans) >= limit:
+            break
         if homes is None:
             block_home, block_q = home, start_q
         else:
@@ -150,7 +155,7 @@ def schedule(protocol: Protocol, seed: int, dt: float, home: tuple[float, float]
                 channel = set()
         kinds = _mixed(rng, block, order, catch | channel) if block.mix else {}
         opposite = block.perturbation.opposite() if "opposite" in block.mix else None
-        for i in range(block.trials):
+        for i in range(block.trials if limit is None else min(block.trials, limit - len(plans))):
             delay = rng.uniform(*protocol.delay)
             t = order[i]
             kind = kinds.get(i, "on")
