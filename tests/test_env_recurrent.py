@@ -2,7 +2,8 @@
 through each game and starts it afresh at each game's first step.
 
 sb3-contrib (and torch) are not in the test extra, so this file is skipped where they are absent, as in the default
-test venv; it runs where the rl extra and sb3-contrib are installed (``pip install -e '.[rl]' sb3-contrib``).
+test venv; it runs where the rl extra and sb3-contrib are installed (``pip install -e '.[rl]' sb3-contrib``), in the
+slow tier (``python -m pytest -m slow tests/test_env_recurrent.py``).
 ``tests/test_env_fields_protocol.py`` tests the same with a stand-in of the same ``predict`` signature everywhere.
 """
 
@@ -77,6 +78,7 @@ def keys_of_games(watched: Watched, steps: int) -> list[np.ndarray]:
     return games
 
 
+@pytest.mark.slow  # some seconds of torch a case: past the README's minute, where sb3-contrib is installed
 @pytest.mark.parametrize("with_reset", [False, True], ids=["together", "one-by-one"])
 def test_evaluate_carries_recurrent_ppos_state_through_each_game(with_reset, monkeypatch):
     model = untrained_lstm()
