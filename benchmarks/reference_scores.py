@@ -329,7 +329,8 @@ def references_v3(ceiling_folder: Path = RESULTS / "ceiling",
 def tier_table(root: Path = RESULTS) -> str:
     """docs/programs.md's table of the separating tier (``armgame.env.suite.TIER``), from the committed results: each
     id's reference (``REFERENCES_V3``, its suite game's) and that game's bound (``hit_bound.json``), the bots' 100 test
-    games (``tier-bots``), PPO's probe (one training seed at 300,000 env steps, ``tier-probe``) and PPO's protocol
+    games (``tier-bots``), PPO's probe (one training seed at 300,000 env steps, ``tier-probe``), RecurrentPPO's (the
+    same with an LSTM, ``examples/train_recurrent.py``, ``tier-recurrent``: a learner with memory) and PPO's protocol
     runs at 4 M env steps (``ppo-tier``: the seeds finished so far), with PPO's protocol 3 score."""
     from armgame.env.evaluation import mean_interval, normalised_score
     from armgame.env.references import REFERENCES_V3
@@ -339,19 +340,20 @@ def tier_table(root: Path = RESULTS) -> str:
     bots = {(r["env_id"], r["policy"]): r for r in
             (json.loads(p.read_text(encoding="utf-8")) for p in sorted((root / "tier-bots").glob("*.json")))}
     lines = ["| id | hidden | reference: the shooting controller (95% CI, games) | bound | random | naive bot "
-             "| model bot | PPO 300 k steps, 1 seed (protocol 3) | PPO 4 M steps: seeds done, mean (95% CI over seeds) "
-             "| PPO / reference (protocol 3) |", "|---|---|---|---:|---:|---:|---:|---:|---|---:|"]
+             "| model bot | PPO 300 k steps, 1 seed (protocol 3) | RecurrentPPO 300 k steps, 1 seed (protocol 3) "
+             "| PPO 4 M steps: seeds done, mean (95% CI over seeds) | PPO / reference (protocol 3) |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---|---:|"]
     for env_id, name in zip(tier_ids(), TIER, strict=True):
         ref = REFERENCES_V3[env_id]
         hidden = ", ".join(f"`{k}={v!r}`" for k, v in TIER[name].items() if k in ("target_shown", "positions_only"))
         bound = bounds[ref["games_of"]]["bound_hits"]
         cells = [f"{bots[(env_id, p)]['mean_hits']:.2f}" if (env_id, p) in bots else "" for p in
                  ("random", "naive", "model")]
-        probe_path = root / "tier-probe" / slug(env_id) / "result.json"
-        probe = ""
-        if probe_path.is_file():  # its hits, and its protocol 3 score
-            hits = json.loads(probe_path.read_text(encoding="utf-8"))["mean_hits"]
-            probe = f"{hits:.1f} ({normalised_score(env_id, hits, protocol=3):.2f})"
+        probes = []
+        for folder in ("tier-probe", "tier-recurrent"):  # PPO's and RecurrentPPO's: its hits, and its protocol 3 score
+            probe_path = root / folder / slug(env_id) / "result.json"
+            hits = json.loads(probe_path.read_text(encoding="utf-8"))["mean_hits"] if probe_path.is_file() else None
+            probes.append("" if hits is None else f"{hits:.1f} ({normalised_score(env_id, hits, protocol=3):.2f})")
         means = [json.loads(p.read_text(encoding="utf-8"))["mean_hits"]
                  for p in sorted((root / "ppo-tier" / slug(env_id)).glob("seed*/result.json"))]
         if means:
@@ -359,10 +361,10 @@ def tier_table(root: Path = RESULTS) -> str:
             runs = f"{len(means)} of 5: {np.mean(means):.1f}" + (f" ({low:.1f}-{high:.1f})" if len(means) > 1 else "")
             score = f"{normalised_score(env_id, float(np.mean(means)), protocol=3):.2f}"
         else:
-            runs, score = "0 of 5: running", ""
+            runs, score = "0 of 5: not yet run", ""
         lines.append(f"| `{slug(env_id)}` | {hidden} | {ref['hits']:.1f} ({ref['low']:.1f}-{ref['high']:.1f}, "
-                     f"{ref['games']}; {slug(ref['games_of'])}'s) | {bound:.0f} | {' | '.join(cells)} | {probe} "
-                     f"| {runs} | {score} |")
+                     f"{ref['games']}; {slug(ref['games_of'])}'s) | {bound:.0f} | {' | '.join(cells)} "
+                     f"| {' | '.join(probes)} | {runs} | {score} |")
     return "\n".join(lines)
 
 

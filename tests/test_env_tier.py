@@ -219,6 +219,38 @@ def test_the_docs_tier_table_is_the_committed_results_and_ppos_probe_is_far_belo
     assert list(first.hits) == TIER_HITS["armgame/ReachPositions-v1"]["model_first"][:2]
 
 
+def test_recurrent_ppos_probes_are_whole_and_the_docs_figures_are_theirs():
+    """benchmarks/results/tier-recurrent holds examples/train_recurrent.py --out runs (RecurrentPPO, 300,000 env steps,
+    training seed 0) on two tier ids; the table (above) and the prose give their figures, and the prose's verdict, no
+    better than PPO's probe or the naive bot, is what the files say."""
+    from armgame.env.evaluation import mean_interval, normalised_score
+    from armgame.env.references import TIER_HITS
+    from armgame.env.suite import EVALUATION_SEEDS
+
+    folder = ROOT / "benchmarks" / "results" / "tier-recurrent"
+    runs = {path.parent.name: json.loads(path.read_text()) for path in sorted(folder.glob("*/result.json"))}
+    assert set(runs) == {"ReachMemory-v1", "ReachPositions-v1"}
+    for name, run in runs.items():
+        assert run["env_id"] == f"armgame/{name}" and run["algorithm"] == "RecurrentPPO" and run["training_seed"] == 0
+        assert run["env_steps"] >= run["budget_steps"] == 300_000
+        assert run["test_seeds"] == [EVALUATION_SEEDS[0], EVALUATION_SEEDS[99]] and len(run["test_hits"]) == 100
+        assert run["mean_hits"] == pytest.approx(sum(run["test_hits"]) / 100)
+        assert Replay.load(folder / name / "game.json").verify()[0]
+    guide = (ROOT / "docs" / "programs.md").read_text(encoding="utf-8")
+    memory, positions = runs["ReachMemory-v1"], runs["ReachPositions-v1"]
+    low, high = mean_interval(memory["test_hits"])
+    share = normalised_score("armgame/ReachPositions-v1", positions["mean_hits"], protocol=3)
+    ppo = json.loads((ROOT / "benchmarks" / "results" / "tier-probe" / "ReachPositions-v1" / "result.json").read_text())
+    assert (f"It scores {memory['mean_hits']:.1f} hits a game on `ReachMemory-v1` (95% CI\n{low:.1f}-{high:.1f}), "
+            f"where random play scores {TIER_HITS['armgame/ReachMemory-v1']['random']:.2f} and the naive bot "
+            f"{TIER_HITS['armgame/ReachMemory-v1']['naive']:.2f}, and {positions['mean_hits']:.1f} on "
+            f"`ReachPositions-v1`, {share:.2f} of the\nreference, below PPO's {ppo['mean_hits']:.1f}.") in guide
+    # "does no better": within the naive bot's reach on the memory id, below PPO without memory on the other.
+    assert high > TIER_HITS["armgame/ReachMemory-v1"]["naive"] and positions["mean_hits"] < ppo["mean_hits"]
+    walls = [float((folder / name / "curve.csv").read_text().split()[-1].split(",")[1]) for name in runs]
+    assert {round(w / 60) for w in walls} == {17} and "Each run took 17\nwall minutes" in guide
+
+
 def test_the_docs_center_out_table_is_the_committed_results_and_evaluates_own_times():
     scores = _reference_scores()
     guide = (ROOT / "docs" / "programs.md").read_text(encoding="utf-8")
