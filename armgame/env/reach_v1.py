@@ -135,11 +135,12 @@ class ReachV1Env(ReachBaseEnv):
     * ``time_limit``, ``decision_steps`` (default 5: a 20 ms step), ``reset_key``, ``config``,
       ``render_mode`` (``"rgb_array"`` or ``"human"``), ``render_size``: as ``armgame/Reach-v0``.
 
+    Since armgame 0.5.0 (unreleased): the observation's hiding arguments (``target_shown``, ``positions_only``)
+    and the separating tier's ids ``ReachMemory-v1``, ``ReachMemoryHold-v1`` and ``ReachPositions-v1``, new ids
+    of v1 that leave every other id's behaviour as it was.
+
     ## Version History
 
-    * v1, armgame 0.6: the observation's hiding arguments (``target_shown``, ``positions_only``) and the
-      separating tier's ids ``ReachMemory-v1``, ``ReachMemoryHold-v1`` and ``ReachPositions-v1``; every other
-      id's behaviour unchanged.
     * v1: hand position and velocity and the hand-to-target vector observed, float32; the
       fraction of time left instead of seconds; the target's position only relative to the hand;
       a dense reward by default; continuous actions in [-1, 1]; the score reward, the harder
