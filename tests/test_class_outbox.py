@@ -34,7 +34,7 @@ FINISH = """async ([round, tab]) => {
 }"""
 
 
-@pytest.mark.parametrize("tabs", [2, 4])
+@pytest.mark.parametrize("tabs", [2, pytest.param(4, marks=pytest.mark.slow)])  # four tabs: the slow tier
 def test_tabs_finishing_games_at_the_same_moment_lose_none(tabs):
     """Every kept game was one shared list, read, changed and written back by each tab: a tab that read it just
     before another tab's write wrote back a list without that tab's game (12 of 40 and 36 of 80 games lost here).
@@ -91,6 +91,7 @@ def _member(page) -> dict:
     return json.loads(page.evaluate("() => localStorage.getItem('armgame.play.member')"))
 
 
+@pytest.mark.slow  # two classes on one port and a browser through both: about 2 s
 def test_games_kept_from_last_weeks_class_are_kept_apart_and_todays_code_plays_at_once(tmp_path):
     """Issue 54's browser: 8 games kept from last week's class at this address and port (and 8 more in the old
     outbox, with last week's code). Today's page handed them in with last week's code: 5 wrong codes, then the

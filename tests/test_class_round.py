@@ -237,6 +237,7 @@ def test_the_winners_are_frozen_at_the_moment_the_projector_says_the_round_is_ov
         assert [(w["name"], w["score"]) for w in shown["winners"]] == [("Bo", bo["score"]), ("Ann", ann["score"])]
 
 
+@pytest.mark.slow  # four games played and a restart
 def test_a_latecomer_starts_level_with_a_game_kept_from_before(tmp_path, monkeypatch):
     """Issue 54: a replay played the day before counted in the round. A round counts a game begun during it, as its
     start ticket says (the class's own clock), at least a game's length before it is handed in; a game kept from

@@ -134,6 +134,7 @@ def test_class_submit_loads_the_client_and_the_replay_reader_only(tmp_path, rehe
     check(modules, packages, COMMAND_LINE | CLIENT | GAME | REPLAYS)
 
 
+@pytest.mark.slow  # a whole headless game against a class: about 1 s
 def test_play_join_loads_what_play_does_and_the_client(tmp_path, rehearsal):
     where, code = rehearsal
     exit_code, modules, packages = loaded(tmp_path, "play", "--headless", "--bot", "model", "--join", where,
@@ -142,6 +143,7 @@ def test_play_join_loads_what_play_does_and_the_client(tmp_path, rehearsal):
     check(modules, packages, COMMAND_LINE | CLIENT | GAME | REPLAYS | PLAY)
 
 
+@pytest.mark.slow  # the window opened against a class
 def test_class_show_loads_the_client_and_the_window_only(tmp_path, rehearsal):
     where, _ = rehearsal
     exit_code, modules, packages = loaded(tmp_path, "class", "show", where)
