@@ -88,6 +88,7 @@ def _verdict(outcome: object) -> tuple:
     return "ok", outcome["name"], outcome["score"], outcome["already"]
 
 
+@pytest.mark.slow  # every hand-in verified twice: about 2.5 s
 def test_batch_verification_gives_exactly_the_single_verdicts(tmp_path):
     mix = _mix()
     single, tokens = _clerk(tmp_path / "single")

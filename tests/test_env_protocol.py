@@ -41,6 +41,7 @@ def test_the_three_seed_ranges_are_disjoint():
     assert len(suite.VALIDATION_SEEDS) == len(suite.EVALUATION_SEEDS) == 10**6
 
 
+@pytest.mark.slow  # a seed's games evaluated twice: about 3 s
 def test_a_seed_scores_the_same_alone_and_after_another_game():
     # The case: the naive bot hit once on this seed alone and never after another game, because one
     # bot's clock ran on between games. evaluate gives every game a fresh bot.

@@ -449,6 +449,7 @@ def test_a_planted_temporary_symlink_is_never_written_through(tmp_path):  # in-p
     assert victim.read_text() == "precious" and out.is_file() and not out.is_symlink()
 
 
+@pytest.mark.slow  # each command against a FIFO: about 2 s
 def test_inputs_that_are_fifos_never_hang(tmp_path):
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
