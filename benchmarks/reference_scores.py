@@ -652,14 +652,15 @@ def runs_table(root: Path = RESULTS) -> str:
 
 def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
     """docs/img/ppo_curves.png: every id with five seeds or more, at its longest budget, a panel of its validation
-    curve over training seeds (the median, and the range shaded) against env steps, with its ceiling, the shooting
-    controller where it plays the id and random play as lines. Returns the panels' titles, in order."""
+    curve over training seeds (the median, and the range shaded) against env steps, with its protocol 2 ceiling and
+    protocol 3 reference where it has them, the shooting controller where it plays the id and random play as lines.
+    Returns the panels' titles, in order."""
     import matplotlib
 
     matplotlib.use("Agg")  # a file, never a window
     import matplotlib.pyplot as plt
 
-    from armgame.env.references import CEILINGS, REFERENCE_HITS
+    from armgame.env.references import CEILINGS, REFERENCE_HITS, REFERENCES_V3, TIER_HITS
 
     controller = _controller_rows(root / "ceiling")
     longest: dict[str, tuple[int, list[Run]]] = {}  # id -> (budget, its runs): the budgets come in rising order
@@ -682,10 +683,16 @@ def curves_figure(out: Path, root: Path = RESULTS) -> list[str]:
         ax.fill_between(x, [r[0] for r in ranges], [r[1] for r in ranges], color="#9ecae1", lw=0,
                         label=f"range over {len(runs)} seeds")
         ax.plot(x, medians, color="#08519c", lw=1.6, label="median (10 validation games)")
-        ax.axhline(CEILINGS[env_id]["hits"], color="black", ls="--", lw=1, label="ceiling")
+        # The tier's ids were made after protocol 2, so they have a protocol 3 reference and no ceiling.
+        if env_id in CEILINGS:
+            ax.axhline(CEILINGS[env_id]["hits"], color="black", ls="--", lw=1, label="ceiling (protocol 2)")
+        if env_id in REFERENCES_V3:
+            ax.axhline(REFERENCES_V3[env_id]["hits"], color="#7b3294", ls="-.", lw=1.2,
+                       label="reference (protocol 3)")
         if env_id in controller:
             ax.axhline(controller[env_id][0], color="#d95f02", ls=":", lw=1.4, label="shooting controller")
-        ax.axhline(REFERENCE_HITS[env_id]["random"], color="grey", lw=0.8, label="random")
+        random_hits = (REFERENCE_HITS.get(env_id) or TIER_HITS[env_id])["random"]
+        ax.axhline(random_hits, color="grey", lw=0.8, label="random")
         titles.append(f"{slug(env_id)}, {budget / 1e6:g} M steps")
         ax.set_title(titles[-1], fontsize=10)
         ax.set_xlabel("env steps (millions)", fontsize=9)
