@@ -12,6 +12,7 @@
     python benchmarks/reference_scores.py table-v1 refs              # protocol 1's table (the model bot normalising)
     python benchmarks/reference_scores.py references refs            # armgame/env/references.py's dict
     python benchmarks/reference_scores.py aggregate runs             # IQM over train_ppo.py --out runs' result.json
+    python benchmarks/reference_scores.py aggregate runs --protocol 2  # the same, normalised by protocol 2's ceilings
     python benchmarks/reference_scores.py curves benchmarks/results/ppo  # the committed runs' curves over seeds
     python benchmarks/reference_scores.py runs --ids armgame/ReachHard-v1 --seeds 0 1 2 3 4 --steps 4000000 \
         --out benchmarks/results/ppo                                 # protocol runs, over as many sittings as it takes
@@ -44,13 +45,18 @@ from typing import Any
 import numpy as np
 
 import armgame.env  # noqa: F401  (registers the ids)
+from armgame.env.errors import EnvArgumentError
 from armgame.env.evaluation import evaluate
-from armgame.env.suite import PROTOCOL_VERSION, suite_ids
+from armgame.env.suite import PROTOCOL_VERSION, PROTOCOLS, suite_ids
 
 GAMES = 100
 PPO_STEPS = 500_000
 IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", "armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1",
        *suite_ids())
+
+
+#: Game seconds a decision (an env step) of every v1 id: 5 physics steps of 4 ms.
+DECISION_SECONDS = 0.02
 
 
 def slug(env_id: str) -> str:
@@ -61,10 +67,14 @@ def run_bots(out: Path, ids: tuple[str, ...], games: int,
              policies: tuple[str, ...] = ("random", "naive", "model")) -> None:
     for env_id in ids:
         for policy in policies:
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             result = evaluate(policy, env_id, games=games)
-            # CenterOut: each game's seconds from a go cue to a hit too, which ranks policies that hit every trial.
-            timing = {"hits_per_minute": round(result.hits_per_minute, 4)} | (
+            # CenterOut: each game's seconds from a go cue to a hit too, which ranks policies that hit every trial;
+            # and the CPU a decision cost, the env's step included, for protocol 3's reference (the model bot's).
+            decisions = round(result.minutes * 60 / DECISION_SECONDS) * result.games
+            timing = {"hits_per_minute": round(result.hits_per_minute, 4), "minutes": round(result.minutes, 6),
+                      "cpu_seconds": round(time.process_time() - cpu, 3), "decisions": decisions,
+                      "processor": _ceiling_benchmark().processor()} | (
                 {"reach_seconds": [None if np.isnan(t) else round(t, 4) for t in result.reach_seconds]}
                 if result.reach_seconds else {})
             write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start,
@@ -292,8 +302,8 @@ def _ceiling_benchmark() -> Any:
     return module
 
 
-def references_v3(ceiling_folder: Path = RESULTS / "ceiling",
-                  reference_folder: Path = RESULTS / "reference") -> dict[str, dict[str, Any]]:
+def references_v3(ceiling_folder: Path = RESULTS / "ceiling", reference_folder: Path = RESULTS / "reference",
+                  center_out_folder: Path = RESULTS / "center-out-time") -> dict[str, dict[str, Any]]:
     """Protocol 3's reference of every Reach id: the shooting controller at ``benchmarks/ceiling.py``'s
     ``REFERENCE`` settings, its mean hits on the test games played so far (``games`` of them, with the 95 % interval
     over games), the code that plays it, and the CPU seconds a decision cost in the same run, on its machine. Read
@@ -322,8 +332,41 @@ def references_v3(ceiling_folder: Path = RESULTS / "ceiling",
             "cpu_per_decision": round(float(data["cpu_seconds"]) / decisions, 5),
             "machine": f"{data.get('processor', 'processor not recorded')}; {data['machine']}",
             "games_of": env_id}
-    return {env_id: {**measured[bench.STANDS_FOR.get(env_id, env_id)]}
-            for env_id in (*bench.DISTINCT, *bench.STANDS_FOR) if bench.STANDS_FOR.get(env_id, env_id) in measured}
+    from armgame.env.references import REFERENCE_HITS, TIER_HITS
+
+    # Each id's own random play is its 0 (a continuous twin's random differs from its key id's, their games do not).
+    reach = {env_id: {**measured[bench.STANDS_FOR.get(env_id, env_id)], "unit": "hits a game",
+                      "random": (REFERENCE_HITS.get(env_id) or TIER_HITS[env_id])["random"]}
+             for env_id in (*bench.DISTINCT, *bench.STANDS_FOR) if bench.STANDS_FOR.get(env_id, env_id) in measured}
+    return reach | center_out_references(center_out_folder)
+
+
+def center_out_references(folder: Path = RESULTS / "center-out-time") -> dict[str, dict[str, Any]]:
+    """Protocol 3's reference of every CenterOut id: the model bot's hits a minute on the 100 test games (its
+    ``bots`` file in ``folder``), since it and most PPO runs hit every trial and time is what still ranks them; the
+    interval is its hits' over games, a minute of the mean episode; the 0 is random play's hits a minute. An id whose
+    model or random file is missing is left out."""
+    from armgame.env.evaluation import mean_interval
+
+    rows = {}
+    for env_id in IDS:
+        if "CenterOut" not in env_id:
+            continue
+        model, random = (folder / f"{slug(env_id)}.{policy}.json" for policy in ("model", "random"))
+        if not (model.is_file() and random.is_file()):
+            continue
+        data = json.loads(model.read_text(encoding="utf-8"))
+        if "cpu_seconds" not in data:  # measured before bots recorded their CPU
+            continue
+        low, high = mean_interval(data["hits"])
+        rows[env_id] = {
+            "hits": round(data["hits_per_minute"], 3), "low": round(low / data["minutes"], 3),
+            "high": round(high / data["minutes"], 3), "games": data["games"], "unit": "hits a minute",
+            "random": round(json.loads(random.read_text(encoding="utf-8"))["hits_per_minute"], 4),
+            "code": 'armgame.env.evaluate("model", ...): the model bot',
+            "cpu_per_decision": round(data["cpu_seconds"] / data["decisions"], 6),
+            "machine": f"{data['processor']}; {data['machine']}", "games_of": env_id}
+    return rows
 
 
 def tier_table(root: Path = RESULTS) -> str:
@@ -371,12 +414,18 @@ def tier_table(root: Path = RESULTS) -> str:
 def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
     """docs/programs.md's table of the CenterOut ids' policies (``bots``' files in ``folder``): hits, hits a minute
     and the seconds from a trial's go cue to its hit (the mean over games with a hit, 95 % interval over them),
-    which ranks policies that all hit every trial."""
+    which ranks policies that all hit every trial; and PPO's timed runs (``center_out_ppo``), pooled over seeds."""
     from armgame.env.evaluation import mean_interval
 
     lines = ["| id | policy | hits a game (95% CI) | hits a minute | s from the go cue to a hit (95% CI) "
              "| games with a hit |", "|---|---|---|---:|---|---:|"]
     rows = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(folder.glob("*.json"))]
+    for env_id, results in center_out_ppo(folder / "ppo").items():  # pooled: every seed's 100 test games
+        rows.append({"env_id": env_id, "policy": f"PPO 1 M, {len(results)} seeds",
+                     "hits": [h for r in results for h in r["test_hits"]],
+                     "hits_per_minute": float(np.mean([r["hits_per_minute"] for r in results])),
+                     "reach_seconds": [t for r in results for t in r["reach_seconds"]],
+                     "games": sum(len(r["test_hits"]) for r in results)})
     order = {"random": 0, "naive": 1, "model": 2}
     for r in sorted(rows, key=lambda r: (IDS.index(r["env_id"]) if r["env_id"] in IDS else len(IDS), r["env_id"],
                                          order.get(r["policy"], 3), r["policy"])):
@@ -393,14 +442,16 @@ def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
 
 
 def references_v3_table() -> str:
-    """docs/programs.md's table of protocol 3's references (``references_v3``), every Reach id: a row without games
-    yet says so."""
+    """docs/programs.md's table of protocol 3's references (``references_v3``), every suite id: a Reach row without
+    games yet says so; a CenterOut row is the model bot's hits a minute, beside PPO's timed runs
+    (``center_out_ppo``)."""
     from armgame.env.evaluation import normalised_score
 
     bench = _ceiling_benchmark()
     rows = references_v3()
     runs = long_runs()
-    lines = ["| id | reference | test games so far | hits (95% CI over games) | CPU s a decision | machine "
+    timed = center_out_ppo()
+    lines = ["| id | reference | test games so far | its score (95% CI over games) | CPU s a decision | machine "
              "| PPO's longest runs, protocol 3 |", "|---|---|---:|---|---:|---|---:|"]
     for env_id in (*bench.DISTINCT, *bench.STANDS_FOR):
         name = env_id.split("/")[1]
@@ -416,14 +467,35 @@ def references_v3_table() -> str:
         ppo = runs.get(env_id, {})
         score = normalised_score(env_id, float(np.mean(ppo[max(ppo)])), protocol=3) if ppo else None
         shown = "" if score is None else f"{score:.2f}"
-        lines.append(f"| `{name}` | `{code}` | {games} | {row['hits']:.1f} ({row['low']:.1f}-{row['high']:.1f}){same} "
-                     f"| {row['cpu_per_decision']:.4f} | {row['machine']} | {shown} |")
+        lines.append(f"| `{name}` | `{code}` | {games} | {row['hits']:.1f} hits a game ({row['low']:.1f}-"
+                     f"{row['high']:.1f}){same} | {row['cpu_per_decision']:.4f} | {row['machine']} | {shown} |")
+    for env_id, row in rows.items():
+        if row["unit"] != "hits a minute":
+            continue
+        results = timed.get(env_id, [])
+        score = (normalised_score(env_id, float(np.mean([r["mean_hits"] for r in results])), protocol=3,
+                                  hits_per_minute=float(np.mean([r["hits_per_minute"] for r in results])))
+                 if results else None)
+        shown = "" if score is None else f"{score:.2f} ({len(results)} of 5 seeds at 1 M)"
+        lines.append(f"| `{env_id.split('/')[1]}` | the model bot | {row['games']} | {row['hits']:.1f} hits a minute "
+                     f"({row['low']:.1f}-{row['high']:.1f}) | {row['cpu_per_decision']:.5f} | {row['machine']} "
+                     f"| {shown} |")
     short = [f"{env_id.split('/')[1]} {rows[env_id]['games'] if env_id in rows else 0}" for env_id in bench.DISTINCT
              if rows.get(env_id, {}).get("games", 0) < 100]
     head = (f"**The table is incomplete**: the test games so far of {', '.join(short)} (of 100; their twins' the "
             "same). "
             "An id without games is left out of `REFERENCES_V3`." if short else "Every id has its 100 test games.")
     return head + "\n\n" + "\n".join(lines)
+
+
+def center_out_ppo(folder: Path = RESULTS / "center-out-time" / "ppo") -> dict[str, list[dict[str, Any]]]:
+    """PPO's CenterOut runs that recorded their hits a minute (``runs --out`` of ``folder``: the protocol runs' recipe
+    at 1 M env steps, made again once ``evaluate`` timed CenterOut), each id's ``result.json`` by training seed."""
+    found: dict[str, list[dict[str, Any]]] = {}
+    for path in sorted(folder.glob("*/seed*/result.json")):
+        result = json.loads(path.read_text(encoding="utf-8"))
+        found.setdefault(result["env_id"], []).append(result)
+    return found
 
 
 def references_v3_source() -> str:
@@ -446,16 +518,17 @@ def ceilings_source(reference: dict[str, dict[str, Any]] | None = None) -> str:
     return "\n".join(lines)
 
 
-def aggregate(folder: Path) -> str:
-    """The IQM, mean and median normalised score, with stratified bootstrap intervals, of the ``result.json`` files
-    (``examples/train_ppo.py --out``) anywhere under ``folder``: one run a training seed and id."""
+def aggregate(folder: Path, protocol: int = PROTOCOL_VERSION) -> str:
+    """The IQM, mean and median normalised score under ``protocol``, with stratified bootstrap intervals, of the
+    ``result.json`` files (``examples/train_ppo.py --out``) anywhere under ``folder``: one run a training seed and
+    id. Each run is scored from its hits (and hits a minute), whatever protocol its file was written under."""
     from armgame.env.evaluation import aggregate_runs
 
-    runs: dict[str, dict[int, float]] = {}
+    runs: dict[str, dict[int, dict[str, Any]]] = {}
     budgets = set()
     for path in sorted(folder.rglob("result.json")):
         r = json.loads(path.read_text(encoding="utf-8"))
-        runs.setdefault(r["env_id"], {})[int(r["training_seed"])] = float(r["mean_hits"])
+        runs.setdefault(r["env_id"], {})[int(r["training_seed"])] = r
         budgets.add(int(r["budget_steps"]))
     if not runs:
         raise SystemExit(f"{folder}: no result.json under it")
@@ -463,9 +536,13 @@ def aggregate(folder: Path) -> str:
     if len(seeds) != 1:
         raise SystemExit(f"{folder}: the ids were not trained with the same seeds: {sorted(seeds)}")
     order = sorted(next(iter(seeds)))
-    result = aggregate_runs({env_id: [by_seed[s] for s in order] for env_id, by_seed in runs.items()})
+    try:
+        result = aggregate_runs({env_id: [by_seed[s] for s in order] for env_id, by_seed in runs.items()},
+                                protocol=protocol)
+    except EnvArgumentError as error:
+        raise SystemExit(f"{folder}: {error}") from None
     lines = [result.summary(), f"budget: {', '.join(f'{b:,}' for b in sorted(budgets))} env steps; "
-                               f"training seeds {order}; protocol {PROTOCOL_VERSION}"]
+                               f"training seeds {order}; protocol {protocol}"]
     for name in ("iqm", "mean", "median"):
         point, low, high = getattr(result, name)
         lines.append(f"  {name:6} {point:.3f} [{low:.3f}, {high:.3f}]")
@@ -748,6 +825,8 @@ def _main(argv: list[str] | None = None) -> int:
     refs.add_argument("folder", type=Path)
     agg = sub.add_parser("aggregate")
     agg.add_argument("folder", type=Path)
+    agg.add_argument("--protocol", type=int, choices=PROTOCOLS, default=PROTOCOL_VERSION,
+                     help=f"the normalisation (default {PROTOCOL_VERSION}; 2: protocol 2's ceilings)")
     cur = sub.add_parser("curves")
     cur.add_argument("folder", type=Path)
     many = sub.add_parser("runs")
@@ -765,7 +844,7 @@ def _main(argv: list[str] | None = None) -> int:
     elif args.command == "references":
         print(references(args.folder))
     elif args.command == "aggregate":
-        print(aggregate(args.folder))
+        print(aggregate(args.folder, args.protocol))
     elif args.command == "curves":
         print(curves(args.folder))
     elif args.command == "runs":

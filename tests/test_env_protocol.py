@@ -156,21 +156,46 @@ def test_each_task_is_resampled_from_its_own_runs_only():
     assert set(np.unique(samples[:, :, 0])) <= {1.0, 2.0} and set(np.unique(samples[:, :, 1])) <= {10.0, 20.0}
 
 
-def test_aggregate_runs_normalises_by_the_references_and_refuses_uneven_runs():
-    from armgame.env.references import CEILINGS
+@pytest.mark.parametrize("protocol", [2, 3])
+def test_aggregate_runs_normalises_by_the_references_and_refuses_uneven_runs(protocol):
+    from armgame.env.references import CEILINGS, REFERENCES_V3
 
-    top = {env_id: CEILINGS[env_id]["hits"] for env_id in ("armgame/Reach-v1", "armgame/ReachHold-v1")}
+    ones = CEILINGS if protocol == 2 else REFERENCES_V3
+    top = {env_id: ones[env_id]["hits"] for env_id in ("armgame/Reach-v1", "armgame/ReachHold-v1")}
     runs = {"armgame/Reach-v1": [top["armgame/Reach-v1"], top["armgame/Reach-v1"], 0.53],
             "armgame/ReachHold-v1": [top["armgame/ReachHold-v1"], 0.46, top["armgame/ReachHold-v1"]]}
-    result = armgame.env.aggregate_runs(runs, reps=1_000)
+    result = armgame.env.aggregate_runs(runs, reps=1_000, protocol=protocol)
     assert result.scores.shape == (3, 2) and result.scores.max() == pytest.approx(1.0)
     # The six scores 1, 1, 0, 1, 0, 1 (normalised): their middle four 0, 1, 1, 1.
     assert result.iqm[0] == pytest.approx(0.75) and result.iqm[1] <= result.iqm[0] <= result.iqm[2]
-    assert "IQM normalised score 0.75" in result.summary()
+    assert f"IQM normalised score (protocol {protocol}) 0.75" in result.summary()
     with pytest.raises(EnvArgumentError, match="same number"):
         armgame.env.aggregate_runs({"armgame/Reach-v1": [1.0], "armgame/ReachHold-v1": [1.0, 2.0]})
     with pytest.raises(EnvArgumentError, match="reference"):
         armgame.env.aggregate_runs({"armgame/Reach-v0": [1.0]})
+
+
+def test_protocol_3_scores_a_center_out_run_by_its_hits_a_minute_and_refuses_a_bare_count():
+    """Every trial of a CenterOut episode is hit by the model bot and by most runs, so protocol 3 ranks them by hits
+    a minute: the model bot's own evaluation scores 1, a run as many hits but slower scores less, and a bare count
+    of hits, which cannot say how fast, is refused rather than read as hits a minute."""
+    from armgame.env.references import REFERENCES_V3
+
+    env_id = "armgame/CenterOut-v1"
+    model = armgame.env.evaluate("model", env_id, games=3)
+    assert model.mean_hits == 8.0 and model.normalised == pytest.approx(1.0, abs=0.02)
+    reference = REFERENCES_V3[env_id]
+    slower = evaluation.normalised_score(env_id, 8.0, hits_per_minute=reference["hits"] * 0.8)
+    assert slower == pytest.approx((reference["hits"] * 0.8 - reference["random"]) /
+                                   (reference["hits"] - reference["random"]))
+    assert evaluation.normalised_score(env_id, 8.0) is None
+    assert evaluation.normalised_score(env_id, 8.0, protocol=2) == pytest.approx(1.0)  # protocol 2: a count
+    with pytest.raises(EnvArgumentError, match="hits a minute"):
+        armgame.env.aggregate_runs({env_id: [8.0, 8.0]})
+    as_read = [{"mean_hits": 8.0, "hits_per_minute": reference["hits"]}, model]  # a result.json, an Evaluation
+    assert armgame.env.aggregate_runs({env_id: as_read}, reps=100).scores.ravel() == pytest.approx([1.0, 1.0],
+                                                                                                   abs=0.02)
+    assert armgame.env.aggregate_runs({env_id: [8.0, 8.0]}, protocol=2, reps=100).scores.ravel().tolist() == [1, 1]
 
 
 # ------------------------------------------------------------------ item 3: every game verifiable
@@ -396,9 +421,18 @@ def test_the_committed_ppo_runs_are_whole_and_summarised_by_their_curves():
     assert (f"two seeds' validation games hit every trial up to 900,000 steps, and their last policies score "
             f"{means[fell[0]]:.1f} and {means[fell[1]]:.1f} on the test games, so PPO's mean there is "
             f"{sum(means.values()) / 5:.1f} of the 8.0 its other three seeds score") in prose
-    # PPO's aggregate over the 4 M runs is ``aggregate``'s report of them, as printed.
-    report = module.aggregate(root / "benchmarks" / "results" / "ppo")
-    assert "\n".join("    " + line for line in report.splitlines()) in text and "x 12 ids" in report
+    # PPO's aggregate over the 4 M runs is ``aggregate``'s report of them, as printed, under protocols 3 and 2.
+    for protocol in (3, 2):
+        report = module.aggregate(root / "benchmarks" / "results" / "ppo", protocol)
+        assert "\n".join("    " + line for line in report.splitlines()) in text and "x 12 ids" in report
+        assert f"(protocol {protocol})" in report
+    # The prose's range of PPO's protocol 3 scores, id by id, is its longest runs'.
+    from armgame.env.evaluation import normalised_score
+
+    scores = [normalised_score(env_id, sum(by_budget[max(by_budget)]) / len(by_budget[max(by_budget)]), protocol=3)
+              for env_id, by_budget in module.long_runs().items() if env_id in module.IDS and "CenterOut" not in env_id]
+    assert len(scores) == 12
+    assert f"id for id within {min(scores):.2f} to {max(scores):.2f}" in text
     # The page's reading of ReachHard-v1's rows: protocol 1's 500 k far below, still rising at 10 M by a fifth of
     # the rise at 4 M, about 3 hits for another 5 M.
     from armgame.env.references import REFERENCE_HITS

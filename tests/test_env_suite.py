@@ -17,7 +17,7 @@ from armgame.env.base import EnvArgumentError
 from armgame.env.center_out_batch import MAX_BATCH_ENVS, CenterOutBatchVectorEnv
 from armgame.env.evaluation import evaluate, mean_interval, normalised_score
 from armgame.env.policies import BotPolicy, bot_policy
-from armgame.env.references import CEILINGS, REFERENCE_HITS
+from armgame.env.references import CEILINGS, REFERENCE_HITS, REFERENCES_V3
 from armgame.env.suite import CENTER_OUT_SUITE, EVALUATION_SEEDS, SUITE, suite_ids
 from armgame.env.variants import NOISE_FACTOR_MAX, ReachVariant
 from armgame.env.vector import BATCH_MIN_ENVS, ReachV1VectorEnv, ReachVectorEnv, batch_plays
@@ -305,7 +305,11 @@ def test_evaluate_is_deterministic_and_reports_an_interval():
     model = evaluate("model", REACH, seeds=[5])  # the id's own arguments: a normalised score
     assert model.normalised == pytest.approx(normalised_score(REACH, model.mean_hits)) and 0.5 < model.normalised < 1.5
     low, high = REFERENCE_HITS[REACH]["random"], CEILINGS[REACH]["hits"]
-    assert (normalised_score(REACH, low), normalised_score(REACH, high)) == (0.0, 1.0)
+    assert (normalised_score(REACH, low, protocol=2), normalised_score(REACH, high, protocol=2)) == (0.0, 1.0)
+    # Protocol 3, the default: the fixed reference is 1, whatever the best mean measured since.
+    reference = REFERENCES_V3[REACH]
+    assert (normalised_score(REACH, reference["random"]), normalised_score(REACH, reference["hits"])) == (0.0, 1.0)
+    assert normalised_score(REACH, high) > 1.0  # protocol 2's ceiling, PPO's mean, is above the reference
     assert normalised_score("armgame/Reach-v0", 50.0) is None
     assert mean_interval([2, 4]) == pytest.approx((3 - 12.706 * 1.0, 3 + 12.706 * 1.0), abs=1e-3)
     for bad in ({"games": 0}, {"games": 1.5}, {"seeds": []}):

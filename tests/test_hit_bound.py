@@ -98,14 +98,24 @@ def test_protocol_3_divides_by_the_reference_and_a_run_above_it_scores_above_1()
     guide = (ROOT / "docs" / "programs.md").read_text(encoding="utf-8")
     assert scores.references_v3_table() in guide
     for env_id, row in REFERENCES_V3.items():
-        random = {**REFERENCE_HITS, **TIER_HITS}[env_id]["random"]
-        assert normalised_score(env_id, row["hits"], protocol=3) == pytest.approx(1.0)
-        assert normalised_score(env_id, row["hits"] + 1.0, protocol=3) > 1.0
-        assert normalised_score(env_id, random, protocol=3) == pytest.approx(0.0)
-        assert row["code"].startswith("armgame.env.ceiling.ShootingController(") and row["cpu_per_decision"] > 0
+        if row["unit"] == "hits a game":  # a Reach id: the controller's hits, random play's from the bots' table
+            assert row["random"] == {**REFERENCE_HITS, **TIER_HITS}[env_id]["random"]
+            assert row["code"].startswith("armgame.env.ceiling.ShootingController(")
+
+            def score(x, env_id=env_id):
+                return normalised_score(env_id, x, protocol=3)
+        else:  # a CenterOut id: the model bot's hits a minute, whatever its count of hits
+            assert row["unit"] == "hits a minute" and "the model bot" in row["code"] and "CenterOut" in env_id
+
+            def score(x, env_id=env_id):
+                return normalised_score(env_id, 8.0, protocol=3, hits_per_minute=x)
+        assert score(row["hits"]) == pytest.approx(1.0) and score(row["hits"] + 1.0) > 1.0
+        assert score(row["random"]) == pytest.approx(0.0) and row["cpu_per_decision"] > 0
+    assert {env_id for env_id, row in REFERENCES_V3.items() if row["unit"] == "hits a minute"} == {
+        env_id for env_id in scores.IDS if "CenterOut" in env_id}
     # Protocol 2's figures are untouched.
-    assert normalised_score("armgame/Reach-v1", CEILINGS["armgame/Reach-v1"]["hits"]) == pytest.approx(1.0)
-    with pytest.raises(ValueError, match="protocol must be 2 or 3"):
+    assert normalised_score("armgame/Reach-v1", CEILINGS["armgame/Reach-v1"]["hits"], protocol=2) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="protocol must be one of 2, 3"):
         normalised_score("armgame/Reach-v1", 50.0, protocol=4)
 
 
@@ -165,7 +175,7 @@ def test_a_complete_reference_is_no_weaker_than_the_controllers_earlier_settings
 
     earlier = Path(__file__).resolve().parents[1] / "benchmarks" / "results" / "ceiling"
     for env_id, ref in REFERENCES_V3.items():
-        if ref["games_of"] != env_id or ref["games"] < 100:
+        if ref["games_of"] != env_id or ref["games"] < 100 or ref["unit"] != "hits a game":  # CenterOut: the bot's
             continue
         before = json.loads((earlier / f"{env_id.split('/')[1]}.json").read_text(encoding="utf-8"))
         hits = before["hits"]

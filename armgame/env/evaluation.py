@@ -4,9 +4,11 @@
 (``armgame.env.suite.EVALUATION_SEEDS``, which no training example uses), one single env, one game
 per seed, and returns an ``Evaluation``: the hits of every game, their mean with a 95 % confidence
 interval (Student's t over games), the score, the rates per minute (so games of another
-``time_limit`` compare) and, where the id has reference scores (``REFERENCE_HITS``), the
-normalised score: 0 for the random policy, 1 for the id's ceiling (``CEILINGS``: the best mean hits measured
-on the test games, by the shooting controller, PPO or the most a CenterOut episode holds; protocol 2).
+``time_limit`` compare) and, where the id has a reference, the normalised score of protocol 3
+(``armgame.env.suite.PROTOCOL_VERSION``): 0 for the random policy, 1 for the id's fixed reference
+(``REFERENCES_V3``: the shooting controller's mean hits on a Reach id, the model bot's hits a minute on a
+CenterOut id). ``normalised_score(..., protocol=2)`` still gives protocol 2's (by ``CEILINGS``, the best mean
+hits measured when it was published).
 
 The same policy, id, seeds and arguments give the same result, bit for bit: every game is reset
 with its seed and a policy that samples (``"random"``) samples from a generator seeded by it.
@@ -50,7 +52,7 @@ import gymnasium as gym
 import numpy as np
 
 from .errors import EnvArgumentError
-from .suite import EVALUATION_SEED_COUNT, EVALUATION_SEEDS
+from .suite import EVALUATION_SEED_COUNT, EVALUATION_SEEDS, PROTOCOL_VERSION, PROTOCOLS
 
 #: Games ``evaluate`` plays by default: a 95 % interval of about +-1 hit on Reach-v1's bots.
 DEFAULT_GAMES = 100
@@ -162,7 +164,8 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     else:
         name, hits, scores, minutes, reach = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs,
                                                               policy_factory)
-    normalised = None if env_kwargs else normalised_score(env_id, float(np.mean(hits)))
+    mean_hits = float(np.mean(hits))
+    normalised = None if env_kwargs else normalised_score(env_id, mean_hits, hits_per_minute=mean_hits / minutes)
     return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised, reach)
 
 
@@ -338,21 +341,40 @@ def _kept(reach: list[float | None]) -> tuple[float, ...]:
     return () if any(t is None for t in reach) else tuple(t for t in reach if t is not None)
 
 
-def normalised_score(env_id: str, mean_hits: float, protocol: int = 2) -> float | None:
-    """``(hits - random) / (ceiling - random)`` by the id's reference scores (protocol 2: ``CEILINGS``); None for an
-    id without them. Protocol 3 divides by the id's reference controller instead (``REFERENCES_V3``: a fixed score
-    of the shooting controller, never a mean of the runs being scored), so a run above it scores above 1."""
+def normalised_score(env_id: str, mean_hits: float, protocol: int = PROTOCOL_VERSION, *,
+                     hits_per_minute: float | None = None) -> float | None:
+    """The score on ``env_id`` as ``protocol`` normalises it: 0 for random play, 1 for the id's reference; None for
+    an id without one (or a CenterOut id's protocol 3 score without ``hits_per_minute``).
+
+    Protocol 3 (the default): ``(x - random) / (reference - random)`` by ``REFERENCES_V3``, a fixed score never
+    made from the runs being scored, so a run above it scores above 1. ``x`` is in the reference's ``unit``: mean
+    hits a game on a Reach id, hits a minute on a CenterOut id (``hits_per_minute``, ``Evaluation.hits_per_minute``),
+    since every trial of an episode is hit by the reference and by most runs, and speed is what still ranks them.
+    Protocol 2: ``(hits - random) / (ceiling - random)`` by ``CEILINGS``, hits a game on every id."""
     from .references import CEILINGS, REFERENCE_HITS, REFERENCES_V3, TIER_HITS
 
-    if protocol not in (2, 3):
-        raise ValueError(f"protocol must be 2 or 3, got {protocol!r}")
-    # The separating tier's random play is in TIER_HITS: it has no protocol 2 ceiling, only protocol 3's reference.
-    reference = REFERENCE_HITS.get(env_id) or TIER_HITS.get(env_id)
-    ceiling = (CEILINGS if protocol == 2 else REFERENCES_V3).get(env_id)
-    if reference is None or ceiling is None:
-        return None
-    low, high = reference["random"], ceiling["hits"]
-    return (mean_hits - low) / (high - low) if high != low else None
+    if protocol not in PROTOCOLS:
+        raise ValueError(f"protocol must be one of {', '.join(map(str, PROTOCOLS))}, got {protocol!r}")
+    if protocol == 3:
+        row = REFERENCES_V3.get(env_id)
+        if row is None:
+            return None
+        x = hits_per_minute if row["unit"] == "hits a minute" else mean_hits
+        low, high = row["random"], row["hits"]
+    else:
+        # The separating tier's random play is in TIER_HITS: it has no protocol 2 ceiling, only protocol 3's.
+        reference = REFERENCE_HITS.get(env_id) or TIER_HITS.get(env_id)
+        ceiling = CEILINGS.get(env_id)
+        if reference is None or ceiling is None:
+            return None
+        x, low, high = mean_hits, reference["random"], ceiling["hits"]
+    return None if x is None or high == low else (x - low) / (high - low)
+
+
+def _scored_per_minute(env_id: str, protocol: int) -> bool:
+    from .references import REFERENCES_V3
+
+    return protocol == 3 and REFERENCES_V3.get(env_id, {}).get("unit") == "hits a minute"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -369,6 +391,7 @@ class Aggregate:
     iqm: tuple[float, float, float]
     mean: tuple[float, float, float]
     median: tuple[float, float, float]
+    protocol: int = PROTOCOL_VERSION  # the normalised scores' (``normalised_score``)
 
     @property
     def runs(self) -> int:
@@ -377,18 +400,21 @@ class Aggregate:
     def summary(self) -> str:
         what = "normalised score" if self.normalised else "hits a game"
         point, low, high = self.iqm
-        return (f"IQM {what} {point:.2f} (95% stratified bootstrap CI {low:.2f} to {high:.2f}) over {self.runs} "
-                f"training seeds x {len(self.env_ids)} ids")
+        under = f" (protocol {self.protocol})" if self.normalised else ""
+        return (f"IQM {what}{under} {point:.2f} (95% stratified bootstrap CI {low:.2f} to {high:.2f}) over "
+                f"{self.runs} training seeds x {len(self.env_ids)} ids")
 
 
-def aggregate_runs(runs: Mapping[str, Sequence[Evaluation | float]], *, normalise: bool = True,
-                   reps: int = 50_000, seed: int = 0) -> Aggregate:
+def aggregate_runs(runs: Mapping[str, Sequence[Evaluation | Mapping[str, Any] | float]], *, normalise: bool = True,
+                   protocol: int = PROTOCOL_VERSION, reps: int = 50_000, seed: int = 0) -> Aggregate:
     """Summarise an algorithm's training seeds over ids: IQM, mean and median with stratified bootstrap intervals.
 
     ``runs`` maps each id to one score per training seed, in the same seeds' order for every id: an
-    ``Evaluation`` (its mean hits) or a number of mean hits. ``normalise``: score each by ``normalised_score``
-    (every id needs reference scores), else by hits. Report the IQM and its interval, the number of
-    training seeds and the budget in env steps (Agarwal et al. 2021)."""
+    ``Evaluation``, a run's ``result.json`` as read (its ``mean_hits``, and ``hits_per_minute`` where it has one)
+    or a number of mean hits. ``normalise``: score each by ``normalised_score`` under ``protocol`` (every id needs
+    a reference; a CenterOut id's protocol 3 score needs its hits a minute, which a bare number does not carry),
+    else by hits. Report the IQM and its interval, the number of training seeds, the budget in env steps and the
+    protocol (Agarwal et al. 2021)."""
     if not runs:
         raise EnvArgumentError("aggregate_runs needs at least one id's runs")
     counts = {len(values) for values in runs.values()}
@@ -399,11 +425,19 @@ def aggregate_runs(runs: Mapping[str, Sequence[Evaluation | float]], *, normalis
     for env_id in env_ids:
         column = []
         for value in runs[env_id]:
-            hits = value.mean_hits if isinstance(value, Evaluation) else float(value)
+            if isinstance(value, Evaluation):
+                hits, per_minute = value.mean_hits, value.hits_per_minute
+            elif isinstance(value, Mapping):
+                hits, per_minute = float(value["mean_hits"]), value.get("hits_per_minute")
+            else:
+                hits, per_minute = float(value), None
             if normalise:
-                score = normalised_score(env_id, hits)
+                score = normalised_score(env_id, hits, protocol, hits_per_minute=per_minute)
                 if score is None:
-                    raise EnvArgumentError(f"{env_id} has no reference scores to normalise by: normalise=False")
+                    reason = ("its protocol 3 score is by hits a minute: pass Evaluations or result.json records"
+                              if per_minute is None and _scored_per_minute(env_id, protocol)
+                              else "it has no reference scores to normalise by: normalise=False")
+                    raise EnvArgumentError(f"{env_id}: {reason}")
                 hits = score
             column.append(hits)
         columns.append(column)
@@ -414,4 +448,4 @@ def aggregate_runs(runs: Mapping[str, Sequence[Evaluation | float]], *, normalis
     for statistic in (iqm, mean_of_tasks, median_of_tasks):
         low, high = stratified_bootstrap_ci(table, statistic, reps=reps, seed=seed)
         summaries.append((float(statistic(table)), low, high))  # type: ignore[arg-type]
-    return Aggregate(env_ids, table, normalise, *summaries)
+    return Aggregate(env_ids, table, normalise, *summaries, protocol=protocol)

@@ -68,8 +68,13 @@ CENTER_OUT_SUITE: dict[str, dict[str, Any]] = {
 #: in a paper. 1: three seed ranges, a fresh policy each game, normalised by random play (0) and the model bot
 #: (1). 2: the same, normalised by each id's ceiling (1; ``armgame.env.references.CEILINGS``: the best mean hits
 #: measured on the test games, by the shooting controller, PPO at a budget where its curve has flattened, or the
-#: most a CenterOut episode holds).
-PROTOCOL_VERSION = 2
+#: most a CenterOut episode holds). 3 (issue 52): the same, normalised by each id's fixed reference (1;
+#: ``armgame.env.references.REFERENCES_V3``: the shooting controller's mean hits on a Reach id, the model bot's
+#: hits a minute on a CenterOut id, where every trial is hit and speed is what still ranks), never a mean of the
+#: runs being scored, so a run above the reference scores above 1. Protocol 2's figures are kept beside it.
+PROTOCOL_VERSION = 3
+#: The protocols ``normalised_score`` still computes: a published figure keeps its meaning.
+PROTOCOLS = (2, 3)
 
 #: Game seeds kept for evaluation: ``armgame.env.evaluate`` plays from here; training never should.
 EVALUATION_SEED_START = 10**9
