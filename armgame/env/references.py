@@ -2,8 +2,9 @@
 
 Made by ``python benchmarks/reference_scores.py references FOLDER`` from that benchmark's runs (its
 ``bots`` and ``ppo`` steps; docs/programs.md's reference table is its ``table`` step of the same
-runs). ``armgame.env.evaluation.normalised_score`` scales by ``random`` (0) and the id's ceiling (1,
-``CEILINGS``, protocol 2; protocol 1 scaled by ``model``);
+runs). ``armgame.env.evaluation.normalised_score`` scales by random play (0) and the id's reference (1,
+``REFERENCES_V3``, protocol 3, each row with its own 0), or under protocol 2 by ``random`` and the id's ceiling
+(``CEILINGS``; protocol 1 scaled by ``model``);
 ``random_first`` and ``model_first`` are the first games' hits, which ``tests/test_env_suite.py``
 replays. ``ppo`` is the mean over ``ppo_seeds``, each a training seed's policy evaluated on the same
 games.
@@ -126,12 +127,12 @@ CEILINGS: dict[str, dict[str, Any]] = {
 }
 
 
-# Protocol 3's reference (``python benchmarks/reference_scores.py references-v3``, from benchmarks/results/ceiling
-# and benchmarks/results/reference; tests/test_hit_bound.py holds it to those files): per Reach id, the shooting
-# controller at its strongest settings tried, its mean hits on the test games played so far (``games``; 95 % interval
-# over games), the code, and the CPU seconds a decision cost in that run; the separating tier's ids
-# (``armgame.env.suite.TIER``) take their suite game's. Not yet the headline: an id is complete at
-# 100 games, and an id whose reference run has no games yet is absent (docs/programs.md, "Protocol 3's reference").
+# Protocol 3's reference (``python benchmarks/reference_scores.py references-v3``, from benchmarks/results/ceiling,
+# benchmarks/results/reference and benchmarks/results/center-out-time; tests/test_hit_bound.py holds it to those
+# files): per Reach id, the shooting controller at its strongest settings tried, its mean hits on the test games
+# played (``games``; 95 % interval over games), the code, and the CPU seconds a decision cost in that run; the
+# separating tier's ids (``armgame.env.suite.TIER``) take their suite game's; per CenterOut id, the model bot's hits
+# a minute (``unit``). ``random`` is each id's 0, in its unit (docs/programs.md, "Protocol 3's reference").
 REFERENCES_V3: dict[str, dict[str, Any]] = {
     'armgame/Reach-v1': {
         'hits': 72.16,
