@@ -15,15 +15,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import shutil
-import subprocess
 import urllib.error
 import urllib.request
 from pathlib import Path
 
 import pytest
 from class_server import running_class
+from node import run_node, skip_without_node
 from test_browser_lab import own_protocols, quick, random_timeline
 
 from armgame.classroom.intake import Clerk
@@ -37,7 +35,6 @@ from armgame.lab.session import LabSession, lab_config
 
 ROOT = Path(__file__).resolve().parent.parent
 RUNNER = ROOT / "tests" / "lab_page_runner.mjs"
-NODE = shutil.which("node")
 
 
 def _post(port: int, path: str, body: dict, headers: dict | None = None) -> tuple[int, dict]:
@@ -135,16 +132,13 @@ def _runs() -> list[tuple[object, object, list]]:
     return out
 
 
-@pytest.mark.skipif(NODE is None and not os.environ.get("ARMGAME_REQUIRE_BROWSER"), reason="no node")
 def test_the_page_tells_each_reach_and_draws_the_curve_as_python_measures_them():
+    skip_without_node("the lab page's words and curve are not checked here")
     runs = _runs()
     stops = [c.total_steps if i == 0 else 6000 for i, (c, _, _) in enumerate(runs)]
     request = {"runs": [{"plan": lab_plan(c, p), "events": e, "stop": stop}
                         for (c, p, e), stop in zip(runs, stops, strict=True)]}
-    done = subprocess.run([NODE, str(RUNNER)], input=json.dumps(request), capture_output=True, text=True,
-                          timeout=120, check=False)
-    assert done.returncode == 0, done.stderr
-    answers = json.loads(done.stdout)
+    answers = run_node(RUNNER, request)
 
     def close(mine: float | None, theirs: float) -> bool:
         if mine is None:
