@@ -237,3 +237,22 @@ print(json.dumps(report))
     run = subprocess.run([sys.executable, "-c", code, env_id], capture_output=True, text=True, env=env, check=True)
     report = json.loads(run.stdout.strip().splitlines()[-1])
     assert report == {"armgame": [], "headless": False, "rgb_array": [None, False], "human": [None, True]}
+
+
+def test_the_envs_muscle_tables_are_the_games_muscles():
+    """Reach's and CenterOut's docstrings (each env's page, as Gymnasium's envs document themselves) each spell out
+    the action's muscles: their keys, names and torques are ``game.muscles.DEFAULT_MUSCLES``', so a muscle changed
+    there fails here until both tables say so."""
+    import re
+
+    from armgame.env.center_out import CenterOutEnv
+    from armgame.game.muscles import DEFAULT_MUSCLES
+
+    def torque(spec) -> str:
+        joint, value = ("shoulder", spec.moment[0]) if spec.moment[0] else ("elbow", spec.moment[1])
+        return f"{joint} {value:+g}"
+
+    expected = [(str(i), m.key, m.name, torque(m)) for i, m in enumerate(DEFAULT_MUSCLES)]
+    for env in (ReachEnv, CenterOutEnv):
+        rows = re.findall(r"^\s*\| (\d)\s+\| (\w)\s+\| ([a-z ]+?)\s+\| (\w+ [+-][\d.]+)\s+\|$", env.__doc__, re.M)
+        assert rows == expected, env.__name__
