@@ -27,17 +27,19 @@ import json
 import math
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import torch
 from stable_baselines3 import PPO
+from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.vec_env import VecMonitor
 
 import armgame.env  # noqa: F401  (registers the ids)
-from armgame.env.evaluation import evaluate
+from armgame.env.evaluation import Evaluation, evaluate
 from armgame.env.record import replay_of
 from armgame.env.sb3 import make_sb3_vec_env
 from armgame.env.suite import PROTOCOL_VERSION, VALIDATION_SEEDS
@@ -46,7 +48,7 @@ from armgame.env.suite import PROTOCOL_VERSION, VALIDATION_SEEDS
 VALIDATION = list(VALIDATION_SEEDS[:10])
 
 
-def validate(model: PPO, env_id: str) -> np.ndarray:
+def validate(model: BaseAlgorithm, env_id: str) -> np.ndarray:
     """Hits in each of 10 whole validation games played by the deterministic policy."""
     envs = gym.make_vec(env_id, num_envs=len(VALIDATION), vectorization_mode="vector_entry_point")
     obs, info = envs.reset(seed=VALIDATION)
@@ -75,11 +77,14 @@ def keep_a_game(model: PPO, env_id: str, path: Path) -> int:
 
 
 class Curve(BaseCallback):
-    """Validates every ``every`` env steps; stops training at the optional wall-clock cap."""
+    """Validates every ``every`` env steps with ``validate`` (hits in each validation game; train_recurrent.py hands
+    its own); stops training at the optional wall-clock cap."""
 
-    def __init__(self, env_id: str, every: int, seconds: float, out: Path | None) -> None:
+    def __init__(self, env_id: str, every: int, seconds: float, out: Path | None,
+                 validate: Callable[[BaseAlgorithm, str], np.ndarray] = validate) -> None:
         super().__init__()
         self.env_id, self.every, self.seconds, self.out = env_id, every, seconds, out
+        self.validate = validate
         self.start = time.perf_counter()
         self.next_eval = 0
         self.rows: list[tuple[int, float, float, int, int]] = []
@@ -92,7 +97,7 @@ class Curve(BaseCallback):
 
     def record(self) -> None:
         wall = time.perf_counter() - self.start
-        hits = validate(self.model, self.env_id)
+        hits = self.validate(self.model, self.env_id)
         self.rows.append((self.num_timesteps, round(wall, 1), float(hits.mean()), int(hits.min()), int(hits.max())))
         print(f"{self.num_timesteps:>9,} steps  {wall:7.0f} s  validation hits per game: mean {hits.mean():5.1f} "
               f"(min {hits.min()}, max {hits.max()})", flush=True)
@@ -103,10 +108,11 @@ class Curve(BaseCallback):
                 writer.writerows(self.rows)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--env", default="armgame/Reach-v1", help="an armgame id with a vector entry point")
-    parser.add_argument("--steps", type=int, default=1_500_000, help="the budget in env steps (default 1,500,000)")
+def arguments(argv: list[str] | None, description: str, env: str, steps: int) -> argparse.Namespace:
+    """The recipe's command line (train_recurrent.py's too), ``env`` and ``steps`` its defaults; makes ``--out``."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--env", default=env, help="an armgame id with a vector entry point")
+    parser.add_argument("--steps", type=int, default=steps, help=f"the budget in env steps (default {steps:,})")
     parser.add_argument("--minutes", type=float, default=math.inf, help="a wall-clock cap as well (default none)")
     parser.add_argument("--envs", type=int, default=32, help="games stepped together (default 32)")
     parser.add_argument("--seed", type=int, default=0, help="training seed")
@@ -116,6 +122,24 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
+    return args
+
+
+def save_result(args: argparse.Namespace, algorithm: str, model: BaseAlgorithm, test: Evaluation) -> None:
+    """Writes ``--out``'s model.zip and result.json, what ``benchmarks/reference_scores.py aggregate`` reads."""
+    model.save(args.out / "model.zip")
+    result = {"env_id": args.env, "algorithm": algorithm, "training_seed": args.seed, "env_steps": model.num_timesteps,
+              "budget_steps": args.steps, "test_seeds": [test.seeds[0], test.seeds[-1]],
+              "test_hits": list(test.hits), "mean_hits": test.mean_hits, "normalised": test.normalised,
+              "protocol": PROTOCOL_VERSION,  # the normalised score's: a file without it is protocol 1's
+              "hits_per_minute": test.hits_per_minute}
+    if test.reach_seconds:  # CenterOut: where every trial is hit, the time to the target still ranks
+        result["reach_seconds"] = [None if math.isnan(t) else round(t, 4) for t in test.reach_seconds]
+    (args.out / "result.json").write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = arguments(argv, __doc__.splitlines()[0], env="armgame/Reach-v1", steps=1_500_000)
 
     # A 64-unit MLP gains nothing from a second thread and loses much when another process shares the cores.
     torch.set_num_threads(1)
@@ -128,15 +152,7 @@ def main(argv: list[str] | None = None) -> int:
     test = evaluate(model, args.env, games=args.test_games)  # once, at the end: the test games
     print(test.summary())
     if args.out is not None:
-        model.save(args.out / "model.zip")
-        result = {"env_id": args.env, "algorithm": "PPO", "training_seed": args.seed, "env_steps": model.num_timesteps,
-                  "budget_steps": args.steps, "test_seeds": [test.seeds[0], test.seeds[-1]],
-                  "test_hits": list(test.hits), "mean_hits": test.mean_hits, "normalised": test.normalised,
-                  "protocol": PROTOCOL_VERSION,  # the normalised score's: a file without it is protocol 1's
-                  "hits_per_minute": test.hits_per_minute}
-        if test.reach_seconds:  # CenterOut: where every trial is hit, the time to the target still ranks
-            result["reach_seconds"] = [None if math.isnan(t) else round(t, 4) for t in test.reach_seconds]
-        (args.out / "result.json").write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
+        save_result(args, "PPO", model, test)
         hits = keep_a_game(model, args.env, args.out / "game.json")
         print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")
     best = max(row[2] for row in curve.rows)

@@ -8,14 +8,10 @@ again), and its doubles must reach JavaScript with their bits. engine.js keeps n
 from __future__ import annotations
 
 import json
-import os
 import re
-import shutil
-import struct
-import subprocess
 from pathlib import Path
 
-import pytest
+from node import bits, node, skip_without_node
 
 import armgame
 from armgame.classroom import jsconstants
@@ -46,23 +42,15 @@ def test_the_generator_writes_and_checks(tmp_path, monkeypatch, capsys):
 
 def test_the_constants_reach_javascript_bit_for_bit():
     """Each double of constants.js, read by JavaScript, has the bits Python computed (repr is exact both ways)."""
-    node = shutil.which("node")
-    if node is None:
-        if os.environ.get("ARMGAME_REQUIRE_BROWSER"):
-            pytest.fail("ARMGAME_REQUIRE_BROWSER is set but node is not installed")
-        pytest.skip("node (Node.js) is not installed")
+    skip_without_node("constants.js's doubles in JavaScript are not checked here")
     script = ("import * as c from './constants.js';"
               "const v = new DataView(new ArrayBuffer(8));"
               "const bits = (x) => { v.setFloat64(0, x); return v.getBigUint64(0).toString(16).padStart(16, '0'); };"
               "process.stdout.write(JSON.stringify({arm: Object.fromEntries(Object.entries(c.ARM).map(([k, x]) =>"
               " [k, bits(x)])), rise: c.RISE.map(bits), decay: c.DECAY.map(bits), version: c.ARMGAME_VERSION}));")
-    done = subprocess.run([node, "--input-type=module", "-e", script], cwd=STATIC, capture_output=True, text=True,
-                          timeout=60, check=False)
+    done = node("--input-type=module", "-e", script, cwd=STATIC)
     assert done.returncode == 0, done.stderr
     got = json.loads(done.stdout)
-
-    def bits(x: float) -> str:
-        return struct.pack(">d", x).hex()
 
     config = GameConfig()
     model, muscles = TwoJointArm(config.arm), MuscleSet(config.muscles, config.dt)

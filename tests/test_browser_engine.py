@@ -19,15 +19,12 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
 import random
-import shutil
-import struct
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from node import bits, run_node, skip_without_node
 
 import armgame
 from armgame.game.bots import Autopilot, make_bot
@@ -41,27 +38,12 @@ from armgame.records.rulesets import REHEARSAL, class_game_name, config_digest
 
 ROOT = Path(__file__).resolve().parent.parent
 RUNNER = ROOT / "tests" / "engine_runner.mjs"
-NODE = shutil.which("node")
-if NODE is None and not os.environ.get("ARMGAME_REQUIRE_BROWSER"):
-    pytest.skip("node (Node.js) is not installed, and ARMGAME_REQUIRE_BROWSER is unset: the browser's engine "
-                "is not checked here (CI sets it)", allow_module_level=True)
+skip_without_node("the browser's engine is not checked here")
 
 SHORT_GAMES = 1000
 TOP_SEED = 2**63 - 1
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from class_speed import student_timeline  # noqa: E402
-
-
-def bits(x: float) -> str:
-    return struct.pack(">d", x).hex()
-
-
-def run_node(request: dict) -> dict:
-    assert NODE is not None, "ARMGAME_REQUIRE_BROWSER is set but node is not installed"
-    done = subprocess.run([NODE, str(RUNNER)], input=json.dumps(request), capture_output=True, text=True,
-                          timeout=120, check=False)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
 
 
 def config_dict(config: GameConfig) -> dict:
@@ -192,7 +174,7 @@ def played() -> dict:
     request = {"games": [{"config": config_dict(c), "events": e, "frame": rng.choice((1, 3, 16, 250, 10**6)),
                           "replay": f"Player {i}" if i >= len(games) + len(knife) else None}
                          for i, (c, e) in enumerate(everything)]}
-    answer = run_node(request)
+    answer = run_node(RUNNER, request)
     return {"games": games, "knife": knife, "full": full, "answer": answer}
 
 
@@ -261,7 +243,8 @@ OTHER_GAMES = {
 
 def test_configs_it_cannot_play_are_refused_in_one_line():
     """The engine plays the class's game only: another arm, step, muscle or integrator is refused, naming it."""
-    answer = run_node({"games": [{"config": config_dict(c), "events": []} for c in OTHER_GAMES.values()]})["games"]
+    request = {"games": [{"config": config_dict(c), "events": []} for c in OTHER_GAMES.values()]}
+    answer = run_node(RUNNER, request)["games"]
     names = {"arm": "arm", "gravity": "arm", "r1": "arm", "dt": "dt", "keys": "muscles", "moment": "muscles",
              "rise": "muscles", "range": "target_elbow_range", "euler": "euler"}
     for (kind, config), got in zip(OTHER_GAMES.items(), answer, strict=True):
@@ -270,7 +253,7 @@ def test_configs_it_cannot_play_are_refused_in_one_line():
 
 
 def test_the_engine_names_this_armgame():
-    assert run_node({})["armgame_version"] == armgame.__version__
+    assert run_node(RUNNER, {})["armgame_version"] == armgame.__version__
 
 
 def test_python_random_in_javascript():
@@ -278,7 +261,7 @@ def test_python_random_in_javascript():
     seeds = [0, 1, 2, 42, 2**31, 2**32 - 1, 2**32, 2**32 + 1, 2**53 - 1, 2**53 + 1, 2**62, TOP_SEED - 1, TOP_SEED]
     seeds += [rng.randrange(2**bits_) for bits_ in range(1, 64) for _ in range(3)]
     request = {"random": [[str(s), 5] for s in seeds] + [["12345678901234567890", 1500]]}
-    answer = run_node(request)["random"]
+    answer = run_node(RUNNER, request)["random"]
     for (seed, count), got in zip(request["random"], answer, strict=True):
         python = random.Random(int(seed))
         assert got == [bits(python.random()) for _ in range(count)], seed
@@ -290,7 +273,7 @@ def test_the_arm_sine_and_the_standard_config():
     angles += [rng.uniform(-10, 10) for _ in range(3000)] + [rng.uniform(-1e6, 1e6) for _ in range(500)]
     seeds = [0, 10, 2**53 + 1, TOP_SEED]
     rehearsals = [[str(s), REHEARSAL.config.time_limit] for s in seeds]  # the rehearsal's clock, as its join says
-    answer = run_node({"sin_cos": angles, "standard": [str(s) for s in seeds] + rehearsals})
+    answer = run_node(RUNNER, {"sin_cos": angles, "standard": [str(s) for s in seeds] + rehearsals})
     for x, got in zip(angles, answer["sin_cos"], strict=True):
         want = [bits(v) for v in trig.sin_cos_python(x)]
         assert got == want == [bits(v) for v in trig.sin_cos(x)], x

@@ -18,17 +18,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 import random
 import re
-import shutil
-import struct
-import subprocess
 import urllib.request
 from pathlib import Path
 
 import pytest
 from class_server import running_class
+from node import bits, run_node, skip_without_node
 
 from armgame.classroom import client
 from armgame.game.bots import Autopilot
@@ -44,28 +41,13 @@ from armgame.records.replay import Replay
 
 ROOT = Path(__file__).resolve().parent.parent
 RUNNER = ROOT / "tests" / "lab_runner.mjs"
-NODE = shutil.which("node")
-if NODE is None and not os.environ.get("ARMGAME_REQUIRE_BROWSER"):
-    pytest.skip("node (Node.js) is not installed, and ARMGAME_REQUIRE_BROWSER is unset: the browser's lab is not "
-                "checked here (CI sets it)", allow_module_level=True)
+skip_without_node("the browser's lab is not checked here")
 
 TOP_SEED = 2**63 - 1
 RUNS = 520
 #: How far a run goes (physics steps): up to 10 s of the lab, a few trials of a preset, a dozen or more at quick
 #: timing. The slow tier's sweep goes further (``test_a_longer_sweep``).
 STOP_STEPS = (800, 1500, 2500)
-
-
-def bits(x: float) -> str:
-    return struct.pack(">d", x).hex()
-
-
-def run_node(request: dict) -> dict:
-    assert NODE is not None, "ARMGAME_REQUIRE_BROWSER is set but node is not installed"
-    done = subprocess.run([NODE, str(RUNNER)], input=json.dumps(request), capture_output=True, text=True,
-                          timeout=300, check=False)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
 
 
 def quick(protocol: Protocol) -> Protocol:
@@ -194,7 +176,7 @@ def sweep(count: int, stops: tuple[int, ...], seed: int) -> dict:
         session, out = play_python(config, protocol, events, config.total_steps)
         expected.append(out)
         whole.append((session, len(runs) - 1))
-    answer = run_node({"plans": plans, "runs": runs})
+    answer = run_node(RUNNER, {"plans": plans, "runs": runs}, timeout=300)
     return {"runs": runs, "expected": expected, "answer": answer, "whole": whole, "plans": plans, "configs": configs}
 
 
@@ -315,8 +297,8 @@ def test_the_class_serves_its_plan_and_takes_the_browsers_run_into_its_curve(tmp
         bot = LabSession(config, protocol, sine="arm")
         Autopilot(bot, make_lab_bot("adaptive")).play()
         events = [[e.step, e.key, e.action] for e in bot.timeline]
-        answer = run_node({"plans": [plan], "runs": [{"plan": 0, "events": events, "stop": config.total_steps,
-                                                      "frame": 4, "replay": "Ann"}]})
+        answer = run_node(RUNNER, {"plans": [plan], "runs": [{"plan": 0, "events": events, "stop": config.total_steps,
+                                                              "frame": 4, "replay": "Ann"}]}, timeout=300)
         monkeypatch.setenv(client.CLIENT_ENV, str(tmp_path / "ann"))
         ann = client.join(client.ClassAddress.parse(f"127.0.0.1:{opened.port}"), opened.clerk.roster.code, "Ann",
                           lab=True)
@@ -336,7 +318,8 @@ def test_plans_it_cannot_play_are_refused_in_one_line(played):
     plan = played["plans"][0]
     bad = [{**plan, "format": "x"}, {**plan, "sine": "library"}, {**plan, "trials": []},
            {**plan, "config": {**plan["config"], "scene": "game"}}]
-    answer = run_node({"plans": bad, "runs": [{"plan": i, "events": [], "stop": 10, "frame": 1} for i in range(4)]})
+    answer = run_node(RUNNER, {"plans": bad, "runs": [{"plan": i, "events": [], "stop": 10, "frame": 1}
+                               for i in range(4)]}, timeout=300)
     errors = [r.get("error", "") for r in answer["runs"]]
     assert all(e and "\n" not in e for e in errors), errors
 

@@ -210,19 +210,21 @@ def test_the_docstring_examples_run():
         assert attempted >= 2 and failed == 0, module.__name__
 
 
-def test_pygame_is_imported_only_to_render_and_never_starts_the_mixer():
+@pytest.mark.parametrize("env_id", ["armgame/Reach-v0", "armgame/CenterOut-v0"])
+def test_pygame_is_imported_only_to_render_and_never_starts_the_mixer(env_id):
     code = """
 import json, os, sys
 import armgame
 report = {"armgame": sorted(m for m in ("gymnasium", "pygame") if m in sys.modules)}
 import gymnasium as gym
 import armgame.env
-env = gym.make("armgame/Reach-v0")
+env_id = sys.argv[1]
+env = gym.make(env_id)
 env.reset(seed=1)
 env.step(env.action_space.sample())
 report["headless"] = "pygame" in sys.modules
 for mode in ("rgb_array", "human"):
-    env = gym.make("armgame/Reach-v0", render_mode=mode, render_size=(64, 64))
+    env = gym.make(env_id, render_mode=mode, render_size=(64, 64))
     env.reset(seed=1)
     env.step(env.action_space.sample())
     env.render()
@@ -232,6 +234,25 @@ for mode in ("rgb_array", "human"):
 print(json.dumps(report))
 """
     env = dict(os.environ, SDL_VIDEODRIVER="dummy", SDL_AUDIODRIVER="dummy")
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+    run = subprocess.run([sys.executable, "-c", code, env_id], capture_output=True, text=True, env=env, check=True)
     report = json.loads(run.stdout.strip().splitlines()[-1])
     assert report == {"armgame": [], "headless": False, "rgb_array": [None, False], "human": [None, True]}
+
+
+def test_the_envs_muscle_tables_are_the_games_muscles():
+    """Reach's and CenterOut's docstrings (each env's page, as Gymnasium's envs document themselves) each spell out
+    the action's muscles: their keys, names and torques are ``game.muscles.DEFAULT_MUSCLES``', so a muscle changed
+    there fails here until both tables say so."""
+    import re
+
+    from armgame.env.center_out import CenterOutEnv
+    from armgame.game.muscles import DEFAULT_MUSCLES
+
+    def torque(spec) -> str:
+        joint, value = ("shoulder", spec.moment[0]) if spec.moment[0] else ("elbow", spec.moment[1])
+        return f"{joint} {value:+g}"
+
+    expected = [(str(i), m.key, m.name, torque(m)) for i, m in enumerate(DEFAULT_MUSCLES)]
+    for env in (ReachEnv, CenterOutEnv):
+        rows = re.findall(r"^\s*\| (\d)\s+\| (\w)\s+\| ([a-z ]+?)\s+\| (\w+ [+-][\d.]+)\s+\|$", env.__doc__, re.M)
+        assert rows == expected, env.__name__

@@ -2,11 +2,8 @@
 
 import dataclasses
 import doctest
-import json
 import math
 import os
-import subprocess
-import sys
 import warnings
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
@@ -256,30 +253,6 @@ def test_rgb_array_frames_show_the_lab_view():
 def test_the_docstring_example_runs():
     failed, attempted = doctest.testmod(armgame.env.center_out)
     assert attempted >= 3 and failed == 0
-
-
-def test_pygame_is_imported_only_to_render_and_never_starts_the_mixer():
-    code = """
-import json, sys
-import armgame, gymnasium as gym, armgame.env
-env = gym.make("armgame/CenterOut-v0")
-env.reset(seed=1)
-env.step(env.action_space.sample())
-report = {"headless": "pygame" in sys.modules}
-for mode in ("rgb_array", "human"):
-    env = gym.make("armgame/CenterOut-v0", render_mode=mode, render_size=(64, 64))
-    env.reset(seed=1)
-    env.step(env.action_space.sample())
-    env.render()
-    import pygame
-    report[mode] = [pygame.mixer.get_init(), pygame.display.get_init()]
-    env.close()
-print(json.dumps(report))
-"""
-    env = dict(os.environ, SDL_VIDEODRIVER="dummy", SDL_AUDIODRIVER="dummy")
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
-    assert json.loads(run.stdout.strip().splitlines()[-1]) == {"headless": False, "rgb_array": [None, False],
-                                                               "human": [None, True]}
 
 
 def test_a_viscous_matrix_option_and_a_paradigm_it_cannot_stand_for():

@@ -197,3 +197,18 @@ def test_the_speed_benchmark_runs():
     assert result["single_ratio"]["median"] > 0
     shares = bench.profile(num_envs=8, steps=3)
     assert shares and 0.0 < sum(share for _, share in shares) <= 1.0 + 1e-9
+
+
+def test_the_v1_vector_env_takes_each_argument_of_the_single_env_with_its_default():
+    """``gym.make_vec`` hands the same keyword arguments to the batched env or, where it does not play them, to
+    single envs (``SingleEnvsVectorEnv``): the two signatures are written twice (each public constructor spells its
+    arguments out), so an argument added to one, or a default changed in one, fails here."""
+    import inspect
+
+    from armgame.env.reach_v1 import ReachV1Env
+    from armgame.env.vector import ReachV1VectorEnv
+
+    single = inspect.signature(ReachV1Env.__init__).parameters
+    batched = inspect.signature(ReachV1VectorEnv.__init__).parameters
+    assert set(batched) - set(single) == {"num_envs", "autoreset_mode"}
+    assert {name: batched[name].default for name in single} == {name: p.default for name, p in single.items()}

@@ -14,7 +14,6 @@ of the old physics stops verifying. docs/development.md's table "The physics' co
 from __future__ import annotations
 
 import hashlib
-import json
 import os
 import re
 import shutil
@@ -24,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from node import run_node, skip_without_node
 
 from armgame.game.batch import BatchGameSession, compiled
 from armgame.game.rules import GameConfig
@@ -31,7 +31,6 @@ from armgame.game.session import GameSession, InputEvent
 from armgame.records.replay import Replay, config_to_dict
 
 ROOT = Path(__file__).resolve().parent.parent
-NODE = shutil.which("node")
 
 #: The committed hash of the golden game. Changed only with a version bump and a CHANGELOG entry that quotes it.
 GOLDEN = "e9ed40b01b8c6ee4552a347d770418571576c063ad43bf8fd521e3df01a8b54e"
@@ -111,15 +110,9 @@ def test_the_batch(kernel, lanes, monkeypatch):
 
 
 def test_the_browser_engine():
-    if NODE is None:
-        if os.environ.get("ARMGAME_REQUIRE_BROWSER"):
-            pytest.fail("ARMGAME_REQUIRE_BROWSER is set but node is not installed")
-        pytest.skip("node (Node.js) is not installed: the browser's engine is checked where it is (CI)")
+    skip_without_node("the browser's engine is not checked here")
     request = {"games": [{"config": config_to_dict(CONFIG), "events": [[e.step, e.key, e.action] for e in EVENTS]}]}
-    done = subprocess.run([NODE, str(ROOT / "tests" / "engine_runner.mjs")], input=json.dumps(request),
-                          capture_output=True, text=True, timeout=60, check=False)
-    assert done.returncode == 0, done.stderr
-    game = json.loads(done.stdout)["games"][0]
+    game = run_node(ROOT / "tests" / "engine_runner.mjs", request, timeout=60)["games"][0]
 
     def floats(hexes: list[str]) -> list[float]:
         return [struct.unpack(">d", bytes.fromhex(h))[0] for h in hexes]

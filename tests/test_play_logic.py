@@ -11,29 +11,19 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import re
-import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
+from node import node, skip_without_node
 
 ROOT = Path(__file__).resolve().parent.parent
 STATIC = ROOT / "armgame" / "classroom" / "static"
-NODE = shutil.which("node")
-if NODE is None and not os.environ.get("ARMGAME_REQUIRE_BROWSER"):
-    pytest.skip("node (Node.js) is not installed, and ARMGAME_REQUIRE_BROWSER is unset: the browser game's modules "
-                "are not checked here (CI sets it)", allow_module_level=True)
-
-
-def _node(*args: str) -> subprocess.CompletedProcess:
-    assert NODE is not None, "ARMGAME_REQUIRE_BROWSER is set but node is not installed"
-    return subprocess.run([NODE, *args], cwd=STATIC, capture_output=True, text=True, timeout=60, check=False)
+skip_without_node("the browser game's modules are not checked here")
 
 
 def test_the_pages_modules_pass_their_node_tests():
-    done = _node("--test", str(ROOT / "tests" / "play_logic.test.mjs"))
+    done = node("--test", str(ROOT / "tests" / "play_logic.test.mjs"), cwd=STATIC)
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
     assert re.search(r"^# fail 0$", done.stdout, re.M) and not re.search(r"^# pass 0$", done.stdout, re.M), done.stdout
 
@@ -74,7 +64,7 @@ def test_the_pages_looks_are_the_pythons():
     from armgame.ui import body, render
     from armgame.ui.palette import PALETTES
 
-    done = _node("--input-type=module", "-e", LOOKS % json.dumps(POSES))
+    done = node("--input-type=module", "-e", LOOKS % json.dumps(POSES), cwd=STATIC)
     assert done.returncode == 0, done.stderr
     looks = json.loads(done.stdout)
     high = PALETTES["high-contrast"]
@@ -143,7 +133,7 @@ def test_the_labs_colours_are_the_lab_windows():
     from armgame.ui.body import blend
     from armgame.ui.palette import PALETTES
 
-    done = _node("--input-type=module", "-e", LAB_LOOKS)
+    done = node("--input-type=module", "-e", LAB_LOOKS, cwd=STATIC)
     assert done.returncode == 0, done.stderr
     looks = json.loads(done.stdout)
     high = PALETTES["high-contrast"]

@@ -38,22 +38,12 @@ from .bounds import MAX_HANDIN_WORK, MAX_ROUND_GAMES_BYTES, REMEMBERED_FORGERIES
 from .errors import RefusedError
 from .roster import Player
 from .rounds import Round
+from .wire import Arrival
 
 CLOSED = "the class is closed to new games: this game is not taken (your replay stays on your machine)"
 #: The current round's games, by entry id, as the clerk took them into it (``rounds.Round.refusal``): the round's
 #: standings survive a restart. Its number and start say which round; another round's file counts nothing.
 ROUND_GAMES = "round.json"
-
-
-@dataclass(frozen=True)
-class Arrival:
-    """A game just entered, as the projector announces it."""
-
-    seq: int
-    name: str
-    score: int
-    note: str
-    program: bool
 
 
 #: What the student's machine is told of a hand-in taken: a JSON object (``ok``, ``already``, ``message``; for a

@@ -43,10 +43,11 @@ from ..valid import check_name
 from .board import Board
 from .bounds import MAX_HANDIN_BYTES, MAX_PLAYERS
 from .errors import RefusedError
-from .handins import AGAIN, Again, Answer, Arrival, Checked, HandInPipeline, read_round_games
+from .handins import AGAIN, Again, Answer, Checked, HandInPipeline, read_round_games
 from .labruns import LAB_DIR, LAB_MORE_DIR, LabRun, lab_identity, read_runs, write_run
 from .roster import Player, Roster, token_digest
 from .rounds import Round, Tickets, new_round
+from .wire import Arrival
 
 NOT_JOINED = ("this machine has not joined the class under that name: join first "
               "(armgame play --join HOST:PORT --code CODE --name NAME)")

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
+from ..classroom.wire import Arrival
 from ..words import plural
 from .display import open_window, toggle_fullscreen
 from .loop import run_loop
@@ -69,19 +70,6 @@ class Row:
     score: int
     games: int
     driver: str | None = None
-
-
-@dataclass(frozen=True)
-class Arrival:
-    seq: int
-    name: str
-    score: int
-    note: str
-    program: bool
-
-    @property
-    def news(self) -> str:
-        return f"{self.name}: {self.score}, {self.note}" if self.note else f"{self.name}: {self.score}"
 
 
 @dataclass(frozen=True)

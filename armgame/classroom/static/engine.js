@@ -261,6 +261,8 @@ export class ArmSession {
     this._l1 = physics.l1;
     this._l2 = physics.l2;
     this._accel = physics.accel;
+    // The arm's step without loads: RK4 of its accel. A lab trial's reach swaps in its loads' (labengine.js).
+    this._step = (q1, q2, w1, w2, t1, t2, dt) => rk4(physics.accel, q1, q2, w1, w2, t1, t2, dt);
     this._muscleKeys = physics.keys;
     this._moments = physics.moments;
     this._rise = physics.rise;
@@ -322,6 +324,42 @@ export class ArmSession {
     }
     this._timeline.push([this._steps, key, action]);
     return true;
+  }
+
+  // ---------------------------------------------------------------------------------- physics
+  /** GameSession.advance, and LabSession's: up to n physics steps, fewer at the clock's end or where the session's
+   * rules end it (`_afterStep` returns true); returns how many ran. A step is GameSession._advance's, in its order:
+   * the muscles' torques from their activation, the activation a step toward its goal, the arm one `_step` under
+   * those torques, then the rules on the new state (`_afterStep`: the game's hit test, the lab's task). */
+  advance(n) {
+    if (!Number.isInteger(n)) fail(`advance takes a whole number of steps, got ${n}`);
+    n = Math.min(n, this._totalSteps - this._steps);
+    if (n <= 0 || this.over) return 0;
+    const dt = this._dt, start = this._steps;
+    const [g0, g1, g2, g3] = this._goal;
+    const [r0, r1, r2, r3] = this._rate;
+    const [[s0, e0], [s1, e1], [s2, e2], [s3, e3]] = this._moments;
+    let ran = 0;
+    while (ran < n) {
+      let [a0, a1, a2, a3] = this._activation;
+      const t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
+      const t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
+      a0 += (g0 - a0) * r0;
+      a1 += (g1 - a1) * r1;
+      a2 += (g2 - a2) * r2;
+      a3 += (g3 - a3) * r3;
+      this._activation = [a0, a1, a2, a3];
+      const [q1, q2, w1, w2] = this._previous = this._state;
+      this._state = this._step(q1, q2, w1, w2, t1, t2, dt);
+      this._steps += 1;
+      ran += 1;
+      if (this._afterStep()) break;
+    }
+    const [q1, q2, w1, w2] = this._state;
+    if (!Number.isFinite(q1 + q2 + w1 + w2)) {
+      fail(`the arm's state became non-finite between t = ${start * dt} and ${(start + n) * dt} s`);
+    }
+    return ran;
   }
 
   // ---------------------------------------------------------------------------------- queries
@@ -457,47 +495,11 @@ export class Game extends ArmSession {
     this._resetTo(...this._start);
   }
 
-  // ---------------------------------------------------------------------------------- physics
-  /** GameSession.advance: up to n physics steps (fewer at the clock's end); returns how many ran. */
-  advance(n) {
-    if (!Number.isInteger(n)) fail(`advance takes a whole number of steps, got ${n}`);
-    n = Math.min(n, this._totalSteps - this._steps);
-    if (n <= 0) return 0;
-    const armAccel = this._accel, dt = this._dt;
-    let [a0, a1, a2, a3] = this._activation;
-    const [g0, g1, g2, g3] = this._goal;
-    const [r0, r1, r2, r3] = this._rate;
-    const [[s0, e0], [s1, e1], [s2, e2], [s3, e3]] = this._moments;
-    let [q1, q2, w1, w2] = this._state;
-    let previous = this._state;
-    let target = this._target;
-    let tx = target.x, ty = target.y, rr = target.radius * target.radius;
-    const start = this._steps;
-    for (let step = 0; step < n; step++) {
-      const t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
-      const t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
-      a0 += (g0 - a0) * r0;
-      a1 += (g1 - a1) * r1;
-      a2 += (g2 - a2) * r2;
-      a3 += (g3 - a3) * r3;
-      previous = [q1, q2, w1, w2];
-      [q1, q2, w1, w2] = rk4(armAccel, q1, q2, w1, w2, t1, t2, dt);
-      const [hx, hy] = this._handAt(q1, q2);
-      const dx = hx - tx, dy = hy - ty;
-      if (dx * dx + dy * dy <= rr) {
-        this._handMoved(hx, hy, (start + step + 1) * dt);
-        target = this._target;
-        tx = target.x; ty = target.y; rr = target.radius * target.radius;
-      }
-    }
-    this._activation = [a0, a1, a2, a3];
-    this._steps = start + n;
-    this._state = [q1, q2, w1, w2];
-    this._previous = previous;
-    if (!Number.isFinite(q1 + q2 + w1 + w2)) {
-      fail(`the arm's state became non-finite between t = ${start * dt} and ${(start + n) * dt} s`);
-    }
-    return n;
+  /** GameSession._advance's rules after a step: a hand on the target is a hit (GameRules.hand_moved). */
+  _afterStep() {
+    const [hx, hy] = this.hand();
+    this._handMoved(hx, hy, this._steps * this._dt);
+    return false;
   }
 
   // ---------------------------------------------------------------------------------- queries

@@ -5,7 +5,8 @@
 // at random or built from the protocol. This file plays the plan on a key timeline with LabSession's rules, in
 // its order: hold at home for the delay, the go cue, the reach (a hit held for the hold time, a no-cursor trial
 // ending where the hand stopped, or the time-out), the arm put home at rest, the reset key. The arm's accel,
-// RK4, the muscles and the arm's own sine are engine.js's, the game's: one definition of the physics.
+// RK4, the muscles, the loop that steps them (ArmSession.advance) and the arm's own sine are engine.js's, the
+// game's: one definition of the physics.
 // tests/test_browser_lab.py holds it to LabSession in Node; the server re-simulates every hand-in anyway.
 
 import { ArmSession, fail, rk4, sinCos } from "./engine.js";
@@ -157,7 +158,7 @@ export class LabRun extends ArmSession {
     this._distance = plan.distance;
     this._stillSpeed = plan.still_speed;
     this._trials = plan.trials;
-    this._unloaded = (q1, q2, w1, w2, t1, t2, dt) => rk4(this._accel, q1, q2, w1, w2, t1, t2, dt);
+    this._unloaded = this._step;
     this._home = [...plan.home];
     this._homeQ = [...plan.home_q];
     this._homeTarget = { x: this._home[0], y: this._home[1], radius: this._homeRadius };
@@ -278,54 +279,19 @@ export class LabRun extends ArmSession {
   }
 
   // ---------------------------------------------------------------------------------- physics
-  /** LabSession._advance: up to n physics steps (fewer at the run's end); returns how many ran. */
-  advance(n) {
-    if (!Number.isInteger(n)) fail(`advance takes a whole number of steps, got ${n}`);
-    n = Math.min(n, this._totalSteps - this._steps);
-    if (n <= 0 || this._finished) return 0;
-    const dt = this._dt, start = this._steps;
-    let [a0, a1, a2, a3] = this._activation;
-    const [g0, g1, g2, g3] = this._goal;
-    const [r0, r1, r2, r3] = this._rate;
-    const [[s0, e0], [s1, e1], [s2, e2], [s3, e3]] = this._moments;
-    let [q1, q2, w1, w2] = this._state;
-    let previous = this._state;
-    let step = this._step, show = this._show;
-    let ran = 0;
-    while (ran < n) {
-      const t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
-      const t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
-      a0 += (g0 - a0) * r0;
-      a1 += (g1 - a1) * r1;
-      a2 += (g2 - a2) * r2;
-      a3 += (g3 - a3) * r3;
-      previous = [q1, q2, w1, w2];
-      [q1, q2, w1, w2] = step(q1, q2, w1, w2, t1, t2, dt);
-      this._steps += 1;
-      ran += 1;
-      let [hx, hy] = this._handAt(q1, q2);
-      if (show !== null) [hx, hy] = show(hx, hy, q1, q2);
-      const event = this._taskStep(hx, hy);
-      if (event) {
-        step = this._step;
-        show = this._show;
-        if (event === ENDED) { // the arm goes home at rest and the muscles relax
-          [q1, q2] = this._homeQ;
-          w1 = w2 = 0.0;
-          previous = [q1, q2, w1, w2];
-          a0 = a1 = a2 = a3 = 0.0;
-          this._cursor = [...this._home];
-          if (this._finished) break;
-        }
-      }
-    }
-    this._activation = [a0, a1, a2, a3];
-    this._state = [q1, q2, w1, w2];
-    this._previous = previous;
-    if (!Number.isFinite(q1 + q2 + w1 + w2)) {
-      fail(`the arm's state became non-finite between t = ${start * dt} and ${(start + n) * dt} s`);
-    }
-    return ran;
+  /** LabSession._advance's rules after a step (engine.js's ArmSession.advance steps the muscles and the arm): the
+   * task on the shown hand; at a trial's end the arm goes home at rest and the muscles relax. True once the run is
+   * finished. */
+  _afterStep() {
+    const [q1, q2] = this._state;
+    let [hx, hy] = this._handAt(q1, q2);
+    if (this._show !== null) [hx, hy] = this._show(hx, hy, q1, q2);
+    if (this._taskStep(hx, hy) !== ENDED) return false;
+    const [h1, h2] = this._homeQ;
+    this._state = this._previous = [h1, h2, 0.0, 0.0];
+    this._activation = [0.0, 0.0, 0.0, 0.0];
+    this._cursor = [...this._home];
+    return this._finished;
   }
 
   /** LabSession.steps_before_an_end: the fewest steps after which the current trial could end (0 once over), so
