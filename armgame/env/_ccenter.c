@@ -87,23 +87,16 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
     if (n <= 0)
         return;
     const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
-    const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
-    const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
     double *x = s + S_X;
-    double a0 = s[S_A], a1 = s[S_A + 1], a2 = s[S_A + 2], a3 = s[S_A + 3];
-    const double g0 = s[S_G], g1 = s[S_G + 1], g2 = s[S_G + 2], g3 = s[S_G + 3];
-    const double r0 = s[S_R], r1 = s[S_R + 1], r2 = s[S_R + 2], r3 = s[S_R + 3];
+    double a[4] = {s[S_A], s[S_A + 1], s[S_A + 2], s[S_A + 3]};
+    const double *g = s + S_G, *r = s + S_R;
     const double limit = t[T_LIMIT];
     const Field field = {(int)t[T_FIELD], {t[T_FP], t[T_FP + 1], t[T_FP + 2], t[T_FP + 3]}, l1, l2};
     int64_t phase = it[I_PHASE], counter = it[I_COUNTER], steps = it[I_STEPS], path = it[I_PATH];
     int64_t ran = 0;
     while (ran < n) {
-        const double t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
-        const double t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
-        a0 += (g0 - a0) * r0;
-        a1 += (g1 - a1) * r1;
-        a2 += (g2 - a2) * r2;
-        a3 += (g3 - a3) * r3;
+        double t1, t2;
+        muscle_step(p, a, g, r, &t1, &t2);
         const int loaded = phase == 1 && field.kind != FIELD_NONE;
         double previous[4];
         memcpy(previous, x, sizeof previous);
@@ -154,7 +147,7 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
         x[0] = t[T_HQ1];
         x[1] = t[T_HQ2];
         x[2] = x[3] = 0.0;
-        a0 = a1 = a2 = a3 = 0.0;
+        a[0] = a[1] = a[2] = a[3] = 0.0;
         s[S_CX] = t[T_HX];
         s[S_CY] = t[T_HY];
         phase = 0;
@@ -163,10 +156,7 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
         it[I_TODO] = n - ran;
         break;
     }
-    s[S_A] = a0;
-    s[S_A + 1] = a1;
-    s[S_A + 2] = a2;
-    s[S_A + 3] = a3;
+    memcpy(s + S_A, a, sizeof a);
     it[I_PHASE] = phase;
     it[I_COUNTER] = counter;
     it[I_STEPS] = steps;
