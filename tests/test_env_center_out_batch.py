@@ -5,6 +5,7 @@ autoreset modes the batch runs, and the speed guard's stop."""
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -207,3 +208,66 @@ def test_the_c_reach_measures_are_reach_metrics_bit_for_bit() -> None:
         want = np.array(list(reach_metrics(reach).as_dict().values()))
         assert np.array_equal(np.isnan(want), np.isnan(out[k])), k
         assert want[~np.isnan(want)].tobytes() == out[k][~np.isnan(out[k])].tobytes(), (k, want, out[k])
+
+
+@compiled
+def test_the_dense_rewards_distance_is_math_hypot_bit_for_bit() -> None:
+    # _ccenter.edges stands for the single env's max(0.0, math.hypot(dx, dy) - radius): CPython's own hypot (not the
+    # C library's, which differs in the last bit now and then), on game-sized, huge, tiny, subnormal, far-apart and
+    # special values, and random bit patterns.
+    rng = np.random.default_rng(53)
+    count = 60_000
+    special = (0.0, -0.0, 5e-324, 1e-310, 2.2250738585072014e-308, 0.5, 1.0, 3.0, 4.0, 0.1, 1e308,
+               1.7976931348623157e308, np.inf, -np.inf, np.nan)
+    xy = np.concatenate([rng.normal(0.0, 0.3, (count, 2)),
+                         rng.uniform(-1, 1, (count, 2)) * 10.0 ** rng.integers(-320, 309, (count, 1)),
+                         rng.integers(0, 2**63, (count, 2), dtype=np.int64).view(np.float64),
+                         np.column_stack([rng.normal(size=count), rng.normal(size=count) * 10.0 ** rng.integers(
+                             -200, 200, count)]),
+                         [(x, y) for x in special for y in special]])
+    n = len(xy)
+    obs, ints, trials = np.zeros((n, 16)), np.zeros((n, center_out_batch.I_COUNT), np.int64), \
+        np.zeros((n, center_out_batch.T_COUNT))
+    obs[:, 12:14] = xy
+    ints[:, center_out_batch.I_PHASE] = rng.integers(0, 2, n)
+    trials[:, center_out_batch.T_TR] = rng.uniform(0.0, 0.05, n) * (np.arange(n) % 3 > 0)
+    trials[:, center_out_batch.T_HR] = rng.uniform(0.0, 0.05, n)
+    out = np.empty(n)
+    center_out_batch._ccenter.edges(obs, ints, trials, None, out)
+    radius = np.where(ints[:, center_out_batch.I_PHASE] == 1, trials[:, center_out_batch.T_TR],
+                      trials[:, center_out_batch.T_HR])
+    want = np.array([max(0.0, math.hypot(x, y) - r) for (x, y), r in zip(xy.tolist(), radius.tolist(), strict=True)])
+    assert want.tobytes() == out.tobytes()
+    runs = rng.integers(0, n, 1000)
+    some = np.empty(len(runs))
+    center_out_batch._ccenter.edges(obs, ints, trials, runs, some)
+    assert some.tobytes() == want[runs].tobytes()
+
+
+@compiled
+@pytest.mark.parametrize("continuous", (False, True))
+def test_actions_of_every_type_and_bad_ones_as_sync(continuous: bool) -> None:
+    # The batch maps the actions in C (_ccenter.act): keys as bools, int8, int64, float64, float32 and lists, levels
+    # as float64, ints and lists, equal to SyncVectorEnv's. A bad value in a stepping run is refused in one line before
+    # any run's muscles change: the batch goes on as its twin, which was never given it.
+    args = {"continuous": continuous, "episode_trials": 1}
+    sync, batch, twin = CenterOutVectorEnv(4, **args), CenterOutBatchVectorEnv(4, **args), \
+        CenterOutBatchVectorEnv(4, **args)
+    same(sync.reset(seed=9), batch.reset(seed=9), "reset")
+    twin.reset(seed=9)
+    rng = np.random.default_rng(9)
+    kinds = ((lambda a: a.astype(np.float64), lambda a: (a * 2 - 1).astype(np.int64), lambda a: (a - 0.5).tolist())
+             if continuous else (lambda a: a.astype(bool), lambda a: a.astype(np.int8), lambda a: a.astype(np.int64),
+                                 lambda a: a.astype(np.float64), lambda a: a.astype(np.float32), lambda a: a.tolist()))
+    for t in range(120):
+        keys = rng.integers(0, 2, (4, 4)) if not continuous else rng.uniform(0, 1, (4, 4))
+        action = kinds[t % len(kinds)](keys)
+        if t % 17 == 5:
+            bad = np.array(action, dtype=np.float64)
+            bad[t % 4, t % 3] = np.nan if continuous else 2.0
+            with pytest.raises(ValueError, match="finite numbers" if continuous else "zeros or ones"):
+                batch.step(bad)
+        a, b = sync.step(action), batch.step(action)
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            same(x, y, f"step {t}, item {k}")
+        same(b, twin.step(action), f"twin, step {t}")
