@@ -476,12 +476,9 @@ class CenterOutBatchVectorEnv(VectorEnv):
         env = self.template
         if env.reward_kind == "sparse":
             return hits.astype(np.float64)
-        shown = np.stack([self._trial, self.ints[:, I_PHASE]], axis=1)
-        edge = self._edges()
-        same = (shown == self._shown).all(axis=1)
-        progress = np.where(same, self._edge - edge, 0.0)
-        self._edge = np.where(stepping, edge, self._edge)
-        self._shown = np.where(stepping[:, None], shown, self._shown)
+        # Each run's last edge less its edge now where it shows the same target, and now's kept where it stepped.
+        progress = np.empty(self.num_envs)
+        _ccenter.progress(self._obs, self.ints, self.trials, self._trial, self._shown, self._edge, stepping, progress)
         return env.progress_weight * progress + env.hit_bonus * hits
 
     def _observations(self) -> np.ndarray:
