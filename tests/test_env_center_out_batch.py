@@ -140,18 +140,20 @@ def test_longer_runs_of_every_kind_equal_sync(env_id: str) -> None:
 
 
 def test_the_docs_batch_figures_are_the_committed_run() -> None:
-    """docs/programs.md's figures for CenterOut's batch are the committed run's
-    (benchmarks/results/env_speed_center_out.json): its load, each id's rate and ratio at 8,192 envs, CenterOut-v1's
-    range there, and the ratios at 4 envs; and the docs say MotorNet was not measured beside it."""
+    """docs/programs.md's figures for CenterOut's batch are the committed runs': beside SyncVectorEnv
+    (benchmarks/results/env_speed_center_out.json: its load, each id's rate and ratio at 8,192 envs, CenterOut-v1's
+    range there, and the ratios at 4 envs), and beside MotorNet's matched env
+    (benchmarks/results/env_speed_center_out_motornet.json: its load, its env's step, and each size's table row)."""
     root = Path(__file__).resolve().parent.parent
-    run = json.loads((root / "benchmarks" / "results" / "env_speed_center_out.json").read_text(encoding="utf-8"))
+    results = root / "benchmarks" / "results"
+    run = json.loads((results / "env_speed_center_out.json").read_text(encoding="utf-8"))
     prose = " ".join((root / "docs" / "programs.md").read_text(encoding="utf-8").split())
     ids = ("armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1")
     assert run["peer"] == "sync" and run["motornet"] is None and set(run["ids"]) == set(ids)
     top = [run["ids"][i]["sizes"]["8192"] for i in ids]
     at4 = [run["ids"][i]["sizes"]["4"] for i in ids]
     spread = min(top[0]["make_vec"]["cpu_rates"]), max(top[0]["make_vec"]["cpu_rates"])
-    assert f"1 M for `CenterOut-v1` (its repeats: {spread[0] / 1e6:.2f} to {spread[1] / 1e6:.2f} M)" in prose
+    assert f"(its repeats: {spread[0] / 1e6:.2f} to {spread[1] / 1e6:.2f} M)" in prose
     load = run["load_average"]
     assert f"measured on 2 cores under a load average of {load[0]:.1f} to {load[1]:.1f}" in prose
     assert (f"the batch makes {top[0]['make_vec']['cpu']['median'] / 1e6:.2f} M (`CenterOut-v1`) and "
@@ -161,7 +163,20 @@ def test_the_docs_batch_figures_are_the_committed_run() -> None:
             f"{top[1]['sync']['cpu']['median'] / 1e3:.0f} k;") in prose
     assert (f"and {at4[0]['ratio']['median']:.2f} and {at4[1]['ratio']['median']:.2f} times it at 4 envs") in prose
     assert all(run["ids"][i]["batch_from"] == center_out_batch.BATCH_FROM for i in ids)
-    assert "MotorNet's matched env (20 ms of RK4 a step) was not measured here" in prose
+    matched = json.loads((results / "env_speed_center_out_motornet.json").read_text(encoding="utf-8"))
+    facts = matched["motornet"]
+    assert matched["peer"] == "motornet" and set(matched["ids"]) == set(ids)
+    assert facts["matched"] and (facts["dt"], facts["ministeps"], facts["integration"]) == (0.02, 5, "rk4")
+    load = matched["load_average"]
+    assert f"({facts['versions']}; load average {load[0]:.1f} to {load[1]:.1f})" in prose
+    for n in matched["ids"][ids[0]]["sizes"]:
+        cells = []
+        for i in ids:
+            rates = matched["ids"][i]["sizes"][n]
+            ratio = rates["ratio"]
+            cells += [f"{rates['make_vec']['cpu']['median']:,.0f}", f"{rates['motornet']['cpu']['median']:,.0f}",
+                      f"{ratio['median']:.2f} [{ratio['min']:.2f} - {ratio['max']:.2f}]"]
+        assert f"| {int(n):,} | " + " | ".join(cells) + " |" in prose, n
 
 
 @pytest.mark.parametrize("name", ("null", "curl", "savings", "random-fields", "generalization"))
