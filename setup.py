@@ -37,7 +37,8 @@ setup(
                  Extension("armgame.game._cbots", ["armgame/game/_cbots.c"], optional=True),
                  Extension("armgame.env._cvector", ["armgame/env/_cvector.c"], optional=True),
                  Extension("armgame.env._ccenter", ["armgame/env/_ccenter.c"],
-                           depends=["armgame/game/_cstep.h", "armgame/physics/_trig.h"], optional=True),
+                           depends=["armgame/game/_cstep.h", "armgame/physics/_trig.h", "armgame/env/_pyhypot.h",
+                                    "armgame/env/_creach.h"], optional=True),
                  Extension("armgame.records._ctimeline", ["armgame/records/_ctimeline.c"], optional=True)],
     cmdclass={"build_ext": BuildExactExt},
 )

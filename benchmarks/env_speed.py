@@ -5,6 +5,7 @@
     python benchmarks/env_speed.py --json       # one JSON object
     python benchmarks/env_speed.py --suite armgame/ReachDelay-v1 --sizes 1 64 1024 8192 --seconds 0.3
     python benchmarks/env_speed.py --suite armgame/Reach-v1 armgame/ReachHard-v1 --motornet --seconds 0.3 --repeats 3
+    python benchmarks/env_speed.py --suite armgame/CenterOut-v1 --motornet-matched --seconds 1 --repeats 3
 
 Env steps per second (one env step = one decision: 5 physics steps of the game, 20 ms; one
 RK4 step of 0.2 s for Acrobot) with random actions drawn before the clock starts, episodes
@@ -23,7 +24,10 @@ reset as they end:
   and its 8-trial episodes, first end together after hundreds of steps, and an ended trial costs its
   ``info["reaches"]`` row, so the figure is a step's cost once trials and episodes end on every step;
 * with ``--suite ID ... --motornet``, instead of ``SyncVectorEnv``: MotorNet's reaching env beside each id's
-  ``make_vec`` vector env at 1 to 8,192 envs (issue 40, item 5: at least 20 times MotorNet's env at every size).
+  ``make_vec`` vector env at 1 to 8,192 envs (issue 40, item 5: at least 20 times MotorNet's env at every size);
+* with ``--suite ID ... --motornet-matched``, MotorNet's same env with its step matched to armgame's (issue 52,
+  item 5: the CenterOut ids at least 10 times it at every size, and at least 1 M env steps per CPU second at
+  8,192 envs).
 
 MotorNet's env is ``motornet.environment.RandomTargetReach`` (MotorNet 0.3.0's one reaching task: a start
 posture and a target drawn at random, the batch stepped as one ``batch_size``) on the ``Reacher`` effector with
@@ -41,6 +45,11 @@ armgame's vector env is single-threaded. The actions, uniform in MotorNet's acti
 drawn before the clock starts; MotorNet's episodes end for the whole batch at once (``max_ep_duration``, 1 s
 by default: 100 steps), and the clock includes the ``reset`` that its API then expects. Where torch or
 motornet does not import, the report says so in one line and gives armgame's columns alone.
+
+MotorNet's matched env (``--motornet-matched``) is that env with its effector given armgame's step: ``timestep``
+0.02 (20 ms an env step), ``n_ministeps`` 5 and ``integration_method`` ``"rk4"``, so that one env step is 5 RK4
+steps of 4 ms on each side, as armgame's game and lab step the arm; its episodes stay 1 s long (50 steps now).
+Only the step changes: the arm, its muscles, the task and the API are the default env's above.
 
 Each figure is measured in several repeats, interleaved with its peer so that load from
 elsewhere falls on both; the report gives the median and the range over repeats, and the
@@ -122,39 +131,46 @@ def vector_runner(env_id: str, num_envs: int, mode: str, warm: int = 1) -> Calla
     return run
 
 
-def motornet_env(effector: str) -> Any:
-    """MotorNet's reaching env on ``effector`` ("reacher" or "arm26"), its defaults kept (see the module's doc)."""
+#: MotorNet's effector arguments for armgame's step (``--motornet-matched``): 20 ms as 5 RK4 steps of 4 ms.
+MATCHED_STEP = {"timestep": 0.02, "n_ministeps": 5, "integration_method": "rk4"}
+
+
+def motornet_env(effector: str, matched: bool = False) -> Any:
+    """MotorNet's reaching env on ``effector`` ("reacher" or "arm26"), its defaults kept or, ``matched``, its step
+    armgame's (``MATCHED_STEP``; see the module's doc)."""
     import motornet as mn
     import torch
 
     torch.set_num_threads(1)  # one core against one core: armgame's vector env is single-threaded
+    step = MATCHED_STEP if matched else {}
     if effector == "reacher":
-        arm = mn.effector.Reacher(muscle=mn.muscle.ReluMuscle())
+        arm = mn.effector.Reacher(muscle=mn.muscle.ReluMuscle(), **step)
     else:
-        arm = mn.effector.RigidTendonArm26(muscle=mn.muscle.RigidTendonHillMuscle())
+        arm = mn.effector.RigidTendonArm26(muscle=mn.muscle.RigidTendonHillMuscle(), **step)
     return mn.environment.RandomTargetReach(effector=arm, differentiable=False)
 
 
-def motornet_facts(effector: str) -> dict[str, object]:
+def motornet_facts(effector: str, matched: bool = False) -> dict[str, object]:
     """MotorNet's versions and its env step (simulated seconds, integration), or why it could not be imported."""
     try:
         import motornet as mn
         import torch
     except ImportError as exc:  # the benchmark runs without it: armgame's columns alone
         return {"missing": f"{type(exc).__name__}: {exc}"}
-    env = motornet_env(effector)
+    env = motornet_env(effector, matched)
     arm = env.effector
-    return {"versions": f"torch {torch.__version__}, motornet {mn.__version__}, {torch.get_num_threads()} thread",
+    return {"matched": matched,
+            "versions": f"torch {torch.__version__}, motornet {mn.__version__}, {torch.get_num_threads()} thread",
             "env": f"RandomTargetReach({type(arm).__name__}({type(arm.muscle).__name__}))",
             "dt": env.dt, "ministeps": arm.n_ministeps, "integration": arm.integration_method,
             "episode_seconds": env.max_ep_duration}
 
 
-def motornet_runner(num_envs: int, effector: str) -> Callable[[float], tuple[float, float]]:
+def motornet_runner(num_envs: int, effector: str, matched: bool = False) -> Callable[[float], tuple[float, float]]:
     """Env-steps per second (vector steps x batch size) of MotorNet's env for about ``seconds``: (wall, CPU)."""
     import torch
 
-    env = motornet_env(effector)
+    env = motornet_env(effector, matched)
     generator = torch.Generator().manual_seed(0)
     actions = [torch.rand(num_envs, env.action_space.shape[0], generator=generator) for _ in range(8)]
     options = {"batch_size": num_envs}
@@ -243,9 +259,10 @@ def _compiled() -> str:
 
 
 def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, repeats: int,
-                  motornet: str | None = None) -> dict[str, object]:
+                  motornet: str | None = None, matched: bool = False) -> dict[str, object]:
     """Each id's ``make_vec`` vector env against its peer, paired, at each size: ``SyncVectorEnv`` of its single
-    envs, or with ``motornet`` (an effector) MotorNet's env, where it imports (else ``make_vec`` alone)."""
+    envs, or with ``motornet`` (an effector) MotorNet's env (``matched``: with armgame's step), where it imports
+    (else ``make_vec`` alone)."""
     from armgame.env import CENTER_OUT_V1_IDS
     from armgame.env.base import EnvArgumentError
     from armgame.env.center_out_batch import BATCH_FROM
@@ -253,7 +270,7 @@ def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, re
     from armgame.lab.session import lab_config
 
     load_before = os.getloadavg()[0]
-    facts = motornet_facts(motornet) if motornet else None
+    facts = motornet_facts(motornet, matched) if motornet else None
     if facts is None:
         peer: str | None = "sync"
     else:  # MotorNet, or where it does not import no peer: make_vec's columns alone
@@ -282,7 +299,7 @@ def measure_suite(env_ids: list[str], sizes: tuple[int, ...], seconds: float, re
                     rates[n] = {**paired(runners, seconds, repeats), "sync": {"refused": str(exc)}}
                     continue
             if peer == "motornet":
-                runners["motornet"] = motornet_runner(n, motornet)  # type: ignore[arg-type]
+                runners["motornet"] = motornet_runner(n, motornet, matched)  # type: ignore[arg-type]
             rates[n] = paired(runners, seconds, repeats)
             if peer:
                 rates[n]["ratio"] = spread([a / b for a, b in zip(rates[n]["make_vec"]["cpu_rates"],  # type: ignore[index]
@@ -340,8 +357,9 @@ def report_motornet(result: dict) -> None:
     """Each id's ``make_vec`` vector env beside MotorNet's env: per CPU second, the ratio per env step and per
     simulated second (the two sides' env steps simulate different times)."""
     facts = result["motornet"]
-    print(f"MotorNet: {facts['env']}, {facts['versions']}; its env step {facts['dt'] * 1e3:g} ms simulated "
-          f"({facts['ministeps']} {facts['integration']} step), episodes of {facts['episode_seconds']:g} s "
+    steps = f"{facts['ministeps']} {facts['integration']} step{'s' if facts['ministeps'] > 1 else ''}"
+    print(f"MotorNet{' (matched)' if facts.get('matched') else ''}: {facts['env']}, {facts['versions']}; its env step "
+          f"{facts['dt'] * 1e3:g} ms simulated ({steps}), episodes of {facts['episode_seconds']:g} s "
           f"reset for the whole batch inside the clock")
     cpu = "per CPU s"
     for env_id, found in result["ids"].items():
@@ -432,6 +450,9 @@ def main() -> None:
                         help="instead: these ids' make_vec vector envs against SyncVectorEnv of their single envs")
     parser.add_argument("--motornet", action="store_true",
                         help="with --suite: MotorNet's reaching env as the peer instead of SyncVectorEnv")
+    parser.add_argument("--motornet-matched", action="store_true",
+                        help="with --suite: MotorNet's env with armgame's step (20 ms as 5 RK4 steps of 4 ms) as the "
+                             "peer")
     parser.add_argument("--motornet-effector", choices=("reacher", "arm26"), default="reacher",
                         help="MotorNet's arm: Reacher with ReluMuscle (default, the closest to armgame's) or "
                              "RigidTendonArm26 with RigidTendonHillMuscle")
@@ -440,13 +461,14 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, help="the seconds of one repeat (default 1, --quick 0.3)")
     parser.add_argument("--repeats", type=int, help="the repeats of each figure (default 5, --quick 3)")
     args = parser.parse_args()
-    if args.motornet and not args.suite:
-        parser.error("--motornet is measured beside --suite ID ...")
-    sizes = tuple(args.sizes or (MOTORNET_SIZES if args.motornet else VECTOR_SIZES))
+    motornet = args.motornet or args.motornet_matched
+    if motornet and not args.suite:
+        parser.error("--motornet and --motornet-matched are measured beside --suite ID ...")
+    sizes = tuple(args.sizes or (MOTORNET_SIZES if motornet else VECTOR_SIZES))
     if args.suite:
         result = measure_suite(args.suite, sizes, args.seconds or (0.3 if args.quick else 1.0),
                                args.repeats or (3 if args.quick else 5),
-                               args.motornet_effector if args.motornet else None)
+                               args.motornet_effector if motornet else None, args.motornet_matched)
         if args.json:
             print(json.dumps(result, default=str))
         else:

@@ -5,6 +5,7 @@ autoreset modes the batch runs, and the speed guard's stop."""
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -139,18 +140,20 @@ def test_longer_runs_of_every_kind_equal_sync(env_id: str) -> None:
 
 
 def test_the_docs_batch_figures_are_the_committed_run() -> None:
-    """docs/programs.md's figures for CenterOut's batch are the committed run's
-    (benchmarks/results/env_speed_center_out.json): its load, each id's rate and ratio at 8,192 envs, CenterOut-v1's
-    range there, and the ratios at 4 envs; and the docs say MotorNet was not measured beside it."""
+    """docs/programs.md's figures for CenterOut's batch are the committed runs': beside SyncVectorEnv
+    (benchmarks/results/env_speed_center_out.json: its load, each id's rate and ratio at 8,192 envs, CenterOut-v1's
+    range there, and the ratios at 4 envs), and beside MotorNet's matched env
+    (benchmarks/results/env_speed_center_out_motornet.json: its load, its env's step, and each size's table row)."""
     root = Path(__file__).resolve().parent.parent
-    run = json.loads((root / "benchmarks" / "results" / "env_speed_center_out.json").read_text(encoding="utf-8"))
+    results = root / "benchmarks" / "results"
+    run = json.loads((results / "env_speed_center_out.json").read_text(encoding="utf-8"))
     prose = " ".join((root / "docs" / "programs.md").read_text(encoding="utf-8").split())
     ids = ("armgame/CenterOut-v1", "armgame/CenterOutContinuous-v1")
     assert run["peer"] == "sync" and run["motornet"] is None and set(run["ids"]) == set(ids)
     top = [run["ids"][i]["sizes"]["8192"] for i in ids]
     at4 = [run["ids"][i]["sizes"]["4"] for i in ids]
     spread = min(top[0]["make_vec"]["cpu_rates"]), max(top[0]["make_vec"]["cpu_rates"])
-    assert f"1 M for `CenterOut-v1` (its repeats: {spread[0] / 1e6:.2f} to {spread[1] / 1e6:.2f} M)" in prose
+    assert f"(its repeats: {spread[0] / 1e6:.2f} to {spread[1] / 1e6:.2f} M)" in prose
     load = run["load_average"]
     assert f"measured on 2 cores under a load average of {load[0]:.1f} to {load[1]:.1f}" in prose
     assert (f"the batch makes {top[0]['make_vec']['cpu']['median'] / 1e6:.2f} M (`CenterOut-v1`) and "
@@ -160,7 +163,20 @@ def test_the_docs_batch_figures_are_the_committed_run() -> None:
             f"{top[1]['sync']['cpu']['median'] / 1e3:.0f} k;") in prose
     assert (f"and {at4[0]['ratio']['median']:.2f} and {at4[1]['ratio']['median']:.2f} times it at 4 envs") in prose
     assert all(run["ids"][i]["batch_from"] == center_out_batch.BATCH_FROM for i in ids)
-    assert "MotorNet's matched env (20 ms of RK4 a step) was not measured here" in prose
+    matched = json.loads((results / "env_speed_center_out_motornet.json").read_text(encoding="utf-8"))
+    facts = matched["motornet"]
+    assert matched["peer"] == "motornet" and set(matched["ids"]) == set(ids)
+    assert facts["matched"] and (facts["dt"], facts["ministeps"], facts["integration"]) == (0.02, 5, "rk4")
+    load = matched["load_average"]
+    assert f"({facts['versions']}; load average {load[0]:.1f} to {load[1]:.1f})" in prose
+    for n in matched["ids"][ids[0]]["sizes"]:
+        cells = []
+        for i in ids:
+            rates = matched["ids"][i]["sizes"][n]
+            ratio = rates["ratio"]
+            cells += [f"{rates['make_vec']['cpu']['median']:,.0f}", f"{rates['motornet']['cpu']['median']:,.0f}",
+                      f"{ratio['median']:.2f} [{ratio['min']:.2f} - {ratio['max']:.2f}]"]
+        assert f"| {int(n):,} | " + " | ".join(cells) + " |" in prose, n
 
 
 @pytest.mark.parametrize("name", ("null", "curl", "savings", "random-fields", "generalization"))
@@ -207,3 +223,66 @@ def test_the_c_reach_measures_are_reach_metrics_bit_for_bit() -> None:
         want = np.array(list(reach_metrics(reach).as_dict().values()))
         assert np.array_equal(np.isnan(want), np.isnan(out[k])), k
         assert want[~np.isnan(want)].tobytes() == out[k][~np.isnan(out[k])].tobytes(), (k, want, out[k])
+
+
+@compiled
+def test_the_dense_rewards_distance_is_math_hypot_bit_for_bit() -> None:
+    # _ccenter.edges stands for the single env's max(0.0, math.hypot(dx, dy) - radius): CPython's own hypot (not the
+    # C library's, which differs in the last bit now and then), on game-sized, huge, tiny, subnormal, far-apart and
+    # special values, and random bit patterns.
+    rng = np.random.default_rng(53)
+    count = 60_000
+    special = (0.0, -0.0, 5e-324, 1e-310, 2.2250738585072014e-308, 0.5, 1.0, 3.0, 4.0, 0.1, 1e308,
+               1.7976931348623157e308, np.inf, -np.inf, np.nan)
+    xy = np.concatenate([rng.normal(0.0, 0.3, (count, 2)),
+                         rng.uniform(-1, 1, (count, 2)) * 10.0 ** rng.integers(-320, 309, (count, 1)),
+                         rng.integers(0, 2**63, (count, 2), dtype=np.int64).view(np.float64),
+                         np.column_stack([rng.normal(size=count), rng.normal(size=count) * 10.0 ** rng.integers(
+                             -200, 200, count)]),
+                         [(x, y) for x in special for y in special]])
+    n = len(xy)
+    obs, ints, trials = np.zeros((n, 16)), np.zeros((n, center_out_batch.I_COUNT), np.int64), \
+        np.zeros((n, center_out_batch.T_COUNT))
+    obs[:, 12:14] = xy
+    ints[:, center_out_batch.I_PHASE] = rng.integers(0, 2, n)
+    trials[:, center_out_batch.T_TR] = rng.uniform(0.0, 0.05, n) * (np.arange(n) % 3 > 0)
+    trials[:, center_out_batch.T_HR] = rng.uniform(0.0, 0.05, n)
+    out = np.empty(n)
+    center_out_batch._ccenter.edges(obs, ints, trials, None, out)
+    radius = np.where(ints[:, center_out_batch.I_PHASE] == 1, trials[:, center_out_batch.T_TR],
+                      trials[:, center_out_batch.T_HR])
+    want = np.array([max(0.0, math.hypot(x, y) - r) for (x, y), r in zip(xy.tolist(), radius.tolist(), strict=True)])
+    assert want.tobytes() == out.tobytes()
+    runs = rng.integers(0, n, 1000)
+    some = np.empty(len(runs))
+    center_out_batch._ccenter.edges(obs, ints, trials, runs, some)
+    assert some.tobytes() == want[runs].tobytes()
+
+
+@compiled
+@pytest.mark.parametrize("continuous", (False, True))
+def test_actions_of_every_type_and_bad_ones_as_sync(continuous: bool) -> None:
+    # The batch maps the actions in C (_ccenter.act): keys as bools, int8, int64, float64, float32 and lists, levels
+    # as float64, ints and lists, equal to SyncVectorEnv's. A bad value in a stepping run is refused in one line before
+    # any run's muscles change: the batch goes on as its twin, which was never given it.
+    args = {"continuous": continuous, "episode_trials": 1}
+    sync, batch, twin = CenterOutVectorEnv(4, **args), CenterOutBatchVectorEnv(4, **args), \
+        CenterOutBatchVectorEnv(4, **args)
+    same(sync.reset(seed=9), batch.reset(seed=9), "reset")
+    twin.reset(seed=9)
+    rng = np.random.default_rng(9)
+    kinds = ((lambda a: a.astype(np.float64), lambda a: (a * 2 - 1).astype(np.int64), lambda a: (a - 0.5).tolist())
+             if continuous else (lambda a: a.astype(bool), lambda a: a.astype(np.int8), lambda a: a.astype(np.int64),
+                                 lambda a: a.astype(np.float64), lambda a: a.astype(np.float32), lambda a: a.tolist()))
+    for t in range(120):
+        keys = rng.integers(0, 2, (4, 4)) if not continuous else rng.uniform(0, 1, (4, 4))
+        action = kinds[t % len(kinds)](keys)
+        if t % 17 == 5:
+            bad = np.array(action, dtype=np.float64)
+            bad[t % 4, t % 3] = np.nan if continuous else 2.0
+            with pytest.raises(ValueError, match="finite numbers" if continuous else "zeros or ones"):
+                batch.step(bad)
+        a, b = sync.step(action), batch.step(action)
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            same(x, y, f"step {t}, item {k}")
+        same(b, twin.step(action), f"twin, step {t}")

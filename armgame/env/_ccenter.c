@@ -1,6 +1,8 @@
 /* CenterOut-v1's vector env in C: ``LabSession._advance``'s loop (the muscles, the arm's step with the trial's
  * field, the speed guard, the shown hand and the task's hold and reach) for a batch of runs, and the v1
- * observation of each. ``armgame.env.center_out_batch`` drives it: it keeps each run's trials (the lab's
+ * observation of each; and a step's per-run work around it: the actions' muscles (``act``), the dense reward
+ * (``progress``, ``edges``: the single env's math.hypot, _pyhypot.h) and each ended trial's reach measures
+ * (``measures``, _creach.h). ``armgame.env.center_out_batch`` drives it: it keeps each run's trials (the lab's
  * ``schedule``) and, at a trial's end, the outcome, its row of the lab's table and the next trial's
  * description; this loop stops a run there and is called again for the steps left.
  *
@@ -22,6 +24,7 @@
 int armgame_use_sincos = 0;
 #endif
 #include "../game/_cstep.h"
+#include "_pyhypot.h"
 
 /* Columns of a run's float state, int state and trial (the Python side names them the same). */
 enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_COUNT = 20 };
@@ -76,8 +79,16 @@ static inline void shown(const double *t, int64_t phase, double q1, double q2, d
     }
 }
 
+/* The step's arm and field code inlined into the run's loop (GCC, Clang): the calls of accel_full, four a step, cost
+ * a tenth of the loop's time. */
+#if defined(__GNUC__) || defined(__clang__)
+#define RUN_FLATTEN __attribute__((flatten))
+#else
+#define RUN_FLATTEN
+#endif
+
 /* One run: up to it[I_TODO] steps, stopping after a trial's end or the guard's stop (it[I_EVENT] says which). */
-static void run(const Arm *arm, const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
+RUN_FLATTEN static void run(const Arm *arm, const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
                 int64_t cap)
 {
     int64_t n = it[I_TODO];
@@ -87,27 +98,23 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
     if (n <= 0)
         return;
     const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
-    const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
-    const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
     double *x = s + S_X;
-    double a0 = s[S_A], a1 = s[S_A + 1], a2 = s[S_A + 2], a3 = s[S_A + 3];
-    const double g0 = s[S_G], g1 = s[S_G + 1], g2 = s[S_G + 2], g3 = s[S_G + 3];
-    const double r0 = s[S_R], r1 = s[S_R + 1], r2 = s[S_R + 2], r3 = s[S_R + 3];
+    double a[4] = {s[S_A], s[S_A + 1], s[S_A + 2], s[S_A + 3]};
+    const double *g = s + S_G, *r = s + S_R;
     const double limit = t[T_LIMIT];
     const Field field = {(int)t[T_FIELD], {t[T_FP], t[T_FP + 1], t[T_FP + 2], t[T_FP + 3]}, l1, l2};
     int64_t phase = it[I_PHASE], counter = it[I_COUNTER], steps = it[I_STEPS], path = it[I_PATH];
     int64_t ran = 0;
     while (ran < n) {
-        const double t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
-        const double t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
-        a0 += (g0 - a0) * r0;
-        a1 += (g1 - a1) * r1;
-        a2 += (g2 - a2) * r2;
-        a3 += (g3 - a3) * r3;
+        double t1, t2;
+        muscle_step(p, a, g, r, &t1, &t2);
         const int loaded = phase == 1 && field.kind != FIELD_NONE;
         double previous[4];
         memcpy(previous, x, sizeof previous);
-        rk4_exact(arm, loaded ? &field : NULL, t1, t2, dt, x);
+        if (loaded)
+            rk4_exact(arm, &field, t1, t2, dt, x);
+        else  /* apart, so that the inlined step without a field has no test of one */
+            rk4_exact(arm, NULL, t1, t2, dt, x);
         if (loaded && !(-limit <= x[2] && x[2] <= limit && -limit <= x[3] && x[3] <= limit)) {
             /* variant.guarded: the state is refused, the run keeps the last one and ends there. */
             s[S_FW1] = x[2];
@@ -154,7 +161,7 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
         x[0] = t[T_HQ1];
         x[1] = t[T_HQ2];
         x[2] = x[3] = 0.0;
-        a0 = a1 = a2 = a3 = 0.0;
+        a[0] = a[1] = a[2] = a[3] = 0.0;
         s[S_CX] = t[T_HX];
         s[S_CY] = t[T_HY];
         phase = 0;
@@ -163,10 +170,7 @@ static void run(const Arm *arm, const double *p, double *s, int64_t *it, const d
         it[I_TODO] = n - ran;
         break;
     }
-    s[S_A] = a0;
-    s[S_A + 1] = a1;
-    s[S_A + 2] = a2;
-    s[S_A + 3] = a3;
+    memcpy(s + S_A, a, sizeof a);
     it[I_PHASE] = phase;
     it[I_COUNTER] = counter;
     it[I_STEPS] = steps;
@@ -279,193 +283,8 @@ fail:
     return NULL;
 }
 
-/* ---------------------------------------------------------------- a trial's reach measures
- * lab.metrics.reach_metrics (its defaults: threshold 0.05, the direction 100 ms after onset, moved from 0.01 m/s)
- * on lab.analysis.reach_of's reach, operation for operation in numpy's order, so each number is the single env's
- * bit for bit: np.gradient's differences, the C library's hypot (np.hypot's), np.argmax's first largest (a NaN
- * first), np.interp's search and slope (numpy's compiled_base.c), np.sum's pairwise sum from its identity 0, and
- * Python's math.atan2 and math.degrees. tests/test_env_center_out_batch.py compares it with reach_metrics. */
-enum { M_RT, M_MT, M_PEAK, M_DIR, M_PERP, M_RATIO, M_COUNT };
-
-/* numpy's pairwise sum of float64 (loops_utils.h.src), as np.add.reduce runs it on one contiguous array. */
-static double pairwise_sum(const double *a, int64_t n)
-{
-    if (n < 8) {
-        double res = -0.0;
-        for (int64_t i = 0; i < n; i++)
-            res += a[i];
-        return res;
-    }
-    if (n <= 128) {
-        double r[8];
-        int64_t i;
-        for (int k = 0; k < 8; k++)
-            r[k] = a[k];
-        for (i = 8; i < n - (n % 8); i += 8)
-            for (int k = 0; k < 8; k++)
-                r[k] += a[i + k];
-        double res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
-        for (; i < n; i++)
-            res += a[i];
-        return res;
-    }
-    int64_t n2 = n / 2;
-    n2 -= n2 % 8;
-    return pairwise_sum(a, n2) + pairwise_sum(a + n2, n - n2);
-}
-
-/* np.interp(x, t, f) at one x, t increasing (n >= 2): numpy's arr_interp without precomputed slopes. */
-static double interp(double x, const double *t, const double *f, int64_t n)
-{
-    if (isnan(x))
-        return x;
-    if (x > t[n - 1])
-        return f[n - 1];
-    if (x < t[0])
-        return f[0];
-    int64_t lo = 0, hi = n; /* the last j with t[j] <= x */
-    while (lo < hi) {
-        const int64_t mid = lo + ((hi - lo) >> 1);
-        if (x >= t[mid])
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    const int64_t j = lo - 1;
-    if (j == n - 1 || t[j] == x)
-        return f[j];
-    const double slope = (f[j + 1] - f[j]) / (t[j + 1] - t[j]);
-    double r = slope * (x - t[j]) + f[j];
-    if (isnan(r)) {
-        r = slope * (x - t[j + 1]) + f[j + 1];
-        if (isnan(r) && f[j] == f[j + 1])
-            r = f[j];
-    }
-    return r;
-}
-
-/* np.argmax over a[from:to]: the first largest, or the first NaN. */
-static int64_t argmax(const double *a, int64_t from, int64_t to)
-{
-    int64_t best = from;
-    for (int64_t k = from; k < to; k++) {
-        if (isnan(a[k]))
-            return k;
-        if (a[k] > a[best])
-            best = k;
-    }
-    return best;
-}
-
-/* Python's math.atan2 (its m_atan2: the special values before the C library's). */
-static double py_atan2(double y, double x)
-{
-    const double pi = 3.141592653589793;
-    if (isnan(x) || isnan(y))
-        return NAN;
-    if (isinf(y)) {
-        if (isinf(x))
-            return copysign(x > 0 ? 0.25 * pi : 0.75 * pi, y);
-        return copysign(0.5 * pi, y);
-    }
-    if (isinf(x) || y == 0.0)
-        return copysign(1.0, x) == 1.0 ? 0.0 * y : copysign(pi, y);
-    return atan2(y, x);
-}
-
-/* One reach: the hand x, y (n samples from the go cue), its first sample's step go, the step dt, the home and
- * target centres; out gets the six measures (NaN where undefined); work holds 6 n doubles. */
-static void reach_measures(const double *x, const double *y, int64_t n, int64_t go, double dt, const double *home,
-                           const double *target, double *out, double *work)
-{
-    for (int k = 0; k < M_COUNT; k++)
-        out[k] = NAN;
-    if (n < 2)
-        return;
-    double *t = work, *speed = work + n, *px = work + 2 * n, *py = work + 3 * n, *seg = work + 4 * n,
-           *side = work + 5 * n;
-    const double go_time = (double)go * dt;
-    int finite = isfinite(go_time) && isfinite(home[0]) && isfinite(home[1]) && isfinite(target[0])
-                 && isfinite(target[1]);
-    for (int64_t k = 0; k < n; k++) {
-        t[k] = (double)(go + k) * dt;
-        finite = finite && isfinite(t[k]) && isfinite(x[k]) && isfinite(y[k]);
-    }
-    if (!finite)
-        return;
-    for (int64_t k = 0; k + 1 < n; k++)
-        if (t[k + 1] - t[k] <= 0.0)
-            return;
-    int64_t first = n; /* t increases: the samples at or after the go cue are a tail */
-    for (int64_t k = 0; k < n; k++)
-        if (t[k] >= go_time) {
-            first = k;
-            break;
-        }
-    if (n - first < 2)
-        return;
-    const double step = (t[n - 1] - t[0]) / (double)(n - 1), two = 2.0 * step;
-    speed[0] = hypot((x[1] - x[0]) / step, (y[1] - y[0]) / step);
-    for (int64_t k = 1; k + 1 < n; k++)
-        speed[k] = hypot((x[k + 1] - x[k - 1]) / two, (y[k + 1] - y[k - 1]) / two);
-    speed[n - 1] = hypot((x[n - 1] - x[n - 2]) / step, (y[n - 1] - y[n - 2]) / step);
-    const int64_t peak = argmax(speed, first, n);
-    const double top = speed[peak];
-    out[M_PEAK] = top;
-    if (!(top >= 0.01) || top == 0.0)
-        return;
-    const double level = 0.05 * top;
-    double t_on = t[0], t_end = t[n - 1];
-    for (int64_t i = peak - 1; i >= 0; i--)
-        if (speed[i] < level) {
-            t_on = t[i] + (level - speed[i]) / (speed[i + 1] - speed[i]) * (t[i + 1] - t[i]);
-            break;
-        }
-    for (int64_t j = peak + 1; j < n; j++)
-        if (speed[j] < level) {
-            t_end = t[j - 1] + (speed[j - 1] - level) / (speed[j - 1] - speed[j]) * (t[j] - t[j - 1]);
-            break;
-        }
-    const double on_x = interp(t_on, t, x, n), on_y = interp(t_on, t, y, n);
-    const double end_x = interp(t_end, t, x, n), end_y = interp(t_end, t, y, n);
-    int64_t m = 0;
-    px[m] = on_x;
-    py[m++] = on_y;
-    for (int64_t k = 0; k < n; k++)
-        if (t[k] > t_on && t[k] < t_end) {
-            px[m] = x[k];
-            py[m++] = y[k];
-        }
-    px[m] = end_x;
-    py[m++] = end_y;
-    for (int64_t k = 0; k + 1 < m; k++)
-        seg[k] = hypot(px[k + 1] - px[k], py[k + 1] - py[k]);
-    const double length = 0.0 + pairwise_sum(seg, m - 1);
-    const double chord = hypot(end_x - on_x, end_y - on_y);
-    out[M_RATIO] = chord > 0.0 ? length / chord : NAN;
-    double at = t_on + 0.1;
-    if (t[n - 1] < at)
-        at = t[n - 1];
-    const double moved_x = interp(at, t, x, n) - on_x, moved_y = interp(at, t, y, n) - on_y;
-    const double aim_x = target[0] - home[0], aim_y = target[1] - home[1];
-    const double distance = hypot(aim_x, aim_y);
-    if (distance > 0.0) {
-        const double u0 = aim_x / distance, u1 = aim_y / distance;
-        for (int64_t k = 0; k < m; k++) {
-            const double a = u0 * (py[k] - home[1]), b = u1 * (px[k] - home[0]);
-            side[k] = fabs(a - b);
-            seg[k] = a - b;
-        }
-        out[M_PERP] = seg[argmax(side, 0, m)];
-        if (moved_x != 0.0 || moved_y != 0.0) {
-            const double cross = u0 * moved_y - u1 * moved_x, dot = u0 * moved_x + u1 * moved_y;
-            const double direction = py_atan2(cross, dot) * (180.0 / 3.141592653589793);
-            out[M_DIR] = direction == -180.0 ? 180.0 : direction;
-        }
-    }
-    out[M_RT] = t_on - go_time;
-    out[M_MT] = t_end - t_on;
-}
+/* The reach measures (lab.metrics.reach_metrics, bit for bit): _creach.h. */
+#include "_creach.h"
 
 PyDoc_STRVAR(measures_doc,
 "measures(xs, ys, runs, samples, go, geometry, out) -> None\n\n"
@@ -524,9 +343,238 @@ fail:
     return NULL;
 }
 
+/* ---------------------------------------------------------------- a step's actions and dense reward
+ * The per-run work of a step that the Python side did in numpy and per env: the action's muscles
+ * (``CenterOutV1Env._press_keys`` and ``_set_levels``) and the distance the dense reward measures
+ * (``CenterOutV1Env._edge``: math.hypot, _pyhypot.h). */
+
+/* A read-only contiguous buffer of count items of itemsize bytes (its format is the caller's to read). */
+static int take_items(PyObject *obj, Buffer *buf, const char *name, Py_ssize_t itemsize, Py_ssize_t count,
+                      int writable)
+{
+    if (PyObject_GetBuffer(obj, &buf->view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0)) < 0)
+        return -1;
+    buf->held = 1;
+    if (buf->view.itemsize != itemsize || buf->view.len != count * itemsize) {
+        PyErr_Format(PyExc_ValueError, "%s: expected a contiguous array of %zd items of %zd bytes", name, count,
+                     itemsize);
+        return -1;
+    }
+    return 0;
+}
+
+/* An action's value k of run i as a double, from its buffer's format (float64, float32, int64 or one byte). */
+static inline double action_at(const void *a, char kind, Py_ssize_t k)
+{
+    switch (kind) {
+    case 'd':
+        return ((const double *)a)[k];
+    case 'f':
+        return (double)((const float *)a)[k];
+    case 'q':
+        return (double)((const int64_t *)a)[k];
+    default:
+        return (double)((const uint8_t *)a)[k];
+    }
+}
+
+PyDoc_STRVAR(act_doc,
+"act(actions, continuous, stepping, finished, ints, held, state, rise, decay, task_of) -> bool\n\n"
+"The single env's _set_levels (continuous) or _press_keys on every run that steps (stepping) and is not over:\n"
+"actions (n, 4) float64, float32, int64 or one-byte; held (n, 4) bool, the keys down; rise and decay (tasks, 4)\n"
+"float64, each run's task's rates by task_of. Returns False, changing nothing, where a stepping run's action\n"
+"is not finite (continuous) or not 0 or 1 (keys).");
+
+static PyObject *act(PyObject *self, PyObject *args)
+{
+    PyObject *obj[10];
+    int continuous;
+    Buffer b[10] = {{{0}}};
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OpOOOOOOOO", &obj[0], &continuous, &obj[1], &obj[2], &obj[3], &obj[4], &obj[5],
+                          &obj[6], &obj[7], &obj[8]))
+        return NULL;
+    const Py_ssize_t n = PyObject_Length(obj[1]);
+    const Py_ssize_t tasks = PyObject_Length(obj[6]);
+    if (n < 0 || tasks < 0)
+        goto fail;
+    if (PyObject_GetBuffer(obj[0], &b[0].view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+        goto fail;
+    b[0].held = 1;
+    const char *f = b[0].view.format ? b[0].view.format : "B";
+    if (f[0] == '<' || f[0] == '=' || f[0] == '@')
+        f++;
+    char kind = 0;
+    if (strcmp(f, "d") == 0 || strcmp(f, "f") == 0 || strcmp(f, "q") == 0)
+        kind = f[0];
+    else if (strcmp(f, "l") == 0 && b[0].view.itemsize == 8)
+        kind = 'q';
+    else if ((strcmp(f, "B") == 0 || strcmp(f, "?") == 0) && !continuous)
+        kind = 'B';
+    if (kind == 0 || b[0].view.len != n * 4 * b[0].view.itemsize) {
+        PyErr_SetString(PyExc_ValueError, "actions: expected (n, 4) float64, float32, int64 or one-byte values");
+        goto fail;
+    }
+    if (take_items(obj[1], &b[1], "stepping", 1, n, 0) < 0 || take_items(obj[2], &b[2], "finished", 1, n, 0) < 0
+        || take(obj[3], &b[3], "ints", 'q', n * I_COUNT) < 0 || take_items(obj[4], &b[4], "held", 1, n * 4, 1) < 0
+        || take(obj[5], &b[5], "state", 'd', n * S_COUNT) < 0 || take(obj[6], &b[6], "rise", 'd', tasks * 4) < 0
+        || take(obj[7], &b[7], "decay", 'd', tasks * 4) < 0 || take(obj[8], &b[8], "task_of", 'q', n) < 0)
+        goto fail;
+    const uint8_t *stepping = b[1].view.buf, *finished = b[2].view.buf;
+    const int64_t *ints = b[3].view.buf, *task_of = b[8].view.buf;
+    uint8_t *held = b[4].view.buf;
+    double *state = b[5].view.buf;
+    const double *rise = b[6].view.buf, *decay = b[7].view.buf;
+    const void *a = b[0].view.buf;
+    for (Py_ssize_t i = 0; i < n; i++)
+        if (task_of[i] < 0 || task_of[i] >= tasks) {
+            PyErr_SetString(PyExc_ValueError, "task_of: a run's task is not in rise and decay");
+            goto fail;
+        }
+    int ok = 1;
+    /* The whole action is checked before any run's muscles change, as the Python step raised before them. */
+    for (Py_ssize_t i = 0; i < n && ok; i++) {
+        if (!stepping[i])
+            continue;
+        for (int m = 0; m < 4; m++) {
+            const double v = action_at(a, kind, 4 * i + m);
+            ok &= continuous ? isfinite(v) : (v == 0.0 || v == 1.0);
+        }
+    }
+    if (ok)
+        for (Py_ssize_t i = 0; i < n; i++) {
+            const int64_t *it = ints + I_COUNT * i;
+            if (!stepping[i] || finished[i] || it[I_STEPS] >= it[I_TOTAL])
+                continue;
+            double *s = state + S_COUNT * i;
+            const double *up_rate = rise + 4 * task_of[i], *down_rate = decay + 4 * task_of[i];
+            for (int m = 0; m < 4; m++) {
+                const double v = action_at(a, kind, 4 * i + m);
+                if (continuous) {
+                    /* np.clip((level + 1) / 2 as * 0.5, 0, 1); the rate rises where the goal is above the activation. */
+                    double level = (v + 1.0) * 0.5;
+                    level = level < 0.0 ? 0.0 : level > 1.0 ? 1.0 : level;
+                    s[S_R + m] = level > s[S_A + m] ? up_rate[m] : down_rate[m];
+                    s[S_G + m] = level;
+                } else {
+                    const uint8_t down = v == 1.0;
+                    if (down == (held[4 * i + m] != 0))
+                        continue;  /* a key held, or left up: its muscle goes on as it was */
+                    held[4 * i + m] = down;
+                    s[S_G + m] = down ? 1.0 : 0.0;
+                    s[S_R + m] = down ? up_rate[m] : down_rate[m];
+                }
+            }
+        }
+    release(b, 10);
+    return PyBool_FromLong(ok);
+fail:
+    release(b, 10);
+    return NULL;
+}
+
+/* A run's cursor distance to its shown target's edge: the single env's max(0.0, math.hypot(dx, dy) - radius). */
+static inline double edge_of(const double *o, const int64_t *it, const double *t)
+{
+    const double radius = it[I_PHASE] == 1 ? t[T_TR] : t[T_HR];
+    const double e = py_hypot(o[12], o[13]) - radius;
+    return e > 0.0 ? e : 0.0;  /* Python's max(0.0, e): 0.0 unless e is above it */
+}
+
+PyDoc_STRVAR(progress_doc,
+"progress(obs, ints, trials, trial, shown, edge, stepping, out) -> None\n\n"
+"The dense reward's progress of every run (CenterOutV1Env._dense_reward's): its last edge (edge) less its edge now\n"
+"where it shows the same target as then (shown (n, 2) int64: the trial and phase it showed; trial: the trial under\n"
+"way), else 0.0, into out; and, for the runs that stepped, edge and shown set to now's.");
+
+static PyObject *progress(PyObject *self, PyObject *args)
+{
+    PyObject *obj[8];
+    Buffer b[8] = {{{0}}};
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOOOO", &obj[0], &obj[1], &obj[2], &obj[3], &obj[4], &obj[5], &obj[6], &obj[7]))
+        return NULL;
+    const Py_ssize_t n = PyObject_Length(obj[1]);
+    if (n < 0 || take(obj[0], &b[0], "obs", 'd', n * 16) < 0 || take(obj[1], &b[1], "ints", 'q', n * I_COUNT) < 0
+        || take(obj[2], &b[2], "trials", 'd', n * T_COUNT) < 0 || take(obj[3], &b[3], "trial", 'q', n) < 0
+        || take(obj[4], &b[4], "shown", 'q', 2 * n) < 0 || take(obj[5], &b[5], "edge", 'd', n) < 0
+        || take_items(obj[6], &b[6], "stepping", 1, n, 0) < 0 || take(obj[7], &b[7], "out", 'd', n) < 0)
+        goto fail;
+    const double *obs = b[0].view.buf, *trials = b[2].view.buf;
+    const int64_t *ints = b[1].view.buf, *trial = b[3].view.buf;
+    int64_t *shown = b[4].view.buf;
+    double *edge = b[5].view.buf, *out = b[7].view.buf;
+    const uint8_t *stepping = b[6].view.buf;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const int64_t *it = ints + I_COUNT * i;
+        const double now = edge_of(obs + 16 * i, it, trials + T_COUNT * i);
+        const int same = shown[2 * i] == trial[i] && shown[2 * i + 1] == it[I_PHASE];
+        out[i] = same ? edge[i] - now : 0.0;
+        if (stepping[i]) {
+            edge[i] = now;
+            shown[2 * i] = trial[i];
+            shown[2 * i + 1] = it[I_PHASE];
+        }
+    }
+    release(b, 8);
+    Py_RETURN_NONE;
+fail:
+    release(b, 8);
+    return NULL;
+}
+
+PyDoc_STRVAR(edges_doc,
+"edges(obs, ints, trials, runs, out) -> None\n\n"
+"Each run's cursor distance to its shown target's edge, max(0.0, math.hypot(obs[:, 12], obs[:, 13]) - radius)\n"
+"(the target's radius in a reach, else home's), bit for bit: of runs (int64) into out, or of every run where\n"
+"runs is None.");
+
+static PyObject *edges(PyObject *self, PyObject *args)
+{
+    PyObject *obj[5];
+    Buffer b[5] = {{{0}}};
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOO", &obj[0], &obj[1], &obj[2], &obj[3], &obj[4]))
+        return NULL;
+    const Py_ssize_t n = PyObject_Length(obj[1]);
+    if (n < 0 || take(obj[0], &b[0], "obs", 'd', n * 16) < 0 || take(obj[1], &b[1], "ints", 'q', n * I_COUNT) < 0
+        || take(obj[2], &b[2], "trials", 'd', n * T_COUNT) < 0)
+        goto fail;
+    Py_ssize_t k = n;
+    const int64_t *runs = NULL;
+    if (obj[3] != Py_None) {
+        k = PyObject_Length(obj[3]);
+        if (k < 0 || take(obj[3], &b[3], "runs", 'q', k) < 0)
+            goto fail;
+        runs = b[3].view.buf;
+        for (Py_ssize_t j = 0; j < k; j++)
+            if (runs[j] < 0 || runs[j] >= n) {
+                PyErr_SetString(PyExc_ValueError, "runs must be within the batch");
+                goto fail;
+            }
+    }
+    if (take(obj[4], &b[4], "out", 'd', k) < 0)
+        goto fail;
+    const double *obs = b[0].view.buf, *trials = b[2].view.buf;
+    const int64_t *ints = b[1].view.buf;
+    double *out = b[4].view.buf;
+    for (Py_ssize_t j = 0; j < k; j++) {
+        const Py_ssize_t i = runs ? runs[j] : j;
+        out[j] = edge_of(obs + 16 * i, ints + I_COUNT * i, trials + T_COUNT * i);
+    }
+    release(b, 5);
+    Py_RETURN_NONE;
+fail:
+    release(b, 5);
+    return NULL;
+}
+
 static PyMethodDef methods[] = {
     {"advance", advance, METH_VARARGS, advance_doc},
     {"measures", measures, METH_VARARGS, measures_doc},
+    {"act", act, METH_VARARGS, act_doc},
+    {"edges", edges, METH_VARARGS, edges_doc},
+    {"progress", progress, METH_VARARGS, progress_doc},
     {NULL, NULL, 0, NULL},
 };
 

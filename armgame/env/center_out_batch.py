@@ -324,6 +324,8 @@ class CenterOutBatchVectorEnv(VectorEnv):
         """Each task's trials' blocks and block names as one table's row, padded with its last trial's: indexed by
         (the run's task, its trial index clipped to the table) it is the block of the trial under way, or of the
         last trial once the run is done (as ``LabSession.block_name`` reads it)."""
+        self._rise = np.stack([t.rise for t in self._task_list])
+        self._decay = np.stack([t.decay for t in self._task_list])
         width = max(len(t.blocks) for t in self._task_list)
         self._blocks = np.stack([np.pad(t.blocks, (0, width - len(t.blocks)), mode="edge") for t in self._task_list])
         self._names = np.stack([np.concatenate([t.block_names, [t.block_names[-1]] * (width - len(t.block_names))])
@@ -391,40 +393,24 @@ class CenterOutBatchVectorEnv(VectorEnv):
         return over | (self._trial - self._first_trial >= self.template.episode_trials)
 
     def _act(self, actions: Any, stepping: np.ndarray) -> None:
-        """The single env's ``_press_keys`` or ``_set_levels`` on every stepping run that is not over."""
+        """The single env's ``_press_keys`` or ``_set_levels`` on every stepping run that is not over, in C
+        (``_ccenter.act``)."""
         n = self.num_envs
-        live = stepping & (self.ints[:, I_STEPS] < self.ints[:, I_TOTAL])
-        live &= ~self._finished
-        if len(self._task_list) > 1:
-            rise = np.stack([t.rise for t in self._task_list])[self._task_of]
-            decay = np.stack([t.decay for t in self._task_list])[self._task_of]
-        else:
-            rise, decay = self._task_list[0].rise, self._task_list[0].decay
-        goal, rate = self.state[:, S_G:S_G + 4], self.state[:, S_R:S_R + 4]
-        everyone = stepping.all()
-        if self.template.continuous:
-            levels = np.asarray(actions, dtype=np.float64)
-            if levels.shape != (n, 4) or not np.isfinite(levels if everyone else levels[stepping]).all():
-                raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) finite numbers in [-1, 1], got "
-                                 f"shape {levels.shape}")
-            levels = np.clip((levels + 1.0) * 0.5, 0.0, 1.0)
-            up = levels > self.state[:, S_A:S_A + 4]
-            where = np.broadcast_to(live[:, None], up.shape)
-            np.copyto(goal, levels, where=where)
-            np.copyto(rate, rise, where=where & up)
-            np.copyto(rate, decay, where=where & ~up)
-            return
-        pressed = np.asarray(actions)
-        keys = pressed if everyone else pressed[stepping]
-        if pressed.shape != (n, 4) or not ((keys == 0) | (keys == 1)).all():
-            raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) zeros or ones (keys held), got shape "
-                             f"{pressed.shape}")
-        down = pressed == 1
-        change = (down != self.held) & live[:, None]
-        self.held ^= change
-        np.copyto(goal, down, where=change)
-        np.copyto(rate, rise, where=change & down)
-        np.copyto(rate, decay, where=change & ~down)
+        continuous = self.template.continuous
+        given = np.asarray(actions)
+        if continuous:
+            if given.dtype not in (np.float64, np.float32):
+                given = np.asarray(actions, dtype=np.float64)
+        elif given.dtype.kind == "b" or given.dtype in (np.int8, np.uint8):
+            given = given.view(np.uint8)  # int8's -1 reads 255: refused as a key, as it was
+        elif given.dtype != np.int64 and given.dtype != np.float64:
+            # Any other keys as 0, 1 or 2 (neither, refused where the run steps), compared as numpy compares them.
+            given = np.where(given == 1, 1, np.where(given == 0, 0, 2)).astype(np.uint8)
+        if given.shape != (n, 4) or not _ccenter.act(np.ascontiguousarray(given), continuous, stepping, self._finished,
+                                                      self.ints, self.held, self.state, self._rise, self._decay,
+                                                      self._task_of):
+            what = "finite numbers in [-1, 1]" if continuous else "zeros or ones (keys held)"
+            raise ValueError(f"a CenterOut-v1 vector action is ({n}, 4) {what}, got shape {given.shape}")
 
     def _advance(self) -> dict[int, list[dict[str, object]]]:
         """Run the C loop until every run has run its steps, ending trials as ``LabSession._task_step`` does."""
@@ -481,23 +467,18 @@ class CenterOutBatchVectorEnv(VectorEnv):
 
     def _edges(self, runs: np.ndarray | None = None) -> np.ndarray:
         """Each cursor's distance to its shown target's edge (of ``runs``, default all), by ``math.hypot`` as the
-        single env measures it."""
-        obs, ints, trials = (self._obs, self.ints, self.trials) if runs is None else \
-            (self._obs[runs], self.ints[runs], self.trials[runs])
-        radius = np.where(ints[:, I_PHASE] == 1, trials[:, T_TR], trials[:, T_HR])
-        d = np.fromiter(map(math.hypot, obs[:, 12].tolist(), obs[:, 13].tolist()), float, len(obs))
-        return np.maximum(0.0, d - radius)
+        single env measures it (``_ccenter.edges``: CPython's hypot in C)."""
+        out = np.empty(self.num_envs if runs is None else len(runs))
+        _ccenter.edges(self._obs, self.ints, self.trials, None if runs is None else runs.astype(np.int64), out)
+        return out
 
     def _rewards(self, hits: np.ndarray, stepping: np.ndarray) -> np.ndarray:
         env = self.template
         if env.reward_kind == "sparse":
             return hits.astype(np.float64)
-        shown = np.stack([self._trial, self.ints[:, I_PHASE]], axis=1)
-        edge = self._edges()
-        same = (shown == self._shown).all(axis=1)
-        progress = np.where(same, self._edge - edge, 0.0)
-        self._edge = np.where(stepping, edge, self._edge)
-        self._shown = np.where(stepping[:, None], shown, self._shown)
+        # Each run's last edge less its edge now where it shows the same target, and now's kept where it stepped.
+        progress = np.empty(self.num_envs)
+        _ccenter.progress(self._obs, self.ints, self.trials, self._trial, self._shown, self._edge, stepping, progress)
         return env.progress_weight * progress + env.hit_bonus * hits
 
     def _observations(self) -> np.ndarray:

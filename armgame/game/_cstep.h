@@ -238,6 +238,18 @@ static inline void rk4_exact(const Arm *arm, const Field *field, double t1, doub
     x[3] = w2 + k * (ka2 + kd2 + 2.0 * (kb2 + kc2));
 }
 
+/* GameSession._advance's muscles for one step: the torques (t1 shoulder, t2 elbow) from the activations a as
+ * they are, then each activation a step toward its goal g at its rate r. The game's loop and the lab's batch
+ * (env/_ccenter.c) both step their muscles here. */
+static inline void muscle_step(const double *p, double a[4], const double g[4], const double r[4], double *t1,
+                               double *t2)
+{
+    *t1 = a[0] * p[P_S0] + a[1] * p[P_S1] + a[2] * p[P_S2] + a[3] * p[P_S3];
+    *t2 = a[0] * p[P_E0] + a[1] * p[P_E1] + a[2] * p[P_E2] + a[3] * p[P_E3];
+    for (int m = 0; m < 4; m++)
+        a[m] += (g[m] - a[m]) * r[m];
+}
+
 /* The relative margin of game_loop's "near" test over the exact one (which Python makes): far above
  * the round-off of squaring by multiplication instead of ``**``. */
 #define NEAR_MARGIN 1e-9
@@ -257,12 +269,8 @@ static inline int64_t game_loop(const Arm *arm, const double *p, const double g[
                                 double ty, double rr, int64_t n, Game *game, int *near)
 {
     double *x = game->x;
-    double a0 = game->a[0], a1 = game->a[1], a2 = game->a[2], a3 = game->a[3];
-    const double g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3];
-    const double r0 = r[0], r1 = r[1], r2 = r[2], r3 = r[3];
+    double a[4] = {game->a[0], game->a[1], game->a[2], game->a[3]};
     const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
-    const double s0 = p[P_S0], s1 = p[P_S1], s2 = p[P_S2], s3 = p[P_S3];
-    const double e0 = p[P_E0], e1 = p[P_E1], e2 = p[P_E2], e3 = p[P_E3];
     const double close = rr * (1.0 + NEAR_MARGIN);
     /* |the hand's move| <= reach1 |dq1| + reach2 |dq2| (numpy_kernel.hand_move_bounds, a hair over). */
     const double reach1 = (l1 + l2) * (1.0 + 1e-9), reach2 = l2 * (1.0 + 1e-9);
@@ -272,12 +280,8 @@ static inline int64_t game_loop(const Arm *arm, const double *p, const double g[
     *near = 0;
     while (ran < n) {
         /* GameSession._advance: torque from the activations, then the muscles step, then RK4. */
-        const double t1 = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3;
-        const double t2 = a0 * e0 + a1 * e1 + a2 * e2 + a3 * e3;
-        a0 += (g0 - a0) * r0;
-        a1 += (g1 - a1) * r1;
-        a2 += (g2 - a2) * r2;
-        a3 += (g3 - a3) * r3;
+        double t1, t2;
+        muscle_step(p, a, g, r, &t1, &t2);
         memcpy(game->previous, x, sizeof game->previous);
         rk4_exact(arm, NULL, t1, t2, dt, x);
         ran++;
@@ -300,10 +304,7 @@ static inline int64_t game_loop(const Arm *arm, const double *p, const double g[
             slack = sqrt(d2h) - radius - 1e-9;
         }
     }
-    game->a[0] = a0;
-    game->a[1] = a1;
-    game->a[2] = a2;
-    game->a[3] = a3;
+    memcpy(game->a, a, sizeof a);
     return ran;
 }
 
