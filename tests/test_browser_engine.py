@@ -178,6 +178,7 @@ def played() -> dict:
     return {"games": games, "knife": knife, "full": full, "answer": answer}
 
 
+@pytest.mark.slow  # node's 1,000 games (3 s): CI's slow tier; the suite plays test_golden's game through the engine
 def test_short_random_games_are_the_python_games_bit_for_bit(played):
     games, answer = played["games"], played["answer"]["games"]
     assert len(games) >= 1000
@@ -195,6 +196,7 @@ def test_short_random_games_are_the_python_games_bit_for_bit(played):
     assert hits >= 150 and resets >= 100 and hidden >= 100 and ignored >= 1000, (hits, resets, hidden, ignored)
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_knife_edge_hits_are_decided_alike(played):
     knife, answer = played["knife"], played["answer"]["games"]
     start = len(played["games"])
@@ -208,6 +210,7 @@ def test_knife_edge_hits_are_decided_alike(played):
                for j in range(0, len(knife), 2))
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_full_games_hand_in_replays_the_server_verifies(played):
     full, answer = played["full"], played["answer"]["games"]
     start = len(played["games"]) + len(played["knife"])

@@ -194,11 +194,13 @@ def same_runs(played: dict) -> None:
         assert mine == theirs, f"run {i} (plan {played['runs'][i]['plan']}) differs from LabSession"
 
 
+@pytest.mark.slow  # node's 520 runs against LabSession (3 s): CI's slow tier; the suite keeps test_lab_page's lesson
 def test_random_lab_runs_are_labsession_bit_for_bit(played):
     assert len(played["runs"]) >= 500
     same_runs(played)
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_the_c_librarys_sine_is_not_the_browsers(played):
     """Why the browser's runs take the arm's own sine: on the C library's, most of the same runs record other paths
     (their replays would not verify), and the fields' runs end in other states."""
@@ -218,6 +220,7 @@ def test_a_longer_sweep():
     same_runs(sweep(1500, (5000, 10000, 20000), 51))
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_the_runs_reach_what_they_are_meant_to_hold(played):
     """The random runs are not idle: they reach every block kind and every way a trial ends."""
     plans, runs, expected = played["plans"], played["runs"], played["expected"]
@@ -242,6 +245,7 @@ def test_the_runs_reach_what_they_are_meant_to_hold(played):
     assert sum(len(out["trials"]) for out in expected) > 2500
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_a_browser_lab_run_hands_in_a_replay_the_server_verifies(played):
     for session, index in played["whole"]:
         text = played["answer"]["runs"][index]["replay"]
@@ -262,6 +266,7 @@ def test_a_browser_lab_run_hands_in_a_replay_the_server_verifies(played):
         assert not Replay.from_bytes(json.dumps(data).encode()).verify()[0]
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_a_replay_without_the_sine_is_the_c_librarys_as_before(played):
     """Lab replays recorded before the browser's lab (no ``sine`` in the task) replay on the C library's sine, as
     they were recorded; the same timeline on the arm's sine is another run's paths."""
@@ -314,6 +319,7 @@ def test_the_class_serves_its_plan_and_takes_the_browsers_run_into_its_curve(tmp
     assert [run.player for run in opened.clerk.lab_runs] == ["Ann"]
 
 
+@pytest.mark.slow  # the same node run: CI's slow tier
 def test_plans_it_cannot_play_are_refused_in_one_line(played):
     plan = played["plans"][0]
     bad = [{**plan, "format": "x"}, {**plan, "sine": "library"}, {**plan, "trials": []},

@@ -26,6 +26,7 @@ def standings(opened) -> dict:
         return json.loads(r.read())
 
 
+@pytest.mark.slow  # a whole class (2 s): its parts are the tests below and test_class_handin_lines' bot by --join
 def test_a_class_from_join_to_standings_one_row_per_student(tmp_path, students, capsys):
     folder = tmp_path / "class"
     with running_class(folder) as opened:

@@ -22,8 +22,9 @@ from armgame.lab.protocol_file import load_protocol, protocol_as_dict
 from armgame.records.replay import Replay
 from armgame.records.storage import DataFileError
 
-#: Two field strengths: baseline, a curl field, washout.
-STRONG = ('name = "strong"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "baseline"\ntrials = 4\n'
+#: Two field strengths: baseline, a curl field, washout (go cues after 0.1 to 0.2 s: the trials matter, not the waits).
+STRONG = ('name = "strong"\ntargets = 2\ntimeout = 1.5\ndelay_min = 0.1\ndelay_max = 0.2\n'
+          '[[blocks]]\nname = "baseline"\ntrials = 4\n'
           '[[blocks]]\nname = "field"\ntrials = 8\nperturbation = "curl"\nb = 10.0\n'
           '[[blocks]]\nname = "washout"\ntrials = 3\n')
 WEAK = STRONG.replace('"strong"', '"weak"').replace("b = 10.0", "b = 4.0")

@@ -34,7 +34,10 @@ FINISH = """async ([round, tab]) => {
 }"""
 
 
-@pytest.mark.parametrize("tabs", [2, pytest.param(4, marks=pytest.mark.slow)])  # four tabs: the slow tier
+# In chromium (two tabs about 2 s, four more): the slow tier. The suite keeps kept.js's store of a key a game in
+# tests/play_logic.test.mjs (node).
+@pytest.mark.slow
+@pytest.mark.parametrize("tabs", [2, 4])
 def test_tabs_finishing_games_at_the_same_moment_lose_none(tabs):
     """Every kept game was one shared list, read, changed and written back by each tab: a tab that read it just
     before another tab's write wrote back a list without that tab's game (12 of 40 and 36 of 80 games lost here).

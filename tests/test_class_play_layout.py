@@ -243,8 +243,9 @@ def test_the_labs_screen_on_every_phone_and_tablet_to_its_end(tmp_path):
     _lab_every_size(tmp_path, PHONES + TABLETS, device_scale_factor=2)
 
 
+@pytest.mark.slow  # chromium (about 2 s): CI's slow tier, so the suite launches no chromium
 def test_a_phone_upright_and_sideways_has_every_control_and_the_whole_reach_on_its_screen(tmp_path):
-    """The suite's cheap part: the two ways a phone is held, joining and playing (the rest is CI's, below)."""
+    """The quick part: the two ways a phone is held, joining and playing (the rest is CI's, below)."""
     _every_size(tmp_path, [(390, 844), (844, 390)], end=False, device_scale_factor=3)
 
 

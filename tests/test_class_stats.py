@@ -27,11 +27,14 @@ from armgame.lab.classstats import estimate, welch
 from armgame.records.replay import Replay
 
 #: Baseline, a curl field, washout: k = 3 at each end of the field's 8 trials, the after-effect on the washout's first.
-LESSON = ('name = "mini"\ntargets = 2\ntimeout = 1.5\n[[blocks]]\nname = "baseline"\ntrials = 4\n'
+#: Go cues after 0.1 to 0.2 s (both protocols): the statistics need the trials, not the waits between them.
+LESSON = ('name = "mini"\ntargets = 2\ntimeout = 1.5\ndelay_min = 0.1\ndelay_max = 0.2\n'
+          '[[blocks]]\nname = "baseline"\ntrials = 4\n'
           '[[blocks]]\nname = "field"\ntrials = 8\nperturbation = "curl"\nb = 10.0\n'
           '[[blocks]]\nname = "washout"\ntrials = 3\n')
 #: Train to 90 deg, probe four directions with channel trials (a channel-trial baseline to each first).
-GENERAL = ('name = "minigen"\ntargets = 4\ntimeout = 1.5\n[[blocks]]\nname = "baseline"\ntrials = 4\n'
+GENERAL = ('name = "minigen"\ntargets = 4\ntimeout = 1.5\ndelay_min = 0.1\ndelay_max = 0.2\n'
+           '[[blocks]]\nname = "baseline"\ntrials = 4\n'
            'channel_trials = 4\n[[blocks]]\nname = "exposure"\ntrials = 4\nperturbation = "curl"\nb = 10.0\n'
            'directions_deg = [90]\n[[blocks]]\nname = "test"\ntrials = 10\nperturbation = "curl"\nb = 10.0\n'
            'channel_trials = 4\ndirections_deg = [90]\nprobe_directions_deg = [0, 90, 180, 270]\n')

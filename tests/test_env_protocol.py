@@ -11,7 +11,6 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 import pytest
-from scipy.stats import trim_mean
 
 import armgame.env
 import armgame.env.statistics
@@ -113,6 +112,8 @@ def test_the_statistics_docstring_runs():
 
 
 def test_the_iqm_is_the_quarter_trimmed_mean():
+    from scipy.stats import trim_mean  # here, not at the top: every worker collects this file, few need scipy.stats
+
     rng = np.random.default_rng(0)
     for shape in ((5, 7), (3, 4), (1, 1), (10, 2)):
         x = rng.normal(size=shape)

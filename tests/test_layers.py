@@ -55,7 +55,7 @@ BASE = ("armgame._native", "armgame.errors", "armgame.files", "armgame.limits", 
 def imported_names(path: Path, module: str) -> Iterator[tuple[int, str]]:
     """(line, absolute module name) of every import in the file, relative ones resolved."""
     package = module.split(".") if path.name == "__init__.py" else module.split(".")[:-1]
-    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+    for node in ast.walk(_parsed(path.read_text(), str(path))):
         if isinstance(node, ast.Import):
             yield from ((node.lineno, alias.name) for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -119,7 +119,7 @@ def runtime_imports(path: Path, module: str, lazy: bool) -> Iterator[tuple[int, 
                 base = ".".join(package[:len(package) - child.level + 1]) if child.level else ""
                 yield child.lineno, ".".join(p for p in (base, child.module or "") if p), \
                     tuple(alias.name for alias in child.names)
-            else:
+            elif isinstance(child, (ast.stmt, ast.excepthandler, ast.match_case)):  # no expression holds an import
                 yield from walk(child)
 
     yield from walk(_parsed(path.read_text(), str(path)))
