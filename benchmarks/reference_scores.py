@@ -2,6 +2,9 @@
 
     python benchmarks/reference_scores.py bots --out refs            # the three fixed policies, 100 games each
     python benchmarks/reference_scores.py bots --out refs --ids armgame/CenterOutHold-v1 --policies naive model
+    python benchmarks/reference_scores.py bots --out benchmarks/results/center-out-time --policies shooting \
+        --ids armgame/CenterOut-v1 armgame/CenterOutContinuous-v1 armgame/CenterOutHold-v1 \
+        armgame/CenterOutHoldContinuous-v1                           # CenterOut's shooting controller
     python benchmarks/reference_scores.py ppo armgame/ReachHold-v1 --seed 0 --out refs   # one PPO run (rl extra)
     python benchmarks/reference_scores.py table                      # docs/programs.md's table, from the results
     python benchmarks/reference_scores.py ceilings                   # armgame/env/references.py's CEILINGS
@@ -71,7 +74,7 @@ def run_bots(out: Path, ids: tuple[str, ...], games: int,
     for env_id in ids:
         for policy in policies:
             start, cpu = time.perf_counter(), time.process_time()
-            result = evaluate(policy, env_id, games=games)
+            result = evaluate(policy, env_id, games=games, policy_factory=_factory(policy))
             # CenterOut: each game's seconds from a go cue to a hit too, which ranks policies that hit every trial;
             # and the CPU a decision cost, the env's step included, for protocol 3's reference (the model bot's).
             decisions = round(result.minutes * 60 / DECISION_SECONDS) * result.games
@@ -83,6 +86,16 @@ def run_bots(out: Path, ids: tuple[str, ...], games: int,
             write(out / f"{slug(env_id)}.{policy}.json", env_id, policy, result.hits, time.perf_counter() - start,
                   timing)
             print(result.summary(), flush=True)
+
+
+def _factory(policy: str) -> Any:
+    """``shooting``: a fresh ``CenterOutShootingController`` a game (``armgame.env.center_out_reference``, a
+    CenterOut id's time-optimal controller on the true state); the bots need none."""
+    if policy != "shooting":
+        return None
+    from armgame.env.center_out_reference import CenterOutShootingController
+
+    return CenterOutShootingController
 
 
 def run_ppo(out: Path, env_id: str, seed: int, steps: int, games: int) -> None:
@@ -804,7 +817,9 @@ def _main(argv: list[str] | None = None) -> int:
     bots.add_argument("--games", type=int, default=GAMES)
     bots.add_argument("--ids", nargs="*", default=list(IDS))
     bots.add_argument("--policies", nargs="*", default=["random", "naive", "model"],
-                      help="some of random, naive and model (a row's bots rerun alone)")
+                      choices=["random", "naive", "model", "shooting"],
+                      help="some of random, naive and model (a row's bots rerun alone); shooting: CenterOut's "
+                      "shooting controller (armgame.env.center_out_reference), on the CenterOut ids only")
     ppo = sub.add_parser("ppo")
     ppo.add_argument("env_id")
     ppo.add_argument("--seed", type=int, default=0)

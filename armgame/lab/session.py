@@ -362,6 +362,12 @@ class LabSession(GameSession):
         return self.outcomes[-1].end_step if self.outcomes else 0
 
     @property
+    def stayed(self) -> int:
+        """Physics steps in a row the cursor has stayed in the target (a reach: a hit at ``hold_steps``), or counted
+        toward the go cue (a hold), so far: what a controller that plans the stay in the target starts from."""
+        return self._counter
+
+    @property
     def block(self):
         plan = self.plan or self.plans[-1]
         return self.protocol.blocks[plan.block]
