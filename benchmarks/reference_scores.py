@@ -60,7 +60,8 @@ IDS = ("armgame/Reach-v1", "armgame/ReachContinuous-v1", "armgame/CenterOut-v1",
 
 #: The candidates for a CenterOut id's protocol 3 reference (``center_out_references``), by the policy their
 #: ``bots`` file names, with the code that plays each.
-CENTER_OUT_REFERENCES = {"model": 'armgame.env.evaluate("model", ...): the model bot'}
+CENTER_OUT_REFERENCES = {"model": 'armgame.env.evaluate("model", ...): the model bot',
+                         "shooting": "armgame.env.center_out_reference.CenterOutShootingController()"}
 #: Game seconds a decision (an env step) of every v1 id: 5 physics steps of 4 ms.
 DECISION_SECONDS = 0.02
 
@@ -494,7 +495,8 @@ def references_v3_table() -> str:
                                   hits_per_minute=float(np.mean([r["hits_per_minute"] for r in results])))
                  if results else None)
         shown = "" if score is None else f"{score:.2f} ({len(results)} of 5 seeds at 1 M)"
-        lines.append(f"| `{env_id.split('/')[1]}` | the model bot | {row['games']} | {row['hits']:.1f} hits a minute "
+        code = row["code"].removeprefix("armgame.env.center_out_reference.")
+        lines.append(f"| `{env_id.split('/')[1]}` | `{code}` | {row['games']} | {row['hits']:.1f} hits a minute "
                      f"({row['low']:.1f}-{row['high']:.1f}) | {row['cpu_per_decision']:.5f} | {row['machine']} "
                      f"| {shown} |")
     short = [f"{env_id.split('/')[1]} {rows[env_id]['games'] if env_id in rows else 0}" for env_id in bench.DISTINCT

@@ -105,7 +105,8 @@ def test_protocol_3_divides_by_the_reference_and_a_run_above_it_scores_above_1()
             def score(x, env_id=env_id):
                 return normalised_score(env_id, x, protocol=3)
         else:  # a CenterOut id: the model bot's hits a minute, whatever its count of hits
-            assert row["unit"] == "hits a minute" and "the model bot" in row["code"] and "CenterOut" in env_id
+            assert row["unit"] == "hits a minute" and "CenterOut" in env_id
+            assert row["code"] in scores.CENTER_OUT_REFERENCES.values()
 
             def score(x, env_id=env_id):
                 return normalised_score(env_id, 8.0, protocol=3, hits_per_minute=x)
