@@ -203,6 +203,15 @@ def test_the_docs_tier_table_is_the_committed_results_and_ppos_probe_is_far_belo
         assert probe["env_id"] == env_id and probe["env_steps"] >= 300_000
         assert normalised_score(env_id, probe["mean_hits"], protocol=3) < 0.7
         assert normalised_score(env_id, probe["mean_hits"], protocol=2) is None  # no protocol 2 ceiling
+    # Issue 52's tier: PPO at the protocol's budget, five training seeds, below 0.7 of the reference on every id.
+    for env_id in tier_ids():
+        runs = [json.loads(p.read_text()) for p in
+                sorted((ROOT / "benchmarks" / "results" / "ppo-tier" / env_id.split("/")[1]).glob("seed*/result.json"))]
+        assert sorted(r["training_seed"] for r in runs) == [0, 1, 2, 3, 4], env_id
+        assert {r["env_id"] for r in runs} == {env_id} and {r["budget_steps"] for r in runs} == {4_000_000}
+        mean = sum(r["mean_hits"] for r in runs) / len(runs)
+        assert normalised_score(env_id, mean, protocol=3) < 0.7, env_id
+    assert "PPO stays far below the reference on all three**: 4 M env steps, five training seeds" in guide
     # The prose's figures are the files'.
     folder = ROOT / "benchmarks" / "results" / "tier-probe"
     probes = {name: json.loads((folder / f"{name}-v1" / "result.json").read_text())["mean_hits"]
