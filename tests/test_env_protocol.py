@@ -436,6 +436,7 @@ def test_the_committed_ppo_runs_are_whole_and_summarised_by_their_curves():
               for env_id, by_budget in module.long_runs().items() if env_id in module.IDS and "CenterOut" not in env_id]
     assert len(scores) == 12
     assert f"id for id within {min(scores):.2f} to {max(scores):.2f}" in text
+    assert f"PPO's protocol 3 score is {min(scores):.2f} to {max(scores):.2f} on every Reach id of the suite" in text
     # The page's reading of ReachHard-v1's rows: protocol 1's 500 k far below, still rising at 10 M by a fifth of
     # the rise at 4 M, about 3 hits for another 5 M.
     from armgame.env.references import REFERENCE_HITS
