@@ -300,9 +300,14 @@ class CenterOutBatchVectorEnv(VectorEnv):
                 self._start_episode(int(i), None, {})
             self._advance()
             rewards[restart] = 0.0
-            restarted = self._infos(restart)
-            for key in ("trial", "trials_done", "hits", "block"):
-                infos[key][restart] = restarted[key][restart]
+            # The restarted games' infos are their new episodes' (their trial, hits and block after the reset).
+            again = np.flatnonzero(restart)
+            trial = self._trial[again]
+            infos["trial"][again] = infos["trials_done"][again] = trial
+            infos["hits"][again] = self._hits[again]
+            width = self._names.shape[1]
+            infos["block"][again] = self._names.ravel().take(self._task_of[again] * width
+                                                             + np.minimum(trial, width - 1))
         book.after_step(terminated | truncated)
         return self._observations(), rewards, terminated, truncated, infos
 
@@ -486,10 +491,13 @@ class CenterOutBatchVectorEnv(VectorEnv):
 
     def _infos(self, games: np.ndarray) -> dict[str, Any]:
         trial, hits = self._trial.copy(), self._hits.copy()
-        block = self._names[self._task_of, np.minimum(trial, self._names.shape[1] - 1)]
+        width = self._names.shape[1]
+        block = self._names.ravel().take(self._task_of * width + np.minimum(trial, width - 1))
+        every = games.all()  # a step's infos: every game's, with no masking to do
         infos: dict[str, Any] = {}
         for key, value in (("trial", trial), ("trials_done", trial.copy()), ("hits", hits), ("block", block)):
-            infos[key] = np.where(games, value, np.zeros_like(value) if value.dtype != object else None)
+            infos[key] = value if every else np.where(games, value, np.zeros_like(value) if value.dtype != object
+                                                      else None)
             infos[f"_{key}"] = games.copy()
         return infos
 
