@@ -28,7 +28,7 @@ int armgame_use_sincos = 0;
 #include "_pyhypot.h"
 
 /* Columns of a run's float state, int state and trial (the Python side names them the same). */
-enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_COUNT = 20 };
+enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_TRIG = 20, S_COUNT = 26 };
 enum { I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_FRESH, I_COUNT };
 enum { T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP, T_SHOW = T_FP + 4, T_SP,
        T_HOLD_AT_HOME = T_SP + 6, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT };
@@ -88,6 +88,34 @@ static inline void shown(const double *t, int64_t phase, double q1, double q2, d
 #define RUN_FLATTEN
 #endif
 
+/* The hand's last sin and cos (of q1 and q1 + q2) with their angles, in the run's state from S_TRIG: the
+ * observation's are the same where its angles are, bit for bit, and take them from here. */
+static inline void keep_trig(double *s, double q1, double q12, double s1, double c1, double s12, double c12)
+{
+    double *k = s + S_TRIG;
+    k[0] = q1;
+    k[1] = q12;
+    k[2] = s1;
+    k[3] = c1;
+    k[4] = s12;
+    k[5] = c12;
+}
+
+/* sin and cos of q1 and q12, from the run's kept ones where their angles have the same bits. */
+static inline void trig_of(const double *s, double q1, double q12, double *s1, double *c1, double *s12, double *c12)
+{
+    const double *k = s + S_TRIG;
+    if (memcmp(&k[0], &q1, sizeof q1) == 0 && memcmp(&k[1], &q12, sizeof q12) == 0) {
+        *s1 = k[2];
+        *c1 = k[3];
+        *s12 = k[4];
+        *c12 = k[5];
+        return;
+    }
+    sin_cos(q1, s1, c1);
+    sin_cos(q12, s12, c12);
+}
+
 /* A run's counts while it steps (run's locals, which the lanes keep per lane). */
 typedef struct {
     int64_t n, ran, phase, counter, steps, path;
@@ -146,6 +174,7 @@ static inline int after_step(const double *p, double *s, int64_t *it, const doub
     double s1, c1, s12, c12;
     sin_cos(x[0], &s1, &c1);
     sin_cos(x[0] + x[1], &s12, &c12);
+    keep_trig(s, x[0], x[0] + x[1], s1, c1, s12, c12);
     double hx = l1 * c1 + l2 * c12, hy = l1 * s1 + l2 * s12;
     shown(t, w->phase, x[0], x[1], &hx, &hy);
     s[S_CX] = hx;
@@ -493,8 +522,7 @@ static PyObject *advance(PyObject *self, PyObject *args)
             const double q1 = s[0], q2 = s[1], w1 = s[2], w2 = s[3];
             const double q12 = q1 + q2, w12 = w1 + w2;
             double c1, s1, c12, s12;
-            sin_cos(q1, &s1, &c1);
-            sin_cos(q12, &s12, &c12);
+            trig_of(s, q1, q12, &s1, &c1, &s12, &c12);
             const int reach = it[I_PHASE] == 1;
             const double cx = s[S_CX], cy = s[S_CY];
             double *o = obs + 16 * i;
