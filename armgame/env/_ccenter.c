@@ -644,6 +644,50 @@ static inline double action_at(const void *a, char kind, Py_ssize_t k)
     }
 }
 
+/* ``act``'s work for one kind of action (a constant where inlined): the whole action checked before any run's
+ * muscles change, as the Python step raised before them; then each stepping run's goals and rates. */
+LANES_INLINE int act_runs(const void *a, const char kind, const int continuous, Py_ssize_t n, const uint8_t *stepping,
+                          const uint8_t *finished, const int64_t *ints, uint8_t *held, double *state,
+                          const double *rise, const double *decay, const int64_t *task_of)
+{
+    int ok = 1;
+    for (Py_ssize_t i = 0; i < n && ok; i++) {
+        if (!stepping[i])
+            continue;
+        for (int m = 0; m < 4; m++) {
+            const double v = action_at(a, kind, 4 * i + m);
+            ok &= continuous ? isfinite(v) : (v == 0.0 || v == 1.0);
+        }
+    }
+    if (!ok)
+        return 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const int64_t *it = ints + I_COUNT * i;
+        if (!stepping[i] || finished[i] || it[I_STEPS] >= it[I_TOTAL])
+            continue;
+        double *s = state + S_COUNT * i;
+        const double *up_rate = rise + 4 * task_of[i], *down_rate = decay + 4 * task_of[i];
+        for (int m = 0; m < 4; m++) {
+            const double v = action_at(a, kind, 4 * i + m);
+            if (continuous) {
+                /* np.clip((level + 1) / 2 as * 0.5, 0, 1); the rate rises where the goal is above the activation. */
+                double level = (v + 1.0) * 0.5;
+                level = level < 0.0 ? 0.0 : level > 1.0 ? 1.0 : level;
+                s[S_R + m] = level > s[S_A + m] ? up_rate[m] : down_rate[m];
+                s[S_G + m] = level;
+            } else {
+                const uint8_t down = v == 1.0;
+                if (down == (held[4 * i + m] != 0))
+                    continue;  /* a key held, or left up: its muscle goes on as it was */
+                held[4 * i + m] = down;
+                s[S_G + m] = down ? 1.0 : 0.0;
+                s[S_R + m] = down ? up_rate[m] : down_rate[m];
+            }
+        }
+    }
+    return 1;
+}
+
 PyDoc_STRVAR(act_doc,
 "act(actions, continuous, stepping, finished, ints, held, state, rise, decay, task_of) -> bool\n\n"
 "The single env's _set_levels (continuous) or _press_keys on every run that steps (stepping) and is not over:\n"
@@ -697,41 +741,19 @@ static PyObject *act(PyObject *self, PyObject *args)
             PyErr_SetString(PyExc_ValueError, "task_of: a run's task is not in rise and decay");
             goto fail;
         }
-    int ok = 1;
-    /* The whole action is checked before any run's muscles change, as the Python step raised before them. */
-    for (Py_ssize_t i = 0; i < n && ok; i++) {
-        if (!stepping[i])
-            continue;
-        for (int m = 0; m < 4; m++) {
-            const double v = action_at(a, kind, 4 * i + m);
-            ok &= continuous ? isfinite(v) : (v == 0.0 || v == 1.0);
-        }
-    }
-    if (ok)
-        for (Py_ssize_t i = 0; i < n; i++) {
-            const int64_t *it = ints + I_COUNT * i;
-            if (!stepping[i] || finished[i] || it[I_STEPS] >= it[I_TOTAL])
-                continue;
-            double *s = state + S_COUNT * i;
-            const double *up_rate = rise + 4 * task_of[i], *down_rate = decay + 4 * task_of[i];
-            for (int m = 0; m < 4; m++) {
-                const double v = action_at(a, kind, 4 * i + m);
-                if (continuous) {
-                    /* np.clip((level + 1) / 2 as * 0.5, 0, 1); the rate rises where the goal is above the activation. */
-                    double level = (v + 1.0) * 0.5;
-                    level = level < 0.0 ? 0.0 : level > 1.0 ? 1.0 : level;
-                    s[S_R + m] = level > s[S_A + m] ? up_rate[m] : down_rate[m];
-                    s[S_G + m] = level;
-                } else {
-                    const uint8_t down = v == 1.0;
-                    if (down == (held[4 * i + m] != 0))
-                        continue;  /* a key held, or left up: its muscle goes on as it was */
-                    held[4 * i + m] = down;
-                    s[S_G + m] = down ? 1.0 : 0.0;
-                    s[S_R + m] = down ? up_rate[m] : down_rate[m];
-                }
-            }
-        }
+    int ok;
+    /* One loop for each kind of action, so that the element's type is known inside it. */
+    if (kind == 'd')
+        ok = continuous ? act_runs(a, 'd', 1, n, stepping, finished, ints, held, state, rise, decay, task_of)
+                        : act_runs(a, 'd', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
+    else if (kind == 'f')
+        ok = continuous ? act_runs(a, 'f', 1, n, stepping, finished, ints, held, state, rise, decay, task_of)
+                        : act_runs(a, 'f', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
+    else if (kind == 'q')
+        ok = continuous ? act_runs(a, 'q', 1, n, stepping, finished, ints, held, state, rise, decay, task_of)
+                        : act_runs(a, 'q', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
+    else
+        ok = act_runs(a, 'B', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
     release(b, 10);
     return PyBool_FromLong(ok);
 fail:
