@@ -106,6 +106,19 @@ def test_the_guards_stop_equals_sync(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 @compiled
+@pytest.mark.parametrize("kind", ["none", KINDS[1], {"perturbation": "constant", "fx": 20.0, "fy": 20.0}],
+                         ids=["none", "curl", "constant"])
+def test_runs_in_vector_lanes_equal_sync(monkeypatch: pytest.MonkeyPatch, kind: object) -> None:
+    # From 16 runs on, the C loop steps blocks of 16 side by side (_lanes.h's RK4): two blocks and 3 runs alone, their
+    # lanes in step without a field, all with one, in different phases of a field's trial, and stopped by the guard.
+    monkeypatch.setattr(center_out_module, "speed_bound", lambda config: 0.5)
+    monkeypatch.setattr(center_out_batch, "speed_bound", lambda config: 0.5)
+    seen = played("armgame/CenterOutContinuous-v1", 35, 300, seed=7, episode_trials=2, protocol=EXPOSED,
+                  perturbation=kind)
+    assert seen["stopped" if "constant" in str(kind) else "reaches"] > 0, seen
+
+
+@compiled
 def test_disabled_autoreset_and_masks_equal_sync() -> None:
     args = {"continuous": False, "episode_trials": 1}
     sync = CenterOutVectorEnv(2, autoreset_mode="Disabled", **args)

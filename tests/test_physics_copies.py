@@ -70,9 +70,9 @@ def test_the_markers_find_each_kind_of_copy():
     matching would not pass the table by finding nothing)."""
     found = holders()
     assert "RK4's weights" in found["armgame/physics/integrators.py"]
-    assert "RK4's weights" in found["armgame/game/_cstep.h"] and "RK4's weights" in found["armgame/game/_clanes.c"]
+    assert "RK4's weights" in found["armgame/game/_cstep.h"] and "RK4's weights" in found["armgame/game/_lanes.h"]
     assert "RK4's weights" in found["armgame/classroom/static/engine.js"]
-    assert "the muscles' step" in found["armgame/game/_clanes.c"]
+    assert "the muscles' step" in found["armgame/game/_lanes.h"]
     assert "the muscles' step" in found["armgame/lab/session.py"]
     assert "the arm's sine" in found["armgame/physics/_trig.h"] and "the arm's sine" in found["armgame/physics/trig.py"]
     assert len(found) >= 13  # 15 before labengine.js and _ccenter.c took their loops from engine.js and _cstep.h

@@ -24,10 +24,11 @@
 int armgame_use_sincos = 0;
 #endif
 #include "../game/_cstep.h"
+#include "../game/_lanes.h"
 #include "_pyhypot.h"
 
 /* Columns of a run's float state, int state and trial (the Python side names them the same). */
-enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_COUNT = 20 };
+enum { S_X = 0, S_A = 4, S_G = 8, S_R = 12, S_CX = 16, S_CY = 17, S_FW1 = 18, S_FW2 = 19, S_TRIG = 20, S_COUNT = 26 };
 enum { I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_FRESH, I_COUNT };
 enum { T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP, T_SHOW = T_FP + 4, T_SP,
        T_HOLD_AT_HOME = T_SP + 6, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT };
@@ -87,94 +88,340 @@ static inline void shown(const double *t, int64_t phase, double q1, double q2, d
 #define RUN_FLATTEN
 #endif
 
-/* One run: up to it[I_TODO] steps, stopping after a trial's end or the guard's stop (it[I_EVENT] says which). */
-RUN_FLATTEN static void run(const Arm *arm, const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
-                int64_t cap)
+/* The hand's last sin and cos (of q1 and q1 + q2) with their angles, in the run's state from S_TRIG: the
+ * observation's are the same where its angles are, bit for bit, and take them from here. */
+static inline void keep_trig(double *s, double q1, double q12, double s1, double c1, double s12, double c12)
+{
+    double *k = s + S_TRIG;
+    k[0] = q1;
+    k[1] = q12;
+    k[2] = s1;
+    k[3] = c1;
+    k[4] = s12;
+    k[5] = c12;
+}
+
+/* sin and cos of q1 and q12, from the run's kept ones where their angles have the same bits. */
+static inline void trig_of(const double *s, double q1, double q12, double *s1, double *c1, double *s12, double *c12)
+{
+    const double *k = s + S_TRIG;
+    if (memcmp(&k[0], &q1, sizeof q1) == 0 && memcmp(&k[1], &q12, sizeof q12) == 0) {
+        *s1 = k[2];
+        *c1 = k[3];
+        *s12 = k[4];
+        *c12 = k[5];
+        return;
+    }
+    sin_cos(q1, s1, c1);
+    sin_cos(q12, s12, c12);
+}
+
+/* A run's counts while it steps (run's locals, which the lanes keep per lane). */
+typedef struct {
+    int64_t n, ran, phase, counter, steps, path;
+} Walk;
+
+/* A run's steps to run now (it[I_TODO], at most those left): sets up w and clears TODO. */
+static inline void begin_walk(int64_t *it, Walk *w)
 {
     int64_t n = it[I_TODO];
     if (it[I_TOTAL] - it[I_STEPS] < n)
         n = it[I_TOTAL] - it[I_STEPS];
     it[I_TODO] = 0;
-    if (n <= 0)
+    w->n = n;
+    w->ran = 0;
+    w->phase = it[I_PHASE];
+    w->counter = it[I_COUNTER];
+    w->steps = it[I_STEPS];
+    w->path = it[I_PATH];
+}
+
+/* The run's counts back into its ints. */
+static inline void end_walk(int64_t *it, const Walk *w)
+{
+    it[I_PHASE] = w->phase;
+    it[I_COUNTER] = w->counter;
+    it[I_STEPS] = w->steps;
+    it[I_PATH] = w->path;
+}
+
+/* What follows a step's RK4 (x the new state, previous the one before it, loaded: the step had the trial's
+ * field): the guard, the shown hand and the task's hold and reach. Returns 1 where the run stops here (a trial's
+ * end or the guard's stop, it[I_EVENT] says which), having put x and a where the stop leaves them. */
+static inline int after_step(const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
+                             int64_t cap, Walk *w, double x[4], double a[4], const double previous[4], int loaded)
+{
+    const double limit = t[T_LIMIT];
+    if (loaded && !(-limit <= x[2] && x[2] <= limit && -limit <= x[3] && x[3] <= limit)) {
+        /* variant.guarded: the state is refused, the run keeps the last one and ends there. */
+        s[S_FW1] = x[2];
+        s[S_FW2] = x[3];
+        memcpy(x, previous, 4 * sizeof(double));
+        it[I_TOTAL] = w->steps;
+        it[I_EVENT] = EVENT_STOPPED;
+        return 1;
+    }
+    w->steps++;
+    w->ran++;
+    if (w->phase == 0 && t[T_HOLD_AT_HOME] == 0.0 && (double)(w->counter + 1) < t[T_DELAY] && w->ran < w->n) {
+        /* The go cue's wait with no hold at home, neither its last step nor the call's: the hand is not looked at
+         * (the next step writes the cursor before anything reads it), and a pair of the C library's sincos is
+         * a fifth of the loop's time. */
+        w->counter++;
+        return 0;
+    }
+    const double l1 = p[P_L1], l2 = p[P_L2];
+    double s1, c1, s12, c12;
+    sin_cos(x[0], &s1, &c1);
+    sin_cos(x[0] + x[1], &s12, &c12);
+    keep_trig(s, x[0], x[0] + x[1], s1, c1, s12, c12);
+    double hx = l1 * c1 + l2 * c12, hy = l1 * s1 + l2 * s12;
+    shown(t, w->phase, x[0], x[1], &hx, &hy);
+    s[S_CX] = hx;
+    s[S_CY] = hy;
+    if (w->phase == 0) {
+        const double dx = hx - t[T_HX], dy = hy - t[T_HY];
+        w->counter = (t[T_HOLD_AT_HOME] == 0.0 || dx * dx + dy * dy <= t[T_HR] * t[T_HR]) ? w->counter + 1 : 0;
+        if ((double)w->counter >= t[T_DELAY]) {
+            w->phase = 1;
+            it[I_GO] = it[I_START] = w->steps;
+            w->counter = 0;
+            xs[0] = hx;
+            ys[0] = hy;
+            w->path = 1;
+        }
+        return 0;
+    }
+    if (w->path < cap) {
+        xs[w->path] = hx;
+        ys[w->path] = hy;
+    }
+    w->path++;
+    const double dx = hx - t[T_TX], dy = hy - t[T_TY];
+    w->counter = dx * dx + dy * dy <= t[T_TR] * t[T_TR] ? w->counter + 1 : 0;
+    const int hit = (double)w->counter >= t[T_HOLD];
+    if (!hit && (double)(w->steps - it[I_GO]) < t[T_TIMEOUT])
+        return 0;
+    /* The trial's end: the arm goes home at rest and the muscles relax; the caller enters the next trial. */
+    it[I_EVENT] = hit ? EVENT_HIT : EVENT_MISS;
+    x[0] = t[T_HQ1];
+    x[1] = t[T_HQ2];
+    x[2] = x[3] = 0.0;
+    a[0] = a[1] = a[2] = a[3] = 0.0;
+    s[S_CX] = t[T_HX];
+    s[S_CY] = t[T_HY];
+    w->phase = 0;
+    w->counter = 0;
+    it[I_START] = w->steps;
+    it[I_TODO] = w->n - w->ran;
+    return 1;
+}
+
+/* The trial's field, for ``rk4_exact``. */
+static inline Field trial_field(const double *p, const double *t)
+{
+    const Field field = {(int)t[T_FIELD], {t[T_FP], t[T_FP + 1], t[T_FP + 2], t[T_FP + 3]}, p[P_L1], p[P_L2]};
+    return field;
+}
+
+/* One run: up to it[I_TODO] steps, stopping after a trial's end or the guard's stop (it[I_EVENT] says which). */
+RUN_FLATTEN static void run(const Arm *arm, const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
+                int64_t cap)
+{
+    Walk w;
+    begin_walk(it, &w);
+    if (w.n <= 0)
         return;
-    const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
+    const double dt = p[P_DT];
     double *x = s + S_X;
     double a[4] = {s[S_A], s[S_A + 1], s[S_A + 2], s[S_A + 3]};
     const double *g = s + S_G, *r = s + S_R;
-    const double limit = t[T_LIMIT];
-    const Field field = {(int)t[T_FIELD], {t[T_FP], t[T_FP + 1], t[T_FP + 2], t[T_FP + 3]}, l1, l2};
-    int64_t phase = it[I_PHASE], counter = it[I_COUNTER], steps = it[I_STEPS], path = it[I_PATH];
-    int64_t ran = 0;
-    while (ran < n) {
+    const Field field = trial_field(p, t);
+    while (w.ran < w.n) {
         double t1, t2;
         muscle_step(p, a, g, r, &t1, &t2);
-        const int loaded = phase == 1 && field.kind != FIELD_NONE;
+        const int loaded = w.phase == 1 && field.kind != FIELD_NONE;
         double previous[4];
         memcpy(previous, x, sizeof previous);
         if (loaded)
             rk4_exact(arm, &field, t1, t2, dt, x);
         else  /* apart, so that the inlined step without a field has no test of one */
             rk4_exact(arm, NULL, t1, t2, dt, x);
-        if (loaded && !(-limit <= x[2] && x[2] <= limit && -limit <= x[3] && x[3] <= limit)) {
-            /* variant.guarded: the state is refused, the run keeps the last one and ends there. */
-            s[S_FW1] = x[2];
-            s[S_FW2] = x[3];
-            memcpy(x, previous, sizeof previous);
-            it[I_TOTAL] = steps;
-            it[I_EVENT] = EVENT_STOPPED;
+        if (after_step(p, s, it, t, xs, ys, cap, &w, x, a, previous, loaded))
             break;
-        }
-        steps++;
-        ran++;
-        double s1, c1, s12, c12;
-        sin_cos(x[0], &s1, &c1);
-        sin_cos(x[0] + x[1], &s12, &c12);
-        double hx = l1 * c1 + l2 * c12, hy = l1 * s1 + l2 * s12;
-        shown(t, phase, x[0], x[1], &hx, &hy);
-        s[S_CX] = hx;
-        s[S_CY] = hy;
-        if (phase == 0) {
-            const double dx = hx - t[T_HX], dy = hy - t[T_HY];
-            counter = (t[T_HOLD_AT_HOME] == 0.0 || dx * dx + dy * dy <= t[T_HR] * t[T_HR]) ? counter + 1 : 0;
-            if ((double)counter >= t[T_DELAY]) {
-                phase = 1;
-                it[I_GO] = it[I_START] = steps;
-                counter = 0;
-                xs[0] = hx;
-                ys[0] = hy;
-                path = 1;
-            }
-            continue;
-        }
-        if (path < cap) {
-            xs[path] = hx;
-            ys[path] = hy;
-        }
-        path++;
-        const double dx = hx - t[T_TX], dy = hy - t[T_TY];
-        counter = dx * dx + dy * dy <= t[T_TR] * t[T_TR] ? counter + 1 : 0;
-        const int hit = (double)counter >= t[T_HOLD];
-        if (!hit && (double)(steps - it[I_GO]) < t[T_TIMEOUT])
-            continue;
-        /* The trial's end: the arm goes home at rest and the muscles relax; the caller enters the next trial. */
-        it[I_EVENT] = hit ? EVENT_HIT : EVENT_MISS;
-        x[0] = t[T_HQ1];
-        x[1] = t[T_HQ2];
-        x[2] = x[3] = 0.0;
-        a[0] = a[1] = a[2] = a[3] = 0.0;
-        s[S_CX] = t[T_HX];
-        s[S_CY] = t[T_HY];
-        phase = 0;
-        counter = 0;
-        it[I_START] = steps;
-        it[I_TODO] = n - ran;
-        break;
     }
     memcpy(s + S_A, a, sizeof a);
-    it[I_PHASE] = phase;
-    it[I_COUNTER] = counter;
-    it[I_STEPS] = steps;
-    it[I_PATH] = path;
+    end_walk(it, &w);
+}
+
+/* ---------------------------------------------------------------- the runs in vector lanes
+ * LANES consecutive runs step together in _lanes.h's RK4 (the game's batch's, the same operations in the same
+ * order as ``rk4_exact``, so each lane's state is the one ``run`` gives, bit for bit); each lane's guard, hand
+ * and rules follow one at a time (``after_step``). A step runs in the lanes where every running lane steps
+ * without a field, or all with the same field; otherwise (runs of the block in different phases of a loaded
+ * trial) that step runs lane by lane in ``rk4_exact``. A lane whose run stops (its steps done, a trial's end,
+ * the guard) sits still until the block's other runs are done. */
+
+#define CENTER_FLATTEN RUN_FLATTEN
+
+/* The lanes' plain step and the loaded one (one field for every lane), each built for several instruction sets
+ * (``LANES_CLONES``). Their guard and slack are not used: ``after_step`` guards, and the lanes' slack is infinite. */
+LANES_CLONES
+static void center_lanes_plain(const Step *k, Lanes *L)
+{
+    (void)step_lanes_as(k, L, 0);
+}
+
+LANES_CLONES
+static void center_lanes_loaded(const Step *k, Lanes *L)
+{
+    (void)step_lanes_as(k, L, 1);
+}
+
+/* A lane out of use: a still arm with relaxed muscles. */
+static void idle_lane(Lanes *L, int l)
+{
+    L->q1[l] = L->q2[l] = L->w1[l] = L->w2[l] = 0.0;
+    for (int m = 0; m < 4; m++)
+        L->a[m][l] = L->g[m][l] = L->r[m][l] = 0.0;
+    L->game[l] = -1;
+}
+
+/* Runs i0 to i0 + LANES - 1 (each that has steps to run: no event pending, TODO above 0), as ``run`` would run each. */
+CENTER_FLATTEN static void run_block(const Arm *arm, const double *p, int mode, double *state, int64_t *ints,
+                                     const double *trials, double *xsall, double *ysall, int64_t cap, Py_ssize_t i0)
+{
+    Lanes L;
+    Walk w[LANES];
+    Step k;
+    memset(&k, 0, sizeof k);
+    k.b = arm->b;
+    k.d = arm->d;
+    k.det0 = arm->det0;
+    k.amd = arm->amd;
+    k.k1 = arm->k1;
+    k.k2 = arm->k2;
+    k.dt = p[P_DT];
+    k.h = 0.5 * p[P_DT];             /* rk4_exact's h and k */
+    k.k = p[P_DT] * (1.0 / 6.0);
+    for (int m = 0; m < 4; m++) {
+        k.s[m] = p[P_S0 + m];
+        k.e[m] = p[P_E0 + m];
+    }
+    k.damping = mode == MODE_DAMPING;
+    k.fast = 0;
+    k.limit = INFINITY;
+    int active = 0;
+    for (int l = 0; l < LANES; l++) {
+        const Py_ssize_t i = i0 + l;
+        double *s = state + S_COUNT * i;
+        int64_t *it = ints + I_COUNT * i;
+        L.sl[l] = INFINITY;
+        L.anchor[l] = 0;
+        L.bc[l] = L.bs[l] = 0.0;
+        L.s[l] = 0;
+        L.run[l] = 0;
+        for (int m = 0; m < 4; m++) {
+            L.ms[m][l] = k.s[m];
+            L.me[m][l] = k.e[m];
+        }
+        idle_lane(&L, l);
+        if (it[I_EVENT] != EVENT_NONE || it[I_TODO] <= 0)
+            continue;
+        begin_walk(it, &w[l]);
+        if (w[l].n <= 0)
+            continue;
+        L.game[l] = i;
+        L.q1[l] = s[S_X];
+        L.q2[l] = s[S_X + 1];
+        L.w1[l] = s[S_X + 2];
+        L.w2[l] = s[S_X + 3];
+        for (int m = 0; m < 4; m++) {
+            L.a[m][l] = s[S_A + m];
+            L.g[m][l] = s[S_G + m];
+            L.r[m][l] = s[S_R + m];
+        }
+        active++;
+    }
+    while (active) {
+        /* Whether the running lanes step alike: all without a field, or all with one and the same. */
+        int loaded = -1, alike = 1;
+        const double *field_of = NULL;
+        for (int l = 0; l < LANES && alike; l++) {
+            if (L.game[l] < 0)
+                continue;
+            const double *t = trials + T_COUNT * L.game[l];
+            const int on = w[l].phase == 1 && (int)t[T_FIELD] != FIELD_NONE;
+            if (loaded < 0)
+                loaded = on;
+            else if (loaded != on)
+                alike = 0;
+            if (on) {
+                if (field_of == NULL)
+                    field_of = t;
+                else if (memcmp(field_of + T_FIELD, t + T_FIELD, 5 * sizeof(double)) != 0)
+                    alike = 0;
+            }
+        }
+        double previous[LANES][4];
+        for (int l = 0; l < LANES; l++) {
+            previous[l][0] = L.q1[l];
+            previous[l][1] = L.q2[l];
+            previous[l][2] = L.w1[l];
+            previous[l][3] = L.w2[l];
+        }
+        if (alike && loaded == 0) {
+            center_lanes_plain(&k, &L);
+        } else if (alike) {
+            k.field = trial_field(p, field_of);
+            center_lanes_loaded(&k, &L);
+        } else {
+            for (int l = 0; l < LANES; l++) {
+                if (L.game[l] < 0)
+                    continue;
+                const double *t = trials + T_COUNT * L.game[l];
+                const Field field = trial_field(p, t);
+                double a[4], g[4], r[4], x[4] = {L.q1[l], L.q2[l], L.w1[l], L.w2[l]}, t1, t2;
+                for (int m = 0; m < 4; m++) {
+                    a[m] = L.a[m][l];
+                    g[m] = L.g[m][l];
+                    r[m] = L.r[m][l];
+                }
+                muscle_step(p, a, g, r, &t1, &t2);
+                if (w[l].phase == 1 && field.kind != FIELD_NONE)
+                    rk4_exact(arm, &field, t1, t2, p[P_DT], x);
+                else
+                    rk4_exact(arm, NULL, t1, t2, p[P_DT], x);
+                L.q1[l] = x[0];
+                L.q2[l] = x[1];
+                L.w1[l] = x[2];
+                L.w2[l] = x[3];
+                for (int m = 0; m < 4; m++)
+                    L.a[m][l] = a[m];
+            }
+        }
+        for (int l = 0; l < LANES; l++) {
+            const Py_ssize_t i = L.game[l];
+            if (i < 0)
+                continue;
+            double *s = state + S_COUNT * i;
+            int64_t *it = ints + I_COUNT * i;
+            const double *t = trials + T_COUNT * i;
+            const int on = w[l].phase == 1 && (int)t[T_FIELD] != FIELD_NONE;
+            double x[4] = {L.q1[l], L.q2[l], L.w1[l], L.w2[l]};
+            double a[4] = {L.a[0][l], L.a[1][l], L.a[2][l], L.a[3][l]};
+            const int stop = after_step(p, s, it, t, xsall + cap * i, ysall + cap * i, cap, &w[l], x, a,
+                                        previous[l], on);
+            if (!stop && w[l].ran < w[l].n)
+                continue;
+            /* The run is done for now: its state back, its lane idle. */
+            memcpy(s + S_X, x, sizeof x);
+            memcpy(s + S_A, a, sizeof a);
+            end_walk(it, &w[l]);
+            idle_lane(&L, l);
+            active--;
+        }
+    }
 }
 
 /* features.wrap_angle: q itself within [-pi, pi], else q - tau round(q / tau) clipped (round: half to even). */
@@ -238,6 +485,26 @@ static PyObject *advance(PyObject *self, PyObject *args)
         int64_t *ints = b[2].view.buf;
         const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
         Py_BEGIN_ALLOW_THREADS
+        /* The lanes take blocks of runs where most of a block has steps to run (a step's first call); the runs
+         * left, and the calls for the few runs a trial's end stopped, run one at a time. */
+        const int lanes = mode != MODE_GRAVITY;  /* accel_lanes has no gravity */
+        Py_ssize_t blocked = 0;
+        for (Py_ssize_t i0 = 0; lanes && i0 + LANES <= n; i0 += LANES) {
+            int due = 0;
+            for (int l = 0; l < LANES; l++) {
+                const int64_t *it = ints + I_COUNT * (i0 + l);
+                due += it[I_EVENT] == EVENT_NONE && it[I_TODO] > 0;
+            }
+            if (2 * due < LANES)
+                continue;
+            for (int l = 0; l < LANES; l++) {  /* run_block clears TODO: the observation's test reads it first */
+                int64_t *it = ints + I_COUNT * (i0 + l);
+                it[I_FRESH] |= it[I_TODO] > 0;
+            }
+            run_block(&arm, p, mode, state, ints, trials, xs, ys, cap, i0);
+            blocked++;
+        }
+        (void)blocked;
         for (Py_ssize_t i = 0; i < n; i++) {
             double *s = state + S_COUNT * i;
             int64_t *it = ints + I_COUNT * i;
@@ -255,8 +522,7 @@ static PyObject *advance(PyObject *self, PyObject *args)
             const double q1 = s[0], q2 = s[1], w1 = s[2], w2 = s[3];
             const double q12 = q1 + q2, w12 = w1 + w2;
             double c1, s1, c12, s12;
-            sin_cos(q1, &s1, &c1);
-            sin_cos(q12, &s12, &c12);
+            trig_of(s, q1, q12, &s1, &c1, &s12, &c12);
             const int reach = it[I_PHASE] == 1;
             const double cx = s[S_CX], cy = s[S_CY];
             double *o = obs + 16 * i;
@@ -378,6 +644,50 @@ static inline double action_at(const void *a, char kind, Py_ssize_t k)
     }
 }
 
+/* ``act``'s work for one kind of action (a constant where inlined): the whole action checked before any run's
+ * muscles change, as the Python step raised before them; then each stepping run's goals and rates. */
+LANES_INLINE int act_runs(const void *a, const char kind, const int continuous, Py_ssize_t n, const uint8_t *stepping,
+                          const uint8_t *finished, const int64_t *ints, uint8_t *held, double *state,
+                          const double *rise, const double *decay, const int64_t *task_of)
+{
+    int ok = 1;
+    for (Py_ssize_t i = 0; i < n && ok; i++) {
+        if (!stepping[i])
+            continue;
+        for (int m = 0; m < 4; m++) {
+            const double v = action_at(a, kind, 4 * i + m);
+            ok &= continuous ? isfinite(v) : (v == 0.0 || v == 1.0);
+        }
+    }
+    if (!ok)
+        return 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const int64_t *it = ints + I_COUNT * i;
+        if (!stepping[i] || finished[i] || it[I_STEPS] >= it[I_TOTAL])
+            continue;
+        double *s = state + S_COUNT * i;
+        const double *up_rate = rise + 4 * task_of[i], *down_rate = decay + 4 * task_of[i];
+        for (int m = 0; m < 4; m++) {
+            const double v = action_at(a, kind, 4 * i + m);
+            if (continuous) {
+                /* np.clip((level + 1) / 2 as * 0.5, 0, 1); the rate rises where the goal is above the activation. */
+                double level = (v + 1.0) * 0.5;
+                level = level < 0.0 ? 0.0 : level > 1.0 ? 1.0 : level;
+                s[S_R + m] = level > s[S_A + m] ? up_rate[m] : down_rate[m];
+                s[S_G + m] = level;
+            } else {
+                const uint8_t down = v == 1.0;
+                if (down == (held[4 * i + m] != 0))
+                    continue;  /* a key held, or left up: its muscle goes on as it was */
+                held[4 * i + m] = down;
+                s[S_G + m] = down ? 1.0 : 0.0;
+                s[S_R + m] = down ? up_rate[m] : down_rate[m];
+            }
+        }
+    }
+    return 1;
+}
+
 PyDoc_STRVAR(act_doc,
 "act(actions, continuous, stepping, finished, ints, held, state, rise, decay, task_of) -> bool\n\n"
 "The single env's _set_levels (continuous) or _press_keys on every run that steps (stepping) and is not over:\n"
@@ -431,41 +741,19 @@ static PyObject *act(PyObject *self, PyObject *args)
             PyErr_SetString(PyExc_ValueError, "task_of: a run's task is not in rise and decay");
             goto fail;
         }
-    int ok = 1;
-    /* The whole action is checked before any run's muscles change, as the Python step raised before them. */
-    for (Py_ssize_t i = 0; i < n && ok; i++) {
-        if (!stepping[i])
-            continue;
-        for (int m = 0; m < 4; m++) {
-            const double v = action_at(a, kind, 4 * i + m);
-            ok &= continuous ? isfinite(v) : (v == 0.0 || v == 1.0);
-        }
-    }
-    if (ok)
-        for (Py_ssize_t i = 0; i < n; i++) {
-            const int64_t *it = ints + I_COUNT * i;
-            if (!stepping[i] || finished[i] || it[I_STEPS] >= it[I_TOTAL])
-                continue;
-            double *s = state + S_COUNT * i;
-            const double *up_rate = rise + 4 * task_of[i], *down_rate = decay + 4 * task_of[i];
-            for (int m = 0; m < 4; m++) {
-                const double v = action_at(a, kind, 4 * i + m);
-                if (continuous) {
-                    /* np.clip((level + 1) / 2 as * 0.5, 0, 1); the rate rises where the goal is above the activation. */
-                    double level = (v + 1.0) * 0.5;
-                    level = level < 0.0 ? 0.0 : level > 1.0 ? 1.0 : level;
-                    s[S_R + m] = level > s[S_A + m] ? up_rate[m] : down_rate[m];
-                    s[S_G + m] = level;
-                } else {
-                    const uint8_t down = v == 1.0;
-                    if (down == (held[4 * i + m] != 0))
-                        continue;  /* a key held, or left up: its muscle goes on as it was */
-                    held[4 * i + m] = down;
-                    s[S_G + m] = down ? 1.0 : 0.0;
-                    s[S_R + m] = down ? up_rate[m] : down_rate[m];
-                }
-            }
-        }
+    int ok;
+    /* One loop for each kind of action, so that the element's type is known inside it. */
+    if (kind == 'd')
+        ok = continuous ? act_runs(a, 'd', 1, n, stepping, finished, ints, held, state, rise, decay, task_of)
+                        : act_runs(a, 'd', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
+    else if (kind == 'f')
+        ok = continuous ? act_runs(a, 'f', 1, n, stepping, finished, ints, held, state, rise, decay, task_of)
+                        : act_runs(a, 'f', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
+    else if (kind == 'q')
+        ok = continuous ? act_runs(a, 'q', 1, n, stepping, finished, ints, held, state, rise, decay, task_of)
+                        : act_runs(a, 'q', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
+    else
+        ok = act_runs(a, 'B', 0, n, stepping, finished, ints, held, state, rise, decay, task_of);
     release(b, 10);
     return PyBool_FromLong(ok);
 fail:

@@ -50,12 +50,15 @@ BATCH_FROM = 4
 MAX_BATCH_ENVS = 65536
 
 # The columns of the C loop's arrays (``_ccenter.c``'s enums).
-S_X, S_A, S_G, S_R, S_CX, S_CY, S_FW1, S_FW2, S_COUNT = 0, 4, 8, 12, 16, 17, 18, 19, 20
+S_X, S_A, S_G, S_R, S_CX, S_CY, S_FW1, S_FW2, S_TRIG, S_COUNT = 0, 4, 8, 12, 16, 17, 18, 19, 20, 26
 I_STEPS, I_TOTAL, I_PHASE, I_COUNTER, I_GO, I_EVENT, I_PATH, I_TODO, I_START, I_FRESH, I_COUNT = range(11)
 T_DELAY, T_TX, T_TY, T_TR, T_HX, T_HY, T_HR, T_HQ1, T_HQ2, T_FIELD, T_FP = range(11)
 T_SHOW, T_SP = T_FP + 4, T_FP + 5
 T_HOLD_AT_HOME, T_HOLD, T_TIMEOUT, T_LIMIT, T_COUNT = T_SP + 6, T_SP + 7, T_SP + 8, T_SP + 9, T_SP + 10
 EVENT_HIT, EVENT_MISS, EVENT_STOPPED = 1, 2, 3
+#: A new run's kept hand trig (the C loop's S_TRIG columns: the angles q1 and q1 + q2, then sin and cos of each), of
+#: angles 0.0, which a run at them reads: sin(0.0) and cos(0.0) are 0.0 and 1.0 in every C library.
+KEPT_TRIG = (0.0, 0.0, 0.0, 1.0, 0.0, 1.0)
 
 
 def batch_refusal(protocol: Protocol) -> str | None:
@@ -220,6 +223,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
         self._tasks: dict[Protocol, _Task] = {}
         task = self._task(env.protocol)
         self.state = np.zeros((n, S_COUNT))
+        self.state[:, S_TRIG:] = KEPT_TRIG
         self.ints = np.zeros((n, I_COUNT), dtype=np.int64)
         self.trials = np.zeros((n, T_COUNT))
         self.xs = np.zeros((n, task.cap))
@@ -300,9 +304,14 @@ class CenterOutBatchVectorEnv(VectorEnv):
                 self._start_episode(int(i), None, {})
             self._advance()
             rewards[restart] = 0.0
-            restarted = self._infos(restart)
-            for key in ("trial", "trials_done", "hits", "block"):
-                infos[key][restart] = restarted[key][restart]
+            # The restarted games' infos are their new episodes' (their trial, hits and block after the reset).
+            again = np.flatnonzero(restart)
+            trial = self._trial[again]
+            infos["trial"][again] = infos["trials_done"][again] = trial
+            infos["hits"][again] = self._hits[again]
+            width = self._names.shape[1]
+            infos["block"][again] = self._names.ravel().take(self._task_of[again] * width
+                                                             + np.minimum(trial, width - 1))
         book.after_step(terminated | truncated)
         return self._observations(), rewards, terminated, truncated, infos
 
@@ -359,6 +368,7 @@ class CenterOutBatchVectorEnv(VectorEnv):
             first = None if env.episode_trials == "block" else int(env.episode_trials) + 1  # its next trial's too
             run = self.runs[i] = _Run(task, lab_seed, first)
             self.state[i] = 0.0
+            self.state[i, S_TRIG:] = KEPT_TRIG
             self.state[i, S_X:S_X + 2] = task.home_q
             self.state[i, S_R:S_R + 4] = task.decay
             self.state[i, S_CX:S_CY + 1] = task.home
@@ -486,10 +496,13 @@ class CenterOutBatchVectorEnv(VectorEnv):
 
     def _infos(self, games: np.ndarray) -> dict[str, Any]:
         trial, hits = self._trial.copy(), self._hits.copy()
-        block = self._names[self._task_of, np.minimum(trial, self._names.shape[1] - 1)]
+        width = self._names.shape[1]
+        block = self._names.ravel().take(self._task_of * width + np.minimum(trial, width - 1))
+        every = games.all()  # a step's infos: every game's, with no masking to do
         infos: dict[str, Any] = {}
         for key, value in (("trial", trial), ("trials_done", trial.copy()), ("hits", hits), ("block", block)):
-            infos[key] = np.where(games, value, np.zeros_like(value) if value.dtype != object else None)
+            infos[key] = value if every else np.where(games, value, np.zeros_like(value) if value.dtype != object
+                                                      else None)
             infos[f"_{key}"] = games.copy()
         return infos
 
