@@ -158,6 +158,10 @@ class ShootingController:
                                    l1 * np.sin(self.grid[:, 0]) + l2 * np.sin(self.grid.sum(1))], axis=1)
         # A target's tolerance in joint space: its radius over each joint's lever arm (roughly).
         self.tolerance = np.array([self.radius / 0.6, self.radius / l2])
+        self._prepare_search(coarse, fine, reach)
+
+    def _prepare_search(self, coarse: int, fine: int, reach: int) -> None:
+        """The search's grids (``coarse`` and ``fine`` decisions, neighbours ``reach`` decisions apart) and no plan."""
         self._coarse_pairs = self._pairs_of(self._options(coarse))
         self._fine_options = self._options(fine)
         self._neighbours = np.array(np.meshgrid(*[range(-reach, reach + 1)] * 4, indexing="ij")).reshape(4, -1).T

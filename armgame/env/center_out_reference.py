@@ -85,14 +85,8 @@ class CenterOutShootingController(ShootingController):
         # The arm goes home at rest after every trial: the state at a hit carries nothing to the next.
         self.margin, self.beta, self.horizon, self.replan, self.research = margin, 0.0, horizon, replan, True
         self.afresh = afresh
-        self._coarse_pairs = self._pairs_of(self._options(coarse))
+        self._prepare_search(coarse, fine, reach)
         self._grids = (self._coarse_pairs, self._pairs_of(self._options(finer)))
-        self._fine_options = self._options(fine)
-        self._neighbours = np.array(np.meshgrid(*[range(-reach, reach + 1)] * 4, indexing="ij")).reshape(4, -1).T
-        self.best = np.array([1, 0, 0, 1, 0, 0])
-        self.position = 0
-        self.target: Any = None
-        self.predicted_steps = -1
         #: The physics step at which the running plan started (its predicted hit is this plus ``predicted_steps``).
         self.plan_step = 0
 
