@@ -37,6 +37,7 @@ the evaluation range, then its deterministic policy evaluated. Each result is on
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import platform
 import sys
@@ -202,14 +203,10 @@ def _reference_hits() -> dict[str, dict[str, Any]]:
 
 def _controller_rows(folder: Path) -> dict[str, tuple[float, float, float, int, str]]:
     """``benchmarks/ceiling.py``'s ``summary`` of ``folder`` (none where there is no folder)."""
-    import importlib.util
 
     if not folder.is_dir():
         return {}
-    spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
-    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
-    spec.loader.exec_module(module)  # type: ignore[union-attr]
-    return module.summary(folder)
+    return _ceiling_benchmark().summary(folder)
 
 
 def ceilings(reference: dict[str, dict[str, Any]] | None = None, controller_folder: Path = RESULTS / "ceiling",
@@ -310,7 +307,9 @@ def table(reference: dict[str, dict[str, Any]] | None = None, controller_folder:
     return "\n".join(lines)
 
 
+@functools.cache
 def _ceiling_benchmark() -> Any:
+    """``benchmarks/ceiling.py`` as a module, run once however many tables and runs read it."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("ceiling_benchmark", Path(__file__).resolve().parent / "ceiling.py")
