@@ -146,10 +146,14 @@ static inline void end_walk(int64_t *it, const Walk *w)
 }
 
 /* What follows a step's RK4 (x the new state, previous the one before it, loaded: the step had the trial's
- * field): the guard, the shown hand and the task's hold and reach. Returns 1 where the run stops here (a trial's
- * end or the guard's stop, it[I_EVENT] says which), having put x and a where the stop leaves them. */
-static inline int after_step(const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
-                             int64_t cap, Walk *w, double x[4], double a[4], const double previous[4], int loaded)
+ * field) is the guard, the shown hand and the task's hold and reach, in two parts around the hand's sin and cos, so
+ * that the lanes take every lane's trig in one loop (``run_block``). ``count_step`` guards and counts the step: it
+ * returns STEP_STOPPED where the guard stopped the run (it[I_EVENT] says so; x is put back), STEP_BLIND where the
+ * hand is not looked at this step, else STEP_HAND: ``hand_step`` then takes the hand's trig. */
+enum { STEP_HAND, STEP_BLIND, STEP_STOPPED };
+
+static inline int count_step(double *s, int64_t *it, const double *t, Walk *w, double x[4], const double previous[4],
+                             int loaded)
 {
     const double limit = t[T_LIMIT];
     if (loaded && !(-limit <= x[2] && x[2] <= limit && -limit <= x[3] && x[3] <= limit)) {
@@ -159,7 +163,7 @@ static inline int after_step(const double *p, double *s, int64_t *it, const doub
         memcpy(x, previous, 4 * sizeof(double));
         it[I_TOTAL] = w->steps;
         it[I_EVENT] = EVENT_STOPPED;
-        return 1;
+        return STEP_STOPPED;
     }
     w->steps++;
     w->ran++;
@@ -168,12 +172,18 @@ static inline int after_step(const double *p, double *s, int64_t *it, const doub
          * (the next step writes the cursor before anything reads it), and a pair of the C library's sincos is
          * a fifth of the loop's time. */
         w->counter++;
-        return 0;
+        return STEP_BLIND;
     }
+    return STEP_HAND;
+}
+
+/* The step's shown hand and rules from the hand's trig (s1, c1 of x[0]; s12, c12 of x[0] + x[1]). Returns 1 where
+ * the trial ends here (it[I_EVENT] says how), having put x and a where the end leaves them. */
+static inline int hand_step(const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
+                            int64_t cap, Walk *w, double x[4], double a[4], double s1, double c1, double s12,
+                            double c12)
+{
     const double l1 = p[P_L1], l2 = p[P_L2];
-    double s1, c1, s12, c12;
-    sin_cos(x[0], &s1, &c1);
-    sin_cos(x[0] + x[1], &s12, &c12);
     keep_trig(s, x[0], x[0] + x[1], s1, c1, s12, c12);
     double hx = l1 * c1 + l2 * c12, hy = l1 * s1 + l2 * s12;
     shown(t, w->phase, x[0], x[1], &hx, &hy);
@@ -215,6 +225,19 @@ static inline int after_step(const double *p, double *s, int64_t *it, const doub
     it[I_START] = w->steps;
     it[I_TODO] = w->n - w->ran;
     return 1;
+}
+
+/* Both parts for one run: returns 1 where the run stops here (a trial's end or the guard's stop). */
+static inline int after_step(const double *p, double *s, int64_t *it, const double *t, double *xs, double *ys,
+                             int64_t cap, Walk *w, double x[4], double a[4], const double previous[4], int loaded)
+{
+    const int kind = count_step(s, it, t, w, x, previous, loaded);
+    if (kind != STEP_HAND)
+        return kind == STEP_STOPPED;
+    double s1, c1, s12, c12;
+    sin_cos(x[0], &s1, &c1);
+    sin_cos(x[0] + x[1], &s12, &c12);
+    return hand_step(p, s, it, t, xs, ys, cap, w, x, a, s1, c1, s12, c12);
 }
 
 /* The trial's field, for ``rk4_exact``. */
@@ -400,28 +423,71 @@ CENTER_FLATTEN static void run_block(const Arm *arm, const double *p, int mode, 
                     L.a[m][l] = a[m];
             }
         }
+        /* Every lane's guard and count, then the hands' trig in one loop (the C library's sincos is a call, which
+         * costs the registers live around it: here few are), then the rules. */
+        int kind[LANES];
+        double x[LANES][4], a[LANES][4], s1[LANES], c1[LANES], s12[LANES], c12[LANES];
+        for (int l = 0; l < LANES; l++) {
+            const Py_ssize_t i = L.game[l];
+            kind[l] = STEP_BLIND;
+            if (i < 0)
+                continue;
+            const double *t = trials + T_COUNT * i;
+            const int on = w[l].phase == 1 && (int)t[T_FIELD] != FIELD_NONE;
+            x[l][0] = L.q1[l];
+            x[l][1] = L.q2[l];
+            x[l][2] = L.w1[l];
+            x[l][3] = L.w2[l];
+            kind[l] = count_step(state + S_COUNT * i, ints + I_COUNT * i, t, &w[l], x[l], previous[l], on);
+        }
+        for (int l = 0; l < LANES; l++)
+            if (kind[l] == STEP_HAND) {
+                sin_cos(x[l][0], &s1[l], &c1[l]);
+                sin_cos(x[l][0] + x[l][1], &s12[l], &c12[l]);
+            }
         for (int l = 0; l < LANES; l++) {
             const Py_ssize_t i = L.game[l];
             if (i < 0)
                 continue;
             double *s = state + S_COUNT * i;
             int64_t *it = ints + I_COUNT * i;
-            const double *t = trials + T_COUNT * i;
-            const int on = w[l].phase == 1 && (int)t[T_FIELD] != FIELD_NONE;
-            double x[4] = {L.q1[l], L.q2[l], L.w1[l], L.w2[l]};
-            double a[4] = {L.a[0][l], L.a[1][l], L.a[2][l], L.a[3][l]};
-            const int stop = after_step(p, s, it, t, xsall + cap * i, ysall + cap * i, cap, &w[l], x, a,
-                                        previous[l], on);
+            for (int m = 0; m < 4; m++)
+                a[l][m] = L.a[m][l];
+            const int stop = kind[l] == STEP_HAND
+                                 ? hand_step(p, s, it, trials + T_COUNT * i, xsall + cap * i, ysall + cap * i, cap,
+                                             &w[l], x[l], a[l], s1[l], c1[l], s12[l], c12[l])
+                                 : kind[l] == STEP_STOPPED;
             if (!stop && w[l].ran < w[l].n)
                 continue;
             /* The run is done for now: its state back, its lane idle. */
-            memcpy(s + S_X, x, sizeof x);
-            memcpy(s + S_A, a, sizeof a);
+            memcpy(s + S_X, x[l], sizeof x[l]);
+            memcpy(s + S_A, a[l], sizeof a[l]);
             end_walk(it, &w[l]);
             idle_lane(&L, l);
             active--;
         }
     }
+}
+
+/* The path lines the block of runs from i0 will write in a call (from each run's I_PATH, five samples at most), asked
+ * for a block ahead: the paths (n x cap x 2 doubles, 100 MB at 8,192 runs) are out of every cache, and the stores that
+ * wait for their lines cost a sixth of the loop without this (benchmarks/env_speed.py, CenterOut-v1 at 8,192).
+ * Inlined always: GCC finds a function of prefetches alone free of effects, and drops its calls. */
+LANES_INLINE void prefetch_paths(const int64_t *ints, double *xs, double *ys, int64_t cap, Py_ssize_t i0)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    for (int l = 0; l < LANES; l++) {
+        const Py_ssize_t i = i0 + l;
+        const int64_t at = ints[I_COUNT * i + I_PATH];
+        const int64_t from = at < cap ? at : cap - 1, to = from + 5 < cap ? from + 5 : cap - 1;
+        __builtin_prefetch(xs + cap * i + from, 1, 3);
+        __builtin_prefetch(ys + cap * i + from, 1, 3);
+        __builtin_prefetch(xs + cap * i + to, 1, 3);
+        __builtin_prefetch(ys + cap * i + to, 1, 3);
+    }
+#else
+    (void)ints, (void)xs, (void)ys, (void)cap, (void)i0;
+#endif
 }
 
 /* features.wrap_angle: q itself within [-pi, pi], else q - tau round(q / tau) clipped (round: half to even). */
@@ -501,6 +567,8 @@ static PyObject *advance(PyObject *self, PyObject *args)
                 int64_t *it = ints + I_COUNT * (i0 + l);
                 it[I_FRESH] |= it[I_TODO] > 0;
             }
+            if (i0 + 2 * LANES <= n)
+                prefetch_paths(ints, xs, ys, cap, i0 + LANES);
             run_block(&arm, p, mode, state, ints, trials, xs, ys, cap, i0);
             blocked++;
         }
