@@ -39,6 +39,17 @@ static inline double action_at(const void *a, char kind, Py_ssize_t k)
     }
 }
 
+/* new where mask is all ones, else old, bit for bit. */
+static inline double blend(double old, double new_value, uint64_t mask)
+{
+    uint64_t a, b;
+    memcpy(&a, &old, sizeof a);
+    memcpy(&b, &new_value, sizeof b);
+    a = (a & ~mask) | (b & mask);
+    memcpy(&old, &a, sizeof old);
+    return old;
+}
+
 /* ``act``'s work for one kind of action (a constant where inlined): the whole action checked before any run's
  * muscles change, as the Python step raised before them; then each stepping run's goals and rates. */
 LANES_INLINE int act_runs(const void *a, const char kind, const int continuous, Py_ssize_t n, const uint8_t *stepping,
@@ -51,7 +62,7 @@ LANES_INLINE int act_runs(const void *a, const char kind, const int continuous, 
             continue;
         for (int m = 0; m < 4; m++) {
             const double v = action_at(a, kind, 4 * i + m);
-            ok &= continuous ? isfinite(v) : (v == 0.0 || v == 1.0);
+            ok &= continuous ? isfinite(v) : ((v == 0.0) | (v == 1.0));
         }
     }
     if (!ok)
@@ -68,15 +79,18 @@ LANES_INLINE int act_runs(const void *a, const char kind, const int continuous, 
                 /* np.clip((level + 1) / 2 as * 0.5, 0, 1); the rate rises where the goal is above the activation. */
                 double level = (v + 1.0) * 0.5;
                 level = level < 0.0 ? 0.0 : level > 1.0 ? 1.0 : level;
-                s[S_R + m] = level > s[S_A + m] ? up_rate[m] : down_rate[m];
+                s[S_R + m] = blend(down_rate[m], up_rate[m], (uint64_t)0 - (uint64_t)(level > s[S_A + m]));
                 s[S_G + m] = level;
             } else {
+                /* A key held, or left up, leaves its muscle going on as it was; a press or a release sets its goal
+                 * and rate. Chosen by masks, with no branch: random keys change half the time, and a mispredicted
+                 * branch a key made this loop seven times as slow (0.18 ms against 0.025 at 8,192 runs). */
                 const uint8_t down = v == 1.0;
-                if (down == (held[4 * i + m] != 0))
-                    continue;  /* a key held, or left up: its muscle goes on as it was */
+                const uint64_t change = (uint64_t)0 - (uint64_t)(down != (held[4 * i + m] != 0));
+                const uint64_t pressed = (uint64_t)0 - (uint64_t)down;
                 held[4 * i + m] = down;
-                s[S_G + m] = down ? 1.0 : 0.0;
-                s[S_R + m] = down ? up_rate[m] : down_rate[m];
+                s[S_G + m] = blend(s[S_G + m], (double)down, change);
+                s[S_R + m] = blend(s[S_R + m], blend(down_rate[m], up_rate[m], pressed), change);
             }
         }
     }
