@@ -238,6 +238,84 @@ def test_the_c_reach_measures_are_reach_metrics_bit_for_bit() -> None:
         assert want[~np.isnan(want)].tobytes() == out[k][~np.isnan(out[k])].tobytes(), (k, want, out[k])
 
 
+def measured_as_reach_metrics(paths: list[tuple[np.ndarray, np.ndarray, int, float, tuple, tuple]]) -> int:
+    """Each (x, y, go, dt, home, target) through _ccenter.measures and through reach_metrics, the same bits; the count
+    of measures defined."""
+    cap = max(len(x) for x, *_ in paths)
+    xs, ys = np.zeros((len(paths), cap)), np.zeros((len(paths), cap))
+    samples, go, geometry = np.zeros(len(paths), np.int64), np.zeros(len(paths), np.int64), np.zeros((len(paths), 5))
+    for k, (x, y, start, dt, home, target) in enumerate(paths):
+        xs[k, :len(x)], ys[k, :len(x)], samples[k], go[k], geometry[k] = x, y, len(x), start, (dt, *home, *target)
+    out = np.zeros((len(paths), len(METRIC_COLUMNS)))
+    center_out_batch._ccenter.measures(xs, ys, np.arange(len(paths)), samples, go, geometry, out)
+    for k, (x, y, start, dt, home, target) in enumerate(paths):
+        reach = Reach(t=(start + np.arange(len(x))) * dt, hand=np.column_stack((x, y)), start=home, target=target,
+                      go_time=start * dt, hit=True)
+        with np.errstate(all="ignore"):  # the huge and tiny paths overflow as numpy measures them
+            want = np.array(list(reach_metrics(reach).as_dict().values()))
+        assert np.array_equal(np.isnan(want), np.isnan(out[k])), (k, want, out[k])
+        assert want[~np.isnan(want)].tobytes() == out[k][~np.isnan(out[k])].tobytes(), (k, want, out[k])
+    return int((~np.isnan(out)).sum())
+
+
+@compiled
+def test_the_c_reach_measures_are_reach_metrics_at_their_edges() -> None:
+    # _ccenter.measures takes a speed's hypot only where the squared differences cannot settle it within their margin:
+    # speeds within ulps of the 5% level (on a step of 2^-8, so that a speed is hypot of 128 times the differences),
+    # the crossing at the first and last samples, speeds tied and nearly tied at the peak, and coordinates, steps and
+    # go cues past the margin's bounds, where every speed is hypot's.
+    paths = []
+    n, dt = 64, 2.0**-8
+    k = np.arange(n) - 11.0
+    ramp = np.where(k > 0, 1e-3 * k * (1.0 + k / 20.0), 0.0)  # still, then every speed above the level up to the end
+    rng = np.random.default_rng(5)
+    for angle in (0.0, *rng.uniform(0.0, 2 * math.pi, 60)):
+        c, s = math.cos(angle), math.sin(angle)
+        speed = np.hypot(*np.gradient(np.column_stack((c * ramp, s * ramp)), dt, axis=0).T)
+        level = 0.05 * float(speed.max())
+        for ulps in range(-12, 13):
+            # sample 10's speed (128 times its differences), and from sample 10 on, the first sample's speed (256 times
+            # them): the level, and up to 12 ulps of x to either side; kept where the level and the squared
+            # differences compared, as the squares they are, would not say what hypot says
+            x, y, ex, ey = c * ramp, s * ramp, c * ramp, s * ramp
+            x[11], y[11], ex[11], ey[11] = c * level / 128.0, s * level / 128.0, c * level / 256.0, s * level / 256.0
+            for _ in range(abs(ulps)):
+                x[11] = math.nextafter(x[11], math.copysign(math.inf, ulps))
+                ex[11] = math.nextafter(ex[11], math.copysign(math.inf, ulps))
+            scaled = (level / 128.0) ** 2
+            if angle == 0.0 or (x[11] ** 2 + y[11] ** 2 < scaled) != (np.hypot(x[11], y[11]) * 128 < level):
+                for path in ((x, y), (x[::-1], y[::-1]), (x[9:], y[9:]), (x[9:][::-1], y[9:][::-1])):
+                    paths.append((*path, 0, dt, (0.0, 0.0), (0.1 * c, 0.1 * s)))
+            if angle == 0.0 or (4 * (ex[11] ** 2 + ey[11] ** 2) < scaled) != (np.hypot(ex[11], ey[11]) * 256 < level):
+                for path in ((ex[10:], ey[10:]), (ex[10:][::-1], ey[10:][::-1])):
+                    paths.append((*path, 0, dt, (0.0, 0.0), (0.1 * c, 0.1 * s)))
+    assert len(paths) >= 200
+    for a1, b1 in rng.uniform(0.3, 0.6, (6, 2)):
+        # two steps of the hand, (a1, b1) at sample 20 and back by (a2, b2) at sample 40, a few ulps from it, whose
+        # speeds' order (or tie) the squared differences get wrong
+        grid = np.arange(-40, 41)
+        a2, b2 = np.broadcast_arrays(a1 + grid[:, None] * np.spacing(a1), b1 - grid * np.spacing(b1))
+        wrong = (a2 * a2 + b2 * b2 > a1 * a1 + b1 * b1) != (np.hypot(a2, b2) > np.hypot(a1, b1))
+        for a, b in list(zip(a2[wrong], b2[wrong], strict=True))[:6]:
+            x, y = (np.concatenate([np.zeros(20), [c / 2], np.full(19, c), [c - d / 2], np.full(20, c - d)])
+                    for c, d in ((a1, a), (b1, b)))
+            paths.append((x, y, 0, dt, (0.0, 0.0), (0.1, 0.1)))
+    tied = np.concatenate([np.zeros(20), np.arange(1.0, 101.0) * 2.0**-10, np.full(30, 100 * 2.0**-10)])
+    paths.append((tied, np.zeros(len(tied)), 3, dt, (0.0, 0.0), (0.1, 0.0)))  # every speed on the way the same
+    paths.append((tied, tied, 3, dt, (0.0, 0.0), (0.1, 0.1)))
+    u = np.clip(np.arange(120) / 80.0 - 0.2, 0.0, 1.0)
+    x = 0.05 * u**3 * (10 - 15 * u + 6 * u * u)
+    for scale in (1e-320, 1e-300, 1e-120, 1e-101, 1e-99, 1.0, 1e99, 1e101, 1e120, 1e300):
+        for dt_ in (1e-300, 1e-101, 1e-99, 0.004, 1e99, 1e101):
+            paths.append((scale * x, scale * (u - 0.5) * 1e-3, 1, dt_, (0.0, 0.0), (scale, scale)))
+    for offset in (9.9e99, 1.1e100):  # coordinates within and past 1e100 in size, their differences far smaller
+        paths.append((offset + 1e90 * x, np.full(len(x), -1e-100), 5, 0.004, (offset, 0.0), (offset + 1e90, 1e89)))
+    for start, step in ((2**52 - 100, 0.004), (2**53 - 50, 1.0), (-60, 0.004), (-60, -0.004), (0, 5e-324),
+                        (0, 2.2250738585072014e-308), (10, 1e306), (2**52 - 130, 0.004)):
+        paths.append((x, x * 0.5, start, step, (0.0, 0.0), (0.05, 0.025)))
+    assert measured_as_reach_metrics(paths) > 4 * len(paths)
+
+
 @compiled
 def test_the_dense_rewards_distance_is_math_hypot_bit_for_bit() -> None:
     # _ccenter.edges stands for the single env's max(0.0, math.hypot(dx, dy) - radius): CPython's own hypot (not the
