@@ -11,6 +11,33 @@
 #include <Python.h>
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* frexp's exponent of a positive finite x, and ldexp(1.0, k): from the bits where the numbers are normal, else the C
+ * library's (the same values, both exact). Two library calls an env a step were a fifth of the dense reward's time. */
+static inline int py_hypot_exponent(double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    const int field = (int)((bits >> 52) & 0x7ff);
+    if (field == 0) {
+        int e;
+        frexp(x, &e);
+        return e;
+    }
+    return field - 1022;
+}
+
+static inline double py_hypot_pow2(int k)
+{
+    if (k < -1022 || k > 1023)
+        return ldexp(1.0, k);
+    const uint64_t bits = (uint64_t)(k + 1023) << 52;
+    double x;
+    memcpy(&x, &bits, sizeof x);
+    return x;
+}
 
 #if PY_VERSION_HEX >= 0x030C0000
 
@@ -36,11 +63,10 @@ static double py_hypot_norm(double v0, double v1, double max)
 {
     if (max == 0.0)
         return max;
-    int max_e;
-    frexp(max, &max_e);
-    if (max_e < -1023)  /* ldexp(1.0, -max_e) would overflow: subnormals made normal first */
+    const int max_e = py_hypot_exponent(max);
+    if (max_e < -1023)  /* py_hypot_pow2(-max_e) would overflow: subnormals made normal first */
         return DBL_MIN * py_hypot_norm(v0 / DBL_MIN, v1 / DBL_MIN, max / DBL_MIN);
-    const double scale = ldexp(1.0, -max_e);
+    const double scale = py_hypot_pow2(-max_e);
     double csum = 1.0, frac1 = 0.0, frac2 = 0.0;
     const double v[2] = {v0, v1};
     for (int i = 0; i < 2; i++) {
@@ -70,12 +96,11 @@ static double py_hypot_norm(double v0, double v1, double max)
     const double T27 = 134217729.0; /* 2**27 + 1 */
     if (max == 0.0)
         return max;
-    int max_e;
-    frexp(max, &max_e);
+    const int max_e = py_hypot_exponent(max);
     double x, t, hi, lo, oldcsum, csum = 1.0, frac1 = 0.0, frac2 = 0.0, frac3 = 0.0;
     const double v[2] = {v0, v1};
     if (max_e >= -1023) {
-        const double scale = ldexp(1.0, -max_e);
+        const double scale = py_hypot_pow2(-max_e);
         for (int i = 0; i < 2; i++) {
             x = v[i] * scale;
             t = x * T27;
