@@ -310,6 +310,42 @@ static void idle_lane(Lanes *L, int l)
     L->game[l] = -1;
 }
 
+/* features.wrap_angle: q itself within [-pi, pi], else q - tau round(q / tau) clipped (round: half to even). */
+static inline double wrap(double q)
+{
+    const double pi = 3.141592653589793, tau = 6.283185307179586;
+    if (-pi <= q && q <= pi)
+        return q;
+    double w = q - tau * rint(q / tau);
+    return w < -pi ? -pi : w > pi ? pi : w;
+}
+
+/* center_out_v1.CenterOutV1Env._observation of a run into o, in its order; it clears the run's FRESH. */
+static inline void observe(const double *p, const double *s, int64_t *it, const double *t, double *o)
+{
+    const double l1 = p[P_L1], l2 = p[P_L2];
+    it[I_FRESH] = 0;
+    const double q1 = s[0], q2 = s[1], w1 = s[2], w2 = s[3];
+    const double q12 = q1 + q2, w12 = w1 + w2;
+    double c1, s1, c12, s12;
+    trig_of(s, q1, q12, &s1, &c1, &s12, &c12);
+    const int reach = it[I_PHASE] == 1;
+    const double cx = s[S_CX], cy = s[S_CY];
+    o[0] = wrap(q1);
+    o[1] = wrap(q2);
+    o[2] = w1;
+    o[3] = w2;
+    memcpy(o + 4, s + S_A, 4 * sizeof(double));
+    o[8] = cx - t[T_HX];
+    o[9] = cy - t[T_HY];
+    o[10] = -l1 * s1 * w1 - l2 * s12 * w12;
+    o[11] = l1 * c1 * w1 + l2 * c12 * w12;
+    o[12] = (reach ? t[T_TX] : t[T_HX]) - cx;
+    o[13] = (reach ? t[T_TY] : t[T_HY]) - cy;
+    o[14] = reach ? 1.0 : 0.0;
+    o[15] = (double)(it[I_STEPS] - it[I_START]) * p[P_DT];
+}
+
 /* Runs i0 to i0 + LANES - 1 (each that has steps to run: no event pending, TODO above 0), as ``run`` would run each. */
 CENTER_FLATTEN static void run_block(const Arm *arm, const double *p, int mode, double *state, int64_t *ints,
                                      const double *trials, double *xsall, double *ysall, int64_t cap, Py_ssize_t i0)
@@ -490,16 +526,6 @@ LANES_INLINE void prefetch_paths(const int64_t *ints, double *xs, double *ys, in
 #endif
 }
 
-/* features.wrap_angle: q itself within [-pi, pi], else q - tau round(q / tau) clipped (round: half to even). */
-static inline double wrap(double q)
-{
-    const double pi = 3.141592653589793, tau = 6.283185307179586;
-    if (-pi <= q && q <= pi)
-        return q;
-    double w = q - tau * rint(q / tau);
-    return w < -pi ? -pi : w > pi ? pi : w;
-}
-
 PyDoc_STRVAR(advance_doc,
 "advance(params, mode, state, ints, trials, xs, ys, obs) -> int\n\n"
 "Run every run of the batch its ints[:, TODO] steps (stopping at a trial's end or the guard's stop, which\n"
@@ -549,7 +575,6 @@ static PyObject *advance(PyObject *self, PyObject *args)
         double *state = b[1].view.buf, *trials = b[3].view.buf, *obs = b[6].view.buf;
         double *xs = b[4].view.buf, *ys = b[5].view.buf;
         int64_t *ints = b[2].view.buf;
-        const double dt = p[P_DT], l1 = p[P_L1], l2 = p[P_L2];
         Py_BEGIN_ALLOW_THREADS
         /* The lanes take blocks of runs where most of a block has steps to run (a step's first call); the runs
          * left, and the calls for the few runs a trial's end stopped, run one at a time. */
@@ -585,28 +610,7 @@ static PyObject *advance(PyObject *self, PyObject *args)
             events += it[I_EVENT] != EVENT_NONE;
             if (!touched)
                 continue;
-            it[I_FRESH] = 0;
-            /* center_out_v1.CenterOutV1Env._observation, in its order. */
-            const double q1 = s[0], q2 = s[1], w1 = s[2], w2 = s[3];
-            const double q12 = q1 + q2, w12 = w1 + w2;
-            double c1, s1, c12, s12;
-            trig_of(s, q1, q12, &s1, &c1, &s12, &c12);
-            const int reach = it[I_PHASE] == 1;
-            const double cx = s[S_CX], cy = s[S_CY];
-            double *o = obs + 16 * i;
-            o[0] = wrap(q1);
-            o[1] = wrap(q2);
-            o[2] = w1;
-            o[3] = w2;
-            memcpy(o + 4, s + S_A, 4 * sizeof(double));
-            o[8] = cx - t[T_HX];
-            o[9] = cy - t[T_HY];
-            o[10] = -l1 * s1 * w1 - l2 * s12 * w12;
-            o[11] = l1 * c1 * w1 + l2 * c12 * w12;
-            o[12] = (reach ? t[T_TX] : t[T_HX]) - cx;
-            o[13] = (reach ? t[T_TY] : t[T_HY]) - cy;
-            o[14] = reach ? 1.0 : 0.0;
-            o[15] = (double)(it[I_STEPS] - it[I_START]) * dt;
+            observe(p, s, it, t, obs + 16 * i);
         }
         Py_END_ALLOW_THREADS
     }
