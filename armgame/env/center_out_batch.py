@@ -138,9 +138,9 @@ class _Task:
         self.blocks = np.array([p.block for p in plans], dtype=np.int64)
         self.block_names = np.array([p.block_name for p in plans], dtype=object)
 
-    def trial(self, plan: TrialPlan) -> np.ndarray:
-        """A trial's row of the C loop's ``trials``."""
-        perturbation = plan.active
+    def base_row(self, perturbation: Perturbation) -> np.ndarray:
+        """The C loop's ``trials`` row of every trial under ``perturbation``, but for its delay and target (kept: not
+        to be written to)."""
         row = self._rows.get(perturbation)
         if row is None:
             row = self.base.copy()
@@ -149,7 +149,11 @@ class _Task:
             kind, numbers = show_row(perturbation, self.home, self.home_q)  # type: ignore[arg-type]
             row[T_SHOW], row[T_SP:T_SP + len(numbers)] = kind, numbers
             self._rows[perturbation] = row
-        row = row.copy()
+        return row
+
+    def trial(self, plan: TrialPlan) -> np.ndarray:
+        """A trial's row of the C loop's ``trials``."""
+        row = self.base_row(plan.active).copy()
         row[T_DELAY], row[T_TX], row[T_TY] = plan.delay_steps, *plan.position
         return row
 
@@ -462,13 +466,21 @@ class CenterOutBatchVectorEnv(VectorEnv):
             reaches.setdefault(i, []).append(row)
         self._hits[ended] += hit
         self._trial[ended] += 1
+        # The next trials' rows for the C loop, written in three assignments rather than a row at a time.
+        going, plans = [], []
         for i, index in zip(ended.tolist(), self._trial[ended].tolist(), strict=True):
             run = runs[i]
             if index >= len(run.task.blocks):  # type: ignore[union-attr]
                 self._finished[i] = True
                 ints[i, I_TODO] = 0
             else:
-                self.trials[i] = run.task.trial(run.plan(index))  # type: ignore[union-attr]
+                going.append(i)
+                plans.append(run.plan(index))  # type: ignore[union-attr]
+        if going:
+            self.trials[going] = [runs[i].task.base_row(plan.active)  # type: ignore[union-attr]
+                                  for i, plan in zip(going, plans, strict=True)]
+            self.trials[going, T_DELAY] = [plan.delay_steps for plan in plans]
+            self.trials[going, T_TX:T_TY + 1] = [plan.position for plan in plans]
 
     def _measure_new(self) -> None:
         fresh = np.flatnonzero(np.isnan(self._edge))
