@@ -13,7 +13,8 @@
  * as their ``plan`` numbers write them, and the rules' tests are ``Target.contains`` and ``_task_step``'s, in the
  * same order. The hand's sin and cos come in pairs from glibc's sincos only where this module's start found it
  * equal to sin and cos, bit for bit (_ckernel.c's check). setup.py builds this file with floating-point contraction
- * off. tests/test_env_center_out_batch.py compares every observation, reward, flag and info with Gymnasium's ``SyncVectorEnv`` of single envs. */
+ * off. tests/test_env_center_out_batch.py compares every observation, reward, flag and info with Gymnasium's
+ * ``SyncVectorEnv`` of single envs. */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #include <math.h>
