@@ -71,6 +71,29 @@ def slug(env_id: str) -> str:
     return env_id.split("/")[-1]
 
 
+def hit_range(env_id: str) -> dict[str, float]:
+    """The values a mean of hits a game can take on ``env_id``, as ``mean_interval``'s ``low`` and ``high``: from 0
+    to, on a CenterOut id, the trials an episode holds (every one hit); a Reach game's hits have no fixed top."""
+    import gymnasium
+
+    if "CenterOut" not in env_id:
+        return {"low": 0.0, "high": float("inf")}
+    from armgame.env.center_out_v1 import DEFAULT_EPISODE_TRIALS
+
+    trials = gymnasium.spec(env_id).kwargs.get("episode_trials", DEFAULT_EPISODE_TRIALS)
+    return {"low": 0.0, "high": float(trials) if isinstance(trials, int) else float("inf")}
+
+
+def per_minute_interval(data: dict[str, Any], path: Path | str = "a bots file") -> tuple[float, float]:
+    """Hits a minute's 95 % interval over the games of a ``bots`` file (``ratio_interval`` of each game's hits and
+    minutes, never below 0); a file from before ``bots`` kept each game's minutes is refused in one line."""
+    from armgame.env.evaluation import ratio_interval
+
+    if "game_minutes" not in data:
+        raise ValueError(f"{path}: no game_minutes (a run before bots kept each game's length): run bots again")
+    return ratio_interval(data["hits"], data["game_minutes"], low=0.0)
+
+
 def run_bots(out: Path, ids: tuple[str, ...], games: int,
              policies: tuple[str, ...] = ("random", "naive", "model")) -> None:
     for env_id in ids:
@@ -79,8 +102,12 @@ def run_bots(out: Path, ids: tuple[str, ...], games: int,
             result = evaluate(policy, env_id, games=games, policy_factory=_factory(policy))
             # CenterOut: each game's seconds from a go cue to a hit too, which ranks policies that hit every trial;
             # and the CPU a decision cost, the env's step included, for protocol 3's reference (the model bot's).
-            decisions = round(result.minutes * 60 / DECISION_SECONDS) * result.games
+            # Every game's decisions, not a mean game's times the games: episodes differ in length.
+            decisions = round(sum(result.game_minutes) * 60 / DECISION_SECONDS)
+            # Each game's minutes too: a CenterOut episode lasts as its trials take, and hits a minute's interval
+            # (Evaluation.hits_per_minute_ci95) is over the games' hits and lengths, not a mean game's.
             timing = {"hits_per_minute": round(result.hits_per_minute, 4), "minutes": round(result.minutes, 6),
+                      "game_minutes": [round(m, 8) for m in result.game_minutes],
                       "cpu_seconds": round(time.process_time() - cpu, 3), "decisions": decisions,
                       "processor": _ceiling_benchmark().processor()} | (
                 {"reach_seconds": [None if np.isnan(t) else round(t, 4) for t in result.reach_seconds]}
@@ -295,7 +322,7 @@ def table(reference: dict[str, dict[str, Any]] | None = None, controller_folder:
         long = [(budget, means) for budget, means in runs.get(env_id, {}).items() if len(means) >= CEILING_SEEDS]
         budget, means = long[-1] if long else (PPO_STEPS, entry.get("ppo_seeds", []))
         if means:
-            low, high = mean_interval(means)
+            low, high = mean_interval(means)  # protocol 2's table as published (no interval of it is below 0)
             ppo = float(np.mean(means))
             cells.append(f"{budget / 1e6:g} M, {len(means)}: {ppo:.1f} ({low:.1f}-{high:.1f})")
         else:
@@ -339,7 +366,7 @@ def references_v3(ceiling_folder: Path = RESULTS / "ceiling", reference_folder: 
         else:
             continue
         hits = data["hits"]
-        low, high = mean_interval(hits)
+        low, high = mean_interval(hits, **hit_range(env_id))
         decisions = data.get("decisions", len(hits) * 3000)  # issue 40's runs: 60 s games of 20 ms decisions
         arguments = ", ".join(f"{k}={v!r}" for k, v in settings.items())
         measured[env_id] = {
@@ -360,10 +387,9 @@ def references_v3(ceiling_folder: Path = RESULTS / "ceiling", reference_folder: 
 def center_out_references(folder: Path = RESULTS / "center-out-time") -> dict[str, dict[str, Any]]:
     """Protocol 3's reference of every CenterOut id: the policy with the most hits a minute on the 100 test games
     among the candidates' files in ``folder`` (``CENTER_OUT_REFERENCES``: those that record their CPU), since every
-    trial is hit and speed is what still ranks them; the interval is its hits' over games, a minute of the mean
-    episode; the 0 is random play's hits a minute. An id without a candidate or random play's file is left out."""
-    from armgame.env.evaluation import mean_interval
-
+    trial is hit and speed is what still ranks them; the interval is hits a minute's over the games, from each game's
+    hits and length (``per_minute_interval``: the reference hits every trial, so its episodes' lengths are what
+    spread); the 0 is random play's hits a minute. An id without a candidate or random play's file is left out."""
     rows = {}
     for env_id in IDS:
         if "CenterOut" not in env_id:
@@ -375,10 +401,10 @@ def center_out_references(folder: Path = RESULTS / "center-out-time") -> dict[st
         if not (candidates and random.is_file()):
             continue
         data = max(candidates, key=lambda data: data["hits_per_minute"])
-        low, high = mean_interval(data["hits"])
+        low, high = per_minute_interval(data, folder / f"{slug(env_id)}.{data['policy']}.json")
         rows[env_id] = {
-            "hits": round(data["hits_per_minute"], 3), "low": round(low / data["minutes"], 3),
-            "high": round(high / data["minutes"], 3), "games": data["games"], "unit": "hits a minute",
+            "hits": round(data["hits_per_minute"], 3), "low": round(low, 3), "high": round(high, 3),
+            "games": data["games"], "unit": "hits a minute",
             "random": round(json.loads(random.read_text(encoding="utf-8"))["hits_per_minute"], 4),
             "code": CENTER_OUT_REFERENCES[data["policy"]],
             "cpu_per_decision": round(data["cpu_seconds"] / data["decisions"], 6),
@@ -417,7 +443,7 @@ def tier_table(root: Path = RESULTS) -> str:
         means = [json.loads(p.read_text(encoding="utf-8"))["mean_hits"]
                  for p in sorted((root / "ppo-tier" / slug(env_id)).glob("seed*/result.json"))]
         if means:
-            low, high = mean_interval(means)
+            low, high = mean_interval(means, **hit_range(env_id))
             runs = f"{len(means)} of 5: {np.mean(means):.1f}" + (f" ({low:.1f}-{high:.1f})" if len(means) > 1 else "")
             score = f"{normalised_score(env_id, float(np.mean(means)), protocol=3):.2f}"
         else:
@@ -431,30 +457,40 @@ def tier_table(root: Path = RESULTS) -> str:
 def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
     """docs/programs.md's table of the CenterOut ids' policies (``bots``' files in ``folder``): hits, hits a minute
     and the seconds from a trial's go cue to its hit (the mean over games with a hit, 95 % interval over them),
-    which ranks policies that all hit every trial; and PPO's timed runs (``center_out_ppo``), pooled over seeds."""
+    which ranks policies that all hit every trial; and PPO's timed runs (``center_out_ppo``), pooled over seeds.
+    Every interval is clipped to the values its quantity can take (``mean_interval``: hits from 0 to the trials an
+    episode holds, seconds and hits a minute from 0). Hits a minute's is over the games (``per_minute_interval``);
+    PPO's files keep each seed's hits a minute but not each game's length, so its row's is over the seeds."""
     from armgame.env.evaluation import mean_interval
 
-    lines = ["| id | policy | hits a game (95% CI) | hits a minute | s from the go cue to a hit (95% CI) "
-             "| games with a hit |", "|---|---|---|---:|---|---:|"]
-    rows = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(folder.glob("*.json"))]
+    lines = ["| id | policy | hits a game (95% CI) | hits a minute (95% CI) | s from the go cue to a hit (95% CI) "
+             "| games with a hit |", "|---|---|---|---|---|---:|"]
+    paths = sorted(folder.glob("*.json"))
+    rows = [json.loads(path.read_text(encoding="utf-8")) for path in paths]
+    for r, path in zip(rows, paths, strict=True):
+        r["per_minute"] = per_minute_interval(r, path)
     for env_id, results in center_out_ppo(folder / "ppo").items():  # pooled: every seed's 100 test games
+        per_seed = [r["hits_per_minute"] for r in results]
+        low, high = mean_interval(per_seed, low=0.0)
         rows.append({"env_id": env_id, "policy": f"PPO 1 M, {len(results)} seeds",
                      "hits": [h for r in results for h in r["test_hits"]],
-                     "hits_per_minute": float(np.mean([r["hits_per_minute"] for r in results])),
+                     "hits_per_minute": float(np.mean(per_seed)), "per_minute": (low, high, " over seeds"),
                      "reach_seconds": [t for r in results for t in r["reach_seconds"]],
                      "games": sum(len(r["test_hits"]) for r in results)})
     order = {"random": 0, "naive": 1, "model": 2}
     for r in sorted(rows, key=lambda r: (IDS.index(r["env_id"]) if r["env_id"] in IDS else len(IDS), r["env_id"],
                                          order.get(r["policy"], 3), r["policy"])):
-        low, high = mean_interval(r["hits"])
+        low, high = mean_interval(r["hits"], **hit_range(r["env_id"]))
         times = [t for t in r.get("reach_seconds", []) if t is not None]
         if times:
-            t_low, t_high = mean_interval(times)
+            t_low, t_high = mean_interval(times, low=0.0)
             reach = f"{np.mean(times):.2f} ({t_low:.2f}-{t_high:.2f})"
         else:
             reach = "no hit"
+        m_low, m_high, *over = r["per_minute"]
+        per_minute = f"{r['hits_per_minute']:.1f} ({m_low:.1f}-{m_high:.1f}{''.join(over)})"
         lines.append(f"| `{slug(r['env_id'])}` | {r['policy']} | {np.mean(r['hits']):.2f} ({low:.2f}-{high:.2f}) "
-                     f"| {r['hits_per_minute']:.1f} | {reach} | {len(times)} of {r['games']} |")
+                     f"| {per_minute} | {reach} | {len(times)} of {r['games']} |")
     return "\n".join(lines)
 
 
@@ -692,7 +728,7 @@ def curves(folder: Path) -> str:
             out.append(f"over the last half of the budget the median rises {slope[0]:+.2f} hits per million env "
                        f"steps (+-2 standard errors: {slope[1]:+.2f} to {slope[2]:+.2f})")
         means = [float(result["mean_hits"]) for _, _, result in runs]
-        low, high = mean_interval(means)
+        low, high = mean_interval(means, **hit_range(env_id))
         after = ", ".join(f"{b:,}" for b in sorted({int(result["env_steps"]) for _, _, result in runs}))
         games = sorted({len(result["test_hits"]) for _, _, result in runs})
         out.append(f"test games ({', '.join(map(str, games))}): {', '.join(f'{m:.1f}' for m in means)}; mean "
@@ -734,7 +770,7 @@ def runs_table(root: Path = RESULTS) -> str:
             word = "flat" if slope[1] <= 0 <= slope[2] else ("rising" if slope[0] > 0 else "falling")
             shape = f"{word}: {slope[0]:+.2f} ({slope[1]:+.2f} to {slope[2]:+.2f})"
         means = [float(result["mean_hits"]) for _, _, result in runs]
-        low, high = mean_interval(means)
+        low, high = mean_interval(means, **hit_range(env_id))
         cells = [f"`{slug(env_id)}`", f"{budget / 1e6:g} M, {len(runs)}", *curve, shape,
                  ", ".join(f"{m:.1f}" for m in means), f"**{np.mean(means):.1f}** ({low:.1f}-{high:.1f})"]
         rows.append(((order.get(env_id, len(order)), budget), "| " + " | ".join(cells) + " |"))

@@ -319,6 +319,54 @@ def test_evaluate_is_deterministic_and_reports_an_interval():
         evaluate("clever", REACH, games=1)
 
 
+def test_hits_a_minute_has_an_interval_over_games_of_different_lengths():
+    """Hits a minute is total hits over total minutes; its interval (``ratio_interval``) comes from each game's hits
+    and length, so episodes that all hit every trial still spread by how long they took (before, the hits'
+    interval over a mean episode: 45.7-45.7 for the CenterOut reference)."""
+    from armgame.env.evaluation import Evaluation, ratio_interval
+
+    hits = [8] * 6
+    near, far = [0.17, 0.18, 0.175, 0.172, 0.178, 0.176], [0.12, 0.24, 0.15, 0.21, 0.175, 0.176]
+    for minutes in (near, far):
+        ratio = sum(hits) / sum(minutes)
+        low, high = ratio_interval(hits, minutes)
+        assert low < ratio < high
+    assert np.ptp(ratio_interval(hits, far)) > 3 * np.ptp(ratio_interval(hits, near))  # wider with the spread
+    # Games of one length: the hits' t interval over that length, as before there were lengths to spread.
+    assert ratio_interval([1, 3, 2], [0.5] * 3) == pytest.approx(tuple(v / 0.5 for v in mean_interval([1, 3, 2])))
+    # One game, or every game the same rate: the ratio twice, no crash; never below 0 when told so.
+    assert ratio_interval([8], [0.2]) == (40.0, 40.0)
+    assert ratio_interval([4, 8], [0.1, 0.2]) == pytest.approx((40.0, 40.0))
+    assert ratio_interval([0, 0, 1], [1.0, 1.0, 1.0], low=0.0)[0] == 0.0 < ratio_interval([0, 0, 1], [1.0] * 3)[1]
+    with pytest.raises(ValueError, match="as many"):
+        ratio_interval([1, 2], [0.5])
+    made = Evaluation("armgame/CenterOut-v1", "x", (1, 2, 3, 4, 5, 6), tuple(hits), tuple(hits), float(np.mean(far)),
+                      None, game_minutes=tuple(far))
+    assert made.hits_per_minute == pytest.approx(8 / np.mean(far))  # the same number as ever
+    assert made.hits_per_minute_ci95 == ratio_interval(hits, far, low=0.0)
+    # evaluate keeps each game's minutes: a CenterOut episode lasts as its trials take.
+    result = evaluate("model", "armgame/CenterOut-v1", games=3)
+    assert len(result.game_minutes) == 3 and len(set(result.game_minutes)) > 1
+    assert result.minutes == pytest.approx(np.mean(result.game_minutes))
+    low, high = result.hits_per_minute_ci95
+    assert low < result.hits_per_minute < high
+    assert evaluate("random", REACH, games=2, time_limit=5.0).game_minutes == (5.0 / 60, 5.0 / 60)
+
+
+def test_a_counts_interval_is_clipped_to_the_values_it_can_take():
+    """Student's t is symmetric, so five seeds of which one is far above the rest give a count's mean a negative
+    lower end (PPO on ReachMemory-v1: -5.4 to 12.3); clipped, it keeps t's upper end and starts at 0."""
+    seeds = [0.5, 0.2, 0.0, 0.3, 16.1]
+    low, high = mean_interval(seeds)
+    assert low < 0
+    assert mean_interval(seeds, low=0.0) == (0.0, high)
+    assert mean_interval([7.9, 8.0, 6.5, 8.0, 8.0], low=0.0, high=8.0)[1] == 8.0
+    from armgame.env.evaluation import Evaluation
+
+    rare = Evaluation(REACH, "random", (1, 2, 3, 4), (0, 0, 0, 1), (0, 0, 0, 1), 1.0, None)
+    assert rare.ci95 == (0.0, mean_interval(rare.hits)[1]) and rare.hits_per_minute_ci95[0] == 0.0
+
+
 class Model:
     """A model with SB3's ``predict``: a fixed linear policy of the observation (one row or many)."""
 

@@ -275,9 +275,55 @@ def test_the_docs_center_out_table_is_the_committed_results_and_evaluates_own_ti
     assert armgame.env.evaluate("model", "armgame/Reach-v1", games=1, time_limit=1.0).reach_seconds == ()
 
 
+def test_the_center_out_files_keep_each_games_minutes_and_the_reference_interval_is_over_them():
+    """``bots`` keeps each game's length (``game_minutes``), whose mean is the file's ``minutes`` and which give its
+    hits a minute; the CenterOut references' interval is hits a minute's over those games, no longer the hits'
+    interval over a mean episode (45.7-45.7 while every game hit all 8 trials). No count's interval in the docs' tables
+    goes below 0, nor above an episode's 8 trials."""
+    import re
+
+    from armgame.env.evaluation import ratio_interval
+    from armgame.env.references import REFERENCES_V3
+
+    scores = _reference_scores()
+    folder = ROOT / "benchmarks" / "results" / "center-out-time"
+    files = {path.name: json.loads(path.read_text()) for path in sorted(folder.glob("*.json"))}
+    assert len(files) == 16  # four ids by random, naive, model and shooting
+    for name, data in files.items():
+        minutes = data["game_minutes"]
+        assert len(minutes) == data["games"] == len(data["hits"]), name
+        assert np.mean(minutes) == pytest.approx(data["minutes"], abs=1e-6), name
+        assert sum(data["hits"]) / sum(minutes) == pytest.approx(data["hits_per_minute"], abs=1e-4), name
+        assert data["decisions"] == round(sum(minutes) * 60 / 0.02), name  # whole 20 ms decisions a game
+    for env_id, row in REFERENCES_V3.items():
+        if row["unit"] != "hits a minute":
+            continue
+        data = files[f"{env_id.split('/')[1]}.shooting.json"]
+        assert set(data["hits"]) == {8} and len(set(data["game_minutes"])) > 1  # every trial hit, in varying time
+        low, high = ratio_interval(data["hits"], data["game_minutes"], low=0.0)
+        assert (row["low"], row["high"]) == (round(low, 3), round(high, 3))
+        assert row["low"] < row["hits"] < row["high"]
+    tables = scores.center_out_timing_table() + scores.tier_table() + scores.runs_table()
+    # An interval is printed "(low-high)": one below 0 reads "(-5.4-12.3)" (a slope's "(-1.36 to +0.63)" may).
+    assert not re.search(r"\(-\d+\.\d+-\d", tables)
+    assert "**7.4** (6.5-8.0)" in scores.runs_table()  # CenterOutHold-v1's PPO seeds: t's 8.4 is past 8 trials
+
+
+def test_bots_writes_each_games_minutes_and_counts_every_games_decisions(tmp_path):
+    scores = _reference_scores()
+    scores.run_bots(tmp_path, ("armgame/CenterOut-v1",), 3, ("model",))
+    data = json.loads((tmp_path / "CenterOut-v1.model.json").read_text())
+    result = armgame.env.evaluate("model", "armgame/CenterOut-v1", games=3)
+    assert data["game_minutes"] == [round(m, 8) for m in result.game_minutes] and len(set(data["game_minutes"])) > 1
+    assert data["decisions"] == round(sum(result.game_minutes) * 3000)  # 20 ms each, not 3 mean games' worth
+    assert scores.per_minute_interval(data) == pytest.approx(result.hits_per_minute_ci95)
+    with pytest.raises(ValueError, match="no game_minutes"):
+        scores.per_minute_interval({"hits": [8]}, "old.json")
+
+
 def test_a_models_centre_out_times_are_measured_in_its_batched_games_as_one_by_one():
     """``evaluate`` plays a model with ``predict`` and no ``reset()`` many games at a time: each game's time from a go
-    cue to a hit is read from its own env when it ends, as in the games played one by one."""
+    cue to a hit and its length are read from its own env when it ends, as in the games played one by one."""
     env_id = "armgame/CenterOut-v1"
 
     class Bots:  # a stand-in model: one model bot a game column, asked together
@@ -291,3 +337,4 @@ def test_a_models_centre_out_times_are_measured_in_its_batched_games_as_one_by_o
     alone = armgame.env.evaluate("model", env_id, games=3)
     assert batched.hits == alone.hits == (8, 8, 8)
     assert batched.reach_seconds == alone.reach_seconds and len(alone.reach_seconds) == 3
+    assert batched.game_minutes == alone.game_minutes and len(set(alone.game_minutes)) == 3  # each game's own length

@@ -4,8 +4,9 @@
 (``armgame.env.suite.EVALUATION_SEEDS``, which no training example uses), one single env, one game
 per seed, and returns an ``Evaluation``: the hits of every game, their mean with a 95 % confidence
 interval (Student's t over games), the score, the rates per minute (so games of another
-``time_limit`` compare) and, where the id has a reference, the normalised score of protocol 3
-(``armgame.env.suite.PROTOCOL_VERSION``): 0 for the random policy, 1 for the id's fixed reference
+``time_limit`` compare; hits a minute with its interval over the games' hits and lengths, ``ratio_interval``, since a
+CenterOut episode lasts as long as its trials take) and, where the id has a reference, the normalised score of
+protocol 3 (``armgame.env.suite.PROTOCOL_VERSION``): 0 for the random policy, 1 for the id's fixed reference
 (``REFERENCES_V3``: the shooting controller's mean hits on a Reach id, the model bot's hits a minute on a
 CenterOut id). ``normalised_score(..., protocol=2)`` still gives protocol 2's (by ``CEILINGS``, the best mean
 hits measured when it was published).
@@ -77,6 +78,9 @@ class Evaluation:
     #: CenterOut ids: each game's mean seconds from a trial's go cue to its hit, over the trials it hit (nan: none);
     #: empty for Reach. Where every policy hits every trial, this is what still ranks them.
     reach_seconds: tuple[float, ...] = ()
+    #: Each game's length in minutes of game time, in ``seeds``' order (``minutes`` is their mean): a Reach game lasts
+    #: its ``time_limit``, a CenterOut episode as long as its trials take. Empty where not measured (made by hand).
+    game_minutes: tuple[float, ...] = ()
 
     @property
     def games(self) -> int:
@@ -88,8 +92,9 @@ class Evaluation:
 
     @property
     def ci95(self) -> tuple[float, float]:
-        """The mean hits' 95 % confidence interval (Student's t over games; the mean twice for one game)."""
-        return mean_interval(self.hits)
+        """The mean hits' 95 % confidence interval (Student's t over games, never below 0: ``mean_interval``; the mean
+        twice for one game)."""
+        return mean_interval(self.hits, low=0.0)
 
     @property
     def mean_score(self) -> float:
@@ -98,6 +103,15 @@ class Evaluation:
     @property
     def hits_per_minute(self) -> float:
         return self.mean_hits / self.minutes
+
+    @property
+    def hits_per_minute_ci95(self) -> tuple[float, float]:
+        """``hits_per_minute``'s 95 % confidence interval over the games (``ratio_interval`` of each game's hits and
+        minutes); without ``game_minutes``, the hits' interval over a game of the mean minutes."""
+        if len(self.game_minutes) != len(self.hits):
+            low, high = self.ci95
+            return low / self.minutes, high / self.minutes
+        return ratio_interval(self.hits, self.game_minutes, low=0.0)
 
     @property
     def score_per_minute(self) -> float:
@@ -118,8 +132,16 @@ class Evaluation:
                 f"{self.games} games), {self.hits_per_minute:.1f} a minute{time}{norm}")
 
 
-def mean_interval(values: Sequence[float]) -> tuple[float, float]:
-    """The mean's 95 % confidence interval by Student's t."""
+def mean_interval(values: Sequence[float], *, low: float = -math.inf,
+                  high: float = math.inf) -> tuple[float, float]:
+    """The mean's 95 % confidence interval by Student's t, clipped to ``[low, high]``: the values the mean can take.
+
+    A count's mean is never below 0 (``low=0``), yet t's symmetric interval goes below it where a few runs are far
+    above the rest (PPO's seeds on ReachMemory-v1: 0.5, 0.2, 0.0, 0.3 and 16.1 hits give -5.4 to 12.3). Clipping
+    keeps t's interval and its coverage: the true mean lies in ``[low, high]``, so the clipped part never held it
+    and the clipped interval holds it whenever t's did; it only stops printing values the quantity cannot take. (A
+    skew-aware interval, a bootstrap's, would move the upper end too, but with five seeds a bootstrap's coverage
+    is worse than t's, so the tables keep t.)"""
     from scipy.stats import t
 
     x = np.asarray(values, dtype=np.float64)
@@ -127,7 +149,37 @@ def mean_interval(values: Sequence[float]) -> tuple[float, float]:
     if len(x) < 2:
         return mean, mean
     half = float(t.ppf(0.975, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
-    return mean - half, mean + half
+    return max(mean - half, low), min(mean + half, high)
+
+
+def ratio_interval(numerators: Sequence[float], denominators: Sequence[float], *, low: float = -math.inf,
+                   high: float = math.inf) -> tuple[float, float]:
+    """The 95 % confidence interval of a ratio of means, ``sum(numerators) / sum(denominators)`` (hits a minute: all
+    games' hits over all their minutes), by the delta method with Student's t over the ``n`` pairs, clipped to
+    ``[low, high]`` as ``mean_interval`` is.
+
+    The ratio's linearisation ``R + mean(y - R x) / mean(x)`` has standard error ``s / (sqrt(n) mean(x))``, ``s``
+    the standard deviation of the residuals ``y_i - R x_i`` (Cochran's ratio estimator); the interval is ``R +- t
+    s / (sqrt(n) mean(x))`` with t's 97.5 % quantile on ``n - 1`` degrees of freedom. So games that all hit every
+    trial still give an interval, from the spread of their lengths, and games of one length give the hits' t
+    interval over that length (``mean_interval(y) / x``), the same as before there were lengths to spread. The
+    delta method rather than a bootstrap: it is closed-form (no seed, no resampling cost in a table), and with 100
+    games of a smooth ratio whose denominator never comes near 0 its normal approximation is sound. One pair, or
+    residuals all 0 (every game the same rate), give the ratio twice."""
+    from scipy.stats import t
+
+    y = np.asarray(numerators, dtype=np.float64)
+    x = np.asarray(denominators, dtype=np.float64)
+    if y.shape != x.shape or y.ndim != 1 or len(y) == 0:
+        raise ValueError(f"ratio_interval needs as many numerators as denominators, at least one, got {y.shape} "
+                         f"and {x.shape}")
+    if not x.sum() > 0:
+        raise ValueError("ratio_interval's denominators must add up to more than 0")
+    ratio = float(y.sum() / x.sum())
+    if len(y) < 2:
+        return ratio, ratio
+    half = float(t.ppf(0.975, len(y) - 1) * (y - ratio * x).std(ddof=1) / (math.sqrt(len(y)) * x.mean()))
+    return max(ratio - half, low), min(ratio + half, high)
 
 
 def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | None = None,
@@ -160,19 +212,20 @@ def evaluate(policy: Policy | str | Any, env_id: str, *, seeds: Sequence[int] | 
     if policy_factory is None and not isinstance(policy, str) and hasattr(policy, "predict") \
             and not callable(getattr(policy, "reset", None)):
         name = type(policy).__name__
-        hits, scores, minutes, reach = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
+        hits, scores, durations, reach = _play_batched(policy, env_id, seeds, deterministic, env_kwargs)
     else:
-        name, hits, scores, minutes, reach = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs,
-                                                              policy_factory)
+        name, hits, scores, durations, reach = _play_one_by_one(policy, env_id, seeds, deterministic, env_kwargs,
+                                                                policy_factory)
     mean_hits = float(np.mean(hits))
+    minutes = float(np.mean(durations))
     normalised = None if env_kwargs else normalised_score(env_id, mean_hits, hits_per_minute=mean_hits / minutes)
-    return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised, reach)
+    return Evaluation(env_id, name, seeds, hits, scores, minutes, normalised, reach, durations)
 
 
 def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
                      env_kwargs: dict[str, Any], policy_factory: Callable[[gym.Env], Policy] | None = None,
-                     ) -> tuple[str, tuple[int, ...], tuple[int, ...], float, tuple[float, ...]]:
-    """The games one after another in one single env: (the policy's name, hits, scores, minutes a game, each
+                     ) -> tuple[str, tuple[int, ...], tuple[int, ...], tuple[float, ...], tuple[float, ...]]:
+    """The games one after another in one single env: (the policy's name, hits, scores, each game's minutes, each
     game's seconds from a go cue to a hit: CenterOut's).
 
     The policy is fresh for each game (``evaluate``): made anew by ``policy_factory`` or, for a bot's name,
@@ -207,7 +260,7 @@ def _play_one_by_one(policy: Any, env_id: str, seeds: tuple[int, ...], determini
             reach.append(_reach_seconds(env))
     finally:
         env.close()
-    return name, tuple(hits), tuple(scores), float(np.mean(durations)), _kept(reach)
+    return name, tuple(hits), tuple(scores), tuple(durations), _kept(reach)
 
 
 #: Games a model's evaluation steps together: one ``predict`` call a step for all of them.
@@ -215,7 +268,8 @@ BATCH = 100
 
 
 def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic: bool,
-                  env_kwargs: dict[str, Any]) -> tuple[tuple[int, ...], tuple[int, ...], float, tuple[float, ...]]:
+                  env_kwargs: dict[str, Any],
+                  ) -> tuple[tuple[int, ...], tuple[int, ...], tuple[float, ...], tuple[float, ...]]:
     """A model's games, ``BATCH`` at a time in Gymnasium's ``SyncVectorEnv`` of single envs (each game the single
     env's, seeded alike), the model asked once a step for all of them: a network's forward pass costs
     about as much for a hundred observations as for one."""
@@ -265,7 +319,7 @@ def _play_batched(model: Any, env_id: str, seeds: tuple[int, ...], deterministic
         scores += final_scores.tolist()
         durations += final_minutes.tolist()
         reach += final_reach
-    return tuple(hits), tuple(scores), float(np.mean(durations)), _kept(reach)
+    return tuple(hits), tuple(scores), tuple(durations), _kept(reach)
 
 
 def _policy(policy: Any, env: gym.Env, deterministic: bool) -> tuple[Policy, str]:
