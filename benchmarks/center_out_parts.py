@@ -2,6 +2,7 @@
 
     python benchmarks/center_out_parts.py                      # CenterOut-v1 at 8,192 envs, about a minute
     python benchmarks/center_out_parts.py --envs 4096 --steps 1500 --json
+    PYTHONPATH=/path/to/another/checkout python benchmarks/center_out_parts.py --json --label "before"
 
 ``gym.make_vec(ID, num_envs=N)`` (``armgame.env.center_out_batch``) steps random actions drawn before the
 clock starts, ``--warm`` steps first (as ``env_speed.py`` does: past the runs' first trial and episode ends,
@@ -66,8 +67,9 @@ class _TimedModule:
         return getattr(self._module, name)
 
 
-def measure(env_id: str, num_envs: int, steps: int, warm: int) -> dict[str, Any]:
-    """The parts' ms a step of ``env_id``'s batch at ``num_envs`` envs, over ``steps`` steps after ``warm``."""
+def measure(env_id: str, num_envs: int, steps: int, warm: int, label: str = "") -> dict[str, Any]:
+    """The parts' ms a step of ``env_id``'s batch at ``num_envs`` envs, over ``steps`` steps after ``warm``; ``label``
+    names the code measured (the armgame imported: another checkout's, with PYTHONPATH)."""
     envs = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point")
     if not isinstance(envs, center_out_batch.CenterOutBatchVectorEnv):
         raise SystemExit(f"{env_id} at {num_envs} envs is not the batch here ({type(envs).__name__})")
@@ -97,7 +99,7 @@ def measure(env_id: str, num_envs: int, steps: int, warm: int) -> dict[str, Any]
     parts["ended trials"] -= parts["measures"]  # _end_trials calls measures: its own Python is the rest
     parts["the rest"] = total - sum(parts.values())
     per_step = {part: round(seconds / steps * 1e3, 4) for part, seconds in parts.items()}
-    return {"env_id": env_id, "num_envs": num_envs, "steps": steps, "warm": warm,
+    return {"label": label, "env_id": env_id, "num_envs": num_envs, "steps": steps, "warm": warm,
             "ms_per_step": round(total / steps * 1e3, 4), "parts_ms_per_step": per_step,
             "trials_ended_per_step": round(ended / steps, 2),
             "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
@@ -120,13 +122,14 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=1500)
     parser.add_argument("--warm", type=int, default=1500)
     parser.add_argument("--json", action="store_true", help="one JSON object instead of the report")
+    parser.add_argument("--label", default="", help="a name for the code measured, kept in the JSON")
     args = parser.parse_args()
     for name in ("envs", "steps"):
         if getattr(args, name) < 1:
             parser.error(f"--{name} must be at least 1")
     if args.warm < 0:
         parser.error("--warm must be 0 or more")
-    result = measure(args.id, args.envs, args.steps, args.warm)
+    result = measure(args.id, args.envs, args.steps, args.warm, args.label)
     if args.json:
         print(json.dumps(result, indent=1))
     else:

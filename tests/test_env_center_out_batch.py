@@ -190,6 +190,42 @@ def test_the_docs_batch_figures_are_the_committed_run() -> None:
             cells += [f"{rates['make_vec']['cpu']['median']:,.0f}", f"{rates['motornet']['cpu']['median']:,.0f}",
                       f"{ratio['median']:.2f} [{ratio['min']:.2f} - {ratio['max']:.2f}]"]
         assert f"| {int(n):,} | " + " | ".join(cells) + " |" in prose, n
+    at = {size: [matched["ids"][i]["sizes"][size] for i in ids] for size in ("4096", "8192")}
+    assert (f"{at['4096'][0]['ratio']['median']:.2f} and {at['4096'][1]['ratio']['median']:.2f} times at 4,096 envs, "
+            f"{at['8192'][0]['ratio']['median']:.2f} and {at['8192'][1]['ratio']['median']:.2f} at 8,192") in prose
+    assert f"each range, {at['8192'][0]['ratio']['min']:.2f} and {at['8192'][1]['ratio']['min']:.2f})" in prose
+    assert all(rates["ratio"]["median"] >= 10 for i in ids for rates in matched["ids"][i]["sizes"].values())
+    assert (f"makes {at['8192'][0]['motornet']['cpu']['median'] / 1e3:.0f} k and "
+            f"{at['8192'][1]['motornet']['cpu']['median'] / 1e3:.0f} k env steps a CPU second") in prose
+    spread = [sorted(run["ids"][i]["sizes"]["8192"]["make_vec"]["cpu_rates"]) for i in ids]
+    assert f"the continuous id ({spread[1][0] / 1e6:.2f} to {spread[1][-1] / 1e6:.2f} M)" in prose
+
+
+def test_the_docs_table_of_a_steps_parts_is_the_committed_run() -> None:
+    """docs/programs.md's table of where a CenterOut batch step's time goes is the runs of
+    benchmarks/results/center_out_parts.json (benchmarks/center_out_parts.py), each figure the mean of the before's
+    runs and of the now's."""
+    root = Path(__file__).resolve().parent.parent
+    parts = json.loads((root / "benchmarks" / "results" / "center_out_parts.json").read_text(encoding="utf-8"))
+    prose = (root / "docs" / "programs.md").read_text(encoding="utf-8")
+    runs = {label: [r for r in parts["runs"] if r["label"] == label] for label in ("e354ef1, before", "this change")}
+    assert all(len(kept) == 2 for kept in runs.values())
+    assert {(r["env_id"], r["num_envs"], r["steps"], r["warm"]) for r in parts["runs"]} == {
+        ("armgame/CenterOut-v1", 8192, 1500, 1500)}
+
+    def mean(label: str, part: str | None) -> float:
+        return float(np.mean([r["ms_per_step"] if part is None else r["parts_ms_per_step"][part] for r in runs[label]]))
+
+    rows = [line for line in prose.splitlines() if line.startswith("| ") and line.count(" | ") == 2]
+    table = rows[rows.index("| part | ms a step, before | now |") + 1:]
+    names = ("advance", "measures", "ended trials", "episode starts", "actions", "dense reward", "the rest")
+    for name, line in zip(names, table, strict=False):
+        cells = line.strip("| ").split(" | ")
+        assert cells[1:] == [f"{mean('e354ef1, before', name):.2f}", f"{mean('this change', name):.2f}"], (name, line)
+    total = f"| **a step** | **{mean('e354ef1, before', None):.2f}** | **{mean('this change', None):.2f}** |"
+    assert table[len(names)] == total
+    ended = {r["trials_ended_per_step"] for r in parts["runs"]}
+    assert f"about {round(min(ended))} trials ending a step" in " ".join(prose.split())
 
 
 @pytest.mark.parametrize("name", ("null", "curl", "savings", "random-fields", "generalization"))
