@@ -332,3 +332,15 @@ def test_the_engine_is_served_and_needs_nothing_a_strict_page_refuses():
         code = re.sub(r'import \{[^}]*\} from "./constants.js";', "", code)
         banned = ("eval(", "new Function", "import ", "import(", "Math.sin", "Math.cos", "WebAssembly", "require(")
         assert not [word for word in banned if word in code], name
+
+
+def test_the_engine_speed_the_docs_give_is_the_committed_run():
+    """docs/development.md's "a 60 s game in X ms" is benchmarks/browser_engine_speed.py's committed run."""
+    root = Path(__file__).resolve().parent.parent
+    run = json.loads((root / "benchmarks" / "results" / "browser_engine_speed.json").read_text(encoding="utf-8"))
+    prose = " ".join((root / "docs" / "development.md").read_text(encoding="utf-8").split())
+    assert run["steps_a_game"] == 15000 and run["node"].startswith("v20.") and len(run["ms"]) == run["games"]
+    assert run["best_ms"] == min(run["ms"]) and run["median_ms"] == sorted(run["ms"])[len(run["ms"]) // 2]
+    assert (f"in {run['best_ms']:.1f} ms at best of {run['games']} games in Node 20, {run['median_ms']:.1f} ms the "
+            f"median") in prose
+    assert f"load average {run['load_average'][0]:.1f}), some {run['us_a_step_best']:.2f} us a step" in prose
