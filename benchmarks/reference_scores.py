@@ -460,7 +460,8 @@ def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
     which ranks policies that all hit every trial; and PPO's timed runs (``center_out_ppo``), pooled over seeds.
     Every interval is clipped to the values its quantity can take (``mean_interval``: hits from 0 to the trials an
     episode holds, seconds and hits a minute from 0). Hits a minute's is over the games (``per_minute_interval``);
-    PPO's files keep each seed's hits a minute but not each game's length, so its row's is over the seeds."""
+    PPO's files from before ``train_ppo.py`` kept each game's length have each seed's hits a minute only, so such a
+    row's is over the seeds."""
     from armgame.env.evaluation import mean_interval
 
     lines = ["| id | policy | hits a game (95% CI) | hits a minute (95% CI) | s from the go cue to a hit (95% CI) "
@@ -471,10 +472,14 @@ def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
         r["per_minute"] = per_minute_interval(r, path)
     for env_id, results in center_out_ppo(folder / "ppo").items():  # pooled: every seed's 100 test games
         per_seed = [r["hits_per_minute"] for r in results]
-        low, high = mean_interval(per_seed, low=0.0)
-        rows.append({"env_id": env_id, "policy": f"PPO 1 M, {len(results)} seeds",
-                     "hits": [h for r in results for h in r["test_hits"]],
-                     "hits_per_minute": float(np.mean(per_seed)), "per_minute": (low, high, " over seeds"),
+        hits = [h for r in results for h in r["test_hits"]]
+        if all("game_minutes" in r for r in results):  # runs since train_ppo.py kept each game's length
+            minutes = [m for r in results for m in r["game_minutes"]]
+            rate, per_minute = sum(hits) / sum(minutes), per_minute_interval({"hits": hits, "game_minutes": minutes})
+        else:
+            rate, per_minute = float(np.mean(per_seed)), (*mean_interval(per_seed, low=0.0), " over seeds")
+        rows.append({"env_id": env_id, "policy": f"PPO 1 M, {len(results)} seeds", "hits": hits,
+                     "hits_per_minute": rate, "per_minute": per_minute,
                      "reach_seconds": [t for r in results for t in r["reach_seconds"]],
                      "games": sum(len(r["test_hits"]) for r in results)})
     order = {"random": 0, "naive": 1, "model": 2}

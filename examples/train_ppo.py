@@ -135,6 +135,8 @@ def save_result(args: argparse.Namespace, algorithm: str, model: BaseAlgorithm, 
               "hits_per_minute": test.hits_per_minute}
     if test.reach_seconds:  # CenterOut: where every trial is hit, the time to the target still ranks
         result["reach_seconds"] = [None if math.isnan(t) else round(t, 4) for t in test.reach_seconds]
+        # and each game's length, for hits a minute's interval over the games (Evaluation.hits_per_minute_ci95)
+        result["game_minutes"] = [round(m, 8) for m in test.game_minutes]
     (args.out / "result.json").write_text(json.dumps(result, indent=1) + "\n", encoding="utf-8")
 
 

@@ -338,3 +338,34 @@ def test_a_models_centre_out_times_are_measured_in_its_batched_games_as_one_by_o
     assert batched.hits == alone.hits == (8, 8, 8)
     assert batched.reach_seconds == alone.reach_seconds and len(alone.reach_seconds) == 3
     assert batched.game_minutes == alone.game_minutes and len(set(alone.game_minutes)) == 3  # each game's own length
+
+
+def test_ppo_rows_that_keep_each_games_minutes_get_hits_a_minutes_interval_over_the_games(tmp_path: Path) -> None:
+    # train_ppo.py keeps each CenterOut test game's minutes now; the table then pools the seeds' games for the interval
+    # (as the bots' rows have it), and keeps the interval over seeds only for the older files that have none.
+    from armgame.env.evaluation import ratio_interval
+
+    reference_scores = _reference_scores()
+    folder = tmp_path / "center-out-time"
+    (folder / "ppo" / "CenterOut-v1").mkdir(parents=True)
+    source = ROOT / "benchmarks" / "results" / "center-out-time" / "CenterOut-v1.model.json"
+    (folder / "CenterOut-v1.model.json").write_text(source.read_text(encoding="utf-8"), encoding="utf-8")
+    games = {0: ([8, 8, 7], [0.2, 0.25, 0.3]), 1: ([8, 6, 8], [0.18, 0.3, 0.22])}
+    for seed, (hits, minutes) in games.items():
+        run = folder / "ppo" / "CenterOut-v1" / f"seed{seed}"
+        run.mkdir()
+        result = {"env_id": "armgame/CenterOut-v1", "test_hits": hits, "game_minutes": minutes,
+                  "hits_per_minute": sum(hits) / sum(minutes), "reach_seconds": [0.6, 0.6, 0.6]}
+        (run / "result.json").write_text(json.dumps(result), encoding="utf-8")
+    row = next(line for line in reference_scores.center_out_timing_table(folder).splitlines() if "PPO" in line)
+    hits = [h for hits, _ in games.values() for h in hits]
+    minutes = [m for _, minutes in games.values() for m in minutes]
+    low, high = ratio_interval(hits, minutes, low=0.0)
+    assert f"| {sum(hits) / sum(minutes):.1f} ({low:.1f}-{high:.1f}) |" in row and "over seeds" not in row
+    for seed in games:  # an older file without the games' minutes: the interval is over the seeds again
+        path = folder / "ppo" / "CenterOut-v1" / f"seed{seed}" / "result.json"
+        result = json.loads(path.read_text(encoding="utf-8"))
+        del result["game_minutes"]
+        path.write_text(json.dumps(result), encoding="utf-8")
+    row = next(line for line in reference_scores.center_out_timing_table(folder).splitlines() if "PPO" in line)
+    assert "over seeds)" in row
