@@ -41,6 +41,7 @@ from stable_baselines3.common.vec_env import VecMonitor
 import armgame.env  # noqa: F401  (registers the ids)
 from armgame.env.evaluation import Evaluation, evaluate
 from armgame.env.record import replay_of
+from armgame.env.references import REFERENCE_HITS, TIER_HITS
 from armgame.env.sb3 import make_sb3_vec_env
 from armgame.env.suite import PROTOCOL_VERSION, VALIDATION_SEEDS
 
@@ -158,7 +159,9 @@ def main(argv: list[str] | None = None) -> int:
         hits = keep_a_game(model, args.env, args.out / "game.json")
         print(f"its game of seed 0 ({hits} hits): armgame replay {args.out / 'game.json'}")
     best = max(row[2] for row in curve.rows)
-    print(f"best validation mean hits per game: {best:.1f} (the naive bot: about 22)")
+    naive = (REFERENCE_HITS.get(args.env) or TIER_HITS.get(args.env) or {}).get("naive")
+    beside = f" (the naive bot's on the test games: {naive:.1f})" if naive is not None else ""
+    print(f"best validation mean hits per game: {best:.1f}{beside}")
     return 0
 
 
