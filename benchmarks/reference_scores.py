@@ -462,7 +462,7 @@ def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
     episode holds, seconds and hits a minute from 0). Hits a minute's is over the games (``per_minute_interval``);
     PPO's files from before ``train_ppo.py`` kept each game's length have each seed's hits a minute only, so such a
     row's is over the seeds."""
-    from armgame.env.evaluation import mean_interval
+    from armgame.env.evaluation import mean_interval, ratio_interval
 
     lines = ["| id | policy | hits a game (95% CI) | hits a minute (95% CI) | s from the go cue to a hit (95% CI) "
              "| games with a hit |", "|---|---|---|---|---|---:|"]
@@ -475,7 +475,7 @@ def center_out_timing_table(folder: Path = RESULTS / "center-out-time") -> str:
         hits = [h for r in results for h in r["test_hits"]]
         if all("game_minutes" in r for r in results):  # runs since train_ppo.py kept each game's length
             minutes = [m for r in results for m in r["game_minutes"]]
-            rate, per_minute = sum(hits) / sum(minutes), per_minute_interval({"hits": hits, "game_minutes": minutes})
+            rate, per_minute = sum(hits) / sum(minutes), ratio_interval(hits, minutes, low=0.0)
         else:
             rate, per_minute = float(np.mean(per_seed)), (*mean_interval(per_seed, low=0.0), " over seeds")
         rows.append({"env_id": env_id, "policy": f"PPO 1 M, {len(results)} seeds", "hits": hits,

@@ -94,27 +94,32 @@ static int64_t t_past(double x, int64_t go, double dt, int64_t lo, int64_t hi, i
     return lo;
 }
 
-/* np.argmax over a[from:to]: the first largest, or the first NaN. The largest comes from four running maxima, then
- * its first place: one best index carried from element to element (its value loaded again on each) was a chain of
- * dependent steps that cost more than the rest of the trial's measures. */
-static int64_t argmax(const double *a, int64_t from, int64_t to)
+/* The largest of a[from:to], none NaN: four running maxima, no one chain of comparisons. */
+static double largest(const double *a, int64_t from, int64_t to)
 {
     double m[4] = {a[from], a[from], a[from], a[from]};
-    int nan = 0;
     int64_t k = from;
     for (; k + 4 <= to; k += 4)
-        for (int j = 0; j < 4; j++) {
-            nan |= isnan(a[k + j]);
+        for (int j = 0; j < 4; j++)
             m[j] = a[k + j] > m[j] ? a[k + j] : m[j];
-        }
-    for (; k < to; k++) {
-        nan |= isnan(a[k]);
+    for (; k < to; k++)
         m[0] = a[k] > m[0] ? a[k] : m[0];
-    }
     for (int j = 1; j < 4; j++)
         m[0] = m[j] > m[0] ? m[j] : m[0];
-    for (k = from; k < to; k++)
-        if (nan ? isnan(a[k]) : a[k] == m[0])
+    return m[0];
+}
+
+/* np.argmax over a[from:to]: the first NaN, else the first place of ``largest``'s maximum. (One best index carried
+ * from element to element, its value loaded again on each, was a chain of dependent steps that cost more than the
+ * rest of the trial's measures.) */
+static int64_t argmax(const double *a, int64_t from, int64_t to)
+{
+    int nan = 0;
+    for (int64_t k = from; k < to; k++)
+        nan |= isnan(a[k]);
+    const double top = nan ? NAN : largest(a, from, to);
+    for (int64_t k = from; k < to; k++)
+        if (nan ? isnan(a[k]) : a[k] == top)
             return k;
     return from;
 }
@@ -165,21 +170,6 @@ static int coordinates_fit(const double *x, const double *y, int64_t n)
         bad |= (hi - u) | ((u - lo) & (0 - u)) | (hi - v) | ((v - lo) & (0 - v));
     }
     return (bad >> 63) == 0;
-}
-
-/* The largest of a[from:to], none NaN: four running maxima, no one chain of comparisons. */
-static double largest(const double *a, int64_t from, int64_t to)
-{
-    double m[4] = {a[from], a[from], a[from], a[from]};
-    int64_t k = from;
-    for (; k + 4 <= to; k += 4)
-        for (int j = 0; j < 4; j++)
-            m[j] = a[k + j] > m[j] ? a[k + j] : m[j];
-    for (; k < to; k++)
-        m[0] = a[k] > m[0] ? a[k] : m[0];
-    for (int j = 1; j < 4; j++)
-        m[0] = m[j] > m[0] ? m[j] : m[0];
-    return m[0];
 }
 
 /* The speeds are needed exactly at a handful of samples only (the peak, the two samples around each level
